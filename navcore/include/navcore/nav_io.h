@@ -1,0 +1,63 @@
+/**
+ * @file nav_io.h
+ * @brief navcore_io: scene files (YAML) in and out, with precise error locations.
+ *
+ * Every problem found in a scene file is reported as one nav_diag, which formats as
+ *   FILE:LINE:COL: error: <field path>: <what is wrong and what is expected>
+ * Lines and columns are 1-based. Reading never crashes on bad input and never aborts at the
+ * first problem: it reports every problem it can find (up to NAV_DIAG_MAX_PER_FILE).
+ */
+#ifndef NAV_IO_H
+#define NAV_IO_H
+
+#include <stddef.h>
+
+#include "nav_export.h"
+#include "nav_scene.h"
+#include "nav_status.h"
+
+NAV_BEGIN_DECLS
+
+#define NAV_DIAG_MAX_PER_FILE 100
+
+/** One diagnostic about an input file. */
+typedef struct nav_diag {
+  char file[512];     /**< file name as given by the caller */
+  int line;           /**< 1-based; 0 when the problem is not tied to a place (e.g. unreadable file) */
+  int col;            /**< 1-based; 0 when line is 0 */
+  char path[256];     /**< field path, e.g. "trajectory.parametric.C_hz[2]"; "" for the whole file */
+  char message[512];  /**< what is wrong and what is expected */
+} nav_diag;
+
+/** Receives one diagnostic; @p d is valid only during the call. */
+typedef void (*nav_diag_fn)(void *user, const nav_diag *d);
+
+/** Format @p d as "FILE:LINE:COL: error: PATH: MESSAGE" into @p buf (always NUL-terminated). */
+NAV_API void nav_diag_format(const nav_diag *d, char *buf, size_t size);
+
+/**
+ * Read and validate a scene file.
+ * @param[in]  path    file to read
+ * @param[out] out     the scene; written only on NAV_OK
+ * @param[in]  report  receives each diagnostic (may be NULL)
+ * @param[in]  user    passed to @p report
+ * @return NAV_OK; NAV_ERR_IO if the file cannot be read; NAV_ERR_PARSE if it is not a valid
+ *         scene (at least one diagnostic was reported); NAV_ERR_INVALID_ARG for NULL arguments.
+ */
+NAV_API NAV_NODISCARD nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn report,
+                                                     void *user);
+
+/** As nav_scene_read_file, from memory; @p display_name is used as FILE in diagnostics. */
+NAV_API NAV_NODISCARD nav_status nav_scene_read_string(const char *text, size_t len, const char *display_name,
+                                                       nav_scene *out, nav_diag_fn report, void *user);
+
+/**
+ * Write @p scene as a complete YAML scene file (current format_version, every field explicit, in
+ * the units of the reader), atomically: a temporary file is written, flushed and renamed.
+ * @return NAV_OK, NAV_ERR_IO, NAV_ERR_INVALID_ARG.
+ */
+NAV_API NAV_NODISCARD nav_status nav_scene_write_file(const char *path, const nav_scene *scene);
+
+NAV_END_DECLS
+
+#endif /* NAV_IO_H */
