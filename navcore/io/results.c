@@ -1,2 +1,251 @@
-/* placeholder: implemented in this issue */
-typedef int nav_placeholder_results;
+/* Result directories (atomic) and the CSV / JSON exporters of a run. */
+#define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "navcore/nav_results.h"
+#include "navcore/nav_version.h"
+
+#define PATH_CAP 4096
+
+struct nav_resultdir {
+  char final_dir[PATH_CAP];
+  char tmp_dir[PATH_CAP];
+  char file[PATH_CAP + 256];
+};
+
+/* mkdir -p of every parent of @p path (not the last component). */
+static int make_parents(const char *path) {
+  char buf[PATH_CAP];
+  if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
+  for (char *p = buf + 1; *p; ++p) {
+    if (*p != '/') continue;
+    *p = '\0';
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
+    *p = '/';
+  }
+  return 0;
+}
+
+static int remove_tree(const char *path) {
+  DIR *d = opendir(path);
+  if (!d) return unlink(path);
+  struct dirent *e;
+  char child[PATH_CAP];
+  while ((e = readdir(d)) != NULL) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+    if (snprintf(child, sizeof child, "%s/%s", path, e->d_name) >= (int)sizeof child) continue;
+    struct stat stt;
+    if (lstat(child, &stt) == 0 && S_ISDIR(stt.st_mode)) remove_tree(child);
+    else unlink(child);
+  }
+  closedir(d);
+  return rmdir(path);
+}
+
+static void fsync_path(const char *path) {
+  const int fd = open(path, O_RDONLY);
+  if (fd >= 0) {
+    (void)fsync(fd);
+    close(fd);
+  }
+}
+
+nav_status nav_resultdir_begin(const char *final_dir, nav_resultdir **out) {
+  if (!final_dir || !*final_dir || !out) return NAV_ERR_INVALID_ARG;
+  nav_resultdir *rd = calloc(1, sizeof *rd);
+  if (!rd) return NAV_ERR_NO_MEMORY;
+  size_t len = strlen(final_dir);
+  while (len > 1 && final_dir[len - 1] == '/') --len;
+  if (len >= sizeof rd->final_dir) goto fail;
+  memcpy(rd->final_dir, final_dir, len);
+  rd->final_dir[len] = '\0';
+  const char *slash = strrchr(rd->final_dir, '/');
+  const char *base = slash ? slash + 1 : rd->final_dir;
+  const int dir_len = slash ? (int)(slash - rd->final_dir) + 1 : 0;
+  if (snprintf(rd->tmp_dir, sizeof rd->tmp_dir, "%.*s.%s.tmp-XXXXXX", dir_len, rd->final_dir, base) >=
+      (int)sizeof rd->tmp_dir)
+    goto fail;
+  if (make_parents(rd->tmp_dir) != 0 || !mkdtemp(rd->tmp_dir)) goto fail;
+  *out = rd;
+  return NAV_OK;
+fail:
+  free(rd);
+  return NAV_ERR_IO;
+}
+
+const char *nav_resultdir_file(nav_resultdir *rd, const char *file_name) {
+  if (!rd || !file_name) return NULL;
+  const int n = snprintf(rd->file, sizeof rd->file, "%s/%s", rd->tmp_dir, file_name);
+  return (n < 0 || n >= (int)sizeof rd->file) ? NULL : rd->file;
+}
+
+nav_status nav_resultdir_commit(nav_resultdir *rd) {
+  if (!rd) return NAV_ERR_INVALID_ARG;
+  nav_status st = NAV_OK;
+  char old[PATH_CAP + 32];
+  bool have_old = false;
+  /* Flush every file, then the directory itself. */
+  DIR *d = opendir(rd->tmp_dir);
+  if (d) {
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+      if (e->d_name[0] == '.') continue;
+      const char *f = nav_resultdir_file(rd, e->d_name);
+      if (f) fsync_path(f);
+    }
+    closedir(d);
+  }
+  fsync_path(rd->tmp_dir);
+  struct stat stt;
+  if (stat(rd->final_dir, &stt) == 0) {
+    /* Move the previous result aside first; rename(2) cannot replace a non-empty directory. */
+    snprintf(old, sizeof old, "%s.old-%ld", rd->tmp_dir, (long)getpid());
+    if (rename(rd->final_dir, old) != 0) {
+      st = NAV_ERR_IO;
+      goto done;
+    }
+    have_old = true;
+  }
+  if (rename(rd->tmp_dir, rd->final_dir) != 0) {
+    st = NAV_ERR_IO;
+    if (have_old) (void)rename(old, rd->final_dir);
+    goto done;
+  }
+  if (have_old) remove_tree(old);
+done:
+  if (st != NAV_OK) remove_tree(rd->tmp_dir);
+  free(rd);
+  return st;
+}
+
+void nav_resultdir_abort(nav_resultdir *rd) {
+  if (!rd) return;
+  remove_tree(rd->tmp_dir);
+  free(rd);
+}
+
+static const char *k_state_header =
+    "t_s,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n";
+static const char *k_error_header =
+    "t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,vel_err_e_mps,"
+    "vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg\n";
+
+nav_status nav_csv_write_header(FILE *f, nav_csv_table table) {
+  if (!f) return NAV_ERR_INVALID_ARG;
+  const char *h = table == NAV_CSV_ERRORS ? k_error_header : k_state_header;
+  return fputs(h, f) < 0 ? NAV_ERR_IO : NAV_OK;
+}
+
+static int write_state(FILE *f, double t, nav_vec3 r, nav_vec3 v, nav_quat q) {
+  const nav_euler e = nav_quat_to_euler(q, NULL);
+  return fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t, r.x, r.y, r.z, v.x, v.y,
+                 v.z, e.roll_rad * NAV_RAD2DEG, e.pitch_rad * NAV_RAD2DEG, e.yaw_rad * NAV_RAD2DEG);
+}
+
+nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record *r) {
+  if (!f || !r) return NAV_ERR_INVALID_ARG;
+  int n = 0;
+  switch (table) {
+  case NAV_CSV_TRUTH:
+    n = write_state(f, r->truth->t_s, r->truth->r_lb_l_m, r->truth->v_lb_l_mps, r->truth->q_b_l);
+    break;
+  case NAV_CSV_NAV:
+    n = write_state(f, r->nav->t_s, r->nav->r_lb_l_m, r->nav->v_lb_l_mps, r->nav->q_b_l);
+    break;
+  case NAV_CSV_ERRORS: {
+    const nav_epoch_errors *e = r->err;
+    n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", e->t_s,
+                e->pos_err_l_m.x, e->pos_err_l_m.y, e->pos_err_l_m.z, e->pos_err_h_m, e->pos_err_v_m,
+                e->vel_err_l_mps.x, e->vel_err_l_mps.y, e->vel_err_l_mps.z, e->vel_err_mps, e->att_err_rad,
+                e->euler_err.roll_rad * NAV_RAD2DEG, e->euler_err.pitch_rad * NAV_RAD2DEG,
+                e->euler_err.yaw_rad * NAV_RAD2DEG);
+    break;
+  }
+  default: return NAV_ERR_INVALID_ARG;
+  }
+  return n < 0 ? NAV_ERR_IO : NAV_OK;
+}
+
+/* JSON string with escapes for quotes, backslashes and control characters. */
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
+    if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+    else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+    else fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+/* JSON has no NaN/Inf: write null for them. */
+static void json_number(FILE *f, double v) {
+  if (isfinite(v)) fprintf(f, "%.17g", v);
+  else fputs("null", f);
+}
+
+static void json_stat(FILE *f, const char *name, nav_stat s, bool last) {
+  fprintf(f, "    \"%s\": {\"rms\": ", name);
+  json_number(f, s.rms);
+  fputs(", \"max\": ", f);
+  json_number(f, s.max);
+  fputs(", \"p95\": ", f);
+  json_number(f, s.p95);
+  fprintf(f, "}%s\n", last ? "" : ",");
+}
+
+nav_status nav_summary_write_json(const char *path, const nav_scene *scene, const nav_run_info *info,
+                                  const nav_sim_summary *sum) {
+  if (!path || !scene || !info || !sum) return NAV_ERR_INVALID_ARG;
+  FILE *f = fopen(path, "w");
+  if (!f) return NAV_ERR_IO;
+  fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
+  json_string(f, scene->name);
+  fputs(", \"file\": ", f);
+  json_string(f, info->scene_file);
+  fprintf(f, "},\n  \"seed\": %llu,\n  \"runs\": %ld,\n  \"ideal\": %s,\n", (unsigned long long)info->seed,
+          sum->runs, info->ideal ? "true" : "false");
+  fprintf(f, "  \"earth_model\": \"%s\",\n  \"algorithm\": \"%s\",\n  \"trajectory\": \"%s\",\n",
+          nav_earth_model_name(scene->earth.model), nav_mech_algorithm_name(scene->navigation.algorithm),
+          nav_traj_type_name(scene->trajectory.type));
+  fputs("  \"duration_s\": ", f);
+  json_number(f, sum->duration_s);
+  fputs(",\n  \"imu_rate_hz\": ", f);
+  json_number(f, scene->imu.rate_hz);
+  fputs(",\n  \"output_rate_hz\": ", f);
+  json_number(f, scene->output.rate_hz);
+  fprintf(f, ",\n  \"partial\": %s,\n", sum->partial ? "true" : "false");
+  const double sps = info->wall_s > 0.0 ? (double)sum->imu_samples * (double)sum->runs / info->wall_s : 0.0;
+  fputs("  \"timing\": {\"wall_s\": ", f);
+  json_number(f, info->wall_s);
+  fprintf(f, ", \"imu_samples\": %lld, \"imu_samples_per_s\": ", (long long)(sum->imu_samples * sum->runs));
+  json_number(f, sps);
+  fputs("},\n  \"final\": {\"t_s\": ", f);
+  json_number(f, sum->final.t_s);
+  fputs(", \"pos_err_h_m\": ", f);
+  json_number(f, sum->final.pos_err_h_m);
+  fputs(", \"pos_err_v_m\": ", f);
+  json_number(f, sum->final.pos_err_v_m);
+  fputs(", \"vel_err_mps\": ", f);
+  json_number(f, sum->final.vel_err_mps);
+  fputs(", \"att_err_rad\": ", f);
+  json_number(f, sum->final.att_err_rad);
+  fputs(", \"yaw_err_rad\": ", f);
+  json_number(f, fabs(sum->final.euler_err.yaw_rad));
+  fprintf(f, "},\n  \"stats\": {\n    \"epochs\": %lld,\n    \"stride\": %lld,\n", (long long)sum->stats_epochs,
+          (long long)sum->stats_stride);
+  json_stat(f, "pos_err_h_m", sum->stats.pos_err_h_m, false);
+  json_stat(f, "pos_err_v_m", sum->stats.pos_err_v_m, false);
+  json_stat(f, "vel_err_mps", sum->stats.vel_err_mps, false);
+  json_stat(f, "att_err_rad", sum->stats.att_err_rad, false);
+  json_stat(f, "yaw_err_rad", sum->stats.yaw_err_rad, true);
+  fputs("  }\n}\n", f);
+  const bool bad = ferror(f) != 0;
+  if (fclose(f) != 0 || bad) return NAV_ERR_IO;
+  return NAV_OK;
+}

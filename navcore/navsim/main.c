@@ -1,1 +1,334 @@
-int main(void) { return 0; }
+/*
+ * navsim: the command-line program of the navigation simulation environment.
+ *
+ * Exit codes: 0 success; 1 failure other than invalid input (I/O, numerical); 2 invalid scene
+ * or invalid command line.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "navcore/nav_io.h"
+#include "navcore/nav_results.h"
+#include "navcore/nav_sim.h"
+#include "navcore/nav_version.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
+
+static const char *k_usage =
+    "usage: navsim [--version] [--help] COMMAND [ARGS]\n"
+    "\n"
+    "Simulate inertial and integrated navigation systems from scene files.\n"
+    "\n"
+    "commands:\n"
+    "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
+    "  run SCENE        simulate a scene and write the results into a directory\n"
+    "\n"
+    "options:\n"
+    "  --version        print \"navsim X.Y.Z\" and exit\n"
+    "  -h, --help       print this help (navsim COMMAND --help for a command)\n"
+    "\n"
+    "exit codes: 0 success, 1 failure (I/O, numerical), 2 invalid scene or command line\n";
+
+static const char *k_usage_check =
+    "usage: navsim check SCENE...\n"
+    "\n"
+    "Read and validate each scene file. Every problem is printed on stderr as\n"
+    "  FILE:LINE:COL: error: FIELD.PATH: what is wrong and what is expected\n"
+    "\n"
+    "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
+
+static const char *k_usage_run =
+    "usage: navsim run SCENE [--out DIR] [--seed N] [--ideal] [--quiet]\n"
+    "\n"
+    "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
+    "navigation -> errors against the reference) and write into DIR:\n"
+    "  summary.json  scene, seed, timing, final errors, statistics (rms/max/p95 over epochs)\n"
+    "  truth.csv     reference state at the output rate\n"
+    "  nav.csv       navigation solution at the output rate\n"
+    "  errors.csv    navigation minus reference at the output rate\n"
+    "The directory appears only when complete (it is built under a hidden name and renamed).\n"
+    "\n"
+    "options:\n"
+    "  --out DIR     result directory (default: out/<scene name>)\n"
+    "  --seed N      random seed, overriding simulation.seed of the scene (0 .. 2^64-1)\n"
+    "  --ideal       perfect sensors and perfect initial state\n"
+    "  --quiet       print nothing but errors\n"
+    "  -h, --help    print this help\n"
+    "\n"
+    "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
+
+/* Print each diagnostic on stderr and count them. */
+typedef struct diag_sink {
+  int count;
+} diag_sink;
+
+static void print_diag(void *user, const nav_diag *d) {
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  fprintf(stderr, "%s\n", line);
+  ((diag_sink *)user)->count++;
+}
+
+/* NAV_OK -> 0; invalid scene -> 2; unreadable -> 1. */
+static int load_scene(const char *path, nav_scene *scene) {
+  diag_sink sink = {0};
+  const nav_status st = nav_scene_read_file(path, scene, print_diag, &sink);
+  if (st == NAV_OK) return EXIT_OK;
+  if (st == NAV_ERR_PARSE) return EXIT_INVALID;
+  if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
+  return EXIT_FAIL;
+}
+
+static int cmd_check(int argc, char **argv) {
+  if (argc < 1) {
+    fprintf(stderr, "navsim check: missing SCENE\n%s", k_usage_check);
+    return EXIT_INVALID;
+  }
+  for (int i = 0; i < argc; ++i)
+    if (is_help(argv[i])) {
+      fputs(k_usage_check, stdout);
+      return EXIT_OK;
+    }
+  int worst = EXIT_OK;
+  for (int i = 0; i < argc; ++i) {
+    nav_scene scene;
+    const int rc = load_scene(argv[i], &scene);
+    if (rc == EXIT_FAIL) worst = EXIT_FAIL;
+    else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
+  }
+  return worst;
+}
+
+/* Files a run writes, opened inside the temporary result directory. */
+typedef struct run_out {
+  FILE *f[3];
+  nav_status st;
+  bool quiet_progress;
+  double t_last_print;
+} run_out;
+
+static nav_callback_result on_record(void *user, const nav_sim_record *r) {
+  run_out *o = user;
+  for (int i = 0; i < 3; ++i) {
+    const nav_status st = nav_csv_write_row(o->f[i], (nav_csv_table)i, r);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  return NAV_CONTINUE;
+}
+
+static nav_callback_result on_progress(void *user, const nav_progress *p) {
+  run_out *o = user;
+  if (o->quiet_progress) return NAV_CONTINUE;
+  const double t = now_s();
+  if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
+    fprintf(stderr, "\r  simulating: %5.1f %%  (t = %.1f s)", 100.0 * p->fraction, p->sim_time_s);
+    if (p->fraction >= 1.0) fputc('\n', stderr);
+    o->t_last_print = t;
+  }
+  return NAV_CONTINUE;
+}
+
+static bool parse_u64(const char *s, uint64_t *out) {
+  if (!s || !*s || *s == '-' || *s == '+') return false;
+  for (const char *p = s; *p; ++p)
+    if (*p < '0' || *p > '9') return false;
+  errno = 0;
+  char *end = NULL;
+  const unsigned long long v = strtoull(s, &end, 10);
+  if (errno != 0 || !end || *end) return false;
+  *out = (uint64_t)v;
+  return true;
+}
+
+/* Scene name -> a safe directory name. */
+static void safe_name(char *out, size_t cap, const char *name) {
+  size_t j = 0;
+  for (const char *p = name; *p && j + 1 < cap; ++p) {
+    const char c = *p;
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                    c == '_' || c == '.';
+    out[j++] = ok ? c : '_';
+  }
+  out[j] = '\0';
+  if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", "scene");
+}
+
+static int cmd_run(int argc, char **argv) {
+  const char *scene_path = NULL, *out_dir = NULL;
+  bool ideal = false, quiet = false, have_seed = false;
+  uint64_t seed = 0;
+  for (int i = 0; i < argc; ++i) {
+    const char *a = argv[i];
+    if (is_help(a)) {
+      fputs(k_usage_run, stdout);
+      return EXIT_OK;
+    } else if (strcmp(a, "--ideal") == 0) {
+      ideal = true;
+    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+      quiet = true;
+    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--seed") == 0) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "navsim run: %s needs a value\n", a);
+        return EXIT_INVALID;
+      }
+      const char *v = argv[++i];
+      if (a[2] == 'o') {
+        out_dir = v;
+      } else if (!parse_u64(v, &seed)) {
+        fprintf(stderr, "navsim run: --seed: expected an integer in [0, 2^64-1], got \"%s\"\n", v);
+        return EXIT_INVALID;
+      } else {
+        have_seed = true;
+      }
+    } else if (a[0] == '-' && a[1] != '\0') {
+      fprintf(stderr, "navsim run: unknown option \"%s\" (see navsim run --help)\n", a);
+      return EXIT_INVALID;
+    } else if (!scene_path) {
+      scene_path = a;
+    } else {
+      fprintf(stderr, "navsim run: only one SCENE may be given (got \"%s\" and \"%s\")\n", scene_path, a);
+      return EXIT_INVALID;
+    }
+  }
+  if (!scene_path) {
+    fprintf(stderr, "navsim run: missing SCENE\n%s", k_usage_run);
+    return EXIT_INVALID;
+  }
+
+  nav_scene scene;
+  int rc = load_scene(scene_path, &scene);
+  if (rc != EXIT_OK) return rc;
+  if (have_seed) scene.simulation.seed = seed;
+
+  char default_dir[600];
+  if (!out_dir) {
+    char nm[NAV_SCENE_NAME_MAX];
+    safe_name(nm, sizeof nm, scene.name);
+    snprintf(default_dir, sizeof default_dir, "out/%s", nm);
+    out_dir = default_dir;
+  }
+
+  nav_sim *sim = NULL;
+  nav_resultdir *rd = NULL;
+  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0};
+  static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
+  nav_status st = nav_sim_create(&scene, &sim);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim run: %s: cannot set up the simulation: %s\n", scene_path, nav_status_str(st));
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  st = nav_resultdir_begin(out_dir, &rd);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim run: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const char *file = nav_resultdir_file(rd, names[i]);
+    o.f[i] = file ? fopen(file, "w") : NULL;
+    if (!o.f[i] || nav_csv_write_header(o.f[i], (nav_csv_table)i) != NAV_OK) {
+      fprintf(stderr, "navsim run: cannot write %s in \"%s\"\n", names[i], out_dir);
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+
+  nav_sim_options opts = nav_sim_options_default();
+  opts.ideal = ideal;
+  opts.record = on_record;
+  opts.progress = on_progress;
+  opts.user = &o;
+  nav_sim_summary sum;
+  const double t0 = now_s();
+  st = nav_sim_run(sim, &opts, &sum);
+  const double wall = now_s() - t0;
+  if (st != NAV_OK || o.st != NAV_OK) {
+    if (o.st != NAV_OK) fprintf(stderr, "navsim run: writing results failed: %s\n", nav_status_str(o.st));
+    else fprintf(stderr, "navsim run: %s: %s\n", scene_path, nav_sim_last_error(sim));
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const bool bad = ferror(o.f[i]) != 0;
+    const int cl = fclose(o.f[i]);
+    o.f[i] = NULL;
+    if (bad || cl != 0) {
+      fprintf(stderr, "navsim run: writing %s failed\n", names[i]);
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+  nav_run_info info = {scene_path, scene.simulation.seed, ideal, wall};
+  st = nav_summary_write_json(nav_resultdir_file(rd, "summary.json"), &scene, &info, &sum);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim run: writing summary.json failed\n");
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  st = nav_resultdir_commit(rd);
+  rd = NULL;
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim run: cannot move the results into \"%s\": %s\n", out_dir, strerror(errno));
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  if (!quiet) {
+    printf("scene      %s (%s, %s Earth, %s mechanization%s)\n", scene.name, scene_path,
+           nav_earth_model_name(scene.earth.model), nav_mech_algorithm_name(scene.navigation.algorithm),
+           ideal ? ", ideal sensors" : "");
+    printf("simulated  %.3f s, %" PRId64 " IMU samples at %g Hz in %.3f s wall (%.3g samples/s)\n", sum.duration_s,
+           sum.imu_samples, scene.imu.rate_hz, wall, wall > 0 ? (double)sum.imu_samples / wall : 0.0);
+    printf("final      horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
+           sum.final.pos_err_h_m, sum.final.pos_err_v_m, sum.final.vel_err_mps, sum.final.att_err_rad);
+    printf("rms        horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
+           sum.stats.pos_err_h_m.rms, sum.stats.pos_err_v_m.rms, sum.stats.vel_err_mps.rms,
+           sum.stats.att_err_rad.rms);
+    printf("results    %s/\n", out_dir);
+  }
+  rc = EXIT_OK;
+
+cleanup:
+  for (int i = 0; i < 3; ++i)
+    if (o.f[i]) fclose(o.f[i]);
+  nav_resultdir_abort(rd);
+  nav_sim_destroy(sim);
+  return rc;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    fputs(k_usage, stderr);
+    return EXIT_INVALID;
+  }
+  const char *cmd = argv[1];
+  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0) {
+    printf("navsim %s\n", nav_version_string());
+    return EXIT_OK;
+  }
+  if (is_help(cmd)) {
+    fputs(k_usage, stdout);
+    return EXIT_OK;
+  }
+  if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
+  if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
+  fprintf(stderr, "navsim: unknown command \"%s\" (see navsim --help)\n", cmd);
+  return EXIT_INVALID;
+}

@@ -1,2 +1,121 @@
-/* placeholder: implemented in this issue */
-typedef int nav_placeholder_imu_ideal;
+/* Exact ideal IMU increments from the reference trajectory (numerics.md section 3.1). */
+#include <stdlib.h>
+
+#include "navcore/nav_truth.h"
+
+struct nav_truth {
+  nav_traj *traj;
+  double dt_s;
+  int64_t n_samples;
+  nav_vec3 g_l_mps2;
+  int n_nodes;
+  double nodes[NAV_GL_MAX_NODES];
+  double weights[NAV_GL_MAX_NODES];
+};
+
+nav_status nav_gauss_legendre(int n, double *nodes, double *weights) {
+  if (n < 1 || n > NAV_GL_MAX_NODES || !nodes || !weights) return NAV_ERR_INVALID_ARG;
+  /* Roots of P_n by Newton's method from Tricomi's initial guess (Abramowitz & Stegun 22.16.6
+   * style); the three-term recurrence (n+1) P_(n+1) = (2n+1) x P_n - n P_(n-1) gives P_n and
+   * P_n' = n (x P_n - P_(n-1)) / (x^2 - 1); weights 2 / ((1 - x^2) P_n'(x)^2) (A&S 25.4.29). */
+  for (int i = 0; i < (n + 1) / 2; ++i) {
+    double x = cos(NAV_PI * ((double)i + 0.75) / ((double)n + 0.5));
+    double dp = 0.0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1.0, p1 = x;
+      for (int m = 2; m <= n; ++m) {
+        const double p2 = ((2.0 * m - 1.0) * x * p1 - (m - 1.0) * p0) / (double)m;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = (double)n * (x * p1 - p0) / (x * x - 1.0);
+      const double dx = p1 / dp;
+      x -= dx;
+      if (fabs(dx) < 1e-17) break;
+    }
+    /* Recompute P_n' at the converged root for the weight. */
+    {
+      double p0 = 1.0, p1 = x;
+      for (int m = 2; m <= n; ++m) {
+        const double p2 = ((2.0 * m - 1.0) * x * p1 - (m - 1.0) * p0) / (double)m;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = (double)n * (x * p1 - p0) / (x * x - 1.0);
+    }
+    const double w = 2.0 / ((1.0 - x * x) * dp * dp);
+    nodes[i] = -x;
+    nodes[n - 1 - i] = x;
+    weights[i] = w;
+    weights[n - 1 - i] = w;
+  }
+  if (n % 2 == 1) nodes[n / 2] = 0.0;
+  return NAV_OK;
+}
+
+nav_status nav_truth_create(const nav_scene *scene, nav_truth **out) {
+  nav_truth *tr = NULL;
+  nav_status st = NAV_OK;
+  if (!scene || !out) return NAV_ERR_INVALID_ARG;
+  if (!(scene->imu.rate_hz > 0.0) || !(scene->trajectory.duration_s > 0.0)) return NAV_ERR_INVALID_ARG;
+  if (scene->earth.model != NAV_EARTH_FLAT) return NAV_ERR_INVALID_ARG;
+  tr = calloc(1, sizeof *tr);
+  if (!tr) return NAV_ERR_NO_MEMORY;
+  tr->dt_s = 1.0 / scene->imu.rate_hz;
+  tr->n_samples = (int64_t)floor(scene->trajectory.duration_s * scene->imu.rate_hz + 1e-9);
+  tr->g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
+  tr->n_nodes = scene->imu.quadrature_nodes;
+  st = nav_gauss_legendre(tr->n_nodes, tr->nodes, tr->weights);
+  if (st != NAV_OK) goto cleanup;
+  st = nav_traj_create(scene, tr->dt_s, &tr->traj);
+  if (st != NAV_OK) goto cleanup;
+  *out = tr;
+  tr = NULL;
+cleanup:
+  nav_truth_destroy(tr);
+  return st;
+}
+
+void nav_truth_destroy(nav_truth *truth) {
+  if (!truth) return;
+  nav_traj_destroy(truth->traj);
+  free(truth);
+}
+
+double nav_truth_dt(const nav_truth *truth) { return truth ? truth->dt_s : 0.0; }
+int64_t nav_truth_sample_count(const nav_truth *truth) { return truth ? truth->n_samples : 0; }
+nav_vec3 nav_truth_gravity_l(const nav_truth *truth) { return truth ? truth->g_l_mps2 : nav_vec3_zero(); }
+
+nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out) {
+  if (!truth) return NAV_ERR_INVALID_ARG;
+  return nav_traj_eval(truth->traj, t_s, out);
+}
+
+nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
+  if (!truth || !out || k < 1) return NAV_ERR_INVALID_ARG;
+  const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
+  const double half = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
+  nav_imu_increment r;
+  r.k = k;
+  r.t_s = t1;
+  r.dt_s = t1 - t0;
+  bool closed = false;
+  nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
+  if (st != NAV_OK) return st;
+  /* dv = integral of C_l_b (a_l - g_l) dt by Gauss-Legendre; when the rate has no closed
+   * integral, dtheta uses the same nodes. */
+  nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
+  for (int i = 0; i < truth->n_nodes; ++i) {
+    nav_traj_state s;
+    st = nav_traj_eval(truth->traj, mid + half * truth->nodes[i], &s);
+    if (st != NAV_OK) return st;
+    const nav_vec3 f_l = nav_vec3_sub(s.a_lb_l_mps2, truth->g_l_mps2);
+    const nav_vec3 f_b = nav_quat_rotate(nav_quat_conj(s.q_b_l), f_l);
+    dv = nav_vec3_axpy(dv, truth->weights[i] * half, f_b);
+    dth = nav_vec3_axpy(dth, truth->weights[i] * half, s.w_lb_b_rps);
+  }
+  if (!closed) r.dtheta_b_rad = dth;
+  r.dv_b_mps = dv;
+  *out = r;
+  return NAV_OK;
+}

@@ -1,0 +1,104 @@
+/**
+ * @file nav_sim.h
+ * @brief Orchestration of one simulation run: truth -> sensors -> navigation -> errors.
+ *
+ * The run is synchronous (style.md section 7). Records at the scene's output rate go to a
+ * callback, so the caller decides what to keep or write; statistics are accumulated inside.
+ * Example:
+ * @code
+ *   nav_sim *sim = NULL;
+ *   if (nav_sim_create(&scene, &sim) == NAV_OK) {
+ *     nav_sim_options o = nav_sim_options_default();
+ *     o.ideal = true;
+ *     nav_sim_summary sum;
+ *     if (nav_sim_run(sim, &o, &sum) == NAV_OK) printf("%g m\n", sum.final.pos_err_h_m);
+ *     nav_sim_destroy(sim);
+ *   }
+ * @endcode
+ */
+#ifndef NAV_SIM_H
+#define NAV_SIM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "nav_errors.h"
+#include "nav_export.h"
+#include "nav_ins.h"
+#include "nav_scene.h"
+#include "nav_status.h"
+#include "nav_traj.h"
+
+NAV_BEGIN_DECLS
+
+/** Explicit callback verdicts (never "any non-zero value"). */
+typedef enum nav_callback_result { NAV_CONTINUE = 0, NAV_STOP = 1 } nav_callback_result;
+
+/** Progress of a run. */
+typedef struct nav_progress {
+  const char *stage;   /**< static string, e.g. "run" */
+  long run;            /**< Monte Carlo run index */
+  double fraction;     /**< 0..1 of the whole job */
+  double sim_time_s;   /**< simulated time reached in the current run */
+} nav_progress;
+
+typedef nav_callback_result (*nav_progress_fn)(void *user, const nav_progress *p);
+
+/** One output epoch: pointers valid only during the callback. */
+typedef struct nav_sim_record {
+  long run;
+  const nav_traj_state *truth;
+  const nav_ins_state *nav;
+  const nav_epoch_errors *err;
+} nav_sim_record;
+
+typedef nav_callback_result (*nav_record_fn)(void *user, const nav_sim_record *r);
+
+typedef struct nav_sim_options {
+  bool ideal;               /**< perfect sensors and perfect initial state */
+  nav_progress_fn progress; /**< may be NULL; called on the running thread at a bounded rate */
+  nav_record_fn record;     /**< may be NULL; called at each output epoch */
+  void *user;               /**< passed to both callbacks */
+} nav_sim_options;
+
+NAV_API nav_sim_options nav_sim_options_default(void);
+
+/** Statistics of a run (all epochs at the IMU rate, decimated by stats_stride if huge). */
+typedef struct nav_sim_stats {
+  nav_stat pos_err_h_m, pos_err_v_m, vel_err_mps, att_err_rad, yaw_err_rad;
+} nav_sim_stats;
+
+typedef struct nav_sim_summary {
+  long runs;
+  int64_t imu_samples;     /**< per run */
+  double duration_s;       /**< simulated duration actually covered */
+  nav_epoch_errors final;  /**< errors at the last epoch (run 0) */
+  nav_sim_stats stats;
+  int64_t stats_epochs;    /**< epochs entering the statistics */
+  int64_t stats_stride;    /**< every stats_stride-th IMU epoch enters the statistics */
+  bool partial;            /**< the run was stopped early (cancel / callback) */
+} nav_sim_summary;
+
+typedef struct nav_sim nav_sim;
+
+/** Create a simulation of a validated scene (copied). */
+NAV_API NAV_NODISCARD nav_status nav_sim_create(const nav_scene *scene, nav_sim **out);
+NAV_API void nav_sim_destroy(nav_sim *sim);
+
+/**
+ * Run the scene.
+ * @return NAV_OK; NAV_ERR_CANCELLED when stopped by a callback or nav_sim_request_cancel (the
+ *         summary then covers the part that ran and is marked partial); NAV_ERR_NUMERIC when the
+ *         navigation diverged to non-finite values; NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out);
+
+/** Ask a running nav_sim_run to stop at the next sample. Thread-safe. */
+NAV_API void nav_sim_request_cancel(nav_sim *sim);
+
+/** Detailed message of the last failure on this handle ("" if none). */
+NAV_API const char *nav_sim_last_error(const nav_sim *sim);
+
+NAV_END_DECLS
+
+#endif /* NAV_SIM_H */

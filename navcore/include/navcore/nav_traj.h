@@ -1,0 +1,69 @@
+/**
+ * @file nav_traj.h
+ * @brief Reference trajectories: position, velocity, acceleration, attitude, angular rate and
+ *        angular acceleration as smooth functions of time (analytic derivatives).
+ *
+ * A trajectory is an opaque, stateful object: models whose attitude is defined by integrating
+ * an angular rate (the paper's Option B) keep a cache of the integrated attitude so that a run
+ * walking forward in time costs O(1) per evaluation. Evaluation at an earlier time than the
+ * cache restarts from the nearest stored checkpoint. Not thread-safe: one thread per object.
+ */
+#ifndef NAV_TRAJ_H
+#define NAV_TRAJ_H
+
+#include "nav_export.h"
+#include "nav_math.h"
+#include "nav_scene.h"
+#include "nav_status.h"
+
+NAV_BEGIN_DECLS
+
+/**
+ * Kinematic state of the body at one time, in the scene frame l (flat Earth: NED at the scene
+ * origin, non-rotating, uniform gravity).
+ */
+typedef struct nav_traj_state {
+  double t_s;
+  nav_vec3 r_lb_l_m;        /**< position of the body (IMU) in l [m] */
+  nav_vec3 v_lb_l_mps;      /**< velocity [m/s] */
+  nav_vec3 a_lb_l_mps2;     /**< acceleration [m/s^2] */
+  nav_quat q_b_l;           /**< attitude (body FRD to l) */
+  nav_vec3 w_lb_b_rps;      /**< angular rate of b relative to l, body axes [rad/s] */
+  nav_vec3 dw_lb_b_rps2;    /**< its time derivative in body axes [rad/s^2] */
+} nav_traj_state;
+
+typedef struct nav_traj nav_traj;
+
+/**
+ * Create the trajectory a scene describes.
+ * @param[in]  scene   validated scene (copied; not kept)
+ * @param[in]  dt_s    IMU sample interval: rate-defined attitude is integrated on a sub-grid of
+ *                     dt_s / substeps aligned with the samples
+ * @param[out] out     new trajectory; destroy with nav_traj_destroy
+ * @return NAV_OK, NAV_ERR_INVALID_ARG, NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_create(const nav_scene *scene, double dt_s, nav_traj **out);
+/** Destroy; accepts NULL. */
+NAV_API void nav_traj_destroy(nav_traj *traj);
+
+/**
+ * Evaluate the trajectory at @p t_s in [0, duration] (it is defined, and smooth, slightly
+ * beyond both ends too, which the quadrature of the last interval never needs).
+ * @return NAV_OK, NAV_ERR_INVALID_ARG (NULL or non-finite t).
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out);
+
+/**
+ * Exact integral of the body angular rate over [t0_s, t1_s] (the ideal gyro increment),
+ * when the model has a closed form; otherwise the caller integrates w_lb_b numerically.
+ * @param[out] has_closed_form true when @p out was filled.
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s,
+                                                        nav_vec3 *out, bool *has_closed_form);
+
+/** Duration of the trajectory [s]. */
+NAV_API double nav_traj_duration(const nav_traj *traj);
+
+NAV_END_DECLS
+
+#endif /* NAV_TRAJ_H */

@@ -1,0 +1,44 @@
+# Shared set-up for scripts/run and scripts/test: the one list of Debian packages, their
+# installation (only what is missing), and the incremental build. Sourced, not executed.
+
+# The single list of Debian 12 packages the project needs (toolchain.md section 1).
+# xauth is only a Recommends of xvfb but xvfb-run needs it, so it is named explicitly.
+NAV_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libcmocka-dev libfyaml-dev libgeographiclib-dev
+  python3
+  xvfb xauth
+)
+
+NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+NAV_BUILD="${NAV_BUILD_DIR:-$NAV_ROOT/build}"
+
+nav_log() { printf '[navsim setup] %s\n' "$*" >&2; }
+
+nav_ensure_packages() {
+  local missing=() p
+  for p in "${NAV_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$p")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null 2>&1 || { nav_log "need root or sudo to install: ${missing[*]}"; return 1; }
+    sudo=(sudo)
+  fi
+  nav_log "installing missing Debian packages: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -q >/dev/null
+  "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# Configure once, then build incrementally. Extra cmake arguments may be passed.
+nav_build() {
+  if [ ! -f "$NAV_BUILD/build.ninja" ]; then
+    nav_log "configuring $NAV_BUILD"
+    cmake -S "$NAV_ROOT" -B "$NAV_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNAV_WERROR=ON "$@" >/dev/null
+  fi
+  cmake --build "$NAV_BUILD" -- -j"$(nproc)" >&2
+}
