@@ -130,8 +130,8 @@ void nav_resultdir_abort(nav_resultdir *rd) {
   free(rd);
 }
 
-static const char *k_state_header =
-    "t_s,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n";
+static const char *k_state_header = "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,"
+                                    "roll_deg,pitch_deg,yaw_deg\n";
 static const char *k_error_header =
     "t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,vel_err_e_mps,"
     "vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg\n";
@@ -142,10 +142,15 @@ nav_status nav_csv_write_header(FILE *f, nav_csv_table table) {
   return fputs(h, f) < 0 ? NAV_ERR_IO : NAV_OK;
 }
 
-static int write_state(FILE *f, double t, nav_vec3 r, nav_vec3 v, nav_quat q) {
-  const nav_euler e = nav_quat_to_euler(q, NULL);
-  return fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t, r.x, r.y, r.z, v.x, v.y,
-                 v.z, e.roll_rad * NAV_RAD2DEG, e.pitch_rad * NAV_RAD2DEG, e.yaw_rad * NAV_RAD2DEG);
+/* One state row in the local-level view: geodetic position, curvilinear NED about the origin,
+ * velocity in n, Euler angles of C_b_n. */
+static int write_state(FILE *f, const nav_frame *fr, double t, nav_vec3 r, nav_vec3 v, nav_quat q) {
+  const nav_local_view w = nav_frame_view(fr, r, v, q);
+  const nav_euler e = nav_quat_to_euler(w.q_b_n, NULL);
+  return fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t,
+                 w.pos.lat_rad * NAV_RAD2DEG, w.pos.lon_rad * NAV_RAD2DEG, w.pos.h_m, w.r_ned_m.x, w.r_ned_m.y,
+                 w.r_ned_m.z, w.v_n_mps.x, w.v_n_mps.y, w.v_n_mps.z, e.roll_rad * NAV_RAD2DEG,
+                 e.pitch_rad * NAV_RAD2DEG, e.yaw_rad * NAV_RAD2DEG);
 }
 
 nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record *r) {
@@ -153,16 +158,16 @@ nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record 
   int n = 0;
   switch (table) {
   case NAV_CSV_TRUTH:
-    n = write_state(f, r->truth->t_s, r->truth->r_lb_l_m, r->truth->v_lb_l_mps, r->truth->q_b_l);
+    n = write_state(f, r->frame, r->truth->t_s, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
     break;
   case NAV_CSV_NAV:
-    n = write_state(f, r->nav->t_s, r->nav->r_lb_l_m, r->nav->v_lb_l_mps, r->nav->q_b_l);
+    n = write_state(f, r->frame, r->nav->t_s, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f);
     break;
   case NAV_CSV_ERRORS: {
     const nav_epoch_errors *e = r->err;
     n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", e->t_s,
-                e->pos_err_l_m.x, e->pos_err_l_m.y, e->pos_err_l_m.z, e->pos_err_h_m, e->pos_err_v_m,
-                e->vel_err_l_mps.x, e->vel_err_l_mps.y, e->vel_err_l_mps.z, e->vel_err_mps, e->att_err_rad,
+                e->pos_err_n_m.x, e->pos_err_n_m.y, e->pos_err_n_m.z, e->pos_err_h_m, e->pos_err_v_m,
+                e->vel_err_n_mps.x, e->vel_err_n_mps.y, e->vel_err_n_mps.z, e->vel_err_mps, e->att_err_rad,
                 e->euler_err.roll_rad * NAV_RAD2DEG, e->euler_err.pitch_rad * NAV_RAD2DEG,
                 e->euler_err.yaw_rad * NAV_RAD2DEG);
     break;
@@ -210,8 +215,13 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   json_string(f, info->scene_file);
   fprintf(f, "},\n  \"seed\": %llu,\n  \"runs\": %ld,\n  \"ideal\": %s,\n", (unsigned long long)info->seed,
           sum->runs, info->ideal ? "true" : "false");
-  fprintf(f, "  \"earth_model\": \"%s\",\n  \"algorithm\": \"%s\",\n  \"trajectory\": \"%s\",\n",
-          nav_earth_model_name(scene->earth.model), nav_mech_algorithm_name(scene->navigation.algorithm),
+  fprintf(f,
+          "  \"earth_model\": \"%s\",\n  \"gravity_model\": \"%s\",\n  \"algorithm\": \"%s\",\n"
+          "  \"mechanization_frame\": \"%s\",\n  \"trajectory\": \"%s\",\n",
+          nav_earth_model_name(scene->earth.model),
+          scene->earth.model == NAV_EARTH_FLAT ? "uniform" : nav_gravity_model_name(scene->earth.gravity_model),
+          nav_mech_algorithm_name(scene->navigation.algorithm),
+          scene->earth.model == NAV_EARTH_FLAT ? "flat" : nav_mech_frame_name(scene->navigation.frame),
           nav_traj_type_name(scene->trajectory.type));
   fputs("  \"duration_s\": ", f);
   json_number(f, sum->duration_s);

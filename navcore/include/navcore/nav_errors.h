@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "nav_export.h"
+#include "nav_frames.h"
 #include "nav_ins.h"
 #include "nav_math.h"
 #include "nav_status.h"
@@ -17,20 +18,26 @@
 
 NAV_BEGIN_DECLS
 
-/** Errors of one epoch; every difference is estimate minus truth, resolved in l (NED). */
+/** Errors of one epoch; every difference is estimate minus truth, resolved in the local-level
+ *  NED frame n at the true position (flat Earth: l). */
 typedef struct nav_epoch_errors {
   double t_s;
-  nav_vec3 pos_err_l_m;   /**< position error N, E, D [m] */
+  nav_vec3 pos_err_n_m;   /**< position error N, E, D [m] */
   double pos_err_h_m;     /**< horizontal: hypot(N, E) [m] */
   double pos_err_v_m;     /**< vertical: |D| [m] */
-  nav_vec3 vel_err_l_mps; /**< velocity error N, E, D [m/s] */
+  nav_vec3 vel_err_n_mps; /**< velocity error N, E, D [m/s] */
   double vel_err_mps;     /**< |velocity error| [m/s] */
   double att_err_rad;     /**< rotation angle |log(C_true^T C_est)| [rad] */
   nav_euler euler_err;    /**< Euler-angle differences, each wrapped to (-pi, pi] [rad] */
 } nav_epoch_errors;
 
-/** Compute the errors of @p est against @p truth at the same epoch. Leaf function: cannot fail. */
-NAV_API nav_epoch_errors nav_errors_compute(const nav_traj_state *truth, const nav_ins_state *est);
+/**
+ * Compute the errors of @p est against @p truth at the same epoch, both given in the frame
+ * @p fr of the scene. Euler-angle errors are differences of the local-level Euler angles
+ * (each wrapped to (-pi, pi]). Leaf function: cannot fail.
+ */
+NAV_API nav_epoch_errors nav_errors_compute(const nav_frame *fr, const nav_traj_state *truth,
+                                            const nav_ins_state *est);
 
 /** RMS, maximum and 95th percentile of a non-negative metric over epochs (and runs). */
 typedef struct nav_stat {

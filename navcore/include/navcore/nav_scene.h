@@ -37,9 +37,18 @@ typedef enum nav_earth_model {
   NAV_EARTH_WGS84 = 1 /**< WGS-84 ellipsoid, Earth rate, transport rate, normal gravity */
 } nav_earth_model;
 
+/** Gravity model of the WGS-84 Earth (truth and mechanization always use the same one). */
+typedef enum nav_gravity_model {
+  NAV_GRAVITY_NORMAL = 0, /**< Somigliana normal gravity with the height series (numerics.md E3.10-E3.11) */
+  NAV_GRAVITY_J2 = 1      /**< J2 gravitation minus centrifugal, valid everywhere incl. the poles (E3.12) */
+} nav_gravity_model;
+
 /** Trajectory model. */
 typedef enum nav_traj_type {
-  NAV_TRAJ_PARAMETRIC = 0 /**< the paper's formula (3), numerics.md section 3.1 */
+  NAV_TRAJ_PARAMETRIC = 0, /**< the paper's formula (3), numerics.md section 3.1 */
+  NAV_TRAJ_WAYPOINTS = 1,  /**< smooth path through waypoints with a speed profile */
+  NAV_TRAJ_SEGMENTS = 2,   /**< segment script (hold, accelerate, turn, climb, ...); motion-definition imports */
+  NAV_TRAJ_TEST_MOTION = 3 /**< test motions with known answers (stationary, coning, sculling, spin, great circle) */
 } nav_traj_type;
 
 /** How the attitude of the parametric trajectory is defined. */
@@ -74,11 +83,30 @@ typedef struct nav_traj_parametric {
   int magnus_substeps; /**< sub-grid h_s = dt / magnus_substeps (default 8) */
 } nav_traj_parametric;
 
+/* ==== BEGIN test motions (owned by the mechanization / hard-cases work) ==== */
+typedef struct nav_traj_test_motion {
+  int reserved;
+} nav_traj_test_motion;
+/* ==== END test motions ==== */
+
+/* ==== BEGIN waypoints and segment scripts (owned by the trajectory-models work) ==== */
+typedef struct nav_traj_waypoints {
+  int reserved;
+} nav_traj_waypoints;
+
+typedef struct nav_traj_segments {
+  int reserved;
+} nav_traj_segments;
+/* ==== END waypoints and segment scripts ==== */
+
 typedef struct nav_scene_trajectory {
   nav_traj_type type;
   double duration_s;
-  nav_euler initial_attitude; /**< C_b_l at t = 0 */
+  nav_euler initial_attitude; /**< C_b_n at t = 0 (flat Earth: C_b_l) */
   nav_traj_parametric parametric;
+  nav_traj_test_motion test_motion;
+  nav_traj_waypoints waypoints;
+  nav_traj_segments segments;
 } nav_scene_trajectory;
 
 typedef struct nav_scene_earth {
@@ -87,6 +115,7 @@ typedef struct nav_scene_earth {
   double origin_lon_rad;
   double origin_h_m;
   double flat_gravity_mps2; /**< magnitude of the uniform gravity of the flat model (down) */
+  nav_gravity_model gravity_model; /**< WGS-84 model only */
 } nav_scene_earth;
 
 typedef struct nav_scene_imu {
@@ -94,8 +123,15 @@ typedef struct nav_scene_imu {
   int quadrature_nodes; /**< Gauss-Legendre nodes for ideal increments (1..8, default 6) */
 } nav_scene_imu;
 
+/** Frame the WGS-84 mechanization integrates in. */
+typedef enum nav_mech_frame {
+  NAV_MECH_NED = 0, /**< local-level NED (latitude, longitude, height); refuses |lat| -> 90 deg */
+  NAV_MECH_ECEF = 1 /**< Earth-fixed: no singularity anywhere, works over the poles */
+} nav_mech_frame;
+
 typedef struct nav_scene_navigation {
   nav_mech_algorithm algorithm;
+  nav_mech_frame frame; /**< WGS-84 only */
 } nav_scene_navigation;
 
 typedef struct nav_scene_output {
@@ -144,6 +180,8 @@ NAV_API NAV_NODISCARD nav_status nav_scene_validate(const nav_scene *scene, nav_
 NAV_API const char *nav_earth_model_name(nav_earth_model m);
 NAV_API const char *nav_mech_algorithm_name(nav_mech_algorithm a);
 NAV_API const char *nav_traj_type_name(nav_traj_type t);
+NAV_API const char *nav_gravity_model_name(nav_gravity_model g);
+NAV_API const char *nav_mech_frame_name(nav_mech_frame f);
 
 NAV_END_DECLS
 

@@ -47,6 +47,7 @@ typedef nav_callback_result (*nav_progress_fn)(void *user, const nav_progress *p
 /** One output epoch: pointers valid only during the callback. */
 typedef struct nav_sim_record {
   long run;
+  const nav_frame *frame; /**< the scene frame the states are expressed in */
   const nav_traj_state *truth;
   const nav_ins_state *nav;
   const nav_epoch_errors *err;

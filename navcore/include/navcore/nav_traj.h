@@ -12,6 +12,9 @@
 #define NAV_TRAJ_H
 
 #include "nav_export.h"
+#include "nav_frames.h"
+#include <stddef.h>
+
 #include "nav_math.h"
 #include "nav_scene.h"
 #include "nav_status.h"
@@ -19,17 +22,17 @@
 NAV_BEGIN_DECLS
 
 /**
- * Kinematic state of the body at one time, in the scene frame l (flat Earth: NED at the scene
- * origin, non-rotating, uniform gravity).
+ * Kinematic state of the body at one time in the scene's reference frame F (nav_frames.h):
+ * F = l on flat Earth, F = e (ECEF) on WGS-84.
  */
 typedef struct nav_traj_state {
   double t_s;
-  nav_vec3 r_lb_l_m;        /**< position of the body (IMU) in l [m] */
-  nav_vec3 v_lb_l_mps;      /**< velocity [m/s] */
-  nav_vec3 a_lb_l_mps2;     /**< acceleration [m/s^2] */
-  nav_quat q_b_l;           /**< attitude (body FRD to l) */
-  nav_vec3 w_lb_b_rps;      /**< angular rate of b relative to l, body axes [rad/s] */
-  nav_vec3 dw_lb_b_rps2;    /**< its time derivative in body axes [rad/s^2] */
+  nav_vec3 r_fb_f_m;     /**< position of the body (IMU) in F [m] */
+  nav_vec3 v_fb_f_mps;   /**< velocity relative to F, resolved in F [m/s] */
+  nav_vec3 a_fb_f_mps2;  /**< acceleration relative to F, resolved in F [m/s^2] */
+  nav_quat q_b_f;        /**< attitude, body FRD to F */
+  nav_vec3 w_fb_b_rps;   /**< angular rate of b relative to F, body axes [rad/s] */
+  nav_vec3 dw_fb_b_rps2; /**< its time derivative in body axes [rad/s^2] */
 } nav_traj_state;
 
 typedef struct nav_traj nav_traj;
@@ -54,15 +57,26 @@ NAV_API void nav_traj_destroy(nav_traj *traj);
 NAV_API NAV_NODISCARD nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out);
 
 /**
- * Exact integral of the body angular rate over [t0_s, t1_s] (the ideal gyro increment),
- * when the model has a closed form; otherwise the caller integrates w_lb_b numerically.
- * @param[out] has_closed_form true when @p out was filled.
+ * Exact integral of the body angular rate relative to F over [t0_s, t1_s] (on flat Earth, the
+ * ideal gyro increment) when the model has a closed form and F = l; otherwise
+ * @p has_closed_form is false and the caller integrates numerically.
  */
 NAV_API NAV_NODISCARD nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s,
                                                         nav_vec3 *out, bool *has_closed_form);
 
 /** Duration of the trajectory [s]. */
 NAV_API double nav_traj_duration(const nav_traj *traj);
+
+/** The scene frame the states are expressed in. */
+NAV_API nav_frame nav_traj_frame(const nav_traj *traj);
+
+/**
+ * As nav_traj_create(); on failure also writes into @p msg (may be NULL) what is wrong, naming
+ * the offending waypoint, segment or field and the limit (infeasible input is an error, never a
+ * silent distortion).
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **out,
+                                                     char *msg, size_t msg_size);
 
 NAV_END_DECLS
 

@@ -11,6 +11,7 @@
 #ifndef NAV_TRUTH_H
 #define NAV_TRUTH_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "nav_export.h"
@@ -28,7 +29,7 @@ typedef struct nav_imu_increment {
   int64_t k;             /**< sample index; t_s = k * dt */
   double t_s;            /**< end of the interval */
   double dt_s;           /**< interval length */
-  nav_vec3 dtheta_b_rad; /**< integral of omega_ib_b (flat: omega_lb_b) */
+  nav_vec3 dtheta_b_rad; /**< integral of omega_ib_b (flat Earth: omega_lb_b) */
   nav_vec3 dv_b_mps;     /**< integral of the specific force f_ib_b */
 } nav_imu_increment;
 
@@ -49,8 +50,18 @@ NAV_API NAV_NODISCARD nav_status nav_truth_state(nav_truth *truth, double t_s, n
 NAV_API double nav_truth_dt(const nav_truth *truth);
 /** Number of IMU samples in the scene duration: floor(duration / dt + 1e-9). */
 NAV_API int64_t nav_truth_sample_count(const nav_truth *truth);
-/** Gravity of the flat model in l [m/s^2] (0, 0, g). */
-NAV_API nav_vec3 nav_truth_gravity_l(const nav_truth *truth);
+/** The scene frame (flat l or ECEF) the states and increments refer to. */
+NAV_API nav_frame nav_truth_frame(const nav_truth *truth);
+
+/** As nav_truth_create(); on failure writes what is wrong into @p msg (may be NULL). */
+NAV_API NAV_NODISCARD nav_status nav_truth_create_msg(const nav_scene *scene, nav_truth **out, char *msg,
+                                                      size_t msg_size);
+
+/**
+ * Gravity (gravitation plus centrifugal) in ECEF at r_eb_e [m/s^2] for the WGS-84 gravity
+ * model @p model; the truth generator and the mechanization share this function.
+ */
+NAV_API nav_vec3 nav_gravity_e_mps2(nav_gravity_model model, nav_vec3 r_eb_e_m);
 
 /**
  * Gauss-Legendre nodes and weights on [-1, 1] for n = 1..NAV_GL_MAX_NODES points, computed by

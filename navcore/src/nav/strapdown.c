@@ -20,7 +20,10 @@ nav_ins_config nav_ins_config_default(void) {
   nav_ins_config c;
   c.earth_model = NAV_EARTH_FLAT;
   c.algorithm = NAV_MECH_FIRST_ORDER;
+  c.mech_frame = NAV_MECH_NED;
+  c.gravity_model = NAV_GRAVITY_NORMAL;
   c.g_l_mps2 = nav_vec3_make(0.0, 0.0, 9.80665);
+  c.clamp_vertical = false;
   return c;
 }
 
@@ -32,12 +35,20 @@ nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initia
   if (!ins) return NAV_ERR_NO_MEMORY;
   ins->cfg = *cfg;
   ins->s = *initial;
-  ins->s.q_b_l = nav_quat_normalize(initial->q_b_l);
+  ins->s.q_b_f = nav_quat_normalize(initial->q_b_f);
   *out = ins;
   return NAV_OK;
 }
 
 void nav_ins_destroy(nav_ins *ins) { free(ins); }
+
+nav_status nav_ins_aid_vertical(nav_ins *ins, double h_m, double v_d_mps) {
+  if (!ins || !isfinite(h_m) || !isfinite(v_d_mps)) return NAV_ERR_INVALID_ARG;
+  /* Flat Earth: D is -height relative to the origin plane; the scene origin height is 0 in l. */
+  ins->s.r_fb_f_m.z = -h_m;
+  ins->s.v_fb_f_mps.z = v_d_mps;
+  return NAV_OK;
+}
 
 const nav_ins_state *nav_ins_get_state(const nav_ins *ins) { return ins ? &ins->s : NULL; }
 
@@ -47,7 +58,7 @@ nav_status nav_ins_step(nav_ins *ins, const nav_imu_increment *imu) {
     return NAV_ERR_NUMERIC;
   const double dt = imu->dt_s;
   const nav_vec3 dth = imu->dtheta_b_rad, dv = imu->dv_b_mps;
-  const nav_mat3 C_b_l = nav_quat_to_dcm(ins->s.q_b_l);
+  const nav_mat3 C_b_l = nav_quat_to_dcm(ins->s.q_b_f);
   nav_vec3 phi, dv_body;
 
   if (ins->cfg.algorithm == NAV_MECH_FIRST_ORDER) {
@@ -69,12 +80,12 @@ nav_status nav_ins_step(nav_ins *ins, const nav_imu_increment *imu) {
 
   nav_ins_state n = ins->s;
   n.t_s = imu->t_s;
-  n.v_lb_l_mps = nav_vec3_add(nav_vec3_add(ins->s.v_lb_l_mps, nav_mat3_mul_vec(C_b_l, dv_body)),
+  n.v_fb_f_mps = nav_vec3_add(nav_vec3_add(ins->s.v_fb_f_mps, nav_mat3_mul_vec(C_b_l, dv_body)),
                               nav_vec3_scale(ins->cfg.g_l_mps2, dt));
-  n.r_lb_l_m = nav_vec3_add(ins->s.r_lb_l_m, nav_vec3_scale(nav_vec3_add(ins->s.v_lb_l_mps, n.v_lb_l_mps), 0.5 * dt));
+  n.r_fb_f_m = nav_vec3_add(ins->s.r_fb_f_m, nav_vec3_scale(nav_vec3_add(ins->s.v_fb_f_mps, n.v_fb_f_mps), 0.5 * dt));
   /* Renormalise every step (numerics.md 4.4 rule 1). */
-  n.q_b_l = nav_quat_normalize(nav_quat_mul(ins->s.q_b_l, nav_quat_from_rotvec(phi)));
-  if (!nav_vec3_isfinite(n.v_lb_l_mps) || !nav_vec3_isfinite(n.r_lb_l_m) || !isfinite(n.q_b_l.w))
+  n.q_b_f = nav_quat_normalize(nav_quat_mul(ins->s.q_b_f, nav_quat_from_rotvec(phi)));
+  if (!nav_vec3_isfinite(n.v_fb_f_mps) || !nav_vec3_isfinite(n.r_fb_f_m) || !isfinite(n.q_b_f.w))
     return NAV_ERR_NUMERIC;
   ins->s = n;
   ins->prev_dtheta_b_rad = dth;

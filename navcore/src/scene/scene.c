@@ -57,11 +57,6 @@ static void issue(checker *c, const char *path, const char *fmt, double v) {
   if (c->report) c->report(c->user, path, msg);
 }
 
-static void issue_text(checker *c, const char *path, const char *msg) {
-  c->count++;
-  if (c->report) c->report(c->user, path, msg);
-}
-
 static void check_finite(checker *c, const char *path, double v) {
   if (!isfinite(v)) issue(c, path, "must be a finite number (got %g)", v);
 }
@@ -97,8 +92,8 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   if (!(s->earth.origin_h_m >= -1.0e5 && s->earth.origin_h_m <= 1.0e8))
     issue(&c, "earth.origin.h_m", "height must be within [-1e5, 1e8] m (got %g)", s->earth.origin_h_m);
   if (s->earth.model == NAV_EARTH_FLAT) check_positive(&c, "earth.gravity_mps2", s->earth.flat_gravity_mps2, 1.0e3);
-  if (s->earth.model == NAV_EARTH_WGS84)
-    issue_text(&c, "earth.model", "the wgs84 Earth model is not available yet in this version; use flat");
+  if (s->earth.gravity_model != NAV_GRAVITY_NORMAL && s->earth.gravity_model != NAV_GRAVITY_J2)
+    issue(&c, "earth.gravity_model", "unknown gravity model %g", (double)s->earth.gravity_model);
 
   check_positive(&c, "trajectory.duration_s", s->trajectory.duration_s, NAV_SCENE_MAX_DURATION_S);
   check_finite(&c, "trajectory.initial_attitude.roll_deg", s->trajectory.initial_attitude.roll_rad);
@@ -119,7 +114,8 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
     if (p->magnus_substeps < 1 || p->magnus_substeps > 1024)
       issue(&c, "trajectory.parametric.magnus_substeps", "must be an integer in [1, 1024] (got %g)",
             (double)p->magnus_substeps);
-  } else {
+  } else if (s->trajectory.type != NAV_TRAJ_WAYPOINTS && s->trajectory.type != NAV_TRAJ_SEGMENTS &&
+             s->trajectory.type != NAV_TRAJ_TEST_MOTION) {
     issue(&c, "trajectory.type", "unknown trajectory type %g", (double)s->trajectory.type);
   }
 
@@ -137,6 +133,8 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
 
   if (s->navigation.algorithm != NAV_MECH_FIRST_ORDER && s->navigation.algorithm != NAV_MECH_HIGH_ORDER)
     issue(&c, "navigation.algorithm", "unknown algorithm %g", (double)s->navigation.algorithm);
+  if (s->navigation.frame != NAV_MECH_NED && s->navigation.frame != NAV_MECH_ECEF)
+    issue(&c, "navigation.frame", "unknown mechanization frame %g", (double)s->navigation.frame);
 
   check_positive(&c, "output.rate_hz", s->output.rate_hz, NAV_SCENE_MAX_RATE_HZ);
   if (isfinite(s->output.rate_hz) && isfinite(s->imu.rate_hz) && s->output.rate_hz > s->imu.rate_hz)
@@ -163,9 +161,28 @@ const char *nav_mech_algorithm_name(nav_mech_algorithm a) {
   return "unknown";
 }
 
+const char *nav_gravity_model_name(nav_gravity_model g) {
+  switch (g) {
+  case NAV_GRAVITY_NORMAL: return "normal";
+  case NAV_GRAVITY_J2: return "j2";
+  }
+  return "unknown";
+}
+
+const char *nav_mech_frame_name(nav_mech_frame f) {
+  switch (f) {
+  case NAV_MECH_NED: return "ned";
+  case NAV_MECH_ECEF: return "ecef";
+  }
+  return "unknown";
+}
+
 const char *nav_traj_type_name(nav_traj_type t) {
   switch (t) {
   case NAV_TRAJ_PARAMETRIC: return "parametric";
+  case NAV_TRAJ_WAYPOINTS: return "waypoints";
+  case NAV_TRAJ_SEGMENTS: return "segments";
+  case NAV_TRAJ_TEST_MOTION: return "test_motion";
   }
   return "unknown";
 }

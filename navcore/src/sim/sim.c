@@ -71,11 +71,14 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   atomic_store(&sim->cancel, false);
   const nav_scene *sc = &sim->scene;
 
-  st = nav_truth_create(sc, &truth);
+  char msg[200];
+  st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
   if (st != NAV_OK) {
-    set_error(sim, "truth generator set-up", st, 0.0);
+    snprintf(sim->last_error, sizeof sim->last_error, "reference trajectory: %s",
+             msg[0] ? msg : nav_status_str(st));
     goto cleanup;
   }
+  const nav_frame frame = nav_truth_frame(truth);
   const int64_t n = nav_truth_sample_count(truth);
   const double dt = nav_truth_dt(truth);
   int64_t out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
@@ -92,22 +95,24 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   nav_traj_state ts;
   st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
-  nav_ins_state s0 = {0.0, ts.r_lb_l_m, ts.v_lb_l_mps, ts.q_b_l};
+  nav_ins_state s0 = {0.0, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f};
   nav_ins_config icfg = nav_ins_config_default();
   icfg.earth_model = sc->earth.model;
   icfg.algorithm = sc->navigation.algorithm;
-  icfg.g_l_mps2 = nav_truth_gravity_l(truth);
+  icfg.mech_frame = sc->navigation.frame;
+  icfg.gravity_model = sc->earth.gravity_model;
+  icfg.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
   st = nav_ins_create(&icfg, &s0, &ins);
   if (st != NAV_OK) {
     set_error(sim, "navigation set-up", st, 0.0);
     goto cleanup;
   }
 
-  nav_epoch_errors err = nav_errors_compute(&ts, nav_ins_get_state(ins));
+  nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
   st = stat_add(&ss, &err);
   if (st != NAV_OK) goto cleanup;
   if (opts->record) {
-    nav_sim_record rec = {0, &ts, nav_ins_get_state(ins), &err};
+    nav_sim_record rec = {0, &frame, &ts, nav_ins_get_state(ins), &err};
     if (opts->record(opts->user, &rec) == NAV_STOP) sum.partial = true;
   }
 
@@ -130,7 +135,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     }
     st = nav_truth_state(truth, imu.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
-    err = nav_errors_compute(&ts, nav_ins_get_state(ins));
+    err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
     if (k % stats_stride == 0) {
       st = stat_add(&ss, &err);
       if (st != NAV_OK) {
@@ -139,7 +144,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       }
     }
     if (opts->record && (k % out_stride == 0 || k == n)) {
-      nav_sim_record rec = {0, &ts, nav_ins_get_state(ins), &err};
+      nav_sim_record rec = {0, &frame, &ts, nav_ins_get_state(ins), &err};
       if (opts->record(opts->user, &rec) == NAV_STOP) sum.partial = true;
     }
     if (opts->progress && (k % PROGRESS_EVERY == 0 || k == n)) {

@@ -10,14 +10,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "navcore/nav_traj.h"
+#include <stdio.h>
+
+#include "traj/traj_internal.h"
 
 /* One checkpoint of the integrated attitude every CHECKPOINT_STRIDE grid steps, so evaluation
  * at an earlier time re-integrates at most that many steps. */
 #define CHECKPOINT_STRIDE 4096
 
-struct nav_traj {
-  nav_traj_type type;
+typedef struct param_model {
   double duration_s;
   nav_traj_parametric p;
   nav_quat q0_b_l;
@@ -27,7 +28,7 @@ struct nav_traj {
   int64_t n_valid;
   int64_t cache_j;     /* grid index of the cached attitude */
   nav_quat cache_q;
-};
+} param_model;
 
 /* omega(t) = a + b sin(2 pi c t + d), element-wise (E3.2). */
 static nav_vec3 param_rate(const nav_traj_parametric *p, double t) {
@@ -56,11 +57,11 @@ static nav_quat magnus_step(const nav_traj_parametric *p, nav_quat q, double t0,
   return nav_quat_normalize(nav_quat_mul(q, nav_quat_from_rotvec(sigma)));
 }
 
-static double grid_time(const nav_traj *tr, int64_t j) { return (double)j * tr->h_s; }
+static double grid_time(const param_model *tr, int64_t j) { return (double)j * tr->h_s; }
 
 /* Advance the cached attitude to grid index j (j >= 0). Checkpoints are recorded as the cache
  * walks forward, so going back costs at most CHECKPOINT_STRIDE steps. */
-static void advance_cache(nav_traj *tr, int64_t j) {
+static void advance_cache(param_model *tr, int64_t j) {
   if (j < tr->cache_j) {
     int64_t c = j / CHECKPOINT_STRIDE;
     if (c >= tr->n_valid) c = tr->n_valid - 1;
@@ -81,7 +82,7 @@ static void advance_cache(nav_traj *tr, int64_t j) {
 }
 
 /* Attitude at any t >= 0: grid point below t, then one partial Magnus step. */
-static nav_quat attitude_at(nav_traj *tr, double t) {
+static nav_quat attitude_at(param_model *tr, double t) {
   const double x = t / tr->h_s;
   int64_t j = (int64_t)floor(x);
   /* Sample times k*dt land on the grid up to rounding: snap to the grid point instead of taking
@@ -94,7 +95,7 @@ static nav_quat attitude_at(nav_traj *tr, double t) {
   return magnus_step(&tr->p, tr->cache_q, grid_time(tr, j), rem);
 }
 
-static nav_status parametric_prepare(nav_traj *tr) {
+static nav_status parametric_prepare(param_model *tr) {
   const double n = ceil(tr->duration_s / tr->h_s) + 2.0 * (double)CHECKPOINT_STRIDE;
   if (!(n < 4.0e12)) return NAV_ERR_OUT_OF_RANGE;
   tr->n_checkpoints = (int64_t)n / CHECKPOINT_STRIDE + 1;
@@ -107,64 +108,72 @@ static nav_status parametric_prepare(nav_traj *tr) {
   return NAV_OK;
 }
 
-nav_status nav_traj_create(const nav_scene *scene, double dt_s, nav_traj **out) {
-  nav_traj *tr = NULL;
-  nav_status st = NAV_OK;
-  if (!scene || !out || !(dt_s > 0.0) || !isfinite(dt_s)) return NAV_ERR_INVALID_ARG;
-  if (scene->trajectory.type != NAV_TRAJ_PARAMETRIC) return NAV_ERR_INVALID_ARG;
-  if (scene->trajectory.parametric.magnus_substeps < 1) return NAV_ERR_INVALID_ARG;
-  tr = calloc(1, sizeof *tr);
+static void param_destroy(void *self) {
+  param_model *tr = self;
+  if (!tr) return;
+  free(tr->checkpoints);
+  free(tr);
+}
+
+static nav_status param_eval(void *self, double t_s, nav_local_kin *out);
+static bool param_rate_integral(void *self, double t0_s, double t1_s, nav_vec3 *out);
+
+nav_status nav_traj_parametric_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
+                                      size_t msg_size) {
+  if (scene->trajectory.parametric.magnus_substeps < 1) {
+    if (msg) snprintf(msg, msg_size, "trajectory.parametric.magnus_substeps must be >= 1");
+    return NAV_ERR_INVALID_ARG;
+  }
+  param_model *tr = calloc(1, sizeof *tr);
   if (!tr) return NAV_ERR_NO_MEMORY;
-  tr->type = scene->trajectory.type;
   tr->duration_s = scene->trajectory.duration_s;
   tr->p = scene->trajectory.parametric;
   tr->q0_b_l = nav_euler_to_quat(scene->trajectory.initial_attitude);
   tr->h_s = dt_s / (double)tr->p.magnus_substeps;
-  st = parametric_prepare(tr);
-  if (st != NAV_OK) goto cleanup;
-  *out = tr;
-  tr = NULL;
-cleanup:
-  nav_traj_destroy(tr);
-  return st;
+  const nav_status st = parametric_prepare(tr);
+  if (st != NAV_OK) {
+    param_destroy(tr);
+    if (msg) snprintf(msg, msg_size, "the trajectory is too long for the Magnus sub-grid");
+    return st;
+  }
+  memset(out, 0, sizeof *out);
+  out->name = "parametric";
+  out->duration_s = tr->duration_s;
+  out->self = tr;
+  out->eval_local = param_eval;
+  out->rate_integral = param_rate_integral;
+  out->destroy = param_destroy;
+  return NAV_OK;
 }
 
-void nav_traj_destroy(nav_traj *traj) {
-  if (!traj) return;
-  free(traj->checkpoints);
-  free(traj);
-}
-
-double nav_traj_duration(const nav_traj *traj) { return traj ? traj->duration_s : 0.0; }
-
-nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
-  if (!traj || !out || !isfinite(t_s) || t_s < 0.0) return NAV_ERR_INVALID_ARG;
+/* Local kinematics: on flat Earth l = n, so omega_lb_b of E3.2 is omega_nb_b. Defined for
+ * t >= -h_s (the attitude is integrated forward from t = 0). */
+static nav_status param_eval(void *self, double t_s, nav_local_kin *out) {
+  param_model *traj = self;
+  if (!(t_s >= -traj->h_s)) return NAV_ERR_OUT_OF_RANGE;
   const nav_traj_parametric *p = &traj->p;
-  nav_traj_state s;
-  s.t_s = t_s;
+  nav_local_kin s;
   for (int i = 0; i < 3; ++i) {
     /* E3.1 and its analytic derivatives. */
     const double B = nav_vec3_get(p->b_m, i), w = NAV_TWO_PI * nav_vec3_get(p->c_hz, i);
     const double ph = w * t_s + nav_vec3_get(p->d_rad, i);
     const double A = nav_vec3_get(p->a_mps2, i);
-    nav_vec3_set(&s.r_lb_l_m, i,
+    nav_vec3_set(&s.r_ned_m, i,
                  nav_vec3_get(p->r0_m, i) + nav_vec3_get(p->v0_mps, i) * t_s + A * t_s * t_s + B * sin(ph));
-    nav_vec3_set(&s.v_lb_l_mps, i, nav_vec3_get(p->v0_mps, i) + 2.0 * A * t_s + w * B * cos(ph));
-    nav_vec3_set(&s.a_lb_l_mps2, i, 2.0 * A - w * w * B * sin(ph));
+    nav_vec3_set(&s.v_ned_mps, i, nav_vec3_get(p->v0_mps, i) + 2.0 * A * t_s + w * B * cos(ph));
+    nav_vec3_set(&s.a_ned_mps2, i, 2.0 * A - w * w * B * sin(ph));
   }
-  s.w_lb_b_rps = param_rate(p, t_s);
-  s.dw_lb_b_rps2 = nav_vec3_make(rate_dot_1(p->wb_rps.x, p->wc_hz.x, p->wd_rad.x, t_s),
+  s.w_nb_b_rps = param_rate(p, t_s);
+  s.dw_nb_b_rps2 = nav_vec3_make(rate_dot_1(p->wb_rps.x, p->wc_hz.x, p->wd_rad.x, t_s),
                                  rate_dot_1(p->wb_rps.y, p->wc_hz.y, p->wd_rad.y, t_s),
                                  rate_dot_1(p->wb_rps.z, p->wc_hz.z, p->wd_rad.z, t_s));
-  s.q_b_l = attitude_at(traj, t_s);
+  s.q_b_n = attitude_at(traj, t_s);
   *out = s;
   return NAV_OK;
 }
 
-nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s, nav_vec3 *out,
-                                  bool *has_closed_form) {
-  if (!traj || !out || !has_closed_form || !isfinite(t0_s) || !isfinite(t1_s)) return NAV_ERR_INVALID_ARG;
-  const nav_traj_parametric *p = &traj->p;
+static bool param_rate_integral(void *self, double t0_s, double t1_s, nav_vec3 *out) {
+  const nav_traj_parametric *p = &((const param_model *)self)->p;
   nav_vec3 r;
   for (int i = 0; i < 3; ++i) {
     /* E3.6: integral of a + b sin(2 pi c t + d); c = 0 degenerates to (a + b sin d) dt. */
@@ -183,6 +192,5 @@ nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s
     nav_vec3_set(&r, i, v);
   }
   *out = r;
-  *has_closed_form = true;
-  return NAV_OK;
+  return true;
 }

@@ -1,26 +1,38 @@
-/* Exact ideal IMU increments from the reference trajectory (numerics.md section 3.1). */
+/*
+ * Exact ideal IMU increments from the reference trajectory (numerics.md section 3).
+ * Flat Earth: omega_ib_b = omega_lb_b, f_b = C_l_b (a_l - g_l).
+ * WGS-84 (truth in ECEF, E3.7-E3.8): f_e = a_e + 2 omega_ie_e x v_e - g_e(r_e),
+ * f_b = C_e_b f_e, omega_ib_b = C_e_b omega_ie_e + omega_eb_b, with the same gravity model as
+ * the mechanization. Both increments are integrated by n-point Gauss-Legendre quadrature over
+ * the sample interval; the gyro increment uses the model's closed form where there is one.
+ */
 #include <stdlib.h>
 
+#include "navcore/nav_earth.h"
 #include "navcore/nav_truth.h"
 
 struct nav_truth {
   nav_traj *traj;
+  nav_frame frame;
+  nav_gravity_model gravity;
   double dt_s;
   int64_t n_samples;
   nav_vec3 g_l_mps2;
   int n_nodes;
   double nodes[NAV_GL_MAX_NODES];
   double weights[NAV_GL_MAX_NODES];
+  char msg[256];
 };
 
 nav_status nav_gauss_legendre(int n, double *nodes, double *weights) {
   if (n < 1 || n > NAV_GL_MAX_NODES || !nodes || !weights) return NAV_ERR_INVALID_ARG;
-  /* Roots of P_n by Newton's method from Tricomi's initial guess (Abramowitz & Stegun 22.16.6
-   * style); the three-term recurrence (n+1) P_(n+1) = (2n+1) x P_n - n P_(n-1) gives P_n and
-   * P_n' = n (x P_n - P_(n-1)) / (x^2 - 1); weights 2 / ((1 - x^2) P_n'(x)^2) (A&S 25.4.29). */
+  /* Roots of P_n by Newton's method from the initial guess cos(pi (i + 3/4) / (n + 1/2))
+   * (Abramowitz & Stegun 22.16.6); the three-term recurrence (m) P_m = (2m - 1) x P_(m-1) -
+   * (m - 1) P_(m-2) gives P_n, and P_n' = n (x P_n - P_(n-1)) / (x^2 - 1); weights
+   * 2 / ((1 - x^2) P_n'(x)^2) (A&S 25.4.29). */
   for (int i = 0; i < (n + 1) / 2; ++i) {
     double x = cos(NAV_PI * ((double)i + 0.75) / ((double)n + 0.5));
-    double dp = 0.0;
+    double dp = 1.0;
     for (int it = 0; it < 100; ++it) {
       double p0 = 1.0, p1 = x;
       for (int m = 2; m <= n; ++m) {
@@ -33,7 +45,6 @@ nav_status nav_gauss_legendre(int n, double *nodes, double *weights) {
       x -= dx;
       if (fabs(dx) < 1e-17) break;
     }
-    /* Recompute P_n' at the converged root for the weight. */
     {
       double p0 = 1.0, p1 = x;
       for (int m = 2; m <= n; ++m) {
@@ -53,27 +64,39 @@ nav_status nav_gauss_legendre(int n, double *nodes, double *weights) {
   return NAV_OK;
 }
 
-nav_status nav_truth_create(const nav_scene *scene, nav_truth **out) {
+nav_vec3 nav_gravity_e_mps2(nav_gravity_model model, nav_vec3 r_eb_e_m) {
+  if (model == NAV_GRAVITY_J2) return nav_earth_gravity_j2_e_mps2(r_eb_e_m);
+  const nav_geodetic p = nav_earth_ecef_to_geodetic(r_eb_e_m);
+  return nav_mat3_mul_vec(nav_earth_dcm_n_e(p.lat_rad, p.lon_rad), nav_earth_gravity_n_mps2(p.lat_rad, p.h_m));
+}
+
+nav_status nav_truth_create_msg(const nav_scene *scene, nav_truth **out, char *msg, size_t msg_size) {
   nav_truth *tr = NULL;
   nav_status st = NAV_OK;
+  if (msg && msg_size) msg[0] = '\0';
   if (!scene || !out) return NAV_ERR_INVALID_ARG;
   if (!(scene->imu.rate_hz > 0.0) || !(scene->trajectory.duration_s > 0.0)) return NAV_ERR_INVALID_ARG;
-  if (scene->earth.model != NAV_EARTH_FLAT) return NAV_ERR_INVALID_ARG;
   tr = calloc(1, sizeof *tr);
   if (!tr) return NAV_ERR_NO_MEMORY;
   tr->dt_s = 1.0 / scene->imu.rate_hz;
   tr->n_samples = (int64_t)floor(scene->trajectory.duration_s * scene->imu.rate_hz + 1e-9);
   tr->g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
+  tr->gravity = scene->earth.gravity_model;
+  tr->frame = nav_frame_from_scene(scene);
   tr->n_nodes = scene->imu.quadrature_nodes;
   st = nav_gauss_legendre(tr->n_nodes, tr->nodes, tr->weights);
   if (st != NAV_OK) goto cleanup;
-  st = nav_traj_create(scene, tr->dt_s, &tr->traj);
+  st = nav_traj_create_msg(scene, tr->dt_s, &tr->traj, msg, msg_size);
   if (st != NAV_OK) goto cleanup;
   *out = tr;
   tr = NULL;
 cleanup:
   nav_truth_destroy(tr);
   return st;
+}
+
+nav_status nav_truth_create(const nav_scene *scene, nav_truth **out) {
+  return nav_truth_create_msg(scene, out, NULL, 0);
 }
 
 void nav_truth_destroy(nav_truth *truth) {
@@ -84,7 +107,7 @@ void nav_truth_destroy(nav_truth *truth) {
 
 double nav_truth_dt(const nav_truth *truth) { return truth ? truth->dt_s : 0.0; }
 int64_t nav_truth_sample_count(const nav_truth *truth) { return truth ? truth->n_samples : 0; }
-nav_vec3 nav_truth_gravity_l(const nav_truth *truth) { return truth ? truth->g_l_mps2 : nav_vec3_zero(); }
+nav_frame nav_truth_frame(const nav_truth *truth) { return truth->frame; }
 
 nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out) {
   if (!truth) return NAV_ERR_INVALID_ARG;
@@ -95,6 +118,8 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (!truth || !out || k < 1) return NAV_ERR_INVALID_ARG;
   const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
   const double half = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
+  const bool flat = truth->frame.model == NAV_EARTH_FLAT;
+  const nav_vec3 w_ie_e = nav_earth_rate_e_rps();
   nav_imu_increment r;
   r.k = k;
   r.t_s = t1;
@@ -102,17 +127,24 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   bool closed = false;
   nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
   if (st != NAV_OK) return st;
-  /* dv = integral of C_l_b (a_l - g_l) dt by Gauss-Legendre; when the rate has no closed
-   * integral, dtheta uses the same nodes. */
   nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
   for (int i = 0; i < truth->n_nodes; ++i) {
     nav_traj_state s;
     st = nav_traj_eval(truth->traj, mid + half * truth->nodes[i], &s);
     if (st != NAV_OK) return st;
-    const nav_vec3 f_l = nav_vec3_sub(s.a_lb_l_mps2, truth->g_l_mps2);
-    const nav_vec3 f_b = nav_quat_rotate(nav_quat_conj(s.q_b_l), f_l);
-    dv = nav_vec3_axpy(dv, truth->weights[i] * half, f_b);
-    dth = nav_vec3_axpy(dth, truth->weights[i] * half, s.w_lb_b_rps);
+    const nav_quat q_f_b = nav_quat_conj(s.q_b_f);
+    nav_vec3 f_f, w_ib_b;
+    if (flat) {
+      f_f = nav_vec3_sub(s.a_fb_f_mps2, truth->g_l_mps2);
+      w_ib_b = s.w_fb_b_rps;
+    } else {
+      f_f = nav_vec3_sub(nav_vec3_add(s.a_fb_f_mps2, nav_vec3_scale(nav_vec3_cross(w_ie_e, s.v_fb_f_mps), 2.0)),
+                         nav_gravity_e_mps2(truth->gravity, s.r_fb_f_m));
+      w_ib_b = nav_vec3_add(nav_quat_rotate(q_f_b, w_ie_e), s.w_fb_b_rps);
+    }
+    const double wgt = truth->weights[i] * half;
+    dv = nav_vec3_axpy(dv, wgt, nav_quat_rotate(q_f_b, f_f));
+    dth = nav_vec3_axpy(dth, wgt, w_ib_b);
   }
   if (!closed) r.dtheta_b_rad = dth;
   r.dv_b_mps = dv;

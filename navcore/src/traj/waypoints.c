@@ -1,0 +1,13 @@
+/* Waypoint trajectories (placeholder until implemented). */
+#include <stdio.h>
+
+#include "traj/traj_internal.h"
+
+nav_status nav_traj_waypoints_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
+                                     size_t msg_size) {
+  (void)scene;
+  (void)dt_s;
+  (void)out;
+  if (msg) snprintf(msg, msg_size, "waypoint trajectories are not available yet");
+  return NAV_ERR_INVALID_ARG;
+}
