@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -28,6 +29,7 @@ static const char *k_usage =
     "commands:\n"
     "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
     "  run SCENE        simulate a scene and write the results into a directory\n"
+    "  bench            speed against error for each algorithm, Earth model and rate\n"
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -329,6 +331,7 @@ int main(int argc, char **argv) {
   }
   if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
+  if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
   fprintf(stderr, "navsim: unknown command \"%s\" (see navsim --help)\n", cmd);
   return EXIT_INVALID;
 }

@@ -1,0 +1,320 @@
+/*
+ * navsim bench: speed against error for every algorithm x Earth model x rate choice.
+ *
+ * Each case generates the ideal increments of its scene once (timed: truth generation), then
+ * runs the mechanization over the stored increments several times (timed: mechanization only),
+ * and reports the closure error at the end of the trajectory. Times are medians of repeated
+ * runs in one process, so ratios between variants are meaningful on a noisy machine.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "bench.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "navcore/nav_errors.h"
+#include "navcore/nav_ins.h"
+#include "navcore/nav_truth.h"
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+  qsort(v, (size_t)n, sizeof *v, cmp_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+typedef struct bench_row {
+  char case_name[64];
+  char variant[64];
+  const char *algorithm;
+  const char *earth_model;
+  const char *frame;
+  double rate_hz;
+  long long samples;
+  double truth_sps, mech_sps, wall_s;
+  double pos_err_m, vel_err_mps, att_err_rad;
+  bool ok;
+  char error[256];
+} bench_row;
+
+/* Run one scene: time truth generation and mechanization separately; closure at the end. */
+static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
+  nav_truth *truth = NULL;
+  nav_ins *ins = NULL;
+  nav_imu_increment *imu = NULL;
+  char msg[160];
+  row->ok = false;
+  row->algorithm = nav_mech_algorithm_name(sc->navigation.algorithm);
+  row->earth_model = nav_earth_model_name(sc->earth.model);
+  row->frame = sc->earth.model == NAV_EARTH_FLAT ? "flat" : nav_mech_frame_name(sc->navigation.frame);
+  row->rate_hz = sc->imu.rate_hz;
+  nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
+  if (st != NAV_OK) {
+    snprintf(row->error, sizeof row->error, "truth: %s", msg[0] ? msg : nav_status_str(st));
+    goto cleanup;
+  }
+  const int64_t n = nav_truth_sample_count(truth);
+  row->samples = (long long)n;
+  imu = malloc((size_t)n * sizeof *imu);
+  if (!imu) {
+    snprintf(row->error, sizeof row->error, "out of memory for %lld increments", (long long)n);
+    goto cleanup;
+  }
+  double t0 = now_s();
+  for (int64_t k = 1; k <= n; ++k) {
+    st = nav_truth_imu(truth, k, &imu[k - 1]);
+    if (st != NAV_OK) {
+      snprintf(row->error, sizeof row->error, "ideal IMU at k = %lld: %s", (long long)k, nav_status_str(st));
+      goto cleanup;
+    }
+  }
+  const double truth_s = now_s() - t0;
+  row->truth_sps = (double)n / truth_s;
+
+  nav_traj_state ts0, ts1;
+  if (nav_truth_state(truth, 0.0, &ts0) != NAV_OK || nav_truth_state(truth, (double)n * nav_truth_dt(truth), &ts1) != NAV_OK) {
+    snprintf(row->error, sizeof row->error, "truth state evaluation failed");
+    goto cleanup;
+  }
+  nav_ins_config cfg = nav_ins_config_default();
+  cfg.earth_model = sc->earth.model;
+  cfg.algorithm = sc->navigation.algorithm;
+  cfg.mech_frame = sc->navigation.frame;
+  cfg.gravity_model = sc->earth.gravity_model;
+  cfg.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
+  const nav_ins_state s0 = {0.0, ts0.r_fb_f_m, ts0.v_fb_f_mps, ts0.q_b_f};
+  double times[16];
+  if (reps > 16) reps = 16;
+  for (int r = 0; r < reps; ++r) {
+    st = nav_ins_create(&cfg, &s0, &ins);
+    if (st != NAV_OK) {
+      snprintf(row->error, sizeof row->error, "mechanization: %s", nav_status_str(st));
+      goto cleanup;
+    }
+    t0 = now_s();
+    for (int64_t k = 0; k < n; ++k) {
+      st = nav_ins_step(ins, &imu[k]);
+      if (st != NAV_OK) break;
+    }
+    times[r] = now_s() - t0;
+    if (st != NAV_OK) {
+      snprintf(row->error, sizeof row->error, "mechanization step: %s", nav_status_str(st));
+      goto cleanup;
+    }
+    if (r + 1 < reps) {
+      nav_ins_destroy(ins);
+      ins = NULL;
+    }
+  }
+  const double mech_s = median(times, reps);
+  row->mech_sps = (double)n / mech_s;
+  row->wall_s = truth_s + mech_s;
+  const nav_frame fr = nav_truth_frame(truth);
+  const nav_epoch_errors e = nav_errors_compute(&fr, &ts1, nav_ins_get_state(ins));
+  row->pos_err_m = nav_vec3_norm(e.pos_err_n_m);
+  row->vel_err_mps = e.vel_err_mps;
+  row->att_err_rad = e.att_err_rad;
+  row->ok = true;
+cleanup:
+  nav_ins_destroy(ins);
+  free(imu);
+  nav_truth_destroy(truth);
+}
+
+/* The cases of a suite. Each is (case name, variant, scene). */
+typedef struct bench_case {
+  const char *name;
+  char variant[64];
+  nav_scene scene;
+} bench_case;
+
+static int add_case(bench_case *cases, int n, int cap, const char *name, const nav_scene *sc) {
+  if (n >= cap) return n;
+  cases[n].name = name;
+  cases[n].scene = *sc;
+  const char *frame = sc->earth.model == NAV_EARTH_FLAT ? "flat" : nav_mech_frame_name(sc->navigation.frame);
+  snprintf(cases[n].variant, sizeof cases[n].variant, "%s/%s/%s/%gHz", nav_mech_algorithm_name(sc->navigation.algorithm),
+           nav_earth_model_name(sc->earth.model), frame, sc->imu.rate_hz);
+  return n + 1;
+}
+
+static int build_cases(bench_case *cases, int cap, bool full) {
+  int n = 0;
+  const double rates_quick[] = {50.0, 100.0, 200.0};
+  const double rates_full[] = {25.0, 50.0, 100.0, 200.0, 400.0};
+  const double *rates = full ? rates_full : rates_quick;
+  const int n_rates = full ? 5 : 3;
+  const nav_mech_algorithm algs[2] = {NAV_MECH_FIRST_ORDER, NAV_MECH_HIGH_ORDER};
+  /* Closure on the paper's parametric trajectory (T3.1), flat and WGS-84 (NED and ECEF). */
+  for (int a = 0; a < 2; ++a)
+    for (int r = 0; r < n_rates; ++r) {
+      nav_scene sc = nav_scene_default();
+      sc.navigation.algorithm = algs[a];
+      sc.imu.rate_hz = rates[r];
+      n = add_case(cases, n, cap, "parametric-closure", &sc);
+      sc.earth.model = NAV_EARTH_WGS84;
+      sc.navigation.frame = NAV_MECH_NED;
+      n = add_case(cases, n, cap, "parametric-closure", &sc);
+      sc.navigation.frame = NAV_MECH_ECEF;
+      n = add_case(cases, n, cap, "parametric-closure", &sc);
+    }
+  /* Throughput on a longer run (600 s at 200 Hz = 120 000 samples) for stable rates. */
+  {
+    nav_scene sc = nav_scene_default();
+    sc.trajectory.duration_s = full ? 600.0 : 200.0;
+    sc.imu.rate_hz = 200.0;
+    sc.navigation.algorithm = NAV_MECH_HIGH_ORDER;
+    n = add_case(cases, n, cap, "throughput", &sc);
+    sc.earth.model = NAV_EARTH_WGS84;
+    sc.navigation.frame = NAV_MECH_NED;
+    n = add_case(cases, n, cap, "throughput", &sc);
+    sc.navigation.frame = NAV_MECH_ECEF;
+    n = add_case(cases, n, cap, "throughput", &sc);
+  }
+  return n;
+}
+
+static int make_dir(const char *path) {
+  char buf[1024];
+  if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
+  for (char *p = buf + 1; *p; ++p) {
+    if (*p != '/') continue;
+    *p = '\0';
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
+    *p = '/';
+  }
+  return (mkdir(buf, 0777) != 0 && errno != EEXIST) ? -1 : 0;
+}
+
+static const char *k_usage_bench =
+    "usage: navsim bench [--suite quick|full] [--out DIR] [--quiet]\n"
+    "\n"
+    "Speed against error: for each algorithm x Earth model x mechanization frame x rate,\n"
+    "the throughput of truth generation and of the mechanization (IMU samples per second,\n"
+    "single thread; medians of repeated runs) and the closure error with ideal sensors.\n"
+    "Writes DIR/bench.csv and DIR/bench.md (default DIR: out/bench) and prints the table.\n"
+    "\n"
+    "options:\n"
+    "  --suite S   quick (default, under a minute) or full\n"
+    "  --out DIR   output directory\n"
+    "  --quiet     do not print the table\n"
+    "\n"
+    "exit codes: 0 success (failed cases are reported in the table), 2 bad options, 1 I/O failure\n";
+
+int navsim_bench(int argc, char **argv) {
+  const char *out_dir = "out/bench";
+  bool full = false, quiet = false;
+  for (int i = 0; i < argc; ++i) {
+    const char *a = argv[i];
+    if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+      fputs(k_usage_bench, stdout);
+      return 0;
+    } else if (strcmp(a, "--quiet") == 0) {
+      quiet = true;
+    } else if ((strcmp(a, "--suite") == 0 || strcmp(a, "--out") == 0) && i + 1 < argc) {
+      const char *v = argv[++i];
+      if (a[2] == 'o') {
+        out_dir = v;
+      } else if (strcmp(v, "quick") == 0 || strcmp(v, "full") == 0) {
+        full = v[0] == 'f';
+      } else {
+        fprintf(stderr, "navsim bench: --suite: expected quick or full, got \"%s\"\n", v);
+        return 2;
+      }
+    } else {
+      fprintf(stderr, "navsim bench: unknown or incomplete option \"%s\" (see navsim bench --help)\n", a);
+      return 2;
+    }
+  }
+  enum { CAP = 64 };
+  bench_case *cases = calloc(CAP, sizeof *cases);
+  bench_row *rows = calloc(CAP, sizeof *rows);
+  if (!cases || !rows) {
+    free(cases);
+    free(rows);
+    fprintf(stderr, "navsim bench: out of memory\n");
+    return 1;
+  }
+  const int n = build_cases(cases, CAP, full);
+  const int reps = full ? 7 : 5;
+  for (int i = 0; i < n; ++i) {
+    snprintf(rows[i].case_name, sizeof rows[i].case_name, "%s", cases[i].name);
+    snprintf(rows[i].variant, sizeof rows[i].variant, "%s", cases[i].variant);
+    bench_scene(&cases[i].scene, reps, &rows[i]);
+    if (!quiet) fprintf(stderr, "\r  bench: %d/%d", i + 1, n);
+  }
+  if (!quiet) fputc('\n', stderr);
+
+  int rc = 0;
+  char path[1200];
+  FILE *csv = NULL, *md = NULL;
+  if (make_dir(out_dir) != 0) {
+    fprintf(stderr, "navsim bench: cannot create \"%s\": %s\n", out_dir, strerror(errno));
+    rc = 1;
+    goto done;
+  }
+  snprintf(path, sizeof path, "%s/bench.csv", out_dir);
+  csv = fopen(path, "w");
+  snprintf(path, sizeof path, "%s/bench.md", out_dir);
+  md = fopen(path, "w");
+  if (!csv || !md) {
+    fprintf(stderr, "navsim bench: cannot write into \"%s\"\n", out_dir);
+    rc = 1;
+    goto done;
+  }
+  fputs("case,variant,algorithm,earth_model,frame,rate_hz,samples,wall_s,samples_per_s,truth_samples_per_s,"
+        "mech_samples_per_s,pos_err_m,vel_err_mps,att_err_rad,status\n",
+        csv);
+  fputs("| case | algorithm | earth | frame | rate [Hz] | samples | truth [samples/s] | mechanization [samples/s] | "
+        "pos err [m] | vel err [m/s] | att err [rad] |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        md);
+  for (int i = 0; i < n; ++i) {
+    const bench_row *r = &rows[i];
+    if (r->ok) {
+      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,%.6g,%.6g,%.6g,%.6g,%.6e,%.6e,%.6e,ok\n", r->case_name, r->variant,
+              r->algorithm, r->earth_model, r->frame, r->rate_hz, r->samples, r->wall_s,
+              (double)r->samples / r->wall_s, r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps, r->att_err_rad);
+      fprintf(md, "| %s | %s | %s | %s | %g | %lld | %.3g | %.3g | %.3e | %.3e | %.3e |\n", r->case_name, r->algorithm,
+              r->earth_model, r->frame, r->rate_hz, r->samples, r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps,
+              r->att_err_rad);
+    } else {
+      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,,,,,,,,\"failed: %s\"\n", r->case_name, r->variant, r->algorithm,
+              r->earth_model, r->frame, r->rate_hz, r->samples, r->error);
+      fprintf(md, "| %s | %s | %s | %s | %g | | failed: %s | | | | |\n", r->case_name, r->algorithm, r->earth_model,
+              r->frame, r->rate_hz, r->error);
+    }
+  }
+  if (!quiet) {
+    printf("%-20s %-11s %-5s %-4s %7s %9s %12s %12s %11s %11s\n", "case", "algorithm", "earth", "frm", "rate_hz",
+           "samples", "truth_sps", "mech_sps", "pos_err_m", "att_err_rad");
+    for (int i = 0; i < n; ++i) {
+      const bench_row *r = &rows[i];
+      if (r->ok)
+        printf("%-20s %-11s %-5s %-4s %7g %9lld %12.3g %12.3g %11.3e %11.3e\n", r->case_name, r->algorithm,
+               r->earth_model, r->frame, r->rate_hz, r->samples, r->truth_sps, r->mech_sps, r->pos_err_m, r->att_err_rad);
+      else
+        printf("%-20s %-11s %-5s %-4s %7g  failed: %s\n", r->case_name, r->algorithm, r->earth_model, r->frame,
+               r->rate_hz, r->error);
+    }
+    printf("results    %s/bench.csv, %s/bench.md\n", out_dir, out_dir);
+  }
+done:
+  if (csv && fclose(csv) != 0) rc = 1;
+  if (md && fclose(md) != 0) rc = 1;
+  free(cases);
+  free(rows);
+  return rc;
+}
