@@ -52,6 +52,8 @@ _Static_assert(sizeof(nav_earth_model) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_traj_type) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_attitude_mode) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_mech_algorithm) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_gravity_model) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_mech_frame) == sizeof(int), "enum storage");
 
 #define PATH_MAX_LEN ((size_t)sizeof(((nav_diag *)0)->path))
 #define MAX_SECTION_FIELDS 64 /* descriptors per section; checked when a section is read */
@@ -79,6 +81,9 @@ static const nav_io_enum_value k_earth_models[] = {
     {"flat", NAV_EARTH_FLAT}, {"wgs84", NAV_EARTH_WGS84}, {NULL, 0}};
 static const nav_io_enum_value k_traj_types[] = {{"parametric", NAV_TRAJ_PARAMETRIC}, {NULL, 0}};
 static const nav_io_enum_value k_attitude_modes[] = {{"magnus", NAV_ATT_RATE_MAGNUS}, {NULL, 0}};
+static const nav_io_enum_value k_gravity_models[] = {
+    {"normal", NAV_GRAVITY_NORMAL}, {"j2", NAV_GRAVITY_J2}, {NULL, 0}};
+static const nav_io_enum_value k_mech_frames[] = {{"ned", NAV_MECH_NED}, {"ecef", NAV_MECH_ECEF}, {NULL, 0}};
 static const nav_io_enum_value k_mech_algorithms[] = {
     {"first_order", NAV_MECH_FIRST_ORDER}, {"high_order", NAV_MECH_HIGH_ORDER}, {NULL, 0}};
 
@@ -108,6 +113,11 @@ static const nav_io_field k_earth[] = {
      .offset = OFF(earth.flat_gravity_mps2),
      .scale = 1.0,
      .comment = "flat model only: uniform gravity, pointing down"},
+    {.key = "gravity_model",
+     .kind = NAV_IO_ENUM,
+     .offset = OFF(earth.gravity_model),
+     .enums = k_gravity_models,
+     .comment = "wgs84 only: normal (Somigliana) or j2"},
 };
 DEFINE_SECTION(k_earth_section, k_earth);
 
@@ -178,6 +188,11 @@ static const nav_io_field k_navigation[] = {
      .kind = NAV_IO_ENUM,
      .offset = OFF(navigation.algorithm),
      .enums = k_mech_algorithms},
+    {.key = "frame",
+     .kind = NAV_IO_ENUM,
+     .offset = OFF(navigation.frame),
+     .enums = k_mech_frames,
+     .comment = "wgs84 only: ned (local level) or ecef (works over the poles)"},
 };
 DEFINE_SECTION(k_navigation_section, k_navigation);
 
