@@ -6,7 +6,6 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
-  python3
   xvfb xauth
 )
 

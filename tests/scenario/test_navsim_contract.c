@@ -1,0 +1,312 @@
+/*
+ * The navsim command-line contract: options, exit codes, result files and summary.json.
+ * Other checks rely on this contract; a failure here means a user-visible behaviour changed.
+ *
+ * The navsim executable and a scratch directory come from the compile definitions NAVSIM_EXE
+ * and NAV_TEST_WORK_DIR, so the test does not depend on the working directory.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <regex.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "nav_test.h"
+
+#define SCENE NAV_SOURCE_DIR "/scenes/paper-parametric.yaml"
+#define WORK NAV_TEST_WORK_DIR
+
+typedef struct result {
+  int code;
+  char out[16384];
+  char err[16384];
+} result;
+
+static void slurp(const char *path, char *buf, size_t cap) {
+  buf[0] = '\0';
+  FILE *f = fopen(path, "r");
+  if (!f) return;
+  const size_t n = fread(buf, 1, cap - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+}
+
+/* Run "navsim ARGS" (ARGS already shell-quoted where needed) in @p cwd; capture both streams. */
+static result *navsim(const char *cwd, const char *args) {
+  static result r;
+  char cmd[4096];
+  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", cwd ? cwd : WORK, NAVSIM_EXE,
+           args, WORK, WORK);
+  const int st = system(cmd);
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  slurp(WORK "/stdout.txt", r.out, sizeof r.out);
+  slurp(WORK "/stderr.txt", r.err, sizeof r.err);
+  return &r;
+}
+
+static void write_file(const char *name, const char *text) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s", WORK, name);
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+static bool is_file(const char *path) {
+  struct stat s;
+  return stat(path, &s) == 0 && S_ISREG(s.st_mode);
+}
+
+static void assert_matches(const char *text, const char *pattern) {
+  regex_t re;
+  assert_int_equal(regcomp(&re, pattern, REG_EXTENDED | REG_NEWLINE), 0);
+  const int rc = regexec(&re, text, 0, NULL, 0);
+  regfree(&re);
+  if (rc != 0) fail_msg("\"%s\" does not match /%s/", text, pattern);
+}
+
+/* Value of "key": NUMBER inside the object that follows "parent": (or the whole text). */
+static double json_number(const char *json, const char *parent, const char *key) {
+  const char *p = json;
+  char pat[128];
+  if (parent) {
+    snprintf(pat, sizeof pat, "\"%s\":", parent);
+    p = strstr(json, pat);
+    if (!p) fail_msg("summary.json has no \"%s\"", parent);
+  }
+  snprintf(pat, sizeof pat, "\"%s\":", key);
+  const char *q = strstr(p, pat);
+  if (!q) fail_msg("summary.json has no \"%s\" (in %s)", key, parent ? parent : "root");
+  char *end = NULL;
+  const double v = strtod(q + strlen(pat), &end);
+  if (end == q + strlen(pat)) fail_msg("summary.json \"%s\" is not a number", key);
+  return v;
+}
+
+static int setup(void **state) {
+  (void)state;
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", WORK, WORK);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+static void test_version_and_help(void **state) {
+  (void)state;
+  result *r = navsim(NULL, "--version");
+  assert_int_equal(r->code, 0);
+  assert_matches(r->out, "^navsim [0-9]+\\.[0-9]+\\.[0-9]+\n$");
+  r = navsim(NULL, "--help");
+  assert_int_equal(r->code, 0);
+  assert_non_null(strstr(r->out, "check SCENE"));
+  assert_non_null(strstr(r->out, "run SCENE"));
+  assert_non_null(strstr(r->out, "--version"));
+  r = navsim(NULL, "run --help");
+  assert_int_equal(r->code, 0);
+  const char *words[] = {"--out", "--seed", "--ideal", "--quiet", "summary.json", "truth.csv", "nav.csv", "errors.csv"};
+  for (size_t i = 0; i < sizeof words / sizeof *words; ++i)
+    if (!strstr(r->out, words[i])) fail_msg("run --help does not mention %s", words[i]);
+  r = navsim(NULL, "check --help");
+  assert_int_equal(r->code, 0);
+  assert_non_null(strstr(r->out, "FILE:LINE:COL"));
+  r = navsim(NULL, "bench --help");
+  assert_int_equal(r->code, 0);
+  assert_non_null(strstr(r->out, "--suite"));
+}
+
+static void test_usage_errors_exit_2(void **state) {
+  (void)state;
+  assert_int_equal(navsim(NULL, "")->code, 2);
+  assert_int_equal(navsim(NULL, "frobnicate")->code, 2);
+  assert_int_equal(navsim(NULL, "run")->code, 2);
+  assert_int_equal(navsim(NULL, "check")->code, 2);
+  assert_int_equal(navsim(NULL, "run " SCENE " --bogus")->code, 2);
+  result *r = navsim(NULL, "run " SCENE " --seed -1");
+  assert_int_equal(r->code, 2);
+  assert_non_null(strstr(r->err, "--seed"));
+  assert_int_equal(navsim(NULL, "run " SCENE " --seed 18446744073709551616")->code, 2);
+  assert_int_equal(navsim(NULL, "bench --suite huge")->code, 2);
+}
+
+static void test_check_scene_library(void **state) {
+  (void)state;
+  DIR *d = opendir(NAV_SOURCE_DIR "/scenes");
+  assert_non_null(d);
+  char args[8192] = "check";
+  int n = 0;
+  struct dirent *e;
+  while ((e = readdir(d)) != NULL) {
+    const size_t len = strlen(e->d_name);
+    if (len > 5 && strcmp(e->d_name + len - 5, ".yaml") == 0) {
+      strcat(args, " '" NAV_SOURCE_DIR "/scenes/");
+      strcat(args, e->d_name);
+      strcat(args, "'");
+      ++n;
+    }
+  }
+  closedir(d);
+  assert_true(n >= 1);
+  result *r = navsim(NULL, args);
+  if (r->code != 0) fail_msg("navsim check of the scene library failed (%d):\n%s", r->code, r->err);
+  assert_string_equal(r->err, "");
+}
+
+static void test_check_invalid_scenes(void **state) {
+  (void)state;
+  write_file("bad.yaml", "format_version: 1\nimu:\n  rat_hz: 100\n");
+  result *r = navsim(NULL, "check '" SCENE "' bad.yaml");
+  assert_int_equal(r->code, 2);
+  assert_matches(r->err, "^bad\\.yaml:3:3: error: imu\\.rat_hz: .*\"rate_hz\"");
+  write_file("badval.yaml", "format_version: 1\nimu:\n  rate_hz: -5\n");
+  r = navsim(NULL, "check badval.yaml");
+  assert_int_equal(r->code, 2);
+  assert_matches(r->err, "^badval\\.yaml:3:12: error: imu\\.rate_hz: must be > 0");
+  r = navsim(NULL, "check does-not-exist.yaml");
+  assert_int_equal(r->code, 1);
+  assert_non_null(strstr(r->err, "does-not-exist.yaml"));
+}
+
+static void test_run_invalid_scene_leaves_nothing(void **state) {
+  (void)state;
+  write_file("bad2.yaml", "format_version: 1\nimu: {rate_hz: abc}\n");
+  result *r = navsim(NULL, "run bad2.yaml --out bad2-out");
+  assert_int_equal(r->code, 2);
+  assert_false(is_file(WORK "/bad2-out/summary.json"));
+  struct stat s;
+  assert_int_not_equal(stat(WORK "/bad2-out", &s), 0);
+}
+
+static void test_run_files_and_summary(void **state) {
+  (void)state;
+  result *r = navsim(NULL, "run '" SCENE "' --out run1 --quiet --ideal --seed 42");
+  if (r->code != 0) fail_msg("navsim run failed (%d): %s", r->code, r->err);
+  assert_string_equal(r->out, "");
+  const char *files[] = {"summary.json", "truth.csv", "nav.csv", "errors.csv"};
+  for (int i = 0; i < 4; ++i) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/run1/%s", WORK, files[i]);
+    if (!is_file(p)) fail_msg("missing %s", p);
+  }
+  static char js[65536];
+  slurp(WORK "/run1/summary.json", js, sizeof js);
+  assert_matches(js, "\"navsim_version\": \"[0-9]+\\.[0-9]+\\.[0-9]+\"");
+  assert_matches(js, "\"scene\": \\{\"name\": \"paper-parametric\", \"file\": \"[^\"]*paper-parametric\\.yaml\"\\}");
+  assert_near(json_number(js, NULL, "seed"), 42.0, 0.0);
+  assert_near(json_number(js, NULL, "runs"), 1.0, 0.0);
+  assert_matches(js, "\"ideal\": true");
+  assert_near(json_number(js, NULL, "duration_s"), 20.0, 1e-9);
+  assert_near(json_number(js, NULL, "imu_rate_hz"), 100.0, 0.0);
+  assert_true(json_number(js, "timing", "wall_s") > 0.0);
+  assert_near(json_number(js, "timing", "imu_samples"), 2000.0, 0.0);
+  assert_true(json_number(js, "timing", "imu_samples_per_s") > 0.0);
+  const char *metrics[] = {"pos_err_h_m", "pos_err_v_m", "vel_err_mps", "att_err_rad", "yaw_err_rad"};
+  for (int i = 0; i < 5; ++i) {
+    char obj[64];
+    snprintf(obj, sizeof obj, "%s\": {\"rms", metrics[i]); /* the stats object, not "final" */
+    const char *p = strstr(js, obj);
+    if (!p) fail_msg("stats.%s missing", metrics[i]);
+    const double rms = json_number(p - 1, NULL, "rms"), mx = json_number(p - 1, NULL, "max"),
+                 p95 = json_number(p - 1, NULL, "p95");
+    assert_true(rms >= 0.0 && p95 <= mx && rms <= mx);
+  }
+  /* Closure of the first-order algorithm on T3.1 at 100 Hz over 20 s within a factor 2 of
+   * numerics.md 3.3 column (a): position 1.470e-3 m, velocity 1.300e-4 m/s, attitude 8.573e-7 rad. */
+  const double h = json_number(js, "final", "pos_err_h_m"), v = json_number(js, "final", "pos_err_v_m");
+  const double pos = sqrt(h * h + v * v), vel = json_number(js, "final", "vel_err_mps"),
+               att = json_number(js, "final", "att_err_rad");
+  const double got[3] = {pos, vel, att}, ref[3] = {1.470e-3, 1.300e-4, 8.573e-7};
+  for (int i = 0; i < 3; ++i)
+    if (!(got[i] > ref[i] / 2 && got[i] < ref[i] * 2)) fail_msg("closure %d: %.4g vs %.4g", i, got[i], ref[i]);
+}
+
+static void test_csv_tables(void **state) {
+  (void)state;
+  result *r = navsim(NULL, "run '" SCENE "' --out run2 --quiet --ideal");
+  assert_int_equal(r->code, 0);
+  static char buf[1 << 20];
+  const char *state_cols = "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,"
+                           "roll_deg,pitch_deg,yaw_deg\n";
+  const char *tables[2] = {WORK "/run2/truth.csv", WORK "/run2/nav.csv"};
+  for (int t = 0; t < 2; ++t) {
+    slurp(tables[t], buf, sizeof buf);
+    assert_int_equal(strncmp(buf, state_cols, strlen(state_cols)), 0);
+    int lines = 0;
+    for (const char *p = buf; *p; ++p) lines += *p == '\n';
+    assert_int_equal(lines, 1 + 201); /* 10 Hz over 20 s, both ends */
+    const char *last = buf + strlen(buf) - 2;
+    while (last > buf && *last != '\n') --last;
+    assert_near(strtod(last + 1, NULL), 20.0, 1e-12);
+  }
+  slurp(WORK "/run2/errors.csv", buf, sizeof buf);
+  assert_matches(buf, "^t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,"
+                      "vel_err_e_mps,vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg$");
+  /* Every cell of every data row is a number. */
+  const char *p = strchr(buf, '\n') + 1;
+  while (*p) {
+    char *end = NULL;
+    strtod(p, &end);
+    if (end == p) fail_msg("non-numeric cell near \"%.20s\"", p);
+    p = end;
+    if (*p == ',' || *p == '\n') ++p;
+  }
+}
+
+static void test_default_out_dir_and_summary_on_terminal(void **state) {
+  (void)state;
+  assert_int_equal(system("mkdir -p '" WORK "/cwd'"), 0);
+  result *r = navsim(WORK "/cwd", "run '" SCENE "' --ideal");
+  assert_int_equal(r->code, 0);
+  assert_non_null(strstr(r->out, "out/paper-parametric"));
+  assert_true(is_file(WORK "/cwd/out/paper-parametric/summary.json"));
+}
+
+static void test_deterministic_and_atomic_replace(void **state) {
+  (void)state;
+  static char a[3][1 << 18], b[3][1 << 18];
+  const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
+  assert_int_equal(navsim(NULL, "run '" SCENE "' --out det --quiet --seed 7")->code, 0);
+  for (int i = 0; i < 3; ++i) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/det/%s", WORK, names[i]);
+    slurp(p, a[i], sizeof a[i]);
+  }
+  write_file("det/stale.txt", "from an earlier run");
+  assert_int_equal(navsim(NULL, "run '" SCENE "' --out det --quiet --seed 7")->code, 0);
+  for (int i = 0; i < 3; ++i) {
+    char p[1024];
+    snprintf(p, sizeof p, "%s/det/%s", WORK, names[i]);
+    slurp(p, b[i], sizeof b[i]);
+    assert_string_equal(a[i], b[i]);
+  }
+  /* The earlier directory was replaced as a whole; no temporary directory is left behind. */
+  assert_false(is_file(WORK "/det/stale.txt"));
+  DIR *d = opendir(WORK);
+  struct dirent *e;
+  while ((e = readdir(d)) != NULL)
+    if (strstr(e->d_name, ".tmp-")) fail_msg("leftover temporary directory %s", e->d_name);
+  closedir(d);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_version_and_help),
+      cmocka_unit_test(test_usage_errors_exit_2),
+      cmocka_unit_test(test_check_scene_library),
+      cmocka_unit_test(test_check_invalid_scenes),
+      cmocka_unit_test(test_run_invalid_scene_leaves_nothing),
+      cmocka_unit_test(test_run_files_and_summary),
+      cmocka_unit_test(test_csv_tables),
+      cmocka_unit_test(test_default_out_dir_and_summary_on_terminal),
+      cmocka_unit_test(test_deterministic_and_atomic_replace),
+  };
+  return cmocka_run_group_tests(tests, setup, NULL);
+}
