@@ -84,18 +84,206 @@ typedef struct nav_traj_parametric {
 } nav_traj_parametric;
 
 /* ==== BEGIN test motions (owned by the mechanization / hard-cases work) ==== */
+/**
+ * Test motions with known answers (numerics.md section 5; testmotion.c). All are smooth with
+ * analytic derivatives (angular acceleration included). Unless stated otherwise the body stays
+ * at the scene origin, and its attitude relative to local level is
+ *   q_b_n(t) = R (x) q_m(t),  R constant, chosen so that q_b_n(0) = trajectory.initial_attitude,
+ * where q_m(t) is the motion's own rotation; the body rate is that of q_m. On the flat Earth
+ * the closed-form gyro increments (E5.2 and its analogues) are available to nav_truth.
+ */
+typedef enum nav_test_motion_kind {
+  /** At rest at the scene origin with trajectory.initial_attitude (T5.4). */
+  NAV_TEST_MOTION_STATIONARY = 0,
+  /** Classic coning (5.1): q_m = [cos(beta/2), 0, sin(beta/2) cos(Omega t), sin(beta/2) sin(Omega t)];
+   *  the body x axis sweeps a cone of half-angle beta about the x axis of R. */
+  NAV_TEST_MOTION_CONING = 1,
+  /** Sculling (5.2): rocking q_m = rotation about body x by theta0 sin(Omega t) with the in-phase
+   *  specific force (0, A sin(Omega t), 0) in body axes. On the flat Earth the uniform gravity is
+   *  added to the kinematic acceleration so that the specific force is exactly that vibration
+   *  (the body falls freely plus the vibration and the rectified drift A J1(theta0) along the
+   *  z axis of R); on WGS-84 the kinematic acceleration is the vibration alone. */
+  NAV_TEST_MOTION_SCULLING = 2,
+  /** Constant-axis spin (5.3): body rate spin_rate_rps about the fixed body axis spin_axis_b. */
+  NAV_TEST_MOTION_SPIN = 3,
+  /** Great-circle flight over the pole (5.5; WGS-84 only, defined in ECEF): constant geocentric
+   *  radius a + gc_height_m and speed along the meridian plane gc_lon_rad, geocentric angle from
+   *  the equator u = gc_start_angle_rad + (V/R) t (through the pole when u crosses pi/2). Body
+   *  x along the velocity, z to the Earth centre, then rotated by trajectory.initial_attitude
+   *  (roll, pitch, yaw relative to that path frame). */
+  NAV_TEST_MOTION_POLAR_GREAT_CIRCLE = 4,
+  /** Vertical loop: constant speed loop_speed_mps along body x and constant pitch rate
+   *  loop_pitch_rate_rps about body y (radius V / rate), in the plane of R's x and z axes,
+   *  starting at the origin along R's x axis. With a level initial attitude the pitch passes
+   *  +90 deg at a quarter loop and -90 deg at three quarters (gimbal lock of Euler angles; the
+   *  attitude is a quaternion throughout). */
+  NAV_TEST_MOTION_VERTICAL_LOOP = 5
+} nav_test_motion_kind;
+
+/** Parameters of the test motions (SI). Only the fields of the selected kind are used. */
 typedef struct nav_traj_test_motion {
-  int reserved;
+  nav_test_motion_kind kind;
+  double cone_half_angle_rad; /**< coning: beta, in (0, pi/2] */
+  double cone_rate_rps;       /**< coning: Omega, rate at which the cone is swept */
+  double scull_angle_rad;     /**< sculling: theta0, amplitude of the rocking, |theta0| <= pi/2 */
+  double scull_accel_mps2;    /**< sculling: A, amplitude of the specific force along body y */
+  double scull_rate_rps;      /**< sculling: Omega (> 0) */
+  double spin_rate_rps;       /**< spin: rate about the axis */
+  nav_vec3 spin_axis_b;       /**< spin: axis in body axes (normalised by the model; non-zero) */
+  double gc_height_m;         /**< great circle: radius a + gc_height_m */
+  double gc_speed_mps;        /**< great circle: speed V */
+  double gc_start_angle_rad;  /**< great circle: u at t = 0 (geocentric angle from the equator) */
+  double gc_lon_rad;          /**< great circle: longitude of the meridian plane */
+  double loop_speed_mps;      /**< vertical loop: speed V */
+  double loop_pitch_rate_rps; /**< vertical loop: pitch rate (non-zero; negative = push-over loop) */
 } nav_traj_test_motion;
+
+/** Name of a test-motion kind as written in scene files ("stationary", "coning", ...). */
+NAV_API const char *nav_test_motion_kind_name(nav_test_motion_kind k);
 /* ==== END test motions ==== */
 
 /* ==== BEGIN waypoints and segment scripts (owned by the trajectory-models work) ==== */
+#define NAV_MAX_WAYPOINTS 1000 /**< waypoints per trajectory */
+#define NAV_MAX_SEGMENTS 2000  /**< segments per script (a motion-definition file has one per command) */
+
+/**
+ * Vehicle limits respected by the waypoint and segment planners (magnitudes, SI). Every
+ * transition is a septic smoothstep ramp (traj_kin_internal.h), so rates, accelerations and
+ * their derivatives are continuous and bounded by these values.
+ */
+typedef struct nav_traj_limits {
+  /** Waypoints: |dV/dt| along the path; segments: each body-velocity component. */
+  double max_accel_mps2;
+  /** Waypoints: |jerk| (along and across the path); segments: d/dt of each body acceleration. */
+  double max_jerk_mps3;
+  /** V x turn rate in turns (waypoints; segment turns, circles, helices, lawnmowers). */
+  double max_lateral_accel_mps2;
+  double max_rate_rps;       /**< waypoints: turn rate; segments: each Euler-angle rate of a manoeuvre */
+  double max_ang_accel_rps2; /**< d/dt of the turn / Euler-angle rate */
+  double max_ang_jerk_rps3;  /**< d2/dt2 of the turn / Euler-angle rate */
+} nav_traj_limits;
+
+/** How a waypoint trajectory defines the attitude. */
+typedef enum nav_wp_attitude_mode {
+  NAV_WP_ATT_GROUND = 0,   /**< heading along the track, pitch from the slope, roll 0 */
+  NAV_WP_ATT_AIRCRAFT = 1, /**< velocity-aligned, coordinated-turn bank roll = atan(V psi_dot / g) */
+  NAV_WP_ATT_FIXED = 2,    /**< constant: trajectory.initial_attitude */
+  NAV_WP_ATT_EULER = 3     /**< per-waypoint Euler angles, interpolated smoothly between waypoint times */
+} nav_wp_attitude_mode;
+
+/** What fixes the timing of a waypoint trajectory. */
+typedef enum nav_wp_timing {
+  NAV_WP_TIMING_SPEED = 0, /**< speed_mps at every waypoint */
+  NAV_WP_TIMING_TIME = 1   /**< time_s at every waypoint; speed_mps only at the first and the last */
+} nav_wp_timing;
+
+/** One waypoint. */
+typedef struct nav_waypoint {
+  nav_vec3 r_ned_m;   /**< position, local N/E/D offsets from the scene origin [m] (curvilinear on WGS-84) */
+  double speed_mps;   /**< speed at the waypoint [m/s] (>= 0; > 0 where the path turns) */
+  double time_s;      /**< timing time: time from the start of the motion (after hold_start_s) at which the
+                           vehicle passes the waypoint (mid-turn); 0 at the first waypoint */
+  nav_euler attitude; /**< attitude mode euler: attitude C_b_n at the waypoint */
+} nav_waypoint;
+
+/**
+ * A path through waypoints (waypoints.c). Straight legs are joined at interior waypoints by
+ * planar fly-by turns whose curvature rises and falls by septic smoothsteps (a smooth
+ * clothoid-like blend: position C4, turn rate C3); speed changes happen on the straight parts,
+ * turns are flown at the waypoint's speed. Infeasible input is an error naming the waypoint and
+ * the limit, never a silent distortion.
+ */
 typedef struct nav_traj_waypoints {
-  int reserved;
+  int count; /**< number of points used, 2..NAV_MAX_WAYPOINTS */
+  nav_wp_timing timing;
+  nav_wp_attitude_mode attitude_mode;
+  double hold_start_s; /**< stationary time before the motion (needs speed 0 at the first waypoint) */
+  double hold_end_s;   /**< stationary time after it (needs speed 0 at the last waypoint) */
+  nav_traj_limits limits;
+  nav_waypoint points[NAV_MAX_WAYPOINTS];
 } nav_traj_waypoints;
 
+/**
+ * Segment kinds. Field use per kind (unused fields are ignored):
+ * - HOLD: duration_s. All rates zero: a moving vehicle continues straight at constant velocity.
+ * - ACCELERATE: speed_mps, the body-x speed to reach.
+ * - TURN, COORD_TURN: yaw_rad (heading change, + = right), yaw_rate_rps (peak rate; 0 = the
+ *   largest the limits allow). COORD_TURN banks (coordinated).
+ * - CLIMB: height_m (height change, + = up) at flight-path angle |pitch_rad|.
+ * - CIRCLE: radius_m, turns (+ = right). FIGURE_EIGHT: radius_m, turns per lobe (sign: first lobe).
+ * - HELIX: radius_m, turns (+ = right), pitch_rad (flight-path angle, + = climbing).
+ * - LAWNMOWER: legs, length_m (straight part of each leg), spacing_m (+ = first turn right).
+ * - MOTION_RATES (gnss-ins-sim type 1): yaw/pitch/roll_rate_rps and accel_b_mps2 for exactly
+ *   duration_s.
+ * - MOTION_ABS_ABS / REL_REL / ABS_REL / REL_ABS (gnss-ins-sim types 2, 3, 4, 5): yaw/pitch/roll_rad
+ *   and v_b_mps, absolute or relative (attitude first, velocity second); they end when converged,
+ *   duration_s is the maximum time. Euler angles are not wrapped (gnss-ins-sim semantics).
+ * The kinds that turn need a positive body-x speed.
+ */
+typedef enum nav_segment_kind {
+  NAV_SEG_HOLD = 0,
+  NAV_SEG_ACCELERATE = 1,
+  NAV_SEG_TURN = 2,
+  NAV_SEG_COORD_TURN = 3,
+  NAV_SEG_CLIMB = 4,
+  NAV_SEG_CIRCLE = 5,
+  NAV_SEG_FIGURE_EIGHT = 6,
+  NAV_SEG_HELIX = 7,
+  NAV_SEG_LAWNMOWER = 8,
+  NAV_SEG_MOTION_RATES = 9,
+  NAV_SEG_MOTION_ABS_ABS = 10,
+  NAV_SEG_MOTION_REL_REL = 11,
+  NAV_SEG_MOTION_ABS_REL = 12,
+  NAV_SEG_MOTION_REL_ABS = 13
+} nav_segment_kind;
+
+/** One segment of a script; see nav_segment_kind for which fields each kind reads. */
+typedef struct nav_segment {
+  nav_segment_kind kind;
+  bool coordinated;  /**< bank into turns: roll += atan(u psi_dot / g) (implied by COORD_TURN) */
+  bool gnss_visible; /**< motion-definition GPS-visibility column, kept for outage modelling */
+  int legs;          /**< LAWNMOWER: number of straight legs (>= 1) */
+  double duration_s; /**< HOLD, MOTION_RATES: exact; MOTION_ABS_ABS .. REL_ABS: maximum */
+  double yaw_rad, pitch_rad, roll_rad;                /**< attitude command or change */
+  double yaw_rate_rps, pitch_rate_rps, roll_rate_rps; /**< Euler-angle rates (MOTION_RATES; TURN peak rate) */
+  nav_vec3 v_b_mps;      /**< body velocity command or change (MOTION_ABS_ABS .. REL_ABS) */
+  nav_vec3 accel_b_mps2; /**< body-velocity rates (MOTION_RATES) */
+  double speed_mps;      /**< ACCELERATE: target body-x speed */
+  double height_m;       /**< CLIMB: height change */
+  double radius_m;       /**< CIRCLE, FIGURE_EIGHT, HELIX: horizontal turn radius */
+  double turns;          /**< CIRCLE, FIGURE_EIGHT, HELIX: number of turns (signed) */
+  double length_m;       /**< LAWNMOWER: straight length of each leg */
+  double spacing_m;      /**< LAWNMOWER: distance between legs (signed) */
+} nav_segment;
+
+/**
+ * A segment script (segments.c). Each segment starts from the end state of the previous one.
+ * Rate steps between MOTION_RATES/HOLD segments are ramped over documented ramp times centred on
+ * the boundary (so a level segment changes the state by exactly rate x duration_s); every other
+ * kind is a rest-to-rest manoeuvre planned within the limits. The script starts with the rates of
+ * its first segment; after its end the final rates continue. The initial attitude is
+ * trajectory.initial_attitude.
+ */
 typedef struct nav_traj_segments {
-  int reserved;
+  int count; /**< number of segments used, 1..NAV_MAX_SEGMENTS */
+  /**
+   * MOTION types 2-5 that cannot converge within duration_s make the largest part of their change
+   * that fits and end unconverged (gnss-ins-sim's rule; set by the motion-definition import).
+   * false: that is an error naming the segment and the limit.
+   */
+  bool allow_unconverged;
+  /**
+   * A rate-step ramp too long to fit (each half of a ramp may use at most half of the adjacent
+   * HOLD/MOTION_RATES segment) is shortened to fit, exceeding max_ang_accel/max_ang_jerk/max_jerk
+   * there, and zero-length HOLD/MOTION_RATES segments are skipped (gnss-ins-sim does not limit
+   * type-1 steps; set by the import; nav_motiondef_script_summary counts them). false: both are
+   * errors naming the segment and the limit.
+   */
+  bool fit_rate_ramps;
+  nav_vec3 r0_ned_m; /**< start position, local NED [m] */
+  nav_vec3 v0_b_mps; /**< start velocity in body axes [m/s] */
+  nav_traj_limits limits;
+  nav_segment items[NAV_MAX_SEGMENTS];
 } nav_traj_segments;
 /* ==== END waypoints and segment scripts ==== */
 

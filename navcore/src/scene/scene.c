@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "navcore/nav_earth.h"
 #include "navcore/nav_scene.h"
 
 nav_scene nav_scene_default(void) {
@@ -34,6 +35,32 @@ nav_scene nav_scene_default(void) {
   p->wd_rad = nav_vec3_make(0.0, 1.0, 2.0);
   p->attitude_mode = NAV_ATT_RATE_MAGNUS;
   p->magnus_substeps = 8;
+
+  /* Test motions: the inputs of numerics.md T5.1, T5.2, T5.3, T5.5; a 1000 m loop at 100 m/s. */
+  nav_traj_test_motion *tm = &s.trajectory.test_motion;
+  tm->kind = NAV_TEST_MOTION_STATIONARY;
+  tm->cone_half_angle_rad = 1.0 * NAV_DEG2RAD;
+  tm->cone_rate_rps = NAV_TWO_PI * 10.0;
+  tm->scull_angle_rad = 1.0 * NAV_DEG2RAD;
+  tm->scull_accel_mps2 = 10.0;
+  tm->scull_rate_rps = NAV_TWO_PI * 10.0;
+  tm->spin_rate_rps = NAV_TWO_PI * 20.0;
+  tm->spin_axis_b = nav_vec3_make(1.0, 2.0, 3.0);
+  tm->gc_height_m = 1000.0;
+  tm->gc_speed_mps = 250.0;
+  tm->gc_start_angle_rad = 88.0 * NAV_DEG2RAD;
+  tm->gc_lon_rad = 0.0;
+  tm->loop_speed_mps = 100.0;
+  tm->loop_pitch_rate_rps = 0.1;
+
+  /* Waypoints and segment scripts (trajectory-models work). Waypoint limits suit a road vehicle;
+   * segment limits are gnss-ins-sim's "high_mobility" (1 m/s^2, 0.5 rad/s^2, 2 rad/s) plus jerk
+   * limits, which gnss-ins-sim does not have. */
+  s.trajectory.waypoints.timing = NAV_WP_TIMING_SPEED;
+  s.trajectory.waypoints.attitude_mode = NAV_WP_ATT_GROUND;
+  s.trajectory.waypoints.limits = (nav_traj_limits){2.0, 2.0, 3.0, 0.5, 0.5, 2.0};
+  s.trajectory.segments.limits = (nav_traj_limits){1.0, 2.0, 10.0, 2.0, 0.5, 2.0};
+  for (int i = 0; i < NAV_MAX_SEGMENTS; ++i) s.trajectory.segments.items[i].gnss_visible = true;
 
   s.imu.rate_hz = 100.0;
   s.imu.quadrature_nodes = 6;
@@ -72,6 +99,146 @@ static void check_vec(checker *c, const char *path, nav_vec3 v) {
   for (int i = 0; i < 3; ++i) {
     snprintf(p, sizeof p, "%s[%d]", path, i);
     check_finite(c, p, nav_vec3_get(v, i));
+  }
+}
+
+/* Test motions: only the fields of the selected kind are checked (as testmotion.c uses them). */
+static void check_test_motion(checker *c, const nav_scene *s) {
+  const nav_traj_test_motion *m = &s->trajectory.test_motion;
+  switch (m->kind) {
+  case NAV_TEST_MOTION_STATIONARY: break;
+  case NAV_TEST_MOTION_CONING:
+    if (!(m->cone_half_angle_rad > 0.0 && m->cone_half_angle_rad <= 0.5 * NAV_PI))
+      issue(c, "trajectory.test_motion.cone_half_angle_rad", "must be in (0, 90] deg (got %g deg)",
+            m->cone_half_angle_rad * NAV_RAD2DEG);
+    check_finite(c, "trajectory.test_motion.cone_rate_rps", m->cone_rate_rps);
+    break;
+  case NAV_TEST_MOTION_SCULLING:
+    if (!(fabs(m->scull_angle_rad) <= 0.5 * NAV_PI))
+      issue(c, "trajectory.test_motion.scull_angle_rad", "must be within [-90, 90] deg (got %g deg)",
+            m->scull_angle_rad * NAV_RAD2DEG);
+    check_finite(c, "trajectory.test_motion.scull_accel_mps2", m->scull_accel_mps2);
+    check_positive(c, "trajectory.test_motion.scull_rate_rps", m->scull_rate_rps, 1.0e6);
+    break;
+  case NAV_TEST_MOTION_SPIN:
+    check_finite(c, "trajectory.test_motion.spin_rate_rps", m->spin_rate_rps);
+    check_vec(c, "trajectory.test_motion.spin_axis_b", m->spin_axis_b);
+    if (nav_vec3_isfinite(m->spin_axis_b) && !(nav_vec3_norm(m->spin_axis_b) > 0.0))
+      issue(c, "trajectory.test_motion.spin_axis_b", "must be a non-zero vector (got norm %g)",
+            nav_vec3_norm(m->spin_axis_b));
+    break;
+  case NAV_TEST_MOTION_POLAR_GREAT_CIRCLE:
+    if (s->earth.model != NAV_EARTH_WGS84)
+      issue(c, "trajectory.test_motion.kind", "polar_great_circle is defined in ECEF and needs earth.model wgs84 (got model %g)",
+            (double)s->earth.model);
+    if (!(m->gc_height_m > -0.5 * NAV_WGS84_B_M && m->gc_height_m < 1.0e8))
+      issue(c, "trajectory.test_motion.gc_height_m", "must be within (-3.2e6, 1e8) m (got %g)", m->gc_height_m);
+    check_finite(c, "trajectory.test_motion.gc_speed_mps", m->gc_speed_mps);
+    check_finite(c, "trajectory.test_motion.gc_start_angle_rad", m->gc_start_angle_rad);
+    check_finite(c, "trajectory.test_motion.gc_lon_rad", m->gc_lon_rad);
+    break;
+  case NAV_TEST_MOTION_VERTICAL_LOOP:
+    check_finite(c, "trajectory.test_motion.loop_speed_mps", m->loop_speed_mps);
+    if (!(isfinite(m->loop_pitch_rate_rps) && m->loop_pitch_rate_rps != 0.0))
+      issue(c, "trajectory.test_motion.loop_pitch_rate_rps", "must be a finite non-zero rate (got %g rad/s)",
+            m->loop_pitch_rate_rps);
+    break;
+  default:
+    issue(c, "trajectory.test_motion.kind", "unknown test motion %g", (double)m->kind);
+    break;
+  }
+}
+
+/* Waypoints and segment scripts: simple field ranges only (feasibility is checked by the planner,
+ * which names the waypoint or segment and the limit). */
+static void check_limits(checker *c, const char *base, const nav_traj_limits *l) {
+  char p[160];
+  const double v[6] = {l->max_accel_mps2, l->max_jerk_mps3,      l->max_lateral_accel_mps2,
+                       l->max_rate_rps,   l->max_ang_accel_rps2, l->max_ang_jerk_rps3};
+  static const char *const names[6] = {"max_accel_mps2", "max_jerk_mps3",      "max_lateral_accel_mps2",
+                                       "max_rate_rps",   "max_ang_accel_rps2", "max_ang_jerk_rps3"};
+  for (int i = 0; i < 6; ++i) {
+    snprintf(p, sizeof p, "%s.limits.%s", base, names[i]);
+    if (!(v[i] > 0.0)) issue(c, p, "must be > 0 (got %g)", v[i]);
+  }
+}
+
+static void check_waypoints(checker *c, const nav_traj_waypoints *w) {
+  char p[160];
+  if (w->count < 2 || w->count > NAV_MAX_WAYPOINTS) {
+    issue(c, "trajectory.waypoints.points", "needs 2 to 1000 waypoints (got %g)", (double)w->count);
+    return;
+  }
+  if (w->timing != NAV_WP_TIMING_SPEED && w->timing != NAV_WP_TIMING_TIME)
+    issue(c, "trajectory.waypoints.timing", "unknown timing %g", (double)w->timing);
+  if ((int)w->attitude_mode < 0 || (int)w->attitude_mode > (int)NAV_WP_ATT_EULER)
+    issue(c, "trajectory.waypoints.attitude_mode", "unknown attitude mode %g", (double)w->attitude_mode);
+  if (!(w->hold_start_s >= 0.0 && w->hold_start_s <= NAV_SCENE_MAX_DURATION_S))
+    issue(c, "trajectory.waypoints.hold_start_s", "must be within [0, 1e7] s (got %g)", w->hold_start_s);
+  if (!(w->hold_end_s >= 0.0 && w->hold_end_s <= NAV_SCENE_MAX_DURATION_S))
+    issue(c, "trajectory.waypoints.hold_end_s", "must be within [0, 1e7] s (got %g)", w->hold_end_s);
+  check_limits(c, "trajectory.waypoints", &w->limits);
+  for (int i = 0; i < w->count; ++i) {
+    const nav_waypoint *q = &w->points[i];
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].r_ned_m", i);
+    check_vec(c, p, q->r_ned_m);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].speed_mps", i);
+    if (!(q->speed_mps >= 0.0 && q->speed_mps <= 1.0e5))
+      issue(c, p, "must be within [0, 1e5] m/s (got %g)", q->speed_mps);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].time_s", i);
+    if (!(q->time_s >= 0.0 && q->time_s <= NAV_SCENE_MAX_DURATION_S))
+      issue(c, p, "must be within [0, 1e7] s (got %g)", q->time_s);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].attitude.roll_deg", i);
+    check_finite(c, p, q->attitude.roll_rad);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].attitude.pitch_deg", i);
+    if (!(fabs(q->attitude.pitch_rad) <= 0.5 * NAV_PI))
+      issue(c, p, "must be within [-90, 90] deg (got %g deg)", q->attitude.pitch_rad * NAV_RAD2DEG);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].attitude.yaw_deg", i);
+    check_finite(c, p, q->attitude.yaw_rad);
+  }
+}
+
+static void check_segments(checker *c, const nav_traj_segments *s) {
+  char p[160];
+  if (s->count < 1 || s->count > NAV_MAX_SEGMENTS) {
+    issue(c, "trajectory.segments.items", "needs 1 to 2000 segments (got %g)", (double)s->count);
+    return;
+  }
+  check_vec(c, "trajectory.segments.r0_ned_m", s->r0_ned_m);
+  check_vec(c, "trajectory.segments.v0_b_mps", s->v0_b_mps);
+  check_limits(c, "trajectory.segments", &s->limits);
+  for (int i = 0; i < s->count; ++i) {
+    const nav_segment *g = &s->items[i];
+    if ((int)g->kind < (int)NAV_SEG_HOLD || (int)g->kind > (int)NAV_SEG_MOTION_REL_ABS) {
+      snprintf(p, sizeof p, "trajectory.segments.items[%d].kind", i);
+      issue(c, p, "unknown segment kind %g", (double)g->kind);
+      continue;
+    }
+    snprintf(p, sizeof p, "trajectory.segments.items[%d].duration_s", i);
+    if (!(g->duration_s >= 0.0 && g->duration_s <= NAV_SCENE_MAX_DURATION_S))
+      issue(c, p, "must be within [0, 1e7] s (got %g)", g->duration_s);
+    const double v[] = {
+        g->yaw_rad,   g->pitch_rad, g->roll_rad,  g->yaw_rate_rps,   g->pitch_rate_rps, g->roll_rate_rps,
+        g->v_b_mps.x, g->v_b_mps.y, g->v_b_mps.z, g->accel_b_mps2.x, g->accel_b_mps2.y, g->accel_b_mps2.z,
+        g->speed_mps, g->height_m,  g->turns,     g->length_m,       g->spacing_m};
+    for (size_t k = 0; k < sizeof v / sizeof v[0]; ++k)
+      if (!isfinite(v[k])) {
+        snprintf(p, sizeof p, "trajectory.segments.items[%d]", i);
+        issue(c, p, "every number must be finite (found %g)", v[k]);
+        break;
+      }
+    if (g->kind == NAV_SEG_CIRCLE || g->kind == NAV_SEG_FIGURE_EIGHT || g->kind == NAV_SEG_HELIX) {
+      snprintf(p, sizeof p, "trajectory.segments.items[%d].radius_m", i);
+      if (!(g->radius_m > 0.0 && g->radius_m <= 1.0e7))
+        issue(c, p, "must be within (0, 1e7] m (got %g)", g->radius_m);
+    }
+    if (g->kind == NAV_SEG_LAWNMOWER) {
+      snprintf(p, sizeof p, "trajectory.segments.items[%d].legs", i);
+      if (g->legs < 1 || g->legs > 100000)
+        issue(c, p, "must be an integer in [1, 100000] (got %g)", (double)g->legs);
+      snprintf(p, sizeof p, "trajectory.segments.items[%d].length_m", i);
+      if (!(g->length_m >= 0.0)) issue(c, p, "must be >= 0 (got %g)", g->length_m);
+    }
   }
 }
 
@@ -114,8 +281,13 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
     if (p->magnus_substeps < 1 || p->magnus_substeps > 1024)
       issue(&c, "trajectory.parametric.magnus_substeps", "must be an integer in [1, 1024] (got %g)",
             (double)p->magnus_substeps);
-  } else if (s->trajectory.type != NAV_TRAJ_WAYPOINTS && s->trajectory.type != NAV_TRAJ_SEGMENTS &&
-             s->trajectory.type != NAV_TRAJ_TEST_MOTION) {
+  } else if (s->trajectory.type == NAV_TRAJ_TEST_MOTION) {
+    check_test_motion(&c, s);
+  } else if (s->trajectory.type == NAV_TRAJ_WAYPOINTS) {
+    check_waypoints(&c, &s->trajectory.waypoints);
+  } else if (s->trajectory.type == NAV_TRAJ_SEGMENTS) {
+    check_segments(&c, &s->trajectory.segments);
+  } else {
     issue(&c, "trajectory.type", "unknown trajectory type %g", (double)s->trajectory.type);
   }
 

@@ -1,13 +1,698 @@
-/* Waypoint trajectories (placeholder until implemented). */
+/*
+ * Waypoint trajectories: straight legs joined by planar fly-by turns, with a speed profile.
+ *
+ * Path. At an interior waypoint i the direction changes from u_(i-1) to u_i by the angle beta_i.
+ * The turn rotates the unit tangent in the plane of the two legs,
+ *   T(t) = cos b(t) u_(i-1) + sin b(t) w_i,   w_i = unit(u_i - (u_i . u_(i-1)) u_(i-1)),
+ * where b(t) is a rest-to-rest move of the turn angle (traj_kin_internal.h): the turn rate b'
+ * rises by a septic smoothstep, may cruise, and falls again. Flown at constant speed V, the
+ * curvature b'/V therefore blends in like a clothoid whose curvature is itself smooth: curvature
+ * C3 in arc length, position C4, so the body rate is C3 and the angular acceleration continuous.
+ * The profile is symmetric, so the turn starts and ends at the same distance L_t from the
+ * corner (along the legs):  L_t = |V int (cos b, sin b) dt| / (2 cos(beta / 2)). The path does
+ * not pass through interior waypoints (fly-by); its closest approach is on the bisector, at the
+ * middle of the turn, which is when the vehicle "passes" the waypoint.
+ *
+ * Turn limits at speed V (the turn rate is b'):
+ *   b' <= min(max_rate, max_lateral_accel / V, sqrt(max_jerk / (sqrt2 V)))
+ *   b'' <= min(max_ang_accel, max_jerk / (sqrt2 V)),  b''' <= max_ang_jerk
+ * (the path jerk in a turn is V sqrt(b''^2 + b'^4) <= max_jerk). The aircraft attitude mode also
+ * bounds the bank dynamics roll' ~ (V/g) b'' and roll'' ~ (V/g) b''': b'' <= max_rate g / V,
+ * b''' <= max_ang_accel g / V.
+ *
+ * Speed. Turns are flown at the waypoint's speed; speed changes are rest-to-rest moves of the
+ * speed (trapezoidal acceleration <= max_accel, jerk <= max_jerk) on the straight parts:
+ * accelerations right after a turn, decelerations right before the next one. With timing
+ * "time", interior waypoint speeds are the mean of the adjacent legs' average speeds and each
+ * straight part gets a cruise speed solved so that the vehicle passes every waypoint (mid-turn)
+ * at its time.
+ *
+ * Attitude: ground (heading and pitch of the tangent, roll 0), aircraft (the same plus the
+ * coordinated bank atan(V psi_dot / g)), fixed, or per-waypoint Euler angles interpolated
+ * between the waypoint times by single rate pulses (septic ramps up and down over half the
+ * interval each; yaw and roll take the shorter way). Derivatives come from jets.
+ *
+ * Infeasible input (fewer than 2 or coincident waypoints, a reversal, a turn at zero speed, legs
+ * too short for the turns or the speed changes, arrival times that cannot be met, attitude
+ * changes beyond the limits) is an error naming the waypoint and the limit.
+ */
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "traj/traj_internal.h"
+#include "navcore/nav_earth.h"
+#include "traj/traj_kin_internal.h"
+
+#define RAD2DEG NAV_RAD2DEG
+#define MAX_ELEVATION_RAD (80.0 * NAV_DEG2RAD)
+#define SQRT2 1.41421356237309504880
+
+typedef enum { P_HOLD, P_STRAIGHT, P_TURN } piece_kind;
+
+typedef struct wp_piece {
+  piece_kind kind;
+  double t0;
+  nav_vec3 u, w; /* tangent (hold/straight) or entry tangent and in-plane normal (turn) */
+  double b0;     /* turn channel value at t0 */
+} wp_piece;
+
+typedef struct wp_model {
+  wp_piece *pieces;
+  size_t n_pieces, cap_pieces;
+  nav_kin_channel speed;  /* x = speed, rate = path acceleration, integral = distance */
+  nav_kin_channel turn;   /* cumulative turn angle */
+  nav_kin_channel eul[3]; /* euler mode: roll, pitch, yaw */
+  nav_kin_path path;
+  nav_wp_attitude_mode mode;
+  nav_euler fixed;
+  double g_mps2;
+  double end_s;
+  double *wp_time;
+  int n_wp;
+  double *breaks;
+  size_t n_breaks;
+} wp_model;
+
+typedef struct wplan {
+  const nav_traj_waypoints *W;
+  int *bad;
+  char *msg;
+  size_t msg_size;
+} wplan;
+
+static nav_status fail(wplan *pl, int index, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static nav_status fail(wplan *pl, int index, const char *fmt, ...) {
+  if (pl->bad) *pl->bad = index;
+  if (pl->msg && pl->msg_size) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(pl->msg, pl->msg_size, fmt, ap);
+    va_end(ap);
+  }
+  return NAV_ERR_INVALID_ARG;
+}
+
+static void wp_free(wp_model *m) {
+  if (!m) return;
+  free(m->pieces);
+  nav_kin_channel_free(&m->speed);
+  nav_kin_channel_free(&m->turn);
+  for (int i = 0; i < 3; ++i)
+    nav_kin_channel_free(&m->eul[i]);
+  nav_kin_path_free(&m->path);
+  free(m->wp_time);
+  free(m->breaks);
+  free(m);
+}
+
+static nav_status add_piece(wp_model *m, piece_kind kind, double t0, nav_vec3 u, nav_vec3 w, double b0) {
+  if (m->n_pieces == m->cap_pieces) {
+    const size_t cap = m->cap_pieces ? 2 * m->cap_pieces : 16;
+    wp_piece *p = realloc(m->pieces, cap * sizeof *p);
+    if (!p) return NAV_ERR_NO_MEMORY;
+    m->pieces = p;
+    m->cap_pieces = cap;
+  }
+  wp_piece *p = &m->pieces[m->n_pieces++];
+  p->kind = kind;
+  p->t0 = t0;
+  p->u = u;
+  p->w = w;
+  p->b0 = b0;
+  return NAV_OK;
+}
+
+/* Speed profile of a straight part: v_a -> c (move), cruise at c, c -> v_b (move). */
+typedef struct straight_plan {
+  nav_kin_move m1, m2;
+  double cruise_s, dist_m, time_s;
+  bool feasible;
+} straight_plan;
+
+static straight_plan straight_with_cruise(double va, double c, double vb, double s_len,
+                                          const nav_kin_lim *lin) {
+  straight_plan sp;
+  sp.m1 = nav_kin_plan_move(c - va, lin);
+  sp.m2 = nav_kin_plan_move(vb - c, lin);
+  const double t1 = nav_kin_move_duration(&sp.m1), t2 = nav_kin_move_duration(&sp.m2);
+  /* A symmetric speed move covers (v_start + v_end) / 2 x its duration. */
+  sp.dist_m = 0.5 * (va + c) * t1 + 0.5 * (c + vb) * t2;
+  const double rest = s_len - sp.dist_m;
+  sp.feasible = rest >= -1e-9 * (1.0 + s_len) && c > 0.0;
+  sp.cruise_s = rest > 0.0 && c > 0.0 ? rest / c : 0.0;
+  sp.time_s = t1 + t2 + sp.cruise_s;
+  return sp;
+}
+
+typedef struct turn_plan {
+  double beta, V, tan_len_m, radius_m, rate_cap;
+  const char *cap_name;
+  nav_kin_move mv;
+  nav_vec3 w;
+} turn_plan;
+
+static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg, size_t msg_size) {
+  const nav_traj_waypoints *W = &scene->trajectory.waypoints;
+  const nav_traj_limits *L = &W->limits;
+  wplan pl = {W, bad, msg, msg_size};
+  nav_vec3 *u = NULL;
+  double *len = NULL, *v = NULL, *tt = NULL;
+  turn_plan *tp = NULL;
+  straight_plan *sp = NULL;
+  nav_status st = NAV_OK;
+  if (bad) *bad = -1;
+  const int N = W->count;
+  if (N < 2 || N > NAV_MAX_WAYPOINTS)
+    return fail(&pl, -1, "trajectory.waypoints: needs 2 to %d waypoints (got %d)", NAV_MAX_WAYPOINTS, N);
+  {
+    const double lv[6] = {L->max_accel_mps2, L->max_jerk_mps3,      L->max_lateral_accel_mps2,
+                          L->max_rate_rps,   L->max_ang_accel_rps2, L->max_ang_jerk_rps3};
+    for (int i = 0; i < 6; ++i)
+      if (!(lv[i] > 0.0)) return fail(&pl, -1, "trajectory.waypoints.limits: every limit must be > 0");
+  }
+  if ((int)W->attitude_mode < 0 || (int)W->attitude_mode > (int)NAV_WP_ATT_EULER)
+    return fail(&pl, -1, "trajectory.waypoints.attitude_mode: unknown mode %d", (int)W->attitude_mode);
+  if (W->timing != NAV_WP_TIMING_SPEED && W->timing != NAV_WP_TIMING_TIME)
+    return fail(&pl, -1, "trajectory.waypoints.timing: unknown timing %d", (int)W->timing);
+  if (!(W->hold_start_s >= 0.0) || !(W->hold_end_s >= 0.0) || !isfinite(W->hold_start_s) ||
+      !isfinite(W->hold_end_s))
+    return fail(&pl, -1, "trajectory.waypoints: hold_start_s and hold_end_s must be finite and >= 0");
+  const bool tangent_att = W->attitude_mode == NAV_WP_ATT_GROUND || W->attitude_mode == NAV_WP_ATT_AIRCRAFT;
+  const bool aircraft = W->attitude_mode == NAV_WP_ATT_AIRCRAFT;
+  const nav_kin_lim lin = {L->max_accel_mps2, L->max_jerk_mps3, INFINITY};
+
+  u = calloc((size_t)N, sizeof *u);
+  len = calloc((size_t)N, sizeof *len);
+  v = calloc((size_t)N, sizeof *v);
+  tt = calloc((size_t)N, sizeof *tt);
+  tp = calloc((size_t)N, sizeof *tp);
+  sp = calloc((size_t)N, sizeof *sp);
+  m->wp_time = calloc((size_t)N, sizeof *m->wp_time);
+  if (!u || !len || !v || !tt || !tp || !sp || !m->wp_time) {
+    st = NAV_ERR_NO_MEMORY;
+    goto cleanup;
+  }
+  m->n_wp = N;
+  for (int i = 0; i < N; ++i) {
+    const nav_waypoint *p = &W->points[i];
+    if (!nav_vec3_isfinite(p->r_ned_m) || !isfinite(p->speed_mps) || !isfinite(p->time_s) ||
+        !isfinite(p->attitude.roll_rad) || !isfinite(p->attitude.pitch_rad) ||
+        !isfinite(p->attitude.yaw_rad)) {
+      st = fail(&pl, i, "waypoint %d: a field is not a finite number", i);
+      goto cleanup;
+    }
+  }
+  /* Legs. */
+  for (int i = 0; i + 1 < N; ++i) {
+    const nav_vec3 d = nav_vec3_sub(W->points[i + 1].r_ned_m, W->points[i].r_ned_m);
+    len[i] = nav_vec3_norm(d);
+    if (!(len[i] > 1e-6)) {
+      st = fail(&pl, i + 1, "waypoint %d coincides with waypoint %d (%.3g m apart; at least 1e-6 m needed)",
+                i + 1, i, len[i]);
+      goto cleanup;
+    }
+    u[i] = nav_vec3_scale(d, 1.0 / len[i]);
+    const double elev = atan2(-u[i].z, hypot(u[i].x, u[i].y));
+    if (tangent_att && fabs(elev) > MAX_ELEVATION_RAD) {
+      st = fail(&pl, i + 1,
+                "waypoint %d: leg %d-%d climbs at %.4g deg; the heading of the %s attitude mode is undefined "
+                "beyond "
+                "80 deg",
+                i + 1, i, i + 1, elev * RAD2DEG, aircraft ? "aircraft" : "ground");
+      goto cleanup;
+    }
+  }
+  /* Speeds (and times). */
+  for (int i = 0; i < N; ++i)
+    v[i] = W->points[i].speed_mps;
+  if (W->timing == NAV_WP_TIMING_TIME) {
+    for (int i = 0; i < N; ++i)
+      tt[i] = W->points[i].time_s;
+    if (tt[0] != 0.0) {
+      st = fail(&pl, 0, "waypoint 0: time_s must be 0 (times count from the start of the motion; got %g s)",
+                tt[0]);
+      goto cleanup;
+    }
+    for (int i = 1; i < N; ++i)
+      if (!(tt[i] > tt[i - 1])) {
+        st = fail(&pl, i, "waypoint %d: time_s %g s is not after waypoint %d's %g s", i, tt[i], i - 1,
+                  tt[i - 1]);
+        goto cleanup;
+      }
+    for (int i = 1; i + 1 < N; ++i)
+      v[i] = 0.5 * (len[i - 1] / (tt[i] - tt[i - 1]) + len[i] / (tt[i + 1] - tt[i]));
+  }
+  for (int i = 0; i < N; ++i)
+    if (!(v[i] >= 0.0)) {
+      st = fail(&pl, i, "waypoint %d: speed_mps must be >= 0 (got %g)", i, v[i]);
+      goto cleanup;
+    }
+  if (W->hold_start_s > 0.0 && v[0] != 0.0) {
+    st = fail(&pl, 0, "waypoint 0: hold_start_s %g s needs speed 0 at the first waypoint (speed_mps is %g)",
+              W->hold_start_s, v[0]);
+    goto cleanup;
+  }
+  if (W->hold_end_s > 0.0 && v[N - 1] != 0.0) {
+    st = fail(&pl, N - 1, "waypoint %d: hold_end_s %g s needs speed 0 at the last waypoint (speed_mps is %g)",
+              N - 1, W->hold_end_s, v[N - 1]);
+    goto cleanup;
+  }
+  /* Turns. */
+  for (int i = 1; i + 1 < N; ++i) {
+    turn_plan *t = &tp[i];
+    const double c = nav_vec3_dot(u[i - 1], u[i]);
+    const double s = nav_vec3_norm(nav_vec3_cross(u[i - 1], u[i]));
+    t->beta = atan2(s, c);
+    if (!(t->beta > 1e-9)) {
+      t->beta = 0.0;
+      continue;
+    }
+    if (t->beta > NAV_PI - 1e-6) {
+      st = fail(&pl, i, "waypoint %d: the path reverses direction (turn of %.6g deg); a fly-by turn cannot",
+                i, t->beta * RAD2DEG);
+      goto cleanup;
+    }
+    t->w = nav_vec3_scale(nav_vec3_axpy(u[i], -c, u[i - 1]), 1.0 / s);
+    const double V = v[i];
+    t->V = V;
+    if (!(V > 0.0)) {
+      st = fail(&pl, i, "waypoint %d: a turn of %.4g deg needs speed > 0 (speed_mps is %g)", i,
+                t->beta * RAD2DEG, V);
+      goto cleanup;
+    }
+    nav_kin_lim lim = {L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3};
+    t->cap_name = "max_rate_rps";
+    if (L->max_lateral_accel_mps2 / V < lim.r_max) {
+      lim.r_max = L->max_lateral_accel_mps2 / V;
+      t->cap_name = "max_lateral_accel_mps2";
+    }
+    if (sqrt(L->max_jerk_mps3 / (SQRT2 * V)) < lim.r_max) {
+      lim.r_max = sqrt(L->max_jerk_mps3 / (SQRT2 * V));
+      t->cap_name = "max_jerk_mps3";
+    }
+    lim.d1_max = fmin(lim.d1_max, L->max_jerk_mps3 / (SQRT2 * V));
+    if (aircraft) {
+      lim.d1_max = fmin(lim.d1_max, L->max_rate_rps * m->g_mps2 / V);
+      lim.d2_max = fmin(lim.d2_max, L->max_ang_accel_rps2 * m->g_mps2 / V);
+    }
+    t->rate_cap = lim.r_max;
+    t->mv = nav_kin_plan_move(t->beta, &lim);
+    double ic, is;
+    nav_kin_move_cos_sin_integral(&t->mv, &ic, &is);
+    t->tan_len_m = V * hypot(ic, is) / (2.0 * cos(0.5 * t->beta));
+    t->radius_m = V / fabs(t->mv.p);
+  }
+  /* Straight parts. */
+  for (int i = 0; i + 1 < N; ++i) {
+    const double s_len = len[i] - tp[i].tan_len_m - tp[i + 1].tan_len_m;
+    if (s_len < -1e-9 * (1.0 + len[i])) {
+      const int j = tp[i].tan_len_m >= tp[i + 1].tan_len_m ? i : i + 1;
+      const turn_plan *t = &tp[j];
+      st = fail(&pl, j,
+                "waypoint %d: turn of %.4g deg at %.4g m/s needs radius %.4g m (turn rate %.4g deg/s, "
+                "limited by %s) "
+                "and %.4g m of leg on each side, but leg %d-%d is only %.4g m long%s",
+                j, t->beta * RAD2DEG, t->V, t->radius_m, fabs(t->mv.p) * RAD2DEG, t->cap_name, t->tan_len_m,
+                i, i + 1, len[i],
+                tp[i].tan_len_m > 0.0 && tp[i + 1].tan_len_m > 0.0 ? " and shared with the neighbouring turn"
+                                                                   : "");
+      goto cleanup;
+    }
+    const double s_use = s_len > 0.0 ? s_len : 0.0;
+    straight_plan *q = &sp[i];
+    if (W->timing == NAV_WP_TIMING_SPEED) {
+      const double va = v[i], vb = v[i + 1];
+      q->m1 = nav_kin_plan_move(vb - va, &lin);
+      q->m2 = nav_kin_plan_move(0.0, &lin);
+      const double t1 = nav_kin_move_duration(&q->m1);
+      q->dist_m = 0.5 * (va + vb) * t1;
+      if (va == 0.0 && vb == 0.0 && s_use > 0.0) {
+        st = fail(&pl, i + 1,
+                  "waypoint %d: the speed is 0 at both ends of leg %d-%d; give one end a speed > 0 or use "
+                  "timing time",
+                  i + 1, i, i + 1);
+        goto cleanup;
+      }
+      if (q->dist_m > s_use + 1e-9 * (1.0 + len[i])) {
+        st = fail(&pl, i + 1,
+                  "waypoint %d: the speed change from %g to %g m/s needs %.4g m (max_accel_mps2 %g, "
+                  "max_jerk_mps3 %g) "
+                  "but only %.4g m of leg %d-%d remain between the turns",
+                  i + 1, va, vb, q->dist_m, L->max_accel_mps2, L->max_jerk_mps3, s_use, i, i + 1);
+        goto cleanup;
+      }
+      const double rest = s_use - q->dist_m > 0.0 ? s_use - q->dist_m : 0.0;
+      const double vc = vb > va ? vb : va; /* cruise at the higher speed */
+      q->cruise_s = vc > 0.0 ? rest / vc : 0.0;
+      q->time_s = t1 + q->cruise_s;
+      q->feasible = true;
+    } else {
+      const double target = tt[i + 1] - tt[i] - 0.5 * nav_kin_move_duration(&tp[i].mv) -
+                            0.5 * nav_kin_move_duration(&tp[i + 1].mv);
+      const double va = v[i], vb = v[i + 1];
+      /* Cruise speed c: the time decreases as c rises while the ramps fit. Scan, then bisect. */
+      const double c_lo = 1e-2, c_hi = fmax(va, vb) + sqrt(L->max_accel_mps2 * s_use) +
+                                       2.0 * s_use / fmax(target, 1e-3) + 1.0;
+      const int n_scan = 600;
+      double best = INFINITY, c_prev = 0.0, f_prev = NAN;
+      bool found = false;
+      for (int k = 0; k <= n_scan && !found; ++k) {
+        const double c = c_lo * pow(c_hi / c_lo, (double)k / n_scan);
+        const straight_plan x = straight_with_cruise(va, c, vb, s_use, &lin);
+        if (!x.feasible) {
+          f_prev = NAN;
+          continue;
+        }
+        if (x.time_s < best) best = x.time_s;
+        const double f = x.time_s - target;
+        if (f == 0.0) {
+          *q = x;
+          found = true;
+        } else if (isfinite(f_prev) && f_prev > 0.0 && f < 0.0) {
+          double a = c_prev, b = c;
+          for (int it = 0; it < 200 && b - a > 1e-15 * b; ++it) {
+            const double mid = 0.5 * (a + b);
+            const straight_plan y = straight_with_cruise(va, mid, vb, s_use, &lin);
+            if (y.feasible && y.time_s > target)
+              a = mid;
+            else
+              b = mid;
+          }
+          *q = straight_with_cruise(va, a, vb, s_use, &lin);
+          if (!q->feasible) *q = straight_with_cruise(va, b, vb, s_use, &lin);
+          found = q->feasible;
+        }
+        c_prev = c;
+        f_prev = f;
+      }
+      if (!found && !isfinite(best)) {
+        st = fail(&pl, i + 1,
+                  "waypoint %d: time_s %g s cannot be met: the %.4g m of leg %d-%d between the turns are too "
+                  "short to "
+                  "change speed from %.4g to %.4g m/s within max_accel_mps2 %g and max_jerk_mps3 %g",
+                  i + 1, tt[i + 1], s_use, i, i + 1, va, vb, L->max_accel_mps2, L->max_jerk_mps3);
+        goto cleanup;
+      }
+      if (!found) {
+        const double t_turns =
+            0.5 * nav_kin_move_duration(&tp[i].mv) + 0.5 * nav_kin_move_duration(&tp[i + 1].mv);
+        st = fail(&pl, i + 1,
+                  "waypoint %d: time_s %g s cannot be met: leg %d-%d takes at least %.4g s within "
+                  "max_accel_mps2 %g and "
+                  "max_jerk_mps3 %g (the turns at its ends take %.4g s of it)",
+                  i + 1, tt[i + 1], i, i + 1, best + t_turns, L->max_accel_mps2, L->max_jerk_mps3, t_turns);
+        goto cleanup;
+      }
+    }
+  }
+  /* Timeline. */
+  nav_kin_channel_init(&m->speed, v[0], 0.0);
+  nav_kin_channel_init(&m->turn, 0.0, 0.0);
+  double t = 0.0;
+  const nav_vec3 z = nav_vec3_zero();
+  if (W->hold_start_s > 0.0) {
+    st = add_piece(m, P_HOLD, 0.0, u[0], z, 0.0);
+    if (st != NAV_OK) goto cleanup;
+    t = W->hold_start_s;
+  }
+  m->wp_time[0] = t;
+  for (int i = 0; i + 1 < N && st == NAV_OK; ++i) {
+    const straight_plan *q = &sp[i];
+    st = add_piece(m, P_STRAIGHT, t, u[i], z, 0.0);
+    if (st != NAV_OK) break;
+    if (W->timing == NAV_WP_TIMING_SPEED) {
+      if (v[i + 1] >= v[i]) {
+        st = nav_kin_channel_add_move(&m->speed, t, &q->m1);
+      } else {
+        st = nav_kin_channel_add_move(&m->speed, t + q->cruise_s, &q->m1);
+      }
+    } else {
+      st = nav_kin_channel_add_move(&m->speed, t, &q->m1);
+      if (st == NAV_OK)
+        st = nav_kin_channel_add_move(&m->speed, t + nav_kin_move_duration(&q->m1) + q->cruise_s, &q->m2);
+    }
+    t += q->time_s;
+    if (st != NAV_OK) break;
+    if (i + 2 < N && tp[i + 1].beta > 0.0) {
+      const double b0 = nav_kin_channel_eval(&m->turn, t).d[0];
+      st = add_piece(m, P_TURN, t, u[i], tp[i + 1].w, b0);
+      if (st == NAV_OK) st = nav_kin_channel_add_move(&m->turn, t, &tp[i + 1].mv);
+      m->wp_time[i + 1] = t + 0.5 * nav_kin_move_duration(&tp[i + 1].mv);
+      t += nav_kin_move_duration(&tp[i + 1].mv);
+    } else {
+      m->wp_time[i + 1] = t;
+    }
+  }
+  if (st != NAV_OK) goto cleanup;
+  if (W->hold_end_s > 0.0) {
+    st = add_piece(m, P_HOLD, t, u[N - 2], z, 0.0);
+    if (st != NAV_OK) goto cleanup;
+    t += W->hold_end_s;
+  }
+  m->end_s = t;
+  /* Attitude channels of the euler mode. */
+  if (W->attitude_mode == NAV_WP_ATT_EULER) {
+    const nav_euler e0 = W->points[0].attitude;
+    nav_kin_channel_init(&m->eul[0], e0.roll_rad, 0.0);
+    nav_kin_channel_init(&m->eul[1], e0.pitch_rad, 0.0);
+    nav_kin_channel_init(&m->eul[2], e0.yaw_rad, 0.0);
+    static const char *const names[3] = {"roll", "pitch", "yaw"};
+    for (int i = 0; i + 1 < N && st == NAV_OK; ++i) {
+      const nav_euler a = W->points[i].attitude, b = W->points[i + 1].attitude;
+      const double d[3] = {remainder(b.roll_rad - a.roll_rad, NAV_TWO_PI), b.pitch_rad - a.pitch_rad,
+                           remainder(b.yaw_rad - a.yaw_rad, NAV_TWO_PI)};
+      const double D = m->wp_time[i + 1] - m->wp_time[i], h = 0.5 * D;
+      for (int c = 0; c < 3 && st == NAV_OK; ++c) {
+        if (d[c] == 0.0) continue;
+        const nav_kin_move mv = {d[c], d[c] / h, h, 0.0};
+        const double rate = fabs(mv.p), acc = rate * NAV_KIN_S1_MAX / h,
+                     jerk = rate * NAV_KIN_S2_MAX / (h * h);
+        const char *lname = NULL;
+        double need = 0.0, lim = 0.0;
+        if (rate > L->max_rate_rps)
+          lname = "max_rate_rps", need = rate, lim = L->max_rate_rps;
+        else if (acc > L->max_ang_accel_rps2)
+          lname = "max_ang_accel_rps2", need = acc, lim = L->max_ang_accel_rps2;
+        else if (jerk > L->max_ang_jerk_rps3)
+          lname = "max_ang_jerk_rps3", need = jerk, lim = L->max_ang_jerk_rps3;
+        if (lname) {
+          st = fail(&pl, i + 1,
+                    "waypoint %d: the %s change of %.4g deg from waypoint %d in %.4g s needs %s %.4g but the "
+                    "limit is %g",
+                    i + 1, names[c], d[c] * RAD2DEG, i, D, lname, need, lim);
+          break;
+        }
+        st = nav_kin_channel_add_move(&m->eul[c], m->wp_time[i], &mv);
+      }
+    }
+    if (st != NAV_OK) goto cleanup;
+  }
+cleanup:
+  free(u);
+  free(len);
+  free(v);
+  free(tt);
+  free(tp);
+  free(sp);
+  return st;
+}
+
+/* ---------------------------------------------------------------- evaluation */
+
+static const wp_piece *find_piece(const wp_model *m, double t) {
+  size_t lo = 0, hi = m->n_pieces;
+  if (t < m->pieces[0].t0) return &m->pieces[0];
+  while (hi - lo > 1) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (m->pieces[mid].t0 <= t)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return &m->pieces[lo];
+}
+
+/* Unit tangent as jets (order 3). */
+static void tangent(const wp_model *m, const wp_piece *p, double t, nav_jet T[3]) {
+  if (p->kind != P_TURN) {
+    T[0] = nav_jet_const(p->u.x);
+    T[1] = nav_jet_const(p->u.y);
+    T[2] = nav_jet_const(p->u.z);
+    return;
+  }
+  const nav_jet b = nav_jet_sub(nav_kin_channel_eval(&m->turn, t), nav_jet_const(p->b0));
+  const nav_jet cb = nav_jet_cos(b), sb = nav_jet_sin(b);
+  T[0] = nav_jet_add(nav_jet_scale(cb, p->u.x), nav_jet_scale(sb, p->w.x));
+  T[1] = nav_jet_add(nav_jet_scale(cb, p->u.y), nav_jet_scale(sb, p->w.y));
+  T[2] = nav_jet_add(nav_jet_scale(cb, p->u.z), nav_jet_scale(sb, p->w.z));
+}
+
+static nav_vec3 wp_velocity(void *self, double t) {
+  const wp_model *m = self;
+  const wp_piece *p = find_piece(m, t);
+  const double V = nav_kin_channel_eval(&m->speed, t).d[0];
+  if (p->kind != P_TURN) return nav_vec3_scale(p->u, V);
+  const double b = nav_kin_channel_eval(&m->turn, t).d[0] - p->b0;
+  return nav_vec3_scale(nav_vec3_add(nav_vec3_scale(p->u, cos(b)), nav_vec3_scale(p->w, sin(b))), V);
+}
+
+static double wp_step(void *self, double ta, double tb) {
+  const wp_model *m = self;
+  const double ts[3] = {ta, 0.5 * (ta + tb), tb};
+  double w = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double r = fabs(nav_kin_channel_eval(&m->turn, ts[i]).d[1]);
+    if (r > w) w = r;
+  }
+  if (w == 0.0) return INFINITY;
+  return w > 1.0 ? 0.5 / w : 0.5;
+}
+
+static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
+  const wp_model *m = self;
+  const wp_piece *p = find_piece(m, t_s);
+  nav_jet T[3];
+  tangent(m, p, t_s, T);
+  const nav_jet V = nav_jet_deriv(nav_kin_channel_eval_integral(&m->speed, t_s)); /* V, V', V'' */
+  nav_local_kin k;
+  nav_jet vel[3];
+  for (int i = 0; i < 3; ++i)
+    vel[i] = nav_jet_mul(V, T[i]);
+  k.v_ned_mps = nav_vec3_make(vel[0].d[0], vel[1].d[0], vel[2].d[0]);
+  k.a_ned_mps2 = nav_vec3_make(vel[0].d[1], vel[1].d[1], vel[2].d[1]);
+  nav_jet roll = nav_jet_const(0.0), pitch, yaw;
+  switch (m->mode) {
+  case NAV_WP_ATT_GROUND:
+  case NAV_WP_ATT_AIRCRAFT:
+    yaw = nav_jet_atan2(T[1], T[0]);
+    pitch = nav_jet_atan2(nav_jet_scale(T[2], -1.0),
+                          nav_jet_sqrt(nav_jet_add(nav_jet_mul(T[0], T[0]), nav_jet_mul(T[1], T[1]))));
+    if (m->mode == NAV_WP_ATT_AIRCRAFT)
+      roll = nav_jet_atan(nav_jet_scale(nav_jet_mul(V, nav_jet_deriv(yaw)), 1.0 / m->g_mps2));
+    break;
+  case NAV_WP_ATT_EULER:
+    roll = nav_kin_channel_eval(&m->eul[0], t_s);
+    pitch = nav_kin_channel_eval(&m->eul[1], t_s);
+    yaw = nav_kin_channel_eval(&m->eul[2], t_s);
+    break;
+  case NAV_WP_ATT_FIXED:
+  default:
+    roll = nav_jet_const(m->fixed.roll_rad);
+    pitch = nav_jet_const(m->fixed.pitch_rad);
+    yaw = nav_jet_const(m->fixed.yaw_rad);
+    break;
+  }
+  const nav_euler e = {roll.d[0], pitch.d[0], yaw.d[0]};
+  k.q_b_n = nav_euler_to_quat(e);
+  nav_kin_euler_rates(roll, pitch, yaw, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
+  k.r_ned_m = nav_kin_path_eval(&m->path, t_s);
+  *out = k;
+  return NAV_OK;
+}
+
+static void wp_destroy(void *self) {
+  wp_free(self);
+}
+
+static double gravity_of(const nav_scene *scene) {
+  if (scene->earth.model == NAV_EARTH_WGS84)
+    return nav_earth_gravity_normal_mps2(scene->earth.origin_lat_rad, scene->earth.origin_h_m);
+  return scene->earth.flat_gravity_mps2;
+}
+
+nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info, int *bad_index,
+                                        char *msg, size_t msg_size) {
+  if (msg && msg_size) msg[0] = '\0';
+  if (!scene || !info) return NAV_ERR_INVALID_ARG;
+  wp_model *m = calloc(1, sizeof *m);
+  if (!m) return NAV_ERR_NO_MEMORY;
+  m->g_mps2 = gravity_of(scene);
+  const nav_status st = plan(scene, m, bad_index, msg, msg_size);
+  if (st == NAV_OK) {
+    info->duration_s = m->end_s;
+    info->unconverged = 0;
+    info->first_unconverged = -1;
+    info->shortened_ramps = 0;
+    info->max_ramp_ang_accel_rps2 = 0.0;
+  }
+  wp_free(m);
+  return st;
+}
 
 nav_status nav_traj_waypoints_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
                                      size_t msg_size) {
-  (void)scene;
   (void)dt_s;
-  (void)out;
-  if (msg) snprintf(msg, msg_size, "waypoint trajectories are not available yet");
-  return NAV_ERR_INVALID_ARG;
+  wp_model *m = NULL;
+  nav_status st = NAV_OK;
+  if (msg && msg_size) msg[0] = '\0';
+  m = calloc(1, sizeof *m);
+  if (!m) return NAV_ERR_NO_MEMORY;
+  m->g_mps2 = gravity_of(scene);
+  m->mode = scene->trajectory.waypoints.attitude_mode;
+  m->fixed = scene->trajectory.initial_attitude;
+  if (!(m->g_mps2 > 0.0)) {
+    if (msg) snprintf(msg, msg_size, "trajectory.waypoints: gravity must be > 0");
+    st = NAV_ERR_INVALID_ARG;
+    goto cleanup;
+  }
+  st = plan(scene, m, NULL, msg, msg_size);
+  if (st != NAV_OK) goto cleanup;
+  {
+    const double t_last =
+        fmax(m->end_s, isfinite(scene->trajectory.duration_s) ? scene->trajectory.duration_s : 0.0) + 1.0;
+    size_t nb = 3 + m->n_pieces + 2 * (m->speed.n + m->turn.n + m->eul[0].n + m->eul[1].n + m->eul[2].n);
+    m->breaks = malloc(nb * sizeof *m->breaks);
+    if (!m->breaks) {
+      st = NAV_ERR_NO_MEMORY;
+      goto cleanup;
+    }
+    size_t n = 0;
+    m->breaks[n++] = 0.0;
+    m->breaks[n++] = m->end_s;
+    m->breaks[n++] = t_last;
+    for (size_t i = 0; i < m->n_pieces; ++i)
+      m->breaks[n++] = m->pieces[i].t0;
+    const nav_kin_channel *chs[5] = {&m->speed, &m->turn, &m->eul[0], &m->eul[1], &m->eul[2]};
+    for (int c = 0; c < 5; ++c)
+      for (size_t i = 0; i < chs[c]->n; ++i) {
+        m->breaks[n++] = chs[c]->steps[i].t0_s;
+        m->breaks[n++] = chs[c]->steps[i].t0_s + chs[c]->steps[i].len_s;
+      }
+    m->n_breaks = nav_kin_sort_unique(m->breaks, n);
+    size_t count = 0;
+    while (count < m->n_breaks && m->breaks[count] <= t_last)
+      ++count;
+    st = nav_kin_path_build(&m->path, m->breaks, count, scene->trajectory.waypoints.points[0].r_ned_m,
+                            wp_velocity, wp_step, m, msg, msg_size);
+    if (st != NAV_OK) goto cleanup;
+  }
+  memset(out, 0, sizeof *out);
+  out->name = "waypoints";
+  out->duration_s = m->end_s;
+  out->self = m;
+  out->eval_local = wp_eval;
+  out->destroy = wp_destroy;
+  m = NULL;
+cleanup:
+  wp_free(m);
+  return st;
+}
+
+size_t nav_traj_waypoints_breaks(const void *self, double *out, size_t cap) {
+  const wp_model *m = self;
+  for (size_t i = 0; i < m->n_breaks && i < cap; ++i)
+    out[i] = m->breaks[i];
+  return m->n_breaks;
+}
+
+size_t nav_traj_waypoints_times(const void *self, double *out, size_t cap) {
+  const wp_model *m = self;
+  for (size_t i = 0; i < (size_t)m->n_wp && i < cap; ++i)
+    out[i] = m->wp_time[i];
+  return (size_t)m->n_wp;
 }

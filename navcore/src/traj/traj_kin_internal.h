@@ -1,0 +1,246 @@
+/*
+ * Shared kinematic building blocks of the waypoint and segment-script models (kinematics.c).
+ *
+ * 1. Jets: a scalar function of time with its first three time derivatives, so attitude laws
+ *    written once (heading = atan2(v_E, v_N), bank = atan(V psi_dot / g), the Euler-rate map)
+ *    give exact analytic rates and angular accelerations (forward-mode differentiation, Leibniz
+ *    and Faa di Bruno rules). An unknown derivative order is NaN, which propagates only into that
+ *    order, so a formula that needs more orders than it was given shows up as NaN in tests.
+ *
+ * 2. Channels: a scalar x(t) whose rate r = dx/dt is piecewise constant, joined by ramps
+ *        r(t) = r_before + dr S((t - t0) / T),  S(u) = 35u^4 - 84u^5 + 70u^6 - 20u^7  (u in [0, 1]),
+ *    the septic smoothstep: S', S'' and S''' vanish at both ends, so r is C3, x is C4 and the
+ *    second integral y = int x dt (the distance of a speed channel) is C5. x and y are closed
+ *    forms (I = int S, J = int I). A symmetric ramp moves x by r_before T + dr T / 2 exactly.
+ *    Peak |S'| = 35/16 at u = 1/2, peak |S''| = 84/(5 sqrt 5) at u = (5 -/+ sqrt 5)/10; a ramp of
+ *    dr over T therefore has peak dr' = 35/16 dr / T and peak dr'' = 7.513 dr / T^2.
+ *
+ * 3. Moves: rest-to-rest changes of a channel value (rate 0 -> p -> cruise -> 0) of minimum
+ *    duration within the limits (rate <= r_max, rate' <= d1_max, rate'' <= d2_max), as two
+ *    ramps. Used for manoeuvres of an angle (rate = angular rate) and of a speed (rate =
+ *    acceleration, so the speed change has a trapezoidal, jerk-limited acceleration).
+ *
+ * 4. Paths: position as the integral of an analytic velocity, by 8-point Gauss-Legendre
+ *    quadrature from checkpoints placed at every non-smooth point and at most h apart in between
+ *    (h from the model: 0.5 s or less, scaled down with the rotation rate). Inside a checkpoint
+ *    interval the velocity is analytic, so the quadrature is exact to rounding; velocity and
+ *    acceleration themselves are always closed forms.
+ */
+#ifndef NAV_TRAJ_KIN_INTERNAL_H
+#define NAV_TRAJ_KIN_INTERNAL_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "navcore/nav_math.h"
+#include "navcore/nav_scene.h"
+#include "navcore/nav_status.h"
+#include "traj/traj_internal.h"
+
+/* ================================================================ jets */
+
+/** f and its first three time derivatives: d[0] = f, d[1] = f', d[2] = f'', d[3] = f'''. */
+typedef struct nav_jet {
+  double d[4];
+} nav_jet;
+
+static inline nav_jet nav_jet_make(double f0, double f1, double f2, double f3) {
+  nav_jet r = {{f0, f1, f2, f3}};
+  return r;
+}
+static inline nav_jet nav_jet_const(double v) {
+  return nav_jet_make(v, 0.0, 0.0, 0.0);
+}
+static inline nav_jet nav_jet_add(nav_jet a, nav_jet b) {
+  return nav_jet_make(a.d[0] + b.d[0], a.d[1] + b.d[1], a.d[2] + b.d[2], a.d[3] + b.d[3]);
+}
+static inline nav_jet nav_jet_sub(nav_jet a, nav_jet b) {
+  return nav_jet_make(a.d[0] - b.d[0], a.d[1] - b.d[1], a.d[2] - b.d[2], a.d[3] - b.d[3]);
+}
+static inline nav_jet nav_jet_scale(nav_jet a, double s) {
+  return nav_jet_make(a.d[0] * s, a.d[1] * s, a.d[2] * s, a.d[3] * s);
+}
+/** Leibniz rule. */
+static inline nav_jet nav_jet_mul(nav_jet f, nav_jet g) {
+  return nav_jet_make(f.d[0] * g.d[0], f.d[1] * g.d[0] + f.d[0] * g.d[1],
+                      f.d[2] * g.d[0] + 2.0 * f.d[1] * g.d[1] + f.d[0] * g.d[2],
+                      f.d[3] * g.d[0] + 3.0 * f.d[2] * g.d[1] + 3.0 * f.d[1] * g.d[2] + f.d[0] * g.d[3]);
+}
+/** h(f) from the derivatives h0..h3 of h at f (Faa di Bruno to third order). */
+static inline nav_jet nav_jet_chain(nav_jet f, double h0, double h1, double h2, double h3) {
+  const double f1 = f.d[1], f2 = f.d[2], f3 = f.d[3];
+  return nav_jet_make(h0, h1 * f1, h2 * f1 * f1 + h1 * f2, h3 * f1 * f1 * f1 + 3.0 * h2 * f1 * f2 + h1 * f3);
+}
+/** The derivative f' as a jet; its third derivative is unknown (NaN). */
+static inline nav_jet nav_jet_deriv(nav_jet f) {
+  return nav_jet_make(f.d[1], f.d[2], f.d[3], NAN);
+}
+static inline nav_jet nav_jet_sin(nav_jet f) {
+  const double s = sin(f.d[0]), c = cos(f.d[0]);
+  return nav_jet_chain(f, s, c, -s, -c);
+}
+static inline nav_jet nav_jet_cos(nav_jet f) {
+  const double s = sin(f.d[0]), c = cos(f.d[0]);
+  return nav_jet_chain(f, c, -s, -c, s);
+}
+static inline nav_jet nav_jet_atan(nav_jet f) {
+  const double x = f.d[0], k = 1.0 / (1.0 + x * x);
+  return nav_jet_chain(f, atan(x), k, -2.0 * x * k * k, (6.0 * x * x - 2.0) * k * k * k);
+}
+/** sqrt(f), f > 0. */
+static inline nav_jet nav_jet_sqrt(nav_jet f) {
+  const double s = sqrt(f.d[0]), i = 1.0 / f.d[0];
+  return nav_jet_chain(f, s, 0.5 / s, -0.25 / s * i, 0.375 / s * i * i);
+}
+/** 1/f, f != 0. */
+static inline nav_jet nav_jet_recip(nav_jet f) {
+  const double i = 1.0 / f.d[0];
+  return nav_jet_chain(f, i, -i * i, 2.0 * i * i * i, -6.0 * i * i * i * i);
+}
+/** atan2(y, x) with derivative (x y' - y x') / (x^2 + y^2); (x, y) != 0. */
+static inline nav_jet nav_jet_atan2(nav_jet y, nav_jet x) {
+  const nav_jet num = nav_jet_sub(nav_jet_mul(x, nav_jet_deriv(y)), nav_jet_mul(y, nav_jet_deriv(x)));
+  const nav_jet q = nav_jet_mul(num, nav_jet_recip(nav_jet_add(nav_jet_mul(x, x), nav_jet_mul(y, y))));
+  return nav_jet_make(atan2(y.d[0], x.d[0]), q.d[0], q.d[1], q.d[2]);
+}
+
+/**
+ * Body rate of b relative to n and its derivative from ZYX Euler-angle jets (numerics.md E3.4):
+ *   w_nb_b = [phi' - psi' sin(theta); theta' cos(phi) + psi' cos(theta) sin(phi);
+ *             -theta' sin(phi) + psi' cos(theta) cos(phi)]
+ * The angles need at least two valid derivative orders.
+ */
+void nav_kin_euler_rates(nav_jet roll, nav_jet pitch, nav_jet yaw, nav_vec3 *w_nb_b_rps,
+                         nav_vec3 *dw_nb_b_rps2);
+
+/* ================================================================ ramps, channels, moves */
+
+/** Peak |S'| and |S''| of the septic smoothstep. */
+#define NAV_KIN_S1_MAX 2.1875
+#define NAV_KIN_S2_MAX 7.5131884024802440 /* 84 / (5 sqrt(5)) */
+
+/** Limits of a channel: |rate| <= r_max, |rate'| <= d1_max, |rate''| <= d2_max (may be INFINITY). */
+typedef struct nav_kin_lim {
+  double r_max, d1_max, d2_max;
+} nav_kin_lim;
+
+/** Shortest ramp that changes the rate by @p dr_abs within @p lim (d1 and d2 bounds). */
+double nav_kin_ramp_time(double dr_abs, const nav_kin_lim *lim);
+
+/** One rate ramp; x0, r0 (value and rate at t0) are filled by nav_kin_channel_add_step. */
+typedef struct nav_kin_step {
+  double t0_s, len_s, dr;
+  double r0, x0, y0;
+} nav_kin_step;
+
+/** A channel: x(0) = x_init, rate r_init before the first ramp, y(0) = 0. */
+typedef struct nav_kin_channel {
+  double x_init, r_init;
+  nav_kin_step *steps;
+  size_t n, cap;
+} nav_kin_channel;
+
+void nav_kin_channel_init(nav_kin_channel *c, double x_init, double r_init);
+void nav_kin_channel_free(nav_kin_channel *c);
+/** Append a ramp starting at or after the end of the previous one (an overlap below 1e-9 s from
+ *  rounding is absorbed by starting at the previous end). dr == 0 appends nothing. */
+nav_status nav_kin_channel_add_step(nav_kin_channel *c, double t0_s, double len_s, double dr);
+/** x and its derivatives (x, r, r', r''). */
+nav_jet nav_kin_channel_eval(const nav_kin_channel *c, double t_s);
+/** y = int_0^t x and its derivatives (y, x, r, r'). */
+nav_jet nav_kin_channel_eval_integral(const nav_kin_channel *c, double t_s);
+/** Rate after the last ramp. */
+double nav_kin_channel_final_rate(const nav_kin_channel *c);
+/** Time the last ramp ends (0 if none). */
+double nav_kin_channel_end(const nav_kin_channel *c);
+
+/** A rest-to-rest move of a channel value by delta: ramp 0 -> p over t_ramp, cruise at p for
+ *  t_cruise, ramp p -> 0 over t_ramp; p (t_ramp + t_cruise) = delta exactly. */
+typedef struct nav_kin_move {
+  double delta, p, t_ramp, t_cruise;
+} nav_kin_move;
+
+static inline double nav_kin_move_duration(const nav_kin_move *m) {
+  return 2.0 * m->t_ramp + m->t_cruise;
+}
+/** Minimum-duration move by @p delta within @p lim. */
+nav_kin_move nav_kin_plan_move(double delta, const nav_kin_lim *lim);
+/** As nav_kin_plan_move, but when that takes longer than @p t_max, the largest move in the same
+ *  direction that fits in t_max (sets *truncated). */
+nav_kin_move nav_kin_plan_move_within(double delta, double t_max, const nav_kin_lim *lim, bool *truncated);
+/** Append a move starting at t0 (two ramps). */
+nav_status nav_kin_channel_add_move(nav_kin_channel *c, double t0_s, const nav_kin_move *m);
+/** Value of a standalone move (from 0) at time t from its start, with derivatives. */
+nav_jet nav_kin_move_eval(const nav_kin_move *m, double t_s);
+/** int cos(b(t)) dt and int sin(b(t)) dt over a standalone move of an angle b (8-point
+ *  Gauss-Legendre on pieces of at most 0.1 rad). */
+void nav_kin_move_cos_sin_integral(const nav_kin_move *m, double *ic, double *is);
+
+/* ================================================================ paths */
+
+typedef nav_vec3 (*nav_kin_vel_fn)(void *self, double t_s);
+/** Longest quadrature interval inside (ta, tb), a smooth stretch; INFINITY when the velocity is
+ *  a polynomial of degree <= 15 there (no rotation), which the rule integrates exactly. */
+typedef double (*nav_kin_step_fn)(void *self, double ta_s, double tb_s);
+
+#define NAV_KIN_GL_NODES 8
+#define NAV_KIN_MAX_CHECKPOINTS 20000000
+
+typedef struct nav_kin_path {
+  double *t;
+  nav_vec3 *r;
+  nav_vec3 *v_const; /* velocity of interval [t_i, t_i+1] when it is constant there, else NaN */
+  size_t n;
+  double x[NAV_KIN_GL_NODES], w[NAV_KIN_GL_NODES];
+  nav_kin_vel_fn vel;
+  void *self;
+} nav_kin_path;
+
+/**
+ * Build checkpoints. @p breaks: sorted times at which the velocity may be non-smooth (first =
+ * the time of @p r0, last = the end of the range that needs accurate positions); duplicates are
+ * allowed. @return NAV_OK, NAV_ERR_NO_MEMORY, NAV_ERR_OUT_OF_RANGE (more than
+ * NAV_KIN_MAX_CHECKPOINTS; msg says so).
+ */
+nav_status nav_kin_path_build(nav_kin_path *p, const double *breaks, size_t n_breaks, nav_vec3 r0,
+                              nav_kin_vel_fn vel, nav_kin_step_fn step, void *self, char *msg,
+                              size_t msg_size);
+nav_vec3 nav_kin_path_eval(const nav_kin_path *p, double t_s);
+void nav_kin_path_free(nav_kin_path *p);
+
+/** Sort and remove duplicates (|a - b| <= 1e-12 s). @return the new count. */
+size_t nav_kin_sort_unique(double *t, size_t n);
+
+/* ================================================================ model queries (tests, import) */
+
+/** Summary of a planned script. */
+typedef struct nav_traj_script_info {
+  double duration_s;     /**< natural length of the script */
+  int unconverged;       /**< motion commands of types 2-5 that ended unconverged */
+  int first_unconverged; /**< index of the first of them, -1 if none */
+  int shortened_ramps;   /**< rate-step ramps shortened to fit (fit_rate_ramps), exceeding the limits */
+  double max_ramp_ang_accel_rps2; /**< largest Euler-angle acceleration of any rate-step ramp */
+} nav_traj_script_info;
+
+/**
+ * Plan the segment script of @p scene without building positions. On failure @p bad_index is the
+ * offending segment (-1 when not tied to one) and msg says what is wrong.
+ */
+nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_info *info, int *bad_index,
+                                       char *msg, size_t msg_size);
+/** Same for waypoints (bad_index = offending waypoint). */
+nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info, int *bad_index,
+                                        char *msg, size_t msg_size);
+/**
+ * Times at which a model built by nav_traj_segments_create / nav_traj_waypoints_create changes
+ * piece or starts/ends a ramp (transitions). Writes up to @p cap, returns the total count.
+ */
+size_t nav_traj_segments_breaks(const void *self, double *out, size_t cap);
+size_t nav_traj_waypoints_breaks(const void *self, double *out, size_t cap);
+/** Segment boundaries B_0 .. B_count (count + 1 values) of a segment model. */
+size_t nav_traj_segments_boundaries(const void *self, double *out, size_t cap);
+/** Times at which a waypoint model passes its waypoints (count values). */
+size_t nav_traj_waypoints_times(const void *self, double *out, size_t cap);
+
+#endif /* NAV_TRAJ_KIN_INTERNAL_H */
