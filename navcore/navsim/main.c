@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "bench.h"
+#include "catalog_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -30,6 +31,7 @@ static const char *k_usage =
     "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
     "  run SCENE        simulate a scene and write the results into a directory\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
+    "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -332,6 +334,10 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
+  if (strcmp(cmd, "catalog") == 0) {
+    char res[4096];
+    return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);
+  }
   fprintf(stderr, "navsim: unknown command \"%s\" (see navsim --help)\n", cmd);
   return EXIT_INVALID;
 }

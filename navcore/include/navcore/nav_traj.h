@@ -64,6 +64,15 @@ NAV_API NAV_NODISCARD nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_t
 NAV_API NAV_NODISCARD nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s,
                                                         nav_vec3 *out, bool *has_closed_form);
 
+/**
+ * Ideal inertial sensor rates at @p t_s: specific force f_ib_b [m/s^2] and angular rate
+ * omega_ib_b [rad/s], body axes, with the scene's Earth and gravity model (flat: uniform
+ * gravity, non-rotating l; WGS-84: Earth rate, transport rate, normal or J2 gravity, computed in
+ * the NED form E3.9 for local models and the ECEF form E3.7-E3.8 for ECEF models).
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2,
+                                                   nav_vec3 *w_ib_b_rps);
+
 /** Duration of the trajectory [s]. */
 NAV_API double nav_traj_duration(const nav_traj *traj);
 

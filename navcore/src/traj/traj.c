@@ -6,11 +6,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "navcore/nav_truth.h"
 #include "traj/traj_internal.h"
 
 struct nav_traj {
   nav_traj_model m;
   nav_frame frame;
+  nav_gravity_model gravity;
+  nav_vec3 g_l_mps2; /* flat Earth: uniform gravity in l */
 };
 
 /* ------------------------------------------------------------------ frames */
@@ -70,7 +73,13 @@ nav_local_view nav_frame_view(const nav_frame *fr, nav_vec3 r_f, nav_vec3 v_f, n
  *   d/dt omega_eb_b = dw_nb_b + C_n_b omega_en_n' - omega_nb_b x (C_n_b omega_en_n)
  * with dR_M/dlat = 3 e^2 R_M sin cos / (1 - e^2 sin^2), dR_N/dlat = e^2 R_N sin cos / (1 - e^2 sin^2).
  */
-static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+/* Velocity, its n-frame derivative and the transport rate (with derivative) from geodetic
+ * kinematics (numerics.md E3.9; Groves 2nd ed. eqs. 2.111, 5.44). */
+typedef struct ned_kin {
+  nav_vec3 v_n, dv_n, w_en_n, dw_en_n;
+} ned_kin;
+
+static ned_kin geo_to_ned_kin(const nav_geo_kin *g) {
   const double lat = g->pos.lat_rad, h = g->pos.h_m;
   const double sl = sin(lat), cl = cos(lat);
   const double dlat = g->dpos.x, dlon = g->dpos.y, dh = g->dpos.z;
@@ -79,12 +88,19 @@ static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
   const double den = 1.0 - NAV_WGS84_E2 * sl * sl;
   const double dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl / den * dlat;
   const double dRN = NAV_WGS84_E2 * RN * sl * cl / den * dlat;
-  const nav_vec3 v_n = nav_vec3_make((RM + h) * dlat, (RN + h) * cl * dlon, -dh);
-  const nav_vec3 dv_n = nav_vec3_make((dRM + dh) * dlat + (RM + h) * ddlat,
-                                      (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon, -ddh);
-  const nav_vec3 w_en_n = nav_vec3_make(dlon * cl, -dlat, -dlon * sl);
-  const nav_vec3 dw_en_n =
-      nav_vec3_make(ddlon * cl - dlon * dlat * sl, -ddlat, -ddlon * sl - dlon * dlat * cl);
+  ned_kin k;
+  k.v_n = nav_vec3_make((RM + h) * dlat, (RN + h) * cl * dlon, -dh);
+  k.dv_n = nav_vec3_make((dRM + dh) * dlat + (RM + h) * ddlat,
+                         (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon, -ddh);
+  k.w_en_n = nav_vec3_make(dlon * cl, -dlat, -dlon * sl);
+  k.dw_en_n = nav_vec3_make(ddlon * cl - dlon * dlat * sl, -ddlat, -ddlon * sl - dlon * dlat * cl);
+  return k;
+}
+
+static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+  const double lat = g->pos.lat_rad;
+  const ned_kin nk = geo_to_ned_kin(g);
+  const nav_vec3 v_n = nk.v_n, dv_n = nk.dv_n, w_en_n = nk.w_en_n, dw_en_n = nk.dw_en_n;
   const nav_mat3 C_n_e = nav_earth_dcm_n_e(lat, g->pos.lon_rad);
   s->r_fb_f_m = nav_earth_geodetic_to_ecef(g->pos);
   s->v_fb_f_mps = nav_mat3_mul_vec(C_n_e, v_n);
@@ -117,6 +133,8 @@ nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **o
   nav_traj *tr = calloc(1, sizeof *tr);
   if (!tr) return NAV_ERR_NO_MEMORY;
   tr->frame = nav_frame_from_scene(scene);
+  tr->gravity = scene->earth.gravity_model;
+  tr->g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
   nav_status st = NAV_ERR_INVALID_ARG;
   switch (scene->trajectory.type) {
   case NAV_TRAJ_PARAMETRIC: st = nav_traj_parametric_create(scene, dt_s, &tr->m, msg, msg_size); break;
@@ -184,6 +202,62 @@ nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
   }
   if (st != NAV_OK) return st;
   *out = s;
+  return NAV_OK;
+}
+
+nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2, nav_vec3 *w_ib_b_rps) {
+  if (!traj || !f_ib_b_mps2 || !w_ib_b_rps || !isfinite(t_s)) return NAV_ERR_INVALID_ARG;
+  nav_status st = NAV_OK;
+  if (traj->m.eval_ecef) {
+    /* ECEF form (E3.7-E3.8): f_e = a_e + 2 w_ie_e x v_e - g_e(r_e). */
+    nav_traj_state s;
+    st = traj->m.eval_ecef(traj->m.self, t_s, &s);
+    if (st != NAV_OK) return st;
+    const nav_vec3 w_ie_e = nav_earth_rate_e_rps();
+    const nav_vec3 f_e = nav_vec3_sub(nav_vec3_add(s.a_fb_f_mps2, nav_vec3_scale(nav_vec3_cross(w_ie_e, s.v_fb_f_mps), 2.0)),
+                                      nav_gravity_e_mps2(traj->gravity, s.r_fb_f_m));
+    const nav_quat q_e_b = nav_quat_conj(s.q_b_f);
+    *f_ib_b_mps2 = nav_quat_rotate(q_e_b, f_e);
+    *w_ib_b_rps = nav_vec3_add(nav_quat_rotate(q_e_b, w_ie_e), s.w_fb_b_rps);
+    return NAV_OK;
+  }
+  if (traj->frame.model == NAV_EARTH_FLAT) {
+    /* Flat, non-rotating l with uniform gravity (E3.3). */
+    nav_local_kin k;
+    st = traj->m.eval_local(traj->m.self, t_s, &k);
+    if (st != NAV_OK) return st;
+    *f_ib_b_mps2 = nav_quat_rotate(nav_quat_conj(k.q_b_n), nav_vec3_sub(k.a_ned_mps2, traj->g_l_mps2));
+    *w_ib_b_rps = k.w_nb_b_rps;
+    return NAV_OK;
+  }
+  /* WGS-84, NED form (E3.9), equal to the ECEF form to round-off (T3.3) and cheaper: no
+   * ECEF -> geodetic conversion for gravity.
+   *   f_n = v_n' + (2 w_ie_n + w_en_n) x v_n - g_n,  f_b = C_n_b f_n
+   *   w_ib_b = w_nb_b + C_n_b (w_ie_n + w_en_n) */
+  nav_geo_kin g;
+  if (traj->m.eval_local) {
+    nav_local_kin k;
+    st = traj->m.eval_local(traj->m.self, t_s, &k);
+    if (st != NAV_OK) return st;
+    g = local_to_geo(&traj->frame, &k);
+  } else {
+    st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
+    if (st != NAV_OK) return st;
+  }
+  const ned_kin nk = geo_to_ned_kin(&g);
+  const nav_vec3 w_ie_n = nav_earth_rate_n_rps(g.pos.lat_rad);
+  nav_vec3 g_n;
+  if (traj->gravity == NAV_GRAVITY_J2) {
+    const nav_mat3 C_n_e = nav_earth_dcm_n_e(g.pos.lat_rad, g.pos.lon_rad);
+    g_n = nav_mat3_tmul_vec(C_n_e, nav_earth_gravity_j2_e_mps2(nav_earth_geodetic_to_ecef(g.pos)));
+  } else {
+    g_n = nav_earth_gravity_n_mps2(g.pos.lat_rad, g.pos.h_m);
+  }
+  const nav_vec3 f_n = nav_vec3_sub(
+      nav_vec3_add(nk.dv_n, nav_vec3_cross(nav_vec3_add(nav_vec3_scale(w_ie_n, 2.0), nk.w_en_n), nk.v_n)), g_n);
+  const nav_quat q_n_b = nav_quat_conj(g.q_b_n);
+  *f_ib_b_mps2 = nav_quat_rotate(q_n_b, f_n);
+  *w_ib_b_rps = nav_vec3_add(g.w_nb_b_rps, nav_quat_rotate(q_n_b, nav_vec3_add(w_ie_n, nk.w_en_n)));
   return NAV_OK;
 }
 

@@ -118,8 +118,6 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (!truth || !out || k < 1) return NAV_ERR_INVALID_ARG;
   const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
   const double half = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
-  const bool flat = truth->frame.model == NAV_EARTH_FLAT;
-  const nav_vec3 w_ie_e = nav_earth_rate_e_rps();
   nav_imu_increment r;
   r.k = k;
   r.t_s = t1;
@@ -129,22 +127,12 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (st != NAV_OK) return st;
   nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
   for (int i = 0; i < truth->n_nodes; ++i) {
-    nav_traj_state s;
-    st = nav_traj_eval(truth->traj, mid + half * truth->nodes[i], &s);
+    nav_vec3 f_b, w_b;
+    st = nav_traj_inertial(truth->traj, mid + half * truth->nodes[i], &f_b, &w_b);
     if (st != NAV_OK) return st;
-    const nav_quat q_f_b = nav_quat_conj(s.q_b_f);
-    nav_vec3 f_f, w_ib_b;
-    if (flat) {
-      f_f = nav_vec3_sub(s.a_fb_f_mps2, truth->g_l_mps2);
-      w_ib_b = s.w_fb_b_rps;
-    } else {
-      f_f = nav_vec3_sub(nav_vec3_add(s.a_fb_f_mps2, nav_vec3_scale(nav_vec3_cross(w_ie_e, s.v_fb_f_mps), 2.0)),
-                         nav_gravity_e_mps2(truth->gravity, s.r_fb_f_m));
-      w_ib_b = nav_vec3_add(nav_quat_rotate(q_f_b, w_ie_e), s.w_fb_b_rps);
-    }
     const double wgt = truth->weights[i] * half;
-    dv = nav_vec3_axpy(dv, wgt, nav_quat_rotate(q_f_b, f_f));
-    dth = nav_vec3_axpy(dth, wgt, w_ib_b);
+    dv = nav_vec3_axpy(dv, wgt, f_b);
+    dth = nav_vec3_axpy(dth, wgt, w_b);
   }
   if (!closed) r.dtheta_b_rad = dth;
   r.dv_b_mps = dv;
