@@ -927,6 +927,16 @@ static void test_motiondef_long_drive(void **state) {
   assert_near(s->trajectory.segments.items[2].v_b_mps.x, 5.0, 0.0);
   assert_int_equal(s->trajectory.segments.items[11].kind, NAV_SEG_MOTION_REL_REL);
   assert_true(s->trajectory.segments.allow_unconverged);
+  assert_true(s->trajectory.segments.fit_rate_ramps);
+  {
+    /* gnss-ins-sim's high_mobility, equal to the segment defaults. */
+    const nav_traj_limits a = s->trajectory.segments.limits;
+    const nav_traj_limits b = nav_scene_default().trajectory.segments.limits;
+    assert_near(a.max_accel_mps2, 1.0, 0.0);
+    assert_near(a.max_ang_accel_rps2, 0.5, 0.0);
+    assert_near(a.max_rate_rps, 2.0, 0.0);
+    assert_memory_equal(&a, &b, sizeof a);
+  }
   assert_int_equal(nav_scene_validate(s, NULL, NULL), NAV_OK);
   nav_script_summary sum;
   char msg[256];

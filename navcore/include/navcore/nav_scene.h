@@ -17,6 +17,7 @@
 
 #include "nav_export.h"
 #include "nav_math.h"
+#include "nav_sensor_config.h"
 #include "nav_status.h"
 
 NAV_BEGIN_DECLS
@@ -306,10 +307,28 @@ typedef struct nav_scene_earth {
   nav_gravity_model gravity_model; /**< WGS-84 model only */
 } nav_scene_earth;
 
+#define NAV_SCENE_CATALOG_NAME_MAX 96
+
 typedef struct nav_scene_imu {
   double rate_hz;
-  int quadrature_nodes; /**< Gauss-Legendre nodes for ideal increments (1..8, default 6) */
+  int quadrature_nodes;       /**< Gauss-Legendre nodes for ideal increments (1..16, default 6) */
+  char catalog[NAV_SCENE_CATALOG_NAME_MAX]; /**< catalog part the model started from ("" = none) */
+  nav_imu_model_config model; /**< error model in SI (terms off by default: a perfect IMU) */
 } nav_scene_imu;
+
+/** GNSS receiver of an integrated scheme. */
+typedef struct nav_scene_gnss {
+  bool enabled;
+  char catalog[NAV_SCENE_CATALOG_NAME_MAX];
+  nav_gnss_model_config model;
+} nav_scene_gnss;
+
+/** Initial navigation errors, drawn once per Monte Carlo run (1-sigma, zero mean). */
+typedef struct nav_scene_initial_errors {
+  nav_vec3 pos_sd_m;    /**< north, east, down [m] */
+  nav_vec3 vel_sd_mps;  /**< north, east, down [m/s] */
+  nav_vec3 att_sd_rad;  /**< about north, east, down (phi-angle, numerics.md E0.1) [rad] */
+} nav_scene_initial_errors;
 
 /** Frame the WGS-84 mechanization integrates in. */
 typedef enum nav_mech_frame {
@@ -317,9 +336,17 @@ typedef enum nav_mech_frame {
   NAV_MECH_ECEF = 1 /**< Earth-fixed: no singularity anywhere, works over the poles */
 } nav_mech_frame;
 
+/** Navigation scheme (architecture.md section 1). */
+typedef enum nav_nav_scheme {
+  NAV_SCHEME_FREE_INS = 0, /**< free-inertial strapdown INS (gyros + accelerometers) */
+  NAV_SCHEME_INS_GNSS = 1  /**< loosely coupled INS/GNSS error-state Kalman filter */
+} nav_nav_scheme;
+
 typedef struct nav_scene_navigation {
+  nav_nav_scheme scheme;
   nav_mech_algorithm algorithm;
   nav_mech_frame frame; /**< WGS-84 only */
+  bool aid_vertical;    /**< free INS: height and vertical velocity from the reference (baro-like aiding) */
 } nav_scene_navigation;
 
 typedef struct nav_scene_output {
@@ -329,6 +356,7 @@ typedef struct nav_scene_output {
 typedef struct nav_scene_simulation {
   uint64_t seed;
   long runs;
+  int threads; /**< worker threads for Monte Carlo (0 = one per core); results do not depend on it */
 } nav_scene_simulation;
 
 /** A complete scene. Plain data: copy it by assignment. */
@@ -338,6 +366,8 @@ typedef struct nav_scene {
   nav_scene_earth earth;
   nav_scene_trajectory trajectory;
   nav_scene_imu imu;
+  nav_scene_gnss gnss;
+  nav_scene_initial_errors initial_errors;
   nav_scene_navigation navigation;
   nav_scene_output output;
   nav_scene_simulation simulation;
@@ -370,6 +400,7 @@ NAV_API const char *nav_mech_algorithm_name(nav_mech_algorithm a);
 NAV_API const char *nav_traj_type_name(nav_traj_type t);
 NAV_API const char *nav_gravity_model_name(nav_gravity_model g);
 NAV_API const char *nav_mech_frame_name(nav_mech_frame f);
+NAV_API const char *nav_nav_scheme_name(nav_nav_scheme s);
 
 NAV_END_DECLS
 

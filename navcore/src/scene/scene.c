@@ -4,6 +4,7 @@
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_scene.h"
+#include "navcore/nav_sensors.h"
 
 nav_scene nav_scene_default(void) {
   nav_scene s;
@@ -68,7 +69,29 @@ nav_scene nav_scene_default(void) {
   s.output.rate_hz = 10.0;
   s.simulation.seed = 1;
   s.simulation.runs = 1;
+  s.simulation.threads = 0;
+  s.imu.model = nav_imu_model_config_default();
+  s.gnss.enabled = false;
+  s.gnss.model = nav_gnss_model_config_default();
+  s.navigation.scheme = NAV_SCHEME_FREE_INS;
+  s.navigation.aid_vertical = false;
   return s;
+}
+
+/* Prefix the sensor validators' relative paths with their scene section. */
+typedef struct prefixed {
+  const char *prefix;
+  nav_scene_issue_fn report;
+  void *user;
+  int count;
+} prefixed;
+
+static void report_prefixed(void *user, const char *path, const char *message) {
+  prefixed *p = user;
+  char full[256];
+  snprintf(full, sizeof full, "%s%s", p->prefix, path);
+  p->count++;
+  if (p->report) p->report(p->user, full, message);
 }
 
 typedef struct checker {
@@ -80,6 +103,11 @@ typedef struct checker {
 static void issue(checker *c, const char *path, const char *fmt, double v) {
   char msg[256];
   snprintf(msg, sizeof msg, fmt, v);
+  c->count++;
+  if (c->report) c->report(c->user, path, msg);
+}
+
+static void issue_text(checker *c, const char *path, const char *msg) {
   c->count++;
   if (c->report) c->report(c->user, path, msg);
 }
@@ -312,6 +340,29 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   if (isfinite(s->output.rate_hz) && isfinite(s->imu.rate_hz) && s->output.rate_hz > s->imu.rate_hz)
     issue(&c, "output.rate_hz", "must not exceed imu.rate_hz (%g Hz)", s->imu.rate_hz);
 
+  {
+    prefixed pi = {"imu.", report, user, 0};
+    if (nav_imu_model_config_validate(&s->imu.model, report_prefixed, &pi) != NAV_OK && pi.count == 0)
+      issue_text(&c, "imu", "invalid IMU error model");
+    c.count += pi.count;
+    if (s->gnss.enabled) {
+      prefixed pg = {"gnss.", report, user, 0};
+      if (nav_gnss_model_config_validate(&s->gnss.model, report_prefixed, &pg) != NAV_OK && pg.count == 0)
+        issue_text(&c, "gnss", "invalid GNSS receiver model");
+      c.count += pg.count;
+    }
+  }
+  check_vec(&c, "initial_errors.position_m", s->initial_errors.pos_sd_m);
+  check_vec(&c, "initial_errors.velocity_mps", s->initial_errors.vel_sd_mps);
+  check_vec(&c, "initial_errors.attitude_deg", s->initial_errors.att_sd_rad);
+  if (s->navigation.scheme != NAV_SCHEME_FREE_INS && s->navigation.scheme != NAV_SCHEME_INS_GNSS)
+    issue(&c, "navigation.scheme", "unknown navigation scheme %g", (double)s->navigation.scheme);
+  if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && !s->gnss.enabled)
+    issue_text(&c, "navigation.scheme", "ins_gnss needs a GNSS receiver: set gnss.enabled: true");
+  if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->earth.model != NAV_EARTH_WGS84)
+    issue_text(&c, "navigation.scheme", "ins_gnss needs the wgs84 Earth model");
+  if (s->simulation.threads < 0 || s->simulation.threads > 256)
+    issue(&c, "simulation.threads", "must be an integer in [0, 256] (got %g)", (double)s->simulation.threads);
   if (s->simulation.runs < 1 || s->simulation.runs > NAV_SCENE_MAX_RUNS)
     issue(&c, "simulation.runs", "must be an integer in [1, 1000000] (got %g)", (double)s->simulation.runs);
   return c.count ? NAV_ERR_INVALID_ARG : NAV_OK;
@@ -337,6 +388,14 @@ const char *nav_gravity_model_name(nav_gravity_model g) {
   switch (g) {
   case NAV_GRAVITY_NORMAL: return "normal";
   case NAV_GRAVITY_J2: return "j2";
+  }
+  return "unknown";
+}
+
+const char *nav_nav_scheme_name(nav_nav_scheme s) {
+  switch (s) {
+  case NAV_SCHEME_FREE_INS: return "free_ins";
+  case NAV_SCHEME_INS_GNSS: return "ins_gnss";
   }
   return "unknown";
 }

@@ -472,19 +472,18 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
         const nav_kin_move mv = {d[c], d[c] / h, h, 0.0};
         const double rate = fabs(mv.p), acc = rate * NAV_KIN_S1_MAX / h,
                      jerk = rate * NAV_KIN_S2_MAX / (h * h);
-        const char *lname = NULL;
-        double need = 0.0, lim = 0.0;
-        if (rate > L->max_rate_rps)
-          lname = "max_rate_rps", need = rate, lim = L->max_rate_rps;
-        else if (acc > L->max_ang_accel_rps2)
-          lname = "max_ang_accel_rps2", need = acc, lim = L->max_ang_accel_rps2;
-        else if (jerk > L->max_ang_jerk_rps3)
-          lname = "max_ang_jerk_rps3", need = jerk, lim = L->max_ang_jerk_rps3;
-        if (lname) {
+        /* The peaks of a single rate pulse: rate, its derivative and second derivative. */
+        static const char *const lnames[3] = {"max_rate_rps", "max_ang_accel_rps2", "max_ang_jerk_rps3"};
+        const double need[3] = {rate, acc, jerk};
+        const double lim[3] = {L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3};
+        int over = -1;
+        for (int q = 2; q >= 0; --q)
+          if (need[q] > lim[q]) over = q;
+        if (over >= 0) {
           st = fail(&pl, i + 1,
                     "waypoint %d: the %s change of %.4g deg from waypoint %d in %.4g s needs %s %.4g but the "
                     "limit is %g",
-                    i + 1, names[c], d[c] * RAD2DEG, i, D, lname, need, lim);
+                    i + 1, names[c], d[c] * RAD2DEG, i, D, lnames[over], need[over], lim[over]);
           break;
         }
         st = nav_kin_channel_add_move(&m->eul[c], m->wp_time[i], &mv);
