@@ -247,6 +247,14 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   json_number(f, sum->final.att_err_rad);
   fputs(", \"yaw_err_rad\": ", f);
   json_number(f, fabs(sum->final.euler_err.yaw_rad));
+  fputs("},\n  \"final_rms_over_runs\": {\"pos_err_h_m\": ", f);
+  json_number(f, sum->final_rms.pos_err_h_m);
+  fputs(", \"pos_err_v_m\": ", f);
+  json_number(f, sum->final_rms.pos_err_v_m);
+  fputs(", \"vel_err_mps\": ", f);
+  json_number(f, sum->final_rms.vel_err_mps);
+  fputs(", \"att_err_rad\": ", f);
+  json_number(f, sum->final_rms.att_err_rad);
   fprintf(f, "},\n  \"stats\": {\n    \"epochs\": %lld,\n    \"stride\": %lld,\n", (long long)sum->stats_epochs,
           (long long)sum->stats_stride);
   json_stat(f, "pos_err_h_m", sum->stats.pos_err_h_m, false);

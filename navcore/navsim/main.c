@@ -48,7 +48,7 @@ static const char *k_usage_check =
     "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static const char *k_usage_run =
-    "usage: navsim run SCENE [--out DIR] [--seed N] [--ideal] [--quiet]\n"
+    "usage: navsim run SCENE [--out DIR] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -61,7 +61,10 @@ static const char *k_usage_run =
     "options:\n"
     "  --out DIR     result directory (default: out/<scene name>)\n"
     "  --seed N      random seed, overriding simulation.seed of the scene (0 .. 2^64-1)\n"
-    "  --ideal       perfect sensors and perfect initial state\n"
+    "  --runs N      Monte Carlo runs, overriding simulation.runs (1 .. 1000000)\n"
+    "  --threads N   worker threads (default: simulation.threads, or one per core); results are\n"
+    "                bit-identical for any thread count\n"
+    "  --ideal       perfect sensors and perfect initial state (a single run)\n"
     "  --quiet       print nothing but errors\n"
     "  -h, --help    print this help\n"
     "\n"
@@ -71,6 +74,11 @@ static double now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static long cores(void) {
+  const long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n > 0 ? n : 1;
 }
 
 static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
@@ -177,7 +185,7 @@ static void safe_name(char *out, size_t cap, const char *name) {
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool ideal = false, quiet = false, have_seed = false;
-  uint64_t seed = 0;
+  uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (is_help(a)) {
@@ -187,6 +195,18 @@ static int cmd_run(int argc, char **argv) {
       ideal = true;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = true;
+    } else if (strcmp(a, "--runs") == 0 || strcmp(a, "--threads") == 0) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "navsim run: %s needs a value\n", a);
+        return EXIT_INVALID;
+      }
+      const char *v = argv[++i];
+      uint64_t *dst = a[2] == 'r' ? &runs : &threads;
+      const uint64_t max = a[2] == 'r' ? (uint64_t)NAV_SCENE_MAX_RUNS : 256u;
+      if (!parse_u64(v, dst) || *dst < 1 || *dst > max) {
+        fprintf(stderr, "navsim run: %s: expected an integer in [1, %llu], got \"%s\"\n", a, (unsigned long long)max, v);
+        return EXIT_INVALID;
+      }
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--seed") == 0) {
       if (i + 1 >= argc) {
         fprintf(stderr, "navsim run: %s needs a value\n", a);
@@ -220,6 +240,8 @@ static int cmd_run(int argc, char **argv) {
   int rc = load_scene(scene_path, &scene);
   if (rc != EXIT_OK) return rc;
   if (have_seed) scene.simulation.seed = seed;
+  if (runs > 0) scene.simulation.runs = (long)runs;
+  if (threads == 0) threads = scene.simulation.threads > 0 ? (uint64_t)scene.simulation.threads : (uint64_t)cores();
 
   char default_dir[600];
   if (!out_dir) {
@@ -257,6 +279,7 @@ static int cmd_run(int argc, char **argv) {
 
   nav_sim_options opts = nav_sim_options_default();
   opts.ideal = ideal;
+  opts.threads = (int)threads;
   opts.record = on_record;
   opts.progress = on_progress;
   opts.user = &o;
@@ -298,10 +321,17 @@ static int cmd_run(int argc, char **argv) {
     printf("scene      %s (%s, %s Earth, %s mechanization%s)\n", scene.name, scene_path,
            nav_earth_model_name(scene.earth.model), nav_mech_algorithm_name(scene.navigation.algorithm),
            ideal ? ", ideal sensors" : "");
-    printf("simulated  %.3f s, %" PRId64 " IMU samples at %g Hz in %.3f s wall (%.3g samples/s)\n", sum.duration_s,
-           sum.imu_samples, scene.imu.rate_hz, wall, wall > 0 ? (double)sum.imu_samples / wall : 0.0);
+    printf("simulated  %ld run%s of %.3f s, %" PRId64 " IMU samples each at %g Hz in %.3f s wall (%.3g samples/s, "
+           "%d thread%s)\n",
+           sum.runs, sum.runs == 1 ? "" : "s", sum.duration_s, sum.imu_samples, scene.imu.rate_hz, wall,
+           wall > 0 ? (double)sum.imu_samples * (double)sum.runs / wall : 0.0, opts.threads,
+           opts.threads == 1 ? "" : "s");
     printf("final      horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
            sum.final.pos_err_h_m, sum.final.pos_err_v_m, sum.final.vel_err_mps, sum.final.att_err_rad);
+    if (sum.runs > 1)
+      printf("final rms  horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad (over runs)\n",
+             sum.final_rms.pos_err_h_m, sum.final_rms.pos_err_v_m, sum.final_rms.vel_err_mps,
+             sum.final_rms.att_err_rad);
     printf("rms        horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
            sum.stats.pos_err_h_m.rms, sum.stats.pos_err_v_m.rms, sum.stats.vel_err_mps.rms,
            sum.stats.att_err_rad.rms);

@@ -55,6 +55,8 @@ NAV_API void nav_stat_acc_destroy(nav_stat_acc *acc);
 /** Add a value; NAV_ERR_OUT_OF_RANGE when full, NAV_ERR_NUMERIC when not finite. */
 NAV_API NAV_NODISCARD nav_status nav_stat_acc_add(nav_stat_acc *acc, double value);
 NAV_API size_t nav_stat_acc_count(const nav_stat_acc *acc);
+/** Forget every value added (keeps the capacity). */
+NAV_API void nav_stat_acc_reset(nav_stat_acc *acc);
 /** Statistics of the values added so far (reorders the stored values; adding may continue). */
 NAV_API nav_stat nav_stat_acc_result(nav_stat_acc *acc);
 

@@ -56,7 +56,8 @@ typedef struct nav_sim_record {
 typedef nav_callback_result (*nav_record_fn)(void *user, const nav_sim_record *r);
 
 typedef struct nav_sim_options {
-  bool ideal;               /**< perfect sensors and perfect initial state */
+  bool ideal;               /**< perfect sensors and perfect initial state (one run) */
+  int threads;              /**< threads for Monte Carlo runs (>= 1); results do not depend on it */
   nav_progress_fn progress; /**< may be NULL; called on the running thread at a bounded rate */
   nav_record_fn record;     /**< may be NULL; called at each output epoch */
   void *user;               /**< passed to both callbacks */
@@ -64,7 +65,8 @@ typedef struct nav_sim_options {
 
 NAV_API nav_sim_options nav_sim_options_default(void);
 
-/** Statistics of a run (all epochs at the IMU rate, decimated by stats_stride if huge). */
+/** Statistics pooled over every run and epoch (epochs at the IMU rate, every stats_stride-th
+ *  one when runs x epochs would exceed 4e6 values). */
 typedef struct nav_sim_stats {
   nav_stat pos_err_h_m, pos_err_v_m, vel_err_mps, att_err_rad, yaw_err_rad;
 } nav_sim_stats;
@@ -74,6 +76,7 @@ typedef struct nav_sim_summary {
   int64_t imu_samples;     /**< per run */
   double duration_s;       /**< simulated duration actually covered */
   nav_epoch_errors final;  /**< errors at the last epoch (run 0) */
+  nav_epoch_errors final_rms; /**< RMS over runs of the final errors (norm fields only) */
   nav_sim_stats stats;
   int64_t stats_epochs;    /**< epochs entering the statistics */
   int64_t stats_stride;    /**< every stats_stride-th IMU epoch enters the statistics */

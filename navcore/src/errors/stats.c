@@ -52,6 +52,14 @@ void nav_stat_acc_destroy(nav_stat_acc *acc) {
 
 size_t nav_stat_acc_count(const nav_stat_acc *acc) { return acc ? acc->count : 0; }
 
+void nav_stat_acc_reset(nav_stat_acc *acc) {
+  if (!acc) return;
+  acc->count = 0;
+  acc->sum_sq = 0.0;
+  acc->comp = 0.0;
+  acc->max = 0.0;
+}
+
 nav_status nav_stat_acc_add(nav_stat_acc *acc, double value) {
   if (!acc) return NAV_ERR_INVALID_ARG;
   if (!isfinite(value)) return NAV_ERR_NUMERIC;

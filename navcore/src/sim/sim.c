@@ -1,16 +1,33 @@
-/* One simulation run: truth -> (ideal) IMU -> strapdown -> errors -> statistics. */
+/*
+ * Simulation runs: truth -> sensors -> navigation -> errors -> statistics, one Monte Carlo run
+ * per (seed, run) stream set, on any number of threads with bit-identical results.
+ *
+ * Determinism: a run depends only on the scene and its index (every random draw comes from a
+ * stream keyed by (seed, run, stream id)); each run writes its metrics into its own rows of a
+ * preallocated table, and the statistics are reduced over that table in run order after every
+ * run has finished. Thread scheduling therefore changes nothing but the wall time.
+ *
+ * Run 0 executes on the calling thread first, so the record callback (the CSV writer of navsim)
+ * sees one run, in order, on the caller's thread; the other runs then share the worker threads.
+ */
+#include <stdarg.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 
+#include "navcore/nav_earth.h"
+#include "navcore/nav_rng.h"
+#include "navcore/nav_sensors.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
 
-/* Above this many epochs per run, statistics use every stride-th epoch so memory stays bounded
- * (5 metrics x 8 bytes x 10 M = 400 MB worst case). */
-#define STATS_MAX_EPOCHS 10000000LL
+/* Values kept per metric for the statistics (runs x epochs / stride): bounded memory
+ * (5 metrics x 8 bytes x 4e6 = 160 MB worst case). */
+#define STATS_MAX_VALUES 4000000LL
 #define PROGRESS_EVERY 65536
+#define N_METRICS 5
 
 struct nav_sim {
   nav_scene scene;
@@ -19,7 +36,9 @@ struct nav_sim {
 };
 
 nav_sim_options nav_sim_options_default(void) {
-  nav_sim_options o = {false, NULL, NULL, NULL};
+  nav_sim_options o;
+  memset(&o, 0, sizeof o);
+  o.threads = 1;
   return o;
 }
 
@@ -42,60 +61,106 @@ void nav_sim_request_cancel(nav_sim *sim) {
 
 const char *nav_sim_last_error(const nav_sim *sim) { return sim ? sim->last_error : ""; }
 
-static void set_error(nav_sim *sim, const char *what, nav_status st, double t_s) {
-  snprintf(sim->last_error, sizeof sim->last_error, "%s failed at t = %.6f s: %s", what, t_s, nav_status_str(st));
-}
+/* ------------------------------------------------------------------ one run */
 
-typedef struct stat_set {
-  nav_stat_acc *acc[5];
-} stat_set;
+/* Shared, read-mostly context of a Monte Carlo job. */
+typedef struct job {
+  nav_sim *sim;
+  const nav_sim_options *opts;
+  bool ideal;
+  long runs;
+  int64_t n;            /* IMU samples per run */
+  int64_t stats_stride; /* every stats_stride-th epoch enters the statistics */
+  int64_t stats_per_run;
+  int64_t out_stride;
+  double *metrics;      /* [N_METRICS][runs][stats_per_run] */
+  nav_epoch_errors *final; /* [runs] */
+  int64_t *samples_done;   /* [runs] */
+  nav_status *status;      /* [runs] */
+  atomic_long next_run;
+  atomic_long runs_done;
+  mtx_t err_lock;
+  bool err_set;
+} job;
 
-static nav_status stat_add(stat_set *ss, const nav_epoch_errors *e) {
-  const double v[5] = {e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad, fabs(e->euler_err.yaw_rad)};
-  for (int i = 0; i < 5; ++i) {
-    const nav_status st = nav_stat_acc_add(ss->acc[i], v[i]);
-    if (st != NAV_OK) return st;
+/* Keep the first failure's message (of any run) for nav_sim_last_error. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void job_error(job *j, const char *fmt, ...) {
+  mtx_lock(&j->err_lock);
+  if (!j->err_set) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(j->sim->last_error, sizeof j->sim->last_error, fmt, ap);
+    va_end(ap);
+    j->err_set = true;
   }
-  return NAV_OK;
+  mtx_unlock(&j->err_lock);
 }
 
-nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out) {
+/*
+ * Initial navigation state of a run: the truth at t = 0 plus, unless ideal, the scene's initial
+ * errors drawn from the run's INIT_* streams, resolved in local-level NED at the true position
+ * (attitude error in the phi-angle convention E0.1: C_est = (I - [phi x]) C_true).
+ */
+static nav_ins_state initial_state(const nav_scene *sc, const nav_frame *fr, const nav_traj_state *ts, long run,
+                                   bool ideal) {
+  nav_ins_state s0 = {0.0, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f};
+  if (ideal) return s0;
+  const nav_scene_initial_errors *ie = &sc->initial_errors;
+  nav_vec3 dr_n, dv_n, phi_n;
+  const nav_vec3 *sd[3] = {&ie->pos_sd_m, &ie->vel_sd_mps, &ie->att_sd_rad};
+  nav_vec3 *draw[3] = {&dr_n, &dv_n, &phi_n};
+  const nav_rng_stream_kind kinds[3] = {NAV_RNG_STREAM_INIT_POS, NAV_RNG_STREAM_INIT_VEL, NAV_RNG_STREAM_INIT_ATT};
+  for (int q = 0; q < 3; ++q)
+    for (int axis = 0; axis < 3; ++axis) {
+      nav_rng r;
+      nav_rng_init(&r, sc->simulation.seed, (uint64_t)run, nav_rng_stream_id(kinds[q], (unsigned)axis));
+      nav_vec3_set(draw[q], axis, nav_vec3_get(*sd[q], axis) * nav_rng_gauss(&r));
+    }
+  const nav_local_view v = nav_frame_view(fr, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f);
+  /* C_f_n^T maps n-resolved vectors into F. */
+  s0.r_fb_f_m = nav_vec3_add(ts->r_fb_f_m, nav_mat3_tmul_vec(v.C_f_n, dr_n));
+  s0.v_fb_f_mps = nav_vec3_add(ts->v_fb_f_mps, nav_mat3_tmul_vec(v.C_f_n, dv_n));
+  const nav_vec3 phi_f = nav_mat3_tmul_vec(v.C_f_n, phi_n);
+  s0.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_rotvec(nav_vec3_scale(phi_f, -1.0)), ts->q_b_f));
+  return s0;
+}
+
+static void store_metrics(job *j, long run, int64_t slot, const nav_epoch_errors *e) {
+  const double v[N_METRICS] = {e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad,
+                               fabs(e->euler_err.yaw_rad)};
+  const int64_t row = (int64_t)run * j->stats_per_run + slot;
+  const int64_t plane = (int64_t)j->runs * j->stats_per_run;
+  for (int m = 0; m < N_METRICS; ++m) j->metrics[(int64_t)m * plane + row] = v[m];
+}
+
+static nav_status run_one(job *j, long run, bool caller_thread) {
+  nav_sim *sim = j->sim;
+  const nav_scene *sc = &sim->scene;
   nav_truth *truth = NULL;
   nav_ins *ins = NULL;
-  stat_set ss = {{NULL, NULL, NULL, NULL, NULL}};
-  nav_status st = NAV_OK;
-  nav_sim_summary sum;
-  if (!sim || !opts || !out) return NAV_ERR_INVALID_ARG;
-  memset(&sum, 0, sizeof sum);
-  sim->last_error[0] = '\0';
-  atomic_store(&sim->cancel, false);
-  const nav_scene *sc = &sim->scene;
-
+  nav_imu_model *imu_model = NULL;
   char msg[200];
-  st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
+  nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
   if (st != NAV_OK) {
-    snprintf(sim->last_error, sizeof sim->last_error, "reference trajectory: %s",
-             msg[0] ? msg : nav_status_str(st));
+    job_error(j, "run %ld: reference trajectory: %s", run, msg[0] ? msg : nav_status_str(st));
     goto cleanup;
   }
   const nav_frame frame = nav_truth_frame(truth);
-  const int64_t n = nav_truth_sample_count(truth);
   const double dt = nav_truth_dt(truth);
-  int64_t out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
-  if (out_stride < 1) out_stride = 1;
-  int64_t stats_stride = (n + 1 + STATS_MAX_EPOCHS - 1) / STATS_MAX_EPOCHS;
-  if (stats_stride < 1) stats_stride = 1;
-  for (int i = 0; i < 5; ++i) {
-    st = nav_stat_acc_create((size_t)(n / stats_stride + 2), &ss.acc[i]);
-    if (st != NAV_OK) goto cleanup;
+  if (!j->ideal) {
+    st = nav_imu_model_create(&sc->imu.model, sc->simulation.seed, (uint64_t)run, &imu_model);
+    if (st != NAV_OK) {
+      job_error(j, "run %ld: IMU error model: %s", run, nav_status_str(st));
+      goto cleanup;
+    }
   }
-
-  /* Initial state. Without sensor or initial-state error models in the scene (format v1),
-   * the non-ideal run equals the ideal one. */
   nav_traj_state ts;
   st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
-  nav_ins_state s0 = {0.0, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f};
+  const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
   nav_ins_config icfg = nav_ins_config_default();
   icfg.earth_model = sc->earth.model;
   icfg.algorithm = sc->navigation.algorithm;
@@ -104,72 +169,256 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   icfg.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
   st = nav_ins_create(&icfg, &s0, &ins);
   if (st != NAV_OK) {
-    set_error(sim, "navigation set-up", st, 0.0);
+    job_error(j, "run %ld: navigation set-up: %s", run, nav_status_str(st));
     goto cleanup;
   }
+  const bool aid = sc->navigation.aid_vertical;
+  const bool record = caller_thread && run == 0 && j->opts->record;
+  bool stop = false;
 
   nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
-  st = stat_add(&ss, &err);
-  if (st != NAV_OK) goto cleanup;
-  if (opts->record) {
-    nav_sim_record rec = {0, &frame, &ts, nav_ins_get_state(ins), &err};
-    if (opts->record(opts->user, &rec) == NAV_STOP) sum.partial = true;
+  store_metrics(j, run, 0, &err);
+  if (record) {
+    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err};
+    if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
   }
-
   int64_t k = 1;
-  for (; k <= n && !sum.partial; ++k) {
+  for (; k <= j->n && !stop; ++k) {
     if (atomic_load_explicit(&sim->cancel, memory_order_relaxed)) {
-      sum.partial = true;
+      stop = true;
       break;
     }
-    nav_imu_increment imu;
-    st = nav_truth_imu(truth, k, &imu);
+    nav_imu_increment ideal_imu, meas;
+    st = nav_truth_imu(truth, k, &ideal_imu);
     if (st != NAV_OK) {
-      set_error(sim, "ideal IMU generation", st, (double)k * dt);
+      job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
+                (double)k * dt);
       goto cleanup;
     }
-    st = nav_ins_step(ins, &imu);
-    if (st != NAV_OK) {
-      set_error(sim, "strapdown navigation", st, imu.t_s);
-      goto cleanup;
-    }
-    st = nav_truth_state(truth, imu.t_s, &ts);
-    if (st != NAV_OK) goto cleanup;
-    err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
-    if (k % stats_stride == 0) {
-      st = stat_add(&ss, &err);
+    if (imu_model) {
+      st = nav_imu_model_apply(imu_model, &ideal_imu, &meas);
       if (st != NAV_OK) {
-        set_error(sim, "error statistics", st, imu.t_s);
+        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal_imu.t_s);
         goto cleanup;
       }
+    } else {
+      meas = ideal_imu;
     }
-    if (opts->record && (k % out_stride == 0 || k == n)) {
-      nav_sim_record rec = {0, &frame, &ts, nav_ins_get_state(ins), &err};
-      if (opts->record(opts->user, &rec) == NAV_STOP) sum.partial = true;
+    st = nav_ins_step(ins, &meas);
+    if (st != NAV_OK) {
+      job_error(j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", run, nav_ins_last_error(ins),
+                meas.t_s);
+      goto cleanup;
     }
-    if (opts->progress && (k % PROGRESS_EVERY == 0 || k == n)) {
-      nav_progress p = {"run", 0, (double)k / (double)n, imu.t_s};
-      if (opts->progress(opts->user, &p) == NAV_STOP) sum.partial = true;
+    st = nav_truth_state(truth, meas.t_s, &ts);
+    if (st != NAV_OK) goto cleanup;
+    if (aid) {
+      /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
+      const nav_local_view v = nav_frame_view(&frame, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f);
+      const double h = frame.model == NAV_EARTH_FLAT ? -ts.r_fb_f_m.z : v.pos.h_m;
+      st = nav_ins_aid_vertical(ins, h, v.v_n_mps.z);
+      if (st != NAV_OK) goto cleanup;
+    }
+    err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
+    if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
+    if (record && (k % j->out_stride == 0 || k == j->n)) {
+      nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err};
+      if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
+    }
+    if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
+      const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
+      nav_progress p = {"run", run, done / (double)j->runs, meas.t_s};
+      if (j->opts->progress(j->opts->user, &p) == NAV_STOP) stop = true;
     }
   }
-
-  sum.runs = 1;
-  sum.imu_samples = k - 1;
-  sum.duration_s = (double)(k - 1) * dt;
-  sum.final = err;
-  sum.stats.pos_err_h_m = nav_stat_acc_result(ss.acc[0]);
-  sum.stats.pos_err_v_m = nav_stat_acc_result(ss.acc[1]);
-  sum.stats.vel_err_mps = nav_stat_acc_result(ss.acc[2]);
-  sum.stats.att_err_rad = nav_stat_acc_result(ss.acc[3]);
-  sum.stats.yaw_err_rad = nav_stat_acc_result(ss.acc[4]);
-  sum.stats_epochs = (int64_t)nav_stat_acc_count(ss.acc[0]);
-  sum.stats_stride = stats_stride;
-  *out = sum;
-  st = sum.partial ? NAV_ERR_CANCELLED : NAV_OK;
+  j->final[run] = err;
+  j->samples_done[run] = k - 1;
+  st = stop ? NAV_ERR_CANCELLED : NAV_OK;
+  if (stop) atomic_store(&sim->cancel, true); /* a stop in run 0 stops the whole job */
 
 cleanup:
-  for (int i = 0; i < 5; ++i) nav_stat_acc_destroy(ss.acc[i]);
+  nav_imu_model_destroy(imu_model);
   nav_ins_destroy(ins);
   nav_truth_destroy(truth);
+  j->status[run] = st;
+  atomic_fetch_add(&j->runs_done, 1);
+  return st;
+}
+
+static int worker(void *arg) {
+  job *j = arg;
+  for (;;) {
+    const long run = atomic_fetch_add(&j->next_run, 1);
+    if (run >= j->runs) break;
+    if (atomic_load(&j->sim->cancel)) {
+      j->status[run] = NAV_ERR_CANCELLED;
+      continue;
+    }
+    (void)run_one(j, run, false);
+  }
+  return 0;
+}
+
+/* ------------------------------------------------------------------ statistics */
+
+static nav_status add_values(const double *v, int64_t count, nav_stat_acc *acc) {
+  nav_status st = NAV_OK;
+  for (int64_t i = 0; i < count && st == NAV_OK; ++i) st = nav_stat_acc_add(acc, v[i]);
+  return st;
+}
+
+nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out) {
+  job j;
+  nav_status st = NAV_OK;
+  nav_truth *probe = NULL;
+  nav_stat_acc *acc = NULL;
+  thrd_t *threads = NULL;
+  int started = 0;
+  bool lock_ok = false;
+  if (!sim || !opts || !out) return NAV_ERR_INVALID_ARG;
+  memset(&j, 0, sizeof j);
+  sim->last_error[0] = '\0';
+  atomic_store(&sim->cancel, false);
+  const nav_scene *sc = &sim->scene;
+  j.sim = sim;
+  j.opts = opts;
+  j.ideal = opts->ideal;
+  /* Ideal runs are identical: one is enough. */
+  j.runs = opts->ideal ? 1 : sc->simulation.runs;
+
+  char msg[200];
+  st = nav_truth_create_msg(sc, &probe, msg, sizeof msg);
+  if (st != NAV_OK) {
+    snprintf(sim->last_error, sizeof sim->last_error, "reference trajectory: %s", msg[0] ? msg : nav_status_str(st));
+    return st;
+  }
+  j.n = nav_truth_sample_count(probe);
+  const double dt = nav_truth_dt(probe);
+  nav_truth_destroy(probe);
+  j.out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
+  if (j.out_stride < 1) j.out_stride = 1;
+  const int64_t epochs = j.n + 1;
+  j.stats_stride = ((int64_t)j.runs * epochs + STATS_MAX_VALUES - 1) / STATS_MAX_VALUES;
+  if (j.stats_stride < 1) j.stats_stride = 1;
+  j.stats_per_run = j.n / j.stats_stride + 1;
+
+  const size_t plane = (size_t)j.runs * (size_t)j.stats_per_run;
+  j.metrics = malloc((size_t)N_METRICS * plane * sizeof *j.metrics);
+  j.final = calloc((size_t)j.runs, sizeof *j.final);
+  j.samples_done = calloc((size_t)j.runs, sizeof *j.samples_done);
+  j.status = calloc((size_t)j.runs, sizeof *j.status);
+  if (!j.metrics || !j.final || !j.samples_done || !j.status) {
+    snprintf(sim->last_error, sizeof sim->last_error, "out of memory for %ld runs x %lld epochs", j.runs,
+             (long long)j.stats_per_run);
+    st = NAV_ERR_NO_MEMORY;
+    goto cleanup;
+  }
+  if (mtx_init(&j.err_lock, mtx_plain) != thrd_success) {
+    st = NAV_ERR_NO_MEMORY;
+    goto cleanup;
+  }
+  lock_ok = true;
+  atomic_init(&j.next_run, 1);
+  atomic_init(&j.runs_done, 0);
+
+  /* Run 0 on this thread (records, progress), then the rest on the workers and this thread. */
+  st = run_one(&j, 0, true);
+  if (st == NAV_OK && j.runs > 1) {
+    int nthreads = opts->threads > 0 ? opts->threads : 1;
+    if (nthreads > 256) nthreads = 256;
+    if ((long)nthreads > j.runs - 1) nthreads = (int)(j.runs - 1);
+    threads = calloc((size_t)nthreads, sizeof *threads);
+    if (!threads) {
+      st = NAV_ERR_NO_MEMORY;
+      goto cleanup;
+    }
+    for (int t = 1; t < nthreads; ++t) {
+      if (thrd_create(&threads[t], worker, &j) != thrd_success) break;
+      ++started;
+    }
+    /* This thread works too, reporting progress between runs. */
+    for (;;) {
+      const long run = atomic_fetch_add(&j.next_run, 1);
+      if (run >= j.runs) break;
+      if (atomic_load(&sim->cancel)) {
+        j.status[run] = NAV_ERR_CANCELLED;
+        continue;
+      }
+      (void)run_one(&j, run, false);
+      if (opts->progress) {
+        nav_progress p = {"monte_carlo", run, (double)atomic_load(&j.runs_done) / (double)j.runs, j.n * dt};
+        if (opts->progress(opts->user, &p) == NAV_STOP) atomic_store(&sim->cancel, true);
+      }
+    }
+    for (int t = 1; t <= started; ++t) thrd_join(threads[t], NULL);
+    for (long r = 0; r < j.runs && st == NAV_OK; ++r) st = j.status[r];
+  }
+  if (st != NAV_OK && st != NAV_ERR_CANCELLED) goto cleanup;
+
+  /* Statistics over every run and stored epoch, reduced in run order (deterministic). A
+   * cancelled job reduces what completed: run 0 up to where it stopped. */
+  nav_sim_summary sum;
+  memset(&sum, 0, sizeof sum);
+  sum.partial = st == NAV_ERR_CANCELLED;
+  long complete_runs = 0;
+  for (long r = 0; r < j.runs; ++r)
+    if (j.status[r] == NAV_OK) ++complete_runs;
+  const long stat_runs = sum.partial ? 1 : j.runs;
+  const int64_t used_epochs = sum.partial ? j.samples_done[0] / j.stats_stride + 1 : j.stats_per_run;
+  nav_status sst = nav_stat_acc_create((size_t)stat_runs * (size_t)used_epochs, &acc);
+  if (sst != NAV_OK) {
+    st = sst;
+    goto cleanup;
+  }
+  nav_stat *dst[N_METRICS] = {&sum.stats.pos_err_h_m, &sum.stats.pos_err_v_m, &sum.stats.vel_err_mps,
+                              &sum.stats.att_err_rad, &sum.stats.yaw_err_rad};
+  for (int m = 0; m < N_METRICS && sst == NAV_OK; ++m) {
+    nav_stat_acc_reset(acc);
+    for (long r = 0; r < stat_runs && sst == NAV_OK; ++r)
+      sst = add_values(j.metrics + (size_t)m * plane + (size_t)r * (size_t)j.stats_per_run, used_epochs, acc);
+    *dst[m] = nav_stat_acc_result(acc);
+  }
+  if (sst != NAV_OK) {
+    snprintf(sim->last_error, sizeof sim->last_error, "error statistics: %s (non-finite navigation errors)",
+             nav_status_str(sst));
+    st = sst;
+    goto cleanup;
+  }
+  sum.runs = sum.partial ? complete_runs : j.runs;
+  sum.imu_samples = j.samples_done[0];
+  sum.duration_s = (double)j.samples_done[0] * dt;
+  sum.final = j.final[0];
+  sum.stats_epochs = (int64_t)stat_runs * used_epochs;
+  sum.stats_stride = j.stats_stride;
+  /* RMS over runs of the final errors. */
+  {
+    double s2[4] = {0.0, 0.0, 0.0, 0.0};
+    long nf = 0;
+    for (long r = 0; r < j.runs; ++r) {
+      if (j.status[r] != NAV_OK) continue;
+      const nav_epoch_errors *e = &j.final[r];
+      s2[0] += e->pos_err_h_m * e->pos_err_h_m;
+      s2[1] += e->pos_err_v_m * e->pos_err_v_m;
+      s2[2] += e->vel_err_mps * e->vel_err_mps;
+      s2[3] += e->att_err_rad * e->att_err_rad;
+      ++nf;
+    }
+    if (nf > 0) {
+      sum.final_rms.pos_err_h_m = sqrt(s2[0] / (double)nf);
+      sum.final_rms.pos_err_v_m = sqrt(s2[1] / (double)nf);
+      sum.final_rms.vel_err_mps = sqrt(s2[2] / (double)nf);
+      sum.final_rms.att_err_rad = sqrt(s2[3] / (double)nf);
+    }
+  }
+  *out = sum;
+
+cleanup:
+  nav_stat_acc_destroy(acc);
+  free(threads);
+  if (lock_ok) mtx_destroy(&j.err_lock);
+  free(j.metrics);
+  free(j.final);
+  free(j.samples_done);
+  free(j.status);
   return st;
 }
