@@ -5,16 +5,16 @@
  *
  * Error state (numerics.md 6.1), in this order, with the named index constants below:
  *
- * | block | index              | size | meaning                                              | unit   |
- * |-------|--------------------|------|------------------------------------------------------|--------|
- * | dr    | NAV_FILTER_IDX_DR  | 3    | position error, computed - true, N/E/D metres         | m      |
- * | dv    | NAV_FILTER_IDX_DV  | 3    | velocity error v_eb_n, computed - true                | m/s    |
- * | phi   | NAV_FILTER_IDX_PHI | 3    | attitude error, C_b_n(comp) = (I - [phi x]) C_b_n(true) | rad  |
- * | b_g   | NAV_FILTER_IDX_BG  | 3    | residual gyro bias in the compensated rate            | rad/s  |
- * | b_a   | NAV_FILTER_IDX_BA  | 3    | residual accelerometer bias in the compensated force  | m/s^2  |
- * | s_g   | NAV_FILTER_IDX_SG  | 3    | residual gyro scale factor (optional)                 | -      |
- * | s_a   | NAV_FILTER_IDX_SA  | 3    | residual accelerometer scale factor (optional)        | -      |
- * | e_gps | layout.idx_gnss_pos| 3    | GNSS position error, GM, N/E/D (optional)             | m      |
+ * | block  | index               | size | meaning                                                 | unit  |
+ * |--------|---------------------|------|---------------------------------------------------------|-------|
+ * | dr     | NAV_FILTER_IDX_DR   | 3    | position error, computed - true, N/E/D metres           | m     |
+ * | dv     | NAV_FILTER_IDX_DV   | 3    | velocity error v_eb_n, computed - true                  | m/s   |
+ * | phi    | NAV_FILTER_IDX_PHI  | 3    | attitude error: C_b_n(comp) = (I - [phi x]) C_b_n(true) | rad   |
+ * | b_g    | NAV_FILTER_IDX_BG   | 3    | residual gyro bias in the compensated rate              | rad/s |
+ * | b_a    | NAV_FILTER_IDX_BA   | 3    | residual accelerometer bias in the compensated force    | m/s^2 |
+ * | s_g    | NAV_FILTER_IDX_SG   | 3    | residual gyro scale factor (optional)                   | -     |
+ * | s_a    | NAV_FILTER_IDX_SA   | 3    | residual accelerometer scale factor (optional)          | -     |
+ * | e_gnss | layout.idx_gnss_pos | 3    | GNSS position error, Gauss-Markov, N/E/D (optional)     | m     |
  *
  * dr is (d lat (R_M + h), d lon (R_N + h) cos lat, -d h). The phi convention is numerics.md
  * (E0.1): [SHIN] and KF-GINS; Groves' delta_psi is -phi. The sensor states are what is still
@@ -119,10 +119,10 @@ typedef enum nav_filter_state_option {
 
 /** Where the blocks of a configured filter live. Plain value. */
 typedef struct nav_filter_layout {
-  size_t n_states;         /**< 15, 18, 21 or 24 */
-  bool has_scale_factors;  /**< s_g at NAV_FILTER_IDX_SG, s_a at NAV_FILTER_IDX_SA */
-  bool has_gnss_pos_gm;    /**< GNSS position-error block present at idx_gnss_pos */
-  size_t idx_gnss_pos;     /**< first index of the GNSS block; meaningful only if has_gnss_pos_gm */
+  size_t n_states;        /**< 15, 18, 21 or 24 */
+  bool has_scale_factors; /**< s_g at NAV_FILTER_IDX_SG, s_a at NAV_FILTER_IDX_SA */
+  bool has_gnss_pos_gm;   /**< GNSS position-error block present at idx_gnss_pos */
+  size_t idx_gnss_pos;    /**< first index of the GNSS block; meaningful only if has_gnss_pos_gm */
 } nav_filter_layout;
 
 /* ---------------------------------------------------------------- configuration */
@@ -130,17 +130,19 @@ typedef struct nav_filter_layout {
 /** Discretisation of the continuous model over one covariance step (numerics.md 6.3). */
 typedef enum nav_filter_discretisation {
   /**
-   * E6.2: Phi = I + F T + F^2 T^2/2, Q_d = (Phi G Q_c G^T Phi^T + G Q_c G^T) T/2, computed with
-   * the sparsity of F and fused into a single P sandwich. The default: at IMU rates it agrees
-   * with Van Loan to 5-6 significant digits on T6.3 at a fraction of the cost (test_filter and
-   * the issue-5 notes give the figures). Use it while |F| T stays small (T <= ~0.02 s).
+   * E6.2: Phi = I + F T + F^2 T^2/2, Q_d = (Phi G Q_c G^T Phi^T + G Q_c G^T) T/2, computed over
+   * the non-zeros of F and fused into a single P sandwich. The default, because at IMU rates it
+   * is as accurate as Van Loan for every purpose here at an eighth of the cost: on T6.3
+   * (dt = 0.01 s) the position sigmas differ from Van Loan by 6e-8 relative; with
+   * cov_decimation 20 (T = 0.2 s) by 2.4e-5. numerics.md 6.3 rates it adequate for T <= 0.1 s.
    */
   NAV_FILTER_DISC_SECOND_ORDER = 0,
   /**
    * E6.1: exact for F constant over the step, through the matrix exponential of the 2n x 2n
-   * Van Loan matrix (scaling and squaring with Pade approximants, Higham 2005). About 10-20
-   * times the cost of the second-order form at n = 15; the right choice with cov_decimation > 1
-   * (long covariance steps) and as the reference.
+   * Van Loan matrix (scaling and squaring with Pade approximants, Higham 2005). About 8.5 times
+   * the cost of the second-order form per covariance step (n = 15 and 24); the reference
+   * discretisation, and the right choice for long covariance steps (cov_decimation > 1), where
+   * its cost is amortised.
    */
   NAV_FILTER_DISC_VAN_LOAN = 1
 } nav_filter_discretisation;
@@ -157,14 +159,14 @@ typedef enum nav_filter_process_term {
  * must be finite and > 0 for the blocks that exist (P0 must be positive definite).
  */
 typedef struct nav_filter_init_sd {
-  nav_vec3 pos_sd_m;         /**< dr, N/E/D [m] */
-  nav_vec3 vel_sd_mps;       /**< dv, N/E/D [m/s] */
-  nav_vec3 att_sd_rad;       /**< phi, N/E/D [rad] (roll/pitch-like, roll/pitch-like, heading) */
-  nav_vec3 gyro_bias_sd_rps; /**< b_g, body axes [rad/s] */
+  nav_vec3 pos_sd_m;           /**< dr, N/E/D [m] */
+  nav_vec3 vel_sd_mps;         /**< dv, N/E/D [m/s] */
+  nav_vec3 att_sd_rad;         /**< phi, N/E/D [rad] (roll/pitch-like, roll/pitch-like, heading) */
+  nav_vec3 gyro_bias_sd_rps;   /**< b_g, body axes [rad/s] */
   nav_vec3 accel_bias_sd_mps2; /**< b_a, body axes [m/s^2] */
-  nav_vec3 gyro_sf_sd;       /**< s_g, unitless (1e-6 = 1 ppm) */
-  nav_vec3 accel_sf_sd;      /**< s_a, unitless */
-  nav_vec3 gnss_pos_sd_m;    /**< GNSS position error, N/E/D [m] */
+  nav_vec3 gyro_sf_sd;         /**< s_g, unitless (1e-6 = 1 ppm) */
+  nav_vec3 accel_sf_sd;        /**< s_a, unitless */
+  nav_vec3 gnss_pos_sd_m;      /**< GNSS position error, N/E/D [m] */
 } nav_filter_init_sd;
 
 /**
@@ -172,47 +174,52 @@ typedef struct nav_filter_init_sd {
  * Start from nav_filter_config_default() and override fields (style.md 6).
  */
 typedef struct nav_filter_config {
-  unsigned states;                              /**< OR of ::nav_filter_state_option; 0: 15 states */
-  nav_filter_discretisation discretisation;     /**< default NAV_FILTER_DISC_SECOND_ORDER */
+  unsigned states;                          /**< OR of ::nav_filter_state_option; 0: 15 states */
+  nav_filter_discretisation discretisation; /**< default NAV_FILTER_DISC_SECOND_ORDER */
   /**
-   * Covariance decimation N >= 1: P is propagated once every N calls of nav_filter_predict().
-   * In between, F dt and G Q_c G^T dt are summed (n^2 additions per IMU step); the covariance
-   * step then discretises the mean F over the summed interval T with the selected method
-   * (for constant F identical to the product of the per-step Phi; the noise is transported
-   * across the interval instead of summed untransported). An update, nav_filter_flush() or
-   * nav_filter_set_cov() first completes the pending partial step, so updates are always applied
-   * to a current P. Default 1.
+   * Covariance decimation N >= 1: P (and x) are propagated once every N calls of
+   * nav_filter_predict(). In between, F dt and G Q_c G^T dt are summed (n^2 additions per IMU
+   * step); the covariance step then applies the selected discretisation to the mean F and mean
+   * G Q_c G^T over the summed interval T. With Van Loan that equals the product of the per-step
+   * transitions when F is constant, and the noise is transported across the interval (not just
+   * summed); with the second-order form the truncation grows as (|F| T)^3. Measured on T6.3
+   * (sigma_N up to 120 s, relative to undecimated Van Loan): Van Loan N = 10, 20: 5e-13;
+   * second order N = 10: 6e-6, N = 20: 2.4e-5. Cost per IMU step at n = 15 (instruction
+   * counts) relative to the undecimated second-order form: second order N = 10: 0.19, N = 20:
+   * 0.15; Van Loan N = 1: 8.4, N = 10: 1.4, N = 20: 0.9. An update, nav_filter_flush() or
+   * nav_filter_set_cov() first completes the pending partial step, so updates always apply to a
+   * current P. Default 1.
    */
   unsigned cov_decimation;
 
-  nav_vec3 gyro_arw_rad_per_sqrt_s;             /**< ARW N_g per axis [rad/sqrt(s)], >= 0 */
-  nav_vec3 accel_vrw_mps_per_sqrt_s;            /**< VRW N_a per axis [m/s/sqrt(s)], >= 0 */
+  nav_vec3 gyro_arw_rad_per_sqrt_s;  /**< ARW N_g per axis [rad/sqrt(s)], >= 0 */
+  nav_vec3 accel_vrw_mps_per_sqrt_s; /**< VRW N_a per axis [m/s/sqrt(s)], >= 0 */
 
-  unsigned gyro_bias_terms;                     /**< OR of ::nav_filter_process_term */
-  nav_vec3 gyro_bias_gm_sd_rps;                 /**< GM: stationary sigma [rad/s], >= 0 */
-  nav_vec3 gyro_bias_gm_tau_s;                  /**< GM: correlation time T [s], > 0, finite */
-  nav_vec3 gyro_bias_rw_rps_per_sqrt_s;         /**< RW: K [rad/s/sqrt(s)], >= 0 */
-  unsigned accel_bias_terms;                    /**< OR of ::nav_filter_process_term */
-  nav_vec3 accel_bias_gm_sd_mps2;               /**< GM: stationary sigma [m/s^2], >= 0 */
-  nav_vec3 accel_bias_gm_tau_s;                 /**< GM: correlation time T [s], > 0, finite */
-  nav_vec3 accel_bias_rw_mps2_per_sqrt_s;       /**< RW: K [m/s^2/sqrt(s)], >= 0 */
+  unsigned gyro_bias_terms;               /**< OR of ::nav_filter_process_term */
+  nav_vec3 gyro_bias_gm_sd_rps;           /**< GM: stationary sigma [rad/s], >= 0 */
+  nav_vec3 gyro_bias_gm_tau_s;            /**< GM: correlation time T [s], > 0, finite */
+  nav_vec3 gyro_bias_rw_rps_per_sqrt_s;   /**< RW: K [rad/s/sqrt(s)], >= 0 */
+  unsigned accel_bias_terms;              /**< OR of ::nav_filter_process_term */
+  nav_vec3 accel_bias_gm_sd_mps2;         /**< GM: stationary sigma [m/s^2], >= 0 */
+  nav_vec3 accel_bias_gm_tau_s;           /**< GM: correlation time T [s], > 0, finite */
+  nav_vec3 accel_bias_rw_mps2_per_sqrt_s; /**< RW: K [m/s^2/sqrt(s)], >= 0 */
 
-  unsigned gyro_sf_terms;                       /**< scale factors: OR of ::nav_filter_process_term */
-  nav_vec3 gyro_sf_gm_sd;                       /**< GM sigma, unitless */
-  nav_vec3 gyro_sf_gm_tau_s;                    /**< GM correlation time [s] */
-  nav_vec3 gyro_sf_rw_per_sqrt_s;               /**< RW K [1/sqrt(s)] */
+  unsigned gyro_sf_terms;         /**< scale factors: OR of ::nav_filter_process_term */
+  nav_vec3 gyro_sf_gm_sd;         /**< GM sigma, unitless */
+  nav_vec3 gyro_sf_gm_tau_s;      /**< GM correlation time [s] */
+  nav_vec3 gyro_sf_rw_per_sqrt_s; /**< RW K [1/sqrt(s)] */
   unsigned accel_sf_terms;
   nav_vec3 accel_sf_gm_sd;
   nav_vec3 accel_sf_gm_tau_s;
   nav_vec3 accel_sf_rw_per_sqrt_s;
 
-  nav_vec3 gnss_pos_gm_sd_m;                    /**< GNSS GM states: stationary sigma, N/E/D [m], >= 0 */
-  nav_vec3 gnss_pos_gm_tau_s;                   /**< GNSS GM states: correlation time [s], > 0, finite */
+  nav_vec3 gnss_pos_gm_sd_m;  /**< GNSS GM states: stationary sigma, N/E/D [m], >= 0 */
+  nav_vec3 gnss_pos_gm_tau_s; /**< GNSS GM states: correlation time [s], > 0, finite */
 
-  nav_filter_init_sd init;                      /**< P0 (diagonal) */
+  nav_filter_init_sd init; /**< P0 (diagonal) */
 
-  nav_vec3 gnss_pos_sd_m;                       /**< default R of position updates: sigma N/E/D [m], > 0 */
-  nav_vec3 gnss_vel_sd_mps;                     /**< default R of velocity updates: sigma N/E/D [m/s], > 0 */
+  nav_vec3 gnss_pos_sd_m;   /**< default R of position updates: sigma N/E/D [m], > 0 */
+  nav_vec3 gnss_vel_sd_mps; /**< default R of velocity updates: sigma N/E/D [m/s], > 0 */
 } nav_filter_config;
 
 /**
@@ -249,12 +256,12 @@ typedef struct nav_filter nav_filter;
  * except in covariance analysis where the reference trajectory is used).
  */
 typedef struct nav_filter_nav {
-  double lat_rad;        /**< geodetic latitude [rad], |lat| < pi/2 (cos lat >= 1e-6) */
-  double h_m;            /**< ellipsoidal height [m] */
-  nav_vec3 v_eb_n_mps;   /**< velocity relative to the Earth, NED [m/s] */
-  nav_mat3 C_b_n;        /**< attitude, body to NED */
-  nav_vec3 f_ib_b_mps2;  /**< compensated specific force, body axes [m/s^2] (mean over the step) */
-  nav_vec3 w_ib_b_rps;   /**< compensated angular rate, body axes [rad/s] (mean over the step) */
+  double lat_rad;       /**< geodetic latitude [rad], |lat| < pi/2 (cos lat >= 1e-6) */
+  double h_m;           /**< ellipsoidal height [m] */
+  nav_vec3 v_eb_n_mps;  /**< velocity relative to the Earth, NED [m/s] */
+  nav_mat3 C_b_n;       /**< attitude, body to NED */
+  nav_vec3 f_ib_b_mps2; /**< compensated specific force, body axes [m/s^2] (mean over the step) */
+  nav_vec3 w_ib_b_rps;  /**< compensated angular rate, body axes [rad/s] (mean over the step) */
 } nav_filter_nav;
 
 /**
@@ -302,8 +309,11 @@ NAV_API NAV_NODISCARD nav_status nav_filter_flush(nav_filter *f);
  * @param[in] z_pos_ned_m measurement, e.g. from nav_filter_gnss_pos_residual() [m]
  * @param[in] r_diag_m2  R diagonal N/E/D [m^2], each > 0; NULL: the config's gnss_pos_sd_m^2
  * @param[in] l_ba_b_m   lever arm, antenna relative to the IMU, body axes [m]
- * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL f/nav, R <= 0); NAV_ERR_NUMERIC (non-finite input,
- *         S or the updated P not positive definite). On error x and P are unchanged.
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL f/nav, R <= 0); NAV_ERR_OUT_OF_RANGE (cos(lat) <
+ *         1e-6); NAV_ERR_NUMERIC (non-finite input, S or the updated P not positive definite).
+ *         Invalid inputs are rejected before anything changes. With valid inputs a pending
+ *         decimated propagation is completed first; if the update itself then fails, x and P are
+ *         those of that completed propagation.
  */
 NAV_API NAV_NODISCARD nav_status nav_filter_update_gnss_pos(nav_filter *f, const nav_filter_nav *nav,
                                                             nav_vec3 z_pos_ned_m, const nav_vec3 *r_diag_m2,
@@ -321,8 +331,8 @@ NAV_API NAV_NODISCARD nav_status nav_filter_update_gnss_pos(nav_filter *f, const
  * C_b_n and w_ib_b_rps are used.
  */
 NAV_API NAV_NODISCARD nav_status nav_filter_update_gnss_vel(nav_filter *f, const nav_filter_nav *nav,
-                                                            nav_vec3 z_vel_ned_mps, const nav_vec3 *r_diag_m2s2,
-                                                            nav_vec3 l_ba_b_m);
+                                                            nav_vec3 z_vel_ned_mps,
+                                                            const nav_vec3 *r_diag_m2s2, nav_vec3 l_ba_b_m);
 
 /**
  * Generic linear update z = H x + v, v ~ N(0, R), by the same algorithm (Cholesky of S, Joseph).
@@ -353,22 +363,27 @@ NAV_API NAV_NODISCARD nav_status nav_filter_reset_errors(nav_filter *f);
  */
 NAV_API NAV_NODISCARD nav_status nav_filter_set_cov(nav_filter *f, const double *P);
 
-/** State estimate x (n doubles; borrowed, valid until the next non-const call or destroy). */
+/**
+ * State estimate x (n doubles, order of the IDX constants; borrowed, valid until the next
+ * non-const call or destroy). With cov_decimation > 1, x and P are those of the last covariance
+ * step; nav_filter_flush() brings them to the current epoch.
+ */
 NAV_API const double *nav_filter_get_state(const nav_filter *f);
 
-/** Covariance P (n x n row-major; borrowed, valid until the next non-const call or destroy). */
+/** Covariance P (n x n row-major; borrowed, valid until the next non-const call or destroy; see
+ *  nav_filter_get_state() about cov_decimation). */
 NAV_API const double *nav_filter_get_cov(const nav_filter *f);
 
 /** The error estimate by block. Plain value. Blocks absent from the layout are zero. */
 typedef struct nav_filter_error {
-  nav_vec3 dr_ned_m;       /**< position error, N/E/D [m] */
-  nav_vec3 dv_n_mps;       /**< velocity error, N/E/D [m/s] */
-  nav_vec3 phi_rad;        /**< attitude error (E0.1), NED [rad] */
-  nav_vec3 b_g_rps;        /**< residual gyro bias, body [rad/s] */
-  nav_vec3 b_a_mps2;       /**< residual accelerometer bias, body [m/s^2] */
-  nav_vec3 s_g;            /**< residual gyro scale factor (0 if absent) */
-  nav_vec3 s_a;            /**< residual accelerometer scale factor (0 if absent) */
-  nav_vec3 gnss_pos_m;     /**< GNSS position error estimate, N/E/D [m] (0 if absent) */
+  nav_vec3 dr_ned_m;   /**< position error, N/E/D [m] */
+  nav_vec3 dv_n_mps;   /**< velocity error, N/E/D [m/s] */
+  nav_vec3 phi_rad;    /**< attitude error (E0.1), NED [rad] */
+  nav_vec3 b_g_rps;    /**< residual gyro bias, body [rad/s] */
+  nav_vec3 b_a_mps2;   /**< residual accelerometer bias, body [m/s^2] */
+  nav_vec3 s_g;        /**< residual gyro scale factor (0 if absent) */
+  nav_vec3 s_a;        /**< residual accelerometer scale factor (0 if absent) */
+  nav_vec3 gnss_pos_m; /**< GNSS position error estimate, N/E/D [m] (0 if absent) */
 } nav_filter_error;
 
 /**
@@ -436,7 +451,8 @@ NAV_API nav_vec3 nav_filter_gnss_pos_residual(nav_geodetic ins_pos, nav_mat3 C_b
  * @param[in] v_gnss_n_mps  measured antenna velocity, NED [m/s]
  * @return z_vel_ned_mps [m/s]
  */
-NAV_API nav_vec3 nav_filter_gnss_vel_residual(const nav_filter_nav *nav, nav_vec3 l_ba_b_m, nav_vec3 v_gnss_n_mps);
+NAV_API nav_vec3 nav_filter_gnss_vel_residual(const nav_filter_nav *nav, nav_vec3 l_ba_b_m,
+                                              nav_vec3 v_gnss_n_mps);
 
 NAV_END_DECLS
 

@@ -141,6 +141,14 @@ NAV_API NAV_NODISCARD nav_status nav_ins_step(nav_ins *ins, const nav_imu_increm
 NAV_API NAV_NODISCARD nav_status nav_ins_aid_vertical(nav_ins *ins, double h_m, double v_d_mps);
 
 /**
+ * Replace the navigation state (closed-loop feedback of an aiding filter). The state is given in
+ * F as for nav_ins_create(); the previous increments used by the coning and sculling terms and
+ * the vertical hold are kept. Allocates nothing. On failure the state is unchanged.
+ * @return NAV_OK; NAV_ERR_NUMERIC for a non-finite state; the statuses of nav_ins_create().
+ */
+NAV_API NAV_NODISCARD nav_status nav_ins_set_state(nav_ins *ins, const nav_ins_state *state);
+
+/**
  * Current state in F (borrowed; valid until the next non-const call or destroy).
  * The NED mechanization computes this e-frame view of its geodetic state on the first call after
  * a step (a cache inside the object), so a caller that reads the state at an output rate does

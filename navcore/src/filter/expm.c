@@ -27,15 +27,28 @@ static const double pade5[6] = {30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0};
 static const double pade7[8] = {17297280.0, 8648640.0, 1995840.0, 277200.0, 25200.0, 1512.0, 56.0, 1.0};
 static const double pade9[10] = {17643225600.0, 8821612800.0, 2075673600.0, 302702400.0, 30270240.0,
                                  2162160.0,     110880.0,     3960.0,       90.0,        1.0};
-static const double pade13[14] = {64764752532480000.0, 32382376266240000.0, 7771770303897600.0,
-                                  1187353796428800.0,  129060195264000.0,   10559470521600.0,
-                                  670442572800.0,      33522128640.0,       1323241920.0,
-                                  40840800.0,          960960.0,            16380.0,
-                                  182.0,               1.0};
+static const double pade13[14] = {64764752532480000.0,
+                                  32382376266240000.0,
+                                  7771770303897600.0,
+                                  1187353796428800.0,
+                                  129060195264000.0,
+                                  10559470521600.0,
+                                  670442572800.0,
+                                  33522128640.0,
+                                  1323241920.0,
+                                  40840800.0,
+                                  960960.0,
+                                  16380.0,
+                                  182.0,
+                                  1.0};
 
-size_t nav_expm_work_size(size_t n) { return 7 * n * n + n; }
+size_t nav_expm_work_size(size_t n) {
+  return 7 * n * n + n;
+}
 
-size_t nav_van_loan_work_size(size_t n) { return 2 * (2 * n) * (2 * n) + nav_expm_work_size(2 * n); }
+size_t nav_van_loan_work_size(size_t n) {
+  return 2 * (2 * n) * (2 * n) + nav_expm_work_size(2 * n);
+}
 
 static double norm1(const double *a, size_t n) {
   double best = 0.0;
@@ -48,8 +61,27 @@ static double norm1(const double *a, size_t n) {
   return best;
 }
 
+/* C = A B (n x n) in i-k-j order, skipping exact zeros of A. The Van Loan matrix is block upper
+ * triangular with a sparse F, so its powers keep many exact zeros and this halves the work or
+ * better; with finite operands skipping 0 * b changes no value (at most the sign of a zero). */
+static void mul_skip(double *c, const double *a, const double *b, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    double *ci = c + i * n;
+    for (size_t j = 0; j < n; ++j)
+      ci[j] = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      const double aik = a[i * n + k];
+      if (aik == 0.0) continue;
+      const double *bk = b + k * n;
+      for (size_t j = 0; j < n; ++j)
+        ci[j] += aik * bk[j];
+    }
+  }
+}
+
 /* out = sum_k c[k] * mats[k] + c_id * I (all n x n). */
-static void lincomb(double *out, size_t n, size_t count, const double *const *mats, const double *c, double c_id) {
+static void lincomb(double *out, size_t n, size_t count, const double *const *mats, const double *c,
+                    double c_id) {
   for (size_t i = 0; i < n * n; ++i) {
     double s = 0.0;
     for (size_t k = 0; k < count; ++k)
@@ -160,26 +192,26 @@ nav_status nav_expm(double *E, const double *A, size_t n, double *work, nav_expm
   for (size_t i = 0; i < nn; ++i)
     As[i] = A[i] * scale;
 
-  nav_matn_mul(A2, As, As, n, n, n);
+  mul_skip(A2, As, As, n);
   double *U = T1;
   if (m == 13) {
     /* Higham (2005) eq. 2.6 for m = 13: six products and one solve.
      * U = A [A6 (b13 A6 + b11 A4 + b9 A2) + b7 A6 + b5 A4 + b3 A2 + b1 I]
      * V =    A6 (b12 A6 + b10 A4 + b8 A2) + b6 A6 + b4 A4 + b2 A2 + b0 I */
-    nav_matn_mul(A4, A2, A2, n, n, n);
-    nav_matn_mul(A6, A4, A2, n, n, n);
+    mul_skip(A4, A2, A2, n);
+    mul_skip(A6, A4, A2, n);
     const double *pw[3] = {A6, A4, A2};
     const double cu1[3] = {b[13], b[11], b[9]};
     lincomb(T1, n, 3, pw, cu1, 0.0);
-    nav_matn_mul(T2, A6, T1, n, n, n);
+    mul_skip(T2, A6, T1, n);
     const double cu2[3] = {b[7], b[5], b[3]};
     lincomb(T1, n, 3, pw, cu2, b[1]);
     for (size_t i = 0; i < nn; ++i)
       T2[i] += T1[i];
-    nav_matn_mul(U, As, T2, n, n, n); /* U in T1 */
+    mul_skip(U, As, T2, n); /* U in T1 */
     const double cv1[3] = {b[12], b[10], b[8]};
     lincomb(T2, n, 3, pw, cv1, 0.0);
-    nav_matn_mul(V, A6, T2, n, n, n);
+    mul_skip(V, A6, T2, n);
     const double cv2[3] = {b[6], b[4], b[2]};
     lincomb(T2, n, 3, pw, cv2, b[0]);
     for (size_t i = 0; i < nn; ++i)
@@ -188,9 +220,9 @@ nav_status nav_expm(double *E, const double *A, size_t n, double *work, nav_expm
     /* Degrees 3..9: powers A2, A4, A6, A8 as needed (A8 in T2). */
     const double *pw[4] = {A2, A4, A6, T2};
     size_t np = (m - 1) / 2; /* number of even powers used: 1, 2, 3, 4 */
-    if (np >= 2) nav_matn_mul(A4, A2, A2, n, n, n);
-    if (np >= 3) nav_matn_mul(A6, A4, A2, n, n, n);
-    if (np >= 4) nav_matn_mul(T2, A6, A2, n, n, n);
+    if (np >= 2) mul_skip(A4, A2, A2, n);
+    if (np >= 3) mul_skip(A6, A4, A2, n);
+    if (np >= 4) mul_skip(T2, A6, A2, n);
     double cu[4] = {0}, cv[4] = {0};
     for (size_t k = 0; k < np; ++k) {
       cu[k] = b[2 * k + 3];
@@ -199,7 +231,7 @@ nav_status nav_expm(double *E, const double *A, size_t n, double *work, nav_expm
     /* V, then the odd polynomial (in E, free until the solve) and U = A (odd polynomial). */
     lincomb(V, n, np, pw, cv, b[0]);
     lincomb(E, n, np, pw, cu, b[1]);
-    nav_matn_mul(U, As, E, n, n, n);
+    mul_skip(U, As, E, n);
   }
 
   /* (V - U) X = (V + U): the denominator in T2 (factored in place), the right-hand side in E. */
@@ -212,7 +244,7 @@ nav_status nav_expm(double *E, const double *A, size_t n, double *work, nav_expm
 
   /* Undo the scaling: E <- E^(2^s), ping-ponging through As. */
   for (unsigned k = 0; k < s; ++k) {
-    nav_matn_mul(As, E, E, n, n, n);
+    mul_skip(As, E, E, n);
     memcpy(E, As, nn * sizeof *E);
   }
   for (size_t i = 0; i < nn; ++i)
@@ -224,8 +256,8 @@ nav_status nav_expm(double *E, const double *A, size_t n, double *work, nav_expm
   return NAV_OK;
 }
 
-nav_status nav_filter_van_loan(double *Phi, double *Qd, const double *FT, const double *QT, size_t n, double *work,
-                               nav_expm_info *info) {
+nav_status nav_filter_van_loan(double *Phi, double *Qd, const double *FT, const double *QT, size_t n,
+                               double *work, nav_expm_info *info) {
   assert(Phi != NULL && Qd != NULL && FT != NULL && QT != NULL && work != NULL);
   if (Phi == NULL || Qd == NULL || FT == NULL || QT == NULL || work == NULL || n == 0 ||
       2 * n > NAV_EXPM_MAX_DIM)

@@ -54,17 +54,17 @@ size_t nav_van_loan_work_size(size_t n);
  * and no accuracy.
  * @return NAV_OK or the status of nav_expm().
  */
-nav_status nav_filter_van_loan(double *Phi, double *Qd, const double *FT, const double *QT, size_t n, double *work,
-                               nav_expm_info *info);
+nav_status nav_filter_van_loan(double *Phi, double *Qd, const double *FT, const double *QT, size_t n,
+                               double *work, nav_expm_info *info);
 
 /* ---------------------------------------------------------------- model (model.c) */
 
 /** Earth quantities F needs at the linearisation point. */
 typedef struct nav_filter_earth_terms {
-  double R_M_m;   /**< meridian radius of curvature (without h) [m] */
-  double R_N_m;   /**< prime-vertical radius of curvature (without h) [m] */
-  double g_mps2;  /**< gravity magnitude [m/s^2] */
-  double w_ie_rps;/**< Earth rotation rate [rad/s] */
+  double R_M_m;    /**< meridian radius of curvature (without h) [m] */
+  double R_N_m;    /**< prime-vertical radius of curvature (without h) [m] */
+  double g_mps2;   /**< gravity magnitude [m/s^2] */
+  double w_ie_rps; /**< Earth rotation rate [rad/s] */
 } nav_filter_earth_terms;
 
 /** WGS-84 radii R_M(lat), R_N(lat), normal gravity gamma(lat, h), omega_ie. */
@@ -87,10 +87,12 @@ void nav_filter_build_F(double *F, const nav_filter_layout *lay, const nav_filte
 void nav_filter_build_GQG(double *GQG, const nav_filter_layout *lay, nav_mat3 C_b_n, const double *qc);
 
 /** H of the GNSS position update (3 x n), E6.3. */
-void nav_filter_build_H_pos(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav, nav_vec3 l_ba_b_m);
+void nav_filter_build_H_pos(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                            nav_vec3 l_ba_b_m);
 
 /** H of the GNSS velocity update (3 x n), E6.4 with the Earth-rate term kept. */
-void nav_filter_build_H_vel(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav, nav_vec3 l_ba_b_m);
+void nav_filter_build_H_vel(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                            nav_vec3 l_ba_b_m);
 
 /** Layout of a configuration's state mask. */
 nav_filter_layout nav_filter_layout_of(unsigned states);

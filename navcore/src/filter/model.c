@@ -18,7 +18,9 @@
 
 /* ---------------------------------------------------------------- configuration */
 
-static nav_vec3 v3(double a) { return nav_vec3_make(a, a, a); }
+static nav_vec3 v3(double a) {
+  return nav_vec3_make(a, a, a);
+}
 
 nav_filter_config nav_filter_config_default(void) {
   nav_filter_config c;
@@ -117,8 +119,8 @@ nav_status nav_filter_config_validate(const nav_filter_config *cfg, nav_scene_is
   check_vec(&ck, "accel_vrw_mps_per_sqrt_s", cfg->accel_vrw_mps_per_sqrt_s, false);
   check_process(&ck, "gyro_bias", cfg->gyro_bias_terms, cfg->gyro_bias_gm_sd_rps, cfg->gyro_bias_gm_tau_s,
                 cfg->gyro_bias_rw_rps_per_sqrt_s);
-  check_process(&ck, "accel_bias", cfg->accel_bias_terms, cfg->accel_bias_gm_sd_mps2, cfg->accel_bias_gm_tau_s,
-                cfg->accel_bias_rw_mps2_per_sqrt_s);
+  check_process(&ck, "accel_bias", cfg->accel_bias_terms, cfg->accel_bias_gm_sd_mps2,
+                cfg->accel_bias_gm_tau_s, cfg->accel_bias_rw_mps2_per_sqrt_s);
   check_vec(&ck, "init.pos_sd_m", cfg->init.pos_sd_m, true);
   check_vec(&ck, "init.vel_sd_mps", cfg->init.vel_sd_mps, true);
   check_vec(&ck, "init.att_sd_rad", cfg->init.att_sd_rad, true);
@@ -196,7 +198,7 @@ void nav_filter_build_F(double *F, const nav_filter_layout *lay, const nav_filte
   const double rm = earth->R_M_m + h, rn = earth->R_N_m + h;
   const double wie = earth->w_ie_rps, g = earth->g_mps2;
   const double rm2 = rm * rm, rn2 = rn * rn, c2 = cl * cl;
-#define F_(i, j) F[(size_t)(i) * n + (size_t)(j)]
+#define F_(i, j) F[(size_t)(i)*n + (size_t)(j)]
   const size_t R = NAV_FILTER_IDX_DR, V = NAV_FILTER_IDX_DV, P = NAV_FILTER_IDX_PHI;
 
   /* F_rr, F_rv */
@@ -262,8 +264,10 @@ void nav_filter_build_GQG(double *GQG, const nav_filter_layout *lay, nav_mat3 C_
   memset(GQG, 0, n * n * sizeof *GQG);
   /* numerics.md 6.2: dv gets C_b_n w_a and phi gets -C_b_n w_g; with independent per-axis white
    * noise the blocks are C diag(q) C^T (the sign of G drops out). */
-  const nav_vec3 qa = nav_vec3_make(qc[NAV_FILTER_IDX_DV], qc[NAV_FILTER_IDX_DV + 1], qc[NAV_FILTER_IDX_DV + 2]);
-  const nav_vec3 qg = nav_vec3_make(qc[NAV_FILTER_IDX_PHI], qc[NAV_FILTER_IDX_PHI + 1], qc[NAV_FILTER_IDX_PHI + 2]);
+  const nav_vec3 qa =
+      nav_vec3_make(qc[NAV_FILTER_IDX_DV], qc[NAV_FILTER_IDX_DV + 1], qc[NAV_FILTER_IDX_DV + 2]);
+  const nav_vec3 qg =
+      nav_vec3_make(qc[NAV_FILTER_IDX_PHI], qc[NAV_FILTER_IDX_PHI + 1], qc[NAV_FILTER_IDX_PHI + 2]);
   nav_mat3 bv = nav_mat3_mul(mul_diag(C_b_n, qa), nav_mat3_transpose(C_b_n));
   nav_mat3 bp = nav_mat3_mul(mul_diag(C_b_n, qg), nav_mat3_transpose(C_b_n));
   /* Exact symmetry of the blocks (the two triangles round differently). */
@@ -280,7 +284,8 @@ void nav_filter_build_GQG(double *GQG, const nav_filter_layout *lay, nav_mat3 C_
 
 /* ---------------------------------------------------------------- measurements */
 
-void nav_filter_build_H_pos(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav, nav_vec3 l_ba_b_m) {
+void nav_filter_build_H_pos(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                            nav_vec3 l_ba_b_m) {
   const size_t n = lay->n_states;
   memset(H, 0, 3 * n * sizeof *H);
   /* E6.3: z = dr + (C_comp - C_true) l = dr + [(C l) x] phi to first order
@@ -294,7 +299,8 @@ void nav_filter_build_H_pos(double *H, const nav_filter_layout *lay, const nav_f
       H[i * n + lay->idx_gnss_pos + i] = -1.0;
 }
 
-void nav_filter_build_H_vel(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav, nav_vec3 l_ba_b_m) {
+void nav_filter_build_H_vel(double *H, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                            nav_vec3 l_ba_b_m) {
   const size_t n = lay->n_states;
   memset(H, 0, 3 * n * sizeof *H);
   /* E6.4: z = dv + C (w x l) - w_ie x (C l) - v_GNSS with w = w_true + b_g + diag(w) s_g:
@@ -307,22 +313,23 @@ void nav_filter_build_H_vel(double *H, const nav_filter_layout *lay, const nav_f
   const nav_vec3 Cwl = nav_mat3_mul_vec(C, nav_vec3_cross(w, l_ba_b_m));
   const nav_vec3 Cl = nav_mat3_mul_vec(C, l_ba_b_m);
   const nav_vec3 w_ie_n = nav_earth_rate_n_rps(nav->lat_rad);
-  const nav_mat3 hphi = nav_mat3_add(nav_mat3_skew(Cwl),
-                                     nav_mat3_scale(nav_mat3_mul(nav_mat3_skew(w_ie_n), nav_mat3_skew(Cl)), -1.0));
+  const nav_mat3 hphi = nav_mat3_add(
+      nav_mat3_skew(Cwl), nav_mat3_scale(nav_mat3_mul(nav_mat3_skew(w_ie_n), nav_mat3_skew(Cl)), -1.0));
   put3(H, n, 0, NAV_FILTER_IDX_PHI, hphi);
   const nav_mat3 mCl = nav_mat3_scale(nav_mat3_mul(C, nav_mat3_skew(l_ba_b_m)), -1.0);
   put3(H, n, 0, NAV_FILTER_IDX_BG, mCl);
   if (lay->has_scale_factors) put3(H, n, 0, NAV_FILTER_IDX_SG, mul_diag(mCl, w));
 }
 
-nav_vec3 nav_filter_gnss_pos_residual(nav_geodetic ins_pos, nav_mat3 C_b_n, nav_vec3 l_ba_b_m, nav_geodetic gnss_pos) {
+nav_vec3 nav_filter_gnss_pos_residual(nav_geodetic ins_pos, nav_mat3 C_b_n, nav_vec3 l_ba_b_m,
+                                      nav_geodetic gnss_pos) {
   /* E6.3 with D = diag(R_M + h, (R_N + h) cos lat, -1) at the INS position. */
   const double rm = nav_earth_radius_meridian_m(ins_pos.lat_rad) + ins_pos.h_m;
   const double rn = nav_earth_radius_prime_vertical_m(ins_pos.lat_rad) + ins_pos.h_m;
   const nav_vec3 Cl = nav_mat3_mul_vec(C_b_n, l_ba_b_m);
   const double dlon = nav_earth_wrap_lon(ins_pos.lon_rad - gnss_pos.lon_rad);
-  return nav_vec3_make((ins_pos.lat_rad - gnss_pos.lat_rad) * rm + Cl.x, dlon * rn * cos(ins_pos.lat_rad) + Cl.y,
-                       -(ins_pos.h_m - gnss_pos.h_m) + Cl.z);
+  return nav_vec3_make((ins_pos.lat_rad - gnss_pos.lat_rad) * rm + Cl.x,
+                       dlon * rn * cos(ins_pos.lat_rad) + Cl.y, -(ins_pos.h_m - gnss_pos.h_m) + Cl.z);
 }
 
 nav_vec3 nav_filter_gnss_vel_residual(const nav_filter_nav *nav, nav_vec3 l_ba_b_m, nav_vec3 v_gnss_n_mps) {

@@ -33,6 +33,7 @@
  */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_ins.h"
@@ -362,10 +363,8 @@ static void ecef_to_ned(nav_vec3 r_e, nav_vec3 v_e, nav_quat q_b_e, nav_geodetic
 
 /* ------------------------------------------------------------------ create / destroy / access */
 
-nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initial, nav_ins **out) {
-  nav_ins *ins = NULL;
-  nav_status st = NAV_OK;
-  if (!cfg || !initial || !out) return NAV_ERR_INVALID_ARG;
+/* Validate and (re)initialise @p ins in place from @p cfg and @p initial; allocates nothing. */
+static nav_status ins_init(nav_ins *ins, const nav_ins_config *cfg, const nav_ins_state *initial) {
   if (cfg->earth_model != NAV_EARTH_FLAT && cfg->earth_model != NAV_EARTH_WGS84) return NAV_ERR_INVALID_ARG;
   if (cfg->algorithm != NAV_MECH_FIRST_ORDER && cfg->algorithm != NAV_MECH_HIGH_ORDER)
     return NAV_ERR_INVALID_ARG;
@@ -381,8 +380,7 @@ nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initia
         !(isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z)) || !(nav_quat_norm(q) > 0.0))
       return NAV_ERR_INVALID_ARG;
   }
-  ins = calloc(1, sizeof *ins);
-  if (!ins) return NAV_ERR_NO_MEMORY;
+  memset(ins, 0, sizeof *ins);
   ins->cfg = *cfg;
   ins->s = *initial;
   ins->s.q_b_f = nav_quat_normalize(initial->q_b_f);
@@ -394,18 +392,50 @@ nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initia
     ins->hold_h_m = p.h_m;
     ins->hold_vd_mps = v_n.z;
     if (cfg->mech_frame == NAV_MECH_NED) {
-      st = ned_set(ins, p, v_n, q_b_n);
-      if (st != NAV_OK) goto cleanup;
+      const nav_status st = ned_set(ins, p, v_n, q_b_n);
+      if (st != NAV_OK) return st;
       ins->s.t_s = initial->t_s;
     } else {
       ins->g_e_mps2 = nav_gravity_e_mps2(cfg->gravity_model, ins->s.r_fb_f_m);
     }
   }
+  return NAV_OK;
+}
+
+nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initial, nav_ins **out) {
+  if (!cfg || !initial || !out) return NAV_ERR_INVALID_ARG;
+  nav_ins *ins = calloc(1, sizeof *ins);
+  if (!ins) return NAV_ERR_NO_MEMORY;
+  const nav_status st = ins_init(ins, cfg, initial);
+  if (st != NAV_OK) {
+    free(ins);
+    return st;
+  }
   *out = ins;
-  ins = NULL;
-cleanup:
-  free(ins);
-  return st;
+  return NAV_OK;
+}
+
+nav_status nav_ins_set_state(nav_ins *ins, const nav_ins_state *state) {
+  if (!ins || !state) return NAV_ERR_INVALID_ARG;
+  const nav_quat q = state->q_b_f;
+  if (!nav_vec3_isfinite(state->r_fb_f_m) || !nav_vec3_isfinite(state->v_fb_f_mps) ||
+      !(isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z)) || !(nav_quat_norm(q) > 0.0))
+    return NAV_ERR_NUMERIC;
+  /* Re-initialise through the create path into a copy (the state stays as it was on failure),
+   * keeping the previous increments: a correction changes the state, not the sensor history
+   * that the coning and sculling terms use, nor the vertical hold. */
+  nav_ins fresh;
+  const nav_status st = ins_init(&fresh, &ins->cfg, state);
+  if (st != NAV_OK) return st;
+  fresh.have_prev = ins->have_prev;
+  fresh.prev_dtheta_b_rad = ins->prev_dtheta_b_rad;
+  fresh.prev_dv_b_mps = ins->prev_dv_b_mps;
+  if (ins->cfg.clamp_vertical) {
+    fresh.hold_h_m = ins->hold_h_m;
+    fresh.hold_vd_mps = ins->hold_vd_mps;
+  }
+  *ins = fresh;
+  return NAV_OK;
 }
 
 void nav_ins_destroy(nav_ins *ins) {
