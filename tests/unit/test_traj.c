@@ -30,7 +30,7 @@
 #include "navcore/nav_truth.h"
 #include "traj/traj_kin_internal.h"
 
-#define LONG_DRIVE NAV_SHARED_DIR "/data/gnss-ins-sim-motion-defs/motion_def-long_drive.csv"
+#define LONG_DRIVE NAV_SOURCE_DIR "/resources/motion_defs/motion_def-long_drive.csv"
 #define D2R NAV_DEG2RAD
 
 /* ------------------------------------------------------------------ helpers */
@@ -1054,7 +1054,7 @@ static void test_motiondef_errors(void **state) {
   assert_near(s->earth.origin_h_m, 5.0, 0.0);
   /* Missing file. */
   log.n = 0;
-  assert_int_equal(nav_motiondef_read_file(NAV_SHARED_DIR "/no/such/file.csv", s, log_diag, &log),
+  assert_int_equal(nav_motiondef_read_file(NAV_SOURCE_DIR "/no/such/file.csv", s, log_diag, &log),
                    NAV_ERR_IO);
   assert_int_equal(log.n, 1);
   free(s);
@@ -1078,7 +1078,7 @@ static void test_motiondef_all_files(void **state) {
   nav_scene *s = new_scene();
   for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
     char path[512];
-    snprintf(path, sizeof path, "%s/data/gnss-ins-sim-motion-defs/%s", NAV_SHARED_DIR, files[i]);
+    snprintf(path, sizeof path, "%s/resources/motion_defs/%s", NAV_SOURCE_DIR, files[i]);
     *s = nav_scene_default();
     diag_log log = {0, {{0}, 0, 0, {0}, {0}}};
     const nav_status st = nav_motiondef_read_file(path, s, log_diag, &log);
@@ -1096,7 +1096,7 @@ static void test_motiondef_all_files(void **state) {
   /* The Komatsu profiles (one command per sample) exceed NAV_MAX_SEGMENTS: a clear error. */
   diag_log log = {0, {{0}, 0, 0, {0}, {0}}};
   assert_int_equal(nav_motiondef_read_file(
-                       NAV_SHARED_DIR "/data/gnss-ins-sim-motion-defs/motion_def-Komatsu_loaded_-5_0.csv", s,
+                       NAV_SOURCE_DIR "/resources/motion_defs/motion_def-Komatsu_loaded_-5_0.csv", s,
                        log_diag, &log),
                    NAV_ERR_PARSE);
   assert_non_null(strstr(log.first.message, "at most 2000"));
