@@ -18,7 +18,7 @@
 #include <threads.h>
 
 #include "navcore/nav_earth.h"
-#include "navcore/nav_filter.h"
+#include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_rng.h"
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_sim.h"
@@ -82,6 +82,7 @@ typedef struct job {
   atomic_long runs_done;
   mtx_t err_lock;
   bool err_set;
+  bool gm_states; /* INS/GNSS: the filter carries GNSS GM error states */
 } job;
 
 /* Keep the first failure's message (of any run) for nav_sim_last_error. */
@@ -129,123 +130,32 @@ static nav_ins_state initial_state(const nav_scene *sc, const nav_frame *fr, con
   return s0;
 }
 
-/* Largest element of a vector. */
-static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
-
-static double rss3(double a, double b, double c) { return sqrt(a * a + b * b + c * c); }
-
-/*
- * The filter's model of the sensors, taken from the scene's error models (the filter is tuned
- * to the truth's statistics, numerics.md 6.2): white noise densities as they are; GM and random
- * walk biases as bias processes; turn-on biases and fixed offsets as the initial bias sigma.
- * Floors keep P0 positive definite where the scene has no error at all (a perfect sensor).
- */
-static nav_filter_config filter_config(const nav_scene *sc) {
-  nav_filter_config c = nav_filter_config_default();
-  const nav_gyro_error_config *g = &sc->imu.model.gyro;
-  const nav_accel_error_config *a = &sc->imu.model.accel;
-  if (g->terms & NAV_IMU_TERM_NOISE) c.gyro_arw_rad_per_sqrt_s = g->arw_rad_per_sqrt_s;
-  if (a->terms & NAV_IMU_TERM_NOISE) c.accel_vrw_mps_per_sqrt_s = a->vrw_mps_per_sqrt_s;
-  c.gyro_bias_terms = 0;
-  c.accel_bias_terms = 0;
-  if (g->terms & NAV_IMU_TERM_BIAS_GM) {
-    c.gyro_bias_terms |= NAV_FILTER_PROC_GM;
-    c.gyro_bias_gm_sd_rps = g->bias_gm_sd_rps;
-    c.gyro_bias_gm_tau_s = g->bias_gm_tau_s;
-  }
-  if (g->terms & NAV_IMU_TERM_BIAS_RW) {
-    c.gyro_bias_terms |= NAV_FILTER_PROC_RW;
-    c.gyro_bias_rw_rps_per_sqrt_s = g->bias_rw_rps_per_sqrt_s;
-  }
-  if (a->terms & NAV_IMU_TERM_BIAS_GM) {
-    c.accel_bias_terms |= NAV_FILTER_PROC_GM;
-    c.accel_bias_gm_sd_mps2 = a->bias_gm_sd_mps2;
-    c.accel_bias_gm_tau_s = a->bias_gm_tau_s;
-  }
-  if (a->terms & NAV_IMU_TERM_BIAS_RW) {
-    c.accel_bias_terms |= NAV_FILTER_PROC_RW;
-    c.accel_bias_rw_mps2_per_sqrt_s = a->bias_rw_mps2_per_sqrt_s;
-  }
-  for (int i = 0; i < 3; ++i) {
-    const bool gt = (g->terms & NAV_IMU_TERM_BIAS_TURN_ON) != 0, at = (a->terms & NAV_IMU_TERM_BIAS_TURN_ON) != 0;
-    const bool gg = (g->terms & NAV_IMU_TERM_BIAS_GM) != 0, ag = (a->terms & NAV_IMU_TERM_BIAS_GM) != 0;
-    const double sg = rss3(gt ? nav_vec3_get(g->bias_turn_on_sd_rps, i) : 0.0,
-                           gt ? nav_vec3_get(g->bias_turn_on_fixed_rps, i) : 0.0,
-                           gg ? nav_vec3_get(g->bias_gm_sd_rps, i) : 0.0);
-    const double sa = rss3(at ? nav_vec3_get(a->bias_turn_on_sd_mps2, i) : 0.0,
-                           at ? nav_vec3_get(a->bias_turn_on_fixed_mps2, i) : 0.0,
-                           ag ? nav_vec3_get(a->bias_gm_sd_mps2, i) : 0.0);
-    /* Floors: 0.01 deg/h and 1 ug, far below any real part, so P0 stays positive definite. */
-    nav_vec3_set(&c.init.gyro_bias_sd_rps, i, fmax(sg, 4.85e-8));
-    nav_vec3_set(&c.init.accel_bias_sd_mps2, i, fmax(sa, 9.8e-6));
-    nav_vec3_set(&c.init.pos_sd_m, i, fmax(nav_vec3_get(sc->initial_errors.pos_sd_m, i), 1e-3));
-    nav_vec3_set(&c.init.vel_sd_mps, i, fmax(nav_vec3_get(sc->initial_errors.vel_sd_mps, i), 1e-4));
-    nav_vec3_set(&c.init.att_sd_rad, i, fmax(nav_vec3_get(sc->initial_errors.att_sd_rad, i), 1e-6));
-  }
-  /* A time-correlated GNSS error gets its own GM states when tau >> update interval
-   * (numerics.md 6.4 (a)); white R on correlated errors would make the filter overconfident. */
-  const nav_gnss_model_config *gm = &sc->gnss.model;
-  if ((gm->terms & NAV_GNSS_TERM_POS_GM) && vmax(gm->pos_gm_sd_m) > 0.0 &&
-      vmax(gm->pos_gm_tau_s) * gm->update_rate_hz > 10.0) {
-    c.states |= NAV_FILTER_STATE_GNSS_POS_GM;
-    c.gnss_pos_gm_sd_m = gm->pos_gm_sd_m;
-    c.gnss_pos_gm_tau_s = gm->pos_gm_tau_s;
-    c.init.gnss_pos_sd_m = gm->pos_gm_sd_m;
-  }
-  return c;
-}
-
-/* Per-run state of the INS/GNSS scheme. */
+/* Per-run state of the INS/GNSS scheme: the receiver model and the closed-loop integration. */
 typedef struct aiding {
   nav_gnss_model *gnss;
-  nav_filter *kf;
-  bool gm_states;    /* GNSS GM error states are in the filter: R holds the white part only */
+  nav_ins_gnss *x;
   int64_t next_epoch;
-  nav_vec3 b_g_rps, b_a_mps2; /* estimated biases, subtracted from the raw increments */
-  long updates;
 } aiding;
 
 static void aiding_destroy(aiding *a) {
-  nav_filter_destroy(a->kf);
+  nav_ins_gnss_destroy(a->x);
   nav_gnss_model_destroy(a->gnss);
-}
-
-/* Filter inputs from the INS state and the compensated increment of the step just taken. */
-static nav_filter_nav filter_nav(const nav_frame *fr, const nav_ins_state *s, const nav_imu_increment *imu) {
-  const nav_local_view v = nav_frame_view(fr, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
-  nav_filter_nav n;
-  n.lat_rad = v.pos.lat_rad;
-  n.h_m = v.pos.h_m;
-  n.v_eb_n_mps = v.v_n_mps;
-  n.C_b_n = nav_quat_to_dcm(v.q_b_n);
-  n.f_ib_b_mps2 = nav_vec3_scale(imu->dv_b_mps, 1.0 / imu->dt_s);
-  n.w_ib_b_rps = nav_vec3_scale(imu->dtheta_b_rad, 1.0 / imu->dt_s);
-  return n;
 }
 
 /*
  * GNSS epochs whose time of validity falls within half an IMU interval of t_k are processed at
  * t_k (numerics.md 6.5: the residual offset is below dt/2; with rates that divide the IMU rate
- * it is zero). The fix is made from the truth at its own time of validity; position and
- * velocity updates are applied, then the error state is fed back into the INS and the bias
- * estimates, and reset (closed loop).
+ * it is zero). Each fix is made by the receiver model from the truth at its own time of validity.
  */
-static nav_status aiding_step(job *j, aiding *a, nav_truth *truth, nav_ins *ins, const nav_frame *fr,
-                              const nav_imu_increment *imu, long run) {
+static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_imu_increment *imu, long run) {
   const nav_scene *sc = &j->sim->scene;
-  nav_filter_nav n = filter_nav(fr, nav_ins_get_state(ins), imu);
-  nav_status st = nav_filter_predict(a->kf, &n, imu->dt_s);
-  if (st != NAV_OK) {
-    job_error(j, "run %ld: filter prediction failed at t = %.6f s: %s", run, imu->t_s, nav_filter_last_error(a->kf));
-    return st;
-  }
   for (;;) {
     const double t_fix = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
     if (!(t_fix <= imu->t_s + 0.5 * imu->dt_s)) break;
     const int64_t epoch = a->next_epoch++;
     if (t_fix < imu->t_s - 0.5 * imu->dt_s) continue; /* before the run's first interval */
     nav_traj_state ts;
-    st = nav_truth_state(truth, t_fix, &ts);
+    nav_status st = nav_truth_state(truth, t_fix, &ts);
     if (st != NAV_OK) return st;
     nav_gnss_fix fix;
     bool has_fix = false;
@@ -255,60 +165,20 @@ static nav_status aiding_step(job *j, aiding *a, nav_truth *truth, nav_ins *ins,
       return st;
     }
     if (!has_fix) continue;
-    const nav_ins_state *s = nav_ins_get_state(ins);
-    const nav_local_view v = nav_frame_view(fr, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
-    n = filter_nav(fr, s, imu);
-    const nav_vec3 l = sc->gnss.model.r_ba_b_m;
-    nav_vec3 r_pos, r_vel;
-    for (int i = 0; i < 3; ++i) {
-      /* Reported sigmas, floored so R stays positive definite for a perfect receiver. */
-      double sp = nav_vec3_get(fix.pos_sd_m, i), sv = nav_vec3_get(fix.vel_sd_mps, i);
-      if (a->gm_states) sp = nav_vec3_get(sc->gnss.model.pos_white_sd_m, i);
-      sp = fmax(sp, 1e-3);
-      sv = fmax(sv, 1e-3);
-      nav_vec3_set(&r_pos, i, sp * sp);
-      nav_vec3_set(&r_vel, i, sv * sv);
-    }
-    const nav_vec3 z_pos = nav_filter_gnss_pos_residual(v.pos, n.C_b_n, l, fix.pos);
-    st = nav_filter_update_gnss_pos(a->kf, &n, z_pos, &r_pos, l);
-    if (st == NAV_OK) {
-      const nav_vec3 z_vel = nav_filter_gnss_vel_residual(&n, l, fix.v_fa_n_mps);
-      st = nav_filter_update_gnss_vel(a->kf, &n, z_vel, &r_vel, l);
-    }
+    nav_ins_gnss_fix f;
+    f.t_s = fix.t_s;
+    f.pos = fix.pos;
+    f.pos_sd_m = fix.pos_sd_m;
+    f.has_vel = true;
+    f.v_n_mps = fix.v_fa_n_mps;
+    f.vel_sd_mps = fix.vel_sd_mps;
+    /* With GNSS GM error states in the filter, R holds only the white part of the error. */
+    if (j->gm_states) f.pos_sd_m = sc->gnss.model.pos_white_sd_m;
+    st = nav_ins_gnss_update(a->x, &f);
     if (st != NAV_OK) {
-      job_error(j, "run %ld: GNSS update failed at t = %.6f s: %s", run, t_fix, nav_filter_last_error(a->kf));
+      job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(a->x));
       return st;
     }
-    /* Closed-loop feedback (numerics.md 6.5). */
-    nav_filter_error dx;
-    st = nav_filter_get_error(a->kf, &dx);
-    if (st != NAV_OK) return st;
-    nav_filter_ins_state fs;
-    fs.lat_rad = v.pos.lat_rad;
-    fs.lon_rad = v.pos.lon_rad;
-    fs.h_m = v.pos.h_m;
-    fs.v_eb_n_mps = v.v_n_mps;
-    fs.q_b_n = v.q_b_n;
-    fs.b_g_rps = a->b_g_rps;
-    fs.b_a_mps2 = a->b_a_mps2;
-    fs.s_g = nav_vec3_zero();
-    fs.s_a = nav_vec3_zero();
-    nav_filter_apply_correction(&fs, &fs, &dx);
-    a->b_g_rps = fs.b_g_rps;
-    a->b_a_mps2 = fs.b_a_mps2;
-    const nav_geodetic p = {fs.lat_rad, fs.lon_rad, fs.h_m};
-    const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
-    nav_ins_state corrected = *s;
-    corrected.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
-    corrected.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, fs.v_eb_n_mps);
-    corrected.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), fs.q_b_n));
-    st = nav_ins_set_state(ins, &corrected);
-    if (st == NAV_OK) st = nav_filter_reset_errors(a->kf);
-    if (st != NAV_OK) {
-      job_error(j, "run %ld: feedback failed at t = %.6f s: %s", run, t_fix, nav_status_str(st));
-      return st;
-    }
-    a->updates++;
   }
   return NAV_OK;
 }
@@ -367,11 +237,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       job_error(j, "run %ld: GNSS receiver model: %s", run, nav_status_str(st));
       goto cleanup;
     }
-    const nav_filter_config fc = filter_config(sc);
-    aid_kf.gm_states = (fc.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
-    st = nav_filter_create(&fc, &aid_kf.kf);
+    const nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
+    st = nav_ins_gnss_create(&xc, &s0, &aid_kf.x);
     if (st != NAV_OK) {
-      job_error(j, "run %ld: Kalman filter set-up: %s", run, nav_status_str(st));
+      job_error(j, "run %ld: INS/GNSS set-up: %s", run, nav_status_str(st));
       goto cleanup;
     }
   }
@@ -407,33 +276,35 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       meas = ideal_imu;
     }
     if (integrated) {
-      /* Subtract the filter's bias estimates from the raw increments. */
-      meas.dtheta_b_rad = nav_vec3_axpy(meas.dtheta_b_rad, -meas.dt_s, aid_kf.b_g_rps);
-      meas.dv_b_mps = nav_vec3_axpy(meas.dv_b_mps, -meas.dt_s, aid_kf.b_a_mps2);
-    }
-    st = nav_ins_step(ins, &meas);
-    if (st != NAV_OK) {
-      job_error(j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", run, nav_ins_last_error(ins),
-                meas.t_s);
-      goto cleanup;
-    }
-    if (integrated) {
-      st = aiding_step(j, &aid_kf, truth, ins, &frame, &meas, run);
+      st = nav_ins_gnss_step(aid_kf.x, &meas);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(aid_kf.x));
+        goto cleanup;
+      }
+      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
+    } else {
+      st = nav_ins_step(ins, &meas);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", run, nav_ins_last_error(ins),
+                  meas.t_s);
+        goto cleanup;
+      }
     }
+    const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x) : nav_ins_get_state(ins);
     st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
-    if (aid) {
+    if (aid && !integrated) {
       /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
       const nav_local_view v = nav_frame_view(&frame, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f);
       const double h = frame.model == NAV_EARTH_FLAT ? -ts.r_fb_f_m.z : v.pos.h_m;
       st = nav_ins_aid_vertical(ins, h, v.v_n_mps.z);
       if (st != NAV_OK) goto cleanup;
     }
-    err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
+    err = nav_errors_compute(&frame, &ts, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err};
+      nav_sim_record rec = {run, &frame, &ts, nav_now, &err};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
     }
     if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
@@ -497,6 +368,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   j.ideal = opts->ideal;
   /* Ideal runs are identical: one is enough. */
   j.runs = opts->ideal ? 1 : sc->simulation.runs;
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS)
+    j.gm_states = (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
 
   char msg[200];
   st = nav_truth_create_msg(sc, &probe, msg, sizeof msg);

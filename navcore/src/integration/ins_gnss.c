@@ -1,0 +1,236 @@
+/*
+ * Loosely coupled INS/GNSS in closed loop (nav_ins_gnss.h): strapdown + error-state EKF +
+ * feedback (numerics.md section 6). Consumes measured increments and fixes only.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "navcore/nav_earth.h"
+#include "navcore/nav_ins_gnss.h"
+#include "navcore/nav_sensors.h"
+
+struct nav_ins_gnss {
+  nav_ins_gnss_config cfg;
+  nav_frame frame;
+  nav_ins *ins;
+  nav_filter *kf;
+  nav_vec3 b_g_rps, b_a_mps2;  /* estimated biases, subtracted from the raw increments */
+  nav_imu_increment last;      /* compensated increment of the last step */
+  bool have_step;
+  long updates;
+  char err[256];
+};
+
+/* Largest element of a vector. */
+static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
+
+static double rss3(double a, double b, double c) { return sqrt(a * a + b * b + c * c); }
+
+/*
+ * The filter's model of the sensors, taken from the scene's error models (the filter is tuned
+ * to the truth's statistics, numerics.md 6.2): white noise densities as they are; GM and random
+ * walk biases as bias processes; turn-on biases and fixed offsets as the initial bias sigma.
+ * Floors keep P0 positive definite where the scene has no error at all (a perfect sensor).
+ */
+static nav_filter_config filter_config(const nav_scene *sc) {
+  nav_filter_config c = nav_filter_config_default();
+  const nav_gyro_error_config *g = &sc->imu.model.gyro;
+  const nav_accel_error_config *a = &sc->imu.model.accel;
+  if (g->terms & NAV_IMU_TERM_NOISE) c.gyro_arw_rad_per_sqrt_s = g->arw_rad_per_sqrt_s;
+  if (a->terms & NAV_IMU_TERM_NOISE) c.accel_vrw_mps_per_sqrt_s = a->vrw_mps_per_sqrt_s;
+  c.gyro_bias_terms = 0;
+  c.accel_bias_terms = 0;
+  if (g->terms & NAV_IMU_TERM_BIAS_GM) {
+    c.gyro_bias_terms |= NAV_FILTER_PROC_GM;
+    c.gyro_bias_gm_sd_rps = g->bias_gm_sd_rps;
+    c.gyro_bias_gm_tau_s = g->bias_gm_tau_s;
+  }
+  if (g->terms & NAV_IMU_TERM_BIAS_RW) {
+    c.gyro_bias_terms |= NAV_FILTER_PROC_RW;
+    c.gyro_bias_rw_rps_per_sqrt_s = g->bias_rw_rps_per_sqrt_s;
+  }
+  if (a->terms & NAV_IMU_TERM_BIAS_GM) {
+    c.accel_bias_terms |= NAV_FILTER_PROC_GM;
+    c.accel_bias_gm_sd_mps2 = a->bias_gm_sd_mps2;
+    c.accel_bias_gm_tau_s = a->bias_gm_tau_s;
+  }
+  if (a->terms & NAV_IMU_TERM_BIAS_RW) {
+    c.accel_bias_terms |= NAV_FILTER_PROC_RW;
+    c.accel_bias_rw_mps2_per_sqrt_s = a->bias_rw_mps2_per_sqrt_s;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const bool gt = (g->terms & NAV_IMU_TERM_BIAS_TURN_ON) != 0, at = (a->terms & NAV_IMU_TERM_BIAS_TURN_ON) != 0;
+    const bool gg = (g->terms & NAV_IMU_TERM_BIAS_GM) != 0, ag = (a->terms & NAV_IMU_TERM_BIAS_GM) != 0;
+    const double sg = rss3(gt ? nav_vec3_get(g->bias_turn_on_sd_rps, i) : 0.0,
+                           gt ? nav_vec3_get(g->bias_turn_on_fixed_rps, i) : 0.0,
+                           gg ? nav_vec3_get(g->bias_gm_sd_rps, i) : 0.0);
+    const double sa = rss3(at ? nav_vec3_get(a->bias_turn_on_sd_mps2, i) : 0.0,
+                           at ? nav_vec3_get(a->bias_turn_on_fixed_mps2, i) : 0.0,
+                           ag ? nav_vec3_get(a->bias_gm_sd_mps2, i) : 0.0);
+    /* Floors: 0.01 deg/h and 1 ug, far below any real part, so P0 stays positive definite. */
+    nav_vec3_set(&c.init.gyro_bias_sd_rps, i, fmax(sg, 4.85e-8));
+    nav_vec3_set(&c.init.accel_bias_sd_mps2, i, fmax(sa, 9.8e-6));
+    nav_vec3_set(&c.init.pos_sd_m, i, fmax(nav_vec3_get(sc->initial_errors.pos_sd_m, i), 1e-3));
+    nav_vec3_set(&c.init.vel_sd_mps, i, fmax(nav_vec3_get(sc->initial_errors.vel_sd_mps, i), 1e-4));
+    nav_vec3_set(&c.init.att_sd_rad, i, fmax(nav_vec3_get(sc->initial_errors.att_sd_rad, i), 1e-6));
+  }
+  /* A time-correlated GNSS error gets its own GM states when tau >> update interval
+   * (numerics.md 6.4 (a)); white R on correlated errors would make the filter overconfident. */
+  const nav_gnss_model_config *gm = &sc->gnss.model;
+  if ((gm->terms & NAV_GNSS_TERM_POS_GM) && vmax(gm->pos_gm_sd_m) > 0.0 &&
+      vmax(gm->pos_gm_tau_s) * gm->update_rate_hz > 10.0) {
+    c.states |= NAV_FILTER_STATE_GNSS_POS_GM;
+    c.gnss_pos_gm_sd_m = gm->pos_gm_sd_m;
+    c.gnss_pos_gm_tau_s = gm->pos_gm_tau_s;
+    c.init.gnss_pos_sd_m = gm->pos_gm_sd_m;
+  }
+  return c;
+}
+
+nav_ins_gnss_config nav_ins_gnss_config_from_scene(const nav_scene *sc) {
+  nav_ins_gnss_config c;
+  memset(&c, 0, sizeof c);
+  c.ins = nav_ins_config_default();
+  c.ins.earth_model = sc->earth.model;
+  c.ins.algorithm = sc->navigation.algorithm;
+  c.ins.mech_frame = sc->navigation.frame;
+  c.ins.gravity_model = sc->earth.gravity_model;
+  c.ins.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
+  c.filter = filter_config(sc);
+  c.r_ba_b_m = sc->gnss.model.r_ba_b_m;
+  c.pos_sd_floor_m = 1e-3;
+  c.vel_sd_floor_mps = 1e-3;
+  return c;
+}
+
+nav_status nav_ins_gnss_create(const nav_ins_gnss_config *cfg, const nav_ins_state *initial, nav_ins_gnss **out) {
+  if (!cfg || !initial || !out) return NAV_ERR_INVALID_ARG;
+  if (cfg->ins.earth_model != NAV_EARTH_WGS84) return NAV_ERR_INVALID_ARG;
+  if (!(cfg->pos_sd_floor_m > 0.0) || !(cfg->vel_sd_floor_mps > 0.0)) return NAV_ERR_INVALID_ARG;
+  nav_ins_gnss *x = calloc(1, sizeof *x);
+  if (!x) return NAV_ERR_NO_MEMORY;
+  x->cfg = *cfg;
+  memset(&x->frame, 0, sizeof x->frame);
+  x->frame.model = NAV_EARTH_WGS84;
+  nav_status st = nav_ins_create(&cfg->ins, initial, &x->ins);
+  if (st == NAV_OK) st = nav_filter_create(&cfg->filter, &x->kf);
+  if (st != NAV_OK) {
+    nav_ins_gnss_destroy(x);
+    return st;
+  }
+  *out = x;
+  return NAV_OK;
+}
+
+void nav_ins_gnss_destroy(nav_ins_gnss *x) {
+  if (!x) return;
+  nav_filter_destroy(x->kf);
+  nav_ins_destroy(x->ins);
+  free(x);
+}
+
+const nav_ins_state *nav_ins_gnss_state(const nav_ins_gnss *x) { return x ? nav_ins_get_state(x->ins) : NULL; }
+const nav_filter *nav_ins_gnss_filter(const nav_ins_gnss *x) { return x ? x->kf : NULL; }
+long nav_ins_gnss_updates(const nav_ins_gnss *x) { return x ? x->updates : 0; }
+const char *nav_ins_gnss_last_error(const nav_ins_gnss *x) { return x ? x->err : ""; }
+
+void nav_ins_gnss_biases(const nav_ins_gnss *x, nav_vec3 *b_g_rps, nav_vec3 *b_a_mps2) {
+  if (!x) return;
+  if (b_g_rps) *b_g_rps = x->b_g_rps;
+  if (b_a_mps2) *b_a_mps2 = x->b_a_mps2;
+}
+
+/* Filter inputs from the INS state and the compensated increment of the step just taken. */
+static nav_filter_nav filter_nav(const nav_frame *fr, const nav_ins_state *s, const nav_imu_increment *imu) {
+  const nav_local_view v = nav_frame_view(fr, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+  nav_filter_nav n;
+  n.lat_rad = v.pos.lat_rad;
+  n.h_m = v.pos.h_m;
+  n.v_eb_n_mps = v.v_n_mps;
+  n.C_b_n = nav_quat_to_dcm(v.q_b_n);
+  n.f_ib_b_mps2 = nav_vec3_scale(imu->dv_b_mps, 1.0 / imu->dt_s);
+  n.w_ib_b_rps = nav_vec3_scale(imu->dtheta_b_rad, 1.0 / imu->dt_s);
+  return n;
+}
+
+nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
+  if (!x || !raw || !(raw->dt_s > 0.0)) return NAV_ERR_INVALID_ARG;
+  nav_imu_increment m = *raw;
+  m.dtheta_b_rad = nav_vec3_axpy(m.dtheta_b_rad, -m.dt_s, x->b_g_rps);
+  m.dv_b_mps = nav_vec3_axpy(m.dv_b_mps, -m.dt_s, x->b_a_mps2);
+  nav_status st = nav_ins_step(x->ins, &m);
+  if (st != NAV_OK) {
+    snprintf(x->err, sizeof x->err, "strapdown navigation stopped at t = %.6f s: %s", m.t_s, nav_ins_last_error(x->ins));
+    return st;
+  }
+  const nav_filter_nav n = filter_nav(&x->frame, nav_ins_get_state(x->ins), &m);
+  st = nav_filter_predict(x->kf, &n, m.dt_s);
+  if (st != NAV_OK) {
+    snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m.t_s, nav_filter_last_error(x->kf));
+    return st;
+  }
+  x->last = m;
+  x->have_step = true;
+  return NAV_OK;
+}
+
+nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
+  if (!x || !fix) return NAV_ERR_INVALID_ARG;
+  if (!x->have_step) {
+    snprintf(x->err, sizeof x->err, "a GNSS fix before the first IMU step (t = %.6f s)", fix->t_s);
+    return NAV_ERR_STATE;
+  }
+  const nav_ins_state *s = nav_ins_get_state(x->ins);
+  const nav_local_view v = nav_frame_view(&x->frame, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+  const nav_filter_nav n = filter_nav(&x->frame, s, &x->last);
+  const nav_vec3 l = x->cfg.r_ba_b_m;
+  nav_vec3 r_pos, r_vel;
+  for (int i = 0; i < 3; ++i) {
+    const double sp = fmax(nav_vec3_get(fix->pos_sd_m, i), x->cfg.pos_sd_floor_m);
+    const double sv = fmax(nav_vec3_get(fix->vel_sd_mps, i), x->cfg.vel_sd_floor_mps);
+    nav_vec3_set(&r_pos, i, sp * sp);
+    nav_vec3_set(&r_vel, i, sv * sv);
+  }
+  const nav_vec3 z_pos = nav_filter_gnss_pos_residual(v.pos, n.C_b_n, l, fix->pos);
+  nav_status st = nav_filter_update_gnss_pos(x->kf, &n, z_pos, &r_pos, l);
+  if (st == NAV_OK && fix->has_vel) {
+    const nav_vec3 z_vel = nav_filter_gnss_vel_residual(&n, l, fix->v_n_mps);
+    st = nav_filter_update_gnss_vel(x->kf, &n, z_vel, &r_vel, l);
+  }
+  if (st != NAV_OK) {
+    snprintf(x->err, sizeof x->err, "GNSS update failed at t = %.6f s: %s", fix->t_s, nav_filter_last_error(x->kf));
+    return st;
+  }
+  /* Closed-loop feedback (numerics.md 6.5). */
+  nav_filter_error dx;
+  st = nav_filter_get_error(x->kf, &dx);
+  if (st != NAV_OK) return st;
+  nav_filter_ins_state fs;
+  fs.lat_rad = v.pos.lat_rad;
+  fs.lon_rad = v.pos.lon_rad;
+  fs.h_m = v.pos.h_m;
+  fs.v_eb_n_mps = v.v_n_mps;
+  fs.q_b_n = v.q_b_n;
+  fs.b_g_rps = x->b_g_rps;
+  fs.b_a_mps2 = x->b_a_mps2;
+  fs.s_g = nav_vec3_zero();
+  fs.s_a = nav_vec3_zero();
+  nav_filter_apply_correction(&fs, &fs, &dx);
+  const nav_geodetic p = {fs.lat_rad, fs.lon_rad, fs.h_m};
+  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
+  nav_ins_state corrected = *s;
+  corrected.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
+  corrected.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, fs.v_eb_n_mps);
+  corrected.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), fs.q_b_n));
+  st = nav_ins_set_state(x->ins, &corrected);
+  if (st == NAV_OK) st = nav_filter_reset_errors(x->kf);
+  if (st != NAV_OK) {
+    snprintf(x->err, sizeof x->err, "feedback failed at t = %.6f s: %s", fix->t_s, nav_status_str(st));
+    return st;
+  }
+  x->b_g_rps = fs.b_g_rps;
+  x->b_a_mps2 = fs.b_a_mps2;
+  x->updates++;
+  return NAV_OK;
+}
