@@ -19,7 +19,9 @@
 
 #include "nav_test.h"
 #include "navcore/nav_sensors.h"
+#include "navcore/nav_filter.h"
 #include "navcore/nav_sim.h"
+#include "navcore/nav_truth.h"
 
 /* chi2(k)/k quantile by Wilson-Hilferty: (1 - 2/(9k) + z sqrt(2/(9k)))^3. */
 static double chi2_over_k(double k, double z) {
@@ -149,6 +151,112 @@ static void test_ideal_ignores_errors(void **state) {
   nav_sim_destroy(sim);
 }
 
+/*
+ * numerics.md T6.6: the T6.3 outage (lat 45 deg, h = 0, 20 m/s north, level, tactical IMU with
+ * random-constant biases, no GNSS) simulated with the full nonlinear simulator (sensor models of
+ * section 2, random initial errors drawn from P0), N = 200 runs; at 10, 30, 60 and 120 s the RMS
+ * north error over runs divided by the covariance-analysis sigma must lie in the 99 % interval
+ * [0.873, 1.130] at >= 3 of the 4 epochs. The covariance sigma is computed here by the filter in
+ * covariance mode along the same truth, and itself checked against T6.3 (0.1 %).
+ */
+static void test_t66_monte_carlo_vs_covariance(void **state) {
+  (void)state;
+  const double d2r = NAV_PI / 180.0, g0 = 9.80665;
+  const double Na = 0.07 / 60.0, Ng = 0.15 * d2r / 60.0, sba = 0.05e-3 * g0, sbg = 0.5 * d2r / 3600.0;
+  nav_scene sc = nav_scene_default();
+  sc.earth.model = NAV_EARTH_WGS84;
+  sc.earth.origin_lat_rad = 45.0 * d2r;
+  sc.earth.origin_lon_rad = 0.0;
+  sc.earth.origin_h_m = 0.0;
+  sc.trajectory.type = NAV_TRAJ_SEGMENTS;
+  sc.trajectory.duration_s = 120.0;
+  sc.trajectory.initial_attitude = (nav_euler){0.0, 0.0, 0.0};
+  sc.trajectory.segments.count = 1;
+  sc.trajectory.segments.v0_b_mps = nav_vec3_make(20.0, 0.0, 0.0);
+  sc.trajectory.segments.items[0].kind = NAV_SEG_HOLD;
+  sc.trajectory.segments.items[0].duration_s = 120.0;
+  sc.imu.rate_hz = 100.0;
+  sc.output.rate_hz = 10.0;
+  sc.navigation.algorithm = NAV_MECH_HIGH_ORDER;
+  sc.imu.model.gyro.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc.imu.model.gyro.arw_rad_per_sqrt_s = nav_vec3_make(Ng, Ng, Ng);
+  sc.imu.model.gyro.bias_turn_on_sd_rps = nav_vec3_make(sbg, sbg, sbg);
+  sc.imu.model.accel.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc.imu.model.accel.vrw_mps_per_sqrt_s = nav_vec3_make(Na, Na, Na);
+  sc.imu.model.accel.bias_turn_on_sd_mps2 = nav_vec3_make(sba, sba, sba);
+  sc.initial_errors.pos_sd_m = nav_vec3_make(0.02, 0.02, 0.02);
+  sc.initial_errors.vel_sd_mps = nav_vec3_make(0.01, 0.01, 0.01);
+  sc.initial_errors.att_sd_rad = nav_vec3_make(0.005 * d2r, 0.005 * d2r, 0.05 * d2r);
+  sc.simulation.runs = 200;
+  sc.simulation.seed = 66;
+
+  /* Covariance analysis along the same truth (15 states, Van Loan, dt = 0.01 s). */
+  nav_filter_config fc = nav_filter_config_default();
+  fc.discretisation = NAV_FILTER_DISC_VAN_LOAN;
+  fc.gyro_arw_rad_per_sqrt_s = nav_vec3_make(Ng, Ng, Ng);
+  fc.accel_vrw_mps_per_sqrt_s = nav_vec3_make(Na, Na, Na);
+  fc.gyro_bias_terms = 0;
+  fc.accel_bias_terms = 0;
+  fc.init.pos_sd_m = sc.initial_errors.pos_sd_m;
+  fc.init.vel_sd_mps = sc.initial_errors.vel_sd_mps;
+  fc.init.att_sd_rad = sc.initial_errors.att_sd_rad;
+  fc.init.gyro_bias_sd_rps = nav_vec3_make(sbg, sbg, sbg);
+  fc.init.accel_bias_sd_mps2 = nav_vec3_make(sba, sba, sba);
+  nav_filter *kf = NULL;
+  assert_int_equal(nav_filter_create(&fc, &kf), NAV_OK);
+  nav_truth *truth = NULL;
+  assert_int_equal(nav_truth_create(&sc, &truth), NAV_OK);
+  const nav_frame fr = nav_truth_frame(truth);
+  const int64_t n = nav_truth_sample_count(truth);
+  const double t_check[4] = {10.0, 30.0, 60.0, 120.0};
+  const double t63[4] = {0.11923, 0.73033, 3.38406, 18.0667};
+  double sigma_n[4];
+  int c = 0;
+  for (int64_t k = 1; k <= n; ++k) {
+    nav_imu_increment imu;
+    nav_traj_state ts;
+    assert_int_equal(nav_truth_imu(truth, k, &imu), NAV_OK);
+    assert_int_equal(nav_truth_state(truth, imu.t_s, &ts), NAV_OK);
+    const nav_local_view v = nav_frame_view(&fr, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f);
+    nav_filter_nav nv = {v.pos.lat_rad, v.pos.h_m, v.v_n_mps, nav_quat_to_dcm(v.q_b_n),
+                         nav_vec3_scale(imu.dv_b_mps, 1.0 / imu.dt_s), nav_vec3_scale(imu.dtheta_b_rad, 1.0 / imu.dt_s)};
+    assert_int_equal(nav_filter_predict(kf, &nv, imu.dt_s), NAV_OK);
+    if (c < 4 && fabs(imu.t_s - t_check[c]) < 1e-9) {
+      const double *P = nav_filter_get_cov(kf);
+      sigma_n[c] = sqrt(P[0]);
+      ++c;
+    }
+  }
+  assert_int_equal(c, 4);
+  nav_truth_destroy(truth);
+  nav_filter_destroy(kf);
+  for (int i = 0; i < 4; ++i) assert_rel_near(sigma_n[i], t63[i], 1e-3);
+
+  /* Monte Carlo with the nonlinear simulator. */
+  nav_sim *sim = NULL;
+  assert_int_equal(nav_sim_create(&sc, &sim), NAV_OK);
+  nav_sim_options o = nav_sim_options_default();
+  o.threads = 2;
+  nav_sim_summary sum;
+  const nav_status st = nav_sim_run(sim, &o, &sum);
+  if (st != NAV_OK) fail_msg("%s", nav_sim_last_error(sim));
+  size_t ne = 0;
+  const nav_sim_envelope_point *env = nav_sim_envelope(sim, &ne);
+  assert_non_null(env);
+  int inside = 0;
+  for (int i = 0; i < 4; ++i) {
+    const size_t e = (size_t)llround(t_check[i] * sc.output.rate_hz);
+    assert_true(e < ne);
+    assert_near(env[e].t_s, t_check[i], 1e-9);
+    const double ratio = env[e].pos_rms_n_m.x / sigma_n[i];
+    print_message("T6.6 t = %5.0f s: MC RMS north %.5g m, covariance sigma %.5g m, ratio %.4f\n", t_check[i],
+                  env[e].pos_rms_n_m.x, sigma_n[i], ratio);
+    if (ratio > 0.873 && ratio < 1.130) ++inside;
+  }
+  nav_sim_destroy(sim);
+  assert_true(inside >= 3);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_deterministic_across_threads),
@@ -156,6 +264,7 @@ int main(void) {
       cmocka_unit_test(test_mc_gyro_noise),
       cmocka_unit_test(test_mc_initial_errors),
       cmocka_unit_test(test_ideal_ignores_errors),
+      cmocka_unit_test(test_t66_monte_carlo_vs_covariance),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -83,6 +83,17 @@ typedef struct nav_sim_summary {
   bool partial;            /**< the run was stopped early (cancel / callback) */
 } nav_sim_summary;
 
+/** Monte Carlo envelope at one output epoch: statistics over runs (numerics.md T6.6). */
+typedef struct nav_sim_envelope_point {
+  double t_s;
+  nav_vec3 pos_rms_n_m;  /**< RMS over runs of the position error, per N/E/D component [m] */
+  nav_vec3 pos_mean_n_m; /**< mean over runs of the position error [m] */
+  double pos_h_rms_m;    /**< RMS over runs of the horizontal error [m] */
+  double pos_h_max_m;    /**< largest horizontal error over runs [m] */
+  double vel_rms_mps;    /**< RMS over runs of |velocity error| [m/s] */
+  double att_rms_rad;    /**< RMS over runs of the attitude error angle [rad] */
+} nav_sim_envelope_point;
+
 typedef struct nav_sim nav_sim;
 
 /** Create a simulation of a validated scene (copied). */
@@ -96,6 +107,13 @@ NAV_API void nav_sim_destroy(nav_sim *sim);
  *         navigation diverged to non-finite values; NAV_ERR_NO_MEMORY.
  */
 NAV_API NAV_NODISCARD nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out);
+
+/**
+ * Per-output-epoch statistics over the Monte Carlo runs of the last nav_sim_run (output rate of
+ * the scene, epochs 0..count-1). Borrowed: valid until the next nav_sim_run or destroy. NULL and
+ * *count = 0 when there is no complete run (or runs x epochs exceeds 4e6 values).
+ */
+NAV_API const nav_sim_envelope_point *nav_sim_envelope(const nav_sim *sim, size_t *count);
 
 /** Ask a running nav_sim_run to stop at the next sample. Thread-safe. */
 NAV_API void nav_sim_request_cancel(nav_sim *sim);

@@ -34,7 +34,12 @@ struct nav_sim {
   nav_scene scene;
   atomic_bool cancel;
   char last_error[256];
+  nav_sim_envelope_point *envelope; /* per output epoch, from the last run */
+  size_t envelope_count;
 };
+
+/* Values per output epoch and run kept for the envelopes: N, E, D, |dv|, attitude angle. */
+#define ENV_VALUES 5
 
 nav_sim_options nav_sim_options_default(void) {
   nav_sim_options o;
@@ -54,7 +59,16 @@ nav_status nav_sim_create(const nav_scene *scene, nav_sim **out) {
   return NAV_OK;
 }
 
-void nav_sim_destroy(nav_sim *sim) { free(sim); }
+void nav_sim_destroy(nav_sim *sim) {
+  if (!sim) return;
+  free(sim->envelope);
+  free(sim);
+}
+
+const nav_sim_envelope_point *nav_sim_envelope(const nav_sim *sim, size_t *count) {
+  if (count) *count = sim && sim->envelope ? sim->envelope_count : 0;
+  return sim ? sim->envelope : NULL;
+}
 
 void nav_sim_request_cancel(nav_sim *sim) {
   if (sim) atomic_store(&sim->cancel, true);
@@ -74,6 +88,8 @@ typedef struct job {
   int64_t stats_stride; /* every stats_stride-th epoch enters the statistics */
   int64_t stats_per_run;
   int64_t out_stride;
+  int64_t n_out;        /* output epochs per run: k = 0, out_stride, ... (and n) */
+  double *env;          /* [runs][n_out][ENV_VALUES], NULL when too large */
   double *metrics;      /* [N_METRICS][runs][stats_per_run] */
   nav_epoch_errors *final; /* [runs] */
   int64_t *samples_done;   /* [runs] */
@@ -83,7 +99,14 @@ typedef struct job {
   mtx_t err_lock;
   bool err_set;
   bool gm_states; /* INS/GNSS: the filter carries GNSS GM error states */
+  /* Truth shared by every run (Monte Carlo): ideal increments k = 1..n and states k = 0..n,
+   * computed once; NULL when the job has one run or would need too much memory. */
+  nav_imu_increment *shared_imu;
+  nav_traj_state *shared_ts;
 } job;
+
+/* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
+#define SHARED_TRUTH_MAX_SAMPLES 4000000LL
 
 /* Keep the first failure's message (of any run) for nav_sim_last_error. */
 #if defined(__GNUC__)
@@ -155,7 +178,11 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     const int64_t epoch = a->next_epoch++;
     if (t_fix < imu->t_s - 0.5 * imu->dt_s) continue; /* before the run's first interval */
     nav_traj_state ts;
-    nav_status st = nav_truth_state(truth, t_fix, &ts);
+    nav_status st = NAV_OK;
+    const double kf = t_fix / imu->dt_s;
+    const int64_t kk = (int64_t)llround(kf);
+    if (j->shared_ts && fabs(kf - (double)kk) < 1e-9 && kk >= 0 && kk <= j->n) ts = j->shared_ts[kk];
+    else st = nav_truth_state(truth, t_fix, &ts);
     if (st != NAV_OK) return st;
     nav_gnss_fix fix;
     bool has_fix = false;
@@ -191,6 +218,23 @@ static void store_metrics(job *j, long run, int64_t slot, const nav_epoch_errors
   for (int m = 0; m < N_METRICS; ++m) j->metrics[(int64_t)m * plane + row] = v[m];
 }
 
+/* Output-epoch slot of sample k, or -1 when k is not an output epoch. */
+static int64_t out_slot(const job *j, int64_t k) {
+  if (k % j->out_stride == 0) return k / j->out_stride;
+  return k == j->n ? j->n_out - 1 : -1;
+}
+
+static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e) {
+  const int64_t slot = out_slot(j, k);
+  if (!j->env || slot < 0 || slot >= j->n_out) return;
+  double *v = j->env + ((int64_t)run * j->n_out + slot) * ENV_VALUES;
+  v[0] = e->pos_err_n_m.x;
+  v[1] = e->pos_err_n_m.y;
+  v[2] = e->pos_err_n_m.z;
+  v[3] = e->vel_err_mps;
+  v[4] = e->att_err_rad;
+}
+
 static nav_status run_one(job *j, long run, bool caller_thread) {
   nav_sim *sim = j->sim;
   const nav_scene *sc = &sim->scene;
@@ -215,7 +259,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     }
   }
   nav_traj_state ts;
-  st = nav_truth_state(truth, 0.0, &ts);
+  if (j->shared_ts) ts = j->shared_ts[0];
+  else st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
   const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
   nav_ins_config icfg = nav_ins_config_default();
@@ -249,6 +294,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
 
   nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
+  store_env(j, run, 0, &err);
   if (record) {
     nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -260,7 +306,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       break;
     }
     nav_imu_increment ideal_imu, meas;
-    st = nav_truth_imu(truth, k, &ideal_imu);
+    if (j->shared_imu) ideal_imu = j->shared_imu[k - 1];
+    else st = nav_truth_imu(truth, k, &ideal_imu);
     if (st != NAV_OK) {
       job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
                 (double)k * dt);
@@ -292,7 +339,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       }
     }
     const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x) : nav_ins_get_state(ins);
-    st = nav_truth_state(truth, meas.t_s, &ts);
+    if (j->shared_ts) ts = j->shared_ts[k];
+    else st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
     if (aid && !integrated) {
       /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
@@ -303,6 +351,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     }
     err = nav_errors_compute(&frame, &ts, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
+    store_env(j, run, k, &err);
     if (record && (k % j->out_stride == 0 || k == j->n)) {
       nav_sim_record rec = {run, &frame, &ts, nav_now, &err};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -379,6 +428,32 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   }
   j.n = nav_truth_sample_count(probe);
   const double dt = nav_truth_dt(probe);
+  if (j.runs > 1 && j.n <= SHARED_TRUTH_MAX_SAMPLES) {
+    /* Generate the truth once for all runs (the same numbers every run would compute). */
+    j.shared_imu = malloc((size_t)j.n * sizeof *j.shared_imu);
+    j.shared_ts = malloc((size_t)(j.n + 1) * sizeof *j.shared_ts);
+    if (j.shared_imu && j.shared_ts) {
+      st = nav_truth_state(probe, 0.0, &j.shared_ts[0]);
+      for (int64_t k = 1; k <= j.n && st == NAV_OK; ++k) {
+        st = nav_truth_imu(probe, k, &j.shared_imu[k - 1]);
+        if (st == NAV_OK) st = nav_truth_state(probe, (double)k * dt, &j.shared_ts[k]);
+        if (opts->progress && k % PROGRESS_EVERY == 0) {
+          nav_progress p = {"truth", 0, 0.0, (double)k * dt};
+          if (opts->progress(opts->user, &p) == NAV_STOP) st = NAV_ERR_CANCELLED;
+        }
+      }
+      if (st != NAV_OK) {
+        snprintf(sim->last_error, sizeof sim->last_error, "reference trajectory: %s", nav_status_str(st));
+        nav_truth_destroy(probe);
+        goto cleanup;
+      }
+    } else {
+      free(j.shared_imu);
+      free(j.shared_ts);
+      j.shared_imu = NULL;
+      j.shared_ts = NULL;
+    }
+  }
   nav_truth_destroy(probe);
   j.out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
   if (j.out_stride < 1) j.out_stride = 1;
@@ -387,6 +462,12 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   if (j.stats_stride < 1) j.stats_stride = 1;
   j.stats_per_run = j.n / j.stats_stride + 1;
 
+  j.n_out = j.n / j.out_stride + 1 + (j.n % j.out_stride != 0 ? 1 : 0);
+  if ((double)j.runs * (double)j.n_out * ENV_VALUES <= (double)STATS_MAX_VALUES)
+    j.env = malloc((size_t)j.runs * (size_t)j.n_out * ENV_VALUES * sizeof *j.env);
+  free(sim->envelope);
+  sim->envelope = NULL;
+  sim->envelope_count = 0;
   const size_t plane = (size_t)j.runs * (size_t)j.stats_per_run;
   j.metrics = malloc((size_t)N_METRICS * plane * sizeof *j.metrics);
   j.final = calloc((size_t)j.runs, sizeof *j.final);
@@ -495,6 +576,34 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       sum.final_rms.att_err_rad = sqrt(s2[3] / (double)nf);
     }
   }
+  /* Envelopes over complete runs, in run order. */
+  if (j.env && !sum.partial) {
+    sim->envelope = calloc((size_t)j.n_out, sizeof *sim->envelope);
+    if (sim->envelope) {
+      sim->envelope_count = (size_t)j.n_out;
+      for (int64_t e = 0; e < j.n_out; ++e) {
+        nav_sim_envelope_point *p = &sim->envelope[e];
+        const int64_t k = e == j.n_out - 1 ? j.n : e * j.out_stride;
+        p->t_s = (double)k * dt;
+        double s2[ENV_VALUES] = {0.0, 0.0, 0.0, 0.0, 0.0}, mean[3] = {0.0, 0.0, 0.0}, h2 = 0.0, hmax = 0.0;
+        for (long r = 0; r < j.runs; ++r) {
+          const double *v = j.env + ((int64_t)r * j.n_out + e) * ENV_VALUES;
+          for (int q = 0; q < ENV_VALUES; ++q) s2[q] += v[q] * v[q];
+          for (int q = 0; q < 3; ++q) mean[q] += v[q];
+          const double h = hypot(v[0], v[1]);
+          h2 += h * h;
+          if (h > hmax) hmax = h;
+        }
+        const double nr = (double)j.runs;
+        p->pos_rms_n_m = nav_vec3_make(sqrt(s2[0] / nr), sqrt(s2[1] / nr), sqrt(s2[2] / nr));
+        p->pos_mean_n_m = nav_vec3_make(mean[0] / nr, mean[1] / nr, mean[2] / nr);
+        p->pos_h_rms_m = sqrt(h2 / nr);
+        p->pos_h_max_m = hmax;
+        p->vel_rms_mps = sqrt(s2[3] / nr);
+        p->att_rms_rad = sqrt(s2[4] / nr);
+      }
+    }
+  }
   *out = sum;
 
 cleanup:
@@ -502,6 +611,9 @@ cleanup:
   free(threads);
   if (lock_ok) mtx_destroy(&j.err_lock);
   free(j.metrics);
+  free(j.env);
+  free(j.shared_imu);
+  free(j.shared_ts);
   free(j.final);
   free(j.samples_done);
   free(j.status);
