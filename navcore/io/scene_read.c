@@ -1,8 +1,11 @@
 /*
  * Scene files, format_version 1: the YAML reader (libfyaml) and the schema tables it shares with
- * the writer. See scene_io_internal.h for how the tables are laid out and extended.
+ * the writer. See scene_io_internal.h for how the tables are laid out and extended. The
+ * trajectory part of the schema (waypoints, segment scripts, test motions, motion-definition
+ * imports) lives in scene_traj_io.c; the custom fields of the sensor sections (catalog look-ups,
+ * "off" lists, GNSS outages) are read and written here, next to their tables.
  *
- * Reading goes in five steps, and each step reports what it finds through nav_diag:
+ * Reading goes in six steps, and each step reports what it finds through nav_diag:
  *   1. size cap and a UTF-8 / binary check of the raw bytes (libfyaml silently drops some invalid
  *      bytes, so it must not see them);
  *   2. libfyaml's event parser builds a small tree of our own (nav_io_node) that keeps the
@@ -11,9 +14,12 @@
  *   3. the tree is walked against the schema tables: unknown keys (with did-you-mean), duplicate
  *      keys, two spellings of one quantity, wrong node kinds, numbers, enums, ranges; every field
  *      read leaves (path -> line:col) in a small map;
- *   4. nav_scene_validate() runs on the result; each (path, message) it reports is placed at the
+ *   4. what needs the whole file (nav_io_traj_finish): waypoints given as latitude/longitude are
+ *      converted with the scene's Earth, a motion-definition file is imported, waypoint and
+ *      segment scripts are planned (feasibility, and their length for duration_s auto);
+ *   5. nav_scene_validate() runs on the result; each (path, message) it reports is placed at the
  *      node of that path (or its nearest parent present in the file, else line 0);
- *   5. the scene is copied out only if nothing was reported.
+ *   6. the scene is copied out only if nothing was reported.
  *
  * Format rules (v1):
  * - format_version is required: a file without it is not taken for a scene. Versions 1 ..
@@ -23,8 +29,12 @@
  *   NAV_IO_MAX_INPUT_BYTES (16 MiB), NAV_IO_MAX_DEPTH levels and NAV_IO_MAX_NODES nodes.
  * - Numbers are YAML 1.2 decimal ints/floats (1, -2.5, 1e-3, .5); .inf/.nan are rejected where a
  *   finite value is required (all v1 doubles). Quoted strings and booleans are not numbers.
- *   Integers also accept 0x.. and 0o..; floats are not integers.
+ *   Integers also accept 0x.. and 0o..; floats are not integers. Booleans are true / false.
  * - Angles may be given as _deg or _rad (rates as _rps or _dps); giving both is an error.
+ *   Sensor figures are given in datasheet units (deg/h, deg/sqrt(h), mg, ug, ppm, mrad, ...) or
+ *   in SI; they are converted once, here, by the factors of the nav_unit_* helpers.
+ * - Keys are read in any order (YAML mappings are unordered): the keys that others build on
+ *   (imu.bias_convention, imu.catalog, gnss.catalog) are applied first, "off" lists last.
  * - An empty section ("imu:") means all defaults.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -41,10 +51,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <libfyaml.h>
 
+#include "navcore/nav_catalog.h"
+#include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
+#include "navcore/nav_sensors.h"
 #include "scene_io_internal.h"
 
 /* Enums are stored through int pointers by the table-driven reader and writer. */
@@ -54,6 +68,8 @@ _Static_assert(sizeof(nav_attitude_mode) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_mech_algorithm) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_gravity_model) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_mech_frame) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_nav_scheme) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_bi_convention) == sizeof(int), "enum storage");
 
 #define PATH_MAX_LEN ((size_t)sizeof(((nav_diag *)0)->path))
 #define MAX_SECTION_FIELDS 64 /* descriptors per section; checked when a section is read */
@@ -62,36 +78,77 @@ _Static_assert(sizeof(nav_mech_frame) == sizeof(int), "enum storage");
 /* ================================================================ schema, format_version 1 */
 
 #define OFF(member) offsetof(nav_scene, member)
+#define SOFF(member) offsetof(nav_io_read_state, member)
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 /* A section table; the reader tracks seen keys in arrays of MAX_SECTION_FIELDS. */
 #define DEFINE_SECTION(name, fields)                                                                         \
   _Static_assert(COUNT(fields) <= MAX_SECTION_FIELDS, #fields ": too many fields");                          \
-  static const nav_io_section name = {fields, COUNT(fields)}
+  static const nav_io_section name = {fields, COUNT(fields), NULL}
+#define DEFINE_SECTION_FINISH(name, fields, fin)                                                             \
+  _Static_assert(COUNT(fields) <= MAX_SECTION_FIELDS, #fields ": too many fields");                          \
+  static const nav_io_section name = {fields, COUNT(fields), fin}
+
+#define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE) /* with .min = 0 */
+#define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
+
+/* Datasheet units -> SI: file value x factor, the factor being the nav_unit_* helper of
+   nav_sensors.h applied to 1 (the helpers are inline functions, not constant expressions). */
+#define K_DEG_PER_H (NAV_DEG2RAD / 3600.0)                      /* nav_unit_deg_per_h_to_rps */
+#define K_DEG_PER_SQRT_H (NAV_DEG2RAD / 60.0)                   /* ..._deg_per_sqrt_h_to_rad_per_sqrt_s */
+#define K_DEG_PER_H_PER_SQRT_H (NAV_DEG2RAD / 3600.0 / 60.0)    /* ..._deg_per_h_per_sqrt_h_to_rps_per_sqrt_s */
+#define K_DEG_PER_H_PER_G (NAV_DEG2RAD / 3600.0 / NAV_G0_MPS2)  /* ..._deg_per_h_per_g_to_rps_per_mps2 */
+#define K_PER_SQRT_H (1.0 / 60.0)                               /* ..._mps_per_sqrt_h_to_mps_per_sqrt_s */
+#define K_MG (1e-3 * NAV_G0_MPS2)                               /* nav_unit_mg_to_mps2 */
+#define K_UG (1e-6 * NAV_G0_MPS2)                               /* nav_unit_ug_to_mps2, ..._ug_per_sqrt_hz_... */
+#define K_PPM 1e-6                                              /* nav_unit_ppm_to_ratio */
+#define K_MRAD 1e-3                                             /* nav_unit_mrad_to_rad */
 
 static void read_format_version(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
-                                const nav_io_node *value, nav_scene *scene);
-static int write_format_version(FILE *fp, const nav_io_field *f, const nav_scene *scene) {
+                                const nav_io_node *value, void *base);
+static nav_status write_format_version(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
   (void)f;
-  (void)scene;
+  (void)base;
+  (void)indent;
   /* The writer always emits the current version (style.md section 11). */
-  return fprintf(fp, "%d", NAV_SCENE_FORMAT_VERSION);
+  return nav_io_writef(w, " %d", NAV_SCENE_FORMAT_VERSION);
 }
+static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *value, void *base);
+static nav_status write_catalog(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool same_string(const nav_io_field *f, const void *a, const void *b);
+static bool catalog_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
+static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *value,
+                     void *base);
+static nav_status write_off(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool off_needed(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
+static bool same_terms(const nav_io_field *f, const void *a, const void *b);
+static void read_outages(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *value, void *base);
+static nav_status write_outages(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool same_outages(const nav_io_field *f, const void *a, const void *b);
+static void read_reported(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                          const nav_io_node *value, void *base);
+static nav_status write_reported(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool same_reported(const nav_io_field *f, const void *a, const void *b);
+static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base);
+static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base);
+static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
 
 static const nav_io_enum_value k_earth_models[] = {
     {"flat", NAV_EARTH_FLAT}, {"wgs84", NAV_EARTH_WGS84}, {NULL, 0}};
-static const nav_io_enum_value k_traj_types[] = {{"parametric", NAV_TRAJ_PARAMETRIC}, {NULL, 0}};
-static const nav_io_enum_value k_attitude_modes[] = {{"magnus", NAV_ATT_RATE_MAGNUS}, {NULL, 0}};
 static const nav_io_enum_value k_gravity_models[] = {
     {"normal", NAV_GRAVITY_NORMAL}, {"j2", NAV_GRAVITY_J2}, {NULL, 0}};
 static const nav_io_enum_value k_mech_frames[] = {{"ned", NAV_MECH_NED}, {"ecef", NAV_MECH_ECEF}, {NULL, 0}};
 static const nav_io_enum_value k_mech_algorithms[] = {
     {"first_order", NAV_MECH_FIRST_ORDER}, {"high_order", NAV_MECH_HIGH_ORDER}, {NULL, 0}};
+static const nav_io_enum_value k_schemes[] = {
+    {"free_ins", NAV_SCHEME_FREE_INS}, {"ins_gnss", NAV_SCHEME_INS_GNSS}, {NULL, 0}};
+static const nav_io_enum_value k_bi_conventions[] = {
+    {"allan_peak", NAV_BI_ALLAN_PEAK}, {"sigma_equals_b", NAV_BI_SIGMA_EQUALS_B}, {NULL, 0}};
 
 /* Plain descriptors; each field's range and flags are spelled out where it is listed. */
 #define F_DOUBLE(k, member, sc, fl)                                                                          \
   { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = OFF(member), .scale = (sc) }
-#define F_VEC3(k, member, sc, fl)                                                                            \
-  { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE | (fl), .offset = OFF(member), .scale = (sc) }
 /* One angle in degrees (preferred, as in the canonical example) or radians. */
 #define ANGLE_DEG_RAD(name, member)                                                                          \
   F_DOUBLE(name "_deg", member, NAV_DEG2RAD, NAV_IO_FINITE),                                                 \
@@ -121,69 +178,255 @@ static const nav_io_field k_earth[] = {
 };
 DEFINE_SECTION(k_earth_section, k_earth);
 
-static const nav_io_field k_attitude[] = {
-    ANGLE_DEG_RAD("roll", trajectory.initial_attitude.roll_rad),
-    ANGLE_DEG_RAD("pitch", trajectory.initial_attitude.pitch_rad),
-    ANGLE_DEG_RAD("yaw", trajectory.initial_attitude.yaw_rad),
-};
-DEFINE_SECTION(k_attitude_section, k_attitude);
-
-static const nav_io_field k_rate[] = {
-    F_VEC3("a_rps", trajectory.parametric.wa_rps, 1.0, 0),
-    F_VEC3("a_dps", trajectory.parametric.wa_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    F_VEC3("b_rps", trajectory.parametric.wb_rps, 1.0, 0),
-    F_VEC3("b_dps", trajectory.parametric.wb_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    F_VEC3("c_hz", trajectory.parametric.wc_hz, 1.0, 0),
-    F_VEC3("d_rad", trajectory.parametric.wd_rad, 1.0, 0),
-    F_VEC3("d_deg", trajectory.parametric.wd_rad, NAV_DEG2RAD, NAV_IO_ALT),
-};
-DEFINE_SECTION(k_rate_section, k_rate);
-
-static const nav_io_field k_parametric[] = {
-    F_VEC3("R0_m", trajectory.parametric.r0_m, 1.0, 0),
-    F_VEC3("V0_mps", trajectory.parametric.v0_mps, 1.0, 0),
-    F_VEC3("A_mps2", trajectory.parametric.a_mps2, 1.0, 0),
-    F_VEC3("B_m", trajectory.parametric.b_m, 1.0, 0),
-    F_VEC3("C_hz", trajectory.parametric.c_hz, 1.0, 0),
-    F_VEC3("D_rad", trajectory.parametric.d_rad, 1.0, 0),
-    F_VEC3("D_deg", trajectory.parametric.d_rad, NAV_DEG2RAD, NAV_IO_ALT),
-    {.key = "rate", .kind = NAV_IO_SECTION, .section = &k_rate_section},
-    {.key = "attitude",
-     .kind = NAV_IO_ENUM,
-     .offset = OFF(trajectory.parametric.attitude_mode),
-     .enums = k_attitude_modes},
-    /* Ranges of integers that only the simulation constrains are left to nav_scene_validate. */
-    {.key = "magnus_substeps", .kind = NAV_IO_INT, .offset = OFF(trajectory.parametric.magnus_substeps)},
-};
-DEFINE_SECTION(k_parametric_section, k_parametric);
-
-static const nav_io_field k_trajectory[] = {
-    {.key = "type", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
-    {.key = "duration_s",
-     .kind = NAV_IO_DOUBLE,
-     .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
-     .offset = OFF(trajectory.duration_s),
-     .scale = 1.0,
-     .min = 0.0,
-     .max = NAV_SCENE_MAX_DURATION_S},
-    {.key = "initial_attitude", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_attitude_section},
-    {.key = "parametric", .kind = NAV_IO_SECTION, .section = &k_parametric_section},
-};
-DEFINE_SECTION(k_trajectory_section, k_trajectory);
-
 #define RATE_HZ(member)                                                                                      \
   {                                                                                                          \
     .key = "rate_hz", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,         \
     .offset = OFF(member), .scale = 1.0, .min = 0.0, .max = NAV_SCENE_MAX_RATE_HZ                            \
   }
 
+/* ---------------------------------------------------------------- IMU error model */
+
+/* One quantity of an error term: key, kind, flags, scene member, scale, then designators (the
+   term bit, mark_as). Its ALT spellings repeat the member and the term. */
+#define Q(k, kd, fl, member, sc, ...)                                                                        \
+  { .key = (k), .kind = (kd), .flags = (fl), .offset = OFF(member), .scale = (sc), __VA_ARGS__ }
+/* An input kept in the reader state (bias instability and the location of the Allan minimum). */
+#define QS(k, fl, member, sc)                                                                                \
+  { .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc) }
+#define G_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.gyro.terms)
+#define A_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.accel.terms)
+#define GM(m) imu.model.gyro.m
+#define AM(m) imu.model.accel.m
+#define ALTS (NAV_IO_ALT | NAV_IO_WRITE_ALT) /* an alternative the writer uses when it is shorter */
+
+/*
+ * Gyro triad (nav_gyro_error_config). Values are 1-sigma per axis; a scalar applies to x, y and
+ * z. The bias instability B with the location tau_min of the Allan minimum is turned into the GM
+ * bias by nav_gm_from_bias_instability() under imu.bias_convention; it is not stored, so the
+ * writer writes the resulting bias_gm_sigma_* and bias_gm_tau_s.
+ */
+static const nav_io_field k_gyro[] = {
+    Q("arw_deg_per_sqrt_h", NAV_IO_VEC3S, NONNEG, GM(arw_rad_per_sqrt_s), K_DEG_PER_SQRT_H,
+      G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("arw_rad_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(arw_rad_per_sqrt_s), 1.0,
+      G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_deg_per_s_per_sqrt_hz", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(arw_rad_per_sqrt_s),
+      NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("bias_turn_on_deg_per_h", NAV_IO_VEC3S, NONNEG, GM(bias_turn_on_sd_rps), K_DEG_PER_H,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_rps"),
+    Q("bias_turn_on_dps", NAV_IO_VEC3S, NONNEG | ALTS, GM(bias_turn_on_sd_rps), NAV_DEG2RAD,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_turn_on_sd_rps), 1.0,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_deg_per_h", NAV_IO_VEC3S, NAV_IO_FINITE, GM(bias_turn_on_fixed_rps), K_DEG_PER_H,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_dps", NAV_IO_VEC3S, NAV_IO_FINITE | ALTS, GM(bias_turn_on_fixed_rps), NAV_DEG2RAD,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_rps", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, GM(bias_turn_on_fixed_rps), 1.0,
+      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    QS("bias_instability_deg_per_h", NONNEG, bi[0], K_DEG_PER_H),
+    QS("bias_instability_rps", NONNEG | NAV_IO_ALT, bi[0], 1.0),
+    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[0], 1.0),
+    Q("bias_gm_sigma_deg_per_h", NAV_IO_VEC3S, NONNEG, GM(bias_gm_sd_rps), K_DEG_PER_H,
+      G_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_rps"),
+    Q("bias_gm_sigma_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_gm_sd_rps), 1.0,
+      G_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, GM(bias_gm_tau_s), 1.0, G_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("rrw_deg_per_h_per_sqrt_h", NAV_IO_VEC3S, NONNEG, GM(bias_rw_rps_per_sqrt_s), K_DEG_PER_H_PER_SQRT_H,
+      G_TERM(NAV_IMU_TERM_BIAS_RW), .mark_as = "bias_rw_rps_per_sqrt_s"),
+    Q("rrw_rps_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_rw_rps_per_sqrt_s), 1.0,
+      G_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, GM(scale_factor_sd), K_PPM, G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(scale_factor_sd), 1.0,
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, GM(scale_factor_fixed), K_PPM,
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_fixed", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, GM(scale_factor_fixed), 1.0,
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG, GM(misalignment_sd_rad), K_MRAD,
+      G_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG | NAV_IO_ALT, GM(misalignment_sd_rad), 1.0,
+      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, GM(misalignment_fixed_rad), K_MRAD,
+      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, GM(misalignment_fixed_rad), 1.0,
+      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("g_sensitivity_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NONNEG, GM(g_sensitivity_sd_rps_per_mps2),
+      K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY), .mark_as = "g_sensitivity_sd_rps_per_mps2"),
+    Q("g_sensitivity_rps_per_mps2", NAV_IO_MAT3_DIAG, NONNEG | NAV_IO_ALT, GM(g_sensitivity_sd_rps_per_mps2),
+      1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NAV_IO_FINITE, GM(g_sensitivity_fixed_rps_per_mps2),
+      K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("g_sensitivity_fixed_rps_per_mps2", NAV_IO_MAT3_DIAG, NAV_IO_FINITE | NAV_IO_ALT,
+      GM(g_sensitivity_fixed_rps_per_mps2), 1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("quantisation_rad", NAV_IO_VEC3S, POSITIVE, GM(quant_step_rad), 1.0, G_TERM(NAV_IMU_TERM_QUANTISATION),
+      .mark_as = "quant_step_rad"),
+    Q("range_dps", NAV_IO_VEC3S, POSITIVE, GM(range_rps), NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_SATURATION)),
+    Q("range_rps", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, GM(range_rps), 1.0, G_TERM(NAV_IMU_TERM_SATURATION)),
+};
+DEFINE_SECTION_FINISH(k_gyro_section, k_gyro, finish_gyro);
+
+/* Accelerometer triad (nav_accel_error_config); as the gyro, in g-based datasheet units. */
+static const nav_io_field k_accel[] = {
+    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_VEC3S, NONNEG, AM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
+      A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("vrw_mps_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), 1.0,
+      A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_ug_per_sqrt_hz", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), K_UG,
+      A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG, AM(bias_turn_on_sd_mps2), K_MG, A_TERM(NAV_IMU_TERM_BIAS_TURN_ON),
+      .mark_as = "bias_turn_on_sd_mps2"),
+    Q("bias_turn_on_mps2", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_turn_on_sd_mps2), 1.0,
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_mg", NAV_IO_VEC3S, NAV_IO_FINITE, AM(bias_turn_on_fixed_mps2), K_MG,
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_mps2", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, AM(bias_turn_on_fixed_mps2), 1.0,
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    QS("bias_instability_ug", NONNEG, bi[1], K_UG),
+    QS("bias_instability_mps2", NONNEG | NAV_IO_ALT, bi[1], 1.0),
+    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[1], 1.0),
+    Q("bias_gm_sigma_ug", NAV_IO_VEC3S, NONNEG, AM(bias_gm_sd_mps2), K_UG, A_TERM(NAV_IMU_TERM_BIAS_GM),
+      .mark_as = "bias_gm_sd_mps2"),
+    Q("bias_gm_sigma_mps2", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_gm_sd_mps2), 1.0,
+      A_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, AM(bias_gm_tau_s), 1.0, A_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_rw_m_per_s2_per_sqrt_h", NAV_IO_VEC3S, NONNEG, AM(bias_rw_mps2_per_sqrt_s), K_PER_SQRT_H,
+      A_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("bias_rw_mps2_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_rw_mps2_per_sqrt_s), 1.0,
+      A_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, AM(scale_factor_sd), K_PPM, A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(scale_factor_sd), 1.0,
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, AM(scale_factor_fixed), K_PPM,
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_fixed", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, AM(scale_factor_fixed), 1.0,
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG, AM(misalignment_sd_rad), K_MRAD,
+      A_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG | NAV_IO_ALT, AM(misalignment_sd_rad), 1.0,
+      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, AM(misalignment_fixed_rad), K_MRAD,
+      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, AM(misalignment_fixed_rad), 1.0,
+      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("quantisation_mps", NAV_IO_VEC3S, POSITIVE, AM(quant_step_mps), 1.0, A_TERM(NAV_IMU_TERM_QUANTISATION),
+      .mark_as = "quant_step_mps"),
+    Q("range_g", NAV_IO_VEC3S, POSITIVE, AM(range_mps2), NAV_G0_MPS2, A_TERM(NAV_IMU_TERM_SATURATION)),
+    Q("range_mps2", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, AM(range_mps2), 1.0, A_TERM(NAV_IMU_TERM_SATURATION)),
+};
+DEFINE_SECTION_FINISH(k_accel_section, k_accel, finish_accel);
+
 static const nav_io_field k_imu[] = {
     RATE_HZ(imu.rate_hz),
     {.key = "quadrature_nodes", .kind = NAV_IO_INT, .offset = OFF(imu.quadrature_nodes)},
+    {.key = "bias_convention",
+     .kind = NAV_IO_ENUM,
+     .flags = NAV_IO_STATE | NAV_IO_EARLY,
+     .offset = SOFF(bias_convention),
+     .enums = k_bi_conventions},
+    {.key = "catalog",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_EARLY,
+     .offset = OFF(imu.catalog),
+     .size = NAV_SCENE_CATALOG_NAME_MAX,
+     .read = read_catalog,
+     .write = write_catalog,
+     .same = same_string,
+     .write_if = catalog_given,
+     .comment = "resources/imu_catalog.csv; the keys below override it"},
+    {.key = "gyro", .kind = NAV_IO_SECTION, .section = &k_gyro_section},
+    {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_accel_section},
+    {.key = "off",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_LATE,
+     .offset = OFF(imu.model),
+     .read = read_off,
+     .write = write_off,
+     .same = same_terms,
+     .write_if = off_needed,
+     .comment = "terms switched off"},
 };
 DEFINE_SECTION(k_imu_section, k_imu);
 
+/* ---------------------------------------------------------------- GNSS receiver */
+
+#define N_TERM(b) .bit = (b), .bits_offset = OFF(gnss.model.terms)
+#define NM(m) gnss.model.m
+
+static const nav_io_field k_reported[] = {
+    Q("position_m", NAV_IO_VEC3S, NONNEG | NAV_IO_REQUIRED, NM(reported_pos_sd_m), 1.0, .bit = 0),
+    Q("velocity_mps", NAV_IO_VEC3S, NONNEG | NAV_IO_REQUIRED, NM(reported_vel_sd_mps), 1.0, .bit = 0),
+};
+DEFINE_SECTION(k_reported_section, k_reported);
+
+static const nav_io_field k_gnss[] = {
+    {.key = "enabled", .kind = NAV_IO_BOOL, .offset = OFF(gnss.enabled)},
+    {.key = "catalog",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_EARLY,
+     .offset = OFF(gnss.catalog),
+     .size = NAV_SCENE_CATALOG_NAME_MAX,
+     .read = read_catalog,
+     .write = write_catalog,
+     .same = same_string,
+     .write_if = catalog_given,
+     .comment = "resources/gnss_receivers.csv; the keys below override it"},
+    {.key = "update_rate_hz",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
+     .offset = OFF(NM(update_rate_hz)),
+     .scale = 1.0,
+     .max = NAV_SCENE_MAX_RATE_HZ},
+    Q("latency_s", NAV_IO_DOUBLE, NONNEG, NM(latency_s), 1.0, .bit = 0),
+    Q("position_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_gm_sd_m), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
+      .mark_as = "pos_gm_sd_m", .comment = "N, E, D; Gauss-Markov"),
+    Q("position_corr_time_s", NAV_IO_VEC3S, NONNEG, NM(pos_gm_tau_s), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
+      .mark_as = "pos_gm_tau_s", .comment = "0: white"),
+    Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_white_sd_m), 1.0, N_TERM(NAV_GNSS_TERM_POS_WHITE),
+      .mark_as = "pos_white_sd_m"),
+    Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG, NM(vel_sd_mps), 1.0, N_TERM(NAV_GNSS_TERM_VEL_WHITE),
+      .mark_as = "vel_sd_mps"),
+    Q("lever_arm_b_m", NAV_IO_VEC3, NAV_IO_FINITE, NM(r_ba_b_m), 1.0, .mark_as = "r_ba_b_m",
+      .comment = "antenna relative to the IMU, body axes"),
+    {.key = "outages",
+     .kind = NAV_IO_CUSTOM,
+     .offset = OFF(gnss.model),
+     .read = read_outages,
+     .write = write_outages,
+     .same = same_outages,
+     .comment = "[t0_s, t1_s): no fix"},
+    {.key = "reported_sigma",
+     .kind = NAV_IO_CUSTOM,
+     .offset = OFF(gnss.model),
+     .section = &k_reported_section,
+     .read = read_reported,
+     .write = write_reported,
+     .same = same_reported},
+    {.key = "off",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_LATE,
+     .offset = OFF(gnss.model),
+     .read = read_off,
+     .write = write_off,
+     .same = same_terms,
+     .write_if = off_needed,
+     .comment = "terms switched off"},
+};
+DEFINE_SECTION(k_gnss_section, k_gnss);
+
+/* ---------------------------------------------------------------- the rest */
+
+static const nav_io_field k_initial_errors[] = {
+    Q("position_m", NAV_IO_VEC3S, NONNEG, initial_errors.pos_sd_m, 1.0, .comment = "1-sigma N, E, D"),
+    Q("velocity_mps", NAV_IO_VEC3S, NONNEG, initial_errors.vel_sd_mps, 1.0, .comment = "1-sigma N, E, D"),
+    Q("attitude_deg", NAV_IO_VEC3S, NONNEG, initial_errors.att_sd_rad, NAV_DEG2RAD,
+      .comment = "1-sigma about N, E, D"),
+    Q("attitude_rad", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, initial_errors.att_sd_rad, 1.0, .bit = 0),
+};
+DEFINE_SECTION(k_initial_errors_section, k_initial_errors);
+
 static const nav_io_field k_navigation[] = {
+    {.key = "scheme", .kind = NAV_IO_ENUM, .offset = OFF(navigation.scheme), .enums = k_schemes},
     {.key = "algorithm",
      .kind = NAV_IO_ENUM,
      .offset = OFF(navigation.algorithm),
@@ -193,6 +436,10 @@ static const nav_io_field k_navigation[] = {
      .offset = OFF(navigation.frame),
      .enums = k_mech_frames,
      .comment = "wgs84 only: ned (local level) or ecef (works over the poles)"},
+    {.key = "aid_vertical",
+     .kind = NAV_IO_BOOL,
+     .offset = OFF(navigation.aid_vertical),
+     .comment = "free INS: height and vertical velocity from the reference"},
 };
 DEFINE_SECTION(k_navigation_section, k_navigation);
 
@@ -207,6 +454,13 @@ static const nav_io_field k_simulation[] = {
      .offset = OFF(simulation.runs),
      .min = 1.0,
      .max = (double)NAV_SCENE_MAX_RUNS},
+    {.key = "threads",
+     .kind = NAV_IO_INT,
+     .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = OFF(simulation.threads),
+     .min = 0.0,
+     .max = 256.0,
+     .comment = "0: one per core; results do not depend on it"},
 };
 DEFINE_SECTION(k_simulation_section, k_simulation);
 
@@ -218,14 +472,16 @@ static const nav_io_field k_root[] = {
      .write = write_format_version},
     {.key = "name", .kind = NAV_IO_STRING, .offset = OFF(name), .size = NAV_SCENE_NAME_MAX},
     {.key = "earth", .kind = NAV_IO_SECTION, .section = &k_earth_section},
-    {.key = "trajectory", .kind = NAV_IO_SECTION, .section = &k_trajectory_section},
+    {.key = "trajectory", .kind = NAV_IO_SECTION, .section = &nav_io_trajectory_section},
     {.key = "imu", .kind = NAV_IO_SECTION, .section = &k_imu_section},
+    {.key = "gnss", .kind = NAV_IO_SECTION, .section = &k_gnss_section, .write_if = gnss_written},
+    {.key = "initial_errors", .kind = NAV_IO_SECTION, .section = &k_initial_errors_section},
     {.key = "navigation", .kind = NAV_IO_SECTION, .section = &k_navigation_section},
     {.key = "output", .kind = NAV_IO_SECTION, .section = &k_output_section},
     {.key = "simulation", .kind = NAV_IO_SECTION, .section = &k_simulation_section},
 };
 _Static_assert(COUNT(k_root) <= MAX_SECTION_FIELDS, "k_root: too many fields");
-const nav_io_section nav_io_scene_schema = {k_root, COUNT(k_root)};
+const nav_io_section nav_io_scene_schema = {k_root, COUNT(k_root), NULL};
 
 /* ================================================================ shared helpers */
 
@@ -306,6 +562,7 @@ struct nav_io_reader {
   size_t nmarks, cap_marks;
   char err_paths[NAV_DIAG_MAX_PER_FILE][PATH_MAX_LEN]; /* paths with a reader error */
   int nerr_paths;
+  nav_io_read_state state; /* inputs without a place in the scene (scene_io_internal.h) */
 };
 
 #define ARENA_BLOCK_BYTES ((size_t)64 * 1024)
@@ -396,6 +653,41 @@ void nav_io_reader_error(nav_io_reader *r, const nav_io_node *node, const nav_io
   emit(r, at != NULL ? at->line : 0, at != NULL ? at->col : 0, r->path, msg);
 }
 
+static bool find_mark(const nav_io_reader *r, const char *path, int *line, int *col);
+
+void nav_io_reader_error_at_path(nav_io_reader *r, const char *path, const char *fmt, ...) {
+  char msg[sizeof(((nav_diag *)0)->message)];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  int line = 0, col = 0;
+  find_mark(r, path, &line, &col);
+  if (r->nerr_paths < NAV_DIAG_MAX_PER_FILE) snprintf(r->err_paths[r->nerr_paths++], PATH_MAX_LEN, "%s", path);
+  emit(r, line, col, path, msg);
+}
+
+void nav_io_reader_forward(nav_io_reader *r, const nav_diag *d) {
+  if (r->ndiag >= NAV_DIAG_MAX_PER_FILE) {
+    r->stop = true;
+    return;
+  }
+  if (r->ndiag == NAV_DIAG_MAX_PER_FILE - 1) {
+    emit(r, 0, 0, "", ""); /* the "too many problems" entry */
+    return;
+  }
+  r->ndiag++;
+  if (r->report != NULL) r->report(r->user, d);
+}
+
+int nav_io_reader_count(const nav_io_reader *r) {
+  return r->ndiag;
+}
+
+nav_io_read_state *nav_io_reader_state(nav_io_reader *r) {
+  return &r->state;
+}
+
 void nav_diag_format(const nav_diag *d, char *buf, size_t size) {
   if (buf == NULL || size == 0) return;
   if (d == NULL) {
@@ -464,13 +756,27 @@ static void path_pop(nav_io_reader *r, size_t saved) {
   r->path[saved] = '\0';
 }
 
+size_t nav_io_path_push_key(nav_io_reader *r, const char *key) {
+  return path_push_key(r, key, strlen(key));
+}
+
+size_t nav_io_path_push_index(nav_io_reader *r, size_t i) {
+  return path_push_index(r, i);
+}
+
+void nav_io_path_pop(nav_io_reader *r, size_t saved) {
+  path_pop(r, saved);
+}
+
 /* Remember where the current path is in the file, for nav_scene_validate's messages. */
 static void mark_path(nav_io_reader *r, const nav_io_node *node, const nav_io_node *fallback) {
   const nav_io_node *at = node != NULL && node->line > 0 ? node : fallback;
   if (at == NULL || at->line <= 0) return;
   if (r->nmarks == r->cap_marks) {
     const size_t cap = r->cap_marks ? 2 * r->cap_marks : 64;
-    if (cap > 65536) return; /* only schema fields are marked: a few hundred at most */
+    /* Schema fields only: a few per waypoint or segment, so a full-size script fits; marks only
+       refine locations, and beyond the cap a message falls back to the nearest marked parent. */
+    if (cap > 65536) return;
     mark_entry *m = realloc(r->marks, cap * sizeof *m);
     if (m == NULL) return; /* marks only refine locations; reading goes on without them */
     r->marks = m;
@@ -480,6 +786,10 @@ static void mark_path(nav_io_reader *r, const nav_io_node *node, const nav_io_no
   snprintf(e->path, sizeof e->path, "%s", r->path);
   e->line = at->line;
   e->col = at->col;
+}
+
+void nav_io_mark(nav_io_reader *r, const nav_io_node *node, const nav_io_node *fallback) {
+  mark_path(r, node, fallback);
 }
 
 /* The mark of @p path, else of its nearest parent ("a.b[2]" -> "a.b" -> "a"); false if none. */
@@ -1011,6 +1321,122 @@ static bool read_u64(nav_io_reader *r, const nav_io_node *key, const nav_io_node
   return true;
 }
 
+/* ================================================================ tree access for the other files */
+
+bool nav_io_node_is_map(const nav_io_node *n) {
+  return n != NULL && n->kind == Y_MAP;
+}
+
+bool nav_io_node_is_seq(const nav_io_node *n) {
+  return n != NULL && n->kind == Y_SEQ;
+}
+
+bool nav_io_node_is_scalar(const nav_io_node *n) {
+  return n != NULL && n->kind == Y_SCALAR && !is_null(n);
+}
+
+bool nav_io_node_text_is(const nav_io_node *n, const char *s) {
+  return n != NULL && n->kind == Y_SCALAR && text_is(n, s);
+}
+
+const char *nav_io_node_text(const nav_io_node *n, size_t *len) {
+  if (len != NULL) *len = n != NULL && n->text != NULL ? n->len : 0;
+  return n != NULL && n->text != NULL ? n->text : "";
+}
+
+size_t nav_io_node_count(const nav_io_node *n) {
+  if (n == NULL) return 0;
+  return n->kind == Y_MAP ? n->count / 2 : n->count;
+}
+
+const nav_io_node *nav_io_node_child(const nav_io_node *n) {
+  return n != NULL ? n->child : NULL;
+}
+
+const nav_io_node *nav_io_node_next(const nav_io_node *n) {
+  return n != NULL ? n->next : NULL;
+}
+
+const nav_io_node *nav_io_map_get(const nav_io_node *map, const char *key, const nav_io_node **key_out) {
+  if (key_out != NULL) *key_out = NULL;
+  if (map == NULL || map->kind != Y_MAP) return NULL;
+  for (const nav_io_node *k = map->child; k != NULL && k->next != NULL; k = k->next->next)
+    if (k->kind == Y_SCALAR && text_is(k, key)) {
+      if (key_out != NULL) *key_out = k;
+      return k->next;
+    }
+  return NULL;
+}
+
+bool nav_io_read_number(nav_io_reader *r, const nav_io_node *key, const nav_io_node *v, double *out) {
+  return parse_double(r, key, v, out);
+}
+
+bool nav_io_check_number(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                         double d) {
+  return check_double(r, f, key, v, d);
+}
+
+void nav_io_expected(nav_io_reader *r, const nav_io_node *key, const nav_io_node *v, const char *expected) {
+  char got[SHOW_MAX + 32];
+  describe(got, sizeof got, v);
+  nav_io_reader_error(r, v, key, "expected %s, got %s", expected, got);
+}
+
+bool nav_io_reject_special(nav_io_reader *r, const nav_io_node *key, const nav_io_node *v) {
+  return reject_special(r, key, v);
+}
+
+/* ================================================================ did you mean */
+
+static char lower(char c) {
+  return c >= 'A' && c <= 'Z' ? (char)(c - 'A' + 'a') : c;
+}
+
+/* Optimal string alignment distance (Levenshtein plus adjacent transpositions), case-blind; three
+   rows (i - 2, i - 1, i) of at most 128 + 1 entries. */
+static size_t edit_distance(const char *a, size_t la, const char *b, size_t lb) {
+  enum { N = 128 };
+  size_t r0[N + 1], r1[N + 1], r2[N + 1];
+  if (la > N || lb > N) return (size_t)-1;
+  for (size_t j = 0; j <= lb; ++j) {
+    r0[j] = j;
+    r1[j] = j;
+  }
+  for (size_t i = 1; i <= la; ++i) {
+    r2[0] = i;
+    for (size_t j = 1; j <= lb; ++j) {
+      const size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+      size_t best = r1[j] + 1;
+      if (r2[j - 1] + 1 < best) best = r2[j - 1] + 1;
+      if (r1[j - 1] + cost < best) best = r1[j - 1] + cost;
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1]) &&
+          r0[j - 2] + 1 < best)
+        best = r0[j - 2] + 1;
+      r2[j] = best;
+    }
+    memcpy(r0, r1, (lb + 1) * sizeof r0[0]);
+    memcpy(r1, r2, (lb + 1) * sizeof r1[0]);
+  }
+  return r1[lb];
+}
+
+const char *nav_io_closest(const char *text, size_t len, const char *const *names, size_t n) {
+  /* The budget grows with the length of the word: one typo in a short key, a few in a long name. */
+  size_t budget = len <= 3 ? 1 : len <= 8 ? 2 : 3;
+  if (len / 5 > budget) budget = len / 5;
+  size_t best = (size_t)-1;
+  const char *best_name = NULL;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t d = edit_distance(text, len, names[i], strlen(names[i]));
+    if (d < best) {
+      best = d;
+      best_name = names[i];
+    }
+  }
+  return best_name != NULL && best <= budget && best < len ? best_name : NULL;
+}
+
 /* ================================================================ fields and sections */
 
 static void list_keys(char *buf, size_t size, const nav_io_section *sec) {
@@ -1034,107 +1460,233 @@ static void list_enum(char *buf, size_t size, const nav_io_enum_value *e) {
 }
 
 static void read_section(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key,
-                         const nav_io_node *v, nav_scene *scene, const nav_io_node *skip_key);
+                         const nav_io_node *v, void *base, const nav_io_node *skip_key);
 
-static void read_vec3(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                      nav_scene *scene) {
-  char got[SHOW_MAX + 32];
-  if (reject_special(r, key, v)) return;
-  if (v->kind != Y_SEQ) {
-    describe(got, sizeof got, v);
-    nav_io_reader_error(r, v, key, "expected a sequence of 3 numbers, got %s", got);
-    return;
-  }
-  if (v->count != 3) {
-    nav_io_reader_error(r, v, key, "expected a sequence of 3 numbers, got %zu", v->count);
-    return;
-  }
-  double x[3];
+/* The @p n items of sequence @p v as numbers, each range-checked as @p f says (file units). */
+static bool read_number_items(nav_io_reader *r, const nav_io_field *f, const nav_io_node *v, double *x,
+                              size_t n) {
   bool ok = true;
   size_t i = 0;
-  for (const nav_io_node *item = v->child; item != NULL && i < 3; item = item->next, ++i) {
+  for (const nav_io_node *item = v->child; item != NULL && i < n; item = item->next, ++i) {
     const size_t saved = path_push_index(r, i);
     mark_path(r, item, v);
     if (!parse_double(r, v, item, &x[i]) || !check_double(r, f, v, item, x[i])) ok = false;
     path_pop(r, saved);
   }
-  if (!ok) return;
-  nav_vec3 *dst = (nav_vec3 *)((char *)scene + f->offset);
-  *dst = nav_vec3_make(x[0] * f->scale, x[1] * f->scale, x[2] * f->scale);
+  return ok;
 }
 
-static void read_enum(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                      nav_scene *scene) {
-  char list[256], got[SHOW_MAX + 32];
-  if (reject_special(r, key, v)) return;
-  if (v->kind == Y_SCALAR && !is_null(v))
-    for (size_t i = 0; f->enums[i].name != NULL; ++i)
-      if (text_is(v, f->enums[i].name)) {
-        *(int *)((char *)scene + f->offset) = f->enums[i].value;
-        return;
-      }
-  list_enum(list, sizeof list, f->enums);
-  describe(got, sizeof got, v);
-  nav_io_reader_error(r, v, key, "expected one of: %s; got %s", list, got);
-}
-
-static void read_string(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                        nav_scene *scene) {
+static bool read_vec3(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                      void *base, bool scalar_ok) {
   char got[SHOW_MAX + 32];
-  if (reject_special(r, key, v)) return;
+  const char *what = scalar_ok ? "a number or a sequence of 3 numbers" : "a sequence of 3 numbers";
+  double x[3];
+  if (reject_special(r, key, v)) return false;
+  if (scalar_ok && v->kind == Y_SCALAR) {
+    if (!parse_double(r, key, v, &x[0]) || !check_double(r, f, key, v, x[0])) return false;
+    x[1] = x[2] = x[0];
+  } else if (v->kind != Y_SEQ) {
+    describe(got, sizeof got, v);
+    nav_io_reader_error(r, v, key, "expected %s, got %s", what, got);
+    return false;
+  } else if (v->count != 3) {
+    nav_io_reader_error(r, v, key, "expected %s, got %zu", what, v->count);
+    return false;
+  } else if (!read_number_items(r, f, v, x, 3)) {
+    return false;
+  }
+  nav_vec3 *dst = (nav_vec3 *)((char *)base + f->offset);
+  *dst = nav_vec3_make(x[0] * f->scale, x[1] * f->scale, x[2] * f->scale);
+  return true;
+}
+
+/* A 3x3 matrix: one number (every off-diagonal element, or the diagonal), 3 numbers (the
+   diagonal; NAV_IO_MAT3_DIAG only) or 3 rows of 3 numbers. */
+static bool read_mat3(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                      void *base) {
+  char got[SHOW_MAX + 32];
+  const bool diag = f->kind == NAV_IO_MAT3_DIAG;
+  const char *what = diag ? "a number or 3 numbers (the diagonal), or 3 rows of 3 numbers"
+                          : "a number (every off-diagonal element) or 3 rows of 3 numbers";
+  double m[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+  if (reject_special(r, key, v)) return false;
+  if (v->kind == Y_SCALAR) {
+    double x = 0.0;
+    if (!parse_double(r, key, v, &x) || !check_double(r, f, key, v, x)) return false;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if ((i == j) == diag) m[i][j] = x;
+  } else if (v->kind != Y_SEQ || v->count != 3) {
+    if (v->kind == Y_SEQ)
+      snprintf(got, sizeof got, "%zu items", v->count);
+    else
+      describe(got, sizeof got, v);
+    nav_io_reader_error(r, v, key, "expected %s, got %s", what, got);
+    return false;
+  } else if (diag && v->child->kind != Y_SEQ) {
+    double x[3];
+    if (!read_number_items(r, f, v, x, 3)) return false;
+    for (int i = 0; i < 3; ++i)
+      m[i][i] = x[i];
+  } else {
+    bool ok = true;
+    size_t i = 0;
+    for (const nav_io_node *row = v->child; row != NULL && i < 3; row = row->next, ++i) {
+      const size_t saved = path_push_index(r, i);
+      if (reject_special(r, v, row)) {
+        ok = false;
+      } else if (row->kind != Y_SEQ || row->count != 3) {
+        if (row->kind == Y_SEQ)
+          snprintf(got, sizeof got, "%zu items", row->count);
+        else
+          describe(got, sizeof got, row);
+        nav_io_reader_error(r, row, v, "expected a row of 3 numbers, got %s", got);
+        ok = false;
+      } else if (!read_number_items(r, f, row, m[i], 3)) {
+        ok = false;
+      }
+      path_pop(r, saved);
+    }
+    if (!ok) return false;
+  }
+  nav_mat3 *dst = (nav_mat3 *)((char *)base + f->offset);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      dst->m[i][j] = m[i][j] * f->scale;
+  return true;
+}
+
+static bool read_bool(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                      void *base) {
+  if (reject_special(r, key, v)) return false;
+  static const char *const yes[] = {"true", "True", "TRUE"}, *const no[] = {"false", "False", "FALSE"};
+  bool *dst = (bool *)((char *)base + f->offset);
+  if (v->kind == Y_SCALAR && !v->quoted)
+    for (size_t i = 0; i < COUNT(yes); ++i) {
+      if (text_is(v, yes[i])) {
+        *dst = true;
+        return true;
+      }
+      if (text_is(v, no[i])) {
+        *dst = false;
+        return true;
+      }
+    }
+  nav_io_expected(r, key, v, "true or false");
+  return false;
+}
+
+bool nav_io_read_enum_value(nav_io_reader *r, const nav_io_enum_value *e, const nav_io_node *key,
+                            const nav_io_node *v, int *out) {
+  char list[512], got[SHOW_MAX + 32];
+  if (reject_special(r, key, v)) return false;
+  if (v->kind == Y_SCALAR && !is_null(v))
+    for (size_t i = 0; e[i].name != NULL; ++i)
+      if (text_is(v, e[i].name)) {
+        *out = e[i].value;
+        return true;
+      }
+  list_enum(list, sizeof list, e);
+  describe(got, sizeof got, v);
+  const char *names[64];
+  size_t n = 0;
+  for (; e[n].name != NULL && n < COUNT(names); ++n)
+    names[n] = e[n].name;
+  const char *best = v->kind == Y_SCALAR && !is_null(v) ? nav_io_closest(v->text, v->len, names, n) : NULL;
+  if (best != NULL)
+    nav_io_reader_error(r, v, key, "expected one of: %s; got %s (did you mean \"%s\"?)", list, got, best);
+  else
+    nav_io_reader_error(r, v, key, "expected one of: %s; got %s", list, got);
+  return false;
+}
+
+static bool read_string(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                        void *base) {
+  char got[SHOW_MAX + 32];
+  if (reject_special(r, key, v)) return false;
   if (v->kind != Y_SCALAR || is_null(v)) {
     describe(got, sizeof got, v);
     nav_io_reader_error(r, v, key, "expected a string, got %s", got);
-    return;
+    return false;
   }
   if (v->len >= f->size) {
     nav_io_reader_error(r, v, key, "is too long (%zu bytes); at most %zu bytes are allowed", v->len,
                         f->size - 1);
-    return;
+    return false;
   }
   for (size_t i = 0; i < v->len; ++i) {
     const unsigned char c = (unsigned char)v->text[i];
     if (c < 0x20 || c == 0x7f) {
       nav_io_reader_error(r, v, key, "must not contain control characters (byte 0x%02x)", c);
-      return;
+      return false;
     }
   }
-  char *dst = (char *)scene + f->offset;
+  char *dst = (char *)base + f->offset;
   memcpy(dst, v->text, v->len);
   dst[v->len] = '\0';
+  return true;
 }
 
-static void read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                       nav_scene *scene) {
-  char *base = (char *)scene;
+/* One value; true if it was stored. A field with a term bit switches its term on. */
+static bool read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                       void *base_in) {
+  char *base = (f->flags & NAV_IO_STATE) ? (char *)&r->state : (char *)base_in;
   double d = 0.0;
   long long ll = 0;
+  int e = 0;
+  bool ok = false;
   switch (f->kind) {
-  case NAV_IO_SECTION: read_section(r, f->section, key, v, scene, NULL); break;
-  case NAV_IO_DOUBLE:
-    if (parse_double(r, key, v, &d) && check_double(r, f, key, v, d))
-      *(double *)(base + f->offset) = d * f->scale;
+  case NAV_IO_SECTION:
+    read_section(r, f->section, key, v, base, NULL);
+    ok = true;
     break;
-  case NAV_IO_VEC3: read_vec3(r, f, key, v, scene); break;
+  case NAV_IO_DOUBLE:
+    ok = parse_double(r, key, v, &d) && check_double(r, f, key, v, d);
+    if (ok) *(double *)(base + f->offset) = d * f->scale;
+    break;
+  case NAV_IO_VEC3: ok = read_vec3(r, f, key, v, base, false); break;
+  case NAV_IO_VEC3S: ok = read_vec3(r, f, key, v, base, true); break;
+  case NAV_IO_MAT3_OFFDIAG:
+  case NAV_IO_MAT3_DIAG: ok = read_mat3(r, f, key, v, base); break;
   case NAV_IO_INT:
-    if (read_integer(r, f, key, v, INT_MIN, INT_MAX, &ll)) *(int *)(base + f->offset) = (int)ll;
+    ok = read_integer(r, f, key, v, INT_MIN, INT_MAX, &ll);
+    if (ok) *(int *)(base + f->offset) = (int)ll;
     break;
   case NAV_IO_LONG:
-    if (read_integer(r, f, key, v, LONG_MIN, LONG_MAX, &ll)) *(long *)(base + f->offset) = (long)ll;
+    ok = read_integer(r, f, key, v, LONG_MIN, LONG_MAX, &ll);
+    if (ok) *(long *)(base + f->offset) = (long)ll;
     break;
-  case NAV_IO_U64: read_u64(r, key, v, (uint64_t *)(base + f->offset)); break;
-  case NAV_IO_ENUM: read_enum(r, f, key, v, scene); break;
-  case NAV_IO_STRING: read_string(r, f, key, v, scene); break;
-  case NAV_IO_CUSTOM: f->read(r, f, key, v, scene); break;
+  case NAV_IO_U64: ok = read_u64(r, key, v, (uint64_t *)(base + f->offset)); break;
+  case NAV_IO_BOOL: ok = read_bool(r, f, key, v, base); break;
+  case NAV_IO_ENUM:
+    ok = nav_io_read_enum_value(r, f->enums, key, v, &e);
+    if (ok) *(int *)(base + f->offset) = e;
+    break;
+  case NAV_IO_STRING: ok = read_string(r, f, key, v, base); break;
+  case NAV_IO_CUSTOM:
+    f->read(r, f, key, v, base);
+    ok = true;
+    break;
   }
+  if (ok && f->bit != 0 && !(f->flags & NAV_IO_STATE)) *(unsigned *)(base + f->bits_offset) |= f->bit;
+  return ok;
+}
+
+void nav_io_read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                       void *base) {
+  (void)read_field(r, f, key, v, base);
 }
 
 /* Fields with the same storage are spellings of one quantity (lat_deg / lat_rad). */
 static size_t group_of(const nav_io_section *sec, size_t i) {
   const nav_io_field *f = &sec->fields[i];
-  if (f->kind == NAV_IO_SECTION || f->kind == NAV_IO_CUSTOM) return i;
-  for (size_t j = 0; j < i; ++j)
-    if (sec->fields[j].kind == f->kind && sec->fields[j].offset == f->offset) return j;
+  if (f->kind == NAV_IO_SECTION) return i;
+  for (size_t j = 0; j < i; ++j) {
+    const nav_io_field *g = &sec->fields[j];
+    if (g->kind == f->kind && g->offset == f->offset && (g->flags & NAV_IO_STATE) == (f->flags & NAV_IO_STATE) &&
+        (f->kind != NAV_IO_CUSTOM || g->read == f->read))
+      return j;
+  }
   return i;
 }
 
@@ -1142,33 +1694,6 @@ static long find_field(const nav_io_section *sec, const nav_io_node *key) {
   for (size_t i = 0; i < sec->count; ++i)
     if (text_is(key, sec->fields[i].key)) return (long)i;
   return -1;
-}
-
-static char lower(char c) {
-  return c >= 'A' && c <= 'Z' ? (char)(c - 'A' + 'a') : c;
-}
-
-/* Optimal string alignment distance (Levenshtein plus adjacent transpositions), case-blind. */
-static size_t edit_distance(const char *a, size_t la, const char *b, size_t lb) {
-  enum { N = 64 };
-  size_t d[N + 1][N + 1];
-  if (la > N || lb > N) return (size_t)-1;
-  for (size_t i = 0; i <= la; ++i)
-    d[i][0] = i;
-  for (size_t j = 0; j <= lb; ++j)
-    d[0][j] = j;
-  for (size_t i = 1; i <= la; ++i)
-    for (size_t j = 1; j <= lb; ++j) {
-      const size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
-      size_t best = d[i - 1][j] + 1;
-      if (d[i][j - 1] + 1 < best) best = d[i][j - 1] + 1;
-      if (d[i - 1][j - 1] + cost < best) best = d[i - 1][j - 1] + cost;
-      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1]) &&
-          d[i - 2][j - 2] + 1 < best)
-        best = d[i - 2][j - 2] + 1;
-      d[i][j] = best;
-    }
-  return d[la][lb];
 }
 
 static void unknown_key(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key) {
@@ -1196,76 +1721,94 @@ static void unknown_key(nav_io_reader *r, const nav_io_section *sec, const nav_i
   }
 
   /* Closest key by edit distance, within a budget that grows with the length of the key. */
-  const size_t budget = key->len <= 3 ? 1 : key->len <= 8 ? 2 : 3;
-  size_t best = (size_t)-1;
-  const char *best_key = NULL;
-  for (size_t i = 0; i < sec->count; ++i) {
-    const char *k = sec->fields[i].key;
-    const size_t dist = edit_distance(key->text, key->len, k, strlen(k));
-    if (dist < best) {
-      best = dist;
-      best_key = k;
-    }
-  }
-  if (best_key != NULL && best <= budget && best < key->len) {
-    nav_io_reader_error(r, key, NULL, "unknown key \"%s\"; did you mean \"%s\"?", shown, best_key);
+  const char *names[MAX_SECTION_FIELDS];
+  for (size_t i = 0; i < sec->count; ++i)
+    names[i] = sec->fields[i].key;
+  const char *best = nav_io_closest(key->text, key->len, names, sec->count);
+  if (best != NULL) {
+    nav_io_reader_error(r, key, NULL, "unknown key \"%s\"; did you mean \"%s\"?", shown, best);
     return;
   }
   list_keys(list, sizeof list, sec);
   nav_io_reader_error(r, key, NULL, "unknown key \"%s\"; expected one of: %s", shown, list);
 }
 
-/* Read the mapping @p map against @p sec. @p skip_key was already read (format_version). */
-static void read_mapping(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *map,
-                         nav_scene *scene, const nav_io_node *skip_key) {
+static int phase_of(const nav_io_field *f) {
+  return (f->flags & NAV_IO_EARLY) ? 0 : (f->flags & NAV_IO_LATE) ? 2 : 1;
+}
+
+/*
+ * Read the mapping @p map against @p sec into @p base. @p skip_key was already read
+ * (format_version). Keys are taken in three passes: NAV_IO_EARLY ones (what the others build on,
+ * e.g. a catalog part), then the others in file order, then NAV_IO_LATE ones ("off" lists), so
+ * the result does not depend on the order of the keys, which YAML leaves open.
+ */
+static void read_mapping(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *map, void *base,
+                         const nav_io_node *skip_key) {
   const nav_io_node *seen_key[MAX_SECTION_FIELDS] = {NULL};
   size_t seen_field[MAX_SECTION_FIELDS] = {0};
   char got[SHOW_MAX + 32];
+  bool has_phase[3] = {false, true, false};
+  for (size_t i = 0; i < sec->count; ++i)
+    has_phase[phase_of(&sec->fields[i])] = true;
 
-  for (const nav_io_node *key = map->child; key != NULL && !r->stop;
-       key = key->next ? key->next->next : NULL) {
-    const nav_io_node *value = key->next;
-    if (value == NULL) break; /* cannot happen: libfyaml gives mappings an even number of events */
-    if (key->kind != Y_SCALAR || is_null(key)) {
-      describe(got, sizeof got, key);
-      nav_io_reader_error(r, key, value, "expected a key name, got %s", got);
-      continue;
-    }
-    const long idx = find_field(sec, key);
-    const size_t saved = path_push_key(r, key->text, key->len);
-    if (idx < 0) {
-      unknown_key(r, sec, key);
-      path_pop(r, saved);
-      continue;
-    }
-    const size_t g = group_of(sec, (size_t)idx);
-    if (seen_key[g] != NULL) {
-      const nav_io_node *first = seen_key[g];
-      if (seen_field[g] == (size_t)idx)
-        nav_io_reader_error(r, key, NULL, "duplicate key \"%s\" (first given at line %d, column %d)",
-                            sec->fields[idx].key, first->line, first->col);
-      else
-        nav_io_reader_error(r, key, NULL, "both \"%s\" and \"%s\" are given; give only one of them",
-                            sec->fields[seen_field[g]].key, sec->fields[idx].key);
-      path_pop(r, saved);
-      continue;
-    }
-    seen_key[g] = key;
-    seen_field[g] = (size_t)idx;
-    if (key != skip_key) {
-      /* Mark the value under every spelling, so validation messages about "lat_deg" find a
-         file that wrote "lat_rad". */
-      for (size_t j = 0; j < sec->count; ++j) {
-        if (group_of(sec, j) != g) continue;
+  for (int pass = 0; pass < 3; ++pass) {
+    if (!has_phase[pass]) continue;
+    for (const nav_io_node *key = map->child; key != NULL && !r->stop; key = key->next ? key->next->next : NULL) {
+      const nav_io_node *value = key->next;
+      if (value == NULL) break; /* cannot happen: libfyaml gives mappings an even number of events */
+      if (key->kind != Y_SCALAR || is_null(key)) {
+        if (pass == 1) {
+          describe(got, sizeof got, key);
+          nav_io_reader_error(r, key, value, "expected a key name, got %s", got);
+        }
+        continue;
+      }
+      const long idx = find_field(sec, key);
+      if (idx < 0) {
+        if (pass == 1) {
+          const size_t saved = path_push_key(r, key->text, key->len);
+          unknown_key(r, sec, key);
+          path_pop(r, saved);
+        }
+        continue;
+      }
+      if (phase_of(&sec->fields[idx]) != pass) continue;
+      const size_t saved = path_push_key(r, key->text, key->len);
+      const size_t g = group_of(sec, (size_t)idx);
+      if (seen_key[g] != NULL) {
+        const nav_io_node *first = seen_key[g];
+        if (seen_field[g] == (size_t)idx)
+          nav_io_reader_error(r, key, NULL, "duplicate key \"%s\" (first given at line %d, column %d)",
+                              sec->fields[idx].key, first->line, first->col);
+        else
+          nav_io_reader_error(r, key, NULL, "both \"%s\" and \"%s\" are given; give only one of them",
+                              sec->fields[seen_field[g]].key, sec->fields[idx].key);
         path_pop(r, saved);
-        path_push_key(r, sec->fields[j].key, strlen(sec->fields[j].key));
-        mark_path(r, value, key);
+        continue;
+      }
+      seen_key[g] = key;
+      seen_field[g] = (size_t)idx;
+      if (key != skip_key) {
+        /* Mark the value under every spelling (and the validators' SI name), so validation
+           messages about "lat_deg" find a file that wrote "lat_rad". */
+        for (size_t j = 0; j < sec->count; ++j) {
+          if (group_of(sec, j) != g) continue;
+          path_pop(r, saved);
+          path_push_key(r, sec->fields[j].key, strlen(sec->fields[j].key));
+          mark_path(r, value, key);
+          if (sec->fields[j].mark_as != NULL) {
+            path_pop(r, saved);
+            path_push_key(r, sec->fields[j].mark_as, strlen(sec->fields[j].mark_as));
+            mark_path(r, value, key);
+          }
+        }
+        path_pop(r, saved);
+        path_push_key(r, key->text, key->len);
+        (void)read_field(r, &sec->fields[idx], key, value, base);
       }
       path_pop(r, saved);
-      path_push_key(r, key->text, key->len);
-      read_field(r, &sec->fields[idx], key, value, scene);
     }
-    path_pop(r, saved);
   }
 
   for (size_t i = 0; i < sec->count && !r->stop; ++i) {
@@ -1275,24 +1818,34 @@ static void read_mapping(nav_io_reader *r, const nav_io_section *sec, const nav_
     nav_io_reader_error(r, map, NULL, "missing required key \"%s\"", f->key);
     path_pop(r, saved);
   }
+  if (sec->finish != NULL && !r->stop) sec->finish(r, map, base);
 }
 
 static void read_section(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key,
-                         const nav_io_node *v, nav_scene *scene, const nav_io_node *skip_key) {
+                         const nav_io_node *v, void *base, const nav_io_node *skip_key) {
   char list[512], got[SHOW_MAX + 32];
   if (reject_special(r, key, v)) return;
-  if (is_null(v)) return; /* "imu:" with every key commented out: all defaults */
+  if (is_null(v)) { /* "imu:" with every key commented out: all defaults */
+    if (sec->finish != NULL) sec->finish(r, v, base);
+    return;
+  }
   if (v->kind != Y_MAP) {
     list_keys(list, sizeof list, sec);
     describe(got, sizeof got, v);
     nav_io_reader_error(r, v, key, "expected a mapping with keys %s; got %s", list, got);
     return;
   }
-  read_mapping(r, sec, v, scene, skip_key);
+  read_mapping(r, sec, v, base, skip_key);
+}
+
+void nav_io_read_section(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key,
+                         const nav_io_node *map, void *base) {
+  read_section(r, sec, key, map, base, NULL);
 }
 
 static void read_format_version(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
-                                const nav_io_node *value, nav_scene *scene) {
+                                const nav_io_node *value, void *base) {
+  nav_scene *scene = base;
   long long v = 0;
   const nav_io_field as_int = {.key = f->key, .kind = NAV_IO_INT};
   if (!read_integer(r, &as_int, key, value, INT_MIN, INT_MAX, &v)) return;
@@ -1339,11 +1892,491 @@ static void read_root(nav_io_reader *r, const nav_io_node *root, nav_scene *scen
     const long idx = find_field(sec, fv_key);
     const size_t saved = path_push_key(r, fv_key->text, fv_key->len);
     mark_path(r, fv_key->next, fv_key);
-    read_field(r, &sec->fields[idx], fv_key, fv_key->next, scene);
+    (void)read_field(r, &sec->fields[idx], fv_key, fv_key->next, scene);
     path_pop(r, saved);
     if (r->newer_format) return;
   }
   read_mapping(r, sec, root, scene, fv_key);
+}
+
+/* ================================================================ custom fields of the sensor sections */
+
+/* The resources directory: $NAV_RESOURCES_DIR, else the source tree's resources/ compiled in
+   (the build-tree fallback; navsim also knows the installed layout). */
+static bool resources_dir(char *buf, size_t size) {
+  const char *env = getenv("NAV_RESOURCES_DIR");
+  if (env != NULL && env[0] != '\0') return snprintf(buf, size, "%s", env) < (int)size;
+#ifdef NAV_IO_SOURCE_RESOURCES_DIR
+  return snprintf(buf, size, "%s", NAV_IO_SOURCE_RESOURCES_DIR) < (int)size;
+#else
+  (void)buf;
+  (void)size;
+  return false;
+#endif
+}
+
+static void forward_diag(void *user, const nav_diag *d) {
+  nav_io_reader_forward(user, d);
+}
+
+static bool contains_nocase(const char *hay, const char *needle, size_t n) {
+  const size_t h = strlen(hay);
+  for (size_t i = 0; n > 0 && i + n <= h; ++i) {
+    size_t k = 0;
+    while (k < n && lower(hay[i + k]) == lower(needle[k]))
+      ++k;
+    if (k == n) return true;
+  }
+  return false;
+}
+
+/*
+ * imu.catalog / gnss.catalog: the part (IMU row name, GNSS mode) whose converted model becomes
+ * the base of the section; the section's other keys then override it. Read first (NAV_IO_EARLY),
+ * after imu.bias_convention, which the conversion of allan_min rows uses.
+ */
+static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *v, void *base) {
+  nav_scene *s = base;
+  const bool imu = f->offset == OFF(imu.catalog);
+  const char *what = imu ? "IMU" : "GNSS receiver";
+  char name[NAV_SCENE_CATALOG_NAME_MAX], dir[NAV_IO_PATH_MAX], path[NAV_IO_PATH_MAX + 32], shown[SHOW_MAX + 4];
+  nav_catalog *cat = NULL;
+  if (reject_special(r, key, v)) return;
+  if (v->kind != Y_SCALAR || is_null(v)) {
+    nav_io_expected(r, key, v, imu ? "an IMU name from resources/imu_catalog.csv"
+                                   : "a receiver mode from resources/gnss_receivers.csv");
+    return;
+  }
+  if (v->len >= sizeof name || memchr(v->text, '\0', v->len) != NULL) {
+    nav_io_reader_error(r, v, key, "is not a catalog name (at most %zu bytes)", sizeof name - 1);
+    return;
+  }
+  memcpy(name, v->text, v->len);
+  name[v->len] = '\0';
+  show(shown, sizeof shown, v->text, v->len);
+  if (!resources_dir(dir, sizeof dir)) {
+    nav_io_reader_error(r, v, key, "cannot find the resources directory with the %s catalog; set NAV_RESOURCES_DIR",
+                        what);
+    return;
+  }
+  snprintf(path, sizeof path, "%s/%s", dir, imu ? "imu_catalog.csv" : "gnss_receivers.csv");
+  nav_catalog_options opt = nav_catalog_options_default();
+  opt.convention = (nav_bi_convention)r->state.bias_convention;
+  const nav_status st = nav_catalog_load(path, &opt, &cat, forward_diag, r);
+  if (st != NAV_OK) {
+    nav_io_reader_error(r, v, key, "cannot load the %s catalog %s (%s)", what, path, nav_status_str(st));
+    goto cleanup;
+  }
+  if (imu) {
+    const nav_catalog_imu_entry *e = nav_catalog_find_imu(cat, name);
+    if (e != NULL) {
+      s->imu.model = e->config;
+      snprintf(s->imu.catalog, sizeof s->imu.catalog, "%s", e->name);
+      goto cleanup;
+    }
+  } else {
+    const nav_catalog_gnss_entry *e = nav_catalog_find_gnss(cat, name);
+    if (e != NULL) {
+      s->gnss.model = e->config;
+      snprintf(s->gnss.catalog, sizeof s->gnss.catalog, "%s", e->name);
+      goto cleanup;
+    }
+  }
+  {
+    /* Unknown: the closest name, else the only name containing what was written. */
+    const char *names[NAV_CATALOG_MAX_ENTRIES] = {NULL};
+    const size_t n = nav_catalog_count(cat);
+    size_t n_sub = 0;
+    const char *sub = NULL;
+    for (size_t i = 0; i < n && i < COUNT(names); ++i) {
+      names[i] = imu ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      if (contains_nocase(names[i], name, v->len)) {
+        sub = names[i];
+        ++n_sub;
+      }
+    }
+    const char *best = nav_io_closest(name, v->len, names, n < COUNT(names) ? n : COUNT(names));
+    if (best == NULL && n_sub == 1) best = sub;
+    if (best != NULL)
+      nav_io_reader_error(r, v, key, "unknown %s \"%s\"; did you mean \"%s\"? (`navsim catalog --%s` lists %s)",
+                          what, shown, best, imu ? "imu" : "gnss", path);
+    else
+      nav_io_reader_error(r, v, key, "unknown %s \"%s\"; `navsim catalog --%s` lists the %zu entries of %s", what,
+                          shown, imu ? "imu" : "gnss", n, path);
+  }
+cleanup:
+  nav_catalog_destroy(cat);
+}
+
+static nav_status write_catalog(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  (void)indent;
+  const nav_status st = nav_io_writef(w, " ");
+  return st != NAV_OK ? st : nav_io_write_quoted(w, (const char *)base + f->offset);
+}
+
+static bool same_string(const nav_io_field *f, const void *a, const void *b) {
+  return strcmp((const char *)a + f->offset, (const char *)b + f->offset) == 0;
+}
+
+static bool catalog_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)w;
+  (void)def;
+  return ((const char *)base + f->offset)[0] != '\0';
+}
+
+/* ---------------------------------------------------------------- "off": terms switched off */
+
+typedef struct term_name {
+  const char *name;
+  unsigned bit;
+} term_name;
+
+static const term_name k_imu_terms[] = {
+    {"bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON}, {"bias_gm", NAV_IMU_TERM_BIAS_GM},
+    {"bias_rw", NAV_IMU_TERM_BIAS_RW},           {"noise", NAV_IMU_TERM_NOISE},
+    {"scale_factor", NAV_IMU_TERM_SCALE_FACTOR}, {"misalignment", NAV_IMU_TERM_MISALIGNMENT},
+    {"g_sensitivity", NAV_IMU_TERM_G_SENSITIVITY}, {"quantisation", NAV_IMU_TERM_QUANTISATION},
+    {"saturation", NAV_IMU_TERM_SATURATION}};
+static const term_name k_gnss_terms[] = {{"position", NAV_GNSS_TERM_POS_GM},
+                                         {"position_white", NAV_GNSS_TERM_POS_WHITE},
+                                         {"velocity", NAV_GNSS_TERM_VEL_WHITE}};
+
+/*
+ * imu.off: [noise, gyro.bias_gm, ...] switches terms off after everything else was read (a
+ * catalog part's term, or one whose values are kept for later). A plain name applies to both
+ * triads, "gyro." / "accel." to one. gnss.off: [position, position_white, velocity].
+ */
+static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
+                     void *base) {
+  nav_scene *s = base;
+  const bool imu = f->offset == OFF(imu.model);
+  const term_name *terms = imu ? k_imu_terms : k_gnss_terms;
+  const size_t nterms = imu ? COUNT(k_imu_terms) : COUNT(k_gnss_terms);
+  char shown[SHOW_MAX + 4];
+  if (reject_special(r, key, v)) return;
+  if (is_null(v)) return;
+  const bool seq = v->kind == Y_SEQ;
+  if (!seq && v->kind != Y_SCALAR) {
+    nav_io_expected(r, key, v, imu ? "a list of term names ([noise, gyro.bias_gm, ...])"
+                                   : "a list of term names ([position, position_white, velocity])");
+    return;
+  }
+  size_t i = 0;
+  for (const nav_io_node *item = seq ? v->child : v; item != NULL; item = seq ? item->next : NULL, ++i) {
+    const size_t saved = seq ? path_push_index(r, i) : r->path_len;
+    if (reject_special(r, v, item)) {
+      path_pop(r, saved);
+      continue;
+    }
+    if (item->kind != Y_SCALAR || is_null(item)) {
+      nav_io_expected(r, v, item, "a term name");
+      path_pop(r, saved);
+      continue;
+    }
+    const char *t = item->text;
+    size_t len = item->len;
+    int triad = -1; /* both */
+    if (imu && len > 5 && memcmp(t, "gyro.", 5) == 0) {
+      triad = 0;
+      t += 5;
+      len -= 5;
+    } else if (imu && len > 6 && memcmp(t, "accel.", 6) == 0) {
+      triad = 1;
+      t += 6;
+      len -= 6;
+    }
+    unsigned bit = 0;
+    for (size_t k = 0; k < nterms; ++k)
+      if (strlen(terms[k].name) == len && memcmp(terms[k].name, t, len) == 0) bit = terms[k].bit;
+    show(shown, sizeof shown, item->text, item->len);
+    if (bit == 0) {
+      const char *names[COUNT(k_imu_terms)] = {NULL};
+      char list[256];
+      size_t n = 0, l = 0;
+      list[0] = '\0';
+      for (size_t k = 0; k < nterms; ++k) {
+        names[n++] = terms[k].name;
+        const int m = snprintf(list + l, sizeof list - l, "%s%s", k ? ", " : "", terms[k].name);
+        if (m > 0 && (size_t)m < sizeof list - l) l += (size_t)m;
+      }
+      const char *best = nav_io_closest(t, len, names, n);
+      if (best != NULL)
+        nav_io_reader_error(r, item, v, "unknown term \"%s\"; did you mean \"%s%s\"?", shown,
+                            triad == 0 ? "gyro." : triad == 1 ? "accel." : "", best);
+      else
+        nav_io_reader_error(r, item, v, "unknown term \"%s\"; terms: %s%s", shown, list,
+                            imu ? " (each optionally prefixed gyro. or accel.)" : "");
+    } else if (imu && triad == 1 && bit == NAV_IMU_TERM_G_SENSITIVITY) {
+      nav_io_reader_error(r, item, v, "g_sensitivity is a gyro term; accelerometers have none");
+    } else if (imu) {
+      if (triad != 1) s->imu.model.gyro.terms &= ~bit;
+      if (triad != 0) s->imu.model.accel.terms &= ~bit;
+    } else {
+      s->gnss.model.terms &= ~bit;
+    }
+    path_pop(r, saved);
+  }
+}
+
+/* A term written with values although it is off, or off while a catalog part (which the reader
+   loads first) may switch it on: it goes into the "off" list. */
+static bool needs_off(const nav_io_writer *w, const nav_io_section *sec, unsigned terms, unsigned bit,
+                      const char *catalog) {
+  if (terms & bit) return false;
+  if (catalog[0] != '\0') return true;
+  for (size_t i = 0; i < sec->count; ++i) {
+    const nav_io_field *f = &sec->fields[i];
+    if (f->bit == bit && !(f->flags & (NAV_IO_ALT | NAV_IO_STATE)) && !nav_io_field_same(f, w->scene, w->def))
+      return true;
+  }
+  return false;
+}
+
+/* The names of the "off" list of @p f; returns how many (names point into static tables or @p buf). */
+static size_t off_names(const nav_io_writer *w, const nav_io_field *f, char buf[][40], size_t cap) {
+  const nav_scene *s = w->scene;
+  size_t n = 0;
+  if (f->offset == OFF(imu.model)) {
+    for (size_t k = 0; k < COUNT(k_imu_terms) && n < cap; ++k) {
+      const unsigned bit = k_imu_terms[k].bit;
+      const bool g = needs_off(w, &k_gyro_section, s->imu.model.gyro.terms, bit, s->imu.catalog);
+      const bool a = bit != NAV_IMU_TERM_G_SENSITIVITY &&
+                     needs_off(w, &k_accel_section, s->imu.model.accel.terms, bit, s->imu.catalog);
+      if (g && (a || bit == NAV_IMU_TERM_G_SENSITIVITY))
+        snprintf(buf[n++], 40, "%s", k_imu_terms[k].name);
+      else if (g)
+        snprintf(buf[n++], 40, "gyro.%s", k_imu_terms[k].name);
+      else if (a)
+        snprintf(buf[n++], 40, "accel.%s", k_imu_terms[k].name);
+    }
+  } else {
+    for (size_t k = 0; k < COUNT(k_gnss_terms) && n < cap; ++k)
+      if (needs_off(w, &k_gnss_section, s->gnss.model.terms, k_gnss_terms[k].bit, s->gnss.catalog))
+        snprintf(buf[n++], 40, "%s", k_gnss_terms[k].name);
+  }
+  return n;
+}
+
+static nav_status write_off(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  (void)base;
+  (void)indent;
+  char names[16][40];
+  const size_t n = off_names(w, f, names, COUNT(names));
+  nav_status st = nav_io_writef(w, " [");
+  for (size_t i = 0; i < n && st == NAV_OK; ++i)
+    st = nav_io_writef(w, "%s%s", i ? ", " : "", names[i]);
+  return st != NAV_OK ? st : nav_io_writef(w, "]");
+}
+
+static bool off_needed(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)base;
+  (void)def;
+  char names[16][40];
+  return off_names(w, f, names, COUNT(names)) > 0;
+}
+
+static bool same_terms(const nav_io_field *f, const void *a, const void *b) {
+  const nav_scene *sa = a, *sb = b;
+  if (f->offset == OFF(imu.model))
+    return sa->imu.model.gyro.terms == sb->imu.model.gyro.terms &&
+           sa->imu.model.accel.terms == sb->imu.model.accel.terms;
+  return sa->gnss.model.terms == sb->gnss.model.terms;
+}
+
+/* ---------------------------------------------------------------- GNSS outages, reported sigmas */
+
+/* gnss.outages: [[t0_s, t1_s], ...], at most NAV_GNSS_MAX_OUTAGES, each with t1_s > t0_s. */
+static void read_outages(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *v, void *base) {
+  nav_gnss_model_config *m = (nav_gnss_model_config *)((char *)base + f->offset);
+  nav_gnss_outage out[NAV_GNSS_MAX_OUTAGES];
+  const nav_io_field finite = {.key = f->key, .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE, .scale = 1.0};
+  char t0[40], t1[40];
+  if (reject_special(r, key, v)) return;
+  if (v->kind != Y_SEQ) {
+    nav_io_expected(r, key, v, "a list of [t0_s, t1_s] intervals");
+    return;
+  }
+  if (v->count > NAV_GNSS_MAX_OUTAGES) {
+    nav_io_reader_error(r, v, key, "at most %d outages are supported (got %zu)", NAV_GNSS_MAX_OUTAGES, v->count);
+    return;
+  }
+  bool ok = true;
+  size_t i = 0;
+  for (const nav_io_node *item = v->child; item != NULL; item = item->next, ++i) {
+    const size_t saved = path_push_index(r, i);
+    mark_path(r, item, v);
+    double x[2] = {0.0, 0.0};
+    if (reject_special(r, v, item)) {
+      ok = false;
+    } else if (item->kind != Y_SEQ || item->count != 2) {
+      nav_io_expected(r, v, item, "[t0_s, t1_s]");
+      ok = false;
+    } else if (!read_number_items(r, &finite, item, x, 2)) {
+      ok = false;
+    } else if (!(x[1] > x[0])) {
+      const size_t s1 = path_push_index(r, 1);
+      nav_io_reader_error(r, item->child->next, item, "the end t1_s = %s must be after the start t0_s = %s",
+                          nav_io_format_double(t1, sizeof t1, x[1]), nav_io_format_double(t0, sizeof t0, x[0]));
+      path_pop(r, s1);
+      ok = false;
+    } else {
+      out[i].t0_s = x[0];
+      out[i].t1_s = x[1];
+    }
+    path_pop(r, saved);
+  }
+  if (!ok) return;
+  m->outage_count = i;
+  for (size_t k = 0; k < i; ++k)
+    m->outages[k] = out[k];
+}
+
+static nav_status write_outages(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  (void)indent;
+  const nav_gnss_model_config *m = (const nav_gnss_model_config *)((const char *)base + f->offset);
+  nav_status st = nav_io_writef(w, " [");
+  for (size_t i = 0; i < m->outage_count && i < NAV_GNSS_MAX_OUTAGES && st == NAV_OK; ++i) {
+    st = nav_io_writef(w, "%s[", i ? ", " : "");
+    if (st == NAV_OK) st = nav_io_write_double(w, m->outages[i].t0_s);
+    if (st == NAV_OK) st = nav_io_writef(w, ", ");
+    if (st == NAV_OK) st = nav_io_write_double(w, m->outages[i].t1_s);
+    if (st == NAV_OK) st = nav_io_writef(w, "]");
+  }
+  return st != NAV_OK ? st : nav_io_writef(w, "]");
+}
+
+static bool same_outages(const nav_io_field *f, const void *a, const void *b) {
+  const nav_gnss_model_config *ma = (const nav_gnss_model_config *)((const char *)a + f->offset);
+  const nav_gnss_model_config *mb = (const nav_gnss_model_config *)((const char *)b + f->offset);
+  if (ma->outage_count != mb->outage_count || ma->outage_count > NAV_GNSS_MAX_OUTAGES) return false;
+  for (size_t i = 0; i < ma->outage_count; ++i)
+    if (!same_bits(ma->outages[i].t0_s, mb->outages[i].t0_s) || !same_bits(ma->outages[i].t1_s, mb->outages[i].t1_s))
+      return false;
+  return true;
+}
+
+/* gnss.reported_sigma: "model" (fixes report the model's sigmas) or {position_m, velocity_mps}. */
+static void read_reported(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                          const nav_io_node *v, void *base) {
+  nav_gnss_model_config *m = (nav_gnss_model_config *)((char *)base + f->offset);
+  if (reject_special(r, key, v)) return;
+  if (v->kind == Y_SCALAR && !v->quoted && text_is(v, "model")) {
+    m->report_model_sigmas = true;
+    return;
+  }
+  if (v->kind != Y_MAP) {
+    nav_io_expected(r, key, v, "\"model\" or {position_m: [N, E, D], velocity_mps: [N, E, D]}");
+    return;
+  }
+  read_section(r, f->section, key, v, base, NULL);
+  m->report_model_sigmas = false;
+}
+
+static nav_status write_reported(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  (void)indent;
+  const nav_gnss_model_config *m = (const nav_gnss_model_config *)((const char *)base + f->offset);
+  if (m->report_model_sigmas) return nav_io_writef(w, " model");
+  const nav_status st = nav_io_writef(w, " ");
+  return st != NAV_OK ? st : nav_io_write_flow(w, f->section, base, w->def);
+}
+
+static bool same_reported(const nav_io_field *f, const void *a, const void *b) {
+  const nav_gnss_model_config *ma = (const nav_gnss_model_config *)((const char *)a + f->offset);
+  const nav_gnss_model_config *mb = (const nav_gnss_model_config *)((const char *)b + f->offset);
+  return ma->report_model_sigmas == mb->report_model_sigmas &&
+         (ma->report_model_sigmas || nav_io_section_same(f->section, a, b));
+}
+
+static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)w;
+  const nav_scene *s = base;
+  return s->gnss.enabled || !nav_io_section_same(f->section, base, def);
+}
+
+/* ---------------------------------------------------------------- bias instability -> GM */
+
+/* Whether a problem was reported about @p path or a field inside it. */
+static bool had_error(const nav_io_reader *r, const char *path) {
+  for (int i = 0; i < r->nerr_paths; ++i)
+    if (path_related(r->err_paths[i], path)) return true;
+  return false;
+}
+
+/*
+ * After imu.gyro / imu.accel: bias_instability_* with bias_instability_tau_min_s define the
+ * first-order GM bias (nav_gm_from_bias_instability, numerics.md 2.3) under imu.bias_convention;
+ * they exclude bias_gm_sigma_* / bias_gm_tau_s, which state the GM directly.
+ */
+static void finish_triad(nav_io_reader *r, const nav_io_node *map, nav_scene *s, int t) {
+  const char *const b_keys[2][2] = {{"bias_instability_deg_per_h", "bias_instability_rps"},
+                                    {"bias_instability_ug", "bias_instability_mps2"}};
+  const char *const gm_keys[2][3] = {{"bias_gm_sigma_deg_per_h", "bias_gm_sigma_rps", "bias_gm_tau_s"},
+                                     {"bias_gm_sigma_ug", "bias_gm_sigma_mps2", "bias_gm_tau_s"}};
+  const nav_io_node *kb = NULL, *kt = NULL, *kg = NULL, *k = NULL;
+  char path[PATH_MAX_LEN];
+  if (map == NULL || map->kind != Y_MAP) return;
+  for (int i = 0; i < 2 && kb == NULL; ++i)
+    if (nav_io_map_get(map, b_keys[t][i], &k) != NULL) kb = k;
+  if (nav_io_map_get(map, "bias_instability_tau_min_s", &k) != NULL) kt = k;
+  for (int i = 0; i < 3 && kg == NULL; ++i)
+    if (nav_io_map_get(map, gm_keys[t][i], &k) != NULL) kg = k;
+  if (kb == NULL && kt == NULL) return;
+  const nav_io_node *at = kb != NULL ? kb : kt;
+  const size_t saved = path_push_key(r, at->text, at->len);
+  if (kb == NULL || kt == NULL) {
+    if (kb != NULL)
+      nav_io_reader_error(r, kb, NULL,
+                          "needs bias_instability_tau_min_s too: the averaging time at which the Allan deviation "
+                          "has its minimum (datasheet, or 100-1000 s for MEMS)");
+    else
+      nav_io_reader_error(r, kt, NULL, "needs %s (or %s) too: the bias instability itself", b_keys[t][0],
+                          b_keys[t][1]);
+  } else if (kg != NULL) {
+    path_pop(r, saved);
+    path_push_key(r, kg->text, kg->len);
+    nav_io_reader_error(r, kg, NULL,
+                        "the Gauss-Markov bias is given twice: use either %s with bias_instability_tau_min_s, or "
+                        "bias_gm_sigma_* with bias_gm_tau_s",
+                        b_keys[t][0]);
+  } else {
+    /* A value the reader rejected stays 0: the other messages already say what is wrong. */
+    const bool bad_b = had_error(r, r->path);
+    path_pop(r, saved);
+    path_push_key(r, kt->text, kt->len);
+    snprintf(path, sizeof path, "%s", r->path);
+    path_pop(r, saved);
+    if (!bad_b && !had_error(r, path)) {
+      const nav_bi_convention conv = (nav_bi_convention)r->state.bias_convention;
+      double sd[3], tau[3];
+      for (int i = 0; i < 3; ++i) {
+        const nav_gm_params gm = nav_gm_from_bias_instability(nav_vec3_get(r->state.bi[t], i),
+                                                              nav_vec3_get(r->state.bi_tau_min_s[t], i), conv);
+        sd[i] = gm.sigma;
+        tau[i] = gm.tau_s;
+      }
+      if (t == 0) {
+        s->imu.model.gyro.bias_gm_sd_rps = nav_vec3_make(sd[0], sd[1], sd[2]);
+        s->imu.model.gyro.bias_gm_tau_s = nav_vec3_make(tau[0], tau[1], tau[2]);
+        s->imu.model.gyro.terms |= NAV_IMU_TERM_BIAS_GM;
+      } else {
+        s->imu.model.accel.bias_gm_sd_mps2 = nav_vec3_make(sd[0], sd[1], sd[2]);
+        s->imu.model.accel.bias_gm_tau_s = nav_vec3_make(tau[0], tau[1], tau[2]);
+        s->imu.model.accel.terms |= NAV_IMU_TERM_BIAS_GM;
+      }
+    }
+    return;
+  }
+  path_pop(r, saved);
+}
+
+static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base) {
+  finish_triad(r, map, base, 0);
+}
+
+static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base) {
+  finish_triad(r, map, base, 1);
 }
 
 /* ================================================================ validation and entry points */
@@ -1365,13 +2398,25 @@ static nav_status read_buffer(const char *text, size_t len, const char *name, na
   nav_io_reader *r = NULL;
   nav_io_node *root = NULL;
   nav_io_c_locale loc;
-  nav_scene scene = nav_scene_default();
+  nav_scene *scene = NULL;
 
   r = calloc(1, sizeof *r);
-  if (r == NULL) return NAV_ERR_NO_MEMORY;
+  scene = malloc(sizeof *scene);
+  if (r == NULL || scene == NULL) {
+    free(r);
+    free(scene);
+    return NAV_ERR_NO_MEMORY;
+  }
+  *scene = nav_scene_default();
   r->file = name;
   r->report = report;
   r->user = user;
+  r->state.scene = scene;
+  r->state.file = name;
+  r->state.bias_convention = NAV_BI_ALLAN_PEAK;
+  r->state.md_allow_unconverged = true;
+  r->state.md_fit_rate_ramps = true;
+  r->state.duration_auto = true;
   nav_io_c_locale_begin(&loc);
 
   if (len > NAV_IO_MAX_INPUT_BYTES) {
@@ -1386,12 +2431,15 @@ static nav_status read_buffer(const char *text, size_t len, const char *name, na
           NAV_SCENE_FORMAT_VERSION);
     goto cleanup;
   }
-  read_root(r, root, &scene);
+  read_root(r, root, scene);
   if (r->newer_format || r->oom || root->kind != Y_MAP) goto cleanup;
+  /* Whatever needs the whole file: geodetic waypoints, motion-definition imports, script lengths. */
+  if (!r->stop) nav_io_traj_finish(r, root, scene);
+  if (r->oom || r->stop) goto cleanup;
 
   /* Cross-field and domain checks shared with the editor; their paths are placed in the file. */
   const int before = r->ndiag;
-  const nav_status vs = nav_scene_validate(&scene, on_validate_issue, r);
+  const nav_status vs = nav_scene_validate(scene, on_validate_issue, r);
   if (vs != NAV_OK && r->ndiag == before && r->nerr_paths == 0)
     emitf(r, 0, 0, "", "the scene is not valid (%s)", nav_status_str(vs));
 
@@ -1399,13 +2447,15 @@ cleanup:
   nav_io_c_locale_end(&loc);
   arena_free(r);
   free(r->marks);
+  free(r->state.geo);
   if (r->oom)
     st = NAV_ERR_NO_MEMORY;
   else if (r->ndiag > 0)
     st = NAV_ERR_PARSE;
   else
-    *out = scene;
+    *out = *scene;
   free(r);
+  free(scene);
   return st;
 }
 

@@ -1,12 +1,23 @@
 /*
- * Scene files: the writer. It walks the schema tables of scene_read.c, so every field the reader
- * knows is written, explicitly, under its preferred key (the spelling of the canonical example:
- * degrees for lat/lon and Euler angles, radians and rad/s for the parametric phases and rates).
+ * Scene files: the writer. It walks the schema tables of scene_read.c and scene_traj_io.c, so
+ * every field the reader knows is written, explicitly, under one of its keys: the shortest exact
+ * spelling among the preferred one (the spelling of the canonical example: degrees for lat/lon
+ * and Euler angles, datasheet units for sensor figures), the SI one, and the alternatives marked
+ * NAV_IO_WRITE_ALT (rpm for a spin rate, Hz for a coning rate).
  *
  * Round trips are bit-exact: numbers are printed with the fewest digits (15..17) that read back
- * to the same double, and a quantity whose preferred key is in degrees is written in degrees only
- * when some decimal degree value converts back (deg * pi/180, exactly as the reader does it) to
- * the same radians; otherwise it is written under its _rad spelling, which the reader accepts too.
+ * to the same double, and a quantity is written in a unit other than SI only when some decimal
+ * value converts back (value * scale, exactly as the reader does it) to the same bits; otherwise
+ * its SI spelling is used, which the reader accepts too. Inputs that have no place in the scene
+ * (bias instability and Allan-minimum time, waypoints in latitude/longitude, the motion-definition
+ * file) are written as what they became: the Gauss-Markov bias, local NED waypoints, the segment
+ * script. What is written is what is read back:
+ * - error-model terms: a term's keys when the term is on or its values differ from the defaults,
+ *   and an "off" list for terms that are off but have values (or may be switched on by a catalog
+ *   part, which the reader loads first);
+ * - sections of unused trajectory types, and the gnss section, only when they differ from the
+ *   defaults (a scene keeps the parameters of a type it does not use);
+ * - in kind-dependent mappings (segments, test motions) the keys of the selected kind only.
  *
  * The file is replaced atomically: PATH.tmp.XXXXXX (mkstemp, same directory), fflush + fsync,
  * rename over PATH, then fsync of the directory (best effort).
@@ -17,6 +28,7 @@
 #include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -58,48 +70,25 @@ static bool exact_file_value(double si, double scale, double *out) {
   return found;
 }
 
-static const double *double_at(const nav_scene *s, const nav_io_field *f) {
-  return (const double *)((const char *)s + f->offset);
+/* ================================================================ output primitives */
+
+nav_status nav_io_writef(nav_io_writer *w, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  const int rc = vfprintf(w->fp, fmt, ap);
+  va_end(ap);
+  return rc < 0 ? NAV_ERR_IO : NAV_OK;
 }
 
-/* The spelling of field @p i of @p sec to write: the preferred one if it is exact, else the SI
-   spelling of the same quantity (scale 1). */
-static const nav_io_field *choose_spelling(const nav_io_section *sec, size_t i, const nav_scene *s) {
-  const nav_io_field *f = &sec->fields[i];
-  if ((f->kind != NAV_IO_DOUBLE && f->kind != NAV_IO_VEC3) || f->scale == 1.0) return f;
-  double si[3] = {0.0, 0.0, 0.0};
-  size_t n = 1;
-  if (f->kind == NAV_IO_VEC3) {
-    const nav_vec3 *p = (const nav_vec3 *)((const char *)s + f->offset);
-    si[0] = p->x;
-    si[1] = p->y;
-    si[2] = p->z;
-    n = 3;
-  } else {
-    si[0] = *double_at(s, f);
-  }
-  double v = 0.0;
-  bool exact = true;
-  for (size_t k = 0; k < n; ++k)
-    if (!exact_file_value(si[k], f->scale, &v)) exact = false;
-  if (exact) return f;
-  for (size_t j = 0; j < sec->count; ++j) {
-    const nav_io_field *g = &sec->fields[j];
-    if (g->kind == f->kind && g->offset == f->offset && g->scale == 1.0) return g;
-  }
-  return f; /* no SI spelling in the table: closest decimal value */
-}
-
-static int write_number(FILE *fp, double si, double scale) {
+nav_status nav_io_write_double(nav_io_writer *w, double v) {
   char buf[40];
-  double v = si;
-  if (!exact_file_value(si, scale, &v)) v = si / scale;
-  return fputs(nav_io_format_double(buf, sizeof buf, v), fp) < 0 ? -1 : 0;
+  return fputs(nav_io_format_double(buf, sizeof buf, v), w->fp) < 0 ? NAV_ERR_IO : NAV_OK;
 }
 
 /* A YAML double-quoted string; control characters are escaped. */
-static int write_quoted(FILE *fp, const char *s) {
-  if (fputc('"', fp) == EOF) return -1;
+nav_status nav_io_write_quoted(nav_io_writer *w, const char *s) {
+  FILE *fp = w->fp;
+  if (fputc('"', fp) == EOF) return NAV_ERR_IO;
   for (const unsigned char *c = (const unsigned char *)s; *c != '\0'; ++c) {
     int rc = 0;
     if (*c == '"' || *c == '\\')
@@ -112,105 +101,327 @@ static int write_quoted(FILE *fp, const char *s) {
       rc = fprintf(fp, "\\x%02x", *c);
     else
       rc = fputc(*c, fp);
-    if (rc < 0) return -1;
+    if (rc < 0) return NAV_ERR_IO;
   }
-  return fputc('"', fp) == EOF ? -1 : 0;
+  return fputc('"', fp) == EOF ? NAV_ERR_IO : NAV_OK;
 }
 
-/* The value of a non-section field (the text after "key: "). */
-static nav_status write_value(FILE *fp, const nav_io_field *f, const nav_scene *s) {
-  const char *base = (const char *)s;
-  int rc = 0;
-  switch (f->kind) {
-  case NAV_IO_SECTION: return NAV_ERR_INVALID_ARG;
-  case NAV_IO_DOUBLE: rc = write_number(fp, *double_at(s, f), f->scale); break;
-  case NAV_IO_VEC3: {
-    const nav_vec3 *v = (const nav_vec3 *)(base + f->offset);
-    rc = fputc('[', fp) == EOF ? -1 : 0;
-    if (rc == 0) rc = write_number(fp, v->x, f->scale);
-    if (rc == 0) rc = fputs(", ", fp) < 0 ? -1 : 0;
-    if (rc == 0) rc = write_number(fp, v->y, f->scale);
-    if (rc == 0) rc = fputs(", ", fp) < 0 ? -1 : 0;
-    if (rc == 0) rc = write_number(fp, v->z, f->scale);
-    if (rc == 0) rc = fputc(']', fp) == EOF ? -1 : 0;
-    break;
+/* ================================================================ numbers in some unit */
+
+/* A small text buffer for one value, so spellings can be compared by length before writing. */
+typedef struct text_buf {
+  char s[1024];
+  size_t n;
+  bool exact; /* every number read back gives the stored bits */
+} text_buf;
+
+static void put(text_buf *t, const char *s) {
+  const size_t l = strlen(s);
+  if (t->n + l < sizeof t->s) {
+    memcpy(t->s + t->n, s, l + 1);
+    t->n += l;
   }
-  case NAV_IO_INT: rc = fprintf(fp, "%d", *(const int *)(base + f->offset)); break;
-  case NAV_IO_LONG: rc = fprintf(fp, "%ld", *(const long *)(base + f->offset)); break;
-  case NAV_IO_U64: rc = fprintf(fp, "%" PRIu64, *(const uint64_t *)(base + f->offset)); break;
+}
+
+static void put_number(text_buf *t, double si, double scale) {
+  char buf[40];
+  double v = si;
+  if (!exact_file_value(si, scale, &v)) {
+    v = si / scale;
+    t->exact = false;
+  }
+  put(t, nav_io_format_double(buf, sizeof buf, v));
+}
+
+static void put_numbers(text_buf *t, const double *si, size_t n, double scale) {
+  put(t, "[");
+  for (size_t i = 0; i < n; ++i) {
+    if (i) put(t, ", ");
+    put_number(t, si[i], scale);
+  }
+  put(t, "]");
+}
+
+static bool all_same(const double *x, const size_t *idx, size_t n) {
+  for (size_t i = 1; i < n; ++i)
+    if (!same_bits(x[idx[i]], x[idx[0]])) return false;
+  return true;
+}
+
+static bool all_zero(const double *x, const size_t *idx, size_t n) {
+  for (size_t i = 0; i < n; ++i)
+    if (!same_bits(x[idx[i]], 0.0)) return false;
+  return true;
+}
+
+/* The value of numeric field @p f of @p base in the unit of @p f, in its shortest form: a vector
+   with three equal elements as one number, a matrix as one number, its diagonal or 3 rows. */
+static void format_numeric(text_buf *t, const nav_io_field *f, const void *base) {
+  const char *p = (const char *)base + f->offset;
+  static const size_t k_diag[3] = {0, 4, 8}, k_off[6] = {1, 2, 3, 5, 6, 7}, k_vec[3] = {0, 1, 2};
+  double x[9];
+  t->n = 0;
+  t->s[0] = '\0';
+  t->exact = true;
+  switch (f->kind) {
+  case NAV_IO_DOUBLE: put_number(t, *(const double *)p, f->scale); return;
+  case NAV_IO_VEC3:
+  case NAV_IO_VEC3S: {
+    const nav_vec3 *v = (const nav_vec3 *)p;
+    x[0] = v->x;
+    x[1] = v->y;
+    x[2] = v->z;
+    if (f->kind == NAV_IO_VEC3S && all_same(x, k_vec, 3))
+      put_number(t, x[0], f->scale);
+    else
+      put_numbers(t, x, 3, f->scale);
+    return;
+  }
+  case NAV_IO_MAT3_OFFDIAG:
+  case NAV_IO_MAT3_DIAG: {
+    const nav_mat3 *m = (const nav_mat3 *)p;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        x[3 * i + j] = m->m[i][j];
+    if (f->kind == NAV_IO_MAT3_OFFDIAG && all_zero(x, k_diag, 3) && all_same(x, k_off, 6)) {
+      put_number(t, x[1], f->scale);
+    } else if (f->kind == NAV_IO_MAT3_DIAG && all_zero(x, k_off, 6)) {
+      if (all_same(x, k_diag, 3)) {
+        put_number(t, x[0], f->scale);
+      } else {
+        const double d[3] = {x[0], x[4], x[8]};
+        put_numbers(t, d, 3, f->scale);
+      }
+    } else {
+      put(t, "[");
+      for (int i = 0; i < 3; ++i) {
+        if (i) put(t, ", ");
+        put_numbers(t, x + 3 * i, 3, f->scale);
+      }
+      put(t, "]");
+    }
+    return;
+  }
+  default: return;
+  }
+}
+
+static bool is_numeric(nav_io_kind k) {
+  return k == NAV_IO_DOUBLE || k == NAV_IO_VEC3 || k == NAV_IO_VEC3S || k == NAV_IO_MAT3_OFFDIAG ||
+         k == NAV_IO_MAT3_DIAG;
+}
+
+/* The spelling of field @p i of @p sec to write and its text: the shortest exact one among the
+   preferred spelling, the SI one and the NAV_IO_WRITE_ALT ones (ties: the earlier in the table). */
+static const nav_io_field *choose_spelling(const nav_io_section *sec, size_t i, const void *base, text_buf *out) {
+  const nav_io_field *f = &sec->fields[i];
+  format_numeric(out, f, base);
+  if (f->scale == 1.0 && out->exact) return f;
+  const nav_io_field *best = out->exact ? f : NULL;
+  text_buf cand;
+  for (size_t j = i + 1; j < sec->count; ++j) {
+    const nav_io_field *g = &sec->fields[j];
+    if (!(g->flags & NAV_IO_ALT) || g->kind != f->kind || g->offset != f->offset ||
+        (g->flags & NAV_IO_STATE) != (f->flags & NAV_IO_STATE))
+      continue;
+    if (g->scale != 1.0 && !(g->flags & NAV_IO_WRITE_ALT)) continue;
+    format_numeric(&cand, g, base);
+    if (!cand.exact) continue;
+    if (best == NULL || cand.n < out->n) {
+      best = g;
+      *out = cand;
+    }
+  }
+  if (best != NULL) return best;
+  format_numeric(out, f, base); /* no SI spelling in the table: the closest decimal value */
+  return f;
+}
+
+/* ================================================================ comparing with the defaults */
+
+bool nav_io_field_same(const nav_io_field *f, const void *a, const void *b) {
+  if (f->flags & (NAV_IO_ALT | NAV_IO_STATE)) return true;
+  const char *pa = (const char *)a + f->offset, *pb = (const char *)b + f->offset;
+  size_t n = 0;
+  switch (f->kind) {
+  case NAV_IO_SECTION: return nav_io_section_same(f->section, a, b);
+  case NAV_IO_DOUBLE: n = 1; break;
+  case NAV_IO_VEC3:
+  case NAV_IO_VEC3S: n = 3; break;
+  case NAV_IO_MAT3_OFFDIAG:
+  case NAV_IO_MAT3_DIAG: n = 9; break;
+  case NAV_IO_INT:
+  case NAV_IO_ENUM: return *(const int *)pa == *(const int *)pb;
+  case NAV_IO_LONG: return *(const long *)pa == *(const long *)pb;
+  case NAV_IO_U64: return *(const uint64_t *)pa == *(const uint64_t *)pb;
+  case NAV_IO_BOOL: return *(const bool *)pa == *(const bool *)pb;
+  case NAV_IO_STRING: return strncmp(pa, pb, f->size) == 0;
+  case NAV_IO_CUSTOM: return f->same != NULL && f->same(f, a, b);
+  }
+  /* Doubles of nav_vec3 / nav_mat3 are contiguous (both are plain arrays of double). */
+  for (size_t i = 0; i < n; ++i) {
+    double x, y;
+    memcpy(&x, pa + i * sizeof(double), sizeof x);
+    memcpy(&y, pb + i * sizeof(double), sizeof y);
+    if (!same_bits(x, y)) return false;
+  }
+  return true;
+}
+
+bool nav_io_section_same(const nav_io_section *sec, const void *a, const void *b) {
+  for (size_t i = 0; i < sec->count; ++i)
+    if (!nav_io_field_same(&sec->fields[i], a, b)) return false;
+  return true;
+}
+
+bool nav_io_field_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  if (f->flags & (NAV_IO_ALT | NAV_IO_STATE)) return false;
+  if (f->kind == NAV_IO_CUSTOM && f->write == NULL) return false;
+  if (f->write_if != NULL) return f->write_if(w, f, base, def);
+  if (f->bit != 0) {
+    const unsigned terms = *(const unsigned *)((const char *)base + f->bits_offset);
+    return (terms & f->bit) != 0 || !nav_io_field_same(f, base, def);
+  }
+  return true;
+}
+
+/* Whether writing @p sec would write anything. */
+static bool section_has_output(const nav_io_writer *w, const nav_io_section *sec, const void *base,
+                               const void *def) {
+  for (size_t i = 0; i < sec->count; ++i) {
+    const nav_io_field *f = &sec->fields[i];
+    if (!nav_io_field_written(w, f, base, def)) continue;
+    if (f->kind != NAV_IO_SECTION || (f->flags & NAV_IO_FLOW) || section_has_output(w, f->section, base, def))
+      return true;
+  }
+  return false;
+}
+
+/* ================================================================ values and sections */
+
+/* The value of a non-section, non-custom field chosen by choose_spelling (the text after "key: "). */
+static nav_status write_scalar(nav_io_writer *w, const nav_io_field *f, const void *base) {
+  const char *p = (const char *)base + f->offset;
+  switch (f->kind) {
+  case NAV_IO_INT: return nav_io_writef(w, "%d", *(const int *)p);
+  case NAV_IO_LONG: return nav_io_writef(w, "%ld", *(const long *)p);
+  case NAV_IO_U64: return nav_io_writef(w, "%" PRIu64, *(const uint64_t *)p);
+  case NAV_IO_BOOL: return nav_io_writef(w, "%s", *(const bool *)p ? "true" : "false");
   case NAV_IO_ENUM: {
-    const int value = *(const int *)(base + f->offset);
+    const int value = *(const int *)p;
     const char *name = NULL;
     for (size_t i = 0; f->enums[i].name != NULL; ++i)
       if (f->enums[i].value == value) name = f->enums[i].name;
     if (name == NULL) return NAV_ERR_INVALID_ARG; /* not a value of the enum: nothing to write */
-    rc = fputs(name, fp);
-    break;
+    return nav_io_writef(w, "%s", name);
   }
-  case NAV_IO_STRING: {
-    const char *str = base + f->offset;
-    if (memchr(str, '\0', f->size) == NULL) return NAV_ERR_INVALID_ARG;
-    rc = write_quoted(fp, str);
-    break;
+  case NAV_IO_STRING:
+    if (memchr(p, '\0', f->size) == NULL) return NAV_ERR_INVALID_ARG;
+    return nav_io_write_quoted(w, p);
+  default: return NAV_ERR_INVALID_ARG;
   }
-  case NAV_IO_CUSTOM: rc = f->write(fp, f, s); break;
+}
+
+/* "key: value" of a non-section field (no newline). */
+static nav_status write_entry(nav_io_writer *w, const nav_io_section *sec, size_t i, const void *base,
+                              int indent) {
+  const nav_io_field *f = &sec->fields[i];
+  if (f->kind == NAV_IO_CUSTOM) {
+    const nav_status st = nav_io_writef(w, "%s:", f->key);
+    return st != NAV_OK ? st : f->write(w, f, base, indent);
   }
-  return rc < 0 ? NAV_ERR_IO : NAV_OK;
+  if (is_numeric(f->kind)) {
+    text_buf t;
+    const nav_io_field *g = choose_spelling(sec, i, base, &t);
+    return nav_io_writef(w, "%s: %s", g->key, t.s);
+  }
+  const nav_status st = nav_io_writef(w, "%s: ", f->key);
+  return st != NAV_OK ? st : write_scalar(w, f, base);
 }
 
 /* "  # a | b" after an enum, or the descriptor's comment. */
-static nav_status write_comment(FILE *fp, const nav_io_field *f) {
-  int rc = 0;
+static nav_status write_comment(nav_io_writer *w, const nav_io_field *f) {
+  nav_status st = NAV_OK;
   if (f->comment != NULL) {
-    rc = fprintf(fp, "  # %s", f->comment);
+    st = nav_io_writef(w, "  # %s", f->comment);
   } else if (f->kind == NAV_IO_ENUM && f->enums[0].name != NULL && f->enums[1].name != NULL) {
-    rc = fputs("  #", fp);
-    for (size_t i = 0; rc >= 0 && f->enums[i].name != NULL; ++i)
-      rc = fprintf(fp, "%s %s", i ? " |" : "", f->enums[i].name);
+    st = nav_io_writef(w, "  #");
+    for (size_t i = 0; st == NAV_OK && f->enums[i].name != NULL; ++i)
+      st = nav_io_writef(w, "%s %s", i ? " |" : "", f->enums[i].name);
   }
-  return rc < 0 ? NAV_ERR_IO : NAV_OK;
+  return st;
 }
 
-static nav_status write_section(FILE *fp, const nav_io_section *sec, const nav_scene *s, int indent) {
+nav_status nav_io_write_flow(nav_io_writer *w, const nav_io_section *sec, const void *base, const void *def) {
+  nav_status st = nav_io_writef(w, "{");
+  bool first = true;
+  for (size_t i = 0; i < sec->count && st == NAV_OK; ++i) {
+    const nav_io_field *f = &sec->fields[i];
+    if (!nav_io_field_written(w, f, base, def)) continue;
+    st = nav_io_writef(w, "%s", first ? "" : ", ");
+    first = false;
+    if (st != NAV_OK) break;
+    if (f->kind == NAV_IO_SECTION) {
+      st = nav_io_writef(w, "%s: ", f->key);
+      if (st == NAV_OK) st = nav_io_write_flow(w, f->section, base, def);
+    } else {
+      st = write_entry(w, sec, i, base, 0);
+    }
+  }
+  return st != NAV_OK ? st : nav_io_writef(w, "}");
+}
+
+/* Each field on its own line: "key: value\n" (lead = false), or "\nkey: value" (lead = true, for
+   custom values, which end without a newline). */
+static nav_status write_lines(nav_io_writer *w, const nav_io_section *sec, const void *base, const void *def,
+                              int indent, bool lead) {
   nav_status st = NAV_OK;
   for (size_t i = 0; i < sec->count && st == NAV_OK; ++i) {
     const nav_io_field *f = &sec->fields[i];
-    if (f->flags & NAV_IO_ALT) continue;
-    if (f->kind == NAV_IO_SECTION && indent == 0 && fputc('\n', fp) == EOF) return NAV_ERR_IO;
+    if (!nav_io_field_written(w, f, base, def)) continue;
+    if (f->kind == NAV_IO_SECTION && !(f->flags & NAV_IO_FLOW) && !section_has_output(w, f->section, base, def))
+      continue; /* e.g. imu.gyro of a perfect IMU */
+    if (f->kind == NAV_IO_SECTION && indent == 0 && !lead) st = nav_io_writef(w, "\n");
+    if (st == NAV_OK) st = nav_io_writef(w, "%s%*s", lead ? "\n" : "", indent, "");
+    if (st != NAV_OK) break;
     if (f->kind == NAV_IO_SECTION && (f->flags & NAV_IO_FLOW)) {
       /* {a: 1, b: 2} on one line, as in the canonical example. */
-      if (fprintf(fp, "%*s%s: {", indent, "", f->key) < 0) return NAV_ERR_IO;
-      bool first = true;
-      for (size_t j = 0; j < f->section->count && st == NAV_OK; ++j) {
-        if (f->section->fields[j].flags & NAV_IO_ALT) continue;
-        const nav_io_field *g = choose_spelling(f->section, j, s);
-        if (fprintf(fp, "%s%s: ", first ? "" : ", ", g->key) < 0) return NAV_ERR_IO;
-        st = write_value(fp, g, s);
-        first = false;
-      }
-      if (st == NAV_OK && fputs("}\n", fp) < 0) return NAV_ERR_IO;
+      st = nav_io_writef(w, "%s: ", f->key);
+      if (st == NAV_OK) st = nav_io_write_flow(w, f->section, base, def);
+      if (st == NAV_OK && !lead) st = nav_io_writef(w, "\n");
     } else if (f->kind == NAV_IO_SECTION) {
-      if (fprintf(fp, "%*s%s:\n", indent, "", f->key) < 0) return NAV_ERR_IO;
-      st = write_section(fp, f->section, s, indent + 2);
+      st = nav_io_writef(w, "%s:%s", f->key, lead ? "" : "\n");
+      if (st == NAV_OK) st = write_lines(w, f->section, base, def, indent + 2, lead);
     } else {
-      const nav_io_field *g = choose_spelling(sec, i, s);
-      if (fprintf(fp, "%*s%s: ", indent, "", g->key) < 0) return NAV_ERR_IO;
-      st = write_value(fp, g, s);
-      if (st == NAV_OK) st = write_comment(fp, f);
-      if (st == NAV_OK && fputc('\n', fp) == EOF) st = NAV_ERR_IO;
+      st = write_entry(w, sec, i, base, indent);
+      if (st == NAV_OK) st = write_comment(w, f);
+      if (st == NAV_OK && !lead) st = nav_io_writef(w, "\n");
     }
   }
   return st;
 }
 
-static nav_status write_scene(FILE *fp, const nav_scene *scene) {
-  if (fprintf(fp,
-              "# navcore scene file, format_version %d, written by navcore_io.\n"
-              "# Units are part of the key names (_deg, _rad, _rps, _hz, _m, _mps, _s ...).\n",
-              NAV_SCENE_FORMAT_VERSION) < 0)
-    return NAV_ERR_IO;
-  return write_section(fp, &nav_io_scene_schema, scene, 0);
+nav_status nav_io_write_block(nav_io_writer *w, const nav_io_section *sec, const void *base, const void *def,
+                              int indent) {
+  return write_lines(w, sec, base, def, indent, false);
 }
+
+nav_status nav_io_write_lines(nav_io_writer *w, const nav_io_section *sec, const void *base, const void *def,
+                              int indent) {
+  return write_lines(w, sec, base, def, indent, true);
+}
+
+static nav_status write_scene(FILE *fp, const nav_scene *scene, const nav_scene *def) {
+  nav_io_writer w = {fp, scene, def};
+  const nav_status st =
+      nav_io_writef(&w,
+                    "# navcore scene file, format_version %d, written by navcore_io.\n"
+                    "# Units are part of the key names (_deg, _rad, _rps, _hz, _m, _mps, _s ...).\n",
+                    NAV_SCENE_FORMAT_VERSION);
+  return st != NAV_OK ? st : nav_io_write_block(&w, &nav_io_scene_schema, scene, def, 0);
+}
+
+/* ================================================================ the file */
 
 /* fsync the directory holding @p path, so the rename itself survives a crash (best effort:
    some file systems refuse fsync on directories). */
@@ -245,11 +456,17 @@ nav_status nav_scene_write_file(const char *path, const nav_scene *scene) {
   bool tmp_exists = false;
   nav_io_c_locale loc;
   bool locale_set = false;
+  nav_scene *def = NULL;
 
   if (path == NULL || scene == NULL || path[0] == '\0') return NAV_ERR_INVALID_ARG;
   const size_t len = strlen(path);
   tmp = malloc(len + sizeof ".tmp.XXXXXX");
-  if (tmp == NULL) return NAV_ERR_NO_MEMORY;
+  def = malloc(sizeof *def); /* a scene is a few hundred kB: not on the stack */
+  if (tmp == NULL || def == NULL) {
+    st = NAV_ERR_NO_MEMORY;
+    goto cleanup;
+  }
+  *def = nav_scene_default();
   memcpy(tmp, path, len);
   memcpy(tmp + len, ".tmp.XXXXXX", sizeof ".tmp.XXXXXX");
 
@@ -275,7 +492,7 @@ nav_status nav_scene_write_file(const char *path, const nav_scene *scene) {
 
   nav_io_c_locale_begin(&loc);
   locale_set = true;
-  st = write_scene(fp, scene);
+  st = write_scene(fp, scene, def);
   nav_io_c_locale_end(&loc);
   locale_set = false;
   if (st != NAV_OK) goto cleanup;
@@ -299,5 +516,6 @@ cleanup:
   if (fd >= 0) close(fd);
   if (tmp_exists) unlink(tmp);
   free(tmp);
+  free(def);
   return st;
 }

@@ -15,6 +15,7 @@
 
 #include "bench.h"
 #include "catalog_cmd.h"
+#include "estimate_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -29,7 +30,8 @@ static const char *k_usage =
     "\n"
     "commands:\n"
     "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
-    "  run SCENE        simulate a scene and write the results into a directory\n"
+    "  estimate SCENE   preliminary estimate: closed-form error growth and covariance analysis\n"
+    "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
     "\n"
@@ -363,6 +365,7 @@ int main(int argc, char **argv) {
   }
   if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
+  if (strcmp(cmd, "estimate") == 0) return navsim_estimate(argc - 2, argv + 2);
   if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
   if (strcmp(cmd, "catalog") == 0) {
     char res[4096];

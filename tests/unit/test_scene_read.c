@@ -320,8 +320,8 @@ static void test_unknown_key_did_you_mean(void **state) {
   /* Nothing close: the valid keys of that level are listed. */
   expect_one(
       "format_version: 1\nsensors: {}\n", 2, 1, "sensors",
-      "unknown key \"sensors\"; expected one of: format_version, name, earth, trajectory, imu, navigation, "
-      "output, simulation");
+      "unknown key \"sensors\"; expected one of: format_version, name, earth, trajectory, imu, gnss, "
+      "initial_errors, navigation, output, simulation");
 }
 
 static void test_wrong_types(void **state) {
@@ -340,7 +340,8 @@ static void test_wrong_types(void **state) {
   expect_one("format_version: 1\nnavigation:\n  algorithm: {a: 1}\n", 3, 14, "navigation.algorithm",
              "expected one of: first_order, high_order; got a mapping");
   expect_one("format_version: 1\nimu: 5\n", 2, 6, "imu",
-             "expected a mapping with keys rate_hz, quadrature_nodes; got \"5\"");
+             "expected a mapping with keys rate_hz, quadrature_nodes, bias_convention, catalog, gyro, accel, off; "
+             "got \"5\"");
   expect_one("format_version: 1\nname: [a, b]\n", 2, 7, "name", "expected a string, got a sequence");
   expect_one("format_version: 1\nimu:\n  quadrature_nodes: 2.5\n", 3, 21, "imu.quadrature_nodes",
              "expected an integer, got \"2.5\"");
@@ -369,7 +370,7 @@ static void test_bad_enum(void **state) {
   expect_one("format_version: 1\nearth:\n  model: flot\n", 3, 10, "earth.model",
              "expected one of: flat, wgs84; got \"flot\"");
   expect_one("format_version: 1\ntrajectory: {type: spline}\n", 2, 20, "trajectory.type",
-             "expected one of: parametric; got \"spline\"");
+             "expected one of: parametric, waypoints, segments, test_motion, motion_def; got \"spline\"");
   expect_one("format_version: 1\ntrajectory:\n  parametric: {attitude: Magnus}\n", 3, 26,
              "trajectory.parametric.attitude", "expected one of: magnus; got \"Magnus\"");
 }

@@ -115,6 +115,31 @@ NAV_API NAV_NODISCARD nav_status nav_sim_run(nav_sim *sim, const nav_sim_options
  */
 NAV_API const nav_sim_envelope_point *nav_sim_envelope(const nav_sim *sim, size_t *count);
 
+/** One epoch of a covariance analysis: predicted one-sigma errors (NED, phi-angle). */
+typedef struct nav_cov_point {
+  double t_s;
+  nav_vec3 pos_sd_n_m;   /**< position sigma N/E/D [m] */
+  double pos_h_sd_m;     /**< sqrt(sigma_N^2 + sigma_E^2) [m] */
+  nav_vec3 vel_sd_n_mps; /**< velocity sigma N/E/D [m/s] */
+  nav_vec3 att_sd_rad;   /**< attitude sigma about N/E/D [rad] */
+} nav_cov_point;
+
+typedef nav_callback_result (*nav_cov_fn)(void *user, const nav_cov_point *p);
+
+/**
+ * Covariance analysis of the scene (numerics.md 6.6): the error covariance of its navigation
+ * scheme propagated along the reference trajectory with the filter's linear model (15 states,
+ * or more as nav_ins_gnss_config_from_scene() decides), GNSS updates at the receiver's epochs
+ * outside the outages for ins_gnss, and no random draws. @p fn receives the output epochs.
+ * WGS-84 scenes only.
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (flat Earth scene); NAV_ERR_CANCELLED when @p fn stops;
+ *         the filter's statuses.
+ */
+NAV_API NAV_NODISCARD nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user);
+
+/** The scene of a simulation (borrowed). */
+NAV_API const nav_scene *nav_sim_scene(const nav_sim *sim);
+
 /** Ask a running nav_sim_run to stop at the next sample. Thread-safe. */
 NAV_API void nav_sim_request_cancel(nav_sim *sim);
 

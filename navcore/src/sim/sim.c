@@ -23,6 +23,7 @@
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
+#include "sim/sim_internal.h"
 
 /* Values kept per metric for the statistics (runs x epochs / stride): bounded memory
  * (5 metrics x 8 bytes x 4e6 = 160 MB worst case). */
@@ -75,6 +76,12 @@ void nav_sim_request_cancel(nav_sim *sim) {
 }
 
 const char *nav_sim_last_error(const nav_sim *sim) { return sim ? sim->last_error : ""; }
+
+const nav_scene *nav_sim_scene(const nav_sim *sim) { return sim ? &sim->scene : NULL; }
+
+void nav_sim_set_error(nav_sim *sim, const char *msg) {
+  if (sim) snprintf(sim->last_error, sizeof sim->last_error, "%s", msg ? msg : "");
+}
 
 /* ------------------------------------------------------------------ one run */
 

@@ -1,0 +1,282 @@
+/*
+ * navsim estimate: the preliminary estimate of the design loop (architecture.md section 1):
+ * closed-form error growth (numerics.md section 1, corrected formulas of the paper) and a
+ * covariance analysis of the scene's scheme along its reference trajectory (numerics.md 6.6),
+ * in milliseconds and without random draws.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "estimate_cmd.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "navcore/nav_analytic.h"
+#include "navcore/nav_earth.h"
+#include "navcore/nav_io.h"
+#include "navcore/nav_results.h"
+#include "navcore/nav_sim.h"
+#include "navcore/nav_version.h"
+
+static const char *k_usage_estimate =
+    "usage: navsim estimate SCENE [--out DIR] [--quiet]\n"
+    "\n"
+    "Preliminary estimate of the scene's navigation errors, without simulation:\n"
+    "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
+    "              error model and initial errors (closed forms E1.6-E1.21; valid for short times,\n"
+    "              no Schuler feedback, small angles: flagged per row)\n"
+    "  covariance  the error covariance of the scene's scheme (free INS or INS/GNSS with its\n"
+    "              outages) propagated along the reference trajectory (wgs84 scenes)\n"
+    "Writes DIR/estimate.csv (one row per output epoch) and DIR/summary.json (default DIR:\n"
+    "out/<scene name>-estimate), atomically.\n"
+    "\n"
+    "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
+
+/* Worst-axis one-sigma of a per-run random constant: fixed offset and sd combined. */
+static double const_sd(unsigned terms, unsigned bit, nav_vec3 fixed, nav_vec3 sd) {
+  if (!(terms & bit)) return 0.0;
+  double m = 0.0;
+  for (int i = 0; i < 3; ++i) m = fmax(m, hypot(nav_vec3_get(fixed, i), nav_vec3_get(sd, i)));
+  return m;
+}
+
+/* The closed-form inputs from the scene: worst axis of every term (a bound over axes). */
+static nav_analytic_estimate_config analytic_config(const nav_scene *sc) {
+  nav_analytic_estimate_config c = nav_analytic_estimate_config_default();
+  nav_analytic_imu_spec *s = &c.imu;
+  const nav_gyro_error_config *g = &sc->imu.model.gyro;
+  const nav_accel_error_config *a = &sc->imu.model.accel;
+  s->g_mps2 = sc->earth.model == NAV_EARTH_FLAT
+                  ? sc->earth.flat_gravity_mps2
+                  : nav_earth_gravity_normal_mps2(sc->earth.origin_lat_rad, sc->earth.origin_h_m);
+  s->init_pos_sd_m = fmax(sc->initial_errors.pos_sd_m.x, sc->initial_errors.pos_sd_m.y);
+  s->init_vel_sd_mps = fmax(sc->initial_errors.vel_sd_mps.x, sc->initial_errors.vel_sd_mps.y);
+  s->init_tilt_sd_rad = fmax(sc->initial_errors.att_sd_rad.x, sc->initial_errors.att_sd_rad.y);
+  s->init_heading_sd_rad = sc->initial_errors.att_sd_rad.z;
+  s->accel_bias_mps2 = const_sd(a->terms, NAV_IMU_TERM_BIAS_TURN_ON, a->bias_turn_on_fixed_mps2, a->bias_turn_on_sd_mps2);
+  s->gyro_bias_rps = const_sd(g->terms, NAV_IMU_TERM_BIAS_TURN_ON, g->bias_turn_on_fixed_rps, g->bias_turn_on_sd_rps);
+  if (a->terms & NAV_IMU_TERM_NOISE) s->accel_vrw_mps_per_sqrt_s = vmax(a->vrw_mps_per_sqrt_s);
+  if (g->terms & NAV_IMU_TERM_NOISE) s->gyro_arw_rad_per_sqrt_s = vmax(g->arw_rad_per_sqrt_s);
+  if (a->terms & NAV_IMU_TERM_BIAS_GM) {
+    s->accel_gm_sd_mps2 = vmax(a->bias_gm_sd_mps2);
+    s->accel_gm_tau_s = vmax(a->bias_gm_tau_s);
+  }
+  if (g->terms & NAV_IMU_TERM_BIAS_GM) {
+    s->gyro_gm_sd_rps = vmax(g->bias_gm_sd_rps);
+    s->gyro_gm_tau_s = vmax(g->bias_gm_tau_s);
+  }
+  if (a->terms & NAV_IMU_TERM_BIAS_RW) s->accel_bias_rw_mps2_per_sqrt_s = vmax(a->bias_rw_mps2_per_sqrt_s);
+  if (g->terms & NAV_IMU_TERM_BIAS_RW) s->gyro_rrw_rps_per_sqrt_s = vmax(g->bias_rw_rps_per_sqrt_s);
+  return c;
+}
+
+typedef struct cov_rows {
+  nav_cov_point *p;
+  size_t n, cap;
+} cov_rows;
+
+static nav_callback_result keep_cov(void *user, const nav_cov_point *p) {
+  cov_rows *r = user;
+  if (r->n >= r->cap) return NAV_STOP;
+  r->p[r->n++] = *p;
+  return NAV_CONTINUE;
+}
+
+static void print_diag(void *user, const nav_diag *d) {
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  fprintf(stderr, "%s\n", line);
+  ++*(int *)user;
+}
+
+int navsim_estimate(int argc, char **argv) {
+  const char *scene_path = NULL, *out_dir = NULL;
+  bool quiet = false;
+  for (int i = 0; i < argc; ++i) {
+    if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+      fputs(k_usage_estimate, stdout);
+      return 0;
+    } else if (strcmp(argv[i], "--quiet") == 0) {
+      quiet = true;
+    } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
+      out_dir = argv[++i];
+    } else if (argv[i][0] == '-') {
+      fprintf(stderr, "navsim estimate: unknown or incomplete option \"%s\" (see navsim estimate --help)\n", argv[i]);
+      return 2;
+    } else if (!scene_path) {
+      scene_path = argv[i];
+    } else {
+      fprintf(stderr, "navsim estimate: only one SCENE may be given\n");
+      return 2;
+    }
+  }
+  if (!scene_path) {
+    fprintf(stderr, "navsim estimate: missing SCENE\n%s", k_usage_estimate);
+    return 2;
+  }
+  nav_scene sc;
+  int ndiag = 0;
+  const nav_status rst = nav_scene_read_file(scene_path, &sc, print_diag, &ndiag);
+  if (rst != NAV_OK) {
+    if (ndiag == 0) fprintf(stderr, "%s: error: %s\n", scene_path, nav_status_str(rst));
+    return rst == NAV_ERR_PARSE ? 2 : 1;
+  }
+  char default_dir[600];
+  if (!out_dir) {
+    snprintf(default_dir, sizeof default_dir, "out/%s-estimate", sc.name[0] ? sc.name : "scene");
+    out_dir = default_dir;
+  }
+
+  int rc = 1;
+  nav_sim *sim = NULL;
+  nav_resultdir *rd = NULL;
+  cov_rows cov = {NULL, 0, 0};
+  nav_analytic_estimate_point *ana = NULL;
+  double *times = NULL;
+  FILE *f = NULL;
+  const double t0 = now_s();
+
+  /* Output epochs of the scene. */
+  const int64_t n_imu = (int64_t)floor(sc.trajectory.duration_s * sc.imu.rate_hz + 1e-9);
+  int64_t stride = (int64_t)llround(sc.imu.rate_hz / sc.output.rate_hz);
+  if (stride < 1) stride = 1;
+  const size_t n_out = (size_t)(n_imu / stride + 2);
+  times = calloc(n_out, sizeof *times);
+  ana = calloc(n_out, sizeof *ana);
+  cov.p = calloc(n_out, sizeof *cov.p);
+  cov.cap = n_out;
+  if (!times || !ana || !cov.p) {
+    fprintf(stderr, "navsim estimate: out of memory\n");
+    goto cleanup;
+  }
+  size_t nt = 0;
+  for (int64_t k = 0; k <= n_imu; k += stride) times[nt++] = (double)k / sc.imu.rate_hz;
+  if (times[nt - 1] < (double)n_imu / sc.imu.rate_hz) times[nt++] = (double)n_imu / sc.imu.rate_hz;
+
+  const nav_analytic_estimate_config acfg = analytic_config(&sc);
+  nav_status st = nav_analytic_estimate(&acfg, times, nt, ana);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(st));
+    goto cleanup;
+  }
+  const double t_analytic = now_s() - t0;
+  bool have_cov = false;
+  double t_cov = 0.0;
+  if (sc.earth.model == NAV_EARTH_WGS84) {
+    st = nav_sim_create(&sc, &sim);
+    if (st == NAV_OK) {
+      const double tc = now_s();
+      st = nav_sim_covariance(sim, keep_cov, &cov);
+      t_cov = now_s() - tc;
+    }
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: covariance analysis failed: %s\n", sim ? nav_sim_last_error(sim) : nav_status_str(st));
+      goto cleanup;
+    }
+    have_cov = cov.n == nt;
+  }
+
+  if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
+    fprintf(stderr, "navsim estimate: cannot create \"%s\": %s\n", out_dir, strerror(errno));
+    goto cleanup;
+  }
+  const char *csv = nav_resultdir_file(rd, "estimate.csv");
+  f = csv ? fopen(csv, "w") : NULL;
+  if (!f) goto cleanup;
+  fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_e_sd_m,"
+        "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
+        "cov_att_e_sd_rad,cov_att_d_sd_rad\n",
+        f);
+  for (size_t i = 0; i < nt; ++i) {
+    fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
+            ana[i].gyro_ins.att_sd_rad, ana[i].gyro_ins_short_time_ok ? 1 : 0);
+    if (have_cov) {
+      const nav_cov_point *p = &cov.p[i];
+      fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p->pos_sd_n_m.x, p->pos_sd_n_m.y,
+              p->pos_sd_n_m.z, p->pos_h_sd_m, p->vel_sd_n_mps.x, p->vel_sd_n_mps.y, p->vel_sd_n_mps.z, p->att_sd_rad.x,
+              p->att_sd_rad.y, p->att_sd_rad.z);
+    } else {
+      fputs(",,,,,,,,,,\n", f);
+    }
+  }
+  const bool bad = ferror(f) != 0;
+  if (fclose(f) != 0 || bad) {
+    f = NULL;
+    goto cleanup;
+  }
+  f = NULL;
+  const char *js = nav_resultdir_file(rd, "summary.json");
+  f = js ? fopen(js, "w") : NULL;
+  if (!f) goto cleanup;
+  const nav_analytic_estimate_point *al = &ana[nt - 1];
+  fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": \"%s\", \"file\": \"%s\"},\n", nav_version_string(),
+          sc.name, scene_path);
+  fprintf(f, "  \"duration_s\": %.17g,\n  \"timing\": {\"analytic_wall_s\": %.6g, \"covariance_wall_s\": %.6g},\n",
+          times[nt - 1], t_analytic, t_cov);
+  fprintf(f, "  \"analytic_final\": {\"pos_sd_m\": %.17g, \"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, \"valid\": %s}",
+          al->gyro_ins.pos_sd_m, al->gyro_ins.vel_sd_mps, al->gyro_ins.att_sd_rad,
+          al->gyro_ins_short_time_ok ? "true" : "false");
+  if (have_cov) {
+    const nav_cov_point *p = &cov.p[nt - 1];
+    double hmax = 0.0;
+    for (size_t i = 0; i < nt; ++i) hmax = fmax(hmax, cov.p[i].pos_h_sd_m);
+    fprintf(f,
+            ",\n  \"covariance_final\": {\"pos_h_sd_m\": %.17g, \"pos_d_sd_m\": %.17g, \"vel_n_sd_mps\": %.17g, "
+            "\"att_d_sd_rad\": %.17g},\n  \"covariance_max\": {\"pos_h_sd_m\": %.17g}",
+            p->pos_h_sd_m, p->pos_sd_n_m.z, p->vel_sd_n_mps.x, p->att_sd_rad.z, hmax);
+  }
+  fputs("\n}\n", f);
+  if (fclose(f) != 0) {
+    f = NULL;
+    goto cleanup;
+  }
+  f = NULL;
+  st = nav_resultdir_commit(rd);
+  rd = NULL;
+  if (st != NAV_OK) goto cleanup;
+  if (!quiet) {
+    printf("scene      %s (%s)\n", sc.name, scene_path);
+    printf("%10s | %-38s | %s\n", "t [s]", "analytic free INS, per axis (1 sigma)",
+           have_cov ? "covariance analysis of the scheme (1 sigma)" : "covariance analysis: wgs84 scenes only");
+    printf("%10s | %11s %11s %11s  | %11s %11s %11s\n", "", "pos [m]", "vel [m/s]", "att [deg]", "pos h [m]",
+           "pos d [m]", "yaw [deg]");
+    const double show[] = {1, 10, 30, 60, 120, 300, 600, 1800, 3600, 1e30};
+    for (size_t s = 0; s < sizeof show / sizeof *show; ++s) {
+      size_t i = nt - 1;
+      for (size_t q = 0; q < nt; ++q)
+        if (times[q] >= show[s]) {
+          i = q;
+          break;
+        }
+      if (s > 0 && times[i] < show[s - 1]) continue;
+      printf("%10.1f | %11.4g %11.4g %11.4g%s |", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
+             ana[i].gyro_ins.att_sd_rad * NAV_RAD2DEG, ana[i].gyro_ins_short_time_ok ? " " : "*");
+      if (have_cov)
+        printf(" %11.4g %11.4g %11.4g", cov.p[i].pos_h_sd_m, cov.p[i].pos_sd_n_m.z, cov.p[i].att_sd_rad.z * NAV_RAD2DEG);
+      printf("\n");
+      if (i == nt - 1) break;
+    }
+    printf("(* beyond the closed forms' validity: Schuler feedback or large angles)\n");
+    printf("computed   analytic %.3g s, covariance %.3g s\n", t_analytic, t_cov);
+    printf("results    %s/\n", out_dir);
+  }
+  rc = 0;
+cleanup:
+  if (f) fclose(f);
+  nav_resultdir_abort(rd);
+  nav_sim_destroy(sim);
+  free(cov.p);
+  free(ana);
+  free(times);
+  return rc;
+}
