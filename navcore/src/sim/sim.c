@@ -15,7 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <threads.h>
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_ins_gnss.h"
@@ -23,6 +22,7 @@
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
+#include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
 
 /* Values kept per metric for the statistics (runs x epochs / stride): bounded memory
@@ -103,7 +103,7 @@ typedef struct job {
   nav_status *status;      /* [runs] */
   atomic_long next_run;
   atomic_long runs_done;
-  mtx_t err_lock;
+  nav_mutex err_lock;
   bool err_set;
   bool gm_states; /* INS/GNSS: the filter carries GNSS GM error states */
   /* Truth shared by every run (Monte Carlo): ideal increments k = 1..n and states k = 0..n,
@@ -120,7 +120,7 @@ typedef struct job {
 __attribute__((format(printf, 2, 3)))
 #endif
 static void job_error(job *j, const char *fmt, ...) {
-  mtx_lock(&j->err_lock);
+  nav_mutex_lock(&j->err_lock);
   if (!j->err_set) {
     va_list ap;
     va_start(ap, fmt);
@@ -128,7 +128,7 @@ static void job_error(job *j, const char *fmt, ...) {
     va_end(ap);
     j->err_set = true;
   }
-  mtx_unlock(&j->err_lock);
+  nav_mutex_unlock(&j->err_lock);
 }
 
 /*
@@ -411,7 +411,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   nav_status st = NAV_OK;
   nav_truth *probe = NULL;
   nav_stat_acc *acc = NULL;
-  thrd_t *threads = NULL;
+  nav_thread *threads = NULL;
+  nav_thread_call *calls = NULL;
   int started = 0;
   bool lock_ok = false;
   if (!sim || !opts || !out) return NAV_ERR_INVALID_ARG;
@@ -486,7 +487,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     st = NAV_ERR_NO_MEMORY;
     goto cleanup;
   }
-  if (mtx_init(&j.err_lock, mtx_plain) != thrd_success) {
+  if (!nav_mutex_init(&j.err_lock)) {
     st = NAV_ERR_NO_MEMORY;
     goto cleanup;
   }
@@ -501,12 +502,13 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     if (nthreads > 256) nthreads = 256;
     if ((long)nthreads > j.runs - 1) nthreads = (int)(j.runs - 1);
     threads = calloc((size_t)nthreads, sizeof *threads);
-    if (!threads) {
+    calls = calloc((size_t)nthreads, sizeof *calls);
+    if (!threads || !calls) {
       st = NAV_ERR_NO_MEMORY;
       goto cleanup;
     }
     for (int t = 1; t < nthreads; ++t) {
-      if (thrd_create(&threads[t], worker, &j) != thrd_success) break;
+      if (!nav_thread_start(&threads[t], &calls[t], worker, &j)) break;
       ++started;
     }
     /* This thread works too, reporting progress between runs. */
@@ -523,7 +525,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
         if (opts->progress(opts->user, &p) == NAV_STOP) atomic_store(&sim->cancel, true);
       }
     }
-    for (int t = 1; t <= started; ++t) thrd_join(threads[t], NULL);
+    for (int t = 1; t <= started; ++t) nav_thread_join(threads[t]);
     for (long r = 0; r < j.runs && st == NAV_OK; ++r) st = j.status[r];
   }
   if (st != NAV_OK && st != NAV_ERR_CANCELLED) goto cleanup;
@@ -616,7 +618,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
 cleanup:
   nav_stat_acc_destroy(acc);
   free(threads);
-  if (lock_ok) mtx_destroy(&j.err_lock);
+  free(calls);
+  if (lock_ok) nav_mutex_destroy(&j.err_lock);
   free(j.metrics);
   free(j.env);
   free(j.shared_imu);
