@@ -42,7 +42,8 @@
 
 /** Largest scene file (or string) the reader accepts [bytes]: 16 MiB. */
 #define NAV_IO_MAX_INPUT_BYTES ((size_t)16 * 1024 * 1024)
-/** Deepest YAML nesting the reader accepts (the v1 schema needs 7: trajectory.waypoints.points[i].attitude). */
+/** Deepest YAML nesting the reader accepts (the v1 schema needs 7: trajectory.waypoints.points[i].attitude).
+ */
 #define NAV_IO_MAX_DEPTH 64
 /** Most YAML nodes (scalars, sequences, mappings) the reader builds from one file. */
 #define NAV_IO_MAX_NODES 1000000
@@ -152,13 +153,14 @@ typedef struct nav_io_geo_point {
 
 /** Reader inputs that have no place in the scene (NAV_IO_STATE fields and what they lead to). */
 typedef struct nav_io_read_state {
-  nav_scene *scene;   /**< the scene being read */
-  const char *file;   /**< the scene file name as given (relative paths resolve against its directory) */
+  nav_scene *scene;    /**< the scene being read */
+  const char *file;    /**< the scene file name as given (relative paths resolve against its directory) */
+  bool file_is_path;   /**< @c file is a file path (nav_scene_read_file), not only a display name */
   int bias_convention; /**< imu.bias_convention (nav_bi_convention) */
   nav_vec3 bi[2];      /**< gyro [rad/s] / accel [m/s^2] bias instability B */
   nav_vec3 bi_tau_min_s[2];
-  double llh[3];           /**< the waypoint being read: lat_rad, lon_rad, h_m */
-  nav_io_geo_point *geo;   /**< waypoints given in geodetic coordinates */
+  double llh[3];         /**< the waypoint being read: lat_rad, lon_rad, h_m */
+  nav_io_geo_point *geo; /**< waypoints given in geodetic coordinates */
   size_t ngeo, cap_geo;
   char md_file[NAV_IO_PATH_MAX]; /**< trajectory.motion_def.file as written */
   bool md_allow_unconverged;
@@ -200,14 +202,11 @@ void nav_io_path_pop(nav_io_reader *r, size_t saved);
 /** Read the mapping @p map (given under @p key) against @p sec into @p base. */
 void nav_io_read_section(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key,
                          const nav_io_node *map, void *base);
-/** Read one value as descriptor @p f describes it, into @p base. */
-void nav_io_read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                       void *base);
 /** Read a number (no range check); false after a reported problem. */
 bool nav_io_read_number(nav_io_reader *r, const nav_io_node *key, const nav_io_node *v, double *out);
 /** Check a number against the range and finiteness flags of @p f (file units). */
-bool nav_io_check_number(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                         double d);
+bool nav_io_check_number(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *v, double d);
 /** Report that @p v (under @p key) is not what @p expected says ("a sequence of waypoints"). */
 void nav_io_expected(nav_io_reader *r, const nav_io_node *key, const nav_io_node *v, const char *expected);
 /** Aliases and tags are refused; true if @p v was one (and was reported). */
@@ -217,16 +216,13 @@ bool nav_io_read_enum_value(nav_io_reader *r, const nav_io_enum_value *e, const 
                             const nav_io_node *v, int *out);
 /** Mark the current path at @p node, for the validators' messages. */
 void nav_io_mark(nav_io_reader *r, const nav_io_node *node, const nav_io_node *fallback);
-/** The closest of @p names to @p text within the did-you-mean budget (ASCII case-blind), or NULL. */
-const char *nav_io_closest(const char *text, size_t len, const char *const *names, size_t n);
 
 /** Tree access. */
 bool nav_io_node_is_map(const nav_io_node *n);
 bool nav_io_node_is_seq(const nav_io_node *n);
-bool nav_io_node_is_scalar(const nav_io_node *n); /**< a scalar that is not null */
 bool nav_io_node_text_is(const nav_io_node *n, const char *s);
 const char *nav_io_node_text(const nav_io_node *n, size_t *len);
-size_t nav_io_node_count(const nav_io_node *n);   /**< items of a sequence, keys of a mapping */
+size_t nav_io_node_count(const nav_io_node *n);             /**< items of a sequence, keys of a mapping */
 const nav_io_node *nav_io_node_child(const nav_io_node *n); /**< first item (in a mapping: the first key) */
 const nav_io_node *nav_io_node_next(const nav_io_node *n);  /**< next sibling */
 /** The value under @p key in mapping @p map (first occurrence), or NULL; *key_out = its key node. */
@@ -252,8 +248,6 @@ nav_status nav_io_write_flow(nav_io_writer *w, const nav_io_section *sec, const 
 bool nav_io_section_same(const nav_io_section *sec, const void *a, const void *b);
 /** Whether the values of field @p f are identical (bit for bit) in @p a and @p b. */
 bool nav_io_field_same(const nav_io_field *f, const void *a, const void *b);
-/** Whether the writer writes @p f of @p base. */
-bool nav_io_field_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
 /** A double, shortest text that reads back to the same bits. */
 nav_status nav_io_write_double(nav_io_writer *w, double v);
 /** A YAML double-quoted string (control characters escaped). */

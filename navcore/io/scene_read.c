@@ -92,20 +92,22 @@ _Static_assert(sizeof(nav_bi_convention) == sizeof(int), "enum storage");
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
 
 /* Datasheet units -> SI: file value x factor, the factor being the nav_unit_* helper of
-   nav_sensors.h applied to 1 (the helpers are inline functions, not constant expressions). */
-#define K_DEG_PER_H (NAV_DEG2RAD / 3600.0)                      /* nav_unit_deg_per_h_to_rps */
-#define K_DEG_PER_SQRT_H (NAV_DEG2RAD / 60.0)                   /* ..._deg_per_sqrt_h_to_rad_per_sqrt_s */
-#define K_DEG_PER_H_PER_SQRT_H (NAV_DEG2RAD / 3600.0 / 60.0)    /* ..._deg_per_h_per_sqrt_h_to_rps_per_sqrt_s */
-#define K_DEG_PER_H_PER_G (NAV_DEG2RAD / 3600.0 / NAV_G0_MPS2)  /* ..._deg_per_h_per_g_to_rps_per_mps2 */
-#define K_PER_SQRT_H (1.0 / 60.0)                               /* ..._mps_per_sqrt_h_to_mps_per_sqrt_s */
-#define K_MG (1e-3 * NAV_G0_MPS2)                               /* nav_unit_mg_to_mps2 */
-#define K_UG (1e-6 * NAV_G0_MPS2)                               /* nav_unit_ug_to_mps2, ..._ug_per_sqrt_hz_... */
-#define K_PPM 1e-6                                              /* nav_unit_ppm_to_ratio */
-#define K_MRAD 1e-3                                             /* nav_unit_mrad_to_rad */
+   nav_sensors.h applied to 1 (the helpers are inline functions, not constant expressions):
+   deg/h, deg/sqrt(h), deg/h/sqrt(h), deg/h/g, (m/s)/sqrt(h), mg, ug (also ug/sqrt(Hz)), ppm, mrad. */
+#define K_DEG_PER_H (NAV_DEG2RAD / 3600.0)
+#define K_DEG_PER_SQRT_H (NAV_DEG2RAD / 60.0)
+#define K_DEG_PER_H_PER_SQRT_H (NAV_DEG2RAD / 3600.0 / 60.0)
+#define K_DEG_PER_H_PER_G (NAV_DEG2RAD / 3600.0 / NAV_G0_MPS2)
+#define K_PER_SQRT_H (1.0 / 60.0)
+#define K_MG (1e-3 * NAV_G0_MPS2)
+#define K_UG (1e-6 * NAV_G0_MPS2)
+#define K_PPM 1e-6
+#define K_MRAD 1e-3
 
 static void read_format_version(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
                                 const nav_io_node *value, void *base);
-static nav_status write_format_version(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+static nav_status write_format_version(nav_io_writer *w, const nav_io_field *f, const void *base,
+                                       int indent) {
   (void)f;
   (void)base;
   (void)indent;
@@ -117,8 +119,8 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
 static nav_status write_catalog(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
 static bool same_string(const nav_io_field *f, const void *a, const void *b);
 static bool catalog_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
-static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *value,
-                     void *base);
+static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                     const nav_io_node *value, void *base);
 static nav_status write_off(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
 static bool off_needed(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
 static bool same_terms(const nav_io_field *f, const void *a, const void *b);
@@ -236,7 +238,8 @@ static const nav_io_field k_gyro[] = {
       G_TERM(NAV_IMU_TERM_BIAS_RW), .mark_as = "bias_rw_rps_per_sqrt_s"),
     Q("rrw_rps_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_rw_rps_per_sqrt_s), 1.0,
       G_TERM(NAV_IMU_TERM_BIAS_RW)),
-    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, GM(scale_factor_sd), K_PPM, G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, GM(scale_factor_sd), K_PPM,
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
     Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(scale_factor_sd), 1.0,
       G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
     Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, GM(scale_factor_fixed), K_PPM,
@@ -249,14 +252,14 @@ static const nav_io_field k_gyro[] = {
       G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, GM(misalignment_fixed_rad), K_MRAD,
       G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, GM(misalignment_fixed_rad), 1.0,
-      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, GM(misalignment_fixed_rad),
+      1.0, G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("g_sensitivity_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NONNEG, GM(g_sensitivity_sd_rps_per_mps2),
       K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY), .mark_as = "g_sensitivity_sd_rps_per_mps2"),
     Q("g_sensitivity_rps_per_mps2", NAV_IO_MAT3_DIAG, NONNEG | NAV_IO_ALT, GM(g_sensitivity_sd_rps_per_mps2),
       1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
-    Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NAV_IO_FINITE, GM(g_sensitivity_fixed_rps_per_mps2),
-      K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NAV_IO_FINITE,
+      GM(g_sensitivity_fixed_rps_per_mps2), K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
     Q("g_sensitivity_fixed_rps_per_mps2", NAV_IO_MAT3_DIAG, NAV_IO_FINITE | NAV_IO_ALT,
       GM(g_sensitivity_fixed_rps_per_mps2), 1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
     Q("quantisation_rad", NAV_IO_VEC3S, POSITIVE, GM(quant_step_rad), 1.0, G_TERM(NAV_IMU_TERM_QUANTISATION),
@@ -274,8 +277,8 @@ static const nav_io_field k_accel[] = {
       A_TERM(NAV_IMU_TERM_NOISE)),
     Q("noise_density_ug_per_sqrt_hz", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), K_UG,
       A_TERM(NAV_IMU_TERM_NOISE)),
-    Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG, AM(bias_turn_on_sd_mps2), K_MG, A_TERM(NAV_IMU_TERM_BIAS_TURN_ON),
-      .mark_as = "bias_turn_on_sd_mps2"),
+    Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG, AM(bias_turn_on_sd_mps2), K_MG,
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2"),
     Q("bias_turn_on_mps2", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_turn_on_sd_mps2), 1.0,
       A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_turn_on_fixed_mg", NAV_IO_VEC3S, NAV_IO_FINITE, AM(bias_turn_on_fixed_mps2), K_MG,
@@ -294,7 +297,8 @@ static const nav_io_field k_accel[] = {
       A_TERM(NAV_IMU_TERM_BIAS_RW)),
     Q("bias_rw_mps2_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_rw_mps2_per_sqrt_s), 1.0,
       A_TERM(NAV_IMU_TERM_BIAS_RW)),
-    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, AM(scale_factor_sd), K_PPM, A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, AM(scale_factor_sd), K_PPM,
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
     Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(scale_factor_sd), 1.0,
       A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
     Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, AM(scale_factor_fixed), K_PPM,
@@ -307,12 +311,13 @@ static const nav_io_field k_accel[] = {
       A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, AM(misalignment_fixed_rad), K_MRAD,
       A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, AM(misalignment_fixed_rad), 1.0,
-      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, AM(misalignment_fixed_rad),
+      1.0, A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("quantisation_mps", NAV_IO_VEC3S, POSITIVE, AM(quant_step_mps), 1.0, A_TERM(NAV_IMU_TERM_QUANTISATION),
       .mark_as = "quant_step_mps"),
     Q("range_g", NAV_IO_VEC3S, POSITIVE, AM(range_mps2), NAV_G0_MPS2, A_TERM(NAV_IMU_TERM_SATURATION)),
-    Q("range_mps2", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, AM(range_mps2), 1.0, A_TERM(NAV_IMU_TERM_SATURATION)),
+    Q("range_mps2", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, AM(range_mps2), 1.0,
+      A_TERM(NAV_IMU_TERM_SATURATION)),
 };
 DEFINE_SECTION_FINISH(k_accel_section, k_accel, finish_accel);
 
@@ -382,8 +387,8 @@ static const nav_io_field k_gnss[] = {
       .mark_as = "pos_gm_sd_m", .comment = "N, E, D; Gauss-Markov"),
     Q("position_corr_time_s", NAV_IO_VEC3S, NONNEG, NM(pos_gm_tau_s), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
       .mark_as = "pos_gm_tau_s", .comment = "0: white"),
-    Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_white_sd_m), 1.0, N_TERM(NAV_GNSS_TERM_POS_WHITE),
-      .mark_as = "pos_white_sd_m"),
+    Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_white_sd_m), 1.0,
+      N_TERM(NAV_GNSS_TERM_POS_WHITE), .mark_as = "pos_white_sd_m"),
     Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG, NM(vel_sd_mps), 1.0, N_TERM(NAV_GNSS_TERM_VEL_WHITE),
       .mark_as = "vel_sd_mps"),
     Q("lever_arm_b_m", NAV_IO_VEC3, NAV_IO_FINITE, NM(r_ba_b_m), 1.0, .mark_as = "r_ba_b_m",
@@ -663,7 +668,8 @@ void nav_io_reader_error_at_path(nav_io_reader *r, const char *path, const char 
   va_end(ap);
   int line = 0, col = 0;
   find_mark(r, path, &line, &col);
-  if (r->nerr_paths < NAV_DIAG_MAX_PER_FILE) snprintf(r->err_paths[r->nerr_paths++], PATH_MAX_LEN, "%s", path);
+  if (r->nerr_paths < NAV_DIAG_MAX_PER_FILE)
+    snprintf(r->err_paths[r->nerr_paths++], PATH_MAX_LEN, "%s", path);
   emit(r, line, col, path, msg);
 }
 
@@ -1331,10 +1337,6 @@ bool nav_io_node_is_seq(const nav_io_node *n) {
   return n != NULL && n->kind == Y_SEQ;
 }
 
-bool nav_io_node_is_scalar(const nav_io_node *n) {
-  return n != NULL && n->kind == Y_SCALAR && !is_null(n);
-}
-
 bool nav_io_node_text_is(const nav_io_node *n, const char *s) {
   return n != NULL && n->kind == Y_SCALAR && text_is(n, s);
 }
@@ -1372,8 +1374,8 @@ bool nav_io_read_number(nav_io_reader *r, const nav_io_node *key, const nav_io_n
   return parse_double(r, key, v, out);
 }
 
-bool nav_io_check_number(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                         double d) {
+bool nav_io_check_number(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                         const nav_io_node *v, double d) {
   return check_double(r, f, key, v, d);
 }
 
@@ -1421,7 +1423,8 @@ static size_t edit_distance(const char *a, size_t la, const char *b, size_t lb) 
   return r1[lb];
 }
 
-const char *nav_io_closest(const char *text, size_t len, const char *const *names, size_t n) {
+/* The closest of @p names to @p text within the did-you-mean budget (ASCII case-blind), or NULL. */
+static const char *closest(const char *text, size_t len, const char *const *names, size_t n) {
   /* The budget grows with the length of the word: one typo in a short key, a few in a long name. */
   size_t budget = len <= 3 ? 1 : len <= 8 ? 2 : 3;
   if (len / 5 > budget) budget = len / 5;
@@ -1592,7 +1595,7 @@ bool nav_io_read_enum_value(nav_io_reader *r, const nav_io_enum_value *e, const 
   size_t n = 0;
   for (; e[n].name != NULL && n < COUNT(names); ++n)
     names[n] = e[n].name;
-  const char *best = v->kind == Y_SCALAR && !is_null(v) ? nav_io_closest(v->text, v->len, names, n) : NULL;
+  const char *best = v->kind == Y_SCALAR && !is_null(v) ? closest(v->text, v->len, names, n) : NULL;
   if (best != NULL)
     nav_io_reader_error(r, v, key, "expected one of: %s; got %s (did you mean \"%s\"?)", list, got, best);
   else
@@ -1672,18 +1675,14 @@ static bool read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_nod
   return ok;
 }
 
-void nav_io_read_field(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                       void *base) {
-  (void)read_field(r, f, key, v, base);
-}
-
 /* Fields with the same storage are spellings of one quantity (lat_deg / lat_rad). */
 static size_t group_of(const nav_io_section *sec, size_t i) {
   const nav_io_field *f = &sec->fields[i];
   if (f->kind == NAV_IO_SECTION) return i;
   for (size_t j = 0; j < i; ++j) {
     const nav_io_field *g = &sec->fields[j];
-    if (g->kind == f->kind && g->offset == f->offset && (g->flags & NAV_IO_STATE) == (f->flags & NAV_IO_STATE) &&
+    if (g->kind == f->kind && g->offset == f->offset &&
+        (g->flags & NAV_IO_STATE) == (f->flags & NAV_IO_STATE) &&
         (f->kind != NAV_IO_CUSTOM || g->read == f->read))
       return j;
   }
@@ -1699,6 +1698,11 @@ static long find_field(const nav_io_section *sec, const nav_io_node *key) {
 static void unknown_key(nav_io_reader *r, const nav_io_section *sec, const nav_io_node *key) {
   char shown[SHOW_MAX + 4], list[512];
   show(shown, sizeof shown, key->text, key->len);
+  /* In a list element (a waypoint, a segment) a misspelt key leaves a field at its default, and
+     validation would only add a confusing message about that field: the element is marked. */
+  const char *dot = strrchr(r->path, '.');
+  if (dot != NULL && dot > r->path && dot[-1] == ']' && r->nerr_paths < NAV_DIAG_MAX_PER_FILE)
+    snprintf(r->err_paths[r->nerr_paths++], PATH_MAX_LEN, "%.*s", (int)(dot - r->path), r->path);
 
   /* "rate" for "rate_hz", "lat" for "lat_deg" / "lat_rad": the unit suffix is missing. */
   const char *prefixed[3];
@@ -1724,7 +1728,7 @@ static void unknown_key(nav_io_reader *r, const nav_io_section *sec, const nav_i
   const char *names[MAX_SECTION_FIELDS];
   for (size_t i = 0; i < sec->count; ++i)
     names[i] = sec->fields[i].key;
-  const char *best = nav_io_closest(key->text, key->len, names, sec->count);
+  const char *best = closest(key->text, key->len, names, sec->count);
   if (best != NULL) {
     nav_io_reader_error(r, key, NULL, "unknown key \"%s\"; did you mean \"%s\"?", shown, best);
     return;
@@ -1754,7 +1758,8 @@ static void read_mapping(nav_io_reader *r, const nav_io_section *sec, const nav_
 
   for (int pass = 0; pass < 3; ++pass) {
     if (!has_phase[pass]) continue;
-    for (const nav_io_node *key = map->child; key != NULL && !r->stop; key = key->next ? key->next->next : NULL) {
+    for (const nav_io_node *key = map->child; key != NULL && !r->stop;
+         key = key->next ? key->next->next : NULL) {
       const nav_io_node *value = key->next;
       if (value == NULL) break; /* cannot happen: libfyaml gives mappings an even number of events */
       if (key->kind != Y_SCALAR || is_null(key)) {
@@ -1940,12 +1945,14 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
   nav_scene *s = base;
   const bool imu = f->offset == OFF(imu.catalog);
   const char *what = imu ? "IMU" : "GNSS receiver";
-  char name[NAV_SCENE_CATALOG_NAME_MAX], dir[NAV_IO_PATH_MAX], path[NAV_IO_PATH_MAX + 32], shown[SHOW_MAX + 4];
+  char name[NAV_SCENE_CATALOG_NAME_MAX], dir[NAV_IO_PATH_MAX], path[NAV_IO_PATH_MAX + 32],
+      shown[SHOW_MAX + 4];
   nav_catalog *cat = NULL;
   if (reject_special(r, key, v)) return;
   if (v->kind != Y_SCALAR || is_null(v)) {
-    nav_io_expected(r, key, v, imu ? "an IMU name from resources/imu_catalog.csv"
-                                   : "a receiver mode from resources/gnss_receivers.csv");
+    nav_io_expected(r, key, v,
+                    imu ? "an IMU name from resources/imu_catalog.csv"
+                        : "a receiver mode from resources/gnss_receivers.csv");
     return;
   }
   if (v->len >= sizeof name || memchr(v->text, '\0', v->len) != NULL) {
@@ -1956,8 +1963,8 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
   name[v->len] = '\0';
   show(shown, sizeof shown, v->text, v->len);
   if (!resources_dir(dir, sizeof dir)) {
-    nav_io_reader_error(r, v, key, "cannot find the resources directory with the %s catalog; set NAV_RESOURCES_DIR",
-                        what);
+    nav_io_reader_error(
+        r, v, key, "cannot find the resources directory with the %s catalog; set NAV_RESOURCES_DIR", what);
     return;
   }
   snprintf(path, sizeof path, "%s/%s", dir, imu ? "imu_catalog.csv" : "gnss_receivers.csv");
@@ -1996,14 +2003,15 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
         ++n_sub;
       }
     }
-    const char *best = nav_io_closest(name, v->len, names, n < COUNT(names) ? n : COUNT(names));
+    const char *best = closest(name, v->len, names, n < COUNT(names) ? n : COUNT(names));
     if (best == NULL && n_sub == 1) best = sub;
     if (best != NULL)
-      nav_io_reader_error(r, v, key, "unknown %s \"%s\"; did you mean \"%s\"? (`navsim catalog --%s` lists %s)",
-                          what, shown, best, imu ? "imu" : "gnss", path);
+      nav_io_reader_error(r, v, key,
+                          "unknown %s \"%s\"; did you mean \"%s\"? (`navsim catalog --%s` lists %s)", what,
+                          shown, best, imu ? "imu" : "gnss", path);
     else
-      nav_io_reader_error(r, v, key, "unknown %s \"%s\"; `navsim catalog --%s` lists the %zu entries of %s", what,
-                          shown, imu ? "imu" : "gnss", n, path);
+      nav_io_reader_error(r, v, key, "unknown %s \"%s\"; `navsim catalog --%s` lists the %zu entries of %s",
+                          what, shown, imu ? "imu" : "gnss", n, path);
   }
 cleanup:
   nav_catalog_destroy(cat);
@@ -2032,12 +2040,15 @@ typedef struct term_name {
   unsigned bit;
 } term_name;
 
-static const term_name k_imu_terms[] = {
-    {"bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON}, {"bias_gm", NAV_IMU_TERM_BIAS_GM},
-    {"bias_rw", NAV_IMU_TERM_BIAS_RW},           {"noise", NAV_IMU_TERM_NOISE},
-    {"scale_factor", NAV_IMU_TERM_SCALE_FACTOR}, {"misalignment", NAV_IMU_TERM_MISALIGNMENT},
-    {"g_sensitivity", NAV_IMU_TERM_G_SENSITIVITY}, {"quantisation", NAV_IMU_TERM_QUANTISATION},
-    {"saturation", NAV_IMU_TERM_SATURATION}};
+static const term_name k_imu_terms[] = {{"bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON},
+                                        {"bias_gm", NAV_IMU_TERM_BIAS_GM},
+                                        {"bias_rw", NAV_IMU_TERM_BIAS_RW},
+                                        {"noise", NAV_IMU_TERM_NOISE},
+                                        {"scale_factor", NAV_IMU_TERM_SCALE_FACTOR},
+                                        {"misalignment", NAV_IMU_TERM_MISALIGNMENT},
+                                        {"g_sensitivity", NAV_IMU_TERM_G_SENSITIVITY},
+                                        {"quantisation", NAV_IMU_TERM_QUANTISATION},
+                                        {"saturation", NAV_IMU_TERM_SATURATION}};
 static const term_name k_gnss_terms[] = {{"position", NAV_GNSS_TERM_POS_GM},
                                          {"position_white", NAV_GNSS_TERM_POS_WHITE},
                                          {"velocity", NAV_GNSS_TERM_VEL_WHITE}};
@@ -2058,8 +2069,9 @@ static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node 
   if (is_null(v)) return;
   const bool seq = v->kind == Y_SEQ;
   if (!seq && v->kind != Y_SCALAR) {
-    nav_io_expected(r, key, v, imu ? "a list of term names ([noise, gyro.bias_gm, ...])"
-                                   : "a list of term names ([position, position_white, velocity])");
+    nav_io_expected(r, key, v,
+                    imu ? "a list of term names ([noise, gyro.bias_gm, ...])"
+                        : "a list of term names ([position, position_white, velocity])");
     return;
   }
   size_t i = 0;
@@ -2100,10 +2112,13 @@ static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node 
         const int m = snprintf(list + l, sizeof list - l, "%s%s", k ? ", " : "", terms[k].name);
         if (m > 0 && (size_t)m < sizeof list - l) l += (size_t)m;
       }
-      const char *best = nav_io_closest(t, len, names, n);
+      const char *best = closest(t, len, names, n);
       if (best != NULL)
         nav_io_reader_error(r, item, v, "unknown term \"%s\"; did you mean \"%s%s\"?", shown,
-                            triad == 0 ? "gyro." : triad == 1 ? "accel." : "", best);
+                            triad == 0   ? "gyro."
+                            : triad == 1 ? "accel."
+                                         : "",
+                            best);
       else
         nav_io_reader_error(r, item, v, "unknown term \"%s\"; terms: %s%s", shown, list,
                             imu ? " (each optionally prefixed gyro. or accel.)" : "");
@@ -2199,7 +2214,8 @@ static void read_outages(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     return;
   }
   if (v->count > NAV_GNSS_MAX_OUTAGES) {
-    nav_io_reader_error(r, v, key, "at most %d outages are supported (got %zu)", NAV_GNSS_MAX_OUTAGES, v->count);
+    nav_io_reader_error(r, v, key, "at most %d outages are supported (got %zu)", NAV_GNSS_MAX_OUTAGES,
+                        v->count);
     return;
   }
   bool ok = true;
@@ -2218,7 +2234,8 @@ static void read_outages(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     } else if (!(x[1] > x[0])) {
       const size_t s1 = path_push_index(r, 1);
       nav_io_reader_error(r, item->child->next, item, "the end t1_s = %s must be after the start t0_s = %s",
-                          nav_io_format_double(t1, sizeof t1, x[1]), nav_io_format_double(t0, sizeof t0, x[0]));
+                          nav_io_format_double(t1, sizeof t1, x[1]),
+                          nav_io_format_double(t0, sizeof t0, x[0]));
       path_pop(r, s1);
       ok = false;
     } else {
@@ -2252,7 +2269,8 @@ static bool same_outages(const nav_io_field *f, const void *a, const void *b) {
   const nav_gnss_model_config *mb = (const nav_gnss_model_config *)((const char *)b + f->offset);
   if (ma->outage_count != mb->outage_count || ma->outage_count > NAV_GNSS_MAX_OUTAGES) return false;
   for (size_t i = 0; i < ma->outage_count; ++i)
-    if (!same_bits(ma->outages[i].t0_s, mb->outages[i].t0_s) || !same_bits(ma->outages[i].t1_s, mb->outages[i].t1_s))
+    if (!same_bits(ma->outages[i].t0_s, mb->outages[i].t0_s) ||
+        !same_bits(ma->outages[i].t1_s, mb->outages[i].t1_s))
       return false;
   return true;
 }
@@ -2327,19 +2345,21 @@ static void finish_triad(nav_io_reader *r, const nav_io_node *map, nav_scene *s,
   const size_t saved = path_push_key(r, at->text, at->len);
   if (kb == NULL || kt == NULL) {
     if (kb != NULL)
-      nav_io_reader_error(r, kb, NULL,
-                          "needs bias_instability_tau_min_s too: the averaging time at which the Allan deviation "
-                          "has its minimum (datasheet, or 100-1000 s for MEMS)");
+      nav_io_reader_error(
+          r, kb, NULL,
+          "needs bias_instability_tau_min_s too: the averaging time at which the Allan deviation "
+          "has its minimum (datasheet, or 100-1000 s for MEMS)");
     else
       nav_io_reader_error(r, kt, NULL, "needs %s (or %s) too: the bias instability itself", b_keys[t][0],
                           b_keys[t][1]);
   } else if (kg != NULL) {
     path_pop(r, saved);
     path_push_key(r, kg->text, kg->len);
-    nav_io_reader_error(r, kg, NULL,
-                        "the Gauss-Markov bias is given twice: use either %s with bias_instability_tau_min_s, or "
-                        "bias_gm_sigma_* with bias_gm_tau_s",
-                        b_keys[t][0]);
+    nav_io_reader_error(
+        r, kg, NULL,
+        "the Gauss-Markov bias is given twice: use either %s with bias_instability_tau_min_s, or "
+        "bias_gm_sigma_* with bias_gm_tau_s",
+        b_keys[t][0]);
   } else {
     /* A value the reader rejected stays 0: the other messages already say what is wrong. */
     const bool bad_b = had_error(r, r->path);
@@ -2351,8 +2371,8 @@ static void finish_triad(nav_io_reader *r, const nav_io_node *map, nav_scene *s,
       const nav_bi_convention conv = (nav_bi_convention)r->state.bias_convention;
       double sd[3], tau[3];
       for (int i = 0; i < 3; ++i) {
-        const nav_gm_params gm = nav_gm_from_bias_instability(nav_vec3_get(r->state.bi[t], i),
-                                                              nav_vec3_get(r->state.bi_tau_min_s[t], i), conv);
+        const nav_gm_params gm = nav_gm_from_bias_instability(
+            nav_vec3_get(r->state.bi[t], i), nav_vec3_get(r->state.bi_tau_min_s[t], i), conv);
         sd[i] = gm.sigma;
         tau[i] = gm.tau_s;
       }
@@ -2392,8 +2412,8 @@ static void on_validate_issue(void *user, const char *path, const char *message)
   emit(r, line, col, path, message != NULL ? message : "invalid value");
 }
 
-static nav_status read_buffer(const char *text, size_t len, const char *name, nav_scene *out,
-                              nav_diag_fn report, void *user) {
+static nav_status read_buffer(const char *text, size_t len, const char *name, bool name_is_path,
+                              nav_scene *out, nav_diag_fn report, void *user) {
   nav_status st = NAV_OK;
   nav_io_reader *r = NULL;
   nav_io_node *root = NULL;
@@ -2413,6 +2433,7 @@ static nav_status read_buffer(const char *text, size_t len, const char *name, na
   r->user = user;
   r->state.scene = scene;
   r->state.file = name;
+  r->state.file_is_path = name_is_path;
   r->state.bias_convention = NAV_BI_ALLAN_PEAK;
   r->state.md_allow_unconverged = true;
   r->state.md_fit_rate_ramps = true;
@@ -2462,8 +2483,8 @@ cleanup:
 nav_status nav_scene_read_string(const char *text, size_t len, const char *display_name, nav_scene *out,
                                  nav_diag_fn report, void *user) {
   if (out == NULL || (text == NULL && len > 0)) return NAV_ERR_INVALID_ARG;
-  return read_buffer(text != NULL ? text : "", len, display_name != NULL ? display_name : "<string>", out,
-                     report, user);
+  return read_buffer(text != NULL ? text : "", len, display_name != NULL ? display_name : "<string>", false,
+                     out, report, user);
 }
 
 static void report_file_problem(const char *path, nav_diag_fn report, void *user, const char *fmt, ...)
@@ -2551,7 +2572,7 @@ nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn rep
     st = NAV_ERR_IO;
     goto cleanup;
   }
-  st = read_buffer(buf, len, path, out, report, user);
+  st = read_buffer(buf, len, path, true, out, report, user);
 
 cleanup:
   free(buf);

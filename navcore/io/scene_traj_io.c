@@ -31,7 +31,7 @@
  * (nav_frame_geodetic_to_local(nav_frame_from_scene(scene))) once the whole file, and so the
  * Earth section wherever it is, has been read; the writer writes the converted ned_m.
  */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath */
 
 #include <errno.h>
 #include <math.h>
@@ -83,7 +83,8 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
 }
 
 /* One double (a base-relative offset) in a unit; the angle and rate spellings. */
-#define D(k, off, sc, fl) {.key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = (off), .scale = (sc)}
+#define D(k, off, sc, fl)                                                                                    \
+  { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = (off), .scale = (sc) }
 #define ANGLE(name, off)                                                                                     \
   D(name "_deg", off, NAV_DEG2RAD, NAV_IO_FINITE), D(name "_rad", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT)
 #define RATE(name, off)                                                                                      \
@@ -104,13 +105,18 @@ static const nav_io_field k_attitude[] = {
 SECTION_OF(k_attitude_section, k_attitude);
 
 #define PV(k, member, sc, fl)                                                                                \
-  {.key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE | (fl), .offset = OFF(trajectory.parametric.member), \
-   .scale = (sc)}
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE | (fl),                                          \
+    .offset = OFF(trajectory.parametric.member), .scale = (sc)                                               \
+  }
 
 static const nav_io_field k_rate[] = {
-    PV("a_rps", wa_rps, 1.0, 0), PV("a_dps", wa_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    PV("b_rps", wb_rps, 1.0, 0), PV("b_dps", wb_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    PV("c_hz", wc_hz, 1.0, 0),   PV("d_rad", wd_rad, 1.0, 0),
+    PV("a_rps", wa_rps, 1.0, 0),
+    PV("a_dps", wa_rps, NAV_DEG2RAD, NAV_IO_ALT),
+    PV("b_rps", wb_rps, 1.0, 0),
+    PV("b_dps", wb_rps, NAV_DEG2RAD, NAV_IO_ALT),
+    PV("c_hz", wc_hz, 1.0, 0),
+    PV("d_rad", wd_rad, 1.0, 0),
     PV("d_deg", wd_rad, NAV_DEG2RAD, NAV_IO_ALT),
 };
 SECTION_OF(k_rate_section, k_rate);
@@ -156,10 +162,12 @@ LIMITS(k_seg_limits_section, trajectory.segments.limits);
 
 /* ================================================================ waypoints */
 
-static bool wp_speed_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+static bool wp_speed_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                             const void *def) {
   return w->scene->trajectory.waypoints.timing == NAV_WP_TIMING_SPEED || !nav_io_field_same(f, base, def);
 }
-static bool wp_time_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+static bool wp_time_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                            const void *def) {
   return w->scene->trajectory.waypoints.timing == NAV_WP_TIMING_TIME || !nav_io_field_same(f, base, def);
 }
 static bool wp_attitude_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
@@ -234,9 +242,10 @@ static void finish_point(nav_io_reader *r, const nav_io_node *map, void *base) {
     size_t len = 0;
     const char *t = nav_io_node_text(geo, &len);
     const size_t saved = nav_io_path_push_key(r, t);
-    nav_io_reader_error(r, geo, NULL,
-                        "the waypoint position is given twice: use either ned_m: [N, E, D] or lat_deg, lon_deg "
-                        "and h_m");
+    nav_io_reader_error(
+        r, geo, NULL,
+        "the waypoint position is given twice: use either ned_m: [N, E, D] or lat_deg, lon_deg "
+        "and h_m");
     nav_io_path_pop(r, saved);
     return;
   }
@@ -249,7 +258,9 @@ static void finish_point(nav_io_reader *r, const nav_io_node *map, void *base) {
   if (geo == NULL) return;
   if (k_lat == NULL || k_lon == NULL || k_h == NULL) {
     nav_io_reader_error(r, map, NULL, "a geodetic waypoint needs lat_deg, lon_deg and h_m (%s missing)",
-                        k_lat == NULL ? "lat_deg is" : k_lon == NULL ? "lon_deg is" : "h_m is");
+                        k_lat == NULL   ? "lat_deg is"
+                        : k_lon == NULL ? "lon_deg is"
+                                        : "h_m is");
     return;
   }
   const nav_waypoint *points = st->scene->trajectory.waypoints.points;
@@ -425,24 +436,26 @@ static const nav_io_enum_value k_seg_kinds[] = {{"hold", NAV_SEG_HOLD},
                                                 {NULL, 0}};
 
 /* Keys shared by the segment kinds (base: nav_segment). */
-#define SEG_KIND {.key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds}
+#define SEG_KIND                                                                                             \
+  { .key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds }
 #define SEG_DURATION                                                                                         \
   {                                                                                                          \
     .key = "duration_s", .kind = NAV_IO_DOUBLE, .flags = NONNEG | NAV_IO_MAX_LE, .offset = GOFF(duration_s), \
     .scale = 1.0, .max = NAV_SCENE_MAX_DURATION_S                                                            \
   }
 #define SEG_COORDINATED                                                                                      \
-  {.key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed}
+  { .key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed }
 #define SEG_GNSS_VISIBLE                                                                                     \
-  {.key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed}
+  { .key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed }
 #define SEG_V3(k, member)                                                                                    \
-  {.key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0}
+  { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0 }
 
 static const nav_io_field k_seg_hold[] = {SEG_KIND, SEG_DURATION, SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_accelerate[] = {
-    SEG_KIND, D("speed_mps", GOFF(speed_mps), 1.0, NAV_IO_FINITE), SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)), RATE("yaw_rate", GOFF(yaw_rate_rps)),
-                                          SEG_COORDINATED, SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_accelerate[] = {SEG_KIND, D("speed_mps", GOFF(speed_mps), 1.0, NAV_IO_FINITE),
+                                                SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
+                                          RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_COORDINATED,
+                                          SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_coord_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
                                                 RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_climb[] = {SEG_KIND, D("height_m", GOFF(height_m), 1.0, NAV_IO_FINITE),
@@ -614,7 +627,8 @@ static const nav_io_enum_value k_tm_kinds[] = {{"stationary", NAV_TEST_MOTION_ST
                                                {"polar_great_circle", NAV_TEST_MOTION_POLAR_GREAT_CIRCLE},
                                                {"vertical_loop", NAV_TEST_MOTION_VERTICAL_LOOP},
                                                {NULL, 0}};
-#define TM_KIND {.key = "kind", .kind = NAV_IO_ENUM, .offset = TM(kind), .enums = k_tm_kinds}
+#define TM_KIND                                                                                              \
+  { .key = "kind", .kind = NAV_IO_ENUM, .offset = TM(kind), .enums = k_tm_kinds }
 
 static const nav_io_field k_tm_stationary[] = {TM_KIND};
 static const nav_io_field k_tm_coning[] = {TM_KIND, ANGLE("cone_half_angle", TM(cone_half_angle_rad)),
@@ -626,13 +640,16 @@ static const nav_io_field k_tm_spin[] = {
     TM_KIND,
     RATE_HZ_ALT("spin_rate", TM(spin_rate_rps)),
     D("spin_rate_rpm", TM(spin_rate_rps), NAV_TWO_PI / 60.0, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT),
-    {.key = "spin_axis_b", .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = TM(spin_axis_b), .scale = 1.0,
+    {.key = "spin_axis_b",
+     .kind = NAV_IO_VEC3,
+     .flags = NAV_IO_FINITE,
+     .offset = TM(spin_axis_b),
+     .scale = 1.0,
      .comment = "body axes; any non-zero length"}};
-static const nav_io_field k_tm_great_circle[] = {TM_KIND,
-                                                 D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE),
-                                                 D("gc_speed_mps", TM(gc_speed_mps), 1.0, NAV_IO_FINITE),
-                                                 ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
-                                                 ANGLE("gc_lon", TM(gc_lon_rad))};
+static const nav_io_field k_tm_great_circle[] = {
+    TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE),
+    D("gc_speed_mps", TM(gc_speed_mps), 1.0, NAV_IO_FINITE), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
+    ANGLE("gc_lon", TM(gc_lon_rad))};
 static const nav_io_field k_tm_loop[] = {TM_KIND, D("loop_speed_mps", TM(loop_speed_mps), 1.0, NAV_IO_FINITE),
                                          RATE("loop_pitch_rate", TM(loop_pitch_rate_rps))};
 SECTION_OF(k_tm_stationary_section, k_tm_stationary);
@@ -670,11 +687,13 @@ static bool same_test_motion(const nav_io_field *f, const void *a, const void *b
   const nav_traj_test_motion *B = &((const nav_scene *)b)->trajectory.test_motion;
   return A->kind == B->kind && same_bits(A->cone_half_angle_rad, B->cone_half_angle_rad) &&
          same_bits(A->cone_rate_rps, B->cone_rate_rps) && same_bits(A->scull_angle_rad, B->scull_angle_rad) &&
-         same_bits(A->scull_accel_mps2, B->scull_accel_mps2) && same_bits(A->scull_rate_rps, B->scull_rate_rps) &&
-         same_bits(A->spin_rate_rps, B->spin_rate_rps) && same_vec3(A->spin_axis_b, B->spin_axis_b) &&
-         same_bits(A->gc_height_m, B->gc_height_m) && same_bits(A->gc_speed_mps, B->gc_speed_mps) &&
+         same_bits(A->scull_accel_mps2, B->scull_accel_mps2) &&
+         same_bits(A->scull_rate_rps, B->scull_rate_rps) && same_bits(A->spin_rate_rps, B->spin_rate_rps) &&
+         same_vec3(A->spin_axis_b, B->spin_axis_b) && same_bits(A->gc_height_m, B->gc_height_m) &&
+         same_bits(A->gc_speed_mps, B->gc_speed_mps) &&
          same_bits(A->gc_start_angle_rad, B->gc_start_angle_rad) && same_bits(A->gc_lon_rad, B->gc_lon_rad) &&
-         same_bits(A->loop_speed_mps, B->loop_speed_mps) && same_bits(A->loop_pitch_rate_rps, B->loop_pitch_rate_rps);
+         same_bits(A->loop_speed_mps, B->loop_speed_mps) &&
+         same_bits(A->loop_pitch_rate_rps, B->loop_pitch_rate_rps);
 }
 
 /* ================================================================ motion_def, duration, type */
@@ -685,14 +704,17 @@ static const nav_io_field k_motion_def[] = {
      .flags = NAV_IO_STATE | NAV_IO_REQUIRED,
      .offset = SOFF(md_file),
      .size = NAV_IO_PATH_MAX},
-    {.key = "allow_unconverged", .kind = NAV_IO_BOOL, .flags = NAV_IO_STATE, .offset = SOFF(md_allow_unconverged)},
+    {.key = "allow_unconverged",
+     .kind = NAV_IO_BOOL,
+     .flags = NAV_IO_STATE,
+     .offset = SOFF(md_allow_unconverged)},
     {.key = "fit_rate_ramps", .kind = NAV_IO_BOOL, .flags = NAV_IO_STATE, .offset = SOFF(md_fit_rate_ramps)},
 };
 SECTION_OF(k_motion_def_section, k_motion_def);
 
 /* duration_s: a number of seconds, or auto (the length of a waypoint or segment script). */
-static void read_duration(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
-                          void *base) {
+static void read_duration(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                          const nav_io_node *v, void *base) {
   nav_io_read_state *st = nav_io_reader_state(r);
   if (nav_io_node_text_is(v, "auto")) {
     st->duration_auto = true;
@@ -712,7 +734,8 @@ static nav_status write_duration(nav_io_writer *w, const nav_io_field *f, const 
 }
 
 static bool same_duration(const nav_io_field *f, const void *a, const void *b) {
-  return same_bits(*(const double *)((const char *)a + f->offset), *(const double *)((const char *)b + f->offset));
+  return same_bits(*(const double *)((const char *)a + f->offset),
+                   *(const double *)((const char *)b + f->offset));
 }
 
 /* Sections of trajectory types: the selected one always, the others when they hold non-defaults. */
@@ -727,12 +750,10 @@ static bool type_written(const nav_io_writer *w, const nav_io_field *f, const vo
   return w->scene->trajectory.type == t || !nav_io_field_same(f, base, def);
 }
 
-static const nav_io_enum_value k_traj_types[] = {{"parametric", NAV_TRAJ_PARAMETRIC},
-                                                 {"waypoints", NAV_TRAJ_WAYPOINTS},
-                                                 {"segments", NAV_TRAJ_SEGMENTS},
-                                                 {"test_motion", NAV_TRAJ_TEST_MOTION},
-                                                 {"motion_def", NAV_IO_TRAJ_MOTION_DEF},
-                                                 {NULL, 0}};
+static const nav_io_enum_value k_traj_types[] = {
+    {"parametric", NAV_TRAJ_PARAMETRIC},    {"waypoints", NAV_TRAJ_WAYPOINTS},
+    {"segments", NAV_TRAJ_SEGMENTS},        {"test_motion", NAV_TRAJ_TEST_MOTION},
+    {"motion_def", NAV_IO_TRAJ_MOTION_DEF}, {NULL, 0}};
 
 static const nav_io_field k_trajectory[] = {
     {.key = "type", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
@@ -762,14 +783,23 @@ const nav_io_section nav_io_trajectory_section = {k_trajectory, COUNT(k_trajecto
 
 /* ================================================================ after the whole file */
 
-/* The motion-definition file relative to the scene file's directory (or as given if absolute, or
-   if the scene has no directory part). */
-static void resolve_path(char *out, size_t size, const char *scene_file, const char *file) {
+/* The motion-definition file relative to the scene file's directory (made absolute when that
+   directory exists, so messages name the file unambiguously), or as given if absolute or if the
+   scene was read from memory under a name without a directory part (then relative to the working
+   directory). */
+static bool resolve_path(char *out, size_t size, const char *scene_file, bool is_path, const char *file) {
   const char *slash = scene_file != NULL ? strrchr(scene_file, '/') : NULL;
-  if (file[0] == '/' || slash == NULL)
-    snprintf(out, size, "%s", file);
-  else
-    snprintf(out, size, "%.*s/%s", (int)(slash - scene_file), scene_file, file);
+  if (file[0] == '/' || (slash == NULL && !is_path)) return snprintf(out, size, "%s", file) < (int)size;
+  char dir[NAV_IO_PATH_MAX];
+  const int n = slash == NULL ? snprintf(dir, sizeof dir, ".")
+                              : snprintf(dir, sizeof dir, "%.*s",
+                                         slash == scene_file ? 1 : (int)(slash - scene_file), scene_file);
+  if (n < 0 || n >= (int)sizeof dir) return false;
+  char *abs = realpath(dir, NULL);
+  const char *d = abs != NULL ? abs : dir;
+  const int m = snprintf(out, size, "%s%s%s", d, strcmp(d, "/") == 0 ? "" : "/", file);
+  free(abs);
+  return m >= 0 && m < (int)size;
 }
 
 static void forward_diag(void *user, const nav_diag *d) {
@@ -791,9 +821,10 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
   bool ok = true;
   /* The file sets what these would set: giving both is ambiguous. */
   if (nav_io_map_get(earth, "origin", NULL) != NULL) {
-    nav_io_reader_error_at_path(r, "earth.origin",
-                                "the motion-definition file (trajectory.motion_def.file) sets the origin; remove "
-                                "earth.origin");
+    nav_io_reader_error_at_path(
+        r, "earth.origin",
+        "the motion-definition file (trajectory.motion_def.file) sets the origin; remove "
+        "earth.origin");
     ok = false;
   }
   if (nav_io_map_get(traj, "initial_attitude", NULL) != NULL) {
@@ -803,13 +834,18 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
     ok = false;
   }
   if (nav_io_map_get(traj, "segments", NULL) != NULL) {
-    nav_io_reader_error_at_path(r, "trajectory.segments",
-                                "the motion-definition file (trajectory.motion_def.file) is the segment script; "
-                                "remove trajectory.segments or use trajectory.type: segments");
+    nav_io_reader_error_at_path(
+        r, "trajectory.segments",
+        "the motion-definition file (trajectory.motion_def.file) is the segment script; "
+        "remove trajectory.segments or use trajectory.type: segments");
     ok = false;
   }
-  char path[NAV_IO_PATH_MAX + 512];
-  resolve_path(path, sizeof path, st->file, st->md_file);
+  char path[3 * NAV_IO_PATH_MAX];
+  if (!resolve_path(path, sizeof path, st->file, st->file_is_path, st->md_file)) {
+    nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
+                                "the path of the motion-definition file is too long");
+    return false;
+  }
   struct stat sb;
   const bool exists = stat(path, &sb) == 0;
   const int err = errno;
@@ -819,8 +855,8 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
       snprintf(why, sizeof why, "not a regular file");
     else if (strerror_r(err, why, sizeof why) != 0)
       snprintf(why, sizeof why, "error %d", err);
-    nav_io_reader_error_at_path(r, "trajectory.motion_def.file", "cannot read the motion-definition file \"%s\": %s",
-                                path, why);
+    nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
+                                "cannot read the motion-definition file \"%s\": %s", path, why);
     return false;
   }
   if (!ok) return false;
@@ -829,8 +865,8 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
   const nav_status s = nav_motiondef_read_file(path, scene, forward_diag, r);
   if (s != NAV_OK) {
     nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
-                                "the motion-definition file \"%s\" was not imported (%s; see its messages)", path,
-                                nav_status_str(s));
+                                "the motion-definition file \"%s\" was not imported (%s; see its messages)",
+                                path, nav_status_str(s));
     return false;
   }
   if (explicit_duration) scene->trajectory.duration_s = duration_s;
@@ -857,7 +893,8 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
   /* 2. A motion-definition import. On failure the type falls back to parametric, so that
         validation does not add messages about an empty segment script (the scene is rejected). */
   bool imported_as_is = false;
-  if ((int)T->type == NAV_IO_TRAJ_MOTION_DEF) {
+  const bool imported = (int)T->type == NAV_IO_TRAJ_MOTION_DEF;
+  if (imported) {
     const int before = nav_io_reader_count(r);
     if (import_motion_def(r, root, scene) && nav_io_reader_count(r) == before) {
       imported_as_is = T->segments.allow_unconverged && T->segments.fit_rate_ramps;
@@ -866,7 +903,8 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
       return;
     }
   } else if (nav_io_map_get(traj, "motion_def", NULL) != NULL) {
-    nav_io_reader_error_at_path(r, "trajectory.motion_def", "is read only with trajectory.type: motion_def (type is %s)",
+    nav_io_reader_error_at_path(r, "trajectory.motion_def",
+                                "is read only with trajectory.type: motion_def (type is %s)",
                                 nav_traj_type_name(T->type));
   }
 
@@ -875,10 +913,11 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
   const bool script = T->type == NAV_TRAJ_WAYPOINTS || T->type == NAV_TRAJ_SEGMENTS;
   if (!script) {
     if (st->duration_auto_given)
-      nav_io_reader_error_at_path(r, "trajectory.duration_s",
-                                  "auto is the length of a waypoint or segment script; trajectory.type %s needs a "
-                                  "number of seconds",
-                                  nav_traj_type_name(T->type));
+      nav_io_reader_error_at_path(
+          r, "trajectory.duration_s",
+          "auto is the length of a waypoint or segment script; trajectory.type %s needs a "
+          "number of seconds",
+          nav_traj_type_name(T->type));
     return;
   }
   if (imported_as_is || nav_io_reader_count(r) > 0) return;
@@ -888,6 +927,13 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
   const bool wp = T->type == NAV_TRAJ_WAYPOINTS;
   const nav_status ps = wp ? nav_traj_waypoints_plan_info(scene, &info, &bad, msg, sizeof msg)
                            : nav_traj_segments_plan_info(scene, &info, &bad, msg, sizeof msg);
+  if (ps != NAV_OK && imported) {
+    /* The segments are not in the scene file: the message names the file and the segment. */
+    nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
+                                "with the allow_unconverged / fit_rate_ramps given: %s",
+                                ps == NAV_ERR_NO_MEMORY ? "out of memory" : msg);
+    return;
+  }
   if (ps != NAV_OK) {
     char path[96];
     if (bad >= 0)

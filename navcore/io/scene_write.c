@@ -213,7 +213,8 @@ static bool is_numeric(nav_io_kind k) {
 
 /* The spelling of field @p i of @p sec to write and its text: the shortest exact one among the
    preferred spelling, the SI one and the NAV_IO_WRITE_ALT ones (ties: the earlier in the table). */
-static const nav_io_field *choose_spelling(const nav_io_section *sec, size_t i, const void *base, text_buf *out) {
+static const nav_io_field *choose_spelling(const nav_io_section *sec, size_t i, const void *base,
+                                           text_buf *out) {
   const nav_io_field *f = &sec->fields[i];
   format_numeric(out, f, base);
   if (f->scale == 1.0 && out->exact) return f;
@@ -274,15 +275,30 @@ bool nav_io_section_same(const nav_io_section *sec, const void *a, const void *b
   return true;
 }
 
-bool nav_io_field_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+/*
+ * Whether field @p i of @p sec is written. A field of an error-model term (bit != 0) is written
+ * when its value differs from the default; a term that is on with every value at its default
+ * is written through its first field, so that reading switches it on again.
+ */
+static bool written(const nav_io_writer *w, const nav_io_section *sec, size_t i, const void *base,
+                    const void *def) {
+  const nav_io_field *f = &sec->fields[i];
   if (f->flags & (NAV_IO_ALT | NAV_IO_STATE)) return false;
   if (f->kind == NAV_IO_CUSTOM && f->write == NULL) return false;
   if (f->write_if != NULL) return f->write_if(w, f, base, def);
-  if (f->bit != 0) {
-    const unsigned terms = *(const unsigned *)((const char *)base + f->bits_offset);
-    return (terms & f->bit) != 0 || !nav_io_field_same(f, base, def);
+  if (f->bit == 0) return true;
+  if (!nav_io_field_same(f, base, def)) return true;
+  const unsigned terms = *(const unsigned *)((const char *)base + f->bits_offset);
+  if (!(terms & f->bit)) return false;
+  size_t first = sec->count;
+  for (size_t j = 0; j < sec->count; ++j) {
+    const nav_io_field *g = &sec->fields[j];
+    if (g->bit != f->bit || g->bits_offset != f->bits_offset || (g->flags & (NAV_IO_ALT | NAV_IO_STATE)))
+      continue;
+    if (!nav_io_field_same(g, base, def)) return false; /* the term is written through that one */
+    if (first == sec->count) first = j;
   }
-  return true;
+  return first == i;
 }
 
 /* Whether writing @p sec would write anything. */
@@ -290,7 +306,7 @@ static bool section_has_output(const nav_io_writer *w, const nav_io_section *sec
                                const void *def) {
   for (size_t i = 0; i < sec->count; ++i) {
     const nav_io_field *f = &sec->fields[i];
-    if (!nav_io_field_written(w, f, base, def)) continue;
+    if (!written(w, sec, i, base, def)) continue;
     if (f->kind != NAV_IO_SECTION || (f->flags & NAV_IO_FLOW) || section_has_output(w, f->section, base, def))
       return true;
   }
@@ -357,7 +373,7 @@ nav_status nav_io_write_flow(nav_io_writer *w, const nav_io_section *sec, const 
   bool first = true;
   for (size_t i = 0; i < sec->count && st == NAV_OK; ++i) {
     const nav_io_field *f = &sec->fields[i];
-    if (!nav_io_field_written(w, f, base, def)) continue;
+    if (!written(w, sec, i, base, def)) continue;
     st = nav_io_writef(w, "%s", first ? "" : ", ");
     first = false;
     if (st != NAV_OK) break;
@@ -378,8 +394,9 @@ static nav_status write_lines(nav_io_writer *w, const nav_io_section *sec, const
   nav_status st = NAV_OK;
   for (size_t i = 0; i < sec->count && st == NAV_OK; ++i) {
     const nav_io_field *f = &sec->fields[i];
-    if (!nav_io_field_written(w, f, base, def)) continue;
-    if (f->kind == NAV_IO_SECTION && !(f->flags & NAV_IO_FLOW) && !section_has_output(w, f->section, base, def))
+    if (!written(w, sec, i, base, def)) continue;
+    if (f->kind == NAV_IO_SECTION && !(f->flags & NAV_IO_FLOW) &&
+        !section_has_output(w, f->section, base, def))
       continue; /* e.g. imu.gyro of a perfect IMU */
     if (f->kind == NAV_IO_SECTION && indent == 0 && !lead) st = nav_io_writef(w, "\n");
     if (st == NAV_OK) st = nav_io_writef(w, "%s%*s", lead ? "\n" : "", indent, "");

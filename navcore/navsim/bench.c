@@ -16,7 +16,10 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "catalog_cmd.h"
 #include "navcore/nav_errors.h"
+#include "navcore/nav_io.h"
+#include "navcore/nav_sim.h"
 #include "navcore/nav_ins.h"
 #include "navcore/nav_truth.h"
 
@@ -46,6 +49,7 @@ typedef struct bench_row {
   long long samples;
   double truth_sps, mech_sps, wall_s;
   double pos_err_m, vel_err_mps, att_err_rad;
+  double rms_h_m; /* whole-pipeline cases: RMS horizontal error over epochs (and runs) */
   bool ok;
   char error[256];
 } bench_row;
@@ -132,6 +136,54 @@ cleanup:
   nav_ins_destroy(ins);
   free(imu);
   nav_truth_destroy(truth);
+}
+
+/*
+ * Whole-pipeline case through nav_sim (truth, sensor models, navigation, errors, statistics):
+ * wall time of the run, samples per second over all runs, final and RMS horizontal error.
+ */
+static void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row) {
+  nav_sim *sim = NULL;
+  row->ok = false;
+  row->algorithm = nav_mech_algorithm_name(sc->navigation.algorithm);
+  row->earth_model = nav_earth_model_name(sc->earth.model);
+  row->frame = sc->earth.model == NAV_EARTH_FLAT ? "flat" : nav_mech_frame_name(sc->navigation.frame);
+  row->rate_hz = sc->imu.rate_hz;
+  row->truth_sps = NAN;
+  nav_status st = nav_sim_create(sc, &sim);
+  if (st != NAV_OK) {
+    snprintf(row->error, sizeof row->error, "scene: %s", nav_status_str(st));
+    return;
+  }
+  nav_sim_options o = nav_sim_options_default();
+  o.ideal = ideal;
+  o.threads = threads;
+  nav_sim_summary sum;
+  const double t0 = now_s();
+  st = nav_sim_run(sim, &o, &sum);
+  const double wall = now_s() - t0;
+  if (st != NAV_OK) {
+    snprintf(row->error, sizeof row->error, "%s", nav_sim_last_error(sim));
+    nav_sim_destroy(sim);
+    return;
+  }
+  row->samples = (long long)(sum.imu_samples * sum.runs);
+  row->wall_s = wall;
+  row->mech_sps = (double)row->samples / wall;
+  row->pos_err_m = hypot(sum.final.pos_err_h_m, sum.final.pos_err_v_m);
+  row->vel_err_mps = sum.final.vel_err_mps;
+  row->att_err_rad = sum.final.att_err_rad;
+  row->rms_h_m = sum.stats.pos_err_h_m.rms;
+  row->ok = true;
+  nav_sim_destroy(sim);
+}
+
+/* A scene of the library, found next to the resources directory. */
+static bool load_library_scene(const char *name, nav_scene *sc) {
+  char res[4096], path[4200];
+  if (!navsim_find_resources_dir(res, sizeof res)) return false;
+  snprintf(path, sizeof path, "%s/../scenes/%s", res, name);
+  return nav_scene_read_file(path, sc, NULL, NULL) == NAV_OK;
 }
 
 /* The cases of a suite. Each is (case name, variant, scene). */
@@ -256,6 +308,39 @@ int navsim_bench(int argc, char **argv) {
     bench_scene(&cases[i].scene, reps, &rows[i]);
     if (!quiet) fprintf(stderr, "\r  bench: %d/%d", i + 1, n);
   }
+  /* Whole-pipeline cases on library scenes. */
+  int n_all = n;
+  {
+    nav_scene *sc = malloc(sizeof *sc);
+    if (sc && load_library_scene("long-drive.yaml", sc)) {
+      /* Closure of the 965 s-class drive with ideal sensors (target <= 1 mm horizontal). */
+      snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-closure");
+      snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "ideal/%s", nav_mech_algorithm_name(sc->navigation.algorithm));
+      bench_sim(sc, true, 1, &rows[n_all++]);
+    }
+    if (sc && load_library_scene("pedestrian-walk.yaml", sc)) {
+      /* What modelling the Earth costs and buys on a short, slow walk: the same scene with the flat
+       * model and with WGS-84 (truth and mechanization always use the same model). */
+      const nav_earth_model models[2] = {NAV_EARTH_FLAT, NAV_EARTH_WGS84};
+      for (int m = 0; m < 2; ++m) {
+        sc->earth.model = models[m];
+        snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "pedestrian-earth-model");
+        snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%s", nav_earth_model_name(models[m]));
+        bench_sim(sc, false, 1, &rows[n_all++]);
+      }
+    }
+    if (sc && load_library_scene("urban-drive-outages.yaml", sc)) {
+      /* Monte Carlo throughput against thread count (results are bit-identical). */
+      sc->simulation.runs = full ? 16 : 4;
+      const int threads[3] = {1, 2, 4};
+      for (int t = 0; t < 3; ++t) {
+        snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "monte-carlo-threads");
+        snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%ld runs/%d threads", sc->simulation.runs, threads[t]);
+        bench_sim(sc, false, threads[t], &rows[n_all++]);
+      }
+    }
+    free(sc);
+  }
   if (!quiet) fputc('\n', stderr);
 
   int rc = 0;
@@ -281,7 +366,7 @@ int navsim_bench(int argc, char **argv) {
   fputs("| case | algorithm | earth | frame | rate [Hz] | samples | truth [samples/s] | mechanization [samples/s] | "
         "pos err [m] | vel err [m/s] | att err [rad] |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         md);
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n_all; ++i) {
     const bench_row *r = &rows[i];
     if (r->ok) {
       fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,%.6g,%.6g,%.6g,%.6g,%.6e,%.6e,%.6e,ok\n", r->case_name, r->variant,
@@ -298,17 +383,18 @@ int navsim_bench(int argc, char **argv) {
     }
   }
   if (!quiet) {
-    printf("%-20s %-11s %-5s %-4s %7s %9s %12s %12s %11s %11s\n", "case", "algorithm", "earth", "frm", "rate_hz",
-           "samples", "truth_sps", "mech_sps", "pos_err_m", "att_err_rad");
-    for (int i = 0; i < n; ++i) {
+    printf("%-24s %-30s %9s %11s %11s %11s %11s\n", "case", "variant", "samples", "truth_sps", "nav_sps", "pos_err_m",
+           "att_err_rad");
+    for (int i = 0; i < n_all; ++i) {
       const bench_row *r = &rows[i];
       if (r->ok)
-        printf("%-20s %-11s %-5s %-4s %7g %9lld %12.3g %12.3g %11.3e %11.3e\n", r->case_name, r->algorithm,
-               r->earth_model, r->frame, r->rate_hz, r->samples, r->truth_sps, r->mech_sps, r->pos_err_m, r->att_err_rad);
+        printf("%-24s %-30s %9lld %11.3g %11.3g %11.3e %11.3e\n", r->case_name, r->variant, r->samples, r->truth_sps,
+               r->mech_sps, r->pos_err_m, r->att_err_rad);
       else
-        printf("%-20s %-11s %-5s %-4s %7g  failed: %s\n", r->case_name, r->algorithm, r->earth_model, r->frame,
-               r->rate_hz, r->error);
+        printf("%-24s %-30s  failed: %s\n", r->case_name, r->variant, r->error);
     }
+    printf("(nav_sps: mechanization alone for the closure cases; the whole pipeline - truth, sensors, navigation,\n"
+           " errors - for the scene cases, where truth_sps is not separate; pos_err_m: final error)\n");
     printf("results    %s/bench.csv, %s/bench.md\n", out_dir, out_dir);
   }
 done:

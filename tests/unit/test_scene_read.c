@@ -21,7 +21,11 @@
 #include <unistd.h>
 
 #include "nav_test.h"
+#include "navcore/nav_catalog.h"
+#include "navcore/nav_frames.h"
 #include "navcore/nav_io.h"
+#include "navcore/nav_motiondef.h"
+#include "navcore/nav_sensors.h"
 
 #define SCENES_DIR NAV_TEST_DATA_DIR "/scenes/"
 
@@ -111,7 +115,83 @@ static int same_double(double a, double b) {
     assert_same_double((a).z, (b).z);                                                                        \
   } while (0)
 
-/* Every field of two scenes is identical, doubles bit for bit. */
+#define assert_same_mat3(a, b)                                                                               \
+  do {                                                                                                       \
+    for (int i_ = 0; i_ < 3; ++i_)                                                                           \
+      for (int j_ = 0; j_ < 3; ++j_)                                                                         \
+        assert_same_double((a).m[i_][j_], (b).m[i_][j_]);                                                    \
+  } while (0)
+#define assert_same_euler(a, b)                                                                              \
+  do {                                                                                                       \
+    assert_same_double((a).roll_rad, (b).roll_rad);                                                          \
+    assert_same_double((a).pitch_rad, (b).pitch_rad);                                                        \
+    assert_same_double((a).yaw_rad, (b).yaw_rad);                                                            \
+  } while (0)
+
+static void assert_limits_same(const nav_traj_limits *a, const nav_traj_limits *b) {
+  assert_same_double(a->max_accel_mps2, b->max_accel_mps2);
+  assert_same_double(a->max_jerk_mps3, b->max_jerk_mps3);
+  assert_same_double(a->max_lateral_accel_mps2, b->max_lateral_accel_mps2);
+  assert_same_double(a->max_rate_rps, b->max_rate_rps);
+  assert_same_double(a->max_ang_accel_rps2, b->max_ang_accel_rps2);
+  assert_same_double(a->max_ang_jerk_rps3, b->max_ang_jerk_rps3);
+}
+
+static void assert_gyro_same(const nav_gyro_error_config *a, const nav_gyro_error_config *b) {
+  assert_int_equal(a->terms, b->terms);
+  assert_same_vec3(a->bias_turn_on_fixed_rps, b->bias_turn_on_fixed_rps);
+  assert_same_vec3(a->bias_turn_on_sd_rps, b->bias_turn_on_sd_rps);
+  assert_same_vec3(a->bias_gm_sd_rps, b->bias_gm_sd_rps);
+  assert_same_vec3(a->bias_gm_tau_s, b->bias_gm_tau_s);
+  assert_same_vec3(a->bias_rw_rps_per_sqrt_s, b->bias_rw_rps_per_sqrt_s);
+  assert_same_vec3(a->arw_rad_per_sqrt_s, b->arw_rad_per_sqrt_s);
+  assert_same_vec3(a->scale_factor_fixed, b->scale_factor_fixed);
+  assert_same_vec3(a->scale_factor_sd, b->scale_factor_sd);
+  assert_same_mat3(a->misalignment_fixed_rad, b->misalignment_fixed_rad);
+  assert_same_mat3(a->misalignment_sd_rad, b->misalignment_sd_rad);
+  assert_same_mat3(a->g_sensitivity_fixed_rps_per_mps2, b->g_sensitivity_fixed_rps_per_mps2);
+  assert_same_mat3(a->g_sensitivity_sd_rps_per_mps2, b->g_sensitivity_sd_rps_per_mps2);
+  assert_same_vec3(a->quant_step_rad, b->quant_step_rad);
+  assert_same_vec3(a->range_rps, b->range_rps);
+}
+
+static void assert_accel_same(const nav_accel_error_config *a, const nav_accel_error_config *b) {
+  assert_int_equal(a->terms, b->terms);
+  assert_same_vec3(a->bias_turn_on_fixed_mps2, b->bias_turn_on_fixed_mps2);
+  assert_same_vec3(a->bias_turn_on_sd_mps2, b->bias_turn_on_sd_mps2);
+  assert_same_vec3(a->bias_gm_sd_mps2, b->bias_gm_sd_mps2);
+  assert_same_vec3(a->bias_gm_tau_s, b->bias_gm_tau_s);
+  assert_same_vec3(a->bias_rw_mps2_per_sqrt_s, b->bias_rw_mps2_per_sqrt_s);
+  assert_same_vec3(a->vrw_mps_per_sqrt_s, b->vrw_mps_per_sqrt_s);
+  assert_same_vec3(a->scale_factor_fixed, b->scale_factor_fixed);
+  assert_same_vec3(a->scale_factor_sd, b->scale_factor_sd);
+  assert_same_mat3(a->misalignment_fixed_rad, b->misalignment_fixed_rad);
+  assert_same_mat3(a->misalignment_sd_rad, b->misalignment_sd_rad);
+  assert_same_vec3(a->quant_step_mps, b->quant_step_mps);
+  assert_same_vec3(a->range_mps2, b->range_mps2);
+}
+
+static void assert_gnss_same(const nav_gnss_model_config *a, const nav_gnss_model_config *b) {
+  assert_int_equal(a->terms, b->terms);
+  assert_same_double(a->update_rate_hz, b->update_rate_hz);
+  assert_same_double(a->latency_s, b->latency_s);
+  assert_same_vec3(a->pos_gm_sd_m, b->pos_gm_sd_m);
+  assert_same_vec3(a->pos_gm_tau_s, b->pos_gm_tau_s);
+  assert_same_vec3(a->pos_white_sd_m, b->pos_white_sd_m);
+  assert_same_vec3(a->vel_sd_mps, b->vel_sd_mps);
+  assert_same_vec3(a->r_ba_b_m, b->r_ba_b_m);
+  assert_int_equal(a->report_model_sigmas, b->report_model_sigmas);
+  assert_same_vec3(a->reported_pos_sd_m, b->reported_pos_sd_m);
+  assert_same_vec3(a->reported_vel_sd_mps, b->reported_vel_sd_mps);
+  assert_int_equal(a->outage_count, b->outage_count);
+  for (size_t i = 0; i < a->outage_count && i < NAV_GNSS_MAX_OUTAGES; ++i) {
+    assert_same_double(a->outages[i].t0_s, b->outages[i].t0_s);
+    assert_same_double(a->outages[i].t1_s, b->outages[i].t1_s);
+  }
+}
+
+/* Every field of two scenes is identical, doubles bit for bit (list slots beyond the counts are
+   unused and not compared). */
 static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_int_equal(a->format_version, b->format_version);
   assert_string_equal(a->name, b->name);
@@ -120,12 +200,13 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_same_double(a->earth.origin_lon_rad, b->earth.origin_lon_rad);
   assert_same_double(a->earth.origin_h_m, b->earth.origin_h_m);
   assert_same_double(a->earth.flat_gravity_mps2, b->earth.flat_gravity_mps2);
-  assert_int_equal(a->trajectory.type, b->trajectory.type);
-  assert_same_double(a->trajectory.duration_s, b->trajectory.duration_s);
-  assert_same_double(a->trajectory.initial_attitude.roll_rad, b->trajectory.initial_attitude.roll_rad);
-  assert_same_double(a->trajectory.initial_attitude.pitch_rad, b->trajectory.initial_attitude.pitch_rad);
-  assert_same_double(a->trajectory.initial_attitude.yaw_rad, b->trajectory.initial_attitude.yaw_rad);
-  const nav_traj_parametric *p = &a->trajectory.parametric, *q = &b->trajectory.parametric;
+  assert_int_equal(a->earth.gravity_model, b->earth.gravity_model);
+
+  const nav_scene_trajectory *ta = &a->trajectory, *tb = &b->trajectory;
+  assert_int_equal(ta->type, tb->type);
+  assert_same_double(ta->duration_s, tb->duration_s);
+  assert_same_euler(ta->initial_attitude, tb->initial_attitude);
+  const nav_traj_parametric *p = &ta->parametric, *q = &tb->parametric;
   assert_same_vec3(p->r0_m, q->r0_m);
   assert_same_vec3(p->v0_mps, q->v0_mps);
   assert_same_vec3(p->a_mps2, q->a_mps2);
@@ -138,12 +219,86 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_same_vec3(p->wd_rad, q->wd_rad);
   assert_int_equal(p->attitude_mode, q->attitude_mode);
   assert_int_equal(p->magnus_substeps, q->magnus_substeps);
+
+  const nav_traj_test_motion *ma = &ta->test_motion, *mb = &tb->test_motion;
+  assert_int_equal(ma->kind, mb->kind);
+  assert_same_double(ma->cone_half_angle_rad, mb->cone_half_angle_rad);
+  assert_same_double(ma->cone_rate_rps, mb->cone_rate_rps);
+  assert_same_double(ma->scull_angle_rad, mb->scull_angle_rad);
+  assert_same_double(ma->scull_accel_mps2, mb->scull_accel_mps2);
+  assert_same_double(ma->scull_rate_rps, mb->scull_rate_rps);
+  assert_same_double(ma->spin_rate_rps, mb->spin_rate_rps);
+  assert_same_vec3(ma->spin_axis_b, mb->spin_axis_b);
+  assert_same_double(ma->gc_height_m, mb->gc_height_m);
+  assert_same_double(ma->gc_speed_mps, mb->gc_speed_mps);
+  assert_same_double(ma->gc_start_angle_rad, mb->gc_start_angle_rad);
+  assert_same_double(ma->gc_lon_rad, mb->gc_lon_rad);
+  assert_same_double(ma->loop_speed_mps, mb->loop_speed_mps);
+  assert_same_double(ma->loop_pitch_rate_rps, mb->loop_pitch_rate_rps);
+
+  const nav_traj_waypoints *wa = &ta->waypoints, *wb = &tb->waypoints;
+  assert_int_equal(wa->count, wb->count);
+  assert_int_equal(wa->timing, wb->timing);
+  assert_int_equal(wa->attitude_mode, wb->attitude_mode);
+  assert_same_double(wa->hold_start_s, wb->hold_start_s);
+  assert_same_double(wa->hold_end_s, wb->hold_end_s);
+  assert_limits_same(&wa->limits, &wb->limits);
+  for (int i = 0; i < wa->count && i < NAV_MAX_WAYPOINTS; ++i) {
+    assert_same_vec3(wa->points[i].r_ned_m, wb->points[i].r_ned_m);
+    assert_same_double(wa->points[i].speed_mps, wb->points[i].speed_mps);
+    assert_same_double(wa->points[i].time_s, wb->points[i].time_s);
+    assert_same_euler(wa->points[i].attitude, wb->points[i].attitude);
+  }
+
+  const nav_traj_segments *sa = &ta->segments, *sb = &tb->segments;
+  assert_int_equal(sa->count, sb->count);
+  assert_int_equal(sa->allow_unconverged, sb->allow_unconverged);
+  assert_int_equal(sa->fit_rate_ramps, sb->fit_rate_ramps);
+  assert_same_vec3(sa->r0_ned_m, sb->r0_ned_m);
+  assert_same_vec3(sa->v0_b_mps, sb->v0_b_mps);
+  assert_limits_same(&sa->limits, &sb->limits);
+  for (int i = 0; i < sa->count && i < NAV_MAX_SEGMENTS; ++i) {
+    const nav_segment *g = &sa->items[i], *h = &sb->items[i];
+    assert_int_equal(g->kind, h->kind);
+    assert_int_equal(g->coordinated, h->coordinated);
+    assert_int_equal(g->gnss_visible, h->gnss_visible);
+    assert_int_equal(g->legs, h->legs);
+    assert_same_double(g->duration_s, h->duration_s);
+    assert_same_double(g->yaw_rad, h->yaw_rad);
+    assert_same_double(g->pitch_rad, h->pitch_rad);
+    assert_same_double(g->roll_rad, h->roll_rad);
+    assert_same_double(g->yaw_rate_rps, h->yaw_rate_rps);
+    assert_same_double(g->pitch_rate_rps, h->pitch_rate_rps);
+    assert_same_double(g->roll_rate_rps, h->roll_rate_rps);
+    assert_same_vec3(g->v_b_mps, h->v_b_mps);
+    assert_same_vec3(g->accel_b_mps2, h->accel_b_mps2);
+    assert_same_double(g->speed_mps, h->speed_mps);
+    assert_same_double(g->height_m, h->height_m);
+    assert_same_double(g->radius_m, h->radius_m);
+    assert_same_double(g->turns, h->turns);
+    assert_same_double(g->length_m, h->length_m);
+    assert_same_double(g->spacing_m, h->spacing_m);
+  }
+
   assert_same_double(a->imu.rate_hz, b->imu.rate_hz);
   assert_int_equal(a->imu.quadrature_nodes, b->imu.quadrature_nodes);
+  assert_string_equal(a->imu.catalog, b->imu.catalog);
+  assert_gyro_same(&a->imu.model.gyro, &b->imu.model.gyro);
+  assert_accel_same(&a->imu.model.accel, &b->imu.model.accel);
+  assert_int_equal(a->gnss.enabled, b->gnss.enabled);
+  assert_string_equal(a->gnss.catalog, b->gnss.catalog);
+  assert_gnss_same(&a->gnss.model, &b->gnss.model);
+  assert_same_vec3(a->initial_errors.pos_sd_m, b->initial_errors.pos_sd_m);
+  assert_same_vec3(a->initial_errors.vel_sd_mps, b->initial_errors.vel_sd_mps);
+  assert_same_vec3(a->initial_errors.att_sd_rad, b->initial_errors.att_sd_rad);
+  assert_int_equal(a->navigation.scheme, b->navigation.scheme);
   assert_int_equal(a->navigation.algorithm, b->navigation.algorithm);
+  assert_int_equal(a->navigation.frame, b->navigation.frame);
+  assert_int_equal(a->navigation.aid_vertical, b->navigation.aid_vertical);
   assert_same_double(a->output.rate_hz, b->output.rate_hz);
   assert_true(a->simulation.seed == b->simulation.seed);
   assert_int_equal(a->simulation.runs, b->simulation.runs);
+  assert_int_equal(a->simulation.threads, b->simulation.threads);
 }
 
 /* A private directory for written files, removed with its content by rm_dir. */
@@ -318,10 +473,9 @@ static void test_unknown_key_did_you_mean(void **state) {
   expect_one("format_version: 1\nearth:\n  origin: {lat: 45}\n", 3, 12, "earth.origin.lat",
              "did you mean \"lat_deg\" or \"lat_rad\"?");
   /* Nothing close: the valid keys of that level are listed. */
-  expect_one(
-      "format_version: 1\nsensors: {}\n", 2, 1, "sensors",
-      "unknown key \"sensors\"; expected one of: format_version, name, earth, trajectory, imu, gnss, "
-      "initial_errors, navigation, output, simulation");
+  expect_one("format_version: 1\nsensors: {}\n", 2, 1, "sensors",
+             "unknown key \"sensors\"; expected one of: format_version, name, earth, trajectory, imu, gnss, "
+             "initial_errors, navigation, output, simulation");
 }
 
 static void test_wrong_types(void **state) {
@@ -339,9 +493,10 @@ static void test_wrong_types(void **state) {
   /* Mapping where a scalar is expected, and the other way round. */
   expect_one("format_version: 1\nnavigation:\n  algorithm: {a: 1}\n", 3, 14, "navigation.algorithm",
              "expected one of: first_order, high_order; got a mapping");
-  expect_one("format_version: 1\nimu: 5\n", 2, 6, "imu",
-             "expected a mapping with keys rate_hz, quadrature_nodes, bias_convention, catalog, gyro, accel, off; "
-             "got \"5\"");
+  expect_one(
+      "format_version: 1\nimu: 5\n", 2, 6, "imu",
+      "expected a mapping with keys rate_hz, quadrature_nodes, bias_convention, catalog, gyro, accel, off; "
+      "got \"5\"");
   expect_one("format_version: 1\nname: [a, b]\n", 2, 7, "name", "expected a string, got a sequence");
   expect_one("format_version: 1\nimu:\n  quadrature_nodes: 2.5\n", 3, 21, "imu.quadrature_nodes",
              "expected an integer, got \"2.5\"");
@@ -679,6 +834,602 @@ static void test_long_values_are_cut_in_messages(void **state) {
   expect_one(text, 2, 7, "name", "is too long (150 bytes); at most 127 bytes are allowed");
 }
 
+/* ---------------------------------------------------------------- trajectories */
+
+/* Tolerance for a datasheet-unit conversion against a hand value: one or two roundings. */
+#define REL_CONV 4e-16
+
+static void test_waypoints(void **state) {
+  (void)state;
+  const double d2r = NAV_PI / 180.0;
+  nav_scene s =
+      read_ok("format_version: 1\n"
+              "trajectory:\n"
+              "  type: waypoints\n"
+              "  waypoints:\n"
+              "    timing: speed\n"
+              "    attitude_mode: euler\n"
+              "    hold_start_s: 2\n"
+              "    hold_end_s: 3\n"
+              "    limits: {max_accel_mps2: 1.5, max_jerk_mps3: 2, max_lateral_accel_mps2: 2.5,\n"
+              "             max_rate_dps: 20, max_ang_accel_dps2: 10, max_ang_jerk_rps3: 0.5}\n"
+              "    points:\n"
+              "      - {ned_m: [0, 0, 0], speed_mps: 0, attitude: {roll_deg: 0, pitch_deg: 0, yaw_deg: 0}}\n"
+              "      - {ned_m: [100, 0, -10], speed_mps: 5, attitude: {yaw_deg: 10}}\n"
+              "      - {ned_m: [200, 50, -10], speed_mps: 0, attitude: {yaw_rad: 0.5}}\n");
+  const nav_traj_waypoints *w = &s.trajectory.waypoints;
+  assert_int_equal(s.trajectory.type, NAV_TRAJ_WAYPOINTS);
+  assert_int_equal(w->count, 3);
+  assert_int_equal(w->timing, NAV_WP_TIMING_SPEED);
+  assert_int_equal(w->attitude_mode, NAV_WP_ATT_EULER);
+  assert_near(w->hold_start_s, 2.0, 0.0);
+  assert_near(w->hold_end_s, 3.0, 0.0);
+  assert_near(w->limits.max_accel_mps2, 1.5, 0.0);
+  assert_near(w->limits.max_jerk_mps3, 2.0, 0.0);
+  assert_near(w->limits.max_lateral_accel_mps2, 2.5, 0.0);
+  assert_rel_near(w->limits.max_rate_rps, 0.3490658503988659, REL_CONV); /* 20 deg/s */
+  assert_rel_near(w->limits.max_ang_accel_rps2, 0.17453292519943295, REL_CONV);
+  assert_near(w->limits.max_ang_jerk_rps3, 0.5, 0.0);
+  assert_vec3_near(w->points[1].r_ned_m, nav_vec3_make(100, 0, -10), 0.0);
+  assert_near(w->points[1].speed_mps, 5.0, 0.0);
+  assert_rel_near(w->points[1].attitude.yaw_rad, 10 * d2r, REL_CONV);
+  assert_near(w->points[2].attitude.yaw_rad, 0.5, 0.0);
+  /* No duration_s: the length of the planned script. */
+  nav_script_summary sum;
+  assert_int_equal(nav_motiondef_script_summary(&s, &sum, NULL, 0), NAV_OK);
+  assert_same_double(s.trajectory.duration_s, sum.duration_s);
+  assert_true(s.trajectory.duration_s > 5.0);
+
+  /* Timing by time: speed only at the ends; an explicit duration longer than the script. */
+  s = read_ok("format_version: 1\n"
+              "trajectory:\n"
+              "  type: waypoints\n"
+              "  duration_s: 100\n"
+              "  waypoints:\n"
+              "    timing: time\n"
+              "    attitude_mode: aircraft\n"
+              "    points:\n"
+              "      - {ned_m: [0, 0, 0], speed_mps: 10, time_s: 0}\n"
+              "      - {ned_m: [200, 0, 0], time_s: 20}\n"
+              "      - {ned_m: [200, 200, 0], speed_mps: 10, time_s: 40}\n");
+  assert_int_equal(s.trajectory.waypoints.timing, NAV_WP_TIMING_TIME);
+  assert_int_equal(s.trajectory.waypoints.attitude_mode, NAV_WP_ATT_AIRCRAFT);
+  assert_near(s.trajectory.waypoints.points[2].time_s, 40.0, 0.0);
+  assert_near(s.trajectory.duration_s, 100.0, 0.0);
+}
+
+static void test_geodetic_waypoints_any_order(void **state) {
+  (void)state;
+  diag_log log;
+  nav_scene s;
+  const nav_status st = read_path(SCENES_DIR "valid-trajectory-first.yaml", &s, &log);
+  if (st != NAV_OK) print_log(&log);
+  assert_int_equal(st, NAV_OK);
+  /* Converted with the Earth section that follows the trajectory in the file. */
+  const nav_frame fr = nav_frame_from_scene(&s);
+  const nav_geodetic p1 = {45.001 * NAV_PI / 180.0, 0.0, 0.0};
+  assert_same_vec3(s.trajectory.waypoints.points[1].r_ned_m, nav_frame_geodetic_to_local(&fr, p1));
+  /* Hand value: 0.001 deg of latitude at 45 deg is R_M(45 deg) x 1.745e-5 = 6367381.8 m x
+     1.7453293e-5 rad = 111.13 m north (the tangent plane differs by < 1 mm over 111 m). */
+  assert_near(s.trajectory.waypoints.points[0].r_ned_m.x, 0.0, 1e-9);
+  assert_near(s.trajectory.waypoints.points[1].r_ned_m.x, 111.13, 0.01);
+  assert_near(s.trajectory.waypoints.points[1].r_ned_m.y, 0.0, 1e-9);
+  /* lon_rad 2e-5 at 45 deg: (R_N + h) cos(lat) x 2e-5 = 6388838 x 0.7071 x 2e-5 = 90.35 m east;
+     h_m -10: 10 m down. */
+  assert_near(s.trajectory.waypoints.points[2].r_ned_m.y, 90.35, 0.02);
+  assert_near(s.trajectory.waypoints.points[2].r_ned_m.z, 10.0, 0.01);
+}
+
+static void test_segment_kinds(void **state) {
+  (void)state;
+  const double d2r = NAV_PI / 180.0;
+  const nav_scene s = read_ok(
+      "format_version: 1\n"
+      "earth: {model: wgs84}\n"
+      "trajectory:\n"
+      "  type: segments\n"
+      "  segments:\n"
+      "    r0_ned_m: [1, 2, -3]\n"
+      "    v0_b_mps: [20, 0, 0]\n"
+      "    allow_unconverged: true\n"
+      "    fit_rate_ramps: false\n"
+      "    limits: {max_accel_mps2: 2, max_jerk_mps3: 4, max_lateral_accel_mps2: 10, max_rate_dps: 30,\n"
+      "             max_ang_accel_dps2: 20, max_ang_jerk_dps3: 60}\n"
+      "    items:\n"
+      "      - {kind: hold, duration_s: 5, gnss_visible: false}\n"
+      "      - {kind: accelerate, speed_mps: 25}\n"
+      "      - {kind: turn, yaw_deg: 90, yaw_rate_dps: 10}\n"
+      "      - {kind: coordinated_turn, yaw_deg: -45, yaw_rate_rps: 0.1}\n"
+      "      - {kind: climb, height_m: 100, pitch_deg: 5}\n"
+      "      - {kind: circle, radius_m: 200, turns: 1, coordinated: true}\n"
+      "      - {kind: figure_eight, radius_m: 150, turns: 1}\n"
+      "      - {kind: helix, radius_m: 300, turns: 0.5, pitch_deg: -2}\n"
+      "      - {kind: lawnmower, legs: 3, length_m: 100, spacing_m: -150}\n"
+      "      - {kind: motion_rates, yaw_rate_dps: 1, pitch_rate_dps: 0, roll_rate_dps: 0,\n"
+      "         accel_b_mps2: [0.1, 0, 0], duration_s: 4}\n"
+      "      - {kind: motion_abs_abs, yaw_deg: 0, pitch_deg: 0, roll_deg: 0, v_b_mps: [20, 0, 0], "
+      "duration_s: 60}\n"
+      "      - {kind: motion_rel_rel, yaw_deg: 10, pitch_deg: 0, roll_deg: 0, v_b_mps: [1, 0, 0], "
+      "duration_s: 30}\n"
+      "      - {kind: motion_abs_rel, yaw_deg: 20, pitch_deg: 0, roll_deg: 0, v_b_mps: [-1, 0, 0], "
+      "duration_s: 30}\n"
+      "      - {kind: motion_rel_abs, yaw_rad: -0.1, pitch_deg: 0, roll_deg: 0, v_b_mps: [15, 0, 0],\n"
+      "         duration_s: 30}\n");
+  const nav_traj_segments *S = &s.trajectory.segments;
+  const nav_segment *g = S->items;
+  assert_int_equal(S->count, 14);
+  assert_vec3_near(S->r0_ned_m, nav_vec3_make(1, 2, -3), 0.0);
+  assert_vec3_near(S->v0_b_mps, nav_vec3_make(20, 0, 0), 0.0);
+  assert_true(S->allow_unconverged);
+  assert_false(S->fit_rate_ramps);
+  assert_rel_near(S->limits.max_ang_jerk_rps3, 1.0471975511965976, REL_CONV); /* 60 deg/s^3 */
+  static const nav_segment_kind kinds[14] = {
+      NAV_SEG_HOLD,           NAV_SEG_ACCELERATE,    NAV_SEG_TURN,           NAV_SEG_COORD_TURN,
+      NAV_SEG_CLIMB,          NAV_SEG_CIRCLE,        NAV_SEG_FIGURE_EIGHT,   NAV_SEG_HELIX,
+      NAV_SEG_LAWNMOWER,      NAV_SEG_MOTION_RATES,  NAV_SEG_MOTION_ABS_ABS, NAV_SEG_MOTION_REL_REL,
+      NAV_SEG_MOTION_ABS_REL, NAV_SEG_MOTION_REL_ABS};
+  for (int i = 0; i < 14; ++i)
+    assert_int_equal(g[i].kind, kinds[i]);
+  assert_near(g[0].duration_s, 5.0, 0.0);
+  assert_false(g[0].gnss_visible);
+  assert_true(g[1].gnss_visible);
+  assert_near(g[1].speed_mps, 25.0, 0.0);
+  assert_rel_near(g[2].yaw_rad, NAV_PI / 2, REL_CONV);
+  assert_rel_near(g[2].yaw_rate_rps, 10 * d2r, REL_CONV);
+  assert_false(g[2].coordinated);
+  assert_rel_near(g[3].yaw_rad, -NAV_PI / 4, REL_CONV);
+  assert_near(g[3].yaw_rate_rps, 0.1, 0.0);
+  assert_near(g[4].height_m, 100.0, 0.0);
+  assert_rel_near(g[4].pitch_rad, 5 * d2r, REL_CONV);
+  assert_near(g[5].radius_m, 200.0, 0.0);
+  assert_near(g[5].turns, 1.0, 0.0);
+  assert_true(g[5].coordinated);
+  assert_near(g[7].turns, 0.5, 0.0);
+  assert_rel_near(g[7].pitch_rad, -2 * d2r, REL_CONV);
+  assert_int_equal(g[8].legs, 3);
+  assert_near(g[8].length_m, 100.0, 0.0);
+  assert_near(g[8].spacing_m, -150.0, 0.0);
+  assert_rel_near(g[9].yaw_rate_rps, d2r, REL_CONV);
+  assert_vec3_near(g[9].accel_b_mps2, nav_vec3_make(0.1, 0, 0), 0.0);
+  assert_near(g[9].duration_s, 4.0, 0.0);
+  assert_vec3_near(g[10].v_b_mps, nav_vec3_make(20, 0, 0), 0.0);
+  assert_near(g[10].duration_s, 60.0, 0.0);
+  assert_rel_near(g[12].yaw_rad, 20 * d2r, REL_CONV);
+  assert_near(g[13].yaw_rad, -0.1, 0.0);
+  nav_script_summary sum;
+  assert_int_equal(nav_motiondef_script_summary(&s, &sum, NULL, 0), NAV_OK);
+  assert_same_double(s.trajectory.duration_s, sum.duration_s);
+}
+
+static void test_test_motions(void **state) {
+  (void)state;
+  const double d2r = NAV_PI / 180.0;
+  nav_scene s = read_ok("format_version: 1\ntrajectory:\n  type: test_motion\n  test_motion:\n"
+                        "    kind: coning\n    cone_half_angle_deg: 2\n    cone_rate_hz: 10\n");
+  assert_int_equal(s.trajectory.type, NAV_TRAJ_TEST_MOTION);
+  assert_int_equal(s.trajectory.test_motion.kind, NAV_TEST_MOTION_CONING);
+  assert_rel_near(s.trajectory.test_motion.cone_half_angle_rad, 2 * d2r, REL_CONV);
+  assert_rel_near(s.trajectory.test_motion.cone_rate_rps, 62.83185307179586, REL_CONV); /* 10 Hz */
+  assert_near(s.trajectory.duration_s, 20.0, 0.0); /* not a script: the default */
+  s = read_ok("format_version: 1\ntrajectory:\n  type: test_motion\n  duration_s: 5\n"
+              "  test_motion: {kind: spin, spin_rate_rpm: 1200, spin_axis_b: [0, 0, 1]}\n");
+  assert_rel_near(s.trajectory.test_motion.spin_rate_rps, 125.66370614359172, REL_CONV); /* 1200 rpm */
+  assert_vec3_near(s.trajectory.test_motion.spin_axis_b, nav_vec3_make(0, 0, 1), 0.0);
+  s = read_ok(
+      "format_version: 1\ntrajectory:\n  type: test_motion\n"
+      "  test_motion: {kind: sculling, scull_angle_rad: 0.1, scull_accel_mps2: 3, scull_rate_dps: 720}\n");
+  assert_near(s.trajectory.test_motion.scull_angle_rad, 0.1, 0.0);
+  assert_near(s.trajectory.test_motion.scull_accel_mps2, 3.0, 0.0);
+  assert_rel_near(s.trajectory.test_motion.scull_rate_rps, 4 * NAV_PI, REL_CONV);
+  s = read_ok("format_version: 1\nearth: {model: wgs84}\ntrajectory:\n  type: test_motion\n"
+              "  test_motion: {kind: polar_great_circle, gc_height_m: 9000, gc_speed_mps: 240,\n"
+              "                gc_start_angle_deg: 85, gc_lon_deg: -30}\n");
+  assert_near(s.trajectory.test_motion.gc_height_m, 9000.0, 0.0);
+  assert_near(s.trajectory.test_motion.gc_speed_mps, 240.0, 0.0);
+  assert_rel_near(s.trajectory.test_motion.gc_start_angle_rad, 85 * d2r, REL_CONV);
+  assert_rel_near(s.trajectory.test_motion.gc_lon_rad, -30 * d2r, REL_CONV);
+  s = read_ok("format_version: 1\ntrajectory:\n  type: test_motion\n"
+              "  test_motion: {kind: vertical_loop, loop_speed_mps: 50, loop_pitch_rate_dps: -9}\n");
+  assert_near(s.trajectory.test_motion.loop_speed_mps, 50.0, 0.0);
+  assert_rel_near(s.trajectory.test_motion.loop_pitch_rate_rps, -9 * d2r, REL_CONV);
+  s = read_ok("format_version: 1\ntrajectory: {type: test_motion, test_motion: {kind: stationary}}\n");
+  assert_int_equal(s.trajectory.test_motion.kind, NAV_TEST_MOTION_STATIONARY);
+}
+
+static void test_motion_def_import(void **state) {
+  (void)state;
+  diag_log log;
+  nav_scene s, direct = nav_scene_default();
+  const nav_status st = read_path(SCENES_DIR "valid-motion-def.yaml", &s, &log);
+  if (st != NAV_OK) print_log(&log);
+  assert_int_equal(st, NAV_OK);
+  /* The same as importing the file directly; only the explicit duration differs. */
+  direct.earth.model = NAV_EARTH_WGS84;
+  snprintf(direct.name, sizeof direct.name, "motion def");
+  assert_int_equal(nav_motiondef_read_file(NAV_SOURCE_DIR "/resources/motion_defs/motion_def-90deg_turn.csv",
+                                           &direct, NULL, NULL),
+                   NAV_OK);
+  assert_true(direct.trajectory.duration_s < 30.0);
+  direct.trajectory.duration_s = 30.0;
+  assert_int_equal(s.trajectory.type, NAV_TRAJ_SEGMENTS);
+  assert_int_equal(s.trajectory.segments.count, 3);
+  assert_scene_same(&s, &direct);
+  assert_rel_near(s.earth.origin_lat_rad, 31.9965 * NAV_PI / 180.0, REL_CONV);
+}
+
+static void test_duration_auto(void **state) {
+  (void)state;
+  static const char *const base = "format_version: 1\n"
+                                  "trajectory:\n"
+                                  "  type: segments\n"
+                                  "  %s\n"
+                                  "  segments:\n"
+                                  "    v0_b_mps: [10, 0, 0]\n"
+                                  "    items: [{kind: hold, duration_s: 7}, {kind: turn, yaw_deg: 30}]\n";
+  char text[512];
+  snprintf(text, sizeof text, base, "duration_s: auto");
+  const nav_scene a = read_ok(text);
+  snprintf(text, sizeof text, base, "initial_attitude: {yaw_deg: 0}"); /* no duration_s */
+  const nav_scene b = read_ok(text);
+  snprintf(text, sizeof text, base, "duration_s: 3");
+  const nav_scene c = read_ok(text);
+  assert_same_double(a.trajectory.duration_s, b.trajectory.duration_s);
+  assert_true(a.trajectory.duration_s > 7.0);
+  assert_near(c.trajectory.duration_s, 3.0, 0.0); /* shorter than the script: the run ends early */
+}
+
+/* ---------------------------------------------------------------- sensors, initial errors */
+
+static void test_sensor_units(void **state) {
+  (void)state;
+  diag_log log;
+  nav_scene s;
+  const nav_status st = read_path(SCENES_DIR "valid-sensors.yaml", &s, &log);
+  if (st != NAV_OK) print_log(&log);
+  assert_int_equal(st, NAV_OK);
+  const nav_gyro_error_config *g = &s.imu.model.gyro;
+  const nav_accel_error_config *a = &s.imu.model.accel;
+  /* Hand values: deg/sqrt(h) x (pi/180)/60, deg/h x (pi/180)/3600, ... (nav_sensors.h). */
+  assert_int_equal(g->terms, NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM |
+                                 NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_SCALE_FACTOR |
+                                 NAV_IMU_TERM_MISALIGNMENT | NAV_IMU_TERM_G_SENSITIVITY |
+                                 NAV_IMU_TERM_SATURATION);
+  assert_rel_near(g->arw_rad_per_sqrt_s.y, 4.3633231299858234e-05, REL_CONV); /* 0.15 deg/sqrt(h) */
+  assert_rel_near(g->bias_turn_on_sd_rps.x, 4.84813681109536e-05, REL_CONV);  /* 10 deg/h */
+  assert_rel_near(g->bias_turn_on_sd_rps.y, 9.69627362219072e-05, REL_CONV);
+  assert_rel_near(g->bias_turn_on_sd_rps.z, 1.454441043328608e-04, REL_CONV);
+  assert_rel_near(g->bias_turn_on_fixed_rps.z, 0.008726646259971648, REL_CONV); /* 0.5 deg/s */
+  /* sigma_equals_b: sigma = B = 2 deg/h; T = 300 s / 1.892617797645221. */
+  assert_rel_near(g->bias_gm_sd_rps.x, 9.69627362219072e-06, REL_CONV);
+  assert_rel_near(g->bias_gm_tau_s.z, 158.51060915376442, REL_CONV);
+  assert_rel_near(g->bias_rw_rps_per_sqrt_s.x, 4.040114009246133e-08, REL_CONV); /* 0.5 deg/h/sqrt(h) */
+  assert_vec3_near(g->scale_factor_sd, nav_vec3_make(5e-4, 5e-4, 5e-4), 1e-19);
+  assert_vec3_near(g->scale_factor_fixed, nav_vec3_make(1e-4, -2e-4, 3e-4), 1e-19);
+  const nav_mat3 mis = {{{0, 5e-4, 5e-4}, {5e-4, 0, 5e-4}, {5e-4, 5e-4, 0}}};
+  assert_mat3_near(g->misalignment_sd_rad, mis, 1e-19);
+  const nav_mat3 gs = {
+      {{4.94372370900905e-06, 0, 0}, {0, 9.8874474180181e-06, 0}, {0, 0, 1.483117112702715e-05}}};
+  assert_mat3_near(g->g_sensitivity_sd_rps_per_mps2, gs, 1e-20);             /* deg/h/g x (pi/180)/3600/g0 */
+  assert_vec3_near(g->quant_step_rad, nav_vec3_make(1e-7, 1e-7, 1e-7), 0.0); /* kept while off */
+  assert_rel_near(g->range_rps.x, 7.853981633974483, REL_CONV);              /* 450 deg/s */
+  assert_int_equal(a->terms, NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM |
+                                 NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_MISALIGNMENT |
+                                 NAV_IMU_TERM_QUANTISATION | NAV_IMU_TERM_SATURATION);
+  assert_rel_near(a->vrw_mps_per_sqrt_s.x, 9.80665e-4, REL_CONV);  /* 100 ug/sqrt(Hz) */
+  assert_rel_near(a->bias_turn_on_sd_mps2.x, 0.0196133, REL_CONV); /* 2 mg */
+  assert_rel_near(a->bias_gm_sd_mps2.y, 4.903325e-4, REL_CONV);    /* 50 ug */
+  assert_near(a->bias_gm_tau_s.y, 600.0, 0.0);
+  assert_rel_near(a->bias_rw_mps2_per_sqrt_s.z, 1.6666666666666667e-05, REL_CONV); /* 0.001 m/s^2/sqrt(h) */
+  const nav_mat3 mf = {{{0, 1e-3, 2e-3}, {3e-3, 0, 4e-3}, {5e-3, 6e-3, 0}}};
+  assert_mat3_near(a->misalignment_fixed_rad, mf, 1e-18);
+  assert_near(a->quant_step_mps.x, 1e-5, 0.0);
+  assert_rel_near(a->range_mps2.y, 156.9064, REL_CONV); /* 16 g */
+
+  const nav_gnss_model_config *n = &s.gnss.model;
+  assert_true(s.gnss.enabled);
+  assert_int_equal(n->terms, NAV_GNSS_TERM_POS_GM | NAV_GNSS_TERM_POS_WHITE | NAV_GNSS_TERM_VEL_WHITE);
+  assert_near(n->update_rate_hz, 5.0, 0.0);
+  assert_near(n->latency_s, 0.1, 0.0);
+  assert_vec3_near(n->pos_gm_sd_m, nav_vec3_make(1.5, 1.5, 3), 0.0);
+  assert_vec3_near(n->pos_gm_tau_s, nav_vec3_make(100, 100, 100), 0.0);
+  assert_vec3_near(n->pos_white_sd_m, nav_vec3_make(0.5, 0.5, 0.5), 0.0);
+  assert_vec3_near(n->vel_sd_mps, nav_vec3_make(0.05, 0.05, 0.05), 0.0);
+  assert_vec3_near(n->r_ba_b_m, nav_vec3_make(0.1, 0.2, -0.3), 0.0);
+  assert_int_equal(n->outage_count, 2);
+  assert_near(n->outages[1].t0_s, 300.5, 0.0);
+  assert_near(n->outages[1].t1_s, 360.0, 0.0);
+  assert_false(n->report_model_sigmas);
+  assert_vec3_near(n->reported_pos_sd_m, nav_vec3_make(2, 2, 4), 0.0);
+  assert_vec3_near(n->reported_vel_sd_mps, nav_vec3_make(0.1, 0.1, 0.1), 0.0);
+
+  assert_vec3_near(s.initial_errors.pos_sd_m, nav_vec3_make(1, 2, 3), 0.0);
+  assert_vec3_near(s.initial_errors.vel_sd_mps, nav_vec3_make(0.05, 0.05, 0.05), 0.0);
+  assert_rel_near(s.initial_errors.att_sd_rad.z, NAV_PI / 180.0, REL_CONV);
+  assert_int_equal(s.navigation.scheme, NAV_SCHEME_INS_GNSS);
+  assert_int_equal(s.navigation.frame, NAV_MECH_ECEF);
+  assert_false(s.navigation.aid_vertical);
+  assert_int_equal(s.simulation.threads, 4);
+
+  /* Defaults: a perfect IMU, no receiver, no initial errors. */
+  s = read_ok("format_version: 1\n");
+  assert_int_equal(s.imu.model.gyro.terms, 0);
+  assert_int_equal(s.imu.model.accel.terms, 0);
+  assert_false(s.gnss.enabled);
+  assert_true(s.gnss.model.report_model_sigmas);
+  assert_int_equal(s.navigation.scheme, NAV_SCHEME_FREE_INS);
+}
+
+static void test_bias_instability_conventions(void **state) {
+  (void)state;
+  /* Default allan_peak: sigma = B / 0.6173642831444413 (numerics.md 2.3). */
+  nav_scene s =
+      read_ok("format_version: 1\nimu:\n  accel: {bias_instability_ug: 50, bias_instability_tau_min_s: "
+              "[300, 600, 900]}\n");
+  assert_rel_near(s.imu.model.accel.bias_gm_sd_mps2.x, 0.0007942352892567314, 1e-15);
+  assert_rel_near(s.imu.model.accel.bias_gm_tau_s.y, 600.0 / 1.892617797645221, 1e-15);
+  assert_true(s.imu.model.accel.terms & NAV_IMU_TERM_BIAS_GM);
+  /* Per-axis instability with the rad/s spelling, sigma_equals_b, keys in any order. */
+  s = read_ok(
+      "format_version: 1\nimu:\n  gyro: {bias_instability_tau_min_s: 100, bias_instability_rps: [1e-6, 2e-6, "
+      "3e-6]}\n  bias_convention: sigma_equals_b\n");
+  assert_vec3_near(s.imu.model.gyro.bias_gm_sd_rps, nav_vec3_make(1e-6, 2e-6, 3e-6), 0.0);
+  /* A scalar applies to all three axes; "off" clears the terms of both triads. */
+  s = read_ok("format_version: 1\nimu:\n  off: [noise]\n  gyro: {arw_rad_per_sqrt_s: 1e-4}\n"
+              "  accel: {vrw_m_per_s_per_sqrt_h: 0.06}\n");
+  assert_vec3_near(s.imu.model.gyro.arw_rad_per_sqrt_s, nav_vec3_make(1e-4, 1e-4, 1e-4), 0.0);
+  assert_rel_near(s.imu.model.accel.vrw_mps_per_sqrt_s.z, 0.001, 1e-15);
+  assert_int_equal(s.imu.model.gyro.terms, 0);
+  assert_int_equal(s.imu.model.accel.terms, 0);
+}
+
+/* The IMU catalog row as nav_catalog_load converts it. */
+static nav_imu_model_config catalog_imu(const char *name, nav_bi_convention conv) {
+  nav_catalog *cat = NULL;
+  nav_catalog_options opt = nav_catalog_options_default();
+  opt.convention = conv;
+  assert_int_equal(nav_catalog_load(NAV_SOURCE_DIR "/resources/imu_catalog.csv", &opt, &cat, NULL, NULL),
+                   NAV_OK);
+  const nav_catalog_imu_entry *e = nav_catalog_find_imu(cat, name);
+  assert_non_null(e);
+  const nav_imu_model_config cfg = e->config;
+  nav_catalog_destroy(cat);
+  return cfg;
+}
+
+static void test_imu_catalog(void **state) {
+  (void)state;
+  nav_scene s = read_ok("format_version: 1\nimu: {catalog: adis16465-1}\n");
+  assert_string_equal(s.imu.catalog, "ADIS16465-1");
+  nav_imu_model_config cfg = catalog_imu("ADIS16465-1", NAV_BI_ALLAN_PEAK);
+  assert_gyro_same(&s.imu.model.gyro, &cfg.gyro);
+  assert_accel_same(&s.imu.model.accel, &cfg.accel);
+  /* The catalog is the base whatever its place among the keys; the other keys override it. */
+  s = read_ok("format_version: 1\nimu:\n  gyro: {arw_deg_per_sqrt_h: 0.2}\n  off: [accel.bias_gm]\n"
+              "  bias_convention: sigma_equals_b\n  catalog: \"Xsens MTi-300\"\n");
+  cfg = catalog_imu("Xsens MTi-300", NAV_BI_SIGMA_EQUALS_B);
+  assert_rel_near(s.imu.model.gyro.arw_rad_per_sqrt_s.x, 0.2 * NAV_PI / 180.0 / 60.0, REL_CONV);
+  assert_same_vec3(s.imu.model.gyro.bias_gm_sd_rps, cfg.gyro.bias_gm_sd_rps);
+  assert_int_equal(s.imu.model.gyro.terms, cfg.gyro.terms);
+  assert_int_equal(s.imu.model.accel.terms, cfg.accel.terms & ~(unsigned)NAV_IMU_TERM_BIAS_GM);
+  assert_same_vec3(s.imu.model.accel.bias_gm_sd_mps2, cfg.accel.bias_gm_sd_mps2); /* kept, but off */
+  assert_same_vec3(s.imu.model.accel.vrw_mps_per_sqrt_s, cfg.accel.vrw_mps_per_sqrt_s);
+}
+
+static void test_gnss_catalog(void **state) {
+  (void)state;
+  nav_scene s =
+      read_ok("format_version: 1\ngnss:\n  enabled: true\n  catalog: rtk fixed\n  update_rate_hz: 5\n"
+              "  off: [velocity]\n");
+  nav_catalog *cat = NULL;
+  assert_int_equal(nav_catalog_load(NAV_SOURCE_DIR "/resources/gnss_receivers.csv", NULL, &cat, NULL, NULL),
+                   NAV_OK);
+  const nav_catalog_gnss_entry *e = nav_catalog_find_gnss(cat, "RTK fixed");
+  assert_non_null(e);
+  assert_string_equal(s.gnss.catalog, "RTK fixed");
+  assert_same_vec3(s.gnss.model.pos_gm_sd_m, e->config.pos_gm_sd_m);
+  assert_same_vec3(s.gnss.model.pos_gm_tau_s, e->config.pos_gm_tau_s);
+  assert_int_equal(s.gnss.model.terms, e->config.terms & ~(unsigned)NAV_GNSS_TERM_VEL_WHITE);
+  assert_near(s.gnss.model.update_rate_hz, 5.0, 0.0);
+  nav_catalog_destroy(cat);
+}
+
+/* ---------------------------------------------------------------- errors of the new sections */
+
+static void test_trajectory_errors(void **state) {
+  (void)state;
+  static const char head[] = "format_version: 1\n"
+                             "trajectory:\n"
+                             "  type: segments\n"
+                             "  segments:\n"
+                             "    v0_b_mps: [10, 0, 0]\n"
+                             "    items:\n";
+  char text[1024];
+  /* Unknown segment kind: did you mean, among the kinds. */
+  snprintf(text, sizeof text, "%s      - {kind: helx, radius_m: 100, turns: 1}\n", head);
+  expect_one(
+      text, 7, 16, "trajectory.segments.items[0].kind",
+      "expected one of: hold, accelerate, turn, coordinated_turn, climb, circle, figure_eight, helix, "
+      "lawnmower, motion_rates, motion_abs_abs, motion_rel_rel, motion_abs_rel, motion_rel_abs; got \"helx\" "
+      "(did you mean \"helix\"?)");
+  /* Unknown key of a kind: did you mean among that kind's keys, else its keys listed. */
+  snprintf(text, sizeof text, "%s      - {kind: circle, radus_m: 100, turns: 1}\n", head);
+  expect_one(text, 7, 24, "trajectory.segments.items[0].radus_m", "did you mean \"radius_m\"?");
+  snprintf(text, sizeof text, "%s      - {kind: turn, radius_m: 100}\n", head);
+  expect_one(text, 7, 22, "trajectory.segments.items[0].radius_m",
+             "unknown key \"radius_m\"; expected one of: kind, yaw_deg, yaw_rad, yaw_rate_dps, yaw_rate_rps, "
+             "coordinated, gnss_visible");
+  snprintf(text, sizeof text, "%s      - {radius_m: 100}\n", head);
+  expect_one(text, 7, 9, "trajectory.segments.items[0].kind", "missing required key \"kind\"");
+  /* The planner's verdict, placed at the segment. */
+  snprintf(text, sizeof text,
+           "%s      - {kind: hold, duration_s: 1}\n      - {kind: circle, radius_m: 1, turns: 1}\n", head);
+  expect_one(text, 8, 9, "trajectory.segments.items[1]", "segment 1 (circle)");
+
+  /* Waypoints: no position, two positions, a partial geodetic one. */
+  static const char wp[] = "format_version: 1\n"
+                           "trajectory:\n"
+                           "  type: waypoints\n"
+                           "  waypoints:\n"
+                           "    points:\n"
+                           "      - {ned_m: [0, 0, 0], speed_mps: 0}\n";
+  snprintf(text, sizeof text, "%s      - {speed_mps: 3}\n", wp);
+  expect_one(text, 7, 9, "trajectory.waypoints.points[1]", "the waypoint has no position");
+  snprintf(text, sizeof text, "%s      - {ned_m: [10, 0, 0], lat_deg: 45, lon_deg: 0, h_m: 0}\n", wp);
+  expect_one(text, 7, 29, "trajectory.waypoints.points[1].lat_deg",
+             "the waypoint position is given twice: use either ned_m: [N, E, D] or lat_deg, lon_deg and h_m");
+  snprintf(text, sizeof text, "%s      - {lat_deg: 45, h_m: 0}\n", wp);
+  expect_one(text, 7, 9, "trajectory.waypoints.points[1]",
+             "needs lat_deg, lon_deg and h_m (lon_deg is missing)");
+  snprintf(text, sizeof text, "%s      - {lat_deg: 91, lon_deg: 0, h_m: 0}\n", wp);
+  expect_one(text, 7, 19, "trajectory.waypoints.points[1].lat_deg", "must be <= 90 (got 91)");
+  snprintf(text, sizeof text, "%s      - 5\n", wp);
+  expect_one(text, 7, 9, "trajectory.waypoints.points[1]", "expected a waypoint");
+
+  /* duration_s auto only for scripts; test motions have per-kind keys too. */
+  expect_one("format_version: 1\ntrajectory: {duration_s: auto}\n", 2, 26, "trajectory.duration_s",
+             "auto is the length of a waypoint or segment script; trajectory.type parametric needs a number");
+  expect_one(
+      "format_version: 1\ntrajectory:\n  type: test_motion\n  test_motion: {kind: spin, cone_rate_hz: 5}\n",
+      4, 29, "trajectory.test_motion.cone_rate_hz", "unknown key \"cone_rate_hz\"");
+  /* A validation message about the SI field, placed at the key that gave it in degrees. */
+  expect_one("format_version: 1\ntrajectory:\n  type: test_motion\n"
+             "  test_motion: {kind: coning, cone_half_angle_deg: 100}\n",
+             4, 52, "trajectory.test_motion.cone_half_angle_rad", "must be in (0, 90] deg (got 100 deg)");
+}
+
+static void test_sensor_errors(void **state) {
+  (void)state;
+  /* Unknown catalog part: did you mean among the catalog's names. */
+  expect_one("format_version: 1\nimu:\n  catalog: ADIS16456-1\n", 3, 12, "imu.catalog",
+             "unknown IMU \"ADIS16456-1\"; did you mean \"ADIS16465-1\"?");
+  expect_one("format_version: 1\ngnss:\n  catalog: \"RTK\"\n", 3, 12, "gnss.catalog",
+             "unknown GNSS receiver \"RTK\"; `navsim catalog --gnss` lists the");
+  /* Outages: t1 > t0, at most NAV_GNSS_MAX_OUTAGES. */
+  expect_one("format_version: 1\ngnss:\n  outages: [[10, 20], [30, 30]]\n", 3, 28, "gnss.outages[1][1]",
+             "the end t1_s = 30 must be after the start t0_s = 30");
+  expect_one("format_version: 1\ngnss:\n  outages: [[10, 20, 30]]\n", 3, 13, "gnss.outages[0]",
+             "expected [t0_s, t1_s], got a sequence");
+  /* Bias instability needs its Allan-minimum time, and excludes the GM keys. */
+  expect_one("format_version: 1\nimu:\n  gyro:\n    bias_instability_deg_per_h: 2\n", 4, 5,
+             "imu.gyro.bias_instability_deg_per_h", "needs bias_instability_tau_min_s too");
+  expect_one("format_version: 1\nimu:\n  accel: {bias_instability_ug: 2, bias_instability_tau_min_s: 100, "
+             "bias_gm_tau_s: 5}\n",
+             3, 68, "imu.accel.bias_gm_tau_s", "the Gauss-Markov bias is given twice");
+  /* Datasheet ranges in file units; both spellings of one quantity. */
+  expect_one("format_version: 1\nimu:\n  gyro: {arw_deg_per_sqrt_h: -0.1}\n", 3, 30,
+             "imu.gyro.arw_deg_per_sqrt_h", "must be >= 0 (got -0.1)");
+  expect_one("format_version: 1\nimu:\n  accel: {range_g: [16, 0, 16]}\n", 3, 25, "imu.accel.range_g[1]",
+             "must be > 0 (got 0)");
+  expect_one("format_version: 1\nimu:\n  gyro: {range_dps: 100, range_rps: 2}\n", 3, 26, "imu.gyro.range_rps",
+             "both \"range_dps\" and \"range_rps\" are given");
+  expect_one("format_version: 1\nimu:\n  gyro: {misalignment_mrad: [1, 2]}\n", 3, 29,
+             "imu.gyro.misalignment_mrad",
+             "expected a number (every off-diagonal element) or 3 rows of 3 numbers, got 2 items");
+  /* "off": did you mean, and gyro-only terms. */
+  expect_one("format_version: 1\nimu:\n  off: [gyro.nose]\n", 3, 9, "imu.off[0]",
+             "unknown term \"gyro.nose\"; did you mean \"gyro.noise\"?");
+  expect_one("format_version: 1\nimu:\n  off: accel.g_sensitivity\n", 3, 8, "imu.off",
+             "g_sensitivity is a gyro term");
+  expect_one("format_version: 1\ngnss:\n  reported_sigma: modle\n", 3, 19, "gnss.reported_sigma",
+             "expected \"model\" or {position_m: [N, E, D], velocity_mps: [N, E, D]}");
+  expect_one("format_version: 1\nnavigation: {aid_vertical: yes}\n", 2, 28, "navigation.aid_vertical",
+             "expected true or false, got the boolean \"yes\"");
+  /* Validation of the sensor model, placed at the key that set it. */
+  expect_one("format_version: 1\nearth: {model: wgs84}\nnavigation: {scheme: ins_gnss}\n", 3, 22,
+             "navigation.scheme", "ins_gnss needs a GNSS receiver");
+}
+
+static void test_motion_def_errors(void **state) {
+  (void)state;
+  diag_log log;
+  nav_scene s;
+  /* A missing file: the message names the resolved path. */
+  assert_int_equal(read_path(SCENES_DIR "invalid-motion-def-missing.yaml", &s, &log), NAV_ERR_PARSE);
+  assert_int_equal(log.n, 1);
+  expect_diag(&log, 0, 5, 22, "trajectory.motion_def.file",
+              "cannot read the motion-definition file \"" NAV_TEST_DATA_DIR
+              "/scenes/no-such-motion.csv\": No such file or directory");
+  /* The file sets the origin: earth.origin as well is an error. */
+  assert_int_equal(read_path(SCENES_DIR "invalid-motion-def-origin.yaml", &s, &log), NAV_ERR_PARSE);
+  assert_int_equal(log.n, 1);
+  expect_diag(&log, 0, 4, 11, "earth.origin",
+              "the motion-definition file (trajectory.motion_def.file) sets the origin; remove earth.origin");
+  /* From memory: a relative path resolves against the directory of the display name. */
+  static const char text[] = "format_version: 1\ntrajectory:\n  type: motion_def\n  motion_def:\n"
+                             "    file: ../../../resources/motion_defs/motion_def-90deg_turn.csv\n";
+  memset(&log, 0, sizeof log);
+  assert_int_equal(nav_scene_read_string(text, strlen(text), SCENES_DIR "mem.yaml", &s, collect, &log),
+                   NAV_OK);
+  assert_int_equal(s.trajectory.segments.count, 3);
+  /* The file also sets the initial attitude and the segment script. */
+  expect_one("format_version: 1\nearth: {model: wgs84}\ntrajectory:\n  type: motion_def\n"
+             "  initial_attitude: {yaw_deg: 3}\n"
+             "  motion_def: {file: " NAV_SOURCE_DIR "/resources/motion_defs/motion_def-90deg_turn.csv}\n",
+             5, 21, "trajectory.initial_attitude",
+             "the motion-definition file (trajectory.motion_def.file) sets the initial attitude");
+  /* Flags stricter than the import's: the planner's verdict, placed at the file. */
+  expect_one("format_version: 1\nearth: {model: wgs84}\ntrajectory:\n  type: motion_def\n"
+             "  motion_def:\n    file: " NAV_SOURCE_DIR "/resources/motion_defs/motion_def-long_drive.csv\n"
+             "    allow_unconverged: false\n",
+             6, 11, "trajectory.motion_def.file",
+             "with the allow_unconverged / fit_rate_ramps given: segment 13 (motion type 5)");
+  /* The section without the type, the type without the section, a malformed file. */
+  expect_one("format_version: 1\ntrajectory:\n  motion_def: {file: x.csv}\n", 3, 15, "trajectory.motion_def",
+             "is read only with trajectory.type: motion_def (type is parametric)");
+  expect_one("format_version: 1\ntrajectory: {type: motion_def}\n", 2, 20, "trajectory.type",
+             "motion_def needs trajectory.motion_def: {file: PATH}");
+  expect_one("format_version: 1\ntrajectory: {type: motion_def, motion_def: {fit_rate_ramps: true}}\n", 2, 44,
+             "trajectory.motion_def.file", "missing required key \"file\"");
+}
+
+/* ---------------------------------------------------------------- the scene library */
+
+/* Every scene of scenes/ is valid, and writing then reading it gives the same scene, bit for
+   bit; writing that again gives the same text. */
+static void test_scene_library_round_trip(void **state) {
+  (void)state;
+  char dir[64], out[128], out2[128], path[512];
+  diag_log log;
+  nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
+  assert_non_null(a);
+  assert_non_null(b);
+  make_dir(dir, sizeof dir);
+  snprintf(out, sizeof out, "%s/rt.yaml", dir);
+  snprintf(out2, sizeof out2, "%s/rt2.yaml", dir);
+  DIR *d = opendir(NAV_SOURCE_DIR "/scenes");
+  assert_non_null(d);
+  int n = 0;
+  for (struct dirent *e = readdir(d); e != NULL; e = readdir(d)) {
+    const size_t len = strlen(e->d_name);
+    if (len < 6 || strcmp(e->d_name + len - 5, ".yaml") != 0) continue;
+    snprintf(path, sizeof path, "%s/scenes/%s", NAV_SOURCE_DIR, e->d_name);
+    nav_status st = read_path(path, a, &log);
+    if (st != NAV_OK) {
+      print_log(&log);
+      fail_msg("%s does not pass validation", path);
+    }
+    assert_int_equal(nav_scene_write_file(out, a), NAV_OK);
+    st = read_path(out, b, &log);
+    if (st != NAV_OK) {
+      print_log(&log);
+      fail_msg("%s written back does not read:\n%s", path, slurp(out));
+    }
+    print_message("[ SCENE    ] %s\n", e->d_name);
+    assert_scene_same(a, b);
+    assert_int_equal(nav_scene_write_file(out2, b), NAV_OK);
+    char *first = strdup(slurp(out));
+    assert_non_null(first);
+    assert_string_equal(first, slurp(out2));
+    free(first);
+    ++n;
+  }
+  closedir(d);
+  assert_true(n >= 11);
+  rm_dir(dir);
+  free(a);
+  free(b);
+}
+
 /* ---------------------------------------------------------------- writing */
 
 static void test_round_trip_canonical(void **state) {
@@ -732,6 +1483,189 @@ static nav_vec3 any_vec3(uint64_t *x) {
   const double a = any_double(x), b = any_double(x), c = any_double(x);
   return nav_vec3_make(a, b, c);
 }
+/* >= 0; one case in four with three equal components (written as one number). */
+static nav_vec3 nonneg_vec3(uint64_t *x) {
+  if (splitmix64(x) % 4 == 0) {
+    const double v = fabs(any_double(x));
+    return nav_vec3_make(v, v, v);
+  }
+  const nav_vec3 v = any_vec3(x);
+  return nav_vec3_make(fabs(v.x), fabs(v.y), fabs(v.z));
+}
+static nav_vec3 positive_vec3(uint64_t *x) {
+  const nav_vec3 v = nonneg_vec3(x);
+  return nav_vec3_make(v.x + 1e-3, v.y + 1e-3, v.z + 1e-3);
+}
+/* A matrix with a zero diagonal (misalignment), or a full one; >= 0 for standard deviations. */
+static nav_mat3 any_mat3(uint64_t *x, bool zero_diagonal, bool nonneg) {
+  nav_mat3 m;
+  const bool same = splitmix64(x) % 3 == 0;
+  const double v = any_double(x);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double e = same ? v : any_double(x);
+      m.m[i][j] = zero_diagonal && i == j ? 0.0 : nonneg ? fabs(e) : e;
+    }
+  return m;
+}
+
+/* Random values for every field, each term on or off at random: a term that is off but holds
+   values is written with an "off" entry. */
+static void random_imu(uint64_t *x, nav_imu_model_config *m) {
+  nav_gyro_error_config *g = &m->gyro;
+  nav_accel_error_config *a = &m->accel;
+  g->terms = (unsigned)splitmix64(x) & NAV_IMU_TERMS_GYRO_ALL;
+  a->terms = (unsigned)splitmix64(x) & NAV_IMU_TERMS_ACCEL_ALL;
+  g->bias_turn_on_fixed_rps = any_vec3(x);
+  g->bias_turn_on_sd_rps = nonneg_vec3(x);
+  g->bias_gm_sd_rps = nonneg_vec3(x);
+  g->bias_gm_tau_s = positive_vec3(x);
+  g->bias_rw_rps_per_sqrt_s = nonneg_vec3(x);
+  g->arw_rad_per_sqrt_s = nonneg_vec3(x);
+  g->scale_factor_fixed = any_vec3(x);
+  g->scale_factor_sd = nonneg_vec3(x);
+  g->misalignment_fixed_rad = any_mat3(x, true, false);
+  g->misalignment_sd_rad = any_mat3(x, true, true);
+  g->g_sensitivity_fixed_rps_per_mps2 = any_mat3(x, false, false);
+  g->g_sensitivity_sd_rps_per_mps2 = any_mat3(x, false, true);
+  g->quant_step_rad = positive_vec3(x);
+  g->range_rps = positive_vec3(x);
+  a->bias_turn_on_fixed_mps2 = any_vec3(x);
+  a->bias_turn_on_sd_mps2 = nonneg_vec3(x);
+  a->bias_gm_sd_mps2 = nonneg_vec3(x);
+  a->bias_gm_tau_s = positive_vec3(x);
+  a->bias_rw_mps2_per_sqrt_s = nonneg_vec3(x);
+  a->vrw_mps_per_sqrt_s = nonneg_vec3(x);
+  a->scale_factor_fixed = any_vec3(x);
+  a->scale_factor_sd = nonneg_vec3(x);
+  a->misalignment_fixed_rad = any_mat3(x, true, false);
+  a->misalignment_sd_rad = any_mat3(x, true, true);
+  a->quant_step_mps = positive_vec3(x);
+  a->range_mps2 = positive_vec3(x);
+}
+
+static void random_gnss(uint64_t *x, nav_scene_gnss *n) {
+  nav_gnss_model_config *m = &n->model;
+  n->enabled = splitmix64(x) & 1;
+  m->terms = (unsigned)splitmix64(x) & NAV_GNSS_TERMS_ALL;
+  m->update_rate_hz = 0.1 + 20.0 * uniform(x);
+  m->latency_s = uniform(x);
+  m->pos_gm_sd_m = nonneg_vec3(x);
+  m->pos_gm_tau_s = nonneg_vec3(x);
+  m->pos_white_sd_m = nonneg_vec3(x);
+  m->vel_sd_mps = nonneg_vec3(x);
+  m->r_ba_b_m = any_vec3(x);
+  m->report_model_sigmas = splitmix64(x) & 1;
+  if (!m->report_model_sigmas) {
+    m->reported_pos_sd_m = nonneg_vec3(x);
+    m->reported_vel_sd_mps = nonneg_vec3(x);
+  }
+  m->outage_count = (size_t)(splitmix64(x) % 4);
+  for (size_t i = 0; i < m->outage_count; ++i) {
+    m->outages[i].t0_s = 1000.0 * uniform(x);
+    m->outages[i].t1_s = m->outages[i].t0_s + 1e-3 + 100.0 * uniform(x);
+  }
+}
+
+/* Trajectory sections of types the scene does not use (written because they differ from the
+   defaults); the test motion gets random values for its kind's parameters only, which are all
+   that is written. */
+static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
+  nav_traj_waypoints *w = &t->waypoints;
+  w->timing = (nav_wp_timing)(splitmix64(x) % 2);
+  w->attitude_mode = (nav_wp_attitude_mode)(splitmix64(x) % 4);
+  w->hold_start_s = 10.0 * uniform(x);
+  w->hold_end_s = 10.0 * uniform(x);
+  w->limits.max_rate_rps = 0.01 + uniform(x);
+  w->limits.max_ang_accel_rps2 = 0.01 + uniform(x);
+  w->count = (int)(splitmix64(x) % 4);
+  for (int i = 0; i < w->count; ++i) {
+    w->points[i].r_ned_m = any_vec3(x);
+    w->points[i].speed_mps = fabs(any_double(x));
+    w->points[i].time_s = fabs(any_double(x));
+    w->points[i].attitude = (nav_euler){any_double(x), any_double(x), any_double(x)};
+  }
+  nav_traj_segments *s = &t->segments;
+  s->allow_unconverged = splitmix64(x) & 1;
+  s->fit_rate_ramps = splitmix64(x) & 1;
+  s->r0_ned_m = any_vec3(x);
+  s->v0_b_mps = any_vec3(x);
+  s->limits.max_ang_jerk_rps3 = 0.01 + uniform(x);
+  s->count = (int)(splitmix64(x) % 6);
+  for (int i = 0; i < s->count; ++i) {
+    nav_segment *g = &s->items[i];
+    g->kind = (nav_segment_kind)(splitmix64(x) % 14);
+    g->gnss_visible = splitmix64(x) & 1;
+    g->coordinated = g->kind != NAV_SEG_HOLD && g->kind != NAV_SEG_ACCELERATE &&
+                     g->kind != NAV_SEG_COORD_TURN && g->kind != NAV_SEG_CLIMB && (splitmix64(x) & 1);
+    switch (g->kind) {
+    case NAV_SEG_HOLD: g->duration_s = 100.0 * uniform(x); break;
+    case NAV_SEG_ACCELERATE: g->speed_mps = any_double(x); break;
+    case NAV_SEG_TURN:
+    case NAV_SEG_COORD_TURN:
+      g->yaw_rad = any_double(x);
+      g->yaw_rate_rps = any_double(x);
+      break;
+    case NAV_SEG_CLIMB:
+      g->height_m = any_double(x);
+      g->pitch_rad = any_double(x);
+      break;
+    case NAV_SEG_HELIX: g->pitch_rad = any_double(x); /* fall through */
+    case NAV_SEG_CIRCLE:
+    case NAV_SEG_FIGURE_EIGHT:
+      g->radius_m = 1.0 + fabs(any_double(x));
+      g->turns = any_double(x);
+      break;
+    case NAV_SEG_LAWNMOWER:
+      g->legs = 1 + (int)(splitmix64(x) % 10);
+      g->length_m = fabs(any_double(x));
+      g->spacing_m = any_double(x);
+      break;
+    case NAV_SEG_MOTION_RATES:
+      g->yaw_rate_rps = any_double(x);
+      g->pitch_rate_rps = any_double(x);
+      g->roll_rate_rps = any_double(x);
+      g->accel_b_mps2 = any_vec3(x);
+      g->duration_s = 100.0 * uniform(x);
+      break;
+    default:
+      g->yaw_rad = any_double(x);
+      g->pitch_rad = any_double(x);
+      g->roll_rad = any_double(x);
+      g->v_b_mps = any_vec3(x);
+      g->duration_s = 100.0 * uniform(x);
+      break;
+    }
+  }
+  nav_traj_test_motion *m = &t->test_motion;
+  m->kind = (nav_test_motion_kind)(splitmix64(x) % 6);
+  switch (m->kind) {
+  case NAV_TEST_MOTION_CONING:
+    m->cone_half_angle_rad = any_double(x);
+    m->cone_rate_rps = any_double(x);
+    break;
+  case NAV_TEST_MOTION_SCULLING:
+    m->scull_angle_rad = any_double(x);
+    m->scull_accel_mps2 = any_double(x);
+    m->scull_rate_rps = any_double(x);
+    break;
+  case NAV_TEST_MOTION_SPIN:
+    m->spin_rate_rps = any_double(x);
+    m->spin_axis_b = any_vec3(x);
+    break;
+  case NAV_TEST_MOTION_POLAR_GREAT_CIRCLE:
+    m->gc_height_m = any_double(x);
+    m->gc_speed_mps = any_double(x);
+    m->gc_start_angle_rad = any_double(x);
+    m->gc_lon_rad = any_double(x);
+    break;
+  case NAV_TEST_MOTION_VERTICAL_LOOP:
+    m->loop_speed_mps = any_double(x);
+    m->loop_pitch_rate_rps = any_double(x);
+    break;
+  default: break;
+  }
+}
 
 static void test_round_trip_random_bit_exact(void **state) {
   (void)state;
@@ -739,21 +1673,27 @@ static void test_round_trip_random_bit_exact(void **state) {
   diag_log log;
   const uint64_t seed = 0x5EED5CE4Eu;
   uint64_t x = seed;
+  nav_scene *ap = malloc(sizeof *ap), *bp = malloc(sizeof *bp);
+  assert_non_null(ap);
+  assert_non_null(bp);
   nav_test_print_seed("test_round_trip_random_bit_exact", seed);
   make_dir(dir, sizeof dir);
   snprintf(path, sizeof path, "%s/rt.yaml", dir);
   for (int k = 0; k < 40; ++k) {
-    nav_scene a = nav_scene_default(), b;
+    nav_scene *a = ap, *b = bp;
+    *a = nav_scene_default();
     /* Arbitrary radians: most have no exact decimal-degree spelling and fall back to _rad. */
-    a.earth.origin_lat_rad = (uniform(&x) - 0.5) * 0.999 * NAV_PI;
-    a.earth.origin_lon_rad = (uniform(&x) - 0.5) * 2.0 * NAV_PI;
-    a.earth.origin_h_m = (uniform(&x) - 0.5) * 2.0e4;
-    a.earth.flat_gravity_mps2 = 9.0 + uniform(&x);
-    a.trajectory.duration_s = 1.0 + 100.0 * uniform(&x);
-    a.trajectory.initial_attitude.roll_rad = any_double(&x);
-    a.trajectory.initial_attitude.pitch_rad = k == 0 ? -0.0 : any_double(&x);
-    a.trajectory.initial_attitude.yaw_rad = k == 1 ? 5e-324 : any_double(&x);
-    nav_traj_parametric *p = &a.trajectory.parametric;
+    a->earth.model = (splitmix64(&x) & 1) ? NAV_EARTH_WGS84 : NAV_EARTH_FLAT;
+    a->earth.gravity_model = (splitmix64(&x) & 1) ? NAV_GRAVITY_J2 : NAV_GRAVITY_NORMAL;
+    a->earth.origin_lat_rad = (uniform(&x) - 0.5) * 0.999 * NAV_PI;
+    a->earth.origin_lon_rad = (uniform(&x) - 0.5) * 2.0 * NAV_PI;
+    a->earth.origin_h_m = (uniform(&x) - 0.5) * 2.0e4;
+    a->earth.flat_gravity_mps2 = 9.0 + uniform(&x);
+    a->trajectory.duration_s = 1.0 + 100.0 * uniform(&x);
+    a->trajectory.initial_attitude.roll_rad = any_double(&x);
+    a->trajectory.initial_attitude.pitch_rad = k == 0 ? -0.0 : any_double(&x);
+    a->trajectory.initial_attitude.yaw_rad = k == 1 ? 5e-324 : any_double(&x);
+    nav_traj_parametric *p = &a->trajectory.parametric;
     p->r0_m = any_vec3(&x);
     p->v0_mps = any_vec3(&x);
     p->a_mps2 = any_vec3(&x);
@@ -765,23 +1705,37 @@ static void test_round_trip_random_bit_exact(void **state) {
     p->wc_hz = any_vec3(&x);
     p->wd_rad = any_vec3(&x);
     p->magnus_substeps = 1 + (int)(splitmix64(&x) % 64);
-    a.imu.rate_hz = 50.0 + 1000.0 * uniform(&x);
-    a.imu.quadrature_nodes = 1 + (int)(splitmix64(&x) % 8);
-    a.navigation.algorithm = (splitmix64(&x) & 1) ? NAV_MECH_HIGH_ORDER : NAV_MECH_FIRST_ORDER;
-    a.output.rate_hz = 1.0 + 40.0 * uniform(&x);
-    a.simulation.seed = splitmix64(&x);
-    a.simulation.runs = 1 + (long)(splitmix64(&x) % 1000);
-    snprintf(a.name, sizeof a.name, "run \"%d\" \\ %s", k, k % 2 ? "caf\xC3\xA9" : "colon: # hash");
-    assert_int_equal(nav_scene_write_file(path, &a), NAV_OK);
-    const nav_status st = read_path(path, &b, &log);
+    random_trajectories(&x, &a->trajectory);
+    a->imu.rate_hz = 50.0 + 1000.0 * uniform(&x);
+    a->imu.quadrature_nodes = 1 + (int)(splitmix64(&x) % 8);
+    random_imu(&x, &a->imu.model);
+    random_gnss(&x, &a->gnss);
+    a->initial_errors.pos_sd_m = nonneg_vec3(&x);
+    a->initial_errors.vel_sd_mps = nonneg_vec3(&x);
+    a->initial_errors.att_sd_rad = nonneg_vec3(&x);
+    a->navigation.scheme = a->gnss.enabled && a->earth.model == NAV_EARTH_WGS84 && (splitmix64(&x) & 1)
+                               ? NAV_SCHEME_INS_GNSS
+                               : NAV_SCHEME_FREE_INS;
+    a->navigation.algorithm = (splitmix64(&x) & 1) ? NAV_MECH_HIGH_ORDER : NAV_MECH_FIRST_ORDER;
+    a->navigation.frame = (splitmix64(&x) & 1) ? NAV_MECH_ECEF : NAV_MECH_NED;
+    a->navigation.aid_vertical = a->navigation.scheme == NAV_SCHEME_FREE_INS && (splitmix64(&x) & 1);
+    a->output.rate_hz = 1.0 + 40.0 * uniform(&x);
+    a->simulation.seed = splitmix64(&x);
+    a->simulation.runs = 1 + (long)(splitmix64(&x) % 1000);
+    a->simulation.threads = (int)(splitmix64(&x) % 257);
+    snprintf(a->name, sizeof a->name, "run \"%d\" \\ %s", k, k % 2 ? "caf\xC3\xA9" : "colon: # hash");
+    assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
+    const nav_status st = read_path(path, b, &log);
     if (st != NAV_OK) {
       print_log(&log);
       fail_msg("case %d: %s", k, slurp(path));
     }
-    assert_scene_same(&a, &b);
+    assert_scene_same(a, b);
   }
   assert_int_equal(count_entries(dir), 1);
   rm_dir(dir);
+  free(ap);
+  free(bp);
 }
 
 static void test_write_errors(void **state) {
@@ -842,6 +1796,20 @@ int main(void) {
       cmocka_unit_test(test_aliases_tags_and_bombs),
       cmocka_unit_test(test_deep_nesting_and_size_limits),
       cmocka_unit_test(test_long_values_are_cut_in_messages),
+      cmocka_unit_test(test_waypoints),
+      cmocka_unit_test(test_geodetic_waypoints_any_order),
+      cmocka_unit_test(test_segment_kinds),
+      cmocka_unit_test(test_test_motions),
+      cmocka_unit_test(test_motion_def_import),
+      cmocka_unit_test(test_duration_auto),
+      cmocka_unit_test(test_sensor_units),
+      cmocka_unit_test(test_bias_instability_conventions),
+      cmocka_unit_test(test_imu_catalog),
+      cmocka_unit_test(test_gnss_catalog),
+      cmocka_unit_test(test_trajectory_errors),
+      cmocka_unit_test(test_sensor_errors),
+      cmocka_unit_test(test_motion_def_errors),
+      cmocka_unit_test(test_scene_library_round_trip),
       cmocka_unit_test(test_round_trip_canonical),
       cmocka_unit_test(test_round_trip_random_bit_exact),
       cmocka_unit_test(test_write_errors),

@@ -284,7 +284,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const bool aid = sc->navigation.aid_vertical;
   const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
   if (integrated) {
-    st = nav_gnss_model_create(&sc->gnss.model, &frame, sc->simulation.seed, (uint64_t)run, &aid_kf.gnss);
+    /* --ideal: the receiver is perfect too (same epochs and outages, no error terms). */
+    nav_gnss_model_config gcfg = sc->gnss.model;
+    if (j->ideal) gcfg.terms = 0;
+    st = nav_gnss_model_create(&gcfg, &frame, sc->simulation.seed, (uint64_t)run, &aid_kf.gnss);
     if (st != NAV_OK) {
       job_error(j, "run %ld: GNSS receiver model: %s", run, nav_status_str(st));
       goto cleanup;
