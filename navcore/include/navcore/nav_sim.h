@@ -28,6 +28,7 @@
 #include "nav_scene.h"
 #include "nav_status.h"
 #include "nav_traj.h"
+#include "nav_truth.h"
 
 NAV_BEGIN_DECLS
 
@@ -51,6 +52,10 @@ typedef struct nav_sim_record {
   const nav_traj_state *truth;
   const nav_ins_state *nav;
   const nav_epoch_errors *err;
+  /** IMU increments of the interval ending at this epoch: ideal and as measured (with the
+   *  scene's sensor errors). NULL at t = 0. Their difference is the simulated sensor error. */
+  const nav_imu_increment *imu_ideal;
+  const nav_imu_increment *imu_measured;
 } nav_sim_record;
 
 typedef nav_callback_result (*nav_record_fn)(void *user, const nav_sim_record *r);

@@ -306,7 +306,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   store_metrics(j, run, 0, &err);
   store_env(j, run, 0, &err);
   if (record) {
-    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err};
+    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
   }
   int64_t k = 1;
@@ -332,6 +332,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     } else {
       meas = ideal_imu;
     }
+    const nav_imu_increment meas_raw = meas;
     if (integrated) {
       st = nav_ins_gnss_step(aid_kf.x, &meas);
       if (st != NAV_OK) {
@@ -363,7 +364,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     store_env(j, run, k, &err);
     if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_now, &err};
+      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
     }
     if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
