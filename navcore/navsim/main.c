@@ -58,7 +58,9 @@ static const char *k_usage_run =
     "  truth.csv     reference state at the output rate\n"
     "  nav.csv       navigation solution at the output rate\n"
     "  errors.csv    navigation minus reference at the output rate (run 0)\n"
-    "  mc_envelope.csv  with several runs: RMS, mean and max of the errors over runs per epoch\n"
+    "  mc_stats.csv  with several runs, per output epoch: mean and RMS over runs of each error\n"
+    "                component, the filter's mean reported sigma and the mean NEES (INS/GNSS)\n"
+    "  mc_final.csv  with several runs: the final errors of every run\n"
     "The directory appears only when complete (it is built under a hidden name and renamed).\n"
     "\n"
     "options:\n"
@@ -307,32 +309,45 @@ static int cmd_run(int argc, char **argv) {
     }
   }
   if (sum.runs > 1) {
-    /* Monte Carlo envelope: statistics over runs at each output epoch. */
-    size_t ne = 0;
+    /* Monte Carlo statistics over runs per output epoch, and the final errors of every run. */
+    size_t ne = 0, nf = 0;
     const nav_sim_envelope_point *env = nav_sim_envelope(sim, &ne);
-    const char *file = nav_resultdir_file(rd, "mc_envelope.csv");
+    const nav_sim_run_final *fin = nav_sim_finals(sim, &nf);
+    const char *file = nav_resultdir_file(rd, "mc_stats.csv");
     FILE *f = (env && file) ? fopen(file, "w") : NULL;
-    if (env && !f) {
-      fprintf(stderr, "navsim run: cannot write mc_envelope.csv\n");
-      rc = EXIT_FAIL;
-      goto cleanup;
-    }
+    bool bad = env && !f;
     if (f) {
-      fputs("t_s,pos_rms_n_m,pos_rms_e_m,pos_rms_d_m,pos_mean_n_m,pos_mean_e_m,pos_mean_d_m,pos_h_rms_m,pos_h_max_m,"
-            "vel_rms_mps,att_rms_rad\n",
+      fputs("t_s,pos_mean_n_m,pos_mean_e_m,pos_mean_d_m,pos_rms_n_m,pos_rms_e_m,pos_rms_d_m,pos_h_rms_m,pos_h_max_m,"
+            "vel_rms_mps,att_rms_rad,pos_sd_reported_n_m,pos_sd_reported_e_m,pos_sd_reported_d_m,nees9_mean\n",
             f);
       for (size_t i = 0; i < ne; ++i) {
         const nav_sim_envelope_point *p = &env[i];
-        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p->t_s, p->pos_rms_n_m.x,
-                p->pos_rms_n_m.y, p->pos_rms_n_m.z, p->pos_mean_n_m.x, p->pos_mean_n_m.y, p->pos_mean_n_m.z,
-                p->pos_h_rms_m, p->pos_h_max_m, p->vel_rms_mps, p->att_rms_rad);
+        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p->t_s,
+                p->pos_mean_n_m.x, p->pos_mean_n_m.y, p->pos_mean_n_m.z, p->pos_rms_n_m.x, p->pos_rms_n_m.y,
+                p->pos_rms_n_m.z, p->pos_h_rms_m, p->pos_h_max_m, p->vel_rms_mps, p->att_rms_rad,
+                p->pos_sd_reported_n_m.x, p->pos_sd_reported_n_m.y, p->pos_sd_reported_n_m.z, p->nees9_mean);
       }
-      const bool bad = ferror(f) != 0;
-      if (fclose(f) != 0 || bad) {
-        fprintf(stderr, "navsim run: writing mc_envelope.csv failed\n");
-        rc = EXIT_FAIL;
-        goto cleanup;
+      bad = ferror(f) != 0;
+      if (fclose(f) != 0) bad = true;
+    }
+    file = nav_resultdir_file(rd, "mc_final.csv");
+    f = (fin && file) ? fopen(file, "w") : NULL;
+    if (fin && !f) bad = true;
+    if (f) {
+      fputs("run,t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_mps,att_err_rad,yaw_err_deg\n", f);
+      for (size_t i = 0; i < nf; ++i) {
+        const nav_epoch_errors *e = &fin[i].err;
+        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", fin[i].run, e->t_s, e->pos_err_n_m.x,
+                e->pos_err_n_m.y, e->pos_err_n_m.z, e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad,
+                e->euler_err.yaw_rad * NAV_RAD2DEG);
       }
+      if (ferror(f) != 0) bad = true;
+      if (fclose(f) != 0) bad = true;
+    }
+    if (bad) {
+      fprintf(stderr, "navsim run: writing mc_stats.csv / mc_final.csv failed\n");
+      rc = EXIT_FAIL;
+      goto cleanup;
     }
   }
   nav_run_info info = {scene_path, scene.simulation.seed, ideal, wall};

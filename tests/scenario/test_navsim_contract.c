@@ -296,6 +296,23 @@ static void test_deterministic_and_atomic_replace(void **state) {
   closedir(d);
 }
 
+static void test_monte_carlo_outputs(void **state) {
+  (void)state;
+  result *r = navsim(NULL, "run '" SCENE "' --out mc --quiet --runs 3 --threads 2");
+  if (r->code != 0) fail_msg("navsim run --runs 3 failed (%d): %s", r->code, r->err);
+  static char buf[1 << 18];
+  slurp(WORK "/mc/mc_stats.csv", buf, sizeof buf);
+  assert_matches(buf, "^t_s,pos_mean_n_m,pos_mean_e_m,pos_mean_d_m,pos_rms_n_m,pos_rms_e_m,pos_rms_d_m,pos_h_rms_m,"
+                      "pos_h_max_m,vel_rms_mps,att_rms_rad,pos_sd_reported_n_m,pos_sd_reported_e_m,"
+                      "pos_sd_reported_d_m,nees9_mean$");
+  slurp(WORK "/mc/mc_final.csv", buf, sizeof buf);
+  int lines = 0;
+  for (const char *p = buf; *p; ++p) lines += *p == '\n';
+  assert_int_equal(lines, 1 + 3);
+  slurp(WORK "/mc/summary.json", buf, sizeof buf);
+  assert_near(json_number(buf, NULL, "runs"), 3.0, 0.0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_version_and_help),
@@ -307,6 +324,7 @@ int main(void) {
       cmocka_unit_test(test_csv_tables),
       cmocka_unit_test(test_default_out_dir_and_summary_on_terminal),
       cmocka_unit_test(test_deterministic_and_atomic_replace),
+      cmocka_unit_test(test_monte_carlo_outputs),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -257,6 +257,72 @@ static void test_t66_monte_carlo_vs_covariance(void **state) {
   assert_true(inside >= 3);
 }
 
+/*
+ * numerics.md T6.5: NEES of a consistent INS/GNSS filter. The filter's model equals the truth's
+ * (white IMU noise, random-constant biases drawn from the filter's P0, initial errors drawn from
+ * P0, white GNSS noise equal to R), so the 9-state NEES averaged over M runs satisfies
+ * M nees ~ chi2(9 M); with M = 100 the 95 % region is computed below. Pass: >= 90 % of the
+ * epochs inside (epochs are correlated).
+ */
+static void test_t65_nees_consistency(void **state) {
+  (void)state;
+  const double d2r = NAV_PI / 180.0, g0 = 9.80665;
+  const double Na = 0.07 / 60.0, Ng = 0.15 * d2r / 60.0, sba = 0.05e-3 * g0, sbg = 0.5 * d2r / 3600.0;
+  nav_scene sc = nav_scene_default();
+  sc.earth.model = NAV_EARTH_WGS84;
+  sc.earth.origin_lat_rad = 45.0 * d2r;
+  sc.trajectory.type = NAV_TRAJ_SEGMENTS;
+  sc.trajectory.duration_s = 60.0;
+  sc.trajectory.initial_attitude = (nav_euler){0.0, 0.0, 0.0};
+  sc.trajectory.segments.count = 2;
+  sc.trajectory.segments.v0_b_mps = nav_vec3_make(20.0, 0.0, 0.0);
+  sc.trajectory.segments.items[0].kind = NAV_SEG_HOLD;
+  sc.trajectory.segments.items[0].duration_s = 20.0;
+  sc.trajectory.segments.items[1].kind = NAV_SEG_HOLD;
+  sc.trajectory.segments.items[1].duration_s = 40.0;
+  sc.imu.rate_hz = 100.0;
+  sc.output.rate_hz = 1.0;
+  sc.navigation.algorithm = NAV_MECH_HIGH_ORDER;
+  sc.navigation.scheme = NAV_SCHEME_INS_GNSS;
+  sc.imu.model.gyro.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc.imu.model.gyro.arw_rad_per_sqrt_s = nav_vec3_make(Ng, Ng, Ng);
+  sc.imu.model.gyro.bias_turn_on_sd_rps = nav_vec3_make(sbg, sbg, sbg);
+  sc.imu.model.accel.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc.imu.model.accel.vrw_mps_per_sqrt_s = nav_vec3_make(Na, Na, Na);
+  sc.imu.model.accel.bias_turn_on_sd_mps2 = nav_vec3_make(sba, sba, sba);
+  sc.initial_errors.pos_sd_m = nav_vec3_make(1.0, 1.0, 2.0);
+  sc.initial_errors.vel_sd_mps = nav_vec3_make(0.1, 0.1, 0.1);
+  sc.initial_errors.att_sd_rad = nav_vec3_make(0.05 * d2r, 0.05 * d2r, 0.5 * d2r);
+  sc.gnss.enabled = true;
+  sc.gnss.model.terms = NAV_GNSS_TERM_POS_WHITE | NAV_GNSS_TERM_VEL_WHITE;
+  sc.gnss.model.update_rate_hz = 1.0;
+  sc.gnss.model.pos_white_sd_m = nav_vec3_make(1.0, 1.0, 2.0);
+  sc.gnss.model.vel_sd_mps = nav_vec3_make(0.05, 0.05, 0.1);
+  sc.simulation.runs = 100;
+  sc.simulation.seed = 65;
+  nav_sim *sim = NULL;
+  assert_int_equal(nav_sim_create(&sc, &sim), NAV_OK);
+  nav_sim_options o = nav_sim_options_default();
+  o.threads = 2;
+  nav_sim_summary sum;
+  if (nav_sim_run(sim, &o, &sum) != NAV_OK) fail_msg("%s", nav_sim_last_error(sim));
+  size_t ne = 0;
+  const nav_sim_envelope_point *env = nav_sim_envelope(sim, &ne);
+  assert_non_null(env);
+  const double k = 9.0 * 100.0;
+  const double lo = 9.0 * chi2_over_k(k, -1.96), hi = 9.0 * chi2_over_k(k, 1.96);
+  size_t inside = 0;
+  double mean_all = 0.0;
+  for (size_t e = 0; e < ne; ++e) {
+    if (env[e].nees9_mean > lo && env[e].nees9_mean < hi) ++inside;
+    mean_all += env[e].nees9_mean;
+  }
+  print_message("T6.5 NEES (9 states, 100 runs): time-average %.3f, %zu of %zu epochs in [%.3f, %.3f]\n",
+                mean_all / (double)ne, inside, ne, lo, hi);
+  nav_sim_destroy(sim);
+  assert_true((double)inside >= 0.9 * (double)ne);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_deterministic_across_threads),
@@ -265,6 +331,7 @@ int main(void) {
       cmocka_unit_test(test_mc_initial_errors),
       cmocka_unit_test(test_ideal_ignores_errors),
       cmocka_unit_test(test_t66_monte_carlo_vs_covariance),
+      cmocka_unit_test(test_t65_nees_consistency),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -76,6 +76,12 @@ typedef struct nav_sim_stats {
   nav_stat pos_err_h_m, pos_err_v_m, vel_err_mps, att_err_rad, yaw_err_rad;
 } nav_sim_stats;
 
+/** Final errors of one Monte Carlo run. */
+typedef struct nav_sim_run_final {
+  long run;
+  nav_epoch_errors err;
+} nav_sim_run_final;
+
 typedef struct nav_sim_summary {
   long runs;
   int64_t imu_samples;     /**< per run */
@@ -97,6 +103,11 @@ typedef struct nav_sim_envelope_point {
   double pos_h_max_m;    /**< largest horizontal error over runs [m] */
   double vel_rms_mps;    /**< RMS over runs of |velocity error| [m/s] */
   double att_rms_rad;    /**< RMS over runs of the attitude error angle [rad] */
+  /** INS/GNSS only (else 0): mean over runs of the filter's reported position sigma N/E/D [m] */
+  nav_vec3 pos_sd_reported_n_m;
+  /** INS/GNSS only: NEES of the 9 navigation error states (position, velocity, attitude in the
+   *  phi-angle convention) averaged over runs; consistent filter: M nees_mean ~ chi2(9 M). */
+  double nees9_mean;
 } nav_sim_envelope_point;
 
 typedef struct nav_sim nav_sim;
@@ -144,6 +155,12 @@ NAV_API NAV_NODISCARD nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn,
 
 /** The scene of a simulation (borrowed). */
 NAV_API const nav_scene *nav_sim_scene(const nav_sim *sim);
+
+/**
+ * Final errors of every run of the last nav_sim_run, in run order (borrowed; valid until the
+ * next nav_sim_run or destroy). NULL and *count = 0 when there is none.
+ */
+NAV_API const nav_sim_run_final *nav_sim_finals(const nav_sim *sim, size_t *count);
 
 /** Ask a running nav_sim_run to stop at the next sample. Thread-safe. */
 NAV_API void nav_sim_request_cancel(nav_sim *sim);

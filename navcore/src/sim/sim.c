@@ -37,10 +37,13 @@ struct nav_sim {
   char last_error[256];
   nav_sim_envelope_point *envelope; /* per output epoch, from the last run */
   size_t envelope_count;
+  nav_sim_run_final *finals; /* per run, from the last run */
+  size_t finals_count;
 };
 
-/* Values per output epoch and run kept for the envelopes: N, E, D, |dv|, attitude angle. */
-#define ENV_VALUES 5
+/* Values per output epoch and run kept for the envelopes: N, E, D, |dv|, attitude angle, and for
+ * INS/GNSS the filter's position sigma N, E, D and the 9-state NEES. */
+#define ENV_VALUES 9
 
 nav_sim_options nav_sim_options_default(void) {
   nav_sim_options o;
@@ -62,8 +65,14 @@ nav_status nav_sim_create(const nav_scene *scene, nav_sim **out) {
 
 void nav_sim_destroy(nav_sim *sim) {
   if (!sim) return;
+  free(sim->finals);
   free(sim->envelope);
   free(sim);
+}
+
+const nav_sim_run_final *nav_sim_finals(const nav_sim *sim, size_t *count) {
+  if (count) *count = sim && sim->finals ? sim->finals_count : 0;
+  return sim ? sim->finals : NULL;
 }
 
 const nav_sim_envelope_point *nav_sim_envelope(const nav_sim *sim, size_t *count) {
@@ -231,7 +240,32 @@ static int64_t out_slot(const job *j, int64_t k) {
   return k == j->n ? j->n_out - 1 : -1;
 }
 
-static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e) {
+/*
+ * NEES of the 9 navigation error states against the filter's covariance (numerics.md T6.5):
+ * e = (dr_n, dv_n, phi) with phi from C_true C_est^T = I + [phi x] (E0.1), resolved in n.
+ * Returns NAN when the block is not positive definite.
+ */
+static double nees9(const nav_filter *kf, const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s,
+                    const nav_epoch_errors *e) {
+  const double *P = nav_filter_get_cov(kf);
+  const size_t n = nav_filter_get_layout(kf).n_states;
+  double B[81], L[81], x[9];
+  for (size_t i = 0; i < 9; ++i)
+    for (size_t q = 0; q < 9; ++q) B[i * 9 + q] = P[i * n + q];
+  const nav_local_view vt = nav_frame_view(fr, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f);
+  const nav_vec3 phi_f = nav_quat_to_rotvec(nav_quat_mul(ts->q_b_f, nav_quat_conj(s->q_b_f)));
+  const nav_vec3 phi_n = nav_mat3_mul_vec(vt.C_f_n, phi_f);
+  const double err[9] = {e->pos_err_n_m.x,   e->pos_err_n_m.y,   e->pos_err_n_m.z, e->vel_err_n_mps.x, e->vel_err_n_mps.y,
+                         e->vel_err_n_mps.z, phi_n.x, phi_n.y, phi_n.z};
+  if (nav_matn_cholesky(L, B, 9) != NAV_OK) return NAN;
+  nav_matn_chol_solve(x, L, err, 9, 1);
+  double q2 = 0.0;
+  for (int i = 0; i < 9; ++i) q2 += err[i] * x[i];
+  return q2;
+}
+
+static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, const nav_filter *kf,
+                      const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s) {
   const int64_t slot = out_slot(j, k);
   if (!j->env || slot < 0 || slot >= j->n_out) return;
   double *v = j->env + ((int64_t)run * j->n_out + slot) * ENV_VALUES;
@@ -240,6 +274,13 @@ static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e) {
   v[2] = e->pos_err_n_m.z;
   v[3] = e->vel_err_mps;
   v[4] = e->att_err_rad;
+  v[5] = v[6] = v[7] = v[8] = 0.0;
+  if (kf) {
+    const double *P = nav_filter_get_cov(kf);
+    const size_t n = nav_filter_get_layout(kf).n_states;
+    for (int i = 0; i < 3; ++i) v[5 + i] = sqrt(P[(size_t)i * n + (size_t)i]);
+    v[8] = nees9(kf, fr, ts, s, e);
+  }
 }
 
 static nav_status run_one(job *j, long run, bool caller_thread) {
@@ -304,7 +345,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
 
   nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
-  store_env(j, run, 0, &err);
+  store_env(j, run, 0, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_ins_get_state(ins));
   if (record) {
     nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -362,7 +403,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     }
     err = nav_errors_compute(&frame, &ts, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
-    store_env(j, run, k, &err);
+    store_env(j, run, k, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_now);
     if (record && (k % j->out_stride == 0 || k == j->n)) {
       nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -589,6 +630,17 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       sum.final_rms.att_err_rad = sqrt(s2[3] / (double)nf);
     }
   }
+  /* Final errors per run (complete runs), in run order. */
+  free(sim->finals);
+  sim->finals = calloc((size_t)j.runs, sizeof *sim->finals);
+  sim->finals_count = 0;
+  if (sim->finals)
+    for (long r = 0; r < j.runs; ++r)
+      if (j.status[r] == NAV_OK) {
+        sim->finals[sim->finals_count].run = r;
+        sim->finals[sim->finals_count].err = j.final[r];
+        sim->finals_count++;
+      }
   /* Envelopes over complete runs, in run order. */
   if (j.env && !sum.partial) {
     sim->envelope = calloc((size_t)j.n_out, sizeof *sim->envelope);
@@ -598,11 +650,14 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
         nav_sim_envelope_point *p = &sim->envelope[e];
         const int64_t k = e == j.n_out - 1 ? j.n : e * j.out_stride;
         p->t_s = (double)k * dt;
-        double s2[ENV_VALUES] = {0.0, 0.0, 0.0, 0.0, 0.0}, mean[3] = {0.0, 0.0, 0.0}, h2 = 0.0, hmax = 0.0;
+        double s2[5] = {0.0, 0.0, 0.0, 0.0, 0.0}, mean[3] = {0.0, 0.0, 0.0}, h2 = 0.0, hmax = 0.0;
+        double sdm[3] = {0.0, 0.0, 0.0}, nees = 0.0;
         for (long r = 0; r < j.runs; ++r) {
           const double *v = j.env + ((int64_t)r * j.n_out + e) * ENV_VALUES;
-          for (int q = 0; q < ENV_VALUES; ++q) s2[q] += v[q] * v[q];
+          for (int q = 0; q < 5; ++q) s2[q] += v[q] * v[q];
           for (int q = 0; q < 3; ++q) mean[q] += v[q];
+          for (int q = 0; q < 3; ++q) sdm[q] += v[5 + q];
+          nees += v[8];
           const double h = hypot(v[0], v[1]);
           h2 += h * h;
           if (h > hmax) hmax = h;
@@ -614,6 +669,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
         p->pos_h_max_m = hmax;
         p->vel_rms_mps = sqrt(s2[3] / nr);
         p->att_rms_rad = sqrt(s2[4] / nr);
+        p->pos_sd_reported_n_m = nav_vec3_make(sdm[0] / nr, sdm[1] / nr, sdm[2] / nr);
+        p->nees9_mean = nees / nr;
       }
     }
   }
