@@ -1,0 +1,1062 @@
+/*
+ * Recorded-data readers (KF-GINS text formats) and the replay of our navigation on them
+ * (nav_recorded.h).
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <locale.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "navcore/nav_earth.h"
+#include "navcore/nav_recorded.h"
+
+/* Buffer of a streaming reader. Larger than the longest line, so a full buffer always holds a
+ * complete line; 256 KiB amortises fread and keeps memory flat for any file size. */
+#define BUF_CAP (256u * 1024u)
+#define MAX_COLS 13
+
+struct nav_rec_reader {
+  nav_rec_format fmt;
+  FILE *f;         /* NULL for a memory source */
+  const char *mem; /* memory source */
+  size_t mem_len, mem_pos;
+  char *buf;       /* BUF_CAP + 1 bytes: room for a terminating NUL after the last line */
+  size_t len, pos; /* unread data is buf[pos, len) */
+  bool src_eof;
+  long line;              /* lines consumed */
+  long rec_line;          /* line of the last record returned */
+  double consumed, total; /* bytes, for the progress fraction */
+  nav_status failed;      /* sticky error status */
+  nav_diag diag;
+  bool have_prev;
+  double t_prev;
+  long prev_line;
+  int64_t k;
+  int gnss_cols;      /* column count fixed by the first GNSS record (0 before) */
+  locale_t c_numeric; /* "C" numbers for strtod, whatever the process locale (a GUI may set one) */
+};
+
+/* ---------------------------------------------------------------- diagnostics */
+
+static void diag_set(nav_diag *d, const char *file, int line, int col, const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+
+static void diag_set(nav_diag *d, const char *file, int line, int col, const char *path, const char *fmt,
+                     ...) {
+  if (!d) return;
+  memset(d, 0, sizeof *d);
+  snprintf(d->file, sizeof d->file, "%s", file ? file : "");
+  d->line = line;
+  d->col = line > 0 ? col : 0;
+  snprintf(d->path, sizeof d->path, "%s", path ? path : "");
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(d->message, sizeof d->message, fmt, ap);
+  va_end(ap);
+}
+
+/* Printable excerpt of a field for a message: control bytes become '?', long text is cut. */
+static void excerpt(char *dst, size_t cap, const char *s, size_t n) {
+  size_t j = 0;
+  const size_t max = cap > 40 ? 32 : cap - 4;
+  for (size_t i = 0; i < n && j < max; ++i) {
+    const unsigned char c = (unsigned char)s[i];
+    dst[j++] = (c < 0x20 || c == 0x7f) ? '?' : (char)c;
+  }
+  if (n > max) {
+    memcpy(dst + j, "...", 3);
+    j += 3;
+  }
+  dst[j] = '\0';
+}
+
+static nav_status fail(nav_rec_reader *r, nav_status st, int line, int col, const char *path,
+                       const char *msg) {
+  char file[sizeof r->diag.file];
+  snprintf(file, sizeof file, "%s", r->diag.file);
+  diag_set(&r->diag, file, line, col, path, "%s", msg);
+  r->failed = st;
+  return st;
+}
+
+/* ---------------------------------------------------------------- reader */
+
+static const char *format_name(nav_rec_format f) {
+  switch (f) {
+  case NAV_REC_IMU: return "IMU";
+  case NAV_REC_GNSS: return "GNSS";
+  case NAV_REC_PVA: return ".nav";
+  default: return "?";
+  }
+}
+
+static nav_status reader_new(nav_rec_format fmt, const char *name, nav_rec_reader **out) {
+  if (fmt != NAV_REC_IMU && fmt != NAV_REC_GNSS && fmt != NAV_REC_PVA) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *r = calloc(1, sizeof *r);
+  if (!r) return NAV_ERR_NO_MEMORY;
+  r->buf = malloc(BUF_CAP + 1);
+  if (!r->buf) {
+    free(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  r->c_numeric = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+  if (r->c_numeric == (locale_t)0) {
+    free(r->buf);
+    free(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  r->fmt = fmt;
+  r->failed = NAV_OK;
+  snprintf(r->diag.file, sizeof r->diag.file, "%s", name ? name : "");
+  *out = r;
+  return NAV_OK;
+}
+
+nav_status nav_rec_reader_open(const char *path, nav_rec_format fmt, nav_rec_reader **out, nav_diag *diag) {
+  if (!path || !out) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *r = NULL;
+  nav_status st = reader_new(fmt, path, &r);
+  if (st != NAV_OK) return st;
+  r->f = fopen(path, "rb");
+  if (!r->f) {
+    diag_set(diag, path, 0, 0, "", "cannot open the %s file: %s", format_name(fmt), strerror(errno));
+    nav_rec_reader_destroy(r);
+    return NAV_ERR_IO;
+  }
+  struct stat sb;
+  if (fstat(fileno(r->f), &sb) == 0 && S_ISREG(sb.st_mode)) r->total = (double)sb.st_size;
+  *out = r;
+  return NAV_OK;
+}
+
+nav_status nav_rec_reader_open_memory(const char *text, size_t len, const char *display_name,
+                                      nav_rec_format fmt, nav_rec_reader **out) {
+  if ((!text && len > 0) || !out) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *r = NULL;
+  const nav_status st = reader_new(fmt, display_name ? display_name : "<memory>", &r);
+  if (st != NAV_OK) return st;
+  r->mem = text;
+  r->mem_len = len;
+  r->total = (double)len;
+  *out = r;
+  return NAV_OK;
+}
+
+void nav_rec_reader_destroy(nav_rec_reader *r) {
+  if (!r) return;
+  if (r->f) fclose(r->f);
+  freelocale(r->c_numeric);
+  free(r->buf);
+  free(r);
+}
+
+const nav_diag *nav_rec_reader_diag(const nav_rec_reader *r) {
+  return r ? &r->diag : NULL;
+}
+long nav_rec_reader_line(const nav_rec_reader *r) {
+  return r ? r->rec_line : 0;
+}
+double nav_rec_reader_fraction(const nav_rec_reader *r) {
+  if (!r || !(r->total > 0.0)) return 0.0;
+  return fmin(1.0, r->consumed / r->total);
+}
+
+/* Refill the buffer after moving the unread bytes to its start. */
+static nav_status refill(nav_rec_reader *r) {
+  if (r->pos > 0) {
+    memmove(r->buf, r->buf + r->pos, r->len - r->pos);
+    r->len -= r->pos;
+    r->pos = 0;
+  }
+  const size_t room = BUF_CAP - r->len;
+  size_t got = 0;
+  if (r->f) {
+    got = fread(r->buf + r->len, 1, room, r->f);
+    if (got < room) {
+      if (ferror(r->f)) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "read error: %s", strerror(errno));
+        return fail(r, NAV_ERR_IO, 0, 0, "", msg);
+      }
+      r->src_eof = true;
+    }
+  } else {
+    got = r->mem_len - r->mem_pos < room ? r->mem_len - r->mem_pos : room;
+    memcpy(r->buf + r->len, r->mem + r->mem_pos, got);
+    r->mem_pos += got;
+    if (r->mem_pos >= r->mem_len) r->src_eof = true;
+  }
+  r->len += got;
+  return NAV_OK;
+}
+
+/* Next line, NUL-terminated in place (its '\n' is overwritten; a last line without one uses the
+ * spare byte of buf). *line = NULL at the end of the input. The line stays valid until the next
+ * call. */
+static nav_status next_line(nav_rec_reader *r, char **line, size_t *n) {
+  *line = NULL;
+  *n = 0;
+  for (;;) {
+    char *start = r->buf + r->pos;
+    const size_t avail = r->len - r->pos;
+    char *nl = memchr(start, '\n', avail);
+    if (nl || (r->src_eof && avail > 0)) {
+      const size_t len = nl ? (size_t)(nl - start) : avail;
+      if (len > NAV_REC_MAX_LINE) break;
+      start[len] = '\0';
+      r->pos += nl ? len + 1 : len;
+      r->consumed += (double)(nl ? len + 1 : len);
+      r->line++;
+      *line = start;
+      *n = len;
+      return NAV_OK;
+    }
+    if (r->src_eof) return NAV_OK;
+    if (avail > NAV_REC_MAX_LINE) break;
+    const nav_status st = refill(r);
+    if (st != NAV_OK) return st;
+  }
+  char msg[128];
+  snprintf(msg, sizeof msg, "line longer than %d bytes; expected a text file of records, one per line",
+           NAV_REC_MAX_LINE);
+  return fail(r, NAV_ERR_PARSE, (int)(r->line + 1), NAV_REC_MAX_LINE + 1, "", msg);
+}
+
+/* ---------------------------------------------------------------- records */
+
+static const char *const k_imu_cols[] = {"t_s",        "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad",
+                                         "dvel_x_mps", "dvel_y_mps",   "dvel_z_mps"};
+static const char *const k_gnss_cols[] = {
+    "t_s",       "lat_deg",   "lon_deg",   "h_m",          "sd_n_m",       "sd_e_m",      "sd_d_m",
+    "vel_n_mps", "vel_e_mps", "vel_d_mps", "vel_sd_n_mps", "vel_sd_e_mps", "vel_sd_d_mps"};
+static const char *const k_pva_cols[] = {"week",     "t_s",       "lat_deg",   "lon_deg",
+                                         "h_m",      "vel_n_mps", "vel_e_mps", "vel_d_mps",
+                                         "roll_deg", "pitch_deg", "yaw_deg"};
+
+static const char *col_name(nav_rec_format f, int i) {
+  switch (f) {
+  case NAV_REC_IMU: return i < 7 ? k_imu_cols[i] : "";
+  case NAV_REC_GNSS: return i < 13 ? k_gnss_cols[i] : "";
+  case NAV_REC_PVA: return i < 11 ? k_pva_cols[i] : "";
+  default: return "";
+  }
+}
+
+static const char *k_expect_imu = "7 columns (t_s, dtheta x/y/z [rad], dvel x/y/z [m/s])";
+static const char *k_expect_gnss =
+    "7 columns (t_s, lat_deg, lon_deg, h_m, position sigma N/E/D [m]) or 13 (the same, then velocity "
+    "N/E/D [m/s] and velocity sigma N/E/D [m/s])";
+static const char *k_expect_pva =
+    "11 columns (week, t_s, lat_deg, lon_deg, h_m, velocity N/E/D [m/s], roll/pitch/yaw [deg])";
+
+/* The fields of one line. */
+typedef struct fields {
+  int count; /* number of fields on the line (may exceed MAX_COLS) */
+  double v[MAX_COLS];
+  int col[MAX_COLS + 1]; /* 1-based column of each field (and of the first extra one) */
+  int end_col;           /* column just after the last field */
+} fields;
+
+static bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+static bool is_num_char(char c) {
+  return (c >= '0' && c <= '9') || c == '+' || c == '-' || c == '.' || c == 'e' || c == 'E';
+}
+
+/* Case-insensitive: is the token a NaN or infinity spelling? (They fail the character check;
+ * this only picks the clearer message.) */
+static bool is_nonfinite_word(const char *s, size_t n) {
+  char w[16];
+  size_t j = 0;
+  if (n > 0 && (s[0] == '+' || s[0] == '-')) {
+    ++s;
+    --n;
+  }
+  if (n >= sizeof w) return false;
+  for (size_t i = 0; i < n; ++i)
+    w[j++] = (char)((s[i] >= 'A' && s[i] <= 'Z') ? s[i] - 'A' + 'a' : s[i]);
+  w[j] = '\0';
+  return strcmp(w, "nan") == 0 || strcmp(w, "inf") == 0 || strcmp(w, "infinity") == 0 ||
+         strncmp(w, "nan(", 4) == 0;
+}
+
+static nav_status field_error(nav_rec_reader *r, int i, int col, const char *what) {
+  char path[64];
+  const char *name = col_name(r->fmt, i);
+  if (name[0])
+    snprintf(path, sizeof path, "column %d (%s)", i + 1, name);
+  else
+    snprintf(path, sizeof path, "column %d", i + 1);
+  return fail(r, NAV_ERR_PARSE, (int)r->line, col, path, what);
+}
+
+/*
+ * Split a line into numbers. A blank or comment line gives count 0. strtod converts each field
+ * (correctly rounded; the caller switches to the "C" numeric locale); the character check first
+ * keeps hexadecimal floats, NaN and infinities out.
+ */
+static nav_status split(nav_rec_reader *r, char *line, size_t n, fields *fl) {
+  fl->count = 0;
+  fl->end_col = 1;
+  size_t i = 0;
+  while (i < n && is_blank(line[i]))
+    ++i;
+  if (i == n || line[i] == '#') return NAV_OK;
+  while (i < n) {
+    const size_t start = i;
+    while (i < n && !is_blank(line[i]))
+      ++i;
+    const size_t len = i - start;
+    const int k = fl->count++;
+    const int col = (int)start + 1;
+    if (k <= MAX_COLS) fl->col[k] = col;
+    fl->end_col = (int)i + 1;
+    if (k < MAX_COLS) {
+      char shown[48], msg[160];
+      bool ok = true;
+      for (size_t j = start; j < i && ok; ++j)
+        ok = is_num_char(line[j]);
+      char *end = NULL;
+      double v = 0.0;
+      if (ok) {
+        /* Overflow gives +-HUGE_VAL (caught below); underflow a denormal or zero, accepted. */
+        v = strtod(line + start, &end);
+        ok = end == line + i;
+      }
+      if (!ok) {
+        excerpt(shown, sizeof shown, line + start, len);
+        if (is_nonfinite_word(line + start, len))
+          snprintf(msg, sizeof msg, "expected a finite number, found \"%s\"", shown);
+        else
+          snprintf(msg, sizeof msg, "expected a number, found \"%s\"%s", shown,
+                   r->line == 1 ? " (a header line must start with '#')" : "");
+        return field_error(r, k, col, msg);
+      }
+      if (!isfinite(v)) {
+        excerpt(shown, sizeof shown, line + start, len);
+        snprintf(msg, sizeof msg, "\"%s\" is out of the range of a double; expected a finite number", shown);
+        return field_error(r, k, col, msg);
+      }
+      fl->v[k] = v;
+    }
+    while (i < n && is_blank(line[i]))
+      ++i;
+  }
+  return NAV_OK;
+}
+
+static nav_status column_count_error(nav_rec_reader *r, const fields *fl, const char *expect) {
+  char msg[320];
+  snprintf(msg, sizeof msg, "expected %s, found %d", expect, fl->count);
+  /* Too many: point at the first extra field; too few: at the end of the line. */
+  int col = fl->end_col;
+  int expected_max = r->fmt == NAV_REC_IMU ? 7 : (r->fmt == NAV_REC_PVA ? 11 : 13);
+  if (r->fmt == NAV_REC_GNSS && r->gnss_cols == 7) expected_max = 7;
+  if (fl->count > expected_max && expected_max <= MAX_COLS) col = fl->col[expected_max];
+  return fail(r, NAV_ERR_PARSE, (int)r->line, col, "", msg);
+}
+
+static nav_status range_error(nav_rec_reader *r, const fields *fl, int i, const char *fmt_msg, double v) {
+  char msg[200];
+  snprintf(msg, sizeof msg, fmt_msg, v);
+  return field_error(r, i, fl->col[i], msg);
+}
+
+/* Next non-blank line as fields, with the column count and time order checked. */
+static nav_status next_record(nav_rec_reader *r, fields *fl, bool *got) {
+  *got = false;
+  if (r->failed != NAV_OK) return r->failed;
+  for (;;) {
+    char *line = NULL;
+    size_t n = 0;
+    nav_status st = next_line(r, &line, &n);
+    if (st != NAV_OK) return st;
+    if (!line) return NAV_OK;
+    /* uselocale is per thread and cheap (a pointer swap): switch around each line only. */
+    const locale_t old = uselocale(r->c_numeric);
+    st = split(r, line, n, fl);
+    uselocale(old);
+    if (st != NAV_OK) return st;
+    if (fl->count > 0) break;
+  }
+  switch (r->fmt) {
+  case NAV_REC_IMU:
+    if (fl->count != 7) return column_count_error(r, fl, k_expect_imu);
+    break;
+  case NAV_REC_GNSS:
+    if (r->gnss_cols == 0 && (fl->count == 7 || fl->count == 13)) r->gnss_cols = fl->count;
+    if (fl->count != r->gnss_cols) {
+      if (r->gnss_cols == 0) return column_count_error(r, fl, k_expect_gnss);
+      char expect[160];
+      snprintf(expect, sizeof expect, "%d columns like the first record of the file", r->gnss_cols);
+      return column_count_error(r, fl, expect);
+    }
+    break;
+  case NAV_REC_PVA:
+    if (fl->count != 11) return column_count_error(r, fl, k_expect_pva);
+    break;
+  default: return NAV_ERR_INVALID_ARG;
+  }
+  const int it = r->fmt == NAV_REC_PVA ? 1 : 0;
+  const double t = fl->v[it];
+  if (r->have_prev && !(t > r->t_prev)) {
+    char msg[200];
+    snprintf(msg, sizeof msg,
+             "time must increase from record to record: %.6f s is not after %.6f s (line %ld)", t, r->t_prev,
+             r->prev_line);
+    return field_error(r, it, fl->col[it], msg);
+  }
+  *got = true;
+  return NAV_OK;
+}
+
+/* Commit a validated record: time order state and the record line. */
+static void accept(nav_rec_reader *r, double t) {
+  r->have_prev = true;
+  r->t_prev = t;
+  r->prev_line = r->line;
+  r->rec_line = r->line;
+}
+
+static double deg_to_rad_wrapped(double deg) {
+  return nav_wrap_pi(deg * NAV_DEG2RAD);
+}
+
+nav_status nav_rec_read_imu(nav_rec_reader *r, nav_imu_increment *out, bool *got) {
+  if (!r || !out || !got || r->fmt != NAV_REC_IMU) return NAV_ERR_INVALID_ARG;
+  fields fl;
+  const nav_status st = next_record(r, &fl, got);
+  if (st != NAV_OK || !*got) return st;
+  /* More than half a turn in one interval is not an increment: usually rates (or degrees), or
+   * another file given as the IMU file. */
+  for (int i = 1; i <= 3; ++i)
+    if (!(fabs(fl.v[i]) <= NAV_PI)) {
+      *got = false;
+      return range_error(
+          r, &fl, i,
+          "angle increment %.9g rad exceeds pi; expected the increment over one interval in rad "
+          "(not a rate, not degrees)",
+          fl.v[i]);
+    }
+  nav_imu_increment m;
+  m.k = r->k;
+  m.t_s = fl.v[0];
+  m.dt_s = r->have_prev ? fl.v[0] - r->t_prev : 0.0;
+  m.dtheta_b_rad = nav_vec3_make(fl.v[1], fl.v[2], fl.v[3]);
+  m.dv_b_mps = nav_vec3_make(fl.v[4], fl.v[5], fl.v[6]);
+  accept(r, m.t_s);
+  r->k++;
+  *out = m;
+  return NAV_OK;
+}
+
+/* Common geodetic checks of GNSS and .nav rows; i is the latitude column. */
+static nav_status check_position(nav_rec_reader *r, const fields *fl, int i) {
+  if (!(fabs(fl->v[i]) <= 90.0))
+    return range_error(r, fl, i, "latitude %.9g deg outside [-90, 90]", fl->v[i]);
+  if (!(fl->v[i + 1] >= -180.0 && fl->v[i + 1] <= 360.0))
+    return range_error(r, fl, i + 1, "longitude %.9g deg outside [-180, 360]", fl->v[i + 1]);
+  return NAV_OK;
+}
+
+nav_status nav_rec_read_gnss(nav_rec_reader *r, nav_ins_gnss_fix *out, bool *got) {
+  if (!r || !out || !got || r->fmt != NAV_REC_GNSS) return NAV_ERR_INVALID_ARG;
+  fields fl;
+  nav_status st = next_record(r, &fl, got);
+  if (st != NAV_OK || !*got) return st;
+  *got = false;
+  st = check_position(r, &fl, 1);
+  if (st != NAV_OK) return st;
+  for (int i = 4; i < fl.count; ++i) {
+    if ((i >= 4 && i <= 6) || i >= 10) {
+      if (!(fl.v[i] >= 0.0))
+        return range_error(r, &fl, i, "standard deviation %.9g is negative; expected >= 0", fl.v[i]);
+    }
+  }
+  nav_ins_gnss_fix f;
+  memset(&f, 0, sizeof f);
+  f.t_s = fl.v[0];
+  f.pos.lat_rad = fl.v[1] * NAV_DEG2RAD;
+  f.pos.lon_rad = deg_to_rad_wrapped(fl.v[2]);
+  f.pos.h_m = fl.v[3];
+  f.pos_sd_m = nav_vec3_make(fl.v[4], fl.v[5], fl.v[6]);
+  f.has_vel = fl.count == 13;
+  if (f.has_vel) {
+    f.v_n_mps = nav_vec3_make(fl.v[7], fl.v[8], fl.v[9]);
+    f.vel_sd_mps = nav_vec3_make(fl.v[10], fl.v[11], fl.v[12]);
+  }
+  accept(r, f.t_s);
+  r->k++;
+  *out = f;
+  *got = true;
+  return NAV_OK;
+}
+
+nav_status nav_rec_read_pva(nav_rec_reader *r, nav_rec_pva *out, bool *got) {
+  if (!r || !out || !got || r->fmt != NAV_REC_PVA) return NAV_ERR_INVALID_ARG;
+  fields fl;
+  nav_status st = next_record(r, &fl, got);
+  if (st != NAV_OK || !*got) return st;
+  *got = false;
+  if (!(fl.v[0] >= 0.0 && fl.v[0] == floor(fl.v[0]) && fl.v[0] <= 1e9))
+    return range_error(r, &fl, 0, "GPS week %.9g: expected an integer >= 0", fl.v[0]);
+  st = check_position(r, &fl, 2);
+  if (st != NAV_OK) return st;
+  if (!(fabs(fl.v[8]) <= 180.0)) return range_error(r, &fl, 8, "roll %.9g deg outside [-180, 180]", fl.v[8]);
+  if (!(fabs(fl.v[9]) <= 90.0)) return range_error(r, &fl, 9, "pitch %.9g deg outside [-90, 90]", fl.v[9]);
+  if (!(fl.v[10] >= -180.0 && fl.v[10] <= 360.0))
+    return range_error(r, &fl, 10, "yaw %.9g deg outside [-180, 360]", fl.v[10]);
+  nav_rec_pva p;
+  p.week = (int)fl.v[0];
+  p.t_s = fl.v[1];
+  p.pos.lat_rad = fl.v[2] * NAV_DEG2RAD;
+  p.pos.lon_rad = deg_to_rad_wrapped(fl.v[3]);
+  p.pos.h_m = fl.v[4];
+  p.v_n_mps = nav_vec3_make(fl.v[5], fl.v[6], fl.v[7]);
+  p.att.roll_rad = fl.v[8] * NAV_DEG2RAD;
+  p.att.pitch_rad = fl.v[9] * NAV_DEG2RAD;
+  p.att.yaw_rad = deg_to_rad_wrapped(fl.v[10]);
+  accept(r, p.t_s);
+  r->k++;
+  *out = p;
+  *got = true;
+  return NAV_OK;
+}
+
+/* ---------------------------------------------------------------- loaders */
+
+static void copy_diag(nav_diag *dst, const nav_rec_reader *r) {
+  if (dst && r) *dst = r->diag;
+}
+
+/* One loader for the three formats; @p read reads one record of @p size bytes into @p slot. */
+typedef nav_status (*read_fn)(nav_rec_reader *r, void *slot, bool *got);
+static nav_status read_imu_v(nav_rec_reader *r, void *s, bool *g) {
+  return nav_rec_read_imu(r, s, g);
+}
+static nav_status read_gnss_v(nav_rec_reader *r, void *s, bool *g) {
+  return nav_rec_read_gnss(r, s, g);
+}
+static nav_status read_pva_v(nav_rec_reader *r, void *s, bool *g) {
+  return nav_rec_read_pva(r, s, g);
+}
+
+static nav_status load(const char *path, nav_rec_format fmt, read_fn read, void *out, size_t size,
+                       size_t capacity, size_t *count, nav_diag *diag) {
+  if (!path || (!out && capacity > 0) || !count) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *r = NULL;
+  nav_status st = nav_rec_reader_open(path, fmt, &r, diag);
+  if (st != NAV_OK) return st;
+  size_t n = 0;
+  for (;;) {
+    bool got = false;
+    if (n == capacity) {
+      /* One more record would not fit: read it to tell "exactly full" from "too many". */
+      union {
+        nav_imu_increment a;
+        nav_ins_gnss_fix b;
+        nav_rec_pva c;
+      } extra;
+      st = read(r, &extra, &got);
+      if (st == NAV_OK && got) {
+        diag_set(diag, path, (int)r->rec_line, 1, "", "more than %zu records; expected at most %zu", capacity,
+                 capacity);
+        st = NAV_ERR_OUT_OF_RANGE;
+        goto cleanup;
+      }
+    } else {
+      st = read(r, (char *)out + n * size, &got);
+    }
+    if (st != NAV_OK) {
+      copy_diag(diag, r);
+      goto cleanup;
+    }
+    if (!got) break;
+    ++n;
+  }
+  *count = n;
+cleanup:
+  nav_rec_reader_destroy(r);
+  return st;
+}
+
+nav_status nav_rec_load_imu(const char *path, nav_imu_increment *out, size_t capacity, size_t *count,
+                            nav_diag *diag) {
+  return load(path, NAV_REC_IMU, read_imu_v, out, sizeof *out, capacity, count, diag);
+}
+nav_status nav_rec_load_gnss(const char *path, nav_ins_gnss_fix *out, size_t capacity, size_t *count,
+                             nav_diag *diag) {
+  return load(path, NAV_REC_GNSS, read_gnss_v, out, sizeof *out, capacity, count, diag);
+}
+nav_status nav_rec_load_pva(const char *path, nav_rec_pva *out, size_t capacity, size_t *count,
+                            nav_diag *diag) {
+  return load(path, NAV_REC_PVA, read_pva_v, out, sizeof *out, capacity, count, diag);
+}
+
+nav_traj_state nav_rec_pva_to_state(const nav_rec_pva *row) {
+  nav_traj_state s;
+  memset(&s, 0, sizeof s);
+  s.t_s = row->t_s;
+  const nav_mat3 C_n_e = nav_earth_dcm_n_e(row->pos.lat_rad, row->pos.lon_rad);
+  s.r_fb_f_m = nav_earth_geodetic_to_ecef(row->pos);
+  s.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, row->v_n_mps);
+  /* q_b_e = q_n_e (x) q_b_n (style.md section 4: inner indices touch). */
+  s.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), nav_euler_to_quat(row->att)));
+  return s;
+}
+
+/* ================================================================ replay */
+
+nav_replay_config nav_replay_config_default(void) {
+  nav_replay_config c;
+  memset(&c, 0, sizeof c);
+  c.nav.ins = nav_ins_config_default();
+  c.nav.ins.earth_model = NAV_EARTH_WGS84;
+  c.nav.ins.algorithm = NAV_MECH_HIGH_ORDER;
+  c.nav.ins.mech_frame = NAV_MECH_NED;
+  c.nav.ins.gravity_model = NAV_GRAVITY_NORMAL;
+  c.nav.filter = nav_filter_config_default();
+  c.nav.r_ba_b_m = nav_vec3_zero();
+  c.nav.pos_sd_floor_m = 1e-3;
+  c.nav.vel_sd_floor_mps = 1e-3;
+  c.ref_sync_tol_s = 1e-4;
+  c.output_interval_s = 0.1;
+  c.gap_factor = 1.5;
+  return c;
+}
+
+/* Running RMS / max of the metrics (streaming: memory does not grow with the epochs). */
+enum { M_POS_H, M_POS_V, M_VEL_H, M_VEL_V, M_ROLL, M_PITCH, M_YAW, M_ATT, N_M };
+
+typedef struct stats_acc {
+  long n;
+  double sum_sq[N_M], max[N_M], t_max[N_M];
+  nav_vec3 sum_pos, sum_vel;
+} stats_acc;
+
+static void stats_add(stats_acc *a, const nav_epoch_errors *e) {
+  const double v[N_M] = {e->pos_err_h_m,
+                         e->pos_err_v_m,
+                         hypot(e->vel_err_n_mps.x, e->vel_err_n_mps.y),
+                         fabs(e->vel_err_n_mps.z),
+                         fabs(e->euler_err.roll_rad),
+                         fabs(e->euler_err.pitch_rad),
+                         fabs(e->euler_err.yaw_rad),
+                         e->att_err_rad};
+  for (int m = 0; m < N_M; ++m) {
+    a->sum_sq[m] += v[m] * v[m];
+    if (a->n == 0 || v[m] > a->max[m]) {
+      a->max[m] = v[m];
+      a->t_max[m] = e->t_s;
+    }
+  }
+  a->sum_pos = nav_vec3_add(a->sum_pos, e->pos_err_n_m);
+  a->sum_vel = nav_vec3_add(a->sum_vel, e->vel_err_n_mps);
+  a->n++;
+}
+
+static nav_replay_stats stats_result(const stats_acc *a) {
+  nav_replay_stats s;
+  memset(&s, 0, sizeof s);
+  s.epochs = a->n;
+  if (a->n == 0) return s;
+  nav_replay_stat *dst[N_M] = {&s.pos_h_m,  &s.pos_v_m,   &s.vel_h_mps, &s.vel_v_mps,
+                               &s.roll_rad, &s.pitch_rad, &s.yaw_rad,   &s.att_rad};
+  for (int m = 0; m < N_M; ++m) {
+    dst[m]->rms = sqrt(a->sum_sq[m] / (double)a->n);
+    dst[m]->max = a->max[m];
+    dst[m]->t_max_s = a->t_max[m];
+  }
+  s.pos_mean_n_m = nav_vec3_scale(a->sum_pos, 1.0 / (double)a->n);
+  s.vel_mean_n_mps = nav_vec3_scale(a->sum_vel, 1.0 / (double)a->n);
+  return s;
+}
+
+/* WGS-84 frame with its origin at @p p (the formulas of nav_frame_from_scene()). */
+static nav_frame frame_at(nav_geodetic p) {
+  nav_frame f;
+  f.model = NAV_EARTH_WGS84;
+  f.origin = p;
+  f.m_per_rad_lat = nav_earth_radius_meridian_m(p.lat_rad) + p.h_m;
+  f.m_per_rad_lon = (nav_earth_radius_prime_vertical_m(p.lat_rad) + p.h_m) * cos(p.lat_rad);
+  return f;
+}
+
+/* The open inputs of a replay with one record of look-ahead each. */
+typedef struct replay {
+  const nav_replay_config *cfg;
+  nav_rec_reader *imu, *gnss, *ref;
+  nav_rec_pva ref_row;
+  bool ref_have;
+  nav_ins_gnss_fix fix;
+  bool fix_have;
+  nav_replay_summary *sum;
+  nav_diag *diag;
+} replay;
+
+static nav_status reader_failed(replay *p, const nav_rec_reader *r, nav_status st) {
+  copy_diag(p->diag, r);
+  return st;
+}
+
+static nav_status ref_next(replay *p) {
+  const nav_status st = nav_rec_read_pva(p->ref, &p->ref_row, &p->ref_have);
+  if (st != NAV_OK) return reader_failed(p, p->ref, st);
+  if (p->ref_have) p->sum->ref_rows++;
+  return NAV_OK;
+}
+
+static nav_status fix_next(replay *p) {
+  const nav_status st = nav_rec_read_gnss(p->gnss, &p->fix, &p->fix_have);
+  if (st != NAV_OK) return reader_failed(p, p->gnss, st);
+  if (p->fix_have) {
+    p->sum->gnss_records++;
+    if (p->fix.has_vel) p->sum->gnss_has_vel = true;
+  }
+  return NAV_OK;
+}
+
+static bool in_outage(const nav_replay_config *c, double t) {
+  for (size_t i = 0; i < c->outage_count; ++i)
+    if (t >= c->outages[i].t0_s && t < c->outages[i].t1_s) return true;
+  return false;
+}
+
+static nav_status check_config(const nav_replay_config *c, nav_diag *diag) {
+  const char *bad = NULL;
+  if (!c->imu_path || !c->ref_path)
+    bad = "an IMU file and a reference file are both required";
+  else if (c->nav.ins.earth_model != NAV_EARTH_WGS84)
+    bad = "recorded data needs the WGS-84 Earth model";
+  else if (!(c->ref_sync_tol_s > 0.0 && isfinite(c->ref_sync_tol_s)))
+    bad = "ref_sync_tol_s must be finite and > 0";
+  else if (!(c->output_interval_s > 0.0 && isfinite(c->output_interval_s)))
+    bad = "output_interval_s must be finite and > 0";
+  else if (!(c->gap_factor > 1.0 && isfinite(c->gap_factor)))
+    bad = "gap_factor must be finite and > 1";
+  else if (c->has_start && !isfinite(c->t_start_s))
+    bad = "the start time must be finite";
+  else if (c->has_end && !isfinite(c->t_end_s))
+    bad = "the end time must be finite";
+  else if (c->has_start && c->has_end && !(c->t_end_s > c->t_start_s))
+    bad = "the end time must be after the start time";
+  else if (c->outage_count > NAV_GNSS_MAX_OUTAGES)
+    bad = "too many outages";
+  for (size_t i = 0; !bad && i < c->outage_count; ++i)
+    if (!(isfinite(c->outages[i].t0_s) && isfinite(c->outages[i].t1_s) &&
+          c->outages[i].t1_s > c->outages[i].t0_s))
+      bad = "each outage needs finite t0 < t1";
+  if (!bad) return NAV_OK;
+  diag_set(diag, "replay", 0, 0, "", "%s", bad);
+  return NAV_ERR_INVALID_ARG;
+}
+
+/* The navigation: the closed loop with GNSS, or the free strapdown INS. */
+typedef struct nav_side {
+  nav_ins_gnss *x;
+  nav_ins *ins;
+} nav_side;
+
+static const nav_ins_state *nav_state(const nav_side *n) {
+  return n->x ? nav_ins_gnss_state(n->x) : nav_ins_get_state(n->ins);
+}
+
+static nav_status nav_fail(nav_diag *diag, nav_status st, const char *what, const char *detail) {
+  diag_set(diag, "replay", 0, 0, "", "%s: %s", what, detail && detail[0] ? detail : nav_status_str(st));
+  return st;
+}
+
+nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out, nav_diag *diag) {
+  if (!cfg || !out) return NAV_ERR_INVALID_ARG;
+  nav_status st = check_config(cfg, diag);
+  if (st != NAV_OK) return st;
+  nav_replay_summary *sum = calloc(1, sizeof *sum);
+  if (!sum) return NAV_ERR_NO_MEMORY;
+  replay p;
+  memset(&p, 0, sizeof p);
+  p.cfg = cfg;
+  p.sum = sum;
+  p.diag = diag;
+  nav_side nav = {NULL, NULL};
+  sum->free_ins = cfg->gnss_path == NULL;
+
+  st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
+  if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
+  if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
+  if (st != NAV_OK) goto cleanup;
+  st = ref_next(&p);
+  if (st == NAV_OK && p.gnss) st = fix_next(&p);
+  if (st != NAV_OK) goto cleanup;
+
+  /* 1. The initial epoch: the first IMU epoch in the window with a reference row. */
+  const double tol = cfg->ref_sync_tol_s;
+  nav_imu_increment inc;
+  bool got = false;
+  for (;;) {
+    st = nav_rec_read_imu(p.imu, &inc, &got);
+    if (st != NAV_OK) {
+      reader_failed(&p, p.imu, st);
+      goto cleanup;
+    }
+    if (got) sum->imu_records++;
+    if (got && !(cfg->has_start && inc.t_s < cfg->t_start_s - tol)) {
+      while (p.ref_have && p.ref_row.t_s < inc.t_s - tol) {
+        st = ref_next(&p);
+        if (st != NAV_OK) goto cleanup;
+      }
+      if (p.ref_have && fabs(p.ref_row.t_s - inc.t_s) <= tol &&
+          !(cfg->has_end && inc.t_s > cfg->t_end_s + tol))
+        break;
+    }
+    if (!got || !p.ref_have || (cfg->has_end && inc.t_s > cfg->t_end_s + tol)) {
+      diag_set(
+          diag, cfg->imu_path, 0, 0, "",
+          "no IMU epoch%s coincides with a row of the reference %s (within %.3g s); the initial state is "
+          "taken from the reference",
+          cfg->has_start || cfg->has_end ? " in the time window" : "", cfg->ref_path, tol);
+      st = NAV_ERR_INVALID_ARG;
+      goto cleanup;
+    }
+  }
+  const nav_rec_pva row0 = p.ref_row;
+  const nav_traj_state ts0 = nav_rec_pva_to_state(&row0);
+  const nav_frame frame = frame_at(row0.pos);
+  nav_ins_state s0;
+  s0.t_s = inc.t_s;
+  s0.r_fb_f_m = ts0.r_fb_f_m;
+  s0.v_fb_f_mps = ts0.v_fb_f_mps;
+  s0.q_b_f = ts0.q_b_f;
+  if (p.gnss)
+    st = nav_ins_gnss_create(&cfg->nav, &s0, &nav.x);
+  else
+    st = nav_ins_create(&cfg->nav.ins, &s0, &nav.ins);
+  if (st != NAV_OK) {
+    nav_fail(diag, st, "cannot set up the navigation", "check the mechanization and filter settings");
+    goto cleanup;
+  }
+  sum->t_first_s = inc.t_s;
+  sum->t_last_s = inc.t_s;
+  nav_epoch_errors err = nav_errors_compute(&frame, &ts0, nav_state(&nav));
+  sum->final = err;
+  bool stop = false;
+  long long last_out = llround(inc.t_s / cfg->output_interval_s);
+  if (cfg->record) {
+    const nav_replay_record rec = {&frame, nav_state(&nav), &ts0, &err, false};
+    stop = cfg->record(cfg->user, &rec) == NAV_STOP;
+  }
+  st = ref_next(&p);
+  if (st != NAV_OK) goto cleanup;
+
+  /* 2. Every following increment. */
+  stats_acc acc, acc_out;
+  memset(&acc, 0, sizeof acc);
+  memset(&acc_out, 0, sizeof acc_out);
+  const double t_first = inc.t_s;
+  double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0, gap_max_h = 0.0;
+  bool have_fix = false, have_spacing = false;
+  while (!stop) {
+    st = nav_rec_read_imu(p.imu, &inc, &got);
+    if (st != NAV_OK) {
+      reader_failed(&p, p.imu, st);
+      goto cleanup;
+    }
+    if (!got) break;
+    sum->imu_records++;
+    if (cfg->has_end && inc.t_s > cfg->t_end_s + tol) break;
+    const double t = inc.t_s, dt = inc.dt_s;
+    if (sum->imu_steps == 0) dt_nominal = dt;
+    if (dt > 1.5 * dt_nominal) sum->imu_gaps++;
+    if (dt > sum->imu_dt_max_s) sum->imu_dt_max_s = dt;
+    if (nav.x)
+      st = nav_ins_gnss_step(nav.x, &inc);
+    else
+      st = nav_ins_step(nav.ins, &inc);
+    if (st != NAV_OK) {
+      nav_fail(diag, st, "navigation failed",
+               nav.x ? nav_ins_gnss_last_error(nav.x) : nav_ins_last_error(nav.ins));
+      goto cleanup;
+    }
+    sum->imu_steps++;
+    sum->t_last_s = t;
+
+    /* The reference row of this epoch, if any (rows in between are counted, not scored). */
+    while (p.ref_have && p.ref_row.t_s < t - tol) {
+      sum->ref_unmatched++;
+      st = ref_next(&p);
+      if (st != NAV_OK) goto cleanup;
+    }
+    const bool has_ref = p.ref_have && fabs(p.ref_row.t_s - t) <= tol;
+    nav_traj_state ts;
+    if (has_ref) ts = nav_rec_pva_to_state(&p.ref_row);
+
+    /* GNSS fixes of this epoch: time of validity within dt/2 (numerics.md 6.5). */
+    bool updated = false;
+    while (p.gnss && p.fix_have && p.fix.t_s <= t + 0.5 * dt) {
+      if (p.fix.t_s <= t - 0.5 * dt) {
+        if (p.fix.t_s <= t_first + 0.5 * dt)
+          sum->gnss_before_start++;
+        else
+          sum->gnss_unmatched++;
+      } else if (in_outage(cfg, p.fix.t_s)) {
+        sum->gnss_dropped++;
+      } else {
+        const double spacing = p.fix.t_s - last_fix_t;
+        if (have_fix && have_spacing && spacing > cfg->gap_factor * min_spacing) {
+          /* The end of a GNSS gap: errors just before the fix that ends it. */
+          nav_replay_gap g;
+          memset(&g, 0, sizeof g);
+          g.t0_s = last_fix_t;
+          g.t1_s = p.fix.t_s;
+          g.pos_h_max_m = gap_max_h;
+          if (has_ref) {
+            const nav_epoch_errors e = nav_errors_compute(&frame, &ts, nav_state(&nav));
+            g.has_end_errors = true;
+            g.pos_h_end_m = e.pos_err_h_m;
+            g.pos_v_end_m = e.pos_err_v_m;
+            g.pos_h_max_m = fmax(gap_max_h, e.pos_err_h_m);
+          }
+          if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
+          sum->gap_count++;
+        }
+        st = nav_ins_gnss_update(nav.x, &p.fix);
+        if (st != NAV_OK) {
+          nav_fail(diag, st, "GNSS update failed", nav_ins_gnss_last_error(nav.x));
+          goto cleanup;
+        }
+        if (have_fix && (!have_spacing || spacing < min_spacing)) {
+          min_spacing = spacing;
+          have_spacing = true;
+        }
+        have_fix = true;
+        last_fix_t = p.fix.t_s;
+        gap_max_h = 0.0;
+        updated = true;
+        sum->gnss_applied++;
+      }
+      st = fix_next(&p);
+      if (st != NAV_OK) goto cleanup;
+    }
+
+    const long long j = llround(t / cfg->output_interval_s);
+    const bool output = j != last_out && fabs(t - (double)j * cfg->output_interval_s) <= 0.5 * dt;
+    if (output) last_out = j;
+    if (has_ref) {
+      err = nav_errors_compute(&frame, &ts, nav_state(&nav));
+      stats_add(&acc, &err);
+      if (output) stats_add(&acc_out, &err);
+      sum->final = err;
+      gap_max_h = fmax(gap_max_h, err.pos_err_h_m);
+    }
+    if (output && cfg->record) {
+      const nav_replay_record rec = {&frame, nav_state(&nav), has_ref ? &ts : NULL, has_ref ? &err : NULL,
+                                     updated};
+      if (cfg->record(cfg->user, &rec) == NAV_STOP) stop = true;
+    }
+    if (has_ref) {
+      st = ref_next(&p);
+      if (st != NAV_OK) goto cleanup;
+    }
+    if (cfg->progress && sum->imu_steps % 8192 == 0) {
+      const nav_progress pr = {"replay", 0, nav_rec_reader_fraction(p.imu), t};
+      if (cfg->progress(cfg->user, &pr) == NAV_STOP) stop = true;
+    }
+  }
+  /* A gap still open at the end of the run. */
+  if (p.gnss && have_fix && have_spacing && sum->t_last_s - last_fix_t > cfg->gap_factor * min_spacing) {
+    nav_replay_gap g;
+    memset(&g, 0, sizeof g);
+    g.t0_s = last_fix_t;
+    g.t1_s = sum->t_last_s;
+    g.open = true;
+    g.has_end_errors = fabs(sum->final.t_s - sum->t_last_s) <= tol;
+    g.pos_h_end_m = sum->final.pos_err_h_m;
+    g.pos_v_end_m = sum->final.pos_err_v_m;
+    g.pos_h_max_m = gap_max_h;
+    if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
+    sum->gap_count++;
+  }
+  if (cfg->progress && !stop) {
+    const nav_progress pr = {"replay", 0, 1.0, sum->t_last_s};
+    (void)cfg->progress(cfg->user, &pr);
+  }
+  sum->stats = stats_result(&acc);
+  sum->stats_output = stats_result(&acc_out);
+  if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
+  sum->partial = stop;
+  *out = *sum;
+  st = stop ? NAV_ERR_CANCELLED : NAV_OK;
+
+cleanup:
+  nav_ins_gnss_destroy(nav.x);
+  nav_ins_destroy(nav.ins);
+  nav_rec_reader_destroy(p.imu);
+  nav_rec_reader_destroy(p.gnss);
+  nav_rec_reader_destroy(p.ref);
+  free(sum);
+  return st;
+}
+
+nav_status nav_replay_score_pva(const char *ref_path, const char *est_path, bool has_start, double t_start_s,
+                                bool has_end, double t_end_s, double sync_tol_s, nav_replay_stats *out,
+                                nav_diag *diag) {
+  if (!ref_path || !est_path || !out || !(sync_tol_s > 0.0)) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *ref = NULL, *est = NULL;
+  stats_acc acc;
+  memset(&acc, 0, sizeof acc);
+  nav_status st = nav_rec_reader_open(ref_path, NAV_REC_PVA, &ref, diag);
+  if (st == NAV_OK) st = nav_rec_reader_open(est_path, NAV_REC_PVA, &est, diag);
+  if (st != NAV_OK) goto cleanup;
+  nav_rec_pva rr, er;
+  bool ref_have = false, est_have = false;
+  bool have_frame = false;
+  nav_frame frame;
+  st = nav_rec_read_pva(ref, &rr, &ref_have);
+  if (st != NAV_OK) {
+    copy_diag(diag, ref);
+    goto cleanup;
+  }
+  for (;;) {
+    st = nav_rec_read_pva(est, &er, &est_have);
+    if (st != NAV_OK) {
+      copy_diag(diag, est);
+      goto cleanup;
+    }
+    if (!est_have || (has_end && er.t_s > t_end_s + sync_tol_s)) break;
+    if (has_start && er.t_s < t_start_s - sync_tol_s) continue;
+    while (ref_have && rr.t_s < er.t_s - sync_tol_s) {
+      st = nav_rec_read_pva(ref, &rr, &ref_have);
+      if (st != NAV_OK) {
+        copy_diag(diag, ref);
+        goto cleanup;
+      }
+    }
+    if (!ref_have) break;
+    if (fabs(rr.t_s - er.t_s) > sync_tol_s) continue;
+    if (!have_frame) {
+      frame = frame_at(rr.pos);
+      have_frame = true;
+    }
+    const nav_traj_state ts = nav_rec_pva_to_state(&rr), es = nav_rec_pva_to_state(&er);
+    const nav_ins_state s = {es.t_s, es.r_fb_f_m, es.v_fb_f_mps, es.q_b_f};
+    const nav_epoch_errors e = nav_errors_compute(&frame, &ts, &s);
+    stats_add(&acc, &e);
+  }
+  if (acc.n == 0) {
+    diag_set(diag, est_path, 0, 0, "", "no row coincides with a row of the reference %s (within %.3g s)",
+             ref_path, sync_tol_s);
+    st = NAV_ERR_INVALID_ARG;
+    goto cleanup;
+  }
+  *out = stats_result(&acc);
+  st = NAV_OK;
+cleanup:
+  nav_rec_reader_destroy(ref);
+  nav_rec_reader_destroy(est);
+  return st;
+}

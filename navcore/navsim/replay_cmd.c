@@ -1,0 +1,806 @@
+/*
+ * navsim replay: run our navigation on recorded IMU / GNSS files (KF-GINS text formats) and
+ * score it against a reference trajectory, next to the published figures of the peer filters
+ * for the same inputs. The replay itself is nav_replay_run() (navcore_io, nav_recorded.h);
+ * this file parses the command line, writes the result directory and prints the tables.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "replay_cmd.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "navcore/nav_io.h"
+#include "navcore/nav_recorded.h"
+#include "navcore/nav_results.h"
+#include "navcore/nav_version.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
+
+#define MAX_PEERS 8
+
+static const char *k_usage_replay =
+    "usage: navsim replay --imu FILE --truth FILE [--gnss FILE] [--scene SCENE] [--start T]\n"
+    "                     [--end T] [--outage T0:T1]... [--peer NAME=FILE]... [--out DIR]\n"
+    "                     [--peers auto|none] [--cov-decimation N] [--quiet]\n"
+    "\n"
+    "Run our navigation on recorded data and score it against a reference:\n"
+    "  --imu FILE      IMU increments, KF-GINS text: t [s], dtheta x/y/z [rad], dvel x/y/z [m/s],\n"
+    "                  the increment over the interval ending at t, body axes forward-right-down\n"
+    "  --gnss FILE     GNSS fixes, KF-GINS text: t, lat [deg], lon [deg], h [m], sigma N/E/D [m]\n"
+    "                  (7 columns), optionally velocity N/E/D and its sigma (13 columns).\n"
+    "                  Without --gnss: free-inertial navigation (pure strapdown)\n"
+    "  --truth FILE    reference .nav (week, t, lat, lon, h, vN vE vD, roll pitch yaw [deg]): the\n"
+    "                  initial state (the row at the first IMU epoch, as KF-GINS is given it) and\n"
+    "                  the scoring (every IMU epoch with a row within 0.1 ms)\n"
+    "  --scene SCENE   (or --config) scene file whose imu error model (ARW, VRW, bias turn-on / GM / random\n"
+    "                  walk), gnss.lever_arm_b_m, initial_errors (P0) and navigation (algorithm,\n"
+    "                  frame) tune the filter; its trajectory, outages and earth model are not\n"
+    "                  used (replay is always WGS-84). Default: high-order mechanization in NED,\n"
+    "                  normal gravity, a tactical-grade filter model (ARW 0.15 deg/sqrt(h), VRW\n"
+    "                  0.07 m/s/sqrt(h), GM biases 0.5 deg/h and 0.05 mg over 1 h), P0 1 m,\n"
+    "                  0.1 m/s, 0.1 deg level, 1 deg heading, no lever arm\n"
+    "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n"
+    "  --outage T0:T1  drop the GNSS fixes with T0 <= t < T1 (repeatable, up to 32)\n"
+    "  --peer NAME=FILE  also score another program's .nav output (e.g. KF-GINS) against the\n"
+    "                  reference over the same window; compared with our figures at its epochs\n"
+    "  --peers auto|none  auto (default): next to ours, print the published KF-GINS and pyins\n"
+    "                  figures when the data is the gnss-ins-sim long_drive set\n"
+    "  --cov-decimation N  propagate the filter covariance once every N IMU steps (default 1;\n"
+    "                  see nav_filter_config.cov_decimation: N = 10 changes the long_drive figures\n"
+    "                  by less than 1e-4 relative and takes about a third less time)\n"
+    "  --out DIR       result directory (default out/replay), written atomically:\n"
+    "                    summary.json  inputs, settings, counts, timing, error statistics,\n"
+    "                                  GNSS gaps with the errors at their end\n"
+    "                    nav.csv       our solution at 10 Hz (columns of navsim run's nav.csv)\n"
+    "                    truth.csv, errors.csv  reference and errors at the 10 Hz epochs that\n"
+    "                                  have a reference row\n"
+    "  --quiet         print nothing but errors\n"
+    "\n"
+    "exit codes: 0 success; 2 invalid files or options; 1 other failure\n";
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static bool parse_double(const char *s, double *out) {
+  if (!s || !*s) return false;
+  errno = 0;
+  char *end = NULL;
+  const double v = strtod(s, &end);
+  if (errno != 0 || !end || *end || !isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+static void print_diag(const nav_diag *d) {
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  fprintf(stderr, "%s\n", line);
+}
+
+static void on_scene_diag(void *user, const nav_diag *d) {
+  (void)user;
+  print_diag(d);
+}
+
+/* ---------------------------------------------------------------- published peer figures */
+
+/*
+ * The reference results of ../shared/data/gnss-ins-sim-long-drive/README.md (KF-GINS and pyins
+ * against truth.nav at all 193 034 epochs at 200 Hz), in the order of the README's table:
+ * horizontal position RMS, max [m]; vertical position RMS, max [m]; horizontal velocity RMS,
+ * max [m/s]; vertical velocity RMS [m/s]; roll, pitch, yaw RMS [deg]; yaw max [deg]; then the
+ * horizontal error at the end of the first and second outage [m]. NAN: not published.
+ */
+enum {
+  F_POS_H_RMS,
+  F_POS_H_MAX,
+  F_POS_V_RMS,
+  F_POS_V_MAX,
+  F_VEL_H_RMS,
+  F_VEL_H_MAX,
+  F_VEL_V_RMS,
+  F_ROLL_RMS,
+  F_PITCH_RMS,
+  F_YAW_RMS,
+  F_YAW_MAX,
+  F_GAP1_H,
+  F_GAP2_H,
+  N_FIG
+};
+
+typedef enum data_case { CASE_FULL_GNSS = 0, CASE_OUTAGES = 1, CASE_FREE_INS = 2 } data_case;
+
+/* What kind of run this is; the published rows of the README for each. */
+static const char *const k_case_names[3] = {"full GNSS", "GNSS with gaps", "free INS (no GNSS)"};
+static const char *const k_case_readme[3] = {"full GNSS", "two 60 s outages", "ideal IMU, no GNSS"};
+
+typedef struct peer_figures {
+  const char *name;
+  double v[3][N_FIG];
+} peer_figures;
+
+static const peer_figures k_peers[2] = {
+    {"KF-GINS",
+     {{0.0219, 0.0752, 0.0271, 0.1166, 0.0078, 0.0309, 0.0049, 0.0069, 0.0073, 0.0488, 0.444, NAN, NAN},
+      {0.850, 7.194, 0.041, 0.276, 0.036, 0.241, 0.0052, 0.0084, 0.0087, 0.0536, 0.444, 7.19, 1.38},
+      {3.84, 8.54, 0.33, 0.76, 0.0107, 0.0159, 0.0009, 0.0000, 0.0000, 0.0000, 0.0000, NAN, NAN}}},
+    {"pyins",
+     {{0.0222, 0.0667, 0.0276, 0.1148, 0.0079, 0.0283, 0.0051, 0.0068, 0.0072, 0.0492, 0.401, NAN, NAN},
+      {0.788, 6.742, 0.071, 0.485, 0.034, 0.228, 0.0057, 0.0082, 0.0086, 0.0536, 0.401, 6.74, 0.97},
+      {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN}}},
+};
+
+static const char *const k_fig_labels[N_FIG] = {
+    "horiz. pos RMS [m]",   "horiz. pos max [m]",   "vert. pos RMS [m]",   "vert. pos max [m]",
+    "horiz. vel RMS [m/s]", "horiz. vel max [m/s]", "vert. vel RMS [m/s]", "roll RMS [deg]",
+    "pitch RMS [deg]",      "yaw RMS [deg]",        "yaw max [deg]",       "gap 1 end horiz. [m]",
+    "gap 2 end horiz. [m]"};
+
+/* The same figures as JSON keys (units in the names). */
+static const char *const k_fig_keys[N_FIG] = {
+    "pos_err_h_rms_m",     "pos_err_h_max_m",   "pos_err_v_rms_m",   "pos_err_v_max_m",
+    "vel_err_h_rms_mps",   "vel_err_h_max_mps", "vel_err_v_rms_mps", "roll_err_rms_deg",
+    "pitch_err_rms_deg",   "yaw_err_rms_deg",   "yaw_err_max_deg",   "gap1_end_pos_err_h_m",
+    "gap2_end_pos_err_h_m"};
+
+static void figures_of(const nav_replay_stats *s, const nav_replay_summary *sum, double v[N_FIG]) {
+  v[F_POS_H_RMS] = s->pos_h_m.rms;
+  v[F_POS_H_MAX] = s->pos_h_m.max;
+  v[F_POS_V_RMS] = s->pos_v_m.rms;
+  v[F_POS_V_MAX] = s->pos_v_m.max;
+  v[F_VEL_H_RMS] = s->vel_h_mps.rms;
+  v[F_VEL_H_MAX] = s->vel_h_mps.max;
+  v[F_VEL_V_RMS] = s->vel_v_mps.rms;
+  v[F_ROLL_RMS] = s->roll_rad.rms * NAV_RAD2DEG;
+  v[F_PITCH_RMS] = s->pitch_rad.rms * NAV_RAD2DEG;
+  v[F_YAW_RMS] = s->yaw_rad.rms * NAV_RAD2DEG;
+  v[F_YAW_MAX] = s->yaw_rad.max * NAV_RAD2DEG;
+  v[F_GAP1_H] = NAN;
+  v[F_GAP2_H] = NAN;
+  if (!sum) return;
+  int k = 0;
+  for (long i = 0; i < sum->gap_count && i < NAV_REPLAY_MAX_GAPS && k < 2; ++i)
+    if (!sum->gaps[i].open && sum->gaps[i].has_end_errors) v[F_GAP1_H + k++] = sum->gaps[i].pos_h_end_m;
+}
+
+/*
+ * Is this the gnss-ins-sim long_drive data of the README? Its reference starts at 100000.000 s
+ * at 31.508183 N, 120.401989 E (README "Provenance"); that is specific enough for a label.
+ */
+static bool is_long_drive(const char *truth_path) {
+  nav_rec_reader *r = NULL;
+  nav_rec_pva row;
+  bool got = false, yes = false;
+  if (nav_rec_reader_open(truth_path, NAV_REC_PVA, &r, NULL) != NAV_OK) return false;
+  if (nav_rec_read_pva(r, &row, &got) == NAV_OK && got)
+    yes = fabs(row.t_s - 100000.0) < 1e-6 && fabs(row.pos.lat_rad * NAV_RAD2DEG - 31.508183) < 1e-7 &&
+          fabs(row.pos.lon_rad * NAV_RAD2DEG - 120.401989) < 1e-7;
+  nav_rec_reader_destroy(r);
+  return yes;
+}
+
+/* ---------------------------------------------------------------- result files */
+
+typedef struct out_files {
+  FILE *f[3]; /* truth.csv, nav.csv, errors.csv */
+  nav_status st;
+  bool show_progress;
+  double t_last_print;
+} out_files;
+
+static nav_callback_result on_record(void *user, const nav_replay_record *r) {
+  out_files *o = user;
+  /* Field by field: the simulator's record may grow fields the replay does not have. */
+  nav_sim_record rec;
+  memset(&rec, 0, sizeof rec);
+  rec.run = 0;
+  rec.frame = r->frame;
+  rec.truth = r->ref;
+  rec.nav = r->nav;
+  rec.err = r->err;
+  nav_status st = nav_csv_write_row(o->f[NAV_CSV_NAV], NAV_CSV_NAV, &rec);
+  if (st == NAV_OK && r->ref) st = nav_csv_write_row(o->f[NAV_CSV_TRUTH], NAV_CSV_TRUTH, &rec);
+  if (st == NAV_OK && r->err) st = nav_csv_write_row(o->f[NAV_CSV_ERRORS], NAV_CSV_ERRORS, &rec);
+  if (st != NAV_OK) {
+    o->st = st;
+    return NAV_STOP;
+  }
+  return NAV_CONTINUE;
+}
+
+static nav_callback_result on_progress(void *user, const nav_progress *p) {
+  out_files *o = user;
+  if (!o->show_progress) return NAV_CONTINUE;
+  const double t = now_s();
+  if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
+    fprintf(stderr, "\r  replaying: %5.1f %%  (t = %.3f s)", 100.0 * p->fraction, p->sim_time_s);
+    if (p->fraction >= 1.0) fputc('\n', stderr);
+    o->t_last_print = t;
+  }
+  return NAV_CONTINUE;
+}
+
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(f, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(f, "\\u%04x", *p);
+    else
+      fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+static void json_number(FILE *f, double v) {
+  if (isfinite(v))
+    fprintf(f, "%.17g", v);
+  else
+    fputs("null", f);
+}
+
+static void json_vec3(FILE *f, nav_vec3 v, double scale) {
+  fputc('[', f);
+  json_number(f, v.x * scale);
+  fputs(", ", f);
+  json_number(f, v.y * scale);
+  fputs(", ", f);
+  json_number(f, v.z * scale);
+  fputc(']', f);
+}
+
+static void json_stat(FILE *f, const char *indent, const char *name, nav_replay_stat s, double scale,
+                      bool last) {
+  fprintf(f, "%s\"%s\": {\"rms\": ", indent, name);
+  json_number(f, s.rms * scale);
+  fputs(", \"max\": ", f);
+  json_number(f, s.max * scale);
+  fputs(", \"t_max_s\": ", f);
+  json_number(f, s.t_max_s);
+  fprintf(f, "}%s\n", last ? "" : ",");
+}
+
+/* "name": {statistics} at @p indent (two spaces per level), followed by a comma unless last. */
+static void json_stats(FILE *f, int indent, const char *name, const nav_replay_stats *s, bool last) {
+  char in[32];
+  snprintf(in, sizeof in, "%*s", 2 * indent + 2, "");
+  fprintf(f, "%*s\"%s\": {\n%s\"epochs\": %ld,\n", 2 * indent, "", name, in, s->epochs);
+  json_stat(f, in, "pos_err_h_m", s->pos_h_m, 1.0, false);
+  json_stat(f, in, "pos_err_v_m", s->pos_v_m, 1.0, false);
+  json_stat(f, in, "vel_err_h_mps", s->vel_h_mps, 1.0, false);
+  json_stat(f, in, "vel_err_v_mps", s->vel_v_mps, 1.0, false);
+  json_stat(f, in, "roll_err_deg", s->roll_rad, NAV_RAD2DEG, false);
+  json_stat(f, in, "pitch_err_deg", s->pitch_rad, NAV_RAD2DEG, false);
+  json_stat(f, in, "yaw_err_deg", s->yaw_rad, NAV_RAD2DEG, false);
+  json_stat(f, in, "att_err_deg", s->att_rad, NAV_RAD2DEG, false);
+  fprintf(f, "%s\"pos_err_mean_ned_m\": ", in);
+  json_vec3(f, s->pos_mean_n_m, 1.0);
+  fprintf(f, ",\n%s\"vel_err_mean_ned_mps\": ", in);
+  json_vec3(f, s->vel_mean_n_mps, 1.0);
+  fprintf(f, "\n%*s}%s\n", 2 * indent, "", last ? "" : ",");
+}
+
+typedef struct peer_arg {
+  char name[64];
+  const char *path;
+  nav_replay_stats stats;
+} peer_arg;
+
+typedef struct replay_job {
+  const char *imu, *gnss, *truth, *config;
+  const nav_replay_config *rc;
+  const nav_replay_summary *sum;
+  data_case dcase;
+  bool long_drive;
+  double wall_s;
+  const peer_arg *peers;
+  int n_peers;
+} replay_job;
+
+static nav_status write_summary(const char *path, const replay_job *j) {
+  FILE *f = fopen(path, "w");
+  if (!f) return NAV_ERR_IO;
+  const nav_replay_summary *s = j->sum;
+  const nav_ins_gnss_config *nc = &j->rc->nav;
+  const nav_filter_config *fc = &nc->filter;
+  fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"command\": \"replay\",\n  \"inputs\": {\"imu\": ",
+          nav_version_string());
+  json_string(f, j->imu);
+  fputs(", \"gnss\": ", f);
+  if (j->gnss)
+    json_string(f, j->gnss);
+  else
+    fputs("null", f);
+  fputs(", \"truth\": ", f);
+  json_string(f, j->truth);
+  fputs(", \"config\": ", f);
+  if (j->config)
+    json_string(f, j->config);
+  else
+    fputs("null", f);
+  fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"case\": ", s->free_ins ? "free_ins" : "ins_gnss");
+  json_string(f, k_case_names[j->dcase]);
+  fprintf(f, ",\n  \"dataset\": %s,\n", j->long_drive ? "\"gnss-ins-sim long_drive\"" : "null");
+  fprintf(
+      f,
+      "  \"settings\": {\"algorithm\": \"%s\", \"mechanization_frame\": \"%s\", \"gravity_model\": \"%s\", ",
+      nav_mech_algorithm_name(nc->ins.algorithm), nav_mech_frame_name(nc->ins.mech_frame),
+      nav_gravity_model_name(nc->ins.gravity_model));
+  fputs("\"lever_arm_b_m\": ", f);
+  json_vec3(f, nc->r_ba_b_m, 1.0);
+  fputs(",\n    \"gyro_arw_deg_per_sqrt_h\": ", f);
+  json_vec3(f, fc->gyro_arw_rad_per_sqrt_s, NAV_RAD2DEG * 60.0);
+  fputs(", \"accel_vrw_mps_per_sqrt_h\": ", f);
+  json_vec3(f, fc->accel_vrw_mps_per_sqrt_s, 60.0);
+  fputs(",\n    \"gyro_bias_gm_sd_deg_per_h\": ", f);
+  json_vec3(f, (fc->gyro_bias_terms & NAV_FILTER_PROC_GM) ? fc->gyro_bias_gm_sd_rps : nav_vec3_zero(),
+            NAV_RAD2DEG * 3600.0);
+  fputs(", \"gyro_bias_gm_tau_s\": ", f);
+  json_vec3(f, fc->gyro_bias_gm_tau_s, 1.0);
+  fputs(", \"accel_bias_gm_sd_mps2\": ", f);
+  json_vec3(f, (fc->accel_bias_terms & NAV_FILTER_PROC_GM) ? fc->accel_bias_gm_sd_mps2 : nav_vec3_zero(),
+            1.0);
+  fputs(", \"accel_bias_gm_tau_s\": ", f);
+  json_vec3(f, fc->accel_bias_gm_tau_s, 1.0);
+  fputs(",\n    \"p0_pos_sd_m\": ", f);
+  json_vec3(f, fc->init.pos_sd_m, 1.0);
+  fputs(", \"p0_vel_sd_mps\": ", f);
+  json_vec3(f, fc->init.vel_sd_mps, 1.0);
+  fputs(", \"p0_att_sd_deg\": ", f);
+  json_vec3(f, fc->init.att_sd_rad, NAV_RAD2DEG);
+  fputs(", \"p0_gyro_bias_sd_deg_per_h\": ", f);
+  json_vec3(f, fc->init.gyro_bias_sd_rps, NAV_RAD2DEG * 3600.0);
+  fputs(", \"p0_accel_bias_sd_mps2\": ", f);
+  json_vec3(f, fc->init.accel_bias_sd_mps2, 1.0);
+  fputs(",\n    \"gnss_pos_sd_floor_m\": ", f);
+  json_number(f, nc->pos_sd_floor_m);
+  fputs(", \"ref_sync_tol_s\": ", f);
+  json_number(f, j->rc->ref_sync_tol_s);
+  fputs(", \"outages\": [", f);
+  for (size_t i = 0; i < j->rc->outage_count; ++i) {
+    fputs(i ? ", [" : "[", f);
+    json_number(f, j->rc->outages[i].t0_s);
+    fputs(", ", f);
+    json_number(f, j->rc->outages[i].t1_s);
+    fputc(']', f);
+  }
+  fputs("]},\n  \"window\": {\"t_first_s\": ", f);
+  json_number(f, s->t_first_s);
+  fputs(", \"t_last_s\": ", f);
+  json_number(f, s->t_last_s);
+  fputs(", \"duration_s\": ", f);
+  json_number(f, s->t_last_s - s->t_first_s);
+  fprintf(f, "},\n  \"partial\": %s,\n", s->partial ? "true" : "false");
+  fprintf(
+      f,
+      "  \"counts\": {\"imu_records\": %ld, \"imu_steps\": %ld, \"imu_gaps\": %ld, \"ref_rows\": %ld, "
+      "\"ref_unmatched\": %ld, \"gnss_records\": %ld, \"gnss_applied\": %ld, \"gnss_dropped_outage\": %ld, "
+      "\"gnss_before_start\": %ld, \"gnss_unmatched\": %ld, \"gnss_has_velocity\": %s},\n",
+      s->imu_records, s->imu_steps, s->imu_gaps, s->ref_rows, s->ref_unmatched, s->gnss_records,
+      s->gnss_applied, s->gnss_dropped, s->gnss_before_start, s->gnss_unmatched,
+      s->gnss_has_vel ? "true" : "false");
+  fputs("  \"timing\": {\"wall_s\": ", f);
+  json_number(f, j->wall_s);
+  fprintf(f, ", \"imu_samples\": %ld, \"imu_samples_per_s\": ", s->imu_steps);
+  json_number(f, j->wall_s > 0.0 ? (double)s->imu_steps / j->wall_s : 0.0);
+  fputs(", \"realtime_factor\": ", f);
+  json_number(f, j->wall_s > 0.0 ? (s->t_last_s - s->t_first_s) / j->wall_s : 0.0);
+  fputs("},\n", f);
+  json_stats(f, 1, "errors", &s->stats, false);
+  json_stats(f, 1, "errors_at_output_epochs", &s->stats_output, false);
+  fputs("  \"final\": {\"t_s\": ", f);
+  json_number(f, s->final.t_s);
+  fputs(", \"pos_err_h_m\": ", f);
+  json_number(f, s->final.pos_err_h_m);
+  fputs(", \"pos_err_v_m\": ", f);
+  json_number(f, s->final.pos_err_v_m);
+  fputs(", \"vel_err_mps\": ", f);
+  json_number(f, s->final.vel_err_mps);
+  fputs(", \"att_err_deg\": ", f);
+  json_number(f, s->final.att_err_rad * NAV_RAD2DEG);
+  fputs("},\n  \"bias_estimates\": {\"gyro_deg_per_h\": ", f);
+  json_vec3(f, s->b_g_rps, NAV_RAD2DEG * 3600.0);
+  fputs(", \"accel_mps2\": ", f);
+  json_vec3(f, s->b_a_mps2, 1.0);
+  fprintf(f, "},\n  \"gnss_gaps\": {\"count\": %ld, \"list\": [", s->gap_count);
+  for (long i = 0; i < s->gap_count && i < NAV_REPLAY_MAX_GAPS; ++i) {
+    const nav_replay_gap *g = &s->gaps[i];
+    fprintf(f, "%s\n    {\"t0_s\": ", i ? "," : "");
+    json_number(f, g->t0_s);
+    fputs(", \"t1_s\": ", f);
+    json_number(f, g->t1_s);
+    fprintf(f, ", \"open\": %s, \"pos_err_h_end_m\": ", g->open ? "true" : "false");
+    json_number(f, g->has_end_errors ? g->pos_h_end_m : NAN);
+    fputs(", \"pos_err_v_end_m\": ", f);
+    json_number(f, g->has_end_errors ? g->pos_v_end_m : NAN);
+    fputs(", \"pos_err_h_max_m\": ", f);
+    json_number(f, g->pos_h_max_m);
+    fputc('}', f);
+  }
+  fputs(s->gap_count > 0 ? "\n  ]},\n" : "]},\n", f);
+  fputs("  \"peers_published\": ", f);
+  if (j->long_drive) {
+    fputs("{\"source\": \"gnss-ins-sim-long-drive/README.md\", \"case\": ", f);
+    json_string(f, k_case_readme[j->dcase]);
+    for (int p = 0; p < 2; ++p) {
+      fprintf(f, ", \"%s\": {", k_peers[p].name);
+      for (int k = 0; k < N_FIG; ++k) {
+        fprintf(f, "%s\"%s\": ", k ? ", " : "", k_fig_keys[k]);
+        json_number(f, k_peers[p].v[j->dcase][k]);
+      }
+      fputc('}', f);
+    }
+    fputs("},\n", f);
+  } else {
+    fputs("null,\n", f);
+  }
+  fputs("  \"peers_scored\": [", f);
+  for (int p = 0; p < j->n_peers; ++p) {
+    fputs(p ? ",\n    {\"name\": " : "\n    {\"name\": ", f);
+    json_string(f, j->peers[p].name);
+    fputs(", \"file\": ", f);
+    json_string(f, j->peers[p].path);
+    fputs(",\n", f);
+    json_stats(f, 3, "errors", &j->peers[p].stats, true);
+    fputs("    }", f);
+  }
+  fputs(j->n_peers ? "\n  ]\n}\n" : "]\n}\n", f);
+  const bool bad = ferror(f) != 0;
+  return (fclose(f) != 0 || bad) ? NAV_ERR_IO : NAV_OK;
+}
+
+/* ---------------------------------------------------------------- terminal tables */
+
+static void print_cell(double v) {
+  if (isfinite(v))
+    printf(" %12.4g", v);
+  else
+    printf(" %12s", "-");
+}
+
+static void print_tables(const replay_job *j, bool show_published) {
+  const nav_replay_summary *s = j->sum;
+  printf("replay     %s%s%s vs %s (%s)\n", j->imu, j->gnss ? " + " : " (free INS)", j->gnss ? j->gnss : "",
+         j->truth, j->config ? j->config : "default filter settings");
+  printf("epochs     %ld IMU steps, %.3f .. %.3f s; %ld scored against the reference", s->imu_steps,
+         s->t_first_s, s->t_last_s, s->stats.epochs);
+  if (s->ref_unmatched > 0) printf(" (%ld reference rows between IMU epochs not scored)", s->ref_unmatched);
+  printf("\n");
+  if (!s->free_ins)
+    printf("gnss       %ld fixes applied, %ld dropped (outages), %ld before the start, %ld unmatched; %ld "
+           "gap%s\n",
+           s->gnss_applied, s->gnss_dropped, s->gnss_before_start, s->gnss_unmatched, s->gap_count,
+           s->gap_count == 1 ? "" : "s");
+  if (s->imu_gaps > 0)
+    printf("warning    %ld IMU intervals longer than 1.5x the first one (max %.4f s)\n", s->imu_gaps,
+           s->imu_dt_max_s);
+  printf("time       %.3f s wall, %.3g IMU samples/s, %.0fx real time\n", j->wall_s,
+         j->wall_s > 0 ? (double)s->imu_steps / j->wall_s : 0.0,
+         j->wall_s > 0 ? (s->t_last_s - s->t_first_s) / j->wall_s : 0.0);
+  printf("case       %s%s\n", k_case_names[j->dcase],
+         j->long_drive ? " (gnss-ins-sim long_drive data set)" : "");
+
+  double ours[N_FIG], ours_out[N_FIG];
+  figures_of(&s->stats, s, ours);
+  figures_of(&s->stats_output, s, ours_out);
+  printf("\n%-22s %12s", "", "navsim");
+  if (show_published)
+    for (int p = 0; p < 2; ++p)
+      printf(" %12s", k_peers[p].name);
+  if (j->n_peers > 0) {
+    printf(" %12s", "navsim@out");
+    for (int p = 0; p < j->n_peers; ++p)
+      printf(" %12.12s", j->peers[p].name);
+  }
+  printf("\n");
+  double pf[MAX_PEERS][N_FIG];
+  for (int p = 0; p < j->n_peers; ++p)
+    figures_of(&j->peers[p].stats, NULL, pf[p]);
+  for (int k = 0; k < N_FIG; ++k) {
+    if (k >= F_GAP1_H && s->free_ins) break;
+    printf("%-22s", k_fig_labels[k]);
+    print_cell(ours[k]);
+    if (show_published)
+      for (int p = 0; p < 2; ++p)
+        print_cell(k_peers[p].v[j->dcase][k]);
+    if (j->n_peers > 0) {
+      print_cell(ours_out[k]);
+      for (int p = 0; p < j->n_peers; ++p)
+        print_cell(pf[p][k]);
+    }
+    printf("\n");
+  }
+  printf("%-22s %12ld", "scored epochs", s->stats.epochs);
+  if (show_published)
+    for (int p = 0; p < 2; ++p)
+      printf(" %12s", isfinite(k_peers[p].v[j->dcase][F_POS_H_RMS]) ? "193034" : "-");
+  if (j->n_peers > 0) {
+    printf(" %12ld", s->stats_output.epochs);
+    for (int p = 0; p < j->n_peers; ++p)
+      printf(" %12ld", j->peers[p].stats.epochs);
+  }
+  printf("\n");
+  if (show_published)
+    printf("(KF-GINS, pyins: published figures of ../shared/data/gnss-ins-sim-long-drive/README.md, case "
+           "\"%s\"%s)\n",
+           k_case_readme[j->dcase], j->dcase == CASE_FREE_INS ? "; the peer row is for IMU_ideal.txt" : "");
+  if (j->n_peers > 0)
+    printf("(navsim@out and the scored peer files: the same metrics at the peers' epochs, every %g s)\n",
+           j->rc->output_interval_s);
+  if (s->gap_count > 0) {
+    printf("\nGNSS gaps (errors just before the first fix after the gap)\n");
+    printf("  %14s %14s %12s %12s %12s\n", "last fix [s]", "next fix [s]", "end h [m]", "end v [m]",
+           "max h [m]");
+    for (long i = 0; i < s->gap_count && i < NAV_REPLAY_MAX_GAPS; ++i) {
+      const nav_replay_gap *g = &s->gaps[i];
+      printf("  %14.3f %14.3f", g->t0_s, g->t1_s);
+      print_cell(g->has_end_errors ? g->pos_h_end_m : NAN);
+      print_cell(g->has_end_errors ? g->pos_v_end_m : NAN);
+      print_cell(g->pos_h_max_m);
+      printf("%s\n", g->open ? "  (open: no fix after it)" : "");
+    }
+  }
+  if (!s->free_ins)
+    printf("\nbias estimates  gyro [%.3f, %.3f, %.3f] deg/h, accel [%.3e, %.3e, %.3e] m/s^2\n",
+           s->b_g_rps.x * NAV_RAD2DEG * 3600.0, s->b_g_rps.y * NAV_RAD2DEG * 3600.0,
+           s->b_g_rps.z * NAV_RAD2DEG * 3600.0, s->b_a_mps2.x, s->b_a_mps2.y, s->b_a_mps2.z);
+  printf("mean errors     pos N/E/D [%.4f, %.4f, %.4f] m, vel N/E/D [%.5f, %.5f, %.5f] m/s\n",
+         s->stats.pos_mean_n_m.x, s->stats.pos_mean_n_m.y, s->stats.pos_mean_n_m.z, s->stats.vel_mean_n_mps.x,
+         s->stats.vel_mean_n_mps.y, s->stats.vel_mean_n_mps.z);
+}
+
+/* ---------------------------------------------------------------- command */
+
+static int need_value(int argc, int i, const char *opt) {
+  if (i + 1 >= argc) {
+    fprintf(stderr, "navsim replay: %s needs a value\n", opt);
+    return 0;
+  }
+  return 1;
+}
+
+int navsim_replay(int argc, char **argv) {
+  const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay";
+  bool quiet = false, peers_auto = true;
+  unsigned cov_decimation = 1u;
+  nav_replay_config rc = nav_replay_config_default();
+  peer_arg peers[MAX_PEERS];
+  int n_peers = 0;
+  for (int i = 0; i < argc; ++i) {
+    const char *a = argv[i];
+    if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+      fputs(k_usage_replay, stdout);
+      return EXIT_OK;
+    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+      quiet = true;
+    } else if (strcmp(a, "--imu") == 0 || strcmp(a, "--gnss") == 0 || strcmp(a, "--truth") == 0 ||
+               strcmp(a, "--config") == 0 || strcmp(a, "--scene") == 0 || strcmp(a, "--out") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      const char **dst = a[2] == 'i'   ? &imu
+                         : a[2] == 'g' ? &gnss
+                         : a[2] == 't' ? &truth
+                         : (a[2] == 'c' || a[2] == 's') ? &config
+                                       : &out_dir;
+      *dst = v;
+    } else if (strcmp(a, "--start") == 0 || strcmp(a, "--end") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      double t = 0.0;
+      if (!parse_double(v, &t)) {
+        fprintf(stderr, "navsim replay: %s: expected a time in seconds (file time base), got \"%s\"\n", a, v);
+        return EXIT_INVALID;
+      }
+      if (a[2] == 's') {
+        rc.has_start = true;
+        rc.t_start_s = t;
+      } else {
+        rc.has_end = true;
+        rc.t_end_s = t;
+      }
+    } else if (strcmp(a, "--outage") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      char buf[128];
+      snprintf(buf, sizeof buf, "%s", v);
+      char *colon = strchr(buf, ':');
+      double t0 = 0.0, t1 = 0.0;
+      if (colon) *colon = '\0';
+      if (!colon || !parse_double(buf, &t0) || !parse_double(colon + 1, &t1) || !(t1 > t0)) {
+        fprintf(
+            stderr,
+            "navsim replay: --outage: expected T0:T1 with T0 < T1 (seconds, file time base), got \"%s\"\n",
+            v);
+        return EXIT_INVALID;
+      }
+      if (rc.outage_count >= NAV_GNSS_MAX_OUTAGES) {
+        fprintf(stderr, "navsim replay: --outage: at most %d outages\n", NAV_GNSS_MAX_OUTAGES);
+        return EXIT_INVALID;
+      }
+      rc.outages[rc.outage_count].t0_s = t0;
+      rc.outages[rc.outage_count].t1_s = t1;
+      rc.outage_count++;
+    } else if (strcmp(a, "--peer") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      const char *eq = strchr(v, '=');
+      if (!eq || eq == v || !eq[1] || (size_t)(eq - v) >= sizeof peers[0].name) {
+        fprintf(stderr, "navsim replay: --peer: expected NAME=FILE (NAME up to 63 characters), got \"%s\"\n",
+                v);
+        return EXIT_INVALID;
+      }
+      if (n_peers >= MAX_PEERS) {
+        fprintf(stderr, "navsim replay: --peer: at most %d peers\n", MAX_PEERS);
+        return EXIT_INVALID;
+      }
+      memset(&peers[n_peers], 0, sizeof peers[n_peers]);
+      snprintf(peers[n_peers].name, sizeof peers[n_peers].name, "%.*s", (int)(eq - v), v);
+      peers[n_peers].path = eq + 1;
+      n_peers++;
+    } else if (strcmp(a, "--cov-decimation") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      double n = 0.0;
+      if (!parse_double(v, &n) || n != floor(n) || n < 1.0 || n > 1000.0) {
+        fprintf(stderr, "navsim replay: --cov-decimation: expected an integer in [1, 1000], got \"%s\"\n", v);
+        return EXIT_INVALID;
+      }
+      cov_decimation = (unsigned)n;
+    } else if (strcmp(a, "--peers") == 0) {
+      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      if (strcmp(v, "auto") == 0)
+        peers_auto = true;
+      else if (strcmp(v, "none") == 0)
+        peers_auto = false;
+      else {
+        fprintf(stderr, "navsim replay: --peers: expected auto or none, got \"%s\"\n", v);
+        return EXIT_INVALID;
+      }
+    } else {
+      fprintf(stderr, "navsim replay: unknown argument \"%s\" (see navsim replay --help)\n", a);
+      return EXIT_INVALID;
+    }
+  }
+  if (!imu || !truth) {
+    fprintf(stderr, "navsim replay: --imu and --truth are required\n%s", k_usage_replay);
+    return EXIT_INVALID;
+  }
+  if (rc.has_start && rc.has_end && !(rc.t_end_s > rc.t_start_s)) {
+    fprintf(stderr, "navsim replay: --end must be after --start\n");
+    return EXIT_INVALID;
+  }
+  if (rc.outage_count > 0 && !gnss)
+    fprintf(stderr, "navsim replay: warning: --outage has no effect without --gnss\n");
+
+  if (config) {
+    /* nav_scene is large (segment scripts): keep it off the stack. */
+    nav_scene *scene = malloc(sizeof *scene);
+    if (!scene) return EXIT_FAIL;
+    const nav_status st = nav_scene_read_file(config, scene, on_scene_diag, NULL);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim replay: --scene %s: %s\n", config,
+              st == NAV_ERR_PARSE ? "not a valid scene (errors above)" : nav_status_str(st));
+      free(scene);
+      return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
+    }
+    rc.nav = nav_ins_gnss_config_from_scene(scene);
+    /* Recorded data lives on the real Earth: WGS-84 whatever the scene's earth.model says. */
+    rc.nav.ins.earth_model = NAV_EARTH_WGS84;
+    free(scene);
+  }
+  rc.nav.filter.cov_decimation = cov_decimation;
+  rc.imu_path = imu;
+  rc.gnss_path = gnss;
+  rc.ref_path = truth;
+
+  int rc_exit = EXIT_FAIL;
+  nav_resultdir *rd = NULL;
+  out_files o;
+  memset(&o, 0, sizeof o);
+  o.show_progress = !quiet && isatty(STDERR_FILENO);
+  static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
+  nav_status st = nav_resultdir_begin(out_dir, &rd);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim replay: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
+    goto cleanup;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const char *file = nav_resultdir_file(rd, names[i]);
+    o.f[i] = file ? fopen(file, "w") : NULL;
+    if (!o.f[i] || nav_csv_write_header(o.f[i], (nav_csv_table)i) != NAV_OK) {
+      fprintf(stderr, "navsim replay: cannot write %s in \"%s\"\n", names[i], out_dir);
+      goto cleanup;
+    }
+  }
+  rc.record = on_record;
+  rc.progress = on_progress;
+  rc.user = &o;
+
+  nav_replay_summary sum;
+  nav_diag d;
+  memset(&d, 0, sizeof d);
+  const double t0 = now_s();
+  st = nav_replay_run(&rc, &sum, &d);
+  const double wall = now_s() - t0;
+  if (st != NAV_OK) {
+    if (o.st != NAV_OK)
+      fprintf(stderr, "navsim replay: writing results failed: %s\n", nav_status_str(o.st));
+    else if (d.message[0])
+      print_diag(&d);
+    else
+      fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
+    rc_exit = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
+    goto cleanup;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const bool bad = ferror(o.f[i]) != 0;
+    const int cl = fclose(o.f[i]);
+    o.f[i] = NULL;
+    if (bad || cl != 0) {
+      fprintf(stderr, "navsim replay: writing %s failed\n", names[i]);
+      goto cleanup;
+    }
+  }
+  for (int p = 0; p < n_peers; ++p) {
+    memset(&d, 0, sizeof d);
+    st = nav_replay_score_pva(truth, peers[p].path, true, sum.t_first_s, true, sum.t_last_s,
+                              rc.ref_sync_tol_s, &peers[p].stats, &d);
+    if (st != NAV_OK) {
+      if (d.message[0]) print_diag(&d);
+      fprintf(stderr, "navsim replay: --peer %s: cannot score %s\n", peers[p].name, peers[p].path);
+      rc_exit = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+
+  replay_job job;
+  memset(&job, 0, sizeof job);
+  job.imu = imu;
+  job.gnss = gnss;
+  job.truth = truth;
+  job.config = config;
+  job.rc = &rc;
+  job.sum = &sum;
+  job.dcase = sum.free_ins ? CASE_FREE_INS
+                           : (sum.gap_count > 0 || sum.gnss_dropped > 0 ? CASE_OUTAGES : CASE_FULL_GNSS);
+  job.long_drive = peers_auto && is_long_drive(truth);
+  job.wall_s = wall;
+  job.peers = peers;
+  job.n_peers = n_peers;
+  st = write_summary(nav_resultdir_file(rd, "summary.json"), &job);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim replay: writing summary.json failed\n");
+    goto cleanup;
+  }
+  st = nav_resultdir_commit(rd);
+  rd = NULL;
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim replay: cannot move the results into \"%s\": %s\n", out_dir, strerror(errno));
+    goto cleanup;
+  }
+  if (!quiet) {
+    print_tables(&job, job.long_drive);
+    if (job.long_drive && (sum.t_first_s > 100000.0051 || sum.t_last_s < 100965.1749))
+      printf("note: the published figures cover the whole data set (100000.005 .. 100965.175 s); this window "
+             "differs\n");
+    printf("results         %s/\n", out_dir);
+  }
+  rc_exit = EXIT_OK;
+
+cleanup:
+  for (int i = 0; i < 3; ++i)
+    if (o.f[i]) fclose(o.f[i]);
+  nav_resultdir_abort(rd);
+  return rc_exit;
+}
