@@ -70,6 +70,7 @@ _Static_assert(sizeof(nav_gravity_model) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_mech_frame) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_nav_scheme) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_bi_convention) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_array_layout_kind) == sizeof(int), "enum storage");
 
 #define PATH_MAX_LEN ((size_t)sizeof(((nav_diag *)0)->path))
 #define MAX_SECTION_FIELDS 64 /* descriptors per section; checked when a section is read */
@@ -135,6 +136,13 @@ static bool same_reported(const nav_io_field *f, const void *a, const void *b);
 static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base);
 static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base);
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
+static void read_array_sensors(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                               const nav_io_node *value, void *base);
+static nav_status write_array_sensors(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool same_array_sensors(const nav_io_field *f, const void *a, const void *b);
+static bool array_sensors_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                                  const void *def);
+static bool array_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
 
 static const nav_io_enum_value k_earth_models[] = {
     {"flat", NAV_EARTH_FLAT}, {"wgs84", NAV_EARTH_WGS84}, {NULL, 0}};
@@ -143,8 +151,15 @@ static const nav_io_enum_value k_gravity_models[] = {
 static const nav_io_enum_value k_mech_frames[] = {{"ned", NAV_MECH_NED}, {"ecef", NAV_MECH_ECEF}, {NULL, 0}};
 static const nav_io_enum_value k_mech_algorithms[] = {
     {"first_order", NAV_MECH_FIRST_ORDER}, {"high_order", NAV_MECH_HIGH_ORDER}, {NULL, 0}};
-static const nav_io_enum_value k_schemes[] = {
-    {"free_ins", NAV_SCHEME_FREE_INS}, {"ins_gnss", NAV_SCHEME_INS_GNSS}, {NULL, 0}};
+static const nav_io_enum_value k_schemes[] = {{"free_ins", NAV_SCHEME_FREE_INS},
+                                              {"ins_gnss", NAV_SCHEME_INS_GNSS},
+                                              {"gyro_free", NAV_SCHEME_GYRO_FREE},
+                                              {NULL, 0}};
+static const nav_io_enum_value k_array_layouts[] = {{"cube6", NAV_ARRAY_LAYOUT_CUBE6},
+                                                    {"nine", NAV_ARRAY_LAYOUT_NINE},
+                                                    {"twelve", NAV_ARRAY_LAYOUT_TWELVE},
+                                                    {"custom", NAV_ARRAY_LAYOUT_CUSTOM},
+                                                    {NULL, 0}};
 static const nav_io_enum_value k_bi_conventions[] = {
     {"allan_peak", NAV_BI_ALLAN_PEAK}, {"sigma_equals_b", NAV_BI_SIGMA_EQUALS_B}, {NULL, 0}};
 
@@ -419,6 +434,94 @@ static const nav_io_field k_gnss[] = {
 };
 DEFINE_SECTION(k_gnss_section, k_gnss);
 
+/* ---------------------------------------------------------------- accelerometer array (gyro-free INS) */
+
+/*
+ * array: {layout, radius_m, sensors (custom), accel: {...}, initial_rate_sd_dps}. The accel
+ * figures apply to every sensor (each draws its own realisation); a term is on when one of its
+ * keys is given, as for the IMU, and "off" lists terms that are off although they have values.
+ */
+#define R_TERM(b) .bit = (b), .bits_offset = OFF(array.accel.terms)
+#define RM(m) array.accel.m
+
+static const nav_io_field k_array_accel[] = {
+    Q("bias_turn_on_mg", NAV_IO_DOUBLE, NONNEG, RM(bias_turn_on_sd_mps2), K_MG,
+      R_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2",
+      .comment = "1-sigma, drawn per sensor and run"),
+    Q("bias_turn_on_mps2", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(bias_turn_on_sd_mps2), 1.0,
+      R_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_gm_sigma_ug", NAV_IO_DOUBLE, NONNEG, RM(bias_gm_sd_mps2), K_UG, R_TERM(NAV_IMU_TERM_BIAS_GM),
+      .mark_as = "bias_gm_sd_mps2"),
+    Q("bias_gm_sigma_mps2", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(bias_gm_sd_mps2), 1.0,
+      R_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_DOUBLE, POSITIVE, RM(bias_gm_tau_s), 1.0, R_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_DOUBLE, NONNEG, RM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
+      R_TERM(NAV_IMU_TERM_NOISE), .mark_as = "vrw_mps_per_sqrt_s"),
+    Q("vrw_mps_per_sqrt_s", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), 1.0,
+      R_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_ug_per_sqrt_hz", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), K_UG,
+      R_TERM(NAV_IMU_TERM_NOISE)),
+    Q("scale_factor_ppm", NAV_IO_DOUBLE, NONNEG, RM(scale_factor_sd), K_PPM,
+      R_TERM(NAV_IMU_TERM_SCALE_FACTOR), .mark_as = "scale_factor_sd"),
+    Q("scale_factor_sd", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(scale_factor_sd), 1.0,
+      R_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+    {.key = "off",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_LATE,
+     .offset = OFF(array.accel),
+     .read = read_off,
+     .write = write_off,
+     .same = same_terms,
+     .write_if = off_needed,
+     .comment = "terms switched off"},
+};
+DEFINE_SECTION(k_array_accel_section, k_array_accel);
+
+/* One sensor of a custom layout (base: nav_scene_array_sensor): its position from the array
+   centre and its sensitive axis (any non-zero length), body axes. */
+static const nav_io_field k_array_sensor[] = {
+    {.key = "position_m",
+     .kind = NAV_IO_VEC3,
+     .flags = NAV_IO_FINITE | NAV_IO_REQUIRED,
+     .offset = offsetof(nav_scene_array_sensor, r_bs_b_m),
+     .scale = 1.0,
+     .mark_as = "r_bs_b_m"},
+    {.key = "axis",
+     .kind = NAV_IO_VEC3,
+     .flags = NAV_IO_FINITE | NAV_IO_REQUIRED,
+     .offset = offsetof(nav_scene_array_sensor, n_s_b),
+     .scale = 1.0,
+     .mark_as = "n_s_b"},
+};
+DEFINE_SECTION(k_array_sensor_section, k_array_sensor);
+
+static const nav_io_field k_array[] = {
+    {.key = "layout",
+     .kind = NAV_IO_ENUM,
+     .offset = OFF(array.layout),
+     .enums = k_array_layouts,
+     .comment = "cube6 | nine | twelve | custom (sensors below)"},
+    {.key = "radius_m",
+     .kind = NAV_IO_DOUBLE,
+     .flags = POSITIVE | NAV_IO_MAX_LE,
+     .offset = OFF(array.radius_m),
+     .scale = 1.0,
+     .max = 100.0,
+     .comment = "arm r of cube6, nine and twelve"},
+    {.key = "sensors",
+     .kind = NAV_IO_CUSTOM,
+     .offset = OFF(array),
+     .read = read_array_sensors,
+     .write = write_array_sensors,
+     .same = same_array_sensors,
+     .write_if = array_sensors_written},
+    {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_array_accel_section},
+    Q("initial_rate_sd_dps", NAV_IO_VEC3S, NONNEG, array.initial_rate_sd_rps, NAV_DEG2RAD,
+      .mark_as = "initial_rate_sd_rps", .comment = "1-sigma error of the initial angular rate, body x, y, z"),
+    Q("initial_rate_sd_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, array.initial_rate_sd_rps, 1.0, .bit = 0),
+};
+DEFINE_SECTION(k_array_section, k_array);
+
 /* ---------------------------------------------------------------- the rest */
 
 static const nav_io_field k_initial_errors[] = {
@@ -480,6 +583,7 @@ static const nav_io_field k_root[] = {
     {.key = "trajectory", .kind = NAV_IO_SECTION, .section = &nav_io_trajectory_section},
     {.key = "imu", .kind = NAV_IO_SECTION, .section = &k_imu_section},
     {.key = "gnss", .kind = NAV_IO_SECTION, .section = &k_gnss_section, .write_if = gnss_written},
+    {.key = "array", .kind = NAV_IO_SECTION, .section = &k_array_section, .write_if = array_written},
     {.key = "initial_errors", .kind = NAV_IO_SECTION, .section = &k_initial_errors_section},
     {.key = "navigation", .kind = NAV_IO_SECTION, .section = &k_navigation_section},
     {.key = "output", .kind = NAV_IO_SECTION, .section = &k_output_section},
@@ -2052,26 +2156,33 @@ static const term_name k_imu_terms[] = {{"bias_turn_on", NAV_IMU_TERM_BIAS_TURN_
 static const term_name k_gnss_terms[] = {{"position", NAV_GNSS_TERM_POS_GM},
                                          {"position_white", NAV_GNSS_TERM_POS_WHITE},
                                          {"velocity", NAV_GNSS_TERM_VEL_WHITE}};
+static const term_name k_array_terms[] = {{"bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON},
+                                          {"bias_gm", NAV_IMU_TERM_BIAS_GM},
+                                          {"noise", NAV_IMU_TERM_NOISE},
+                                          {"scale_factor", NAV_IMU_TERM_SCALE_FACTOR}};
 
 /*
  * imu.off: [noise, gyro.bias_gm, ...] switches terms off after everything else was read (a
  * catalog part's term, or one whose values are kept for later). A plain name applies to both
  * triads, "gyro." / "accel." to one. gnss.off: [position, position_white, velocity].
+ * array.accel.off: [bias_turn_on, bias_gm, noise, scale_factor].
  */
 static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key, const nav_io_node *v,
                      void *base) {
   nav_scene *s = base;
   const bool imu = f->offset == OFF(imu.model);
-  const term_name *terms = imu ? k_imu_terms : k_gnss_terms;
-  const size_t nterms = imu ? COUNT(k_imu_terms) : COUNT(k_gnss_terms);
+  const bool arr = f->offset == OFF(array.accel);
+  const term_name *terms = imu ? k_imu_terms : arr ? k_array_terms : k_gnss_terms;
+  const size_t nterms = imu ? COUNT(k_imu_terms) : arr ? COUNT(k_array_terms) : COUNT(k_gnss_terms);
   char shown[SHOW_MAX + 4];
   if (reject_special(r, key, v)) return;
   if (is_null(v)) return;
   const bool seq = v->kind == Y_SEQ;
   if (!seq && v->kind != Y_SCALAR) {
     nav_io_expected(r, key, v,
-                    imu ? "a list of term names ([noise, gyro.bias_gm, ...])"
-                        : "a list of term names ([position, position_white, velocity])");
+                    imu   ? "a list of term names ([noise, gyro.bias_gm, ...])"
+                    : arr ? "a list of term names ([bias_turn_on, bias_gm, noise, scale_factor])"
+                          : "a list of term names ([position, position_white, velocity])");
     return;
   }
   size_t i = 0;
@@ -2127,6 +2238,8 @@ static void read_off(nav_io_reader *r, const nav_io_field *f, const nav_io_node 
     } else if (imu) {
       if (triad != 1) s->imu.model.gyro.terms &= ~bit;
       if (triad != 0) s->imu.model.accel.terms &= ~bit;
+    } else if (arr) {
+      s->array.accel.terms &= ~bit;
     } else {
       s->gnss.model.terms &= ~bit;
     }
@@ -2165,6 +2278,10 @@ static size_t off_names(const nav_io_writer *w, const nav_io_field *f, char buf[
       else if (a)
         snprintf(buf[n++], 40, "accel.%s", k_imu_terms[k].name);
     }
+  } else if (f->offset == OFF(array.accel)) {
+    for (size_t k = 0; k < COUNT(k_array_terms) && n < cap; ++k)
+      if (needs_off(w, &k_array_accel_section, s->array.accel.terms, k_array_terms[k].bit, ""))
+        snprintf(buf[n++], 40, "%s", k_array_terms[k].name);
   } else {
     for (size_t k = 0; k < COUNT(k_gnss_terms) && n < cap; ++k)
       if (needs_off(w, &k_gnss_section, s->gnss.model.terms, k_gnss_terms[k].bit, s->gnss.catalog))
@@ -2196,6 +2313,7 @@ static bool same_terms(const nav_io_field *f, const void *a, const void *b) {
   if (f->offset == OFF(imu.model))
     return sa->imu.model.gyro.terms == sb->imu.model.gyro.terms &&
            sa->imu.model.accel.terms == sb->imu.model.accel.terms;
+  if (f->offset == OFF(array.accel)) return sa->array.accel.terms == sb->array.accel.terms;
   return sa->gnss.model.terms == sb->gnss.model.terms;
 }
 
@@ -2311,6 +2429,72 @@ static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const vo
   (void)w;
   const nav_scene *s = base;
   return s->gnss.enabled || !nav_io_section_same(f->section, base, def);
+}
+
+/* ---------------------------------------------------------------- accelerometer array */
+
+/* array.sensors: [{position_m: [x, y, z], axis: [x, y, z]}, ...], at most 16. */
+static void read_array_sensors(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                               const nav_io_node *v, void *base) {
+  nav_scene_array *a = (nav_scene_array *)((char *)base + f->offset);
+  if (reject_special(r, key, v)) return;
+  if (v->kind != Y_SEQ) {
+    nav_io_expected(r, key, v, "a list of sensors (- {position_m: [x, y, z], axis: [x, y, z]})");
+    return;
+  }
+  if (v->count > NAV_SCENE_ARRAY_MAX_SENSORS) {
+    nav_io_reader_error(r, v, key, "at most %d accelerometers are supported (got %zu)",
+                        NAV_SCENE_ARRAY_MAX_SENSORS, v->count);
+    return;
+  }
+  a->custom_count = (int)v->count;
+  size_t i = 0;
+  for (const nav_io_node *item = v->child; item != NULL; item = item->next, ++i) {
+    const size_t saved = path_push_index(r, i);
+    mark_path(r, item, v);
+    if (reject_special(r, v, item)) {
+      /* reported */
+    } else if (item->kind != Y_MAP) {
+      nav_io_expected(r, v, item, "a sensor {position_m: [x, y, z], axis: [x, y, z]}");
+    } else {
+      nav_io_read_section(r, &k_array_sensor_section, v, item, &a->custom[i]);
+    }
+    path_pop(r, saved);
+  }
+}
+
+static nav_status write_array_sensors(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  const nav_scene_array *a = (const nav_scene_array *)((const char *)base + f->offset);
+  static const nav_scene_array_sensor zero; /* every key is written: the defaults do not matter */
+  if (a->custom_count <= 0) return nav_io_writef(w, " []");
+  nav_status st = NAV_OK;
+  for (int i = 0; i < a->custom_count && i < NAV_SCENE_ARRAY_MAX_SENSORS && st == NAV_OK; ++i) {
+    st = nav_io_writef(w, "\n%*s- ", indent + 2, "");
+    if (st == NAV_OK) st = nav_io_write_flow(w, &k_array_sensor_section, &a->custom[i], &zero);
+  }
+  return st;
+}
+
+static bool same_array_sensors(const nav_io_field *f, const void *a, const void *b) {
+  const nav_scene_array *A = (const nav_scene_array *)((const char *)a + f->offset);
+  const nav_scene_array *B = (const nav_scene_array *)((const char *)b + f->offset);
+  if (A->custom_count != B->custom_count) return false;
+  for (int i = 0; i < A->custom_count && i < NAV_SCENE_ARRAY_MAX_SENSORS; ++i)
+    if (!nav_io_section_same(&k_array_sensor_section, &A->custom[i], &B->custom[i])) return false;
+  return true;
+}
+
+static bool array_sensors_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                                  const void *def) {
+  (void)w;
+  return !same_array_sensors(f, base, def);
+}
+
+/* The array section: for the gyro-free scheme, or when it differs from the defaults. */
+static bool array_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)w;
+  const nav_scene *s = base;
+  return s->navigation.scheme == NAV_SCHEME_GYRO_FREE || !nav_io_section_same(f->section, base, def);
 }
 
 /* ---------------------------------------------------------------- bias instability -> GM */

@@ -5,7 +5,7 @@
  * the tables they serve; the generic machinery is in scene_read.c and scene_write.c.
  *
  *   trajectory:
- *     type: parametric | waypoints | segments | test_motion | motion_def
+ *     type: parametric | waypoints | segments | test_motion | motion_def | recorded
  *     duration_s: 120            # or auto (the default for waypoints, segments and motion_def)
  *     initial_attitude: {roll_deg: 0, pitch_deg: 0, yaw_deg: 90}
  *     parametric: {...}          # the paper's formula (3)
@@ -13,6 +13,7 @@
  *     segments: {r0_ned_m, v0_b_mps, allow_unconverged, fit_rate_ramps, limits, items: [...]}
  *     test_motion: {kind: coning, ...the parameters of that kind}
  *     motion_def: {file: PATH, allow_unconverged, fit_rate_ramps}
+ *     recorded: {file: PATH, format: kf_gins_nav, start_s, end_s, knot_rate_hz, pos_sd_m, vel_sd_mps}
  *
  * duration_s. A waypoint or segment script has a natural length (nav_motiondef_script_summary);
  * "auto", or no duration_s at all, uses it. A longer explicit duration is allowed: after the end
@@ -26,6 +27,15 @@
  * earth.origin, trajectory.initial_attitude or trajectory.segments as well is an error. The
  * scene keeps no reference to the file: the writer writes the imported script as
  * type: segments (nav_scene has no field for the file name).
+ *
+ * recorded. The recorded reference file (relative to the scene file's directory, or absolute) is
+ * read when the whole scene has been read (nav_track_read_file: malformed lines are reported as
+ * FILE:LINE:COL) and fitted (nav_track_fit); the scene keeps the fitted model and the settings,
+ * with the file name resolved to an absolute path, which the writer writes back (the fit is
+ * deterministic, so reading the written scene gives the same model). The file sets the initial
+ * attitude (giving trajectory.initial_attitude as well is an error) and, unless earth.origin is
+ * given, the Earth origin: both are the model's state at the first sample. duration_s auto (or
+ * absent) is the recorded span; a number must not exceed it.
  *
  * Waypoints given as lat/lon/h are converted to local NED with the scene's frame
  * (nav_frame_geodetic_to_local(nav_frame_from_scene(scene))) once the whole file, and so the
@@ -44,6 +54,7 @@
 
 #include "navcore/nav_frames.h"
 #include "navcore/nav_motiondef.h"
+#include "navcore/nav_track_io.h"
 #include "scene_io_internal.h"
 #include "traj/traj_kin_internal.h"
 
@@ -58,6 +69,7 @@ _Static_assert(sizeof(nav_wp_timing) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_wp_attitude_mode) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_segment_kind) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_test_motion_kind) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_recorded_format) == sizeof(int), "enum storage");
 
 static bool same_bits(double a, double b) {
   return memcmp(&a, &b, sizeof a) == 0;
@@ -712,6 +724,43 @@ static const nav_io_field k_motion_def[] = {
 };
 SECTION_OF(k_motion_def_section, k_motion_def);
 
+/* trajectory.recorded: settings only; the file is read and fitted after the whole scene. */
+#define RO(member) OFF(trajectory.recorded.member)
+static const nav_io_enum_value k_recorded_formats[] = {{"kf_gins_nav", NAV_RECORDED_KF_GINS_NAV}, {NULL, 0}};
+static const nav_io_field k_recorded[] = {
+    {.key = "file",
+     .kind = NAV_IO_STRING,
+     .flags = NAV_IO_REQUIRED,
+     .offset = RO(file),
+     .size = NAV_RECORDED_PATH_MAX},
+    {.key = "format", .kind = NAV_IO_ENUM, .offset = RO(format), .enums = k_recorded_formats},
+    {.key = "start_s",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NAV_IO_FINITE,
+     .offset = RO(start_s),
+     .scale = 1.0,
+     .bit = NAV_RECORDED_HAS_START,
+     .bits_offset = RO(window),
+     .comment = "file time base"},
+    {.key = "end_s",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NAV_IO_FINITE,
+     .offset = RO(end_s),
+     .scale = 1.0,
+     .bit = NAV_RECORDED_HAS_END,
+     .bits_offset = RO(window)},
+    {.key = "knot_rate_hz",
+     .kind = NAV_IO_DOUBLE,
+     .flags = POSITIVE | NAV_IO_MAX_LE,
+     .offset = RO(knot_rate_hz),
+     .scale = 1.0,
+     .min = 0.0,
+     .max = 1000.0},
+    D("pos_sd_m", RO(pos_sd_m), 1.0, POSITIVE),
+    D("vel_sd_mps", RO(vel_sd_mps), 1.0, POSITIVE),
+};
+SECTION_OF(k_recorded_section, k_recorded);
+
 /* duration_s: a number of seconds, or auto (the length of a waypoint or segment script). */
 static void read_duration(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
                           const nav_io_node *v, void *base) {
@@ -745,6 +794,8 @@ static bool type_written(const nav_io_writer *w, const nav_io_field *f, const vo
     t = NAV_TRAJ_WAYPOINTS;
   else if (f->section == &k_segments_section)
     t = NAV_TRAJ_SEGMENTS;
+  else if (f->section == &k_recorded_section)
+    t = NAV_TRAJ_RECORDED;
   else if (f->kind == NAV_IO_CUSTOM)
     t = NAV_TRAJ_TEST_MOTION;
   return w->scene->trajectory.type == t || !nav_io_field_same(f, base, def);
@@ -753,7 +804,15 @@ static bool type_written(const nav_io_writer *w, const nav_io_field *f, const vo
 static const nav_io_enum_value k_traj_types[] = {
     {"parametric", NAV_TRAJ_PARAMETRIC},    {"waypoints", NAV_TRAJ_WAYPOINTS},
     {"segments", NAV_TRAJ_SEGMENTS},        {"test_motion", NAV_TRAJ_TEST_MOTION},
-    {"motion_def", NAV_IO_TRAJ_MOTION_DEF}, {NULL, 0}};
+    {"motion_def", NAV_IO_TRAJ_MOTION_DEF}, {"recorded", NAV_TRAJ_RECORDED}, {NULL, 0}};
+
+/* The initial attitude of a recorded trajectory is the recorded one: not written. */
+static bool attitude_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)f;
+  (void)base;
+  (void)def;
+  return w->scene->trajectory.type != NAV_TRAJ_RECORDED;
+}
 
 static const nav_io_field k_trajectory[] = {
     {.key = "type", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
@@ -767,7 +826,11 @@ static const nav_io_field k_trajectory[] = {
      .read = read_duration,
      .write = write_duration,
      .same = same_duration},
-    {.key = "initial_attitude", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_attitude_section},
+    {.key = "initial_attitude",
+     .kind = NAV_IO_SECTION,
+     .flags = NAV_IO_FLOW,
+     .section = &k_attitude_section,
+     .write_if = attitude_written},
     {.key = "parametric", .kind = NAV_IO_SECTION, .section = &k_parametric_section, .write_if = type_written},
     {.key = "waypoints", .kind = NAV_IO_SECTION, .section = &k_waypoints_section, .write_if = type_written},
     {.key = "segments", .kind = NAV_IO_SECTION, .section = &k_segments_section, .write_if = type_written},
@@ -778,6 +841,7 @@ static const nav_io_field k_trajectory[] = {
      .same = same_test_motion,
      .write_if = type_written},
     {.key = "motion_def", .kind = NAV_IO_SECTION, .section = &k_motion_def_section, .write_if = never},
+    {.key = "recorded", .kind = NAV_IO_SECTION, .section = &k_recorded_section, .write_if = type_written},
 };
 const nav_io_section nav_io_trajectory_section = {k_trajectory, COUNT(k_trajectory), NULL};
 
@@ -875,6 +939,85 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
   return true;
 }
 
+/* Read and fit trajectory.recorded.file (type recorded); false after a reported problem. */
+static bool load_recorded(nav_io_reader *r, const nav_io_node *root, nav_scene *scene) {
+  nav_io_read_state *st = nav_io_reader_state(r);
+  nav_traj_recorded *R = &scene->trajectory.recorded;
+  const nav_io_node *traj = nav_io_map_get(root, "trajectory", NULL);
+  const nav_io_node *earth = nav_io_map_get(root, "earth", NULL);
+  if (nav_io_map_get(traj, "recorded", NULL) == NULL) {
+    nav_io_reader_error_at_path(r, "trajectory.type",
+                                "recorded needs trajectory.recorded: {file: PATH} (a recorded reference, "
+                                "relative to this file)");
+    return false;
+  }
+  if (R->file[0] == '\0') return false; /* missing or rejected: reported */
+  bool ok = true;
+  if ((R->window & NAV_RECORDED_HAS_START) && (R->window & NAV_RECORDED_HAS_END) && !(R->end_s > R->start_s)) {
+    nav_io_reader_error_at_path(r, "trajectory.recorded.end_s", "must be later than start_s (got %.17g s, start_s %.17g s)",
+                                R->end_s, R->start_s);
+    ok = false;
+  }
+  if (nav_io_map_get(traj, "initial_attitude", NULL) != NULL) {
+    nav_io_reader_error_at_path(r, "trajectory.initial_attitude",
+                                "the recorded file (trajectory.recorded.file) sets the initial attitude; remove "
+                                "trajectory.initial_attitude");
+    ok = false;
+  }
+  char path[3 * NAV_IO_PATH_MAX];
+  if (!resolve_path(path, sizeof path, st->file, st->file_is_path, R->file) || strlen(path) >= sizeof R->file) {
+    nav_io_reader_error_at_path(r, "trajectory.recorded.file", "the path of the recorded file is too long");
+    return false;
+  }
+  struct stat sb;
+  const bool exists = stat(path, &sb) == 0;
+  const int err = errno;
+  if (!exists || !S_ISREG(sb.st_mode)) {
+    char why[128];
+    if (exists)
+      snprintf(why, sizeof why, "not a regular file");
+    else if (strerror_r(err, why, sizeof why) != 0)
+      snprintf(why, sizeof why, "error %d", err);
+    nav_io_reader_error_at_path(r, "trajectory.recorded.file", "cannot read the recorded file \"%s\": %s", path,
+                                why);
+    return false;
+  }
+  if (!ok) return false;
+  /* The canonical name (no "dir/../"), which the scene keeps and the writer writes. */
+  char *canonical = realpath(path, NULL);
+  if (canonical != NULL && strlen(canonical) < sizeof path) snprintf(path, sizeof path, "%s", canonical);
+  free(canonical);
+  nav_track_sample *samples = NULL;
+  size_t n = 0;
+  const nav_status s = nav_track_read_file(path, R->format, R->window, R->start_s, R->end_s,
+                                           "trajectory.recorded.file", &samples, &n, forward_diag, r);
+  if (s != NAV_OK) {
+    nav_io_reader_error_at_path(r, "trajectory.recorded.file",
+                                "the recorded file \"%s\" was not loaded (%s; see its messages)", path,
+                                nav_status_str(s));
+    return false;
+  }
+  char msg[sizeof(((nav_diag *)0)->message) - 64];
+  const nav_status fs = nav_track_fit(R, samples, n, msg, sizeof msg);
+  free(samples);
+  if (fs != NAV_OK) {
+    nav_io_reader_error_at_path(r, fs == NAV_ERR_OUT_OF_RANGE ? "trajectory.recorded.knot_rate_hz"
+                                                             : "trajectory.recorded.file",
+                                "cannot fit the recorded samples: %s",
+                                fs == NAV_ERR_NO_MEMORY ? "out of memory" : msg);
+    return false;
+  }
+  const size_t path_len = strlen(path);
+  if (path_len >= sizeof R->file) {
+    nav_io_reader_error_at_path(r, "trajectory.recorded.file", "the path of the recorded file is too long");
+    return false;
+  }
+  memcpy(R->file, path, path_len + 1);
+  if (nav_track_set_scene_start(R, scene, nav_io_map_get(earth, "origin", NULL) == NULL) != NAV_OK) return false;
+  if (st->duration_auto) scene->trajectory.duration_s = R->span_s;
+  return true;
+}
+
 void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *scene) {
   nav_io_read_state *st = nav_io_reader_state(r);
   nav_scene_trajectory *T = &scene->trajectory;
@@ -908,7 +1051,15 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
                                 nav_traj_type_name(T->type));
   }
 
-  /* 3. Scripts: plan once for the feasibility check (naming the waypoint or segment) and for
+  /* 3. A recorded reference: read and fit the file. On failure the type falls back to
+        parametric, so that validation does not add a message about the missing fit (the scene
+        is rejected). */
+  if (T->type == NAV_TRAJ_RECORDED) {
+    if (!load_recorded(r, root, scene)) T->type = NAV_TRAJ_PARAMETRIC;
+    return;
+  }
+
+  /* 4. Scripts: plan once for the feasibility check (naming the waypoint or segment) and for
         duration_s auto. An import with its own flags was planned by the import already. */
   const bool script = T->type == NAV_TRAJ_WAYPOINTS || T->type == NAV_TRAJ_SEGMENTS;
   if (!script) {

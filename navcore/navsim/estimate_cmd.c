@@ -3,6 +3,20 @@
  * closed-form error growth (numerics.md section 1, corrected formulas of the paper) and a
  * covariance analysis of the scene's scheme along its reference trajectory (numerics.md 6.6),
  * in milliseconds and without random draws.
+ *
+ * Outputs and their conventions (also in `navsim estimate --help` and estimate.json "conventions"):
+ * - The free-INS closed forms are per level axis (one north or east channel, numerics.md 1.2):
+ *   every row E1.6-E1.17 separately (nav_analytic_gyro_ins_table_eval(): columns
+ *   pos_sd_m_<term>, vel_sd_mps_<term>, att_sd_rad_<term>, e.g. pos_sd_m_E1.10_accel_bias) and
+ *   their root-sum-square E1.21 (analytic_pos_sd_m, ...). Bias rows are the one-sigma of a
+ *   zero-mean random constant; every input is the worst axis of the scene's IMU model.
+ * - Horizontal = sqrt(2) x per axis (north and east independent with equal sigma: the RSS of two
+ *   equal per-axis sigmas): analytic_pos_h_sd_m, analytic_vel_h_sd_mps.
+ * - Vertical (analytic_pos_v_sd_m): the accelerometer rows E1.10-E1.13 and the vertical initial
+ *   errors E1.6-E1.7 (same kernels as a level axis, no tilt or gyro coupling); valid while the
+ *   vertical-channel instability is negligible, t << tau_v = sqrt(a / (2 g)) = 570 s on WGS-84
+ *   (delta_h = b tau_v^2 (cosh(t/tau_v) - 1) = b t^2/2 (1 + (t/tau_v)^2/12 + ...), numerics.md
+ *   1.2 (iv)): analytic_pos_v_valid is 1 while (t/tau_v)^2/12 < 1 %, always on a flat Earth.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "estimate_cmd.h"
@@ -26,11 +40,21 @@ static const char *k_usage_estimate =
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
     "              error model and initial errors (closed forms E1.6-E1.21; valid for short times,\n"
-    "              no Schuler feedback, small angles: flagged per row)\n"
+    "              no Schuler feedback, small angles: flagged per row), term by term and in total\n"
     "  covariance  the error covariance of the scene's scheme (free INS or INS/GNSS with its\n"
     "              outages) propagated along the reference trajectory (wgs84 scenes)\n"
-    "Writes DIR/estimate.csv (one row per output epoch) and DIR/summary.json (default DIR:\n"
-    "out/<scene name>-estimate), atomically.\n"
+    "Writes into DIR (default out/<scene name>-estimate), atomically:\n"
+    "  estimate.csv   one row per output epoch: t_s; the analytic totals per axis\n"
+    "                 (analytic_pos_sd_m, analytic_vel_sd_mps, analytic_att_sd_rad, analytic_valid);\n"
+    "                 the covariance columns (cov_*, empty unless wgs84); analytic_pos_h_sd_m and\n"
+    "                 analytic_vel_h_sd_mps (horizontal = sqrt(2) x per axis: independent north and\n"
+    "                 east channels with equal sigma); analytic_pos_v_sd_m and analytic_pos_v_valid\n"
+    "                 (vertical: accelerometer rows and vertical initial errors, t << 570 s on\n"
+    "                 WGS-84); then each row of E1.6-E1.17 per axis: pos_sd_m_<term>,\n"
+    "                 vel_sd_mps_<term>, att_sd_rad_<term> (e.g. pos_sd_m_E1.10_accel_bias)\n"
+    "  estimate.json  the final values (totals and every term), the conventions, and the verdict\n"
+    "                 for each requirement of the scene (\"requirements\": [] until scenes carry them)\n"
+    "  summary.json   scene, timing, final analytic and covariance values\n"
     "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
@@ -80,6 +104,28 @@ static nav_analytic_estimate_config analytic_config(const nav_scene *sc) {
   return c;
 }
 
+/* Column suffix of a table row: its label with blanks as underscores ("E1.10_accel_bias"). */
+static void term_label(nav_analytic_term_id id, char *buf, size_t cap) {
+  snprintf(buf, cap, "%s", nav_analytic_term_name(id));
+  for (char *p = buf; *p; ++p)
+    if (*p == ' ') *p = '_';
+}
+
+/* Vertical-channel spec: the accelerometer rows with the vertical initial errors; no tilt,
+ * heading or gyro coupling into the vertical (numerics.md 1.2 (iv)). */
+static nav_analytic_imu_spec vertical_spec(const nav_analytic_imu_spec *h, const nav_scene *sc) {
+  nav_analytic_imu_spec v = nav_analytic_imu_spec_default();
+  v.g_mps2 = h->g_mps2;
+  v.init_pos_sd_m = sc->initial_errors.pos_sd_m.z;
+  v.init_vel_sd_mps = sc->initial_errors.vel_sd_mps.z;
+  v.accel_bias_mps2 = h->accel_bias_mps2;
+  v.accel_vrw_mps_per_sqrt_s = h->accel_vrw_mps_per_sqrt_s;
+  v.accel_gm_sd_mps2 = h->accel_gm_sd_mps2;
+  v.accel_gm_tau_s = h->accel_gm_tau_s;
+  v.accel_bias_rw_mps2_per_sqrt_s = h->accel_bias_rw_mps2_per_sqrt_s;
+  return v;
+}
+
 typedef struct cov_rows {
   nav_cov_point *p;
   size_t n, cap;
@@ -97,6 +143,74 @@ static void print_diag(void *user, const nav_diag *d) {
   nav_diag_format(d, line, sizeof line);
   fprintf(stderr, "%s\n", line);
   ++*(int *)user;
+}
+
+static void json_text(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    const unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\')
+      fprintf(f, "\\%c", c);
+    else if (c < 0x20)
+      fprintf(f, "\\u%04x", c);
+    else
+      fputc(c, f);
+  }
+  fputc('"', f);
+}
+
+/*
+ * estimate.json: the final values of the analytic estimate (totals and every term), the
+ * covariance analysis when available, the conventions, and one verdict per requirement of the
+ * scene. Scenes carry no requirements yet (issue 6), so the list is empty.
+ * @return 0, or -1 when the file cannot be written.
+ */
+static int write_estimate_json(const char *path, const nav_scene *sc, const char *scene_path,
+                               const nav_analytic_gyro_ins_table *tab, const nav_analytic_estimate_point *al,
+                               double pos_v_m, bool pos_v_valid, const nav_cov_point *cov) {
+  FILE *f = path ? fopen(path, "w") : NULL;
+  if (!f) return -1;
+  fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
+  json_text(f, sc->name);
+  fputs(", \"file\": ", f);
+  json_text(f, scene_path);
+  fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"t_s\": %.17g,\n", nav_nav_scheme_name(sc->navigation.scheme), tab->t_s);
+  fputs("  \"conventions\": {\"per_axis\": \"one level channel (north or east) of a free-inertial INS, numerics.md "
+        "1.2; inputs are the worst axis of the IMU model\", \"horizontal\": \"sqrt(2) x per axis (independent "
+        "north and east channels with equal sigma)\", \"vertical\": \"accelerometer rows E1.10-E1.13 and the "
+        "vertical initial errors; valid for t << 570 s on WGS-84\", \"total\": \"root-sum-square of the rows "
+        "(E1.21); bias rows are the one-sigma of zero-mean random constants\"},\n",
+        f);
+  fprintf(f,
+          "  \"analytic_final\": {\"pos_sd_m\": %.17g, \"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, \"pos_h_sd_m\": "
+          "%.17g, \"vel_h_sd_mps\": %.17g, \"pos_v_sd_m\": %.17g, \"valid\": %s, \"pos_v_valid\": %s,\n"
+          "    \"terms\": [\n",
+          al->gyro_ins.pos_sd_m, al->gyro_ins.vel_sd_mps, al->gyro_ins.att_sd_rad, sqrt(2.0) * al->gyro_ins.pos_sd_m,
+          sqrt(2.0) * al->gyro_ins.vel_sd_mps, pos_v_m, al->gyro_ins_short_time_ok ? "true" : "false",
+          pos_v_valid ? "true" : "false");
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+    const nav_analytic_term_id id = (nav_analytic_term_id)q;
+    const char *name = nav_analytic_term_name(id);
+    const char *blank = strchr(name, ' ');
+    const int eq_len = blank ? (int)(blank - name) : (int)strlen(name);
+    fprintf(f,
+            "      {\"equation\": \"%.*s\", \"term\": \"%s\", \"kind\": \"%s\", \"pos_sd_m\": %.17g, "
+            "\"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, \"pos_h_sd_m\": %.17g}%s\n",
+            eq_len, name, blank ? blank + 1 : "", nav_analytic_term_is_process(id) ? "process" : "random_constant",
+            tab->term[q].pos_m, tab->term[q].vel_mps, tab->term[q].att_rad, sqrt(2.0) * tab->term[q].pos_m,
+            q + 1 < NAV_ANALYTIC_TERM_COUNT ? "," : "");
+  }
+  fputs("    ]},\n", f);
+  if (cov)
+    fprintf(f,
+            "  \"covariance_final\": {\"pos_h_sd_m\": %.17g, \"pos_d_sd_m\": %.17g, \"vel_n_sd_mps\": %.17g, "
+            "\"vel_e_sd_mps\": %.17g, \"att_d_sd_rad\": %.17g},\n",
+            cov->pos_h_sd_m, cov->pos_sd_n_m.z, cov->vel_sd_n_mps.x, cov->vel_sd_n_mps.y, cov->att_sd_rad.z);
+  else
+    fputs("  \"covariance_final\": null,\n", f);
+  fputs("  \"requirements\": []\n}\n", f);
+  const bool bad = ferror(f) != 0;
+  return (fclose(f) != 0 || bad) ? -1 : 0;
 }
 
 int navsim_estimate(int argc, char **argv) {
@@ -142,6 +256,8 @@ int navsim_estimate(int argc, char **argv) {
   nav_resultdir *rd = NULL;
   cov_rows cov = {NULL, 0, 0};
   nav_analytic_estimate_point *ana = NULL;
+  nav_analytic_gyro_ins_table *tab = NULL;
+  double *pos_v = NULL;
   double *times = NULL;
   FILE *f = NULL;
   const double t0 = now_s();
@@ -155,7 +271,9 @@ int navsim_estimate(int argc, char **argv) {
   ana = calloc(n_out, sizeof *ana);
   cov.p = calloc(n_out, sizeof *cov.p);
   cov.cap = n_out;
-  if (!times || !ana || !cov.p) {
+  tab = calloc(n_out, sizeof *tab);
+  pos_v = calloc(n_out, sizeof *pos_v);
+  if (!times || !ana || !cov.p || !tab || !pos_v) {
     fprintf(stderr, "navsim estimate: out of memory\n");
     goto cleanup;
   }
@@ -169,7 +287,22 @@ int navsim_estimate(int argc, char **argv) {
     fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(st));
     goto cleanup;
   }
+  /* Term by term (E1.6-E1.17) and the vertical channel. */
+  const nav_analytic_imu_spec vspec = vertical_spec(&acfg.imu, &sc);
+  for (size_t i = 0; i < nt && st == NAV_OK; ++i) {
+    nav_analytic_gyro_ins_table vt;
+    st = nav_analytic_gyro_ins_table_eval(&acfg.imu, times[i], &tab[i]);
+    if (st == NAV_OK) st = nav_analytic_gyro_ins_table_eval(&vspec, times[i], &vt);
+    if (st == NAV_OK) pos_v[i] = vt.rss.pos_m;
+  }
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim estimate: analytic table failed: %s\n", nav_status_str(st));
+    goto cleanup;
+  }
   const double t_analytic = now_s() - t0;
+  /* Vertical validity: (t / tau_v)^2 / 12 < 1 %, tau_v = sqrt(a / (2 g)) (numerics.md 1.2 (iv)). */
+  const double tau_v_s = sqrt(NAV_WGS84_A_M / (2.0 * acfg.imu.g_mps2));
+  const double t_v_max_s = sc.earth.model == NAV_EARTH_FLAT ? INFINITY : tau_v_s * sqrt(0.12);
   bool have_cov = false;
   double t_cov = 0.0;
   if (sc.earth.model == NAV_EARTH_WGS84) {
@@ -195,19 +328,31 @@ int navsim_estimate(int argc, char **argv) {
   if (!f) goto cleanup;
   fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_e_sd_m,"
         "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
-        "cov_att_e_sd_rad,cov_att_d_sd_rad\n",
+        "cov_att_e_sd_rad,cov_att_d_sd_rad,analytic_pos_h_sd_m,analytic_vel_h_sd_mps,analytic_pos_v_sd_m,"
+        "analytic_pos_v_valid",
         f);
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+    char lab[64];
+    term_label((nav_analytic_term_id)q, lab, sizeof lab);
+    fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
+  }
+  fputc('\n', f);
   for (size_t i = 0; i < nt; ++i) {
     fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
             ana[i].gyro_ins.att_sd_rad, ana[i].gyro_ins_short_time_ok ? 1 : 0);
     if (have_cov) {
       const nav_cov_point *p = &cov.p[i];
-      fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p->pos_sd_n_m.x, p->pos_sd_n_m.y,
+      fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", p->pos_sd_n_m.x, p->pos_sd_n_m.y,
               p->pos_sd_n_m.z, p->pos_h_sd_m, p->vel_sd_n_mps.x, p->vel_sd_n_mps.y, p->vel_sd_n_mps.z, p->att_sd_rad.x,
               p->att_sd_rad.y, p->att_sd_rad.z);
     } else {
-      fputs(",,,,,,,,,,\n", f);
+      fputs(",,,,,,,,,,", f);
     }
+    fprintf(f, ",%.17g,%.17g,%.17g,%d", sqrt(2.0) * ana[i].gyro_ins.pos_sd_m, sqrt(2.0) * ana[i].gyro_ins.vel_sd_mps,
+            pos_v[i], times[i] < t_v_max_s ? 1 : 0);
+    for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q)
+      fprintf(f, ",%.17g,%.17g,%.17g", tab[i].term[q].pos_m, tab[i].term[q].vel_mps, tab[i].term[q].att_rad);
+    fputc('\n', f);
   }
   const bool bad = ferror(f) != 0;
   if (fclose(f) != 0 || bad) {
@@ -241,6 +386,11 @@ int navsim_estimate(int argc, char **argv) {
     goto cleanup;
   }
   f = NULL;
+  if (write_estimate_json(nav_resultdir_file(rd, "estimate.json"), &sc, scene_path, &tab[nt - 1], al, pos_v[nt - 1],
+                          times[nt - 1] < t_v_max_s, have_cov ? &cov.p[nt - 1] : NULL) != 0) {
+    fprintf(stderr, "navsim estimate: writing estimate.json failed\n");
+    goto cleanup;
+  }
   st = nav_resultdir_commit(rd);
   rd = NULL;
   if (st != NAV_OK) goto cleanup;
@@ -267,6 +417,28 @@ int navsim_estimate(int argc, char **argv) {
       if (i == nt - 1) break;
     }
     printf("(* beyond the closed forms' validity: Schuler feedback or large angles)\n");
+    const nav_analytic_gyro_ins_table *tf = &tab[nt - 1];
+    printf("final      t = %g s: horizontal %.4g m (sqrt(2) x per axis), vertical %.4g m%s\n", times[nt - 1],
+           sqrt(2.0) * al->gyro_ins.pos_sd_m, pos_v[nt - 1], times[nt - 1] < t_v_max_s ? "" : " (beyond its validity)");
+    /* The three largest rows of the final per-axis position (they add in squares). */
+    int top[3] = {-1, -1, -1};
+    for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+      const double v = tf->term[q].pos_m;
+      if (!(v > 0.0)) continue;
+      for (int r = 0; r < 3; ++r)
+        if (top[r] < 0 || v > tf->term[top[r]].pos_m) {
+          for (int u = 2; u > r; --u) top[u] = top[u - 1];
+          top[r] = q;
+          break;
+        }
+    }
+    if (top[0] >= 0) {
+      printf("largest    per axis:");
+      for (int r = 0; r < 3 && top[r] >= 0; ++r)
+        printf("%s %s %.4g m", r ? "," : "", nav_analytic_term_name((nav_analytic_term_id)top[r]),
+               tf->term[top[r]].pos_m);
+      printf(" (of %.4g m, root-sum-square)\n", tf->rss.pos_m);
+    }
     printf("computed   analytic %.3g s, covariance %.3g s\n", t_analytic, t_cov);
     printf("results    %s/\n", out_dir);
   }
@@ -276,6 +448,8 @@ cleanup:
   nav_resultdir_abort(rd);
   nav_sim_destroy(sim);
   free(cov.p);
+  free(tab);
+  free(pos_v);
   free(ana);
   free(times);
   return rc;

@@ -13,9 +13,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "allan_cmd.h"
 #include "bench.h"
 #include "catalog_cmd.h"
 #include "estimate_cmd.h"
+#include "replay_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -32,8 +34,10 @@ static const char *k_usage =
     "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
     "  estimate SCENE   preliminary estimate: closed-form error growth and covariance analysis\n"
     "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
+    "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
+    "  allan            Allan-deviation check of a catalog part or scene IMU against its spec\n"
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -58,6 +62,10 @@ static const char *k_usage_run =
     "  truth.csv     reference state at the output rate\n"
     "  nav.csv       navigation solution at the output rate\n"
     "  errors.csv    navigation minus reference at the output rate (run 0)\n"
+    "  imu_errors.csv  simulated sensor errors at the output rate (run 0; only when the scene's IMU\n"
+    "                has error terms and without --ideal): measured minus ideal IMU output over the\n"
+    "                IMU interval ending at each epoch (one sample, not averaged), gyros in deg/s,\n"
+    "                accelerometers in m/s^2\n"
     "  mc_stats.csv  with several runs, per output epoch: mean and RMS over runs of each error\n"
     "                component, the filter's mean reported sigma and the mean NEES (INS/GNSS)\n"
     "  mc_final.csv  with several runs: the final errors of every run\n"
@@ -136,12 +144,36 @@ typedef struct run_out {
   nav_status st;
   bool quiet_progress;
   double t_last_print;
+  FILE *imu_err; /* imu_errors.csv, or NULL when not written */
 } run_out;
+
+static const char *k_imu_errors_header =
+    "t_s,gyro_err_x_dps,gyro_err_y_dps,gyro_err_z_dps,accel_err_x_mps2,accel_err_y_mps2,accel_err_z_mps2\n";
+
+/* One imu_errors.csv row: (measured - ideal) / dt of the interval ending at the epoch, i.e. the
+ * sensor error as a rate (deg/s only here, at the output edge). No row at t = 0 (no interval). */
+static nav_status write_imu_error_row(FILE *f, const nav_sim_record *r) {
+  if (!r->imu_ideal || !r->imu_measured) return NAV_OK;
+  const double dt = r->imu_ideal->dt_s;
+  const nav_vec3 dw = nav_vec3_sub(r->imu_measured->dtheta_b_rad, r->imu_ideal->dtheta_b_rad);
+  const nav_vec3 df = nav_vec3_sub(r->imu_measured->dv_b_mps, r->imu_ideal->dv_b_mps);
+  const double k = NAV_RAD2DEG / dt;
+  const int n = fprintf(f, "%.17g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", r->imu_ideal->t_s, dw.x * k, dw.y * k, dw.z * k,
+                        df.x / dt, df.y / dt, df.z / dt);
+  return n < 0 ? NAV_ERR_IO : NAV_OK;
+}
 
 static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   run_out *o = user;
   for (int i = 0; i < 3; ++i) {
     const nav_status st = nav_csv_write_row(o->f[i], (nav_csv_table)i, r);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  if (o->imu_err) {
+    const nav_status st = write_imu_error_row(o->imu_err, r);
     if (st != NAV_OK) {
       o->st = st;
       return NAV_STOP;
@@ -258,7 +290,7 @@ static int cmd_run(int argc, char **argv) {
 
   nav_sim *sim = NULL;
   nav_resultdir *rd = NULL;
-  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0};
+  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, NULL};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -277,6 +309,15 @@ static int cmd_run(int argc, char **argv) {
     o.f[i] = file ? fopen(file, "w") : NULL;
     if (!o.f[i] || nav_csv_write_header(o.f[i], (nav_csv_table)i) != NAV_OK) {
       fprintf(stderr, "navsim run: cannot write %s in \"%s\"\n", names[i], out_dir);
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+  if (!ideal && (scene.imu.model.gyro.terms | scene.imu.model.accel.terms) != 0) {
+    const char *file = nav_resultdir_file(rd, "imu_errors.csv");
+    o.imu_err = file ? fopen(file, "w") : NULL;
+    if (!o.imu_err || fputs(k_imu_errors_header, o.imu_err) < 0) {
+      fprintf(stderr, "navsim run: cannot write imu_errors.csv in \"%s\"\n", out_dir);
       rc = EXIT_FAIL;
       goto cleanup;
     }
@@ -304,6 +345,16 @@ static int cmd_run(int argc, char **argv) {
     o.f[i] = NULL;
     if (bad || cl != 0) {
       fprintf(stderr, "navsim run: writing %s failed\n", names[i]);
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+  if (o.imu_err) {
+    const bool bad = ferror(o.imu_err) != 0;
+    const int cl = fclose(o.imu_err);
+    o.imu_err = NULL;
+    if (bad || cl != 0) {
+      fprintf(stderr, "navsim run: writing imu_errors.csv failed\n");
       rc = EXIT_FAIL;
       goto cleanup;
     }
@@ -389,6 +440,7 @@ static int cmd_run(int argc, char **argv) {
 cleanup:
   for (int i = 0; i < 3; ++i)
     if (o.f[i]) fclose(o.f[i]);
+  if (o.imu_err) fclose(o.imu_err);
   nav_resultdir_abort(rd);
   nav_sim_destroy(sim);
   return rc;
@@ -411,7 +463,9 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(cmd, "estimate") == 0) return navsim_estimate(argc - 2, argv + 2);
+  if (strcmp(cmd, "replay") == 0) return navsim_replay(argc - 2, argv + 2);
   if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
+  if (strcmp(cmd, "allan") == 0) return navsim_allan(argc - 2, argv + 2);
   if (strcmp(cmd, "catalog") == 0) {
     char res[4096];
     return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);

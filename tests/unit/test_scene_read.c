@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "nav_test.h"
+#include "navcore/nav_array.h"
 #include "navcore/nav_catalog.h"
 #include "navcore/nav_frames.h"
 #include "navcore/nav_io.h"
@@ -190,6 +191,24 @@ static void assert_gnss_same(const nav_gnss_model_config *a, const nav_gnss_mode
   }
 }
 
+/* The accelerometer array of the gyro-free scheme, bit for bit. */
+static void assert_array_same(const nav_scene_array *a, const nav_scene_array *b) {
+  assert_int_equal(a->layout, b->layout);
+  assert_same_double(a->radius_m, b->radius_m);
+  assert_int_equal(a->custom_count, b->custom_count);
+  for (int i = 0; i < a->custom_count && i < NAV_SCENE_ARRAY_MAX_SENSORS; ++i) {
+    assert_same_vec3(a->custom[i].r_bs_b_m, b->custom[i].r_bs_b_m);
+    assert_same_vec3(a->custom[i].n_s_b, b->custom[i].n_s_b);
+  }
+  assert_int_equal(a->accel.terms, b->accel.terms);
+  assert_same_double(a->accel.bias_turn_on_sd_mps2, b->accel.bias_turn_on_sd_mps2);
+  assert_same_double(a->accel.bias_gm_sd_mps2, b->accel.bias_gm_sd_mps2);
+  assert_same_double(a->accel.bias_gm_tau_s, b->accel.bias_gm_tau_s);
+  assert_same_double(a->accel.vrw_mps_per_sqrt_s, b->accel.vrw_mps_per_sqrt_s);
+  assert_same_double(a->accel.scale_factor_sd, b->accel.scale_factor_sd);
+  assert_same_vec3(a->initial_rate_sd_rps, b->initial_rate_sd_rps);
+}
+
 /* Every field of two scenes is identical, doubles bit for bit (list slots beyond the counts are
    unused and not compared). */
 static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
@@ -295,6 +314,7 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_int_equal(a->navigation.algorithm, b->navigation.algorithm);
   assert_int_equal(a->navigation.frame, b->navigation.frame);
   assert_int_equal(a->navigation.aid_vertical, b->navigation.aid_vertical);
+  assert_array_same(&a->array, &b->array);
   assert_same_double(a->output.rate_hz, b->output.rate_hz);
   assert_true(a->simulation.seed == b->simulation.seed);
   assert_int_equal(a->simulation.runs, b->simulation.runs);
@@ -475,7 +495,7 @@ static void test_unknown_key_did_you_mean(void **state) {
   /* Nothing close: the valid keys of that level are listed. */
   expect_one("format_version: 1\nsensors: {}\n", 2, 1, "sensors",
              "unknown key \"sensors\"; expected one of: format_version, name, earth, trajectory, imu, gnss, "
-             "initial_errors, navigation, output, simulation");
+             "array, initial_errors, navigation, output, simulation");
 }
 
 static void test_wrong_types(void **state) {
@@ -525,7 +545,7 @@ static void test_bad_enum(void **state) {
   expect_one("format_version: 1\nearth:\n  model: flot\n", 3, 10, "earth.model",
              "expected one of: flat, wgs84; got \"flot\"");
   expect_one("format_version: 1\ntrajectory: {type: spline}\n", 2, 20, "trajectory.type",
-             "expected one of: parametric, waypoints, segments, test_motion, motion_def; got \"spline\"");
+             "expected one of: parametric, waypoints, segments, test_motion, motion_def, recorded; got \"spline\"");
   expect_one("format_version: 1\ntrajectory:\n  parametric: {attitude: Magnus}\n", 3, 26,
              "trajectory.parametric.attitude", "expected one of: magnus; got \"Magnus\"");
 }
@@ -1339,6 +1359,139 @@ static void test_sensor_errors(void **state) {
              "navigation.scheme", "ins_gnss needs a GNSS receiver");
 }
 
+/* ---------------------------------------------------------------- gyro-free array */
+
+static const char k_custom_array[] = "format_version: 1\n"
+                                     "navigation: {scheme: gyro_free}\n"
+                                     "array:\n"
+                                     "  layout: custom\n"
+                                     "  sensors:\n"
+                                     "    - {position_m: [0.1, 0, 0], axis: [0, 1, 1]}\n"
+                                     "    - {position_m: [-0.1, 0, 0], axis: [0, 1, -1]}\n"
+                                     "    - {position_m: [0, 0.1, 0], axis: [1, 0, 1]}\n"
+                                     "    - {position_m: [0, -0.1, 0], axis: [-1, 0, 1]}\n"
+                                     "    - {position_m: [0, 0, 0.1], axis: [1, 1, 0]}\n"
+                                     "    - {position_m: [0, 0, -0.1], axis: [1, -1, 0]}\n"
+                                     "  accel: {noise_density_ug_per_sqrt_hz: 100, bias_gm_sigma_mps2: 2e-4, "
+                                     "bias_gm_tau_s: 60}\n"
+                                     "  initial_rate_sd_rps: [1e-3, 2e-3, 0]\n";
+
+static void test_gyro_free_array(void **state) {
+  (void)state;
+  /* Built-in layout, datasheet units converted once (nav_unit_* factors), one number per term. */
+  nav_scene s = read_ok("format_version: 1\n"
+                        "navigation: {scheme: gyro_free, algorithm: high_order}\n"
+                        "array:\n"
+                        "  layout: twelve\n"
+                        "  radius_m: 0.25\n"
+                        "  accel: {bias_turn_on_mg: 1, bias_gm_sigma_ug: 20, bias_gm_tau_s: 300,\n"
+                        "          vrw_m_per_s_per_sqrt_h: 0.06, scale_factor_ppm: 300}\n"
+                        "  initial_rate_sd_dps: 0.01\n");
+  assert_int_equal(s.navigation.scheme, NAV_SCHEME_GYRO_FREE);
+  assert_int_equal(s.array.layout, NAV_ARRAY_LAYOUT_TWELVE);
+  assert_same_double(s.array.radius_m, 0.25);
+  assert_int_equal(s.array.custom_count, 0);
+  assert_int_equal(s.array.accel.terms, NAV_ARRAY_TERMS_ALL);
+  assert_same_double(s.array.accel.bias_turn_on_sd_mps2, 1.0 * (1e-3 * NAV_G0_MPS2));
+  assert_same_double(s.array.accel.bias_gm_sd_mps2, 20.0 * (1e-6 * NAV_G0_MPS2));
+  assert_same_double(s.array.accel.bias_gm_tau_s, 300.0);
+  assert_same_double(s.array.accel.vrw_mps_per_sqrt_s, 0.06 * (1.0 / 60.0));
+  assert_same_double(s.array.accel.scale_factor_sd, 300.0 * 1e-6);
+  assert_same_double(s.array.initial_rate_sd_rps.z, 0.01 * NAV_DEG2RAD);
+  /* Defaults: the cube, r = 0.1 m, ideal sensors; the scheme stays free_ins. */
+  s = read_ok("format_version: 1\narray:\n");
+  assert_int_equal(s.navigation.scheme, NAV_SCHEME_FREE_INS);
+  assert_int_equal(s.array.layout, NAV_ARRAY_LAYOUT_CUBE6);
+  assert_same_double(s.array.radius_m, 0.1);
+  assert_int_equal(s.array.accel.terms, 0);
+  /* A custom layout: axes kept as written (normalised where used), SI spellings. */
+  s = read_ok(k_custom_array);
+  assert_int_equal(s.array.layout, NAV_ARRAY_LAYOUT_CUSTOM);
+  assert_int_equal(s.array.custom_count, 6);
+  assert_same_vec3(s.array.custom[3].r_bs_b_m, nav_vec3_make(0.0, -0.1, 0.0));
+  assert_same_vec3(s.array.custom[3].n_s_b, nav_vec3_make(-1.0, 0.0, 1.0));
+  assert_int_equal(s.array.accel.terms, NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_GM);
+  assert_same_double(s.array.accel.vrw_mps_per_sqrt_s, 100.0 * (1e-6 * NAV_G0_MPS2));
+  assert_same_double(s.array.accel.bias_gm_sd_mps2, 2e-4);
+  assert_same_vec3(s.array.initial_rate_sd_rps, nav_vec3_make(1e-3, 2e-3, 0.0));
+
+  /* One problem each, at its place. */
+  expect_one("format_version: 1\narray: {layout: cubee}\n", 2, 17, "array.layout",
+             "expected one of: cube6, nine, twelve, custom; got \"cubee\" (did you mean \"cube6\"?)");
+  expect_one("format_version: 1\narray: {radius_m: 0}\n", 2, 19, "array.radius_m", "must be > 0 (got 0)");
+  expect_one("format_version: 1\narray: {sensors: {position_m: [0, 0, 0]}}\n", 2, 18, "array.sensors",
+             "expected a list of sensors (- {position_m: [x, y, z], axis: [x, y, z]})");
+  expect_one("format_version: 1\narray:\n  sensors:\n    - {position_m: [0.1, 0, 0]}\n", 4, 7,
+             "array.sensors[0].axis", "missing required key \"axis\"");
+  expect_one(
+      "format_version: 1\narray: {layout: custom, sensors: [{position_m: [1, 0, 0], axis: [0, 1, 0]}]}\n", 2,
+      34, "array.sensors", "a custom layout needs 6 to 16 sensors (got 1)");
+  expect_one("format_version: 1\narray: {accel: {bias_gm_tau_s: 0}}\n", 2, 32, "array.accel.bias_gm_tau_s",
+             "must be > 0 (got 0)");
+  expect_one("format_version: 1\narray: {accel: {vrw_m_per_s_per_sqrt_h: 0.1, vrw_mps_per_sqrt_s: 1e-3}}\n",
+             2, 46, "array.accel.vrw_mps_per_sqrt_s",
+             "both \"vrw_m_per_s_per_sqrt_h\" and \"vrw_mps_per_sqrt_s\" are given");
+  expect_one("format_version: 1\narray: {accel: {off: [nose]}}\n", 2, 23, "array.accel.off[0]",
+             "unknown term \"nose\"; did you mean \"noise\"?");
+  expect_one("format_version: 1\narray: {initial_rate_sd_dps: [0.1, -1, 0]}\n", 2, 36,
+             "array.initial_rate_sd_dps[1]", "must be >= 0 (got -1)");
+  expect_one("format_version: 1\nnavigation: {scheme: gyro_free, aid_vertical: true}\n", 2, 47,
+             "navigation.aid_vertical", "applies to the free INS only, not to gyro_free");
+  /* Validation of the layout, placed at the sensors: every axis along its lever arm. */
+  expect_one(
+      "format_version: 1\narray:\n  layout: custom\n  sensors:\n"
+      "    - {position_m: [0.1, 0, 0], axis: [1, 0, 0]}\n    - {position_m: [-0.1, 0, 0], axis: [1, 0, 0]}\n"
+      "    - {position_m: [0, 0.1, 0], axis: [0, 1, 0]}\n    - {position_m: [0, -0.1, 0], axis: [0, 1, 0]}\n"
+      "    - {position_m: [0, 0, 0.1], axis: [0, 0, 1]}\n    - {position_m: [0, 0, -0.1], axis: [0, 0, 1]}\n",
+      5, 5, "array.sensors", "H (E1.23) is singular or its condition number exceeds 1e8");
+  expect_one(
+      "format_version: 1\narray:\n  layout: custom\n  sensors:\n"
+      "    - {position_m: [0.1, 0, 0], axis: [0, 0, 0]}\n    - {position_m: [-0.1, 0, 0], axis: [0, 1, -1]}\n"
+      "    - {position_m: [0, 0.1, 0], axis: [1, 0, 1]}\n    - {position_m: [0, -0.1, 0], axis: [-1, 0, 1]}\n"
+      "    - {position_m: [0, 0, 0.1], axis: [1, 1, 0]}\n    - {position_m: [0, 0, -0.1], axis: [1, -1, "
+      "0]}\n",
+      5, 39, "array.sensors[0].n_s_b", "the sensitive axis must be a non-zero vector (got norm 0)");
+
+  /* Round trip, bit for bit: a custom layout with awkward numbers, a term on with every value
+     at its default (written through its first key), and a term off with values ("off" list). */
+  char dir[64], path[128];
+  diag_log log;
+  nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
+  assert_non_null(a);
+  assert_non_null(b);
+  *a = read_ok(k_custom_array);
+  a->array.custom_count = 7;
+  a->array.custom[6].r_bs_b_m = nav_vec3_make(0.1 / 3.0, -2e-17, 0.07);
+  a->array.custom[6].n_s_b = nav_vec3_make(1.0 / 3.0, 0.0, -NAV_PI);
+  a->array.accel.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  a->array.accel.bias_turn_on_sd_mps2 = 0.0;
+  a->array.accel.bias_gm_sd_mps2 = 1.2345e-4; /* GM off, values kept */
+  a->array.accel.vrw_mps_per_sqrt_s = 0.1 / 7.0;
+  a->array.initial_rate_sd_rps = nav_vec3_make(1e-3 * NAV_DEG2RAD, 0.3, 0.3);
+  make_dir(dir, sizeof dir);
+  snprintf(path, sizeof path, "%s/gf.yaml", dir);
+  assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
+  const nav_status st = read_path(path, b, &log);
+  if (st != NAV_OK) {
+    print_log(&log);
+    fail_msg("written back does not read:\n%s", slurp(path));
+  }
+  assert_scene_same(a, b);
+  const char *text = slurp(path);
+  assert_non_null(strstr(text, "  scheme: gyro_free  #"));
+  assert_non_null(strstr(text, "\narray:\n  layout: custom  #"));
+  assert_non_null(strstr(text, "\n    - {position_m: [0.1, 0, 0], axis: [0, 1, 1]}\n"));
+  assert_non_null(strstr(text, "    off: [bias_gm]"));
+  assert_non_null(strstr(text, "    bias_turn_on_mg: 0"));
+  /* A scene that does not use the array and keeps its defaults has no array section. */
+  *a = nav_scene_default();
+  assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
+  assert_null(strstr(slurp(path), "array:"));
+  rm_dir(dir);
+  free(a);
+  free(b);
+}
+
 static void test_motion_def_errors(void **state) {
   (void)state;
   diag_log log;
@@ -1667,6 +1820,26 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
   }
 }
 
+/* A random array section (any layout; custom sensors kept even when the layout is built in). */
+static void random_array(uint64_t *x, nav_scene_array *a) {
+  a->layout = (nav_array_layout_kind)(splitmix64(x) % 4);
+  a->radius_m = 0.01 + uniform(x);
+  a->custom_count = (int)(splitmix64(x) % (NAV_SCENE_ARRAY_MAX_SENSORS + 1));
+  if (a->layout == NAV_ARRAY_LAYOUT_CUSTOM) a->custom_count = 6 + (int)(splitmix64(x) % 11);
+  /* Generic positions and axes within a metre: H well conditioned (a custom layout is checked). */
+  for (int i = 0; i < a->custom_count; ++i) {
+    a->custom[i].r_bs_b_m = nav_vec3_make(uniform(x) - 0.5, uniform(x) - 0.5, uniform(x) - 0.5);
+    a->custom[i].n_s_b = nav_vec3_make(uniform(x) - 0.5, uniform(x) - 0.5, 0.1 + uniform(x));
+  }
+  a->accel.terms = (unsigned)splitmix64(x) & NAV_ARRAY_TERMS_ALL;
+  a->accel.bias_turn_on_sd_mps2 = uniform(x) * 1e-2;
+  a->accel.bias_gm_sd_mps2 = uniform(x) * 1e-3;
+  a->accel.bias_gm_tau_s = 1.0 + 1000.0 * uniform(x);
+  a->accel.vrw_mps_per_sqrt_s = uniform(x) * 1e-3;
+  a->accel.scale_factor_sd = uniform(x) * 1e-3;
+  a->initial_rate_sd_rps = nonneg_vec3(x);
+}
+
 static void test_round_trip_random_bit_exact(void **state) {
   (void)state;
   char dir[64], path[128];
@@ -1719,6 +1892,15 @@ static void test_round_trip_random_bit_exact(void **state) {
     a->navigation.algorithm = (splitmix64(&x) & 1) ? NAV_MECH_HIGH_ORDER : NAV_MECH_FIRST_ORDER;
     a->navigation.frame = (splitmix64(&x) & 1) ? NAV_MECH_ECEF : NAV_MECH_NED;
     a->navigation.aid_vertical = a->navigation.scheme == NAV_SCHEME_FREE_INS && (splitmix64(&x) & 1);
+    {
+      /* The array from its own stream, so the draws of the other fields are those of before. */
+      uint64_t xa = seed + 0xA77A1u * (uint64_t)(k + 1);
+      random_array(&xa, &a->array);
+      if (a->navigation.scheme == NAV_SCHEME_FREE_INS && (splitmix64(&xa) & 1)) {
+        a->navigation.scheme = NAV_SCHEME_GYRO_FREE;
+        a->navigation.aid_vertical = false;
+      }
+    }
     a->output.rate_hz = 1.0 + 40.0 * uniform(&x);
     a->simulation.seed = splitmix64(&x);
     a->simulation.runs = 1 + (long)(splitmix64(&x) % 1000);
@@ -1809,6 +1991,7 @@ int main(void) {
       cmocka_unit_test(test_trajectory_errors),
       cmocka_unit_test(test_sensor_errors),
       cmocka_unit_test(test_motion_def_errors),
+      cmocka_unit_test(test_gyro_free_array),
       cmocka_unit_test(test_scene_library_round_trip),
       cmocka_unit_test(test_round_trip_canonical),
       cmocka_unit_test(test_round_trip_random_bit_exact),

@@ -15,9 +15,24 @@
  * A = H [f; omega_dot] + c(omega) (E1.23) with H = [n_i^T, (r_i x n_i)^T] (N x 6). The array
  * determines f and omega_dot; omega itself must be integrated (nav_gyrofree.h).
  *
+ * Layouts: the cube of numerics.md 1.5, a nine- and a twelve-sensor layout, or any N = 6..16
+ * sensors (nav_accel_array filled by the caller, or a scene's custom layout); geometry factors of
+ * the built-in ones (r = arm; kappa for omega_dot, kappa_f for f, per axis):
+ *
+ * | layout | N | omega_dot noise     | f noise         | f, omega_dot correlated | H^+ annihilates c |
+ * |--------|---|---------------------|-----------------|-------------------------|-------------------|
+ * | cube6  | 6 | 0.7071 sigma / r    | 0.7071 sigma    | no                      | yes               |
+ * | nine   | 9 | 0.9129 sigma / r    | 0.7454 sigma    | yes                     | no (iterated)     |
+ * | twelve |12 | 0.5 sigma / r       | 0.5 sigma       | no                      | yes               |
+ *
+ * The error model ::nav_array_model gives each sensor its own bias, Gauss-Markov bias, white
+ * noise and scale factor (below).
+ *
  * The geometry functions are pure (implemented in src/analytic/analytic.c, since they also feed
- * the analytical error estimate of nav_analytic.h); the truth generator ::nav_array_truth is a
- * stateful object (src/truth/array_ideal.c), not synchronised: one thread per object.
+ * the analytical error estimate of nav_analytic.h; the nine- and twelve-sensor and scene layouts
+ * in src/truth/array_ideal.c); the truth generator ::nav_array_truth and the error model
+ * ::nav_array_model (src/sensors/array_model.c) are stateful objects, not synchronised: one
+ * thread per object.
  */
 #ifndef NAV_ARRAY_H
 #define NAV_ARRAY_H
@@ -37,7 +52,7 @@ NAV_BEGIN_DECLS
 /** Fewest accelerometers that can determine f and omega_dot (6 unknowns). */
 #define NAV_ARRAY_MIN_SENSORS 6
 /** Capacity of the fixed-size array descriptions (no allocation anywhere in the array code). */
-#define NAV_ARRAY_MAX_SENSORS 16
+#define NAV_ARRAY_MAX_SENSORS NAV_SCENE_ARRAY_MAX_SENSORS
 /**
  * Largest accepted 2-norm condition number of the column-scaled H (H with its omega_dot columns
  * divided by the reference arm r_ref, so that the number does not depend on the unit of length;
@@ -68,6 +83,53 @@ typedef struct nav_accel_array {
  * @return NAV_OK; NAV_ERR_INVALID_ARG for NULL or r not finite and positive.
  */
 NAV_API NAV_NODISCARD nav_status nav_array_cube_layout(double r_m, nav_accel_array *out);
+
+/**
+ * The nine-accelerometer layout of Padgaonkar, Krieger and King (J. Appl. Mech. 42(3), 1975,
+ * "3-2-2-2"): a triad at O (sensors 0-2 along x, y, z) and two sensors at distance @p r_m on each
+ * positive axis, measuring the two directions across the arm:
+ * sensors 3, 4 at (r,0,0) along y, z; 5, 6 at (0,r,0) along x, z; 7, 8 at (0,0,r) along x, y.
+ * Geometry (derived from H^T H = [[3I, r K], [r K^T, 2r^2 I]], K = [k x], k = -(1,1,1)):
+ * (H^T H)^-1 has the diagonal 5/9 (f) and 5/(6 r^2) (omega_dot), so the noise gains are
+ * sigma_f = sqrt(5/9) sigma = 0.745 sigma and sigma_omega_dot = sqrt(5/6) sigma / r = 0.913 sigma / r
+ * per axis, i.e. kappa_f = 0.745 and kappa = 0.913 relative to r (0.745 relative to the geometry's
+ * r_ref = r sqrt(2/3)); the f and omega_dot estimates are correlated. For omega_dot it is worse
+ * than the cube (the central triad sees no rotation). The original's merit is a closed-form
+ * estimator of omega_dot that needs no omega (noise sigma / r, kappa = 1); the least-squares H^+
+ * used here has less noise but does not annihilate c(omega), so the gyro-free INS iterates its
+ * implicit rate (nav_gyrofree_config.max_iterations).
+ * @param[in]  r_m  arm length r > 0 [m]
+ * @param[out] out  the layout (untouched on error)
+ * @return NAV_OK; NAV_ERR_INVALID_ARG for NULL or r not finite and positive.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_nine_layout(double r_m, nav_accel_array *out);
+
+/**
+ * The twelve-accelerometer layout: two sensors at each face centre of the cube (distance r from
+ * O), along both face diagonals, i.e. a dual-axis sensor measuring the whole tangential
+ * acceleration there; equivalently the cube layout (sensors 0-5, nav_array_cube_layout()) plus
+ * its mirror pattern (sensors 6-11, s = 1/sqrt 2): r_i/r = (+-1,0,0), (0,+-1,0), (0,0,+-1) as
+ * for 0-5; n_i/s = (0,1,-1), (0,1,1), (1,0,-1), (1,0,1), (1,-1,0), (1,1,0).
+ * Geometry: each axis is tangential at four faces, so H^T H = diag(4 I, 4 r^2 I):
+ * kappa = kappa_f = 1/2 (the cube's 1/sqrt 2 divided by sqrt 2 for twice the sensors), f and
+ * omega_dot uncorrelated, and the omega_dot rows annihilate c(omega) as for the cube
+ * (sum over faces of r_f x c_f = 2 r^2 sum_j w_j e_j x w = 2 r^2 w x w = 0).
+ * @param[in]  r_m  arm length r > 0 [m]
+ * @param[out] out  the layout (untouched on error)
+ * @return NAV_OK; NAV_ERR_INVALID_ARG for NULL or r not finite and positive.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_twelve_layout(double r_m, nav_accel_array *out);
+
+/**
+ * The layout of a scene's array section: the built-in kind with arm radius_m, or the custom
+ * sensors with their axes normalised to unit length.
+ * @param[in]  sa   the scene's array section
+ * @param[out] out  the layout (untouched on error)
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, unknown kind, radius not finite and positive, custom
+ *         count outside [6, 16], non-finite values or a zero axis). Does not check conditioning:
+ *         call nav_array_geometry_compute() for that.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_layout_from_scene(const nav_scene_array *sa, nav_accel_array *out);
 
 /**
  * Measurement matrix, its pseudo-inverse and the geometry factors of an array (E1.23-E1.25).
@@ -199,6 +261,83 @@ NAV_API int64_t nav_array_truth_sample_count(const nav_array_truth *truth);
 NAV_API nav_frame nav_array_truth_frame(const nav_array_truth *truth);
 /** The layout (borrowed; valid until destroy). */
 NAV_API const nav_accel_array *nav_array_truth_layout(const nav_array_truth *truth);
+
+/* ------------------------------------------------------------------ array error model */
+
+/**
+ * @name Accelerometer-array error model
+ * Each accelerometer of the array has its own error terms with the figures of a
+ * ::nav_array_error_config (the same for every sensor) and its own realisation. Per sample
+ * interval (t_(k-1), t_k] of length dt, sensor i (numerics.md E2.3 for one axis):
+ *
+ *     dA~_i = (1 + s_i) dA_i + int (b0_i + b_GM,i(t)) dt + W_i,   W_i ~ N(0, N^2 dt),
+ *
+ * with s_i ~ N(0, scale_factor_sd^2) and b0_i ~ N(0, bias_turn_on_sd^2) drawn once per run, the
+ * Gauss-Markov bias stationary from t = 0 and its integral drawn exactly with the bias step
+ * (the pair discretisation documented in nav_sensors.h), so the statistics of the output do not
+ * depend on the sample rate, as for ::nav_imu_model.
+ *
+ * Streams (nav_rng.h: "the accelerometer index for a distributed accelerometer array"): sensor i
+ * uses nav_rng_stream_id(kind, i) with kind NAV_RNG_STREAM_ACCEL_BIAS_TURN_ON (b0_i, first draw),
+ * NAV_RNG_STREAM_ACCEL_SCALE_FACTOR (s_i, first draw), NAV_RNG_STREAM_ACCEL_BIAS_GM (start value,
+ * then two normals per sample: bias step, integral) and NAV_RNG_STREAM_ACCEL_NOISE (one normal per
+ * sample). Switching a term or a sensor on or off never changes another's realisation. In a
+ * gyro-free run there is no accelerometer triad, so these streams are not shared with one.
+ * @{
+ */
+
+/** Every term off (an ideal array). */
+NAV_API nav_array_error_config nav_array_error_config_default(void);
+
+/** Terms the array model supports. */
+#define NAV_ARRAY_TERMS_ALL                                                                                  \
+  ((unsigned)NAV_IMU_TERM_BIAS_TURN_ON | (unsigned)NAV_IMU_TERM_BIAS_GM | (unsigned)NAV_IMU_TERM_NOISE |     \
+   (unsigned)NAV_IMU_TERM_SCALE_FACTOR)
+
+/**
+ * Check an array error configuration: unknown or unsupported term bits, negative or non-finite
+ * sigmas of enabled terms, GM T not finite and positive. Fields of disabled terms are ignored.
+ * @param[in] report called once per problem with a path relative to the configuration
+ *                   ("bias_gm_tau_s"; the scene prefixes "array.accel.") and a message; may be NULL
+ * @return NAV_OK, or NAV_ERR_INVALID_ARG if anything was reported or @p cfg is NULL.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_error_config_validate(const nav_array_error_config *cfg,
+                                                                 nav_scene_issue_fn report, void *user);
+
+/** The error model of one array in one Monte Carlo run. Opaque; one thread per object. */
+typedef struct nav_array_model nav_array_model;
+
+/**
+ * Create the model of run @p run: draws every per-run constant. The only allocation.
+ * @param[in]  cfg        error terms (copied); must pass nav_array_error_config_validate()
+ * @param[in]  n_sensors  N, 1..NAV_ARRAY_MAX_SENSORS
+ * @param[in]  seed, run  stream keys (nav_rng_init())
+ * @param[out] out        the model; destroy with nav_array_model_destroy()
+ * @return NAV_OK; NAV_ERR_INVALID_ARG; NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_model_create(const nav_array_error_config *cfg, int n_sensors,
+                                                        uint64_t seed, uint64_t run, nav_array_model **out);
+/** Destroy; accepts NULL. */
+NAV_API void nav_array_model_destroy(nav_array_model *model);
+
+/**
+ * Apply the errors to one interval's ideal increments (in place allowed: @p measured may be
+ * @p ideal). Allocation-free.
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, sensor count differs from the model's, dt not
+ *         finite and positive); NAV_ERR_NUMERIC (non-finite ideal increment). @p measured is
+ *         untouched on error.
+ */
+NAV_API NAV_NODISCARD nav_status nav_array_model_apply(nav_array_model *model,
+                                                       const nav_array_increment *ideal,
+                                                       nav_array_increment *measured);
+
+/** Turn-on bias b0_i of sensor @p i [m/s^2] (0 when the term is off or i is out of range). */
+NAV_API double nav_array_model_bias_turn_on(const nav_array_model *model, int i);
+/** Scale-factor error s_i of sensor @p i [-] (0 when the term is off or i is out of range). */
+NAV_API double nav_array_model_scale_factor(const nav_array_model *model, int i);
+/** Current Gauss-Markov bias b_GM,i of sensor @p i [m/s^2] (0 when off or out of range). */
+NAV_API double nav_array_model_bias_gm(const nav_array_model *model, int i);
+/** @} */
 
 NAV_END_DECLS
 

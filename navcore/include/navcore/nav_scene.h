@@ -49,7 +49,8 @@ typedef enum nav_traj_type {
   NAV_TRAJ_PARAMETRIC = 0, /**< the paper's formula (3), numerics.md section 3.1 */
   NAV_TRAJ_WAYPOINTS = 1,  /**< smooth path through waypoints with a speed profile */
   NAV_TRAJ_SEGMENTS = 2,   /**< segment script (hold, accelerate, turn, climb, ...); motion-definition imports */
-  NAV_TRAJ_TEST_MOTION = 3 /**< test motions with known answers (stationary, coning, sculling, spin, great circle) */
+  NAV_TRAJ_TEST_MOTION = 3, /**< test motions with known answers (stationary, coning, sculling, spin, great circle) */
+  NAV_TRAJ_RECORDED = 4     /**< a recorded reference (time, position, velocity, attitude) fitted by splines */
 } nav_traj_type;
 
 /** How the attitude of the parametric trajectory is defined. */
@@ -288,6 +289,91 @@ typedef struct nav_traj_segments {
 } nav_traj_segments;
 /* ==== END waypoints and segment scripts ==== */
 
+/* ==== BEGIN recorded reference (owned by the recorded-trajectory work; nav_track.h) ==== */
+/**
+ * Most B-spline control points of a recorded trajectory: knot_rate_hz x span_s + 5 must fit.
+ * The fitted model lives in the scene by value (56 bytes per control point, about 70 KB here),
+ * so the scene stays plain data under its 512 KB budget: 300 s at 4 Hz, 965 s at 1.3 Hz,
+ * 30 min at 0.7 Hz.
+ */
+#define NAV_RECORDED_MAX_CTRL 1280
+/** Longest recorded-file path kept in the scene [bytes, with the NUL]. */
+#define NAV_RECORDED_PATH_MAX 1024
+
+/** Format of a recorded reference file. */
+typedef enum nav_recorded_format {
+  /** KF-GINS / i2Nav .nav: 11 whitespace-separated columns per line: GPS week, GPS seconds of
+   *  week [s], latitude [deg], longitude [deg], ellipsoidal height [m], velocity N, E, D [m/s],
+   *  roll, pitch, yaw [deg] (ZYX Euler angles of C_b_n, body forward-right-down). */
+  NAV_RECORDED_KF_GINS_NAV = 0
+} nav_recorded_format;
+
+/** trajectory.recorded.window bits: which ends of the time window were given. */
+enum {
+  NAV_RECORDED_HAS_START = 1u << 0, /**< start_s given */
+  NAV_RECORDED_HAS_END = 1u << 1    /**< end_s given */
+};
+
+/**
+ * How well the fitted model reproduces recorded samples (nav_track_residuals()). Position and
+ * velocity differences are model minus record resolved in NED at the recorded position,
+ * attitude is the rotation angle between the two attitudes.
+ */
+typedef struct nav_recorded_fit_stats {
+  long samples;        /**< samples compared (0: no fit yet) */
+  double pos_rms_m;    /**< RMS of |dr| (3-D) [m] */
+  double pos_max_m;    /**< largest |dr| [m] */
+  double pos_max_t_s;  /**< its time, scene time base [s] */
+  double pos_h_rms_m;  /**< RMS of hypot(dN, dE) [m] */
+  double pos_v_rms_m;  /**< RMS of |dD| [m] */
+  double vel_rms_mps;  /**< RMS of |dv| (3-D) [m/s] */
+  double vel_max_mps;  /**< largest |dv| [m/s] */
+  double vel_max_t_s;  /**< its time [s] */
+  double att_rms_rad;  /**< RMS of the rotation angle [rad] */
+  double att_max_rad;  /**< largest rotation angle [rad] */
+  double att_max_t_s;  /**< its time [s] */
+  double max_gap_s;    /**< longest time between consecutive samples [s]: the model bridges gaps
+                            smoothly (quadratically where no sample constrains it) */
+  double max_gap_t_s;  /**< scene time of the sample that ends that gap [s] */
+} nav_recorded_fit_stats;
+
+/**
+ * A recorded reference trajectory (recorded.c, nav_track.h). The settings come from the scene
+ * file; the model is a least-squares fit of the recorded samples made when the scene is read
+ * (nav_track_fit()), kept here as uniform quintic B-spline control points:
+ *   - position: curvilinear N, E, D metres from the reference point (lat = ref_lat + N / m_lat,
+ *     lon = ref_lon + E / m_lon, h = ref_h - D, with m_lat = R_M(ref_lat) + ref_h and m_lon =
+ *     (R_N(ref_lat) + ref_h) cos(ref_lat)), fitted to the recorded positions and velocities;
+ *   - attitude: q_b_n = p / |p| with p a 4-vector spline fitted to the recorded attitude
+ *     quaternions (made sign-continuous).
+ * Both are C4, so velocity, acceleration, angular rate and angular acceleration are analytic
+ * and continuous. Scene time 0 is the first recorded sample in the window (file time t0_s).
+ * The recorded samples themselves are not kept.
+ */
+typedef struct nav_traj_recorded {
+  /* ---- settings (scene file) */
+  char file[NAV_RECORDED_PATH_MAX]; /**< the recorded file; navcore_io stores it resolved (absolute) */
+  nav_recorded_format format;
+  unsigned window;      /**< NAV_RECORDED_HAS_START / _HAS_END */
+  double start_s;       /**< first sample time to use, file time base [s] (if HAS_START) */
+  double end_s;         /**< last sample time to use, file time base [s] (if HAS_END) */
+  double knot_rate_hz;  /**< B-spline knots per second (the bandwidth of the model) */
+  double pos_sd_m;      /**< fit weight of a recorded position: 1 / pos_sd_m^2 per axis */
+  double vel_sd_mps;    /**< fit weight of a recorded velocity: 1 / vel_sd_mps^2 per axis */
+  /* ---- fitted model (nav_track_fit; not in the scene file) */
+  double t0_s;          /**< file time of scene time 0 [s] */
+  double span_s;        /**< last minus first sample time in the window [s] */
+  double ref_lat_rad;   /**< origin of the curvilinear coordinates: the first sample [rad] */
+  double ref_lon_rad;   /**< [rad] */
+  double ref_h_m;       /**< ellipsoidal height [m] */
+  double knot_dt_s;     /**< knot spacing [s] */
+  int count;            /**< control points used (knot intervals + 5); 0: not fitted */
+  nav_vec3 ctrl_ned_m[NAV_RECORDED_MAX_CTRL]; /**< position control points [m] */
+  nav_quat ctrl_q[NAV_RECORDED_MAX_CTRL];     /**< attitude control points (not unit) */
+  nav_recorded_fit_stats fit; /**< residuals against the samples of the fit */
+} nav_traj_recorded;
+/* ==== END recorded reference ==== */
+
 typedef struct nav_scene_trajectory {
   nav_traj_type type;
   double duration_s;
@@ -296,6 +382,7 @@ typedef struct nav_scene_trajectory {
   nav_traj_test_motion test_motion;
   nav_traj_waypoints waypoints;
   nav_traj_segments segments;
+  nav_traj_recorded recorded;
 } nav_scene_trajectory;
 
 typedef struct nav_scene_earth {
@@ -339,7 +426,11 @@ typedef enum nav_mech_frame {
 /** Navigation scheme (architecture.md section 1). */
 typedef enum nav_nav_scheme {
   NAV_SCHEME_FREE_INS = 0, /**< free-inertial strapdown INS (gyros + accelerometers) */
-  NAV_SCHEME_INS_GNSS = 1  /**< loosely coupled INS/GNSS error-state Kalman filter */
+  NAV_SCHEME_INS_GNSS = 1, /**< loosely coupled INS/GNSS error-state Kalman filter */
+  /** Gyro-free INS from the accelerometer array of the scene's @c array section (nav_gyrofree.h,
+   *  numerics.md 1.5); the imu section's triads are not used, only imu.rate_hz and
+   *  imu.quadrature_nodes. */
+  NAV_SCHEME_GYRO_FREE = 2
 } nav_nav_scheme;
 
 typedef struct nav_scene_navigation {
@@ -359,6 +450,64 @@ typedef struct nav_scene_simulation {
   int threads; /**< worker threads for Monte Carlo (0 = one per core); results do not depend on it */
 } nav_scene_simulation;
 
+/* ==== BEGIN accelerometer array (gyro-free INS) ==== */
+/** Most accelerometers in an array (the same as NAV_ARRAY_MAX_SENSORS of nav_array.h). */
+#define NAV_SCENE_ARRAY_MAX_SENSORS 16
+
+/**
+ * Built-in accelerometer-array layouts (nav_array.h documents each geometry and its geometry
+ * factors kappa; r = nav_scene_array.radius_m).
+ */
+typedef enum nav_array_layout_kind {
+  NAV_ARRAY_LAYOUT_CUBE6 = 0,  /**< six sensors at the cube's face centres, axes along face diagonals
+                                    (numerics.md 1.5): kappa = kappa_f = 1/sqrt 2 */
+  NAV_ARRAY_LAYOUT_NINE = 1,   /**< nine: a triad at the centre and two sensors on each axis at r
+                                    (Padgaonkar 3-2-2-2) */
+  NAV_ARRAY_LAYOUT_TWELVE = 2, /**< twelve: both face diagonals at each face centre (two cubes):
+                                    kappa = kappa_f = 1/2 */
+  NAV_ARRAY_LAYOUT_CUSTOM = 3  /**< positions and axes of nav_scene_array.custom */
+} nav_array_layout_kind;
+
+/** One accelerometer of a user-defined array. */
+typedef struct nav_scene_array_sensor {
+  nav_vec3 r_bs_b_m; /**< position relative to the array centre O (the body origin), body axes [m] */
+  nav_vec3 n_s_b;    /**< sensitive axis, body axes; any non-zero length (normalised when used) */
+} nav_scene_array_sensor;
+
+/**
+ * Error terms of every accelerometer of an array (the same figures for each sensor; each sensor
+ * draws its own realisation from its own streams). A term is used only when its bit
+ * (::nav_imu_term: BIAS_TURN_ON, BIAS_GM, NOISE, SCALE_FACTOR) is set in @c terms; the fields of
+ * a clear bit are ignored. Per sample interval dt, sensor i (the model of nav_sensors.h, one axis):
+ *   dA~_i = (1 + s_i) dA_i + int (b0_i + b_GM,i) dt + W_i,   W_i ~ N(0, N^2 dt).
+ */
+typedef struct nav_array_error_config {
+  unsigned terms;              /**< OR of NAV_IMU_TERM_BIAS_TURN_ON | _BIAS_GM | _NOISE | _SCALE_FACTOR */
+  double bias_turn_on_sd_mps2; /**< BIAS_TURN_ON: 1-sigma of b0_i (zero mean) [m/s^2], >= 0 */
+  double bias_gm_sd_mps2;      /**< BIAS_GM: stationary sigma [m/s^2], >= 0 */
+  double bias_gm_tau_s;        /**< BIAS_GM: correlation time T [s], > 0, finite */
+  double vrw_mps_per_sqrt_s;   /**< NOISE: white-noise density N [m/s/sqrt(s)], >= 0 */
+  double scale_factor_sd;      /**< SCALE_FACTOR: 1-sigma of s_i (zero mean, unitless), >= 0 */
+} nav_array_error_config;
+
+/**
+ * The accelerometer array of the gyro-free scheme (NAV_SCHEME_GYRO_FREE). Its sample rate and
+ * quadrature are those of the imu section. Random streams (nav_rng.h): sensor i uses the
+ * NAV_RNG_STREAM_ACCEL_* kinds with channel i; the initial angular-rate error of body axis j uses
+ * NAV_RNG_STREAM_INIT_ATT with channel 3 + j (channels 0-2 are the initial attitude error).
+ */
+typedef struct nav_scene_array {
+  nav_array_layout_kind layout;
+  double radius_m;  /**< arm r of the built-in layouts [m], > 0 (not used by CUSTOM) */
+  int custom_count; /**< CUSTOM: number of sensors, 6..NAV_SCENE_ARRAY_MAX_SENSORS */
+  nav_scene_array_sensor custom[NAV_SCENE_ARRAY_MAX_SENSORS]; /**< CUSTOM: the sensors */
+  nav_array_error_config accel;                               /**< per-sensor error terms */
+  /** 1-sigma error of the initial angular rate omega_ib_b given to the gyro-free INS (the array
+   *  cannot observe the rate), per body axis [rad/s], >= 0; drawn once per run, zero mean. */
+  nav_vec3 initial_rate_sd_rps;
+} nav_scene_array;
+/* ==== END accelerometer array ==== */
+
 /** A complete scene. Plain data: copy it by assignment. */
 typedef struct nav_scene {
   int format_version;
@@ -367,6 +516,7 @@ typedef struct nav_scene {
   nav_scene_trajectory trajectory;
   nav_scene_imu imu;
   nav_scene_gnss gnss;
+  nav_scene_array array; /**< accelerometer array of the gyro-free scheme */
   nav_scene_initial_errors initial_errors;
   nav_scene_navigation navigation;
   nav_scene_output output;
@@ -401,6 +551,7 @@ NAV_API const char *nav_traj_type_name(nav_traj_type t);
 NAV_API const char *nav_gravity_model_name(nav_gravity_model g);
 NAV_API const char *nav_mech_frame_name(nav_mech_frame f);
 NAV_API const char *nav_nav_scheme_name(nav_nav_scheme s);
+NAV_API const char *nav_array_layout_kind_name(nav_array_layout_kind k);
 
 NAV_END_DECLS
 

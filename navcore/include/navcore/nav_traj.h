@@ -73,6 +73,27 @@ NAV_API NAV_NODISCARD nav_status nav_traj_rate_integral(const nav_traj *traj, do
 NAV_API NAV_NODISCARD nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2,
                                                    nav_vec3 *w_ib_b_rps);
 
+/**
+ * Ideal IMU increments over [t0_s, t1_s]: the integrals of f_ib_b [m/s^2 -> m/s] and omega_ib_b
+ * [rad/s -> rad] (body axes, the model of nav_traj_inertial) by the quadrature rule with @p n
+ * nodes @p x (ascending, on [-1, 1]) and weights @p w, e.g. from nav_gauss_legendre. Equal to
+ * summing nav_traj_inertial at the nodes up to rounding, but evaluated for the whole interval
+ * at once, which is several times faster (shared lookups and trigonometry, no angular
+ * acceleration). The results depend only on the arguments, never on earlier calls; walking
+ * forward over the sample grid t_k = k dt (dt of the create call) is the fast case.
+ * @param[in]  traj          trajectory (its caches are updated)
+ * @param[in]  t0_s, t1_s    interval [s]
+ * @param[in]  n             node count, 1..16
+ * @param[in]  x, w          nodes and weights on [-1, 1] (n each)
+ * @param[out] dv_b_mps      integral of the specific force, body axes [m/s]
+ * @param[out] dtheta_b_rad  integral of the angular rate omega_ib_b, body axes [rad]
+ * @return NAV_OK, NAV_ERR_INVALID_ARG (NULL, n out of range, non-finite times), or the model's
+ *         status (NAV_ERR_OUT_OF_RANGE before the start of a rate-integrated attitude).
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n,
+                                                             const double *x, const double *w, nav_vec3 *dv_b_mps,
+                                                             nav_vec3 *dtheta_b_rad);
+
 /** Duration of the trajectory [s]. */
 NAV_API double nav_traj_duration(const nav_traj *traj);
 

@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "navcore/nav_array.h"
 #include "navcore/nav_earth.h"
 #include "navcore/nav_scene.h"
 #include "navcore/nav_sensors.h"
@@ -63,6 +64,14 @@ nav_scene nav_scene_default(void) {
   s.trajectory.segments.limits = (nav_traj_limits){1.0, 2.0, 10.0, 2.0, 0.5, 2.0};
   for (int i = 0; i < NAV_MAX_SEGMENTS; ++i) s.trajectory.segments.items[i].gnss_visible = true;
 
+  /* Recorded reference (nav_track.h): 4 knots per second follows a road vehicle's manoeuvres
+   * (bandwidth ~2 Hz) and fits 300 s in the scene; 1 cm / 1 cm/s weigh position and velocity
+   * alike for a reference solution of RTK quality. No samples until a file is loaded. */
+  s.trajectory.recorded.format = NAV_RECORDED_KF_GINS_NAV;
+  s.trajectory.recorded.knot_rate_hz = 4.0;
+  s.trajectory.recorded.pos_sd_m = 0.01;
+  s.trajectory.recorded.vel_sd_mps = 0.01;
+
   s.imu.rate_hz = 100.0;
   s.imu.quadrature_nodes = 6;
   s.navigation.algorithm = NAV_MECH_FIRST_ORDER;
@@ -75,6 +84,12 @@ nav_scene nav_scene_default(void) {
   s.gnss.model = nav_gnss_model_config_default();
   s.navigation.scheme = NAV_SCHEME_FREE_INS;
   s.navigation.aid_vertical = false;
+  /* Gyro-free INS: the cube of numerics.md 1.6 (r = 0.1 m), ideal sensors, perfect initial rate. */
+  s.array.layout = NAV_ARRAY_LAYOUT_CUBE6;
+  s.array.radius_m = 0.1;
+  s.array.custom_count = 0;
+  s.array.accel = nav_array_error_config_default();
+  s.array.initial_rate_sd_rps = nav_vec3_zero();
   return s;
 }
 
@@ -270,6 +285,88 @@ static void check_segments(checker *c, const nav_traj_segments *s) {
   }
 }
 
+/* The accelerometer array of the gyro-free scheme (checked whatever the scheme, like the IMU). */
+static void check_array(checker *c, const nav_scene_array *a, nav_scene_issue_fn report, void *user) {
+  char p[160];
+  if ((int)a->layout < (int)NAV_ARRAY_LAYOUT_CUBE6 || (int)a->layout > (int)NAV_ARRAY_LAYOUT_CUSTOM)
+    issue(c, "array.layout", "unknown array layout %g", (double)a->layout);
+  check_positive(c, "array.radius_m", a->radius_m, 100.0);
+  for (int i = 0; i < 3; ++i) {
+    snprintf(p, sizeof p, "array.initial_rate_sd_rps[%d]", i);
+    const double v = nav_vec3_get(a->initial_rate_sd_rps, i);
+    if (!(isfinite(v) && v >= 0.0)) issue(c, p, "must be finite and >= 0 (got %g)", v);
+  }
+  {
+    prefixed pa = {"array.accel.", report, user, 0};
+    if (nav_array_error_config_validate(&a->accel, report_prefixed, &pa) != NAV_OK && pa.count == 0)
+      issue_text(c, "array.accel", "invalid accelerometer error model");
+    c->count += pa.count;
+  }
+  if (a->layout != NAV_ARRAY_LAYOUT_CUSTOM) return;
+  if (a->custom_count < NAV_ARRAY_MIN_SENSORS || a->custom_count > NAV_ARRAY_MAX_SENSORS) {
+    issue(c, "array.sensors", "a custom layout needs 6 to 16 sensors (got %g)", (double)a->custom_count);
+    return;
+  }
+  const int before = c->count;
+  for (int i = 0; i < a->custom_count; ++i) {
+    snprintf(p, sizeof p, "array.sensors[%d].r_bs_b_m", i);
+    check_vec(c, p, a->custom[i].r_bs_b_m);
+    snprintf(p, sizeof p, "array.sensors[%d].n_s_b", i);
+    check_vec(c, p, a->custom[i].n_s_b);
+    const double nn = nav_vec3_norm(a->custom[i].n_s_b);
+    if (nav_vec3_isfinite(a->custom[i].n_s_b) && !(nn > 0.0 && isfinite(nn)))
+      issue(c, p, "the sensitive axis must be a non-zero vector (got norm %g)", nn);
+  }
+  if (c->count != before) return;
+  /* The layout must determine f and omega_dot: H of full rank and well conditioned (E1.23). */
+  nav_accel_array arr;
+  nav_array_geometry geo;
+  if (nav_array_layout_from_scene(a, &arr) != NAV_OK || nav_array_geometry_compute(&arr, &geo) != NAV_OK)
+    issue_text(c, "array.sensors",
+               "the sensors cannot determine specific force and angular acceleration: H (E1.23) is singular "
+               "or its condition number exceeds 1e8 (e.g. parallel axes, or every axis along its lever arm)");
+}
+
+/* Recorded reference: the settings, and a fitted model (nav_track_fit) consistent with them. */
+static void check_recorded(checker *c, const nav_scene *s) {
+  const nav_traj_recorded *r = &s->trajectory.recorded;
+  if (s->earth.model != NAV_EARTH_WGS84)
+    issue_text(c, "trajectory.type", "recorded is a geodetic trajectory and needs earth.model: wgs84");
+  if (r->format != NAV_RECORDED_KF_GINS_NAV) issue(c, "trajectory.recorded.format", "unknown format %g", (double)r->format);
+  if (!(r->knot_rate_hz > 0.0 && r->knot_rate_hz <= 1000.0))
+    issue(c, "trajectory.recorded.knot_rate_hz", "must be within (0, 1000] Hz (got %g)", r->knot_rate_hz);
+  check_positive(c, "trajectory.recorded.pos_sd_m", r->pos_sd_m, 1.0e6);
+  check_positive(c, "trajectory.recorded.vel_sd_mps", r->vel_sd_mps, 1.0e6);
+  if ((r->window & NAV_RECORDED_HAS_START) && !isfinite(r->start_s))
+    issue(c, "trajectory.recorded.start_s", "must be a finite number (got %g)", r->start_s);
+  if ((r->window & NAV_RECORDED_HAS_END) && !isfinite(r->end_s))
+    issue(c, "trajectory.recorded.end_s", "must be a finite number (got %g)", r->end_s);
+  if ((r->window & NAV_RECORDED_HAS_START) && (r->window & NAV_RECORDED_HAS_END) && !(r->end_s > r->start_s))
+    issue(c, "trajectory.recorded.end_s", "must be later than start_s (got %g s)", r->end_s);
+  if (r->count < 6 || r->count > NAV_RECORDED_MAX_CTRL) {
+    issue(c, "trajectory.recorded.file", "no fitted samples (%g control points); load the file with navcore_io "
+          "or fit samples with nav_track_fit", (double)r->count);
+    return;
+  }
+  bool finite = isfinite(r->t0_s) && isfinite(r->span_s) && isfinite(r->ref_lat_rad) && isfinite(r->ref_lon_rad) &&
+                isfinite(r->ref_h_m) && isfinite(r->knot_dt_s);
+  for (int i = 0; i < r->count && finite; ++i)
+    finite = nav_vec3_isfinite(r->ctrl_ned_m[i]) && isfinite(r->ctrl_q[i].w) && isfinite(r->ctrl_q[i].x) &&
+             isfinite(r->ctrl_q[i].y) && isfinite(r->ctrl_q[i].z);
+  if (!finite) {
+    issue_text(c, "trajectory.recorded.file", "the fitted model is not finite");
+    return;
+  }
+  if (!(r->span_s > 0.0) || !(r->knot_dt_s > 0.0) || (double)(r->count - 5) * r->knot_dt_s < r->span_s * (1.0 - 1e-12))
+    issue(c, "trajectory.recorded.file", "the fitted model does not cover its span of %g s", r->span_s);
+  if (!(fabs(r->ref_lat_rad) <= 89.0 * NAV_DEG2RAD))
+    issue(c, "trajectory.recorded.file", "the recorded trajectory starts at latitude %g deg; it must stay within "
+          "89 deg of the equator", r->ref_lat_rad * NAV_RAD2DEG);
+  /* The model continues smoothly a little beyond the data, but it is not data there. */
+  if (isfinite(s->trajectory.duration_s) && s->trajectory.duration_s > r->span_s * (1.0 + 1e-12) + 1e-9)
+    issue(c, "trajectory.duration_s", "must not exceed the recorded span of %.9g s", r->span_s);
+}
+
 nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report, void *user) {
   checker c = {report, user, 0};
   if (!scene) return NAV_ERR_INVALID_ARG;
@@ -315,6 +412,8 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
     check_waypoints(&c, &s->trajectory.waypoints);
   } else if (s->trajectory.type == NAV_TRAJ_SEGMENTS) {
     check_segments(&c, &s->trajectory.segments);
+  } else if (s->trajectory.type == NAV_TRAJ_RECORDED) {
+    check_recorded(&c, s);
   } else {
     issue(&c, "trajectory.type", "unknown trajectory type %g", (double)s->trajectory.type);
   }
@@ -355,8 +454,12 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   check_vec(&c, "initial_errors.position_m", s->initial_errors.pos_sd_m);
   check_vec(&c, "initial_errors.velocity_mps", s->initial_errors.vel_sd_mps);
   check_vec(&c, "initial_errors.attitude_deg", s->initial_errors.att_sd_rad);
-  if (s->navigation.scheme != NAV_SCHEME_FREE_INS && s->navigation.scheme != NAV_SCHEME_INS_GNSS)
+  if (s->navigation.scheme != NAV_SCHEME_FREE_INS && s->navigation.scheme != NAV_SCHEME_INS_GNSS &&
+      s->navigation.scheme != NAV_SCHEME_GYRO_FREE)
     issue(&c, "navigation.scheme", "unknown navigation scheme %g", (double)s->navigation.scheme);
+  if (s->navigation.scheme == NAV_SCHEME_GYRO_FREE && s->navigation.aid_vertical)
+    issue_text(&c, "navigation.aid_vertical", "applies to the free INS only, not to gyro_free");
+  check_array(&c, &s->array, report, user);
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && !s->gnss.enabled)
     issue_text(&c, "navigation.scheme", "ins_gnss needs a GNSS receiver: set gnss.enabled: true");
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->earth.model != NAV_EARTH_WGS84)
@@ -398,6 +501,17 @@ const char *nav_nav_scheme_name(nav_nav_scheme s) {
   switch (s) {
   case NAV_SCHEME_FREE_INS: return "free_ins";
   case NAV_SCHEME_INS_GNSS: return "ins_gnss";
+  case NAV_SCHEME_GYRO_FREE: return "gyro_free";
+  }
+  return "unknown";
+}
+
+const char *nav_array_layout_kind_name(nav_array_layout_kind k) {
+  switch (k) {
+  case NAV_ARRAY_LAYOUT_CUBE6: return "cube6";
+  case NAV_ARRAY_LAYOUT_NINE: return "nine";
+  case NAV_ARRAY_LAYOUT_TWELVE: return "twelve";
+  case NAV_ARRAY_LAYOUT_CUSTOM: return "custom";
   }
   return "unknown";
 }
@@ -416,6 +530,7 @@ const char *nav_traj_type_name(nav_traj_type t) {
   case NAV_TRAJ_WAYPOINTS: return "waypoints";
   case NAV_TRAJ_SEGMENTS: return "segments";
   case NAV_TRAJ_TEST_MOTION: return "test_motion";
+  case NAV_TRAJ_RECORDED: return "recorded";
   }
   return "unknown";
 }

@@ -40,6 +40,11 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
     nav_sim_set_error(sim, "covariance analysis needs the wgs84 Earth model (the error model is the NED one)");
     return NAV_ERR_INVALID_ARG;
   }
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE) {
+    nav_sim_set_error(sim, "covariance analysis models gyro INS schemes; for gyro_free use the closed forms "
+                           "(navsim estimate) or Monte Carlo");
+    return NAV_ERR_INVALID_ARG;
+  }
   nav_truth *truth = NULL;
   nav_filter *kf = NULL;
   char msg[200];

@@ -119,6 +119,7 @@ typedef struct job {
    * computed once; NULL when the job has one run or would need too much memory. */
   nav_imu_increment *shared_imu;
   nav_traj_state *shared_ts;
+  nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
 } job;
 
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
@@ -289,6 +290,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   nav_truth *truth = NULL;
   nav_ins *ins = NULL;
   nav_imu_model *imu_model = NULL;
+  nav_sim_gyrofree *gf = NULL; /* gyro-free scheme (sim_gyrofree.c): replaces the IMU */
   aiding aid_kf;
   memset(&aid_kf, 0, sizeof aid_kf);
   char msg[200];
@@ -299,7 +301,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   const nav_frame frame = nav_truth_frame(truth);
   const double dt = nav_truth_dt(truth);
-  if (!j->ideal) {
+  const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE;
+  if (!j->ideal && !gyro_free) {
     st = nav_imu_model_create(&sc->imu.model, sc->simulation.seed, (uint64_t)run, &imu_model);
     if (st != NAV_OK) {
       job_error(j, "run %ld: IMU error model: %s", run, nav_status_str(st));
@@ -340,6 +343,13 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       goto cleanup;
     }
   }
+  if (gyro_free) {
+    st = nav_sim_gyrofree_create(sc, j->gf_truth, run, j->ideal, &icfg, &s0, &gf, msg, sizeof msg);
+    if (st != NAV_OK) {
+      job_error(j, "run %ld: gyro-free INS: %s", run, msg[0] ? msg : nav_status_str(st));
+      goto cleanup;
+    }
+  }
   const bool record = caller_thread && run == 0 && j->opts->record;
   bool stop = false;
 
@@ -364,7 +374,14 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
                 (double)k * dt);
       goto cleanup;
     }
-    if (imu_model) {
+    if (gf) {
+      /* Gyro-free: the array replaces the IMU; meas is the INS's equivalent (dtheta, dv). */
+      st = nav_sim_gyrofree_step(gf, k, &meas);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: %s", run, nav_sim_gyrofree_last_error(gf));
+        goto cleanup;
+      }
+    } else if (imu_model) {
       st = nav_imu_model_apply(imu_model, &ideal_imu, &meas);
       if (st != NAV_OK) {
         job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal_imu.t_s);
@@ -382,7 +399,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       }
       st = aiding_fixes(j, &aid_kf, truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
-    } else {
+    } else if (!gf) {
       st = nav_ins_step(ins, &meas);
       if (st != NAV_OK) {
         job_error(j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", run, nav_ins_last_error(ins),
@@ -390,7 +407,9 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         goto cleanup;
       }
     }
-    const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x) : nav_ins_get_state(ins);
+    const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x)
+                                   : gf       ? nav_sim_gyrofree_state(gf)
+                                              : nav_ins_get_state(ins);
     if (j->shared_ts) ts = j->shared_ts[k];
     else st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
@@ -421,6 +440,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
 
 cleanup:
   aiding_destroy(&aid_kf);
+  nav_sim_gyrofree_destroy(gf);
   nav_imu_model_destroy(imu_model);
   nav_ins_destroy(ins);
   nav_truth_destroy(truth);
@@ -508,6 +528,15 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     }
   }
   nav_truth_destroy(probe);
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && j.runs > 1) {
+    /* The ideal array increments are those of every run too: sampled once (sim_gyrofree.c). */
+    st = nav_sim_gyrofree_truth_create(sc, &j.gf_truth, msg, sizeof msg);
+    if (st != NAV_OK) {
+      snprintf(sim->last_error, sizeof sim->last_error, "accelerometer array: %s",
+               msg[0] ? msg : nav_status_str(st));
+      goto cleanup;
+    }
+  }
   j.out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
   if (j.out_stride < 1) j.out_stride = 1;
   const int64_t epochs = j.n + 1;
@@ -685,6 +714,7 @@ cleanup:
   free(j.env);
   free(j.shared_imu);
   free(j.shared_ts);
+  nav_sim_gyrofree_truth_destroy(j.gf_truth);
   free(j.final);
   free(j.samples_done);
   free(j.status);

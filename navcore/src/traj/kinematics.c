@@ -132,6 +132,47 @@ static ptrdiff_t find_step(const nav_kin_channel *c, double t) {
   return (ptrdiff_t)lo;
 }
 
+/* find_step through a cached index: sequential evaluation stays in the same step or moves to
+ * the next one, so the binary search is rarely needed. The result is the same index. */
+static ptrdiff_t find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
+  const ptrdiff_t n = (ptrdiff_t)c->n;
+  for (ptrdiff_t k = *hint; k <= *hint + 1 && k < n; ++k) {
+    if (k < -1) break;
+    const bool lo_ok = k < 0 ? (n == 0 || t < c->steps[0].t0_s) : c->steps[k].t0_s <= t;
+    const bool hi_ok = k + 1 >= n || t < c->steps[k + 1].t0_s;
+    if (lo_ok && hi_ok) {
+      *hint = k;
+      return k;
+    }
+  }
+  *hint = find_step(c, t);
+  return *hint;
+}
+
+void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
+                               double *r1) {
+  /* x, r and r' of channel_state (the same expressions, hence the same numbers) without y, r''
+   * and r'''. */
+  const ptrdiff_t k = find_step_hint(c, t_s, hint);
+  if (k >= 0) {
+    const nav_kin_step *s = &c->steps[k];
+    const double d = t_s - s->t0_s;
+    if (d < s->len_s) {
+      const double T = s->len_s, u = d / T;
+      *x = s->x0 + s->r0 * d + s->dr * T * ss_I(u);
+      *r = s->r0 + s->dr * ss_S(u);
+      *r1 = s->dr * ss_S1(u) / T;
+      return;
+    }
+    *x = s->x0 + s->r0 * d + s->dr * (d - 0.5 * s->len_s);
+    *r = s->r0 + s->dr;
+  } else {
+    *x = c->x_init + c->r_init * t_s;
+    *r = c->r_init;
+  }
+  *r1 = 0.0;
+}
+
 /* Full state at t: x, y and rate jets (r, r', r'', r'''). */
 static void channel_state(const nav_kin_channel *c, double t, double *x, double *y, double r[4]) {
   const ptrdiff_t k = find_step(c, t);

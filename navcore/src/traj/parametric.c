@@ -12,22 +12,48 @@
 
 #include <stdio.h>
 
-#include "traj/traj_internal.h"
+#include "traj/traj_kin_internal.h"
 
 /* One checkpoint of the integrated attitude every CHECKPOINT_STRIDE grid steps, so evaluation
  * at an earlier time re-integrates at most that many steps. */
 #define CHECKPOINT_STRIDE 4096
 
+/* Per-node constants of a quadrature rule on the sample interval [t0, t0 + dt] (node_table). */
+typedef struct node_const {
+  int m;              /* sub-grid step below the node: grid index (k - 1) S + m */
+  double rem;         /* node offset from that grid point [s]; 0 on the grid */
+  double rate[3][2];  /* cos, sin of w_i o (rate phase advance from t0 to the node, o = offset) */
+  double pos[3][2];   /* cos, sin of W_i o (position phase advance) */
+  double part[2][3][2]; /* cos, sin of w_i o at the two Magnus nodes of the partial step */
+} node_const;
+
 typedef struct param_model {
   double duration_s;
   nav_traj_parametric p;
   nav_quat q0_b_l;
-  double h_s;          /* Magnus sub-grid step */
+  double dt_s;         /* IMU interval (sample grid K dt) */
+  int substeps;        /* S: sub-grid steps per sample */
+  double h_s;          /* Magnus sub-grid step dt / S */
   nav_quat *checkpoints; /* q_b_l at grid index i * CHECKPOINT_STRIDE, i < n_valid */
   int64_t n_checkpoints;
   int64_t n_valid;
   int64_t cache_j;     /* grid index of the cached attitude */
   nav_quat cache_q;
+  /* Grid steps: step j = K S + m has its two Magnus nodes at t_K + (m + 1/2 -/+ sqrt(3)/6) h_s,
+   * t_K = K dt; step_cs[((m * 2 + node) * 3 + axis) * 2 + {0, 1}] = cos, sin of w_axis times that
+   * offset. With the rate phases at t_K (anchor) this gives the rates without trigonometry. */
+  double *step_cs;
+  double wa[3], wb[3]; /* a and b of E3.2 */
+  /* Phases at the sample times t_K = K dt: rate (anchor_*) and position (pos_*) sinusoids,
+   * sin and cos of 2 pi c_i t_K + d_i and 2 pi C_i t_K + D_i (see phase_at). */
+  int64_t anchor_k, pos_k; /* K of the cached phases, -1 if none */
+  double anchor_s[3], anchor_c[3], pos_s[3], pos_c[3];
+  double rate_step[3][2], pos_step[3][2]; /* cos, sin of the phase advance over dt */
+  double half_cs[3][2]; /* cos, sin of the rate phase advance over dt / 2 */
+  /* Node constants of the last quadrature rule (nav_traj_parametric_nodes). */
+  int nc_n;
+  double nc_x[NAV_KIN_MAX_NODES];
+  node_const nc[NAV_KIN_MAX_NODES];
 } param_model;
 
 /* omega(t) = a + b sin(2 pi c t + d), element-wise (E3.2). */
@@ -59,6 +85,117 @@ static nav_quat magnus_step(const nav_traj_parametric *p, nav_quat q, double t0,
 
 static double grid_time(const param_model *tr, int64_t j) { return (double)j * tr->h_s; }
 
+/*
+ * exp of a rotation vector as a quaternion, [cos(a/2), sin(a/2)/a sigma], a = |sigma|. Below
+ * a = 0.2 rad (every Magnus step of a sub-grid, except for spin rates above 0.2 / h_s) by the
+ * Taylor series of cos x and sin(x)/x in x^2 = a^2/4, so that no sqrt and no trigonometry are
+ * needed: through x^4 while x^2 < 1e-5 (first omitted terms x^6/720, x^6/5040 < 1.4e-18),
+ * through x^8 while x^2 < 1e-3 (x^10/10! < 2.8e-22), else through x^10 (x^12/12! < 2.1e-21 at
+ * the bound). All far below rounding. Above 0.2 rad, the closed form.
+ */
+static nav_quat quat_exp(nav_vec3 sigma) {
+  const double a2 = nav_vec3_dot(sigma, sigma);
+  double w, s;
+  const double x2 = 0.25 * a2;
+  if (x2 < 1e-5) {
+    w = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0));
+    s = 0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0)));
+  } else if (x2 < 1e-3) {
+    w = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0))));
+    s = 0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0)))));
+  } else if (a2 < 0.04) {
+    w = 1.0 - x2 * (1.0 / 2.0) *
+                  (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0) * (1.0 - x2 * (1.0 / 90.0)))));
+    s = 0.5 * (1.0 - x2 * (1.0 / 6.0) *
+                         (1.0 - x2 * (1.0 / 20.0) *
+                                    (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0) * (1.0 - x2 * (1.0 / 110.0))))));
+  } else {
+    const double a = sqrt(a2);
+    w = cos(0.5 * a);
+    s = sin(0.5 * a) / a;
+  }
+  const nav_quat q = {w, s * sigma.x, s * sigma.y, s * sigma.z};
+  return q;
+}
+
+/* q / |q| for |q| = 1 + e with e at rounding level (a product of unit quaternions): one Newton
+ * step for 1/sqrt(n), n = |q|^2, from 1: (3 - n)/2, exact to O(e^2). No sqrt, no division. */
+static inline nav_quat renormalize(nav_quat q) {
+  const double s = 1.5 - 0.5 * (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  const nav_quat r = {q.w * s, q.x * s, q.y * s, q.z * s};
+  return r;
+}
+
+/* The E3.5 step from two-node rates over h: C <- C exp([sigma x]). */
+static nav_quat magnus_apply(nav_quat q, nav_vec3 w_a, nav_vec3 w_b, double h) {
+  static const double k_cross = 0.14433756729740644113; /* sqrt(3)/12 */
+  const nav_vec3 sigma =
+      nav_vec3_add(nav_vec3_scale(nav_vec3_add(w_a, w_b), 0.5 * h), nav_vec3_scale(nav_vec3_cross(w_a, w_b), k_cross * h * h));
+  return renormalize(nav_quat_mul(q, quat_exp(sigma)));
+}
+
+/* Phases are re-evaluated directly every PHASE_BLOCK samples. */
+#define PHASE_BLOCK 64
+
+/*
+ * sin and cos of the phases f_i t_K + g_i (f = 2 pi x frequency) at t_K = K dt into s, c, with
+ * *k the K they hold. A pure function of K: sin/cos directly when K is a multiple of PHASE_BLOCK,
+ * else the phases of K - 1 advanced by f_i dt (angle addition with step = {cos, sin} of f_i dt).
+ * A forward walk costs one rotation per sample; a jump walks from the block start. The
+ * rotations add at most PHASE_BLOCK roundings (~1e-14), less than the rounding of the argument
+ * f t_K + g itself once t_K is more than a few seconds.
+ */
+static void phase_at(int64_t K, double dt, nav_vec3 f, nav_vec3 g, double step[3][2], int64_t *k, double s[3],
+                     double c[3]) {
+  if (K == *k) return;
+  int64_t j = *k;
+  if (!(j >= 0 && j < K && K - j < PHASE_BLOCK && K / PHASE_BLOCK == j / PHASE_BLOCK)) {
+    j = K - K % PHASE_BLOCK;
+    const double t = (double)j * dt;
+    for (int i = 0; i < 3; ++i) {
+      const double ph = nav_vec3_get(f, i) * t + nav_vec3_get(g, i);
+      s[i] = sin(ph);
+      c[i] = cos(ph);
+    }
+  }
+  for (; j < K; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const double sn = s[i] * step[i][0] + c[i] * step[i][1];
+      c[i] = c[i] * step[i][0] - s[i] * step[i][1];
+      s[i] = sn;
+    }
+  *k = K;
+}
+
+static nav_vec3 two_pi_times(nav_vec3 hz) {
+  return nav_vec3_make(NAV_TWO_PI * hz.x, NAV_TWO_PI * hz.y, NAV_TWO_PI * hz.z);
+}
+
+/* Rate phases at the sample time t_K (the anchor of the grid steps of sample K). */
+static inline void set_anchor(param_model *tr, int64_t K) {
+  if (K != tr->anchor_k)
+    phase_at(K, tr->dt_s, two_pi_times(tr->p.wc_hz), tr->p.wd_rad, tr->rate_step, &tr->anchor_k, tr->anchor_s,
+           tr->anchor_c);
+}
+
+/* omega = a + b sin(phase(t_K) + w o) from the anchor and cs = {cos w o, sin w o} per axis. */
+static inline nav_vec3 rate_from_anchor(const param_model *tr, const double cs[3][2]) {
+  double r[3];
+  for (int i = 0; i < 3; ++i)
+    r[i] = tr->wa[i] + tr->wb[i] * (tr->anchor_s[i] * cs[i][0] + tr->anchor_c[i] * cs[i][1]);
+  return nav_vec3_make(r[0], r[1], r[2]);
+}
+
+/* Grid step j -> j + 1 (numerics.md E3.5). Every grid step, whoever asks for it, is computed
+ * here from the anchor of its sample, so the cached attitudes are a pure function of j. */
+static nav_quat grid_step(param_model *tr, nav_quat q, int64_t j) {
+  const int64_t K = j / tr->substeps;
+  const int64_t m = j - K * tr->substeps;
+  set_anchor(tr, K);
+  const double(*cs)[3][2] = (const double(*)[3][2])(tr->step_cs + m * 12);
+  return magnus_apply(q, rate_from_anchor(tr, cs[0]), rate_from_anchor(tr, cs[1]), tr->h_s);
+}
+
 /* Advance the cached attitude to grid index j (j >= 0). Checkpoints are recorded as the cache
  * walks forward, so going back costs at most CHECKPOINT_STRIDE steps. */
 static void advance_cache(param_model *tr, int64_t j) {
@@ -69,7 +206,7 @@ static void advance_cache(param_model *tr, int64_t j) {
     tr->cache_q = tr->checkpoints[c];
   }
   while (tr->cache_j < j) {
-    tr->cache_q = magnus_step(&tr->p, tr->cache_q, grid_time(tr, tr->cache_j), tr->h_s);
+    tr->cache_q = grid_step(tr, tr->cache_q, tr->cache_j);
     tr->cache_j++;
     if (tr->cache_j % CHECKPOINT_STRIDE == 0) {
       const int64_t c = tr->cache_j / CHECKPOINT_STRIDE;
@@ -105,6 +242,33 @@ static nav_status parametric_prepare(param_model *tr) {
   tr->n_valid = 1;
   tr->cache_j = 0;
   tr->cache_q = tr->q0_b_l;
+  tr->step_cs = malloc((size_t)tr->substeps * 12 * sizeof *tr->step_cs);
+  if (!tr->step_cs) return NAV_ERR_NO_MEMORY;
+  static const double k_off = 0.28867513459481288225; /* sqrt(3)/6 */
+  for (int m = 0; m < tr->substeps; ++m)
+    for (int node = 0; node < 2; ++node) {
+      const double o = ((double)m + (node == 0 ? 0.5 - k_off : 0.5 + k_off)) * tr->h_s;
+      for (int i = 0; i < 3; ++i) {
+        const double ph = NAV_TWO_PI * nav_vec3_get(tr->p.wc_hz, i) * o;
+        tr->step_cs[((m * 2 + node) * 3 + i) * 2] = cos(ph);
+        tr->step_cs[((m * 2 + node) * 3 + i) * 2 + 1] = sin(ph);
+      }
+    }
+  for (int i = 0; i < 3; ++i) {
+    tr->wa[i] = nav_vec3_get(tr->p.wa_rps, i);
+    tr->wb[i] = nav_vec3_get(tr->p.wb_rps, i);
+    const double fr = NAV_TWO_PI * nav_vec3_get(tr->p.wc_hz, i) * tr->dt_s;
+    const double fp = NAV_TWO_PI * nav_vec3_get(tr->p.c_hz, i) * tr->dt_s;
+    tr->rate_step[i][0] = cos(fr);
+    tr->rate_step[i][1] = sin(fr);
+    tr->pos_step[i][0] = cos(fp);
+    tr->pos_step[i][1] = sin(fp);
+    tr->half_cs[i][0] = cos(0.5 * fr);
+    tr->half_cs[i][1] = sin(0.5 * fr);
+  }
+  tr->anchor_k = -1;
+  tr->pos_k = -1;
+  tr->nc_n = 0;
   return NAV_OK;
 }
 
@@ -112,6 +276,7 @@ static void param_destroy(void *self) {
   param_model *tr = self;
   if (!tr) return;
   free(tr->checkpoints);
+  free(tr->step_cs);
   free(tr);
 }
 
@@ -129,6 +294,8 @@ nav_status nav_traj_parametric_create(const nav_scene *scene, double dt_s, nav_t
   tr->duration_s = scene->trajectory.duration_s;
   tr->p = scene->trajectory.parametric;
   tr->q0_b_l = nav_euler_to_quat(scene->trajectory.initial_attitude);
+  tr->dt_s = dt_s;
+  tr->substeps = tr->p.magnus_substeps;
   tr->h_s = dt_s / (double)tr->p.magnus_substeps;
   const nav_status st = parametric_prepare(tr);
   if (st != NAV_OK) {
@@ -173,8 +340,29 @@ static nav_status param_eval(void *self, double t_s, nav_local_kin *out) {
 }
 
 static bool param_rate_integral(void *self, double t0_s, double t1_s, nav_vec3 *out) {
-  const nav_traj_parametric *p = &((const param_model *)self)->p;
+  param_model *tr = self;
+  const nav_traj_parametric *p = &tr->p;
   nav_vec3 r;
+  const double kf = nearbyint(t0_s / tr->dt_s);
+  if (kf >= 0.0 && kf < 9.0e15 && kf * tr->dt_s == t0_s && (kf + 1.0) * tr->dt_s == t1_s) {
+    /* A sample interval: as below, with sin(w (t0 + t1)/2 + d) = sin(phase(t0) + w dt/2) from
+     * the anchor phases (constants half_cs) and sin(w dt/2) = half_cs[i][1]. */
+    set_anchor(tr, (int64_t)kf);
+    for (int i = 0; i < 3; ++i) {
+      const double a = tr->wa[i], b = tr->wb[i], c = nav_vec3_get(p->wc_hz, i), d = nav_vec3_get(p->wd_rad, i);
+      double v;
+      if (c == 0.0) {
+        v = (a + b * sin(d)) * (t1_s - t0_s);
+      } else {
+        const double w = NAV_TWO_PI * c;
+        const double smid = tr->anchor_s[i] * tr->half_cs[i][0] + tr->anchor_c[i] * tr->half_cs[i][1];
+        v = a * (t1_s - t0_s) + (2.0 * b / w) * smid * tr->half_cs[i][1];
+      }
+      nav_vec3_set(&r, i, v);
+    }
+    *out = r;
+    return true;
+  }
   for (int i = 0; i < 3; ++i) {
     /* E3.6: integral of a + b sin(2 pi c t + d); c = 0 degenerates to (a + b sin d) dt. */
     const double a = nav_vec3_get(p->wa_rps, i), b = nav_vec3_get(p->wb_rps, i);
@@ -193,4 +381,97 @@ static bool param_rate_integral(void *self, double t0_s, double t1_s, nav_vec3 *
   }
   *out = r;
   return true;
+}
+
+/* Node constants for the rule x on [t0, t0 + dt]: node offset o = dt (1 + x) / 2. */
+static void node_table(param_model *tr, int n, const double *x) {
+  static const double k_off = 0.28867513459481288225; /* sqrt(3)/6 */
+  if (tr->nc_n == n && memcmp(tr->nc_x, x, (size_t)n * sizeof *x) == 0) return;
+  const nav_traj_parametric *p = &tr->p;
+  for (int i = 0; i < n; ++i) {
+    node_const *c = &tr->nc[i];
+    const double o = 0.5 * tr->dt_s * (1.0 + x[i]);
+    /* The grid point below, snapped as in attitude_at. */
+    const double g = o / tr->h_s;
+    double m = floor(g);
+    if (g - m > 1.0 - 1e-9) m += 1.0;
+    if (m < 0.0) m = 0.0;
+    if (m > (double)(tr->substeps - 1)) m = (double)(tr->substeps - 1);
+    c->m = (int)m;
+    c->rem = o - m * tr->h_s;
+    if (fabs(c->rem) < 1e-9 * tr->h_s) c->rem = 0.0;
+    const double oa = m * tr->h_s + (0.5 - k_off) * c->rem, ob = m * tr->h_s + (0.5 + k_off) * c->rem;
+    for (int a = 0; a < 3; ++a) {
+      const double w = NAV_TWO_PI * nav_vec3_get(p->wc_hz, a), W = NAV_TWO_PI * nav_vec3_get(p->c_hz, a);
+      c->rate[a][0] = cos(w * o);
+      c->rate[a][1] = sin(w * o);
+      c->pos[a][0] = cos(W * o);
+      c->pos[a][1] = sin(W * o);
+      c->part[0][a][0] = cos(w * oa);
+      c->part[0][a][1] = sin(w * oa);
+      c->part[1][a][0] = cos(w * ob);
+      c->part[1][a][1] = sin(w * ob);
+    }
+  }
+  memcpy(tr->nc_x, x, (size_t)n * sizeof *x);
+  tr->nc_n = n;
+}
+
+/*
+ * Ideal-IMU nodes on the sample interval [t_(k-1), t_k]: param_eval at each node, with every
+ * sinusoid written as sin(phase(t_(k-1)) + w o) = S cos(w o) + C sin(w o) from six sincos per
+ * interval (the rate and position phases at t_(k-1)) and per-rule constants, and the attitude as
+ * in attitude_at: the cached grid attitude (grid steps are shared with nav_traj_eval) and one
+ * partial Magnus step from the grid point below each node. Off the sample grid, param_eval.
+ */
+nav_status nav_traj_parametric_nodes(void *self, nav_kin_nodes *io) {
+  param_model *tr = self;
+  const nav_traj_parametric *p = &tr->p;
+  if (io->k < 1) {
+    for (int i = 0; i < io->n; ++i) {
+      nav_local_kin k;
+      const nav_status st = param_eval(self, io->t_s[i], &k);
+      if (st != NAV_OK) return st;
+      io->C_b_n[i] = nav_quat_to_dcm(k.q_b_n);
+      io->w_nb_b_rps[i] = k.w_nb_b_rps;
+      io->v_ned_mps[i] = k.v_ned_mps;
+      io->a_ned_mps2[i] = k.a_ned_mps2;
+      io->r_ned_m[i] = k.r_ned_m;
+    }
+    io->has_pos = true;
+    return NAV_OK;
+  }
+  node_table(tr, io->n, io->x);
+  const int64_t K = io->k - 1;
+  set_anchor(tr, K);
+  if (K != tr->pos_k)
+    phase_at(K, tr->dt_s, two_pi_times(p->c_hz), p->d_rad, tr->pos_step, &tr->pos_k, tr->pos_s, tr->pos_c);
+  const double *ps = tr->pos_s, *pc = tr->pos_c;
+  for (int i = 0; i < io->n; ++i) {
+    const node_const *c = &tr->nc[i];
+    const double t = io->t_s[i];
+    /* E3.1 and its derivatives. */
+    double r[3], v[3], acc[3];
+    for (int a = 0; a < 3; ++a) {
+      const double B = nav_vec3_get(p->b_m, a), W = NAV_TWO_PI * nav_vec3_get(p->c_hz, a);
+      const double A = nav_vec3_get(p->a_mps2, a);
+      const double sn = ps[a] * c->pos[a][0] + pc[a] * c->pos[a][1];
+      const double cs = pc[a] * c->pos[a][0] - ps[a] * c->pos[a][1];
+      r[a] = nav_vec3_get(p->r0_m, a) + nav_vec3_get(p->v0_mps, a) * t + A * t * t + B * sn;
+      v[a] = nav_vec3_get(p->v0_mps, a) + 2.0 * A * t + W * B * cs;
+      acc[a] = 2.0 * A - W * W * B * sn;
+    }
+    io->r_ned_m[i] = nav_vec3_make(r[0], r[1], r[2]);
+    io->v_ned_mps[i] = nav_vec3_make(v[0], v[1], v[2]);
+    io->a_ned_mps2[i] = nav_vec3_make(acc[0], acc[1], acc[2]);
+    io->w_nb_b_rps[i] = rate_from_anchor(tr, c->rate);
+    /* Attitude: grid point, then the partial step (E3.5) over rem. */
+    advance_cache(tr, K * tr->substeps + c->m);
+    set_anchor(tr, K); /* advance_cache may have moved it (a restart from a checkpoint) */
+    nav_quat q = tr->cache_q;
+    if (c->rem != 0.0) q = magnus_apply(q, rate_from_anchor(tr, c->part[0]), rate_from_anchor(tr, c->part[1]), c->rem);
+    io->C_b_n[i] = nav_quat_to_dcm(q);
+  }
+  io->has_pos = true;
+  return NAV_OK;
 }

@@ -55,6 +55,7 @@ typedef struct seg_model {
   double *breaks;
   size_t n_breaks;
   nav_traj_script_info info;
+  ptrdiff_t hint[CH_N]; /* step index of each channel at the last node evaluation (speed only) */
 } seg_model;
 
 typedef struct planner {
@@ -705,6 +706,61 @@ static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
   return NAV_OK;
 }
 
+/*
+ * Ideal-IMU nodes: seg_eval without the position (the caller integrates the velocity) and
+ * without the angular acceleration, with the attitude as a DCM. The channels are found through
+ * cached step indices, the bank jet is reduced to its first derivative, and the sine and cosine
+ * of an Euler angle are reused while the angle is unchanged (a level stretch), so a ground
+ * vehicle costs one sincos per node. The expressions are those of seg_state, nav_euler_to_dcm
+ * and nav_kin_euler_rates (value parts of the jets).
+ */
+nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io) {
+  seg_model *m = self;
+  double last[3] = {NAN, NAN, NAN}, sn[3] = {0.0, 0.0, 0.0}, cs[3] = {1.0, 1.0, 1.0};
+  const bool coordinated = m->ch[CH_CYAW].n > 0;
+  for (int i = 0; i < io->n; ++i) {
+    const double t = io->t_s[i];
+    double ang[3], rate[3], vb[3], vbd[3], r1;
+    /* ang/rate: yaw, pitch, roll (channel order). */
+    for (int c = 0; c < 3; ++c)
+      nav_kin_channel_eval_rate(&m->ch[c], t, &m->hint[c], &ang[c], &rate[c], &r1);
+    for (int c = 0; c < 3; ++c)
+      nav_kin_channel_eval_rate(&m->ch[CH_U + c], t, &m->hint[CH_U + c], &vb[c], &vbd[c], &r1);
+    if (coordinated) {
+      /* Bank atan(z), z = u psi_dot_c / g, and its rate z' / (1 + z^2). */
+      double cx, cr, cr1;
+      nav_kin_channel_eval_rate(&m->ch[CH_CYAW], t, &m->hint[CH_CYAW], &cx, &cr, &cr1);
+      if (cr != 0.0 || cr1 != 0.0) {
+        const double gi = 1.0 / m->g_mps2;
+        const double z0 = vb[0] * cr * gi, z1 = (vbd[0] * cr + vb[0] * cr1) * gi;
+        ang[2] += atan(z0);
+        rate[2] += 1.0 / (1.0 + z0 * z0) * z1;
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+      if (!(ang[c] == last[c])) {
+        sn[c] = sin(ang[c]);
+        cs[c] = cos(ang[c]);
+        last[c] = ang[c];
+      }
+    const double sy = sn[0], cy = cs[0], sp = sn[1], cp = cs[1], sr = sn[2], cr = cs[2];
+    const nav_mat3 C = {{{cp * cy, -cr * sy + sr * sp * cy, sr * sy + cr * sp * cy},
+                         {cp * sy, cr * cy + sr * sp * sy, -sr * cy + cr * sp * sy},
+                         {-sp, sr * cp, cr * cp}}};
+    /* numerics.md E3.4: omega_nb_b from the Euler rates (roll, pitch, yaw). */
+    const double dpsi = rate[0], dth = rate[1], dphi = rate[2];
+    const nav_vec3 w = nav_vec3_make(dphi - dpsi * sp, dth * cr + dpsi * (cp * sr), dpsi * (cp * cr) - dth * sr);
+    const nav_vec3 v_b = nav_vec3_make(vb[0], vb[1], vb[2]);
+    const nav_vec3 v_b_dot = nav_vec3_make(vbd[0], vbd[1], vbd[2]);
+    io->C_b_n[i] = C;
+    io->w_nb_b_rps[i] = w;
+    io->v_ned_mps[i] = nav_mat3_mul_vec(C, v_b);
+    io->a_ned_mps2[i] = nav_mat3_mul_vec(C, nav_vec3_add(v_b_dot, nav_vec3_cross(w, v_b)));
+  }
+  io->has_pos = false;
+  return NAV_OK;
+}
+
 static void seg_destroy(void *self) {
   seg_free(self);
 }
@@ -786,6 +842,8 @@ nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_tra
   out->self = m;
   out->eval_local = seg_eval;
   out->destroy = seg_destroy;
+  for (int c = 0; c < CH_N; ++c)
+    m->hint[c] = -1;
   m = NULL;
 cleanup:
   seg_free(m);

@@ -7,13 +7,29 @@
 #include <string.h>
 
 #include "navcore/nav_truth.h"
-#include "traj/traj_internal.h"
+#include "traj/traj_kin_internal.h"
+
+/* Positions of the ideal IMU's position chain are re-anchored to the model's own (exact)
+ * position every CHAIN_BLOCK samples; see chain_positions. */
+#define CHAIN_BLOCK 64
 
 struct nav_traj {
   nav_traj_model m;
   nav_frame frame;
   nav_gravity_model gravity;
   nav_vec3 g_l_mps2; /* flat Earth: uniform gravity in l */
+  double dt_s;       /* IMU interval of the create call (sample grid k dt) */
+  /* Node evaluator of the model for the ideal IMU (traj_kin_internal.h), or NULL. */
+  nav_status (*nodes)(void *self, nav_kin_nodes *io);
+  /* Quadrature rule of the last increment and, for it, A[i][j] = int_{-1}^{x_i} L_j(s) ds (L_j:
+   * Lagrange basis of the nodes), which integrates the velocity from t0 to each node. */
+  int q_n;
+  double q_x[NAV_KIN_MAX_NODES], q_w[NAV_KIN_MAX_NODES];
+  double q_A[NAV_KIN_MAX_NODES][NAV_KIN_MAX_NODES];
+  /* Position chain: R(chain_j) when chain_ok (a cache of a pure function of j). */
+  bool chain_ok;
+  int64_t chain_j;
+  nav_vec3 chain_r;
 };
 
 /* ------------------------------------------------------------------ frames */
@@ -135,12 +151,23 @@ nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **o
   tr->frame = nav_frame_from_scene(scene);
   tr->gravity = scene->earth.gravity_model;
   tr->g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
+  tr->dt_s = dt_s;
   nav_status st = NAV_ERR_INVALID_ARG;
   switch (scene->trajectory.type) {
-  case NAV_TRAJ_PARAMETRIC: st = nav_traj_parametric_create(scene, dt_s, &tr->m, msg, msg_size); break;
+  case NAV_TRAJ_PARAMETRIC:
+    st = nav_traj_parametric_create(scene, dt_s, &tr->m, msg, msg_size);
+    tr->nodes = nav_traj_parametric_nodes;
+    break;
   case NAV_TRAJ_TEST_MOTION: st = nav_traj_test_motion_create(scene, dt_s, &tr->m, msg, msg_size); break;
-  case NAV_TRAJ_WAYPOINTS: st = nav_traj_waypoints_create(scene, dt_s, &tr->m, msg, msg_size); break;
-  case NAV_TRAJ_SEGMENTS: st = nav_traj_segments_create(scene, dt_s, &tr->m, msg, msg_size); break;
+  case NAV_TRAJ_WAYPOINTS:
+    st = nav_traj_waypoints_create(scene, dt_s, &tr->m, msg, msg_size);
+    tr->nodes = nav_traj_waypoints_nodes;
+    break;
+  case NAV_TRAJ_SEGMENTS:
+    st = nav_traj_segments_create(scene, dt_s, &tr->m, msg, msg_size);
+    tr->nodes = nav_traj_segments_nodes;
+    break;
+  case NAV_TRAJ_RECORDED: st = nav_traj_recorded_create(scene, dt_s, &tr->m, msg, msg_size); break;
   default:
     if (msg) snprintf(msg, msg_size, "trajectory type %d is not available", (int)scene->trajectory.type);
     break;
@@ -267,5 +294,228 @@ nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s
   *has_closed_form = false;
   if (traj->frame.model != NAV_EARTH_FLAT || !traj->m.rate_integral) return NAV_OK;
   *has_closed_form = traj->m.rate_integral(traj->m.self, t0_s, t1_s, out);
+  return NAV_OK;
+}
+
+/* ------------------------------------------------------------------ ideal IMU increments */
+
+/* Generic form: nav_traj_inertial at each node. */
+static nav_status increment_by_nodes(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
+                                     const double *w, nav_vec3 *dv, nav_vec3 *dth) {
+  const double half = 0.5 * (t1_s - t0_s), mid = 0.5 * (t1_s + t0_s);
+  nav_vec3 sv = nav_vec3_zero(), st_ = nav_vec3_zero();
+  for (int i = 0; i < n; ++i) {
+    nav_vec3 f_b, w_b;
+    const nav_status st = nav_traj_inertial(traj, mid + half * x[i], &f_b, &w_b);
+    if (st != NAV_OK) return st;
+    const double wgt = w[i] * half;
+    sv = nav_vec3_axpy(sv, wgt, f_b);
+    st_ = nav_vec3_axpy(st_, wgt, w_b);
+  }
+  *dv = sv;
+  *dth = st_;
+  return NAV_OK;
+}
+
+/* Make (x, w) the rule of the position chain: the integration matrix, and a new chain. */
+static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
+  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 && memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
+    return;
+  tr->q_n = n;
+  memcpy(tr->q_x, x, (size_t)n * sizeof *x);
+  memcpy(tr->q_w, w, (size_t)n * sizeof *w);
+  tr->chain_ok = false;
+  /* A[i][j] = int_{-1}^{x_i} L_j: the n-point rule itself mapped onto [-1, x_i] is exact for
+   * the degree n - 1 of L_j (the caller's rule is Gauss-Legendre, exact to degree 2n - 1; any
+   * interpolatory rule with n nodes is exact to degree n - 1). L_j by its product form. */
+  for (int i = 0; i < n; ++i) {
+    const double hl = 0.5 * (x[i] + 1.0);
+    for (int j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (int q = 0; q < n; ++q) {
+        const double s = -1.0 + hl * (1.0 + x[q]);
+        double l = 1.0;
+        for (int m = 0; m < n; ++m)
+          if (m != j) l *= (s - x[m]) / (x[j] - x[m]);
+        sum += w[q] * l;
+      }
+      tr->q_A[i][j] = hl * sum;
+    }
+  }
+}
+
+/* Sample index k with t0 = (k - 1) dt and t1 = k dt exactly, or -1. */
+static int64_t grid_index(const nav_traj *tr, double t0_s, double t1_s) {
+  const double kf = nearbyint(t1_s / tr->dt_s);
+  if (!(kf >= 1.0 && kf < 9.0e15)) return -1;
+  const int64_t k = (int64_t)kf;
+  if ((double)k * tr->dt_s != t1_s || (double)(k - 1) * tr->dt_s != t0_s) return -1;
+  return k;
+}
+
+/* The model's own position (exact: its checkpoint quadrature). */
+static nav_status model_position(nav_traj *tr, double t_s, nav_vec3 *r) {
+  nav_local_kin k;
+  const nav_status st = tr->m.eval_local(tr->m.self, t_s, &k);
+  if (st == NAV_OK) *r = k.r_ned_m;
+  return st;
+}
+
+/* r(t0) + int_t0^t1 v by the rule, from the node velocities of io. */
+static nav_vec3 chain_step(const nav_traj *tr, nav_vec3 r0, const nav_kin_nodes *io, double half) {
+  nav_vec3 s = nav_vec3_zero();
+  for (int j = 0; j < io->n; ++j)
+    s = nav_vec3_axpy(s, tr->q_w[j], io->v_ned_mps[j]);
+  return nav_vec3_axpy(r0, half, s);
+}
+
+/*
+ * Positions at the nodes for models whose position is a quadrature of the velocity (segments,
+ * waypoints): evaluating it at every node would cost eight velocity evaluations each. Only the
+ * WGS-84 gravity and radii use these positions, and they change by 3e-6 m/s^2 per metre of
+ * height, so an error of 1e-9 m would already be below the rounding of f; the chain below is
+ * good to about 1e-10 m.
+ * Sample-grid positions R(j) (t_j = j dt) are a pure function of j, so results never depend on
+ * the order of calls: R(j) is the model's position when j is a multiple of CHAIN_BLOCK, else
+ * R(j - 1) plus the integral of the velocity over the interval by the caller's rule at its nodes
+ * (the velocities the increment evaluates anyway). Within an interval, r_i = R(k - 1) +
+ * half sum_j A[i][j] v_j (the integral of the velocity's interpolant, error ~ h^(n+1) v^(n)).
+ * A sequential run costs one model position per CHAIN_BLOCK samples; a jump re-integrates at most
+ * CHAIN_BLOCK - 1 intervals. Off the grid the model's position at t0 anchors the nodes.
+ */
+static nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
+  nav_vec3 r0;
+  nav_status st = NAV_OK;
+  if (io->k < 1) {
+    st = model_position(tr, io->t0_s, &r0);
+  } else {
+    const int64_t j = io->k - 1;
+    if (tr->chain_ok && tr->chain_j == j) {
+      r0 = tr->chain_r;
+    } else {
+      /* Anchor of the block, or the cached value when it lies between the anchor and j. */
+      int64_t i = j - j % CHAIN_BLOCK;
+      if (tr->chain_ok && tr->chain_j > i && tr->chain_j < j) {
+        i = tr->chain_j;
+        r0 = tr->chain_r;
+      } else {
+        st = model_position(tr, (double)i * tr->dt_s, &r0);
+      }
+      nav_kin_nodes tmp;
+      tmp.n = io->n;
+      tmp.x = io->x;
+      tmp.need_pos = false;
+      for (; st == NAV_OK && i < j; ++i) {
+        tmp.k = i + 1;
+        tmp.t0_s = (double)i * tr->dt_s;
+        tmp.t1_s = (double)(i + 1) * tr->dt_s;
+        const double h = 0.5 * (tmp.t1_s - tmp.t0_s), m = 0.5 * (tmp.t1_s + tmp.t0_s);
+        for (int q = 0; q < io->n; ++q)
+          tmp.t_s[q] = m + h * io->x[q];
+        st = tr->nodes(tr->m.self, &tmp);
+        if (st == NAV_OK) r0 = chain_step(tr, r0, &tmp, h);
+      }
+    }
+    if (st != NAV_OK) return st;
+    /* R(k) for the next interval. */
+    nav_vec3 r1;
+    if (io->k % CHAIN_BLOCK == 0)
+      st = model_position(tr, io->t1_s, &r1);
+    else
+      r1 = chain_step(tr, r0, io, half);
+    if (st != NAV_OK) return st;
+    tr->chain_ok = true;
+    tr->chain_j = io->k;
+    tr->chain_r = r1;
+  }
+  if (st != NAV_OK) return st;
+  for (int i = 0; i < io->n; ++i) {
+    nav_vec3 s = nav_vec3_zero();
+    for (int j = 0; j < io->n; ++j)
+      s = nav_vec3_axpy(s, tr->q_A[i][j], io->v_ned_mps[j]);
+    io->r_ned_m[i] = nav_vec3_axpy(r0, half, s);
+  }
+  io->has_pos = true;
+  return NAV_OK;
+}
+
+/*
+ * WGS-84, NED form (E3.9) at one node, as in nav_traj_inertial with normal gravity, from the
+ * local kinematics and the attitude as a DCM; sin and cos of the latitude are shared by the
+ * radii, the Earth rate and gravity.
+ */
+static void ned_inertial(const nav_traj *tr, nav_vec3 r, nav_vec3 v, nav_vec3 a, const nav_mat3 *C_b_n,
+                         nav_vec3 w_nb_b, nav_vec3 *f_b, nav_vec3 *w_ib_b) {
+  const nav_frame *fr = &tr->frame;
+  const double sy = fr->m_per_rad_lon != 0.0 ? 1.0 / fr->m_per_rad_lon : 0.0;
+  const double lat = fr->origin.lat_rad + r.x / fr->m_per_rad_lat, h = fr->origin.h_m - r.z;
+  const double dlat = v.x / fr->m_per_rad_lat, dlon = v.y * sy, dh = -v.z;
+  const double ddlat = a.x / fr->m_per_rad_lat, ddlon = a.y * sy, ddh = -a.z;
+  const double sl = sin(lat), cl = cos(lat);
+  /* Groves (2.105), (2.106); numerics.md E3.9. */
+  const double den = 1.0 - NAV_WGS84_E2 * sl * sl, sq = sqrt(den);
+  const double RN = NAV_WGS84_A_M / sq, RM = NAV_WGS84_A_M * (1.0 - NAV_WGS84_E2) / (den * sq);
+  const double dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl / den * dlat;
+  const double dRN = NAV_WGS84_E2 * RN * sl * cl / den * dlat;
+  const nav_vec3 v_n = nav_vec3_make((RM + h) * dlat, (RN + h) * cl * dlon, -dh);
+  const nav_vec3 dv_n = nav_vec3_make((dRM + dh) * dlat + (RM + h) * ddlat,
+                                      (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon, -ddh);
+  const nav_vec3 w_en_n = nav_vec3_make(dlon * cl, -dlat, -dlon * sl);
+  const nav_vec3 w_ie_n = nav_vec3_make(NAV_WGS84_OMEGA_IE_RPS * cl, 0.0, -NAV_WGS84_OMEGA_IE_RPS * sl);
+  /* Normal gravity: TR8350.2 (4-1), (4-3); numerics.md E3.10-E3.11. */
+  const double s2 = sl * sl, ea = NAV_WGS84_A_M;
+  const double lin = (2.0 / ea) * (1.0 + NAV_WGS84_F + NAV_WGS84_M - 2.0 * NAV_WGS84_F * s2);
+  const double quad = 3.0 / (ea * ea);
+  const double g = NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) / sq * (1.0 - lin * h + quad * h * h);
+  const nav_vec3 f_n = nav_vec3_sub(
+      nav_vec3_add(dv_n, nav_vec3_cross(nav_vec3_add(nav_vec3_scale(w_ie_n, 2.0), w_en_n), v_n)), nav_vec3_make(0.0, 0.0, g));
+  *f_b = nav_mat3_tmul_vec(*C_b_n, f_n);
+  *w_ib_b = nav_vec3_add(w_nb_b, nav_mat3_tmul_vec(*C_b_n, nav_vec3_add(w_ie_n, w_en_n)));
+}
+
+nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
+                                       const double *w, nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad) {
+  if (!traj || !x || !w || !dv_b_mps || !dtheta_b_rad || n < 1 || n > NAV_KIN_MAX_NODES || !isfinite(t0_s) ||
+      !isfinite(t1_s))
+    return NAV_ERR_INVALID_ARG;
+  const bool flat = traj->frame.model == NAV_EARTH_FLAT;
+  if (!traj->nodes || (!flat && traj->gravity != NAV_GRAVITY_NORMAL))
+    return increment_by_nodes(traj, t0_s, t1_s, n, x, w, dv_b_mps, dtheta_b_rad);
+  for (int i = 1; i < n; ++i)
+    if (!(x[i] > x[i - 1])) return increment_by_nodes(traj, t0_s, t1_s, n, x, w, dv_b_mps, dtheta_b_rad);
+  const double half = 0.5 * (t1_s - t0_s), mid = 0.5 * (t1_s + t0_s);
+  nav_kin_nodes nd;
+  nd.n = n;
+  nd.x = x;
+  nd.t0_s = t0_s;
+  nd.t1_s = t1_s;
+  for (int i = 0; i < n; ++i)
+    nd.t_s[i] = mid + half * x[i];
+  nd.k = grid_index(traj, t0_s, t1_s);
+  nd.need_pos = !flat;
+  nd.has_pos = false;
+  nav_status st = traj->nodes(traj->m.self, &nd);
+  if (st != NAV_OK) return st;
+  if (!flat && !nd.has_pos) {
+    set_rule(traj, n, x, w);
+    st = chain_positions(traj, &nd, half);
+    if (st != NAV_OK) return st;
+  }
+  nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
+  for (int i = 0; i < n; ++i) {
+    nav_vec3 f_b, w_b;
+    if (flat) {
+      /* Flat, non-rotating l with uniform gravity (E3.3). */
+      f_b = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
+      w_b = nd.w_nb_b_rps[i];
+    } else {
+      ned_inertial(traj, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i], nd.w_nb_b_rps[i], &f_b, &w_b);
+    }
+    const double wgt = w[i] * half;
+    dv = nav_vec3_axpy(dv, wgt, f_b);
+    dth = nav_vec3_axpy(dth, wgt, w_b);
+  }
+  *dv_b_mps = dv;
+  *dtheta_b_rad = dth;
   return NAV_OK;
 }

@@ -71,5 +71,8 @@ nav_status nav_traj_waypoints_create(const nav_scene *scene, double dt_s, nav_tr
                                      size_t msg_size);
 nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
                                     size_t msg_size);
+/* Recorded reference (recorded.c): evaluates the fit stored in scene->trajectory.recorded. */
+nav_status nav_traj_recorded_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
+                                    size_t msg_size);
 
 #endif /* NAV_TRAJ_INTERNAL_H */

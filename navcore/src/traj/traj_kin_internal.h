@@ -32,6 +32,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "navcore/nav_math.h"
 #include "navcore/nav_scene.h"
@@ -150,6 +151,10 @@ nav_status nav_kin_channel_add_step(nav_kin_channel *c, double t0_s, double len_
 nav_jet nav_kin_channel_eval(const nav_kin_channel *c, double t_s);
 /** y = int_0^t x and its derivatives (y, x, r, r'). */
 nav_jet nav_kin_channel_eval_integral(const nav_kin_channel *c, double t_s);
+/** x, its rate r and r' at t (the numbers of nav_kin_channel_eval). @p hint caches the step
+ *  index between calls (start with -1); it only saves the search and never changes a result. */
+void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
+                               double *r1);
 /** Rate after the last ramp. */
 double nav_kin_channel_final_rate(const nav_kin_channel *c);
 /** Time the last ramp ends (0 if none). */
@@ -242,5 +247,58 @@ size_t nav_traj_waypoints_breaks(const void *self, double *out, size_t cap);
 size_t nav_traj_segments_boundaries(const void *self, double *out, size_t cap);
 /** Times at which a waypoint model passes its waypoints (count values). */
 size_t nav_traj_waypoints_times(const void *self, double *out, size_t cap);
+
+/* ================================================================ ideal-IMU node evaluation */
+
+/*
+ * The ideal IMU (nav_traj_inertial_increment, traj.c) needs, at the n quadrature nodes of one
+ * sample interval, only the attitude, omega_nb_b, velocity and acceleration of a local model:
+ * no angular acceleration, and the position only on WGS-84 (for gravity and the radii). A model
+ * may provide a node evaluator that computes exactly these for all nodes at once and shares the
+ * work between them (segment lookup, trigonometry of a common anchor). Its numbers equal those
+ * of eval_local at the same times up to rounding (last bits): they are different expressions of
+ * the same analytic functions, never an approximation.
+ */
+#define NAV_KIN_MAX_NODES 16 /* = NAV_GL_MAX_NODES */
+
+typedef struct nav_kin_nodes {
+  /* in */
+  int n;                         /* node count, 1..NAV_KIN_MAX_NODES */
+  const double *x;               /* nodes on [-1, 1], ascending (nav_gauss_legendre) */
+  double t0_s, t1_s;             /* the interval */
+  double t_s[NAV_KIN_MAX_NODES]; /* node times 0.5 (t0 + t1) + 0.5 (t1 - t0) x_i */
+  int64_t k;                     /* t0 = (k - 1) dt and t1 = k dt exactly (dt of the model), else -1 */
+  bool need_pos;                 /* positions are wanted if the model has them cheaply */
+  /* out */
+  bool has_pos;                           /* r_ned_m filled (else the caller integrates v) */
+  nav_vec3 r_ned_m[NAV_KIN_MAX_NODES];    /* as nav_local_kin */
+  nav_vec3 v_ned_mps[NAV_KIN_MAX_NODES];  /* as nav_local_kin */
+  nav_vec3 a_ned_mps2[NAV_KIN_MAX_NODES]; /* as nav_local_kin */
+  nav_vec3 w_nb_b_rps[NAV_KIN_MAX_NODES]; /* as nav_local_kin */
+  nav_mat3 C_b_n[NAV_KIN_MAX_NODES];      /* the attitude q_b_n of nav_local_kin as a DCM */
+} nav_kin_nodes;
+
+/** Node evaluators of the models (self as created by the matching nav_traj_*_create). */
+nav_status nav_traj_parametric_nodes(void *self, nav_kin_nodes *io);
+nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io);
+nav_status nav_traj_waypoints_nodes(void *self, nav_kin_nodes *io);
+
+/** Largest |d| for nav_kin_sincos_near. */
+#define NAV_KIN_NEAR_RAD 0.05
+
+/**
+ * sin and cos of a0 + d from s0 = sin a0 and c0 = cos a0, for |d| <= NAV_KIN_NEAR_RAD: angle
+ * addition with sin d and cos d - 1 by their Taylor series through d^11 and d^12 (truncation
+ * below d^13 / 13! = 2e-27 at the bound, far under rounding), added as small corrections so
+ * that the result is as accurate as a direct sin/cos (about one ulp).
+ */
+static inline void nav_kin_sincos_near(double s0, double c0, double d, double *s, double *c) {
+  const double d2 = d * d;
+  const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0 * (1.0 - d2 / 110.0)))));
+  const double cm1 =
+      -0.5 * d2 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0 * (1.0 - d2 / 90.0 * (1.0 - d2 / 132.0)))));
+  *s = s0 + (c0 * sd + s0 * cm1);
+  *c = c0 + (c0 * cm1 - s0 * sd);
+}
 
 #endif /* NAV_TRAJ_KIN_INTERNAL_H */

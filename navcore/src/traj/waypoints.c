@@ -552,7 +552,7 @@ static double wp_step(void *self, double ta, double tb) {
   return w > 1.0 ? 0.5 / w : 0.5;
 }
 
-static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
+static nav_status wp_kin(void *self, double t_s, nav_local_kin *out, bool with_pos) {
   const wp_model *m = self;
   const wp_piece *p = find_piece(m, t_s);
   nav_jet T[3];
@@ -589,8 +589,28 @@ static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
   const nav_euler e = {roll.d[0], pitch.d[0], yaw.d[0]};
   k.q_b_n = nav_euler_to_quat(e);
   nav_kin_euler_rates(roll, pitch, yaw, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
-  k.r_ned_m = nav_kin_path_eval(&m->path, t_s);
+  k.r_ned_m = with_pos ? nav_kin_path_eval(&m->path, t_s) : nav_vec3_zero();
   *out = k;
+  return NAV_OK;
+}
+
+static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
+  return wp_kin(self, t_s, out, true);
+}
+
+/* Ideal-IMU nodes: wp_eval without the position (the caller integrates the velocity), with
+ * the attitude as a DCM. */
+nav_status nav_traj_waypoints_nodes(void *self, nav_kin_nodes *io) {
+  for (int i = 0; i < io->n; ++i) {
+    nav_local_kin k;
+    const nav_status st = wp_kin(self, io->t_s[i], &k, false);
+    if (st != NAV_OK) return st;
+    io->C_b_n[i] = nav_quat_to_dcm(k.q_b_n);
+    io->w_nb_b_rps[i] = k.w_nb_b_rps;
+    io->v_ned_mps[i] = k.v_ned_mps;
+    io->a_ned_mps2[i] = k.a_ned_mps2;
+  }
+  io->has_pos = false;
   return NAV_OK;
 }
 

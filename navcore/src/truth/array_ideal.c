@@ -1,5 +1,6 @@
 /*
- * Exact ideal accelerometer-array increments from the reference trajectory (numerics.md 1.5,
+ * Accelerometer-array layouts (the nine- and twelve-sensor ones and the scene's; the cube is in
+ * analytic.c) and exact ideal array increments from the reference trajectory (numerics.md 1.5,
  * E1.22, with the integration rules of section 3.1).
  *
  * Each sensor i reads A_i = n_i . (f + omega_dot x r_i + omega x (omega x r_i)) (body axes,
@@ -21,6 +22,72 @@
 #include "navcore/nav_array.h"
 #include "navcore/nav_earth.h"
 #include "navcore/nav_truth.h"
+
+/* ------------------------------------------------------------------ layouts */
+
+/* A layout from tables of r_i / r and n_i / n_scale (n_scale makes the axes unit vectors: 1 for
+ * coordinate axes, sqrt(1/2) for face diagonals, as nav_array_cube_layout() computes them, so the
+ * twelve-sensor layout's first six sensors equal the cube's bit for bit). The geometry and the
+ * kappa of each layout are derived in nav_array.h. */
+static nav_status layout_from_table(double r_m, int n, const double (*k_r)[3], const double (*k_n)[3],
+                                    double n_scale, nav_accel_array *out) {
+  if (!out || !isfinite(r_m) || !(r_m > 0.0)) return NAV_ERR_INVALID_ARG;
+  nav_accel_array a;
+  memset(&a, 0, sizeof a);
+  a.n_sensors = n;
+  for (int i = 0; i < n; ++i) {
+    a.r_bs_b_m[i] = nav_vec3_make(r_m * k_r[i][0], r_m * k_r[i][1], r_m * k_r[i][2]);
+    a.n_s_b[i] = nav_vec3_make(n_scale * k_n[i][0], n_scale * k_n[i][1], n_scale * k_n[i][2]);
+  }
+  *out = a;
+  return NAV_OK;
+}
+
+nav_status nav_array_nine_layout(double r_m, nav_accel_array *out) {
+  /* Padgaonkar 3-2-2-2: a triad at O, then two sensors across each positive axis. */
+  static const double k_r[9][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1, 0, 0}, {1, 0, 0},
+                                   {0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}};
+  static const double k_n[9][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 1, 0}, {0, 0, 1},
+                                   {1, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+  return layout_from_table(r_m, 9, k_r, k_n, 1.0, out);
+}
+
+nav_status nav_array_twelve_layout(double r_m, nav_accel_array *out) {
+  /* The cube (numerics.md 1.5 table), then the other diagonal of each face. */
+  static const double k_r[12][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+                                    {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const double k_n[12][3] = {{0, 1, 1},  {0, 1, -1}, {1, 0, 1},  {-1, 0, 1}, {1, 1, 0},  {1, -1, 0},
+                                    {0, 1, -1}, {0, 1, 1},  {1, 0, -1}, {1, 0, 1},  {1, -1, 0}, {1, 1, 0}};
+  return layout_from_table(r_m, 12, k_r, k_n, sqrt(0.5), out);
+}
+
+nav_status nav_array_layout_from_scene(const nav_scene_array *sa, nav_accel_array *out) {
+  if (!sa || !out) return NAV_ERR_INVALID_ARG;
+  switch (sa->layout) {
+  case NAV_ARRAY_LAYOUT_CUBE6: return nav_array_cube_layout(sa->radius_m, out);
+  case NAV_ARRAY_LAYOUT_NINE: return nav_array_nine_layout(sa->radius_m, out);
+  case NAV_ARRAY_LAYOUT_TWELVE: return nav_array_twelve_layout(sa->radius_m, out);
+  case NAV_ARRAY_LAYOUT_CUSTOM: break;
+  default: return NAV_ERR_INVALID_ARG;
+  }
+  if (sa->custom_count < NAV_ARRAY_MIN_SENSORS || sa->custom_count > NAV_ARRAY_MAX_SENSORS)
+    return NAV_ERR_INVALID_ARG;
+  nav_accel_array a;
+  memset(&a, 0, sizeof a);
+  a.n_sensors = sa->custom_count;
+  for (int i = 0; i < a.n_sensors; ++i) {
+    const nav_scene_array_sensor *c = &sa->custom[i];
+    const double nn = nav_vec3_norm(c->n_s_b);
+    if (!nav_vec3_isfinite(c->r_bs_b_m) || !nav_vec3_isfinite(c->n_s_b) || !(nn > 0.0) || !isfinite(nn))
+      return NAV_ERR_INVALID_ARG;
+    a.r_bs_b_m[i] = c->r_bs_b_m;
+    a.n_s_b[i] = nav_vec3_scale(c->n_s_b, 1.0 / nn);
+  }
+  *out = a;
+  return NAV_OK;
+}
+
+/* ------------------------------------------------------------------ ideal increments */
 
 struct nav_array_truth {
   nav_traj *traj;

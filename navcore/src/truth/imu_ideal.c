@@ -117,7 +117,6 @@ nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out) {
 nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (!truth || !out || k < 1) return NAV_ERR_INVALID_ARG;
   const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
-  const double half = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
   nav_imu_increment r;
   r.k = k;
   r.t_s = t1;
@@ -125,15 +124,10 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   bool closed = false;
   nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
   if (st != NAV_OK) return st;
-  nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
-  for (int i = 0; i < truth->n_nodes; ++i) {
-    nav_vec3 f_b, w_b;
-    st = nav_traj_inertial(truth->traj, mid + half * truth->nodes[i], &f_b, &w_b);
-    if (st != NAV_OK) return st;
-    const double wgt = truth->weights[i] * half;
-    dv = nav_vec3_axpy(dv, wgt, f_b);
-    dth = nav_vec3_axpy(dth, wgt, w_b);
-  }
+  /* Gauss-Legendre over the interval, all nodes at once (nav_traj_inertial_increment). */
+  nav_vec3 dv, dth;
+  st = nav_traj_inertial_increment(truth->traj, t0, t1, truth->n_nodes, truth->nodes, truth->weights, &dv, &dth);
+  if (st != NAV_OK) return st;
   if (!closed) r.dtheta_b_rad = dth;
   r.dv_b_mps = dv;
   *out = r;
