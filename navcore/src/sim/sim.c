@@ -569,12 +569,12 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   atomic_init(&j.next_run, 1);
   atomic_init(&j.runs_done, 0);
 
-  /* Run 0 on this thread (records, progress), then the rest on the workers and this thread. */
-  st = run_one(&j, 0, true);
-  if (st == NAV_OK && j.runs > 1) {
+  /* Workers start first and take runs 1..N-1; run 0 runs on this thread (records, progress),
+   * then this thread joins the pool. */
+  if (j.runs > 1) {
     int nthreads = opts->threads > 0 ? opts->threads : 1;
     if (nthreads > 256) nthreads = 256;
-    if ((long)nthreads > j.runs - 1) nthreads = (int)(j.runs - 1);
+    if ((long)nthreads > j.runs) nthreads = (int)j.runs;
     threads = calloc((size_t)nthreads, sizeof *threads);
     calls = calloc((size_t)nthreads, sizeof *calls);
     if (!threads || !calls) {
@@ -585,6 +585,10 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       if (!nav_thread_start(&threads[t], &calls[t], worker, &j)) break;
       ++started;
     }
+  }
+  st = run_one(&j, 0, true);
+  if (st != NAV_OK) atomic_store(&sim->cancel, true);
+  if (j.runs > 1) {
     /* This thread works too, reporting progress between runs. */
     for (;;) {
       const long run = atomic_fetch_add(&j.next_run, 1);
