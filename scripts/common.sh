@@ -6,6 +6,7 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
+  libvtk9-dev fonts-dejavu-core
   xvfb xauth
 )
 
@@ -37,7 +38,8 @@ nav_ensure_packages() {
 nav_build() {
   if [ ! -f "$NAV_BUILD/build.ninja" ]; then
     nav_log "configuring $NAV_BUILD"
-    cmake -S "$NAV_ROOT" -B "$NAV_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNAV_WERROR=ON "$@" >/dev/null
+    cmake -S "$NAV_ROOT" -B "$NAV_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNAV_WERROR=ON \
+      -DNAV_BUILD_VIEWER=ON "$@" >/dev/null
   fi
   cmake --build "$NAV_BUILD" -- -j"$(nproc)" >&2
 }

@@ -35,6 +35,7 @@ static const char *k_usage =
     "  estimate SCENE   preliminary estimate: closed-form error growth and covariance analysis\n"
     "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
     "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
+    "  render DIR       headless images of a result directory: 3D view and error charts (navview)\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
     "  allan            Allan-deviation check of a catalog part or scene IMU against its spec\n"
@@ -446,6 +447,63 @@ cleanup:
   return rc;
 }
 
+static const char *k_usage_render =
+    "usage: navsim render RESULT_DIR [--png FILE] [--chart FILE] [navview options]\n"
+    "\n"
+    "Render a result directory of navsim run with the VTK viewer (navview): --png writes the 3D\n"
+    "view (reference and estimated paths, attitude triads, error tube), --chart the error charts.\n"
+    "Defaults: RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
+    "(navview --help). Rendering needs an X server: without DISPLAY it runs under xvfb-run.\n"
+    "\n"
+    "exit codes: those of navview: 0 success, 2 bad options, 1 unreadable result directory or other failure\n";
+
+/* Run navview (built with the viewer, or on PATH) on a result directory, under xvfb-run when
+ * there is no display. navsim stays free of VTK: the viewer is a separate program. */
+static int cmd_render(int argc, char **argv) {
+  if (argc < 1 || is_help(argv[0])) {
+    fputs(k_usage_render, argc < 1 ? stderr : stdout);
+    return argc < 1 ? EXIT_INVALID : EXIT_OK;
+  }
+#ifdef NAVVIEW_EXE
+  const char *viewer = NAVVIEW_EXE;
+#else
+  const char *viewer = "navview";
+#endif
+  char png[4200], chart[4200];
+  bool has_png = false, has_chart = false;
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--png") == 0) has_png = true;
+    if (strcmp(argv[i], "--chart") == 0) has_chart = true;
+  }
+  snprintf(png, sizeof png, "%s/view.png", argv[0]);
+  snprintf(chart, sizeof chart, "%s/errors.png", argv[0]);
+  char **args = calloc((size_t)argc + 10, sizeof *args);
+  if (!args) return EXIT_FAIL;
+  int n = 0;
+  const bool need_x = getenv("DISPLAY") == NULL || getenv("DISPLAY")[0] == '\0';
+  if (need_x) {
+    args[n++] = "xvfb-run";
+    args[n++] = "-a";
+    args[n++] = "-s";
+    args[n++] = "-screen 0 1280x1024x24";
+  }
+  args[n++] = (char *)viewer;
+  for (int i = 0; i < argc; ++i) args[n++] = argv[i];
+  if (!has_png && !has_chart) {
+    args[n++] = "--png";
+    args[n++] = png;
+    args[n++] = "--chart";
+    args[n++] = chart;
+  }
+  args[n] = NULL;
+  fflush(stdout);
+  execvp(args[0], args);
+  fprintf(stderr, "navsim render: cannot start %s: %s%s\n", args[0], strerror(errno),
+          need_x ? " (no DISPLAY: xvfb-run is needed)" : "");
+  free(args);
+  return EXIT_FAIL;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     fputs(k_usage, stderr);
@@ -464,6 +522,7 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(cmd, "estimate") == 0) return navsim_estimate(argc - 2, argv + 2);
   if (strcmp(cmd, "replay") == 0) return navsim_replay(argc - 2, argv + 2);
+  if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
   if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
   if (strcmp(cmd, "allan") == 0) return navsim_allan(argc - 2, argv + 2);
   if (strcmp(cmd, "catalog") == 0) {

@@ -468,6 +468,32 @@ static void test_allan_catalog_part(void **state) {
   assert_matches(buf, "\"pass\": false\n}");
 }
 
+/* navsim render (viewer built): both PNGs of a result directory appear and are real images. */
+static void test_render(void **state) {
+  (void)state;
+#ifdef NAV_HAVE_VIEWER
+  assert_int_equal(navsim(NULL, "run '" SCENE "' --out rend --quiet --ideal")->code, 0);
+  result *r = navsim(NULL, "render rend --size 320x240");
+  if (r->code != 0) fail_msg("navsim render failed (%d): %s", r->code, r->err);
+  const char *pngs[2] = {WORK "/rend/view.png", WORK "/rend/errors.png"};
+  for (int i = 0; i < 2; ++i) {
+    FILE *f = fopen(pngs[i], "rb");
+    if (!f) fail_msg("missing %s", pngs[i]);
+    unsigned char sig[8] = {0};
+    assert_int_equal(fread(sig, 1, 8, f), 8);
+    fseek(f, 0, SEEK_END);
+    const long size = ftell(f);
+    fclose(f);
+    assert_memory_equal(sig, "\x89PNG\r\n\x1a\n", 8);
+    assert_true(size > 2000);
+  }
+  /* A missing result directory cannot be read: exit 1, as navsim check on a missing file. */
+  assert_int_equal(navsim(NULL, "render does-not-exist")->code, 1);
+#else
+  skip();
+#endif
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_version_and_help),
@@ -480,6 +506,7 @@ int main(void) {
       cmocka_unit_test(test_default_out_dir_and_summary_on_terminal),
       cmocka_unit_test(test_deterministic_and_atomic_replace),
       cmocka_unit_test(test_monte_carlo_outputs),
+      cmocka_unit_test(test_render),
       cmocka_unit_test(test_run_imu_errors),
       cmocka_unit_test(test_estimate_e121),
       cmocka_unit_test(test_allan_catalog_part),

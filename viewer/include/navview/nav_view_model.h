@@ -1,0 +1,142 @@
+/**
+ * @file nav_view_model.h
+ * @brief The 3D scene as plain data: decimated paths, triads, envelope tube, grid, all in the
+ *        render frame r (nav_view_frame.h). No VTK types; NavSceneView turns it into actors.
+ *
+ * Keeping the geometry out of VTK makes it testable without a display: the envelope radii, the
+ * triad orientations and the decimation error are checked by unit tests.
+ */
+#ifndef NAV_VIEW_MODEL_H
+#define NAV_VIEW_MODEL_H
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "navview/nav_view_result.h"
+
+/** Where the radius of the error-envelope tube comes from. */
+enum class NavEnvelopeSource {
+  Auto,       /**< Monte Carlo RMS when mc_stats.csv is present, else run 0 errors */
+  RunErrors,  /**< k * horizontal error of run 0 (errors.csv) */
+  MonteCarlo, /**< k * RMS over runs of the horizontal error (mc_stats.csv) */
+  None        /**< no tube */
+};
+
+/** Camera presets of the 3D view. */
+enum class NavCameraPreset {
+  Oblique, /**< from the south-south-west, 50 deg above the horizon, perspective */
+  Top      /**< plan view, north up, parallel projection */
+};
+
+/** Options of the 3D view. Defaults give the "default view" of the issue. */
+struct NavViewOptions {
+  int width_px = 1000;
+  int height_px = 700;
+  /** Playback time [s] of the vehicle glyph and the read-out; NaN: end of the run. */
+  double time_s = NAN;
+  /** Attitude-error exaggeration k: the estimated triad shows exp(k*phi) C_b_n(truth), where
+   *  phi is the rotation vector of C_b_n(nav) C_b_n(truth)^T; k = 1 shows the true estimate. */
+  double att_exaggeration = 1.0;
+  /** Envelope tube radius = envelope_k * sigma_h [m]. */
+  double envelope_k = 3.0;
+  NavEnvelopeSource envelope_source = NavEnvelopeSource::Auto;
+  /** Interval between triads [s]; <= 0: automatic (about 24 along the run). */
+  double triad_interval_s = 0.0;
+  /** Triad arrow length [m]; <= 0: automatic (from the scene extent). */
+  double triad_size_m = 0.0;
+  /** Colour the estimated path by horizontal error magnitude (with a scalar bar). */
+  bool color_by_error = false;
+  /** Draw text (title, read-out, legend, scale label, axis letters, scalar-bar labels). Render
+   *  tests switch it off: no system-font text in compared images (style.md section 10). */
+  bool show_text = true;
+  bool show_grid = true;
+  bool show_axes = true;
+  bool show_triads = true;
+  bool show_vehicle = true;
+  /** Screen-space decimation tolerance [pixels]. */
+  double decimate_px = 0.5;
+  NavCameraPreset camera = NavCameraPreset::Oblique;
+  /** Explicit camera (render frame r) instead of the preset, for render tests. */
+  bool fixed_camera = false;
+  double camera_position_r[3] = {0, 0, 1};
+  double camera_focal_r[3] = {0, 0, 0};
+  double camera_view_up_r[3] = {0, 1, 0};
+  double camera_view_angle_deg = 30.0;
+  /** Multisample anti-aliasing samples (0: off). */
+  int multisamples = 8;
+};
+
+/** A decimated polyline in the render frame. */
+struct NavPolyline {
+  std::vector<double> xyz_r;        /**< 3 per kept point [m] */
+  std::vector<double> scalar;       /**< optional per-point scalar (error magnitude [m]) */
+  std::vector<size_t> source_index; /**< epoch index of each kept point in the full track */
+  size_t Size() const { return xyz_r.size() / 3; }
+};
+
+/** Attitude triads: one per time, positions and body-to-render quaternions. */
+struct NavTriadSet {
+  std::vector<double> t_s;
+  std::vector<double> xyz_r; /**< 3 per triad [m] */
+  std::vector<double> q_b_r; /**< 4 per triad {w, x, y, z} */
+  size_t Size() const { return t_s.size(); }
+};
+
+/** Error-envelope tube around the reference path. */
+struct NavTube {
+  std::vector<double> xyz_r;    /**< 3 per kept point [m] */
+  std::vector<double> radius_m; /**< tube radius per kept point [m] */
+  std::vector<double> sigma_m;  /**< the sigma fed in per kept point [m] (radius = k * sigma) */
+  std::vector<size_t> source_index;
+  size_t Size() const { return radius_m.size(); }
+};
+
+/** The whole 3D scene as data. */
+struct NavSceneModel {
+  NavPolyline reference;
+  NavPolyline estimate;
+  std::vector<NavPolyline> extra_runs;
+  NavTriadSet triads_ref;
+  NavTriadSet triads_est;
+  NavTube envelope;
+  std::string envelope_label;              /**< legend text of the tube, empty when there is none */
+  double error_max_m = 0.0;                /**< colour range of the estimate [0, error_max_m] */
+  double bounds_r[6] = {0, 0, 0, 0, 0, 0}; /**< xmin xmax ymin ymax zmin zmax of all paths [m] */
+  double ground_z_r = 0.0;                 /**< z of the ground grid [m] */
+  double grid_spacing_m = 1.0;
+  double grid_r[4] = {0, 0, 0, 0}; /**< xmin xmax ymin ymax of the grid [m] */
+  double triad_size_m = 1.0;
+  double triad_interval_s = 1.0;
+  double t_begin_s = 0.0, t_end_s = 0.0;
+  double decimation_tol_m = 0.0;
+  size_t full_points = 0; /**< epochs of all drawn paths before decimation */
+};
+
+/** Bounds {xmin xmax ymin ymax zmin zmax} in frame r of the reference, estimate and extra runs. */
+void NavResultBoundsRender(const NavResult &result, double bounds_r[6]);
+
+/** The "nice" grid spacing (1, 2 or 5 times a power of ten) giving at most about 12 cells
+ *  across @p extent_m. */
+double NavNiceGridSpacing(double extent_m);
+
+/** Sample @p track at time @p t: position in frame r (linear interpolation) and, when the track
+ *  has attitude, C_b_n as a row-major 3x3 (interpolated along the geodesic between epochs).
+ *  @return false when the track is empty. */
+bool NavTrackSample(const NavTrack &track, double t, double pos_r[3], double c_b_n[9]);
+
+/**
+ * Build the scene model of @p result.
+ * @param[in]  result    the loaded result
+ * @param[in]  options   view options (triads, envelope, colouring, exaggeration)
+ * @param[in]  tol_m     decimation tolerance [m] (from the screen-space tolerance and the view);
+ *                       negative: layout only (bounds, grid, triad size and interval, times),
+ *                       no paths, tube or triads
+ * @param[out] model     the scene
+ * @param[out] error     message on failure (empty truth, no attitude...)
+ * @return true on success.
+ */
+bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &options, double tol_m,
+                        NavSceneModel *model, std::string *error);
+
+#endif /* NAV_VIEW_MODEL_H */

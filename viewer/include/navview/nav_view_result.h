@@ -1,0 +1,114 @@
+/**
+ * @file nav_view_result.h
+ * @brief Loading a navsim result directory (truth.csv, nav.csv, errors.csv, mc_stats.csv,
+ *        summary.json) into plain C++ containers. No VTK types (style.md section 2).
+ *
+ * Units: the files carry degrees in their `_deg` columns (I/O edge); everything stored here is
+ * SI (`_rad`, `_m`, `_s`). Positions are in the scene-fixed NED frame `l` (origin at the scene
+ * origin), attitudes are ZYX Euler angles of C_b_n.
+ *
+ * Errors are reported as "FILE:LINE: error: MESSAGE" (LINE is 1-based; the header is line 1),
+ * the same shape as `navsim check`. Nothing here throws or aborts on bad input.
+ */
+#ifndef NAV_VIEW_RESULT_H
+#define NAV_VIEW_RESULT_H
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+/** A parsed numeric CSV table: one header line of column names, then rows of numbers. */
+struct NavCsvTable {
+  std::vector<std::string> columns; /**< column names, in file order */
+  std::vector<double> values;       /**< row-major, rows * columns.size() values */
+  std::vector<int> line_of_row;     /**< 1-based file line of each row (for messages) */
+  size_t rows = 0;
+
+  /** Index of column @p name, or -1 when absent. */
+  int Column(const std::string &name) const;
+  /** Value of row @p row, column @p col (no bounds check). */
+  double At(size_t row, int col) const { return values[row * columns.size() + static_cast<size_t>(col)]; }
+};
+
+/**
+ * Parse CSV text with a header line. Every data field must be a finite decimal number; blank
+ * lines are ignored, CR-LF line ends are accepted.
+ * @param[in]  text          the whole file content
+ * @param[in]  display_name  file name used in error messages
+ * @param[out] out           the table (left untouched on failure)
+ * @param[out] error         "display_name:LINE: error: ..." on failure
+ * @return true on success.
+ */
+bool NavCsvParse(const std::string &text, const std::string &display_name, NavCsvTable *out,
+                 std::string *error);
+
+/** Read and parse a CSV file (NavCsvParse on its content); I/O errors name the file. */
+bool NavCsvReadFile(const std::string &path, NavCsvTable *out, std::string *error);
+
+/** A state history at the output rate (truth.csv or nav.csv), SI units. */
+struct NavTrack {
+  std::vector<double> t_s;       /**< epoch times [s], non-decreasing */
+  std::vector<double> pos_ned_m; /**< 3 per epoch: north, east, down in frame l [m] */
+  std::vector<double> euler_rad; /**< 3 per epoch: roll, pitch, yaw of C_b_n [rad]; may be empty */
+  size_t Size() const { return t_s.size(); }
+  bool HasAttitude() const { return !euler_rad.empty(); }
+};
+
+/** errors.csv of run 0 (navigation minus reference), SI units. Empty when absent. */
+struct NavErrorSeries {
+  std::vector<double> t_s;
+  std::vector<double> pos_err_ned_m; /**< 3 per epoch [m] */
+  std::vector<double> pos_err_h_m;   /**< horizontal error magnitude [m] */
+  std::vector<double> pos_err_v_m;   /**< vertical error magnitude [m] */
+  std::vector<double> att_err_rad;   /**< attitude error angle [rad] */
+  std::vector<double> euler_err_rad; /**< 3 per epoch: roll, pitch, yaw error [rad] */
+  size_t Size() const { return t_s.size(); }
+};
+
+/** mc_stats.csv: per-epoch statistics over the Monte Carlo runs, SI units. Empty when absent. */
+struct NavEnvelope {
+  std::vector<double> t_s;
+  std::vector<double> pos_rms_ned_m; /**< 3 per epoch: RMS over runs of the N, E, D errors [m] */
+  std::vector<double> pos_h_rms_m;   /**< RMS over runs of the horizontal error [m] */
+  std::vector<double> att_rms_rad;   /**< RMS over runs of the attitude error [rad]; may be empty */
+  size_t Size() const { return t_s.size(); }
+};
+
+/** Everything the viewer shows of one result. */
+struct NavResult {
+  std::string dir;        /**< the result directory (empty for in-memory results) */
+  std::string scene_name; /**< from summary.json, else the directory name */
+  int runs = 1;           /**< Monte Carlo runs (summary.json) */
+  NavTrack truth;         /**< reference (truth.csv) */
+  NavTrack nav;           /**< estimate of run 0 (nav.csv) */
+  /** Further estimated paths (e.g. a handful of Monte Carlo runs), positions only; in-memory
+   *  results may fill it, navsim result directories do not carry them yet. */
+  std::vector<NavTrack> extra_runs;
+  NavErrorSeries errors;          /**< errors.csv (run 0) */
+  NavEnvelope envelope;           /**< mc_stats.csv */
+  std::vector<std::string> notes; /**< non-fatal remarks (missing optional files) */
+};
+
+/**
+ * Load a result directory written by `navsim run`.
+ * truth.csv and nav.csv are required (t_s, pos_n_m, pos_e_m, pos_d_m, roll_deg, pitch_deg,
+ * yaw_deg); errors.csv, mc_stats.csv and summary.json are optional (a note is recorded).
+ * @param[in]  dir    the directory
+ * @param[out] out    the result (left untouched on failure)
+ * @param[out] error  "FILE:LINE: error: ..." or "DIR: error: ..." on failure
+ * @return true on success.
+ */
+bool NavLoadResultDir(const std::string &dir, NavResult *out, std::string *error);
+
+/**
+ * Index of the last epoch with t_s[i] <= t (0 when t precedes the first epoch, Size()-1 when it
+ * follows the last), by binary search. @p t_s must be non-empty and non-decreasing.
+ */
+size_t NavTimeIndex(const std::vector<double> &t_s, double t);
+
+/** Linear interpolation of a per-epoch series (@p stride values per epoch, component @p comp)
+ *  at time @p t, clamped to the ends. Returns NaN for an empty series. */
+double NavInterpolate(const std::vector<double> &t_s, const std::vector<double> &v, int stride, int comp,
+                      double t);
+
+#endif /* NAV_VIEW_RESULT_H */

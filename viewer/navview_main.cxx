@@ -1,0 +1,338 @@
+// navview: render a navsim result directory (3D view and error charts) headless to PNG, or open
+// it interactively. A thin front end over libnavview.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "navcore/nav_version.h"
+#include "navview/navview.h"
+
+namespace {
+
+void Usage(FILE *f) {
+  std::fprintf(f,
+               "usage: navview RESULT_DIR [--png FILE] [--chart FILE] [--size WxH] [--time T]\n"
+               "               [--exaggerate K] [options]\n"
+               "       navview --bench [--bench-epochs N] [--bench-paths M] [--size WxH]\n"
+               "\n"
+               "Show the result directory written by `navsim run`: reference and estimated paths,\n"
+               "attitude triads, the error-envelope tube, ground grid with scale, NED axes and legend.\n"
+               "With --png and/or --chart it renders headless and exits; with neither it opens an\n"
+               "interactive window (needs a display). Rendering always needs an X server: run headless\n"
+               "jobs under xvfb-run -a.\n"
+               "\n"
+               "options:\n"
+               "  --png FILE          write the 3D view as PNG\n"
+               "  --chart FILE        write the error-vs-time charts as PNG\n"
+               "  --size WxH          image/window size in pixels (default 1000x700; charts 900x800)\n"
+               "  --time T            playback time of the vehicle glyph and read-out [s] (default: end)\n"
+               "  --exaggerate K      attitude-error exaggeration of the estimated triads (default 1)\n"
+               "  --envelope-k K      tube radius = K x sigma_h (default 3)\n"
+               "  --envelope SRC      auto | run | mc | none (default auto: mc when mc_stats.csv exists)\n"
+               "  --triad-interval S  seconds between triads (default: about 24 along the run)\n"
+               "  --triad-size M      triad arrow length [m] (default: from the scene extent)\n"
+               "  --color-by-error    colour the estimated path by horizontal error (with a scalar bar)\n"
+               "  --view NAME         oblique | top (default oblique)\n"
+               "  --no-text           no labels, legend or read-out\n"
+               "  --msaa N            multisample anti-aliasing samples, 0 = off (default: 8 for PNG,\n"
+               "                      0 for the interactive window and --bench)\n"
+               "  --decimate-px PX    screen-space decimation tolerance in pixels (default 0.5)\n"
+               "  --bench [FRAMES]    measure frames per second of the default view (offscreen); without\n"
+               "                      RESULT_DIR on a synthetic one-hour, 200 Hz case with 20 paths\n"
+               "  --bench-epochs N    epochs of the synthetic case (default 720000)\n"
+               "  --bench-paths M     estimated paths of the synthetic case (default 20)\n"
+               "  --version, -h/--help\n"
+               "\n"
+               "interactive keys: space play/pause, f camera follow, c colour by error, +/- exaggeration,\n"
+               "p pick the path under the mouse, r reset camera, q quit; drag the time slider.\n"
+               "\n"
+               "exit codes: 0 success; 2 invalid command line; 1 other failure (input, display, output)\n");
+}
+
+bool ParseDouble(const char *s, double *out) {
+  char *end = nullptr;
+  const double v = std::strtod(s, &end);
+  if (end == s || *end != '\0' || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+bool ParseSize(const char *s, int *w, int *h) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(s, "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X')) return false;
+  if (a < 16 || b < 16 || a > 8192 || b > 8192) return false;
+  *w = a;
+  *h = b;
+  return true;
+}
+
+// Synthetic one-hour drive for the benchmark: a smooth wandering loop of about 50 km, run 0 with
+// a random-walk position error and attitude error, and further runs with their own random walks.
+std::shared_ptr<NavResult> SyntheticResult(size_t epochs, int paths) {
+  auto r = std::make_shared<NavResult>();
+  r->scene_name = "synthetic bench";
+  r->runs = paths;
+  const double dt = 1.0 / 200.0, pi = 3.14159265358979323846;
+  auto truth_at = [&](double t, double ned[3], double *yaw) {
+    const double w1 = 2 * pi / 3600.0, w2 = 2 * pi / 300.0, w3 = 2 * pi / 1800.0;
+    ned[0] = 6000.0 * std::sin(w1 * t) + 700.0 * std::sin(w2 * t);
+    ned[1] = 4000.0 * std::sin(w3 * t) + 700.0 * std::cos(w2 * t);
+    ned[2] = -20.0 * std::sin(w3 * t);
+    const double vn = 6000.0 * w1 * std::cos(w1 * t) + 700.0 * w2 * std::cos(w2 * t);
+    const double ve = 4000.0 * w3 * std::cos(w3 * t) - 700.0 * w2 * std::sin(w2 * t);
+    *yaw = std::atan2(ve, vn);
+  };
+  std::mt19937_64 rng(42);
+  std::normal_distribution<double> g(0.0, 1.0);
+  NavTrack &tr = r->truth;
+  NavTrack &nv = r->nav;
+  tr.t_s.resize(epochs);
+  tr.pos_ned_m.resize(3 * epochs);
+  tr.euler_rad.resize(3 * epochs);
+  nv = tr;
+  NavErrorSeries &er = r->errors;
+  er.t_s.resize(epochs);
+  er.pos_err_ned_m.resize(3 * epochs);
+  er.pos_err_h_m.resize(epochs);
+  er.pos_err_v_m.resize(epochs);
+  er.att_err_rad.resize(epochs);
+  er.euler_err_rad.resize(3 * epochs);
+  NavEnvelope &en = r->envelope;
+  en.t_s.resize(epochs);
+  en.pos_rms_ned_m.resize(3 * epochs);
+  en.pos_h_rms_m.resize(epochs);
+  en.att_rms_rad.resize(epochs);
+  double walk[3] = {0, 0, 0}, att[3] = {0, 0, 0};
+  for (size_t i = 0; i < epochs; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    double ned[3], yaw;
+    truth_at(t, ned, &yaw);
+    tr.t_s[i] = nv.t_s[i] = er.t_s[i] = en.t_s[i] = t;
+    for (int k = 0; k < 3; ++k) {
+      walk[k] += 0.02 * g(rng);
+      att[k] += 2e-6 * g(rng);
+      tr.pos_ned_m[3 * i + k] = ned[k];
+      nv.pos_ned_m[3 * i + k] = ned[k] + walk[k];
+      er.pos_err_ned_m[3 * i + k] = walk[k];
+      er.euler_err_rad[3 * i + k] = att[k];
+    }
+    tr.euler_rad[3 * i + 2] = yaw;
+    for (int k = 0; k < 3; ++k)
+      nv.euler_rad[3 * i + k] = tr.euler_rad[3 * i + k] + att[k];
+    er.pos_err_h_m[i] = std::hypot(walk[0], walk[1]);
+    er.pos_err_v_m[i] = std::fabs(walk[2]);
+    er.att_err_rad[i] = std::sqrt(att[0] * att[0] + att[1] * att[1] + att[2] * att[2]);
+    // RMS of a random walk with 0.02 m steps: 0.02 sqrt(i) per axis.
+    const double s = 0.02 * std::sqrt(static_cast<double>(i));
+    for (int k = 0; k < 3; ++k)
+      en.pos_rms_ned_m[3 * i + k] = s;
+    en.pos_h_rms_m[i] = s * std::sqrt(2.0);
+    en.att_rms_rad[i] = 2e-6 * std::sqrt(3.0 * static_cast<double>(i));
+  }
+  for (int p = 1; p < paths; ++p) {
+    NavTrack run;
+    run.t_s = tr.t_s;
+    run.pos_ned_m.resize(3 * epochs);
+    double w[3] = {0, 0, 0};
+    for (size_t i = 0; i < epochs; ++i)
+      for (int k = 0; k < 3; ++k) {
+        w[k] += 0.02 * g(rng);
+        run.pos_ned_m[3 * i + k] = tr.pos_ned_m[3 * i + k] + w[k];
+      }
+    r->extra_runs.push_back(std::move(run));
+  }
+  return r;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  std::string dir, png, chart;
+  NavViewOptions opt;
+  NavChartOptions copt;
+  bool size_given = false, bench = false, msaa_given = false;
+  int bench_frames = 60, bench_paths = 20;
+  long bench_epochs = 720000;
+
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto need = [&](const char *what) -> const char * {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "navview: %s needs %s\n", a.c_str(), what);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    auto bad = [&](const char *v) {
+      std::fprintf(stderr, "navview: invalid value '%s' for %s\n", v, a.c_str());
+      std::exit(2);
+    };
+    double v = 0.0;
+    if (a == "-h" || a == "--help") {
+      Usage(stdout);
+      return 0;
+    } else if (a == "--version") {
+      std::printf("navview %d.%d.%d\n", NAV_VERSION_MAJOR, NAV_VERSION_MINOR, NAV_VERSION_PATCH);
+      return 0;
+    } else if (a == "--png") {
+      png = need("a FILE");
+    } else if (a == "--chart") {
+      chart = need("a FILE");
+    } else if (a == "--size") {
+      const char *s = need("WxH");
+      if (!ParseSize(s, &opt.width_px, &opt.height_px)) bad(s);
+      copt.width_px = opt.width_px;
+      copt.height_px = opt.height_px;
+      size_given = true;
+    } else if (a == "--time") {
+      const char *s = need("T [s]");
+      if (!ParseDouble(s, &opt.time_s)) bad(s);
+    } else if (a == "--exaggerate") {
+      const char *s = need("K");
+      if (!ParseDouble(s, &v) || v < 0.0 || v > 1e6) bad(s);
+      opt.att_exaggeration = v;
+    } else if (a == "--envelope-k") {
+      const char *s = need("K");
+      if (!ParseDouble(s, &v) || v < 0.0 || v > 1e6) bad(s);
+      opt.envelope_k = v;
+      copt.band_k = v > 0.0 ? v : copt.band_k;
+    } else if (a == "--envelope") {
+      const std::string s = need("auto|run|mc|none");
+      if (s == "auto")
+        opt.envelope_source = NavEnvelopeSource::Auto;
+      else if (s == "run")
+        opt.envelope_source = NavEnvelopeSource::RunErrors;
+      else if (s == "mc")
+        opt.envelope_source = NavEnvelopeSource::MonteCarlo;
+      else if (s == "none")
+        opt.envelope_source = NavEnvelopeSource::None;
+      else
+        bad(s.c_str());
+    } else if (a == "--triad-interval") {
+      const char *s = need("S [s]");
+      if (!ParseDouble(s, &v) || v <= 0.0) bad(s);
+      opt.triad_interval_s = v;
+    } else if (a == "--triad-size") {
+      const char *s = need("M [m]");
+      if (!ParseDouble(s, &v) || v <= 0.0) bad(s);
+      opt.triad_size_m = v;
+    } else if (a == "--color-by-error") {
+      opt.color_by_error = true;
+    } else if (a == "--view") {
+      const std::string s = need("oblique|top");
+      if (s == "oblique")
+        opt.camera = NavCameraPreset::Oblique;
+      else if (s == "top")
+        opt.camera = NavCameraPreset::Top;
+      else
+        bad(s.c_str());
+    } else if (a == "--msaa") {
+      const char *s = need("N");
+      if (!ParseDouble(s, &v) || v < 0 || v > 16) bad(s);
+      opt.multisamples = static_cast<int>(v);
+      msaa_given = true;
+    } else if (a == "--decimate-px") {
+      const char *s = need("PX");
+      if (!ParseDouble(s, &v) || v < 0.0 || v > 100.0) bad(s);
+      opt.decimate_px = v;
+    } else if (a == "--no-text") {
+      opt.show_text = false;
+      copt.show_text = false;
+    } else if (a == "--bench") {
+      bench = true;
+      if (i + 1 < argc && argv[i + 1][0] != '-' && ParseDouble(argv[i + 1], &v)) {
+        if (v < 1 || v > 100000) bad(argv[i + 1]);
+        bench_frames = static_cast<int>(v);
+        ++i;
+      }
+    } else if (a == "--bench-epochs") {
+      const char *s = need("N");
+      if (!ParseDouble(s, &v) || v < 2 || v > 1e8) bad(s);
+      bench_epochs = static_cast<long>(v);
+    } else if (a == "--bench-paths") {
+      const char *s = need("M");
+      if (!ParseDouble(s, &v) || v < 1 || v > 1000) bad(s);
+      bench_paths = static_cast<int>(v);
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "navview: unknown option '%s' (see navview --help)\n", a.c_str());
+      return 2;
+    } else if (dir.empty()) {
+      dir = a;
+    } else {
+      std::fprintf(stderr, "navview: more than one RESULT_DIR ('%s', '%s')\n", dir.c_str(), a.c_str());
+      return 2;
+    }
+  }
+  if (!size_given) {
+    copt.width_px = 900;
+    copt.height_px = 800;
+  }
+  if (dir.empty() && !bench) {
+    Usage(stderr);
+    return 2;
+  }
+
+  // Multisampling costs about a factor three in frame rate on llvmpipe: PNGs get 8 samples,
+  // the interactive window and the benchmark none unless --msaa says otherwise.
+  if (!msaa_given && (bench || (png.empty() && chart.empty()))) opt.multisamples = 0;
+
+  std::string err;
+  std::shared_ptr<NavResult> result;
+  if (!dir.empty()) {
+    result = std::make_shared<NavResult>();
+    if (!NavLoadResultDir(dir, result.get(), &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      return 1;
+    }
+    for (const std::string &n : result->notes)
+      std::fprintf(stderr, "navview: note: %s\n", n.c_str());
+  } else {
+    std::printf("navview: synthesising %ld epochs x %d paths...\n", bench_epochs, bench_paths);
+    std::fflush(stdout);
+    result = SyntheticResult(static_cast<size_t>(bench_epochs), bench_paths);
+  }
+
+  NavSceneView view;
+  view.SetResult(result);
+  view.SetOptions(opt);
+  if (bench) {
+    NavBenchResult b;
+    if (!view.Benchmark(bench_frames, &b, &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      return 1;
+    }
+    std::printf("navview bench: %dx%d, %zu epochs in %zu paths -> %zu drawn vertices (tolerance %.3g m)\n",
+                opt.width_px, opt.height_px, b.full_points, 2 + result->extra_runs.size(), b.drawn_points,
+                b.tol_m);
+    std::printf(
+        "navview bench: build + first frame %.2f s, %.1f frames/s over %d frames (%.1f ms CPU per frame, "
+        "all threads)\n",
+        b.build_s, b.fps, b.frames, 1e3 * b.cpu_s_per_frame);
+    if (png.empty() && chart.empty()) return 0;
+  }
+  int rc = 0;
+  if (!png.empty()) {
+    if (!view.RenderPng(png, &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      rc = 1;
+    }
+  }
+  if (!chart.empty()) {
+    if (!NavRenderErrorChartPng(*result, copt, chart, &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      rc = 1;
+    }
+  }
+  if (png.empty() && chart.empty() && !bench) {
+    if (!view.RunInteractive(&err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      return 1;
+    }
+  }
+  return rc;
+}
