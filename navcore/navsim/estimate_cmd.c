@@ -28,6 +28,7 @@
 #include <time.h>
 
 #include "navcore/nav_analytic.h"
+#include "navcore/nav_array.h"
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
@@ -101,6 +102,16 @@ static nav_analytic_estimate_config analytic_config(const nav_scene *sc) {
   }
   if (a->terms & NAV_IMU_TERM_BIAS_RW) s->accel_bias_rw_mps2_per_sqrt_s = vmax(a->bias_rw_mps2_per_sqrt_s);
   if (g->terms & NAV_IMU_TERM_BIAS_RW) s->gyro_rrw_rps_per_sqrt_s = vmax(g->bias_rw_rps_per_sqrt_s);
+  /* Gyro-free scheme: the array's geometry (kappa from its H, E1.23-E1.25) and per-sensor errors
+   * (biases as zero-mean random constants: turn-on and GM sigma combined). */
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && nav_array_layout_from_scene(&sc->array, &c.array) == NAV_OK) {
+    const nav_array_error_config *ae = &sc->array.accel;
+    c.with_gyrofree = true;
+    c.array_accel_bias_mps2 = hypot((ae->terms & NAV_IMU_TERM_BIAS_TURN_ON) ? ae->bias_turn_on_sd_mps2 : 0.0,
+                                    (ae->terms & NAV_IMU_TERM_BIAS_GM) ? ae->bias_gm_sd_mps2 : 0.0);
+    c.array_accel_noise_mps_per_sqrt_s = (ae->terms & NAV_IMU_TERM_NOISE) ? ae->vrw_mps_per_sqrt_s : 0.0;
+    c.array_init_rate_sd_rps = vmax(sc->array.initial_rate_sd_rps);
+  }
   return c;
 }
 
@@ -336,6 +347,8 @@ int navsim_estimate(int argc, char **argv) {
     term_label((nav_analytic_term_id)q, lab, sizeof lab);
     fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
   }
+  if (acfg.with_gyrofree)
+    fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_pos_m", f);
   fputc('\n', f);
   for (size_t i = 0; i < nt; ++i) {
     fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
@@ -352,6 +365,9 @@ int navsim_estimate(int argc, char **argv) {
             pos_v[i], times[i] < t_v_max_s ? 1 : 0);
     for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q)
       fprintf(f, ",%.17g,%.17g,%.17g", tab[i].term[q].pos_m, tab[i].term[q].vel_mps, tab[i].term[q].att_rad);
+    if (acfg.with_gyrofree)
+      fprintf(f, ",%.17g,%.17g,%.17g,%d,%.17g", ana[i].gyrofree.pos_sd_m, ana[i].gyrofree.vel_sd_mps,
+              ana[i].gyrofree.att_sd_rad, ana[i].gyrofree_small_angle_ok ? 1 : 0, ana[i].gyrofree_paper_pos_m);
     fputc('\n', f);
   }
   const bool bad = ferror(f) != 0;
@@ -371,6 +387,12 @@ int navsim_estimate(int argc, char **argv) {
   fprintf(f, "  \"analytic_final\": {\"pos_sd_m\": %.17g, \"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, \"valid\": %s}",
           al->gyro_ins.pos_sd_m, al->gyro_ins.vel_sd_mps, al->gyro_ins.att_sd_rad,
           al->gyro_ins_short_time_ok ? "true" : "false");
+  if (acfg.with_gyrofree)
+    fprintf(f,
+            ",\n  \"gyrofree_final\": {\"pos_sd_m\": %.17g, \"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, "
+            "\"small_angle_ok\": %s, \"paper_formula_pos_m\": %.17g}",
+            al->gyrofree.pos_sd_m, al->gyrofree.vel_sd_mps, al->gyrofree.att_sd_rad,
+            al->gyrofree_small_angle_ok ? "true" : "false", al->gyrofree_paper_pos_m);
   if (have_cov) {
     const nav_cov_point *p = &cov.p[nt - 1];
     double hmax = 0.0;
@@ -417,6 +439,13 @@ int navsim_estimate(int argc, char **argv) {
       if (i == nt - 1) break;
     }
     printf("(* beyond the closed forms' validity: Schuler feedback or large angles)\n");
+    if (acfg.with_gyrofree) {
+      printf("gyro-free  %s array, per axis (E1.25-E1.28, corrected 1/252):\n", nav_array_layout_kind_name(sc.array.layout));
+      for (size_t i = 0; i < nt; i += (nt > 10 ? nt / 10 : 1))
+        printf("%10.1f | pos %11.4g m  vel %11.4g m/s  att %11.4g deg%s  (paper's formula: %.4g m)\n", times[i],
+               ana[i].gyrofree.pos_sd_m, ana[i].gyrofree.vel_sd_mps, ana[i].gyrofree.att_sd_rad * NAV_RAD2DEG,
+               ana[i].gyrofree_small_angle_ok ? " " : "*", ana[i].gyrofree_paper_pos_m);
+    }
     const nav_analytic_gyro_ins_table *tf = &tab[nt - 1];
     printf("final      t = %g s: horizontal %.4g m (sqrt(2) x per axis), vertical %.4g m%s\n", times[nt - 1],
            sqrt(2.0) * al->gyro_ins.pos_sd_m, pos_v[nt - 1], times[nt - 1] < t_v_max_s ? "" : " (beyond its validity)");
