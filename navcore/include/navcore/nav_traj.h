@@ -91,8 +91,8 @@ NAV_API NAV_NODISCARD nav_status nav_traj_inertial(nav_traj *traj, double t_s, n
  *         status (NAV_ERR_OUT_OF_RANGE before the start of a rate-integrated attitude).
  */
 NAV_API NAV_NODISCARD nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n,
-                                                             const double *x, const double *w, nav_vec3 *dv_b_mps,
-                                                             nav_vec3 *dtheta_b_rad);
+                                                             const double *x, const double *w,
+                                                             nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad);
 
 /** Duration of the trajectory [s]. */
 NAV_API double nav_traj_duration(const nav_traj *traj);

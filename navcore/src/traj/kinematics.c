@@ -149,11 +149,10 @@ static ptrdiff_t find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *h
   return *hint;
 }
 
-void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
-                               double *r1) {
-  /* x, r and r' of channel_state (the same expressions, hence the same numbers) without y, r''
-   * and r'''. */
-  const ptrdiff_t k = find_step_hint(c, t_s, hint);
+/* x, r and r' of channel_state in step k (the same expressions, hence the same numbers),
+ * without y and the higher rate derivatives. */
+static inline void rate_state(const nav_kin_channel *c, ptrdiff_t k, double t_s, double *x, double *r,
+                              double *r1) {
   if (k >= 0) {
     const nav_kin_step *s = &c->steps[k];
     const double d = t_s - s->t0_s;
@@ -173,9 +172,42 @@ void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *
   *r1 = 0.0;
 }
 
+void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
+                               double *r1) {
+  rate_state(c, find_step_hint(c, t_s, hint), t_s, x, r, r1);
+}
+
+void nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
+                                 double *x, double *r, double *r1) {
+  if (n < 1) return;
+  /* A channel at rest over the whole span (after its ramps, at zero rate: the usual case for
+   * most channels) is evaluated once; its value is constant there, up to the rounding of
+   * x0 + r0 d + dr (d - len/2) with r0 + dr = 0. */
+  const ptrdiff_t k0 = find_step_hint(c, t_s[0], hint);
+  const double t_last = t_s[n - 1];
+  bool constant;
+  if (k0 < 0) {
+    constant = c->r_init == 0.0 && (c->n == 0 || t_last < c->steps[0].t0_s);
+  } else {
+    const nav_kin_step *s = &c->steps[k0];
+    constant = s->r0 + s->dr == 0.0 && !(t_s[0] - s->t0_s < s->len_s) &&
+               ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s);
+  }
+  rate_state(c, k0, t_s[0], &x[0], &r[0], &r1[0]);
+  for (int i = 1; i < n; ++i) {
+    if (constant) {
+      x[i] = x[0];
+      r[i] = r[0];
+      r1[i] = r1[0];
+    } else {
+      rate_state(c, find_step_hint(c, t_s[i], hint), t_s[i], &x[i], &r[i], &r1[i]);
+    }
+  }
+}
+
 /* Full state at t: x, y and rate jets (r, r', r'', r'''). */
-static void channel_state(const nav_kin_channel *c, double t, double *x, double *y, double r[4]) {
-  const ptrdiff_t k = find_step(c, t);
+static void channel_state_k(const nav_kin_channel *c, ptrdiff_t k, double t, double *x, double *y,
+                            double r[4]) {
   r[1] = r[2] = r[3] = 0.0;
   if (k >= 0) {
     const nav_kin_step *s = &c->steps[k];
@@ -192,6 +224,16 @@ static void channel_state(const nav_kin_channel *c, double t, double *x, double 
     }
   }
   after_state(c, k, t, x, y, &r[0]);
+}
+
+static void channel_state(const nav_kin_channel *c, double t, double *x, double *y, double r[4]) {
+  channel_state_k(c, find_step(c, t), t, x, y, r);
+}
+
+nav_jet nav_kin_channel_eval_hint(const nav_kin_channel *c, double t_s, ptrdiff_t *hint) {
+  double x, y, r[4];
+  channel_state_k(c, find_step_hint(c, t_s, hint), t_s, &x, &y, r);
+  return nav_jet_make(x, r[0], r[1], r[2]);
 }
 
 nav_jet nav_kin_channel_eval(const nav_kin_channel *c, double t_s) {

@@ -55,7 +55,12 @@ typedef struct seg_model {
   double *breaks;
   size_t n_breaks;
   nav_traj_script_info info;
-  ptrdiff_t hint[CH_N]; /* step index of each channel at the last node evaluation (speed only) */
+  /* Cached step indices of the channels (speed only, never a result): of the node evaluation,
+   * of seg_state and of seg_velocity, whose time patterns differ. */
+  ptrdiff_t hint[CH_N], st_hint[CH_N], vel_hint[CH_N];
+  /* seg_velocity: the last Euler angles and their DCM, reused while the angles are unchanged. */
+  double vel_ang[3];
+  nav_mat3 vel_C;
 } seg_model;
 
 typedef struct planner {
@@ -645,17 +650,17 @@ typedef struct seg_att {
   nav_jet yaw, pitch, roll, u, v, w;
 } seg_att;
 
-static seg_att seg_state(const seg_model *m, double t) {
+static seg_att seg_state(seg_model *m, double t) {
   seg_att a;
-  a.yaw = nav_kin_channel_eval(&m->ch[CH_YAW], t);
-  a.pitch = nav_kin_channel_eval(&m->ch[CH_PITCH], t);
-  a.roll = nav_kin_channel_eval(&m->ch[CH_ROLL], t);
-  a.u = nav_kin_channel_eval(&m->ch[CH_U], t);
-  a.v = nav_kin_channel_eval(&m->ch[CH_V], t);
-  a.w = nav_kin_channel_eval(&m->ch[CH_W], t);
+  a.yaw = nav_kin_channel_eval_hint(&m->ch[CH_YAW], t, &m->st_hint[CH_YAW]);
+  a.pitch = nav_kin_channel_eval_hint(&m->ch[CH_PITCH], t, &m->st_hint[CH_PITCH]);
+  a.roll = nav_kin_channel_eval_hint(&m->ch[CH_ROLL], t, &m->st_hint[CH_ROLL]);
+  a.u = nav_kin_channel_eval_hint(&m->ch[CH_U], t, &m->st_hint[CH_U]);
+  a.v = nav_kin_channel_eval_hint(&m->ch[CH_V], t, &m->st_hint[CH_V]);
+  a.w = nav_kin_channel_eval_hint(&m->ch[CH_W], t, &m->st_hint[CH_W]);
   if (m->ch[CH_CYAW].n > 0) {
     /* Coordinated bank atan(u psi_dot_c / g): zero with its derivatives where psi_dot_c is. */
-    const nav_jet cy = nav_jet_deriv(nav_kin_channel_eval(&m->ch[CH_CYAW], t));
+    const nav_jet cy = nav_jet_deriv(nav_kin_channel_eval_hint(&m->ch[CH_CYAW], t, &m->st_hint[CH_CYAW]));
     if (cy.d[0] != 0.0 || cy.d[1] != 0.0 || cy.d[2] != 0.0)
       a.roll = nav_jet_add(a.roll, nav_jet_atan(nav_jet_scale(nav_jet_mul(a.u, cy), 1.0 / m->g_mps2)));
   }
@@ -663,20 +668,28 @@ static seg_att seg_state(const seg_model *m, double t) {
 }
 
 static nav_vec3 seg_velocity(void *self, double t) {
-  const seg_model *m = self;
-  const double yaw = nav_kin_channel_eval(&m->ch[CH_YAW], t).d[0];
-  const double pitch = nav_kin_channel_eval(&m->ch[CH_PITCH], t).d[0];
-  double roll = nav_kin_channel_eval(&m->ch[CH_ROLL], t).d[0];
-  const double u = nav_kin_channel_eval(&m->ch[CH_U], t).d[0];
-  if (m->ch[CH_CYAW].n > 0) roll += atan(u * nav_kin_channel_eval(&m->ch[CH_CYAW], t).d[1] / m->g_mps2);
-  const nav_euler e = {roll, pitch, yaw};
-  const nav_vec3 vb = nav_vec3_make(u, nav_kin_channel_eval(&m->ch[CH_V], t).d[0],
-                                    nav_kin_channel_eval(&m->ch[CH_W], t).d[0]);
-  return nav_mat3_mul_vec(nav_euler_to_dcm(e), vb);
+  seg_model *m = self;
+  ptrdiff_t *h = m->vel_hint;
+  const double yaw = nav_kin_channel_eval_hint(&m->ch[CH_YAW], t, &h[CH_YAW]).d[0];
+  const double pitch = nav_kin_channel_eval_hint(&m->ch[CH_PITCH], t, &h[CH_PITCH]).d[0];
+  double roll = nav_kin_channel_eval_hint(&m->ch[CH_ROLL], t, &h[CH_ROLL]).d[0];
+  const double u = nav_kin_channel_eval_hint(&m->ch[CH_U], t, &h[CH_U]).d[0];
+  if (m->ch[CH_CYAW].n > 0)
+    roll += atan(u * nav_kin_channel_eval_hint(&m->ch[CH_CYAW], t, &h[CH_CYAW]).d[1] / m->g_mps2);
+  if (!(roll == m->vel_ang[0] && pitch == m->vel_ang[1] && yaw == m->vel_ang[2])) {
+    const nav_euler e = {roll, pitch, yaw};
+    m->vel_C = nav_euler_to_dcm(e);
+    m->vel_ang[0] = roll;
+    m->vel_ang[1] = pitch;
+    m->vel_ang[2] = yaw;
+  }
+  const nav_vec3 vb = nav_vec3_make(u, nav_kin_channel_eval_hint(&m->ch[CH_V], t, &h[CH_V]).d[0],
+                                    nav_kin_channel_eval_hint(&m->ch[CH_W], t, &h[CH_W]).d[0]);
+  return nav_mat3_mul_vec(m->vel_C, vb);
 }
 
 static double seg_step(void *self, double ta, double tb) {
-  const seg_model *m = self;
+  seg_model *m = self;
   const double ts[3] = {ta, 0.5 * (ta + tb), tb};
   double w = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -690,7 +703,7 @@ static double seg_step(void *self, double ta, double tb) {
 }
 
 static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
-  const seg_model *m = self;
+  seg_model *m = self;
   const seg_att a = seg_state(m, t_s);
   const nav_euler e = {a.roll.d[0], a.pitch.d[0], a.yaw.d[0]};
   nav_local_kin k;
@@ -709,53 +722,82 @@ static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
 /*
  * Ideal-IMU nodes: seg_eval without the position (the caller integrates the velocity) and
  * without the angular acceleration, with the attitude as a DCM. The channels are found through
- * cached step indices, the bank jet is reduced to its first derivative, and the sine and cosine
- * of an Euler angle are reused while the angle is unchanged (a level stretch), so a ground
- * vehicle costs one sincos per node. The expressions are those of seg_state, nav_euler_to_dcm
- * and nav_kin_euler_rates (value parts of the jets).
+ * cached step indices and a channel at rest is evaluated once per interval; the bank jet is
+ * reduced to its first derivative; the sine and cosine of an Euler angle come from one sincos
+ * per interval (angle addition to the other nodes, or reuse while the angle is unchanged). The
+ * expressions are those of seg_state, nav_euler_to_dcm and nav_kin_euler_rates (value parts of
+ * the jets), so the numbers agree with seg_eval to rounding.
  */
 nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io) {
   seg_model *m = self;
-  double last[3] = {NAN, NAN, NAN}, sn[3] = {0.0, 0.0, 0.0}, cs[3] = {1.0, 1.0, 1.0};
-  const bool coordinated = m->ch[CH_CYAW].n > 0;
-  for (int i = 0; i < io->n; ++i) {
-    const double t = io->t_s[i];
-    double ang[3], rate[3], vb[3], vbd[3], r1;
-    /* ang/rate: yaw, pitch, roll (channel order). */
-    for (int c = 0; c < 3; ++c)
-      nav_kin_channel_eval_rate(&m->ch[c], t, &m->hint[c], &ang[c], &rate[c], &r1);
-    for (int c = 0; c < 3; ++c)
-      nav_kin_channel_eval_rate(&m->ch[CH_U + c], t, &m->hint[CH_U + c], &vb[c], &vbd[c], &r1);
-    if (coordinated) {
-      /* Bank atan(z), z = u psi_dot_c / g, and its rate z' / (1 + z^2). */
-      double cx, cr, cr1;
-      nav_kin_channel_eval_rate(&m->ch[CH_CYAW], t, &m->hint[CH_CYAW], &cx, &cr, &cr1);
-      if (cr != 0.0 || cr1 != 0.0) {
-        const double gi = 1.0 / m->g_mps2;
-        const double z0 = vb[0] * cr * gi, z1 = (vbd[0] * cr + vb[0] * cr1) * gi;
-        ang[2] += atan(z0);
-        rate[2] += 1.0 / (1.0 + z0 * z0) * z1;
+  const int n = io->n;
+  /* Channel values at all nodes; ang/rate: yaw, pitch, roll (channel order). */
+  double ang[3][NAV_KIN_MAX_NODES], rate[3][NAV_KIN_MAX_NODES], vb[3][NAV_KIN_MAX_NODES],
+      vbd[3][NAV_KIN_MAX_NODES];
+  double r1[NAV_KIN_MAX_NODES];
+  for (int c = 0; c < 3; ++c) {
+    nav_kin_channel_eval_rate_n(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
+    nav_kin_channel_eval_rate_n(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+  }
+  if (m->ch[CH_CYAW].n > 0) {
+    /* Bank atan(z), z = u psi_dot_c / g, and its rate z' / (1 + z^2). */
+    double cx[NAV_KIN_MAX_NODES], cr[NAV_KIN_MAX_NODES], cr1[NAV_KIN_MAX_NODES];
+    nav_kin_channel_eval_rate_n(&m->ch[CH_CYAW], io->t_s, n, &m->hint[CH_CYAW], cx, cr, cr1);
+    const double gi = 1.0 / m->g_mps2;
+    for (int i = 0; i < n; ++i)
+      if (cr[i] != 0.0 || cr1[i] != 0.0) {
+        const double z0 = vb[0][i] * cr[i] * gi, z1 = (vbd[0][i] * cr[i] + vb[0][i] * cr1[i]) * gi;
+        ang[2][i] += atan(z0);
+        rate[2][i] += 1.0 / (1.0 + z0 * z0) * z1;
+      }
+  }
+  /* sin and cos of the Euler angles: directly at the first node, at the others by angle addition
+   * from it (they differ by at most rate x dt), reused while an angle is unchanged. */
+  double sn[3][NAV_KIN_MAX_NODES], cs[3][NAV_KIN_MAX_NODES];
+  for (int c = 0; c < 3; ++c) {
+    const double a0 = ang[c][0];
+    sn[c][0] = sin(a0);
+    cs[c][0] = cos(a0);
+    for (int i = 1; i < n; ++i) {
+      const double d = ang[c][i] - a0;
+      if (d == 0.0) {
+        sn[c][i] = sn[c][0];
+        cs[c][i] = cs[c][0];
+      } else if (fabs(d) <= NAV_KIN_NEAR_RAD) {
+        nav_kin_sincos_near(sn[c][0], cs[c][0], d, &sn[c][i], &cs[c][i]);
+      } else {
+        sn[c][i] = sin(ang[c][i]);
+        cs[c][i] = cos(ang[c][i]);
       }
     }
-    for (int c = 0; c < 3; ++c)
-      if (!(ang[c] == last[c])) {
-        sn[c] = sin(ang[c]);
-        cs[c] = cos(ang[c]);
-        last[c] = ang[c];
-      }
-    const double sy = sn[0], cy = cs[0], sp = sn[1], cp = cs[1], sr = sn[2], cr = cs[2];
-    const nav_mat3 C = {{{cp * cy, -cr * sy + sr * sp * cy, sr * sy + cr * sp * cy},
-                         {cp * sy, cr * cy + sr * sp * sy, -sr * cy + cr * sp * sy},
-                         {-sp, sr * cp, cr * cp}}};
-    /* numerics.md E3.4: omega_nb_b from the Euler rates (roll, pitch, yaw). */
-    const double dpsi = rate[0], dth = rate[1], dphi = rate[2];
-    const nav_vec3 w = nav_vec3_make(dphi - dpsi * sp, dth * cr + dpsi * (cp * sr), dpsi * (cp * cr) - dth * sr);
-    const nav_vec3 v_b = nav_vec3_make(vb[0], vb[1], vb[2]);
-    const nav_vec3 v_b_dot = nav_vec3_make(vbd[0], vbd[1], vbd[2]);
-    io->C_b_n[i] = C;
-    io->w_nb_b_rps[i] = w;
-    io->v_ned_mps[i] = nav_mat3_mul_vec(C, v_b);
-    io->a_ned_mps2[i] = nav_mat3_mul_vec(C, nav_vec3_add(v_b_dot, nav_vec3_cross(w, v_b)));
+  }
+  for (int i = 0; i < n; ++i) {
+    const double sy = sn[0][i], cy = cs[0][i], sp = sn[1][i], cp = cs[1][i], sr = sn[2][i], cr = cs[2][i];
+    /* C_b_n = R_z(yaw) R_y(pitch) R_x(roll) (nav_euler_to_dcm). */
+    nav_mat3 *C = &io->C_b_n[i];
+    C->m[0][0] = cp * cy;
+    C->m[0][1] = -cr * sy + sr * sp * cy;
+    C->m[0][2] = sr * sy + cr * sp * cy;
+    C->m[1][0] = cp * sy;
+    C->m[1][1] = cr * cy + sr * sp * sy;
+    C->m[1][2] = -sr * cy + cr * sp * sy;
+    C->m[2][0] = -sp;
+    C->m[2][1] = sr * cp;
+    C->m[2][2] = cr * cp;
+    /* numerics.md E3.4: omega_nb_b from the Euler rates. */
+    const double dpsi = rate[0][i], dth = rate[1][i], dphi = rate[2][i];
+    const double wx = dphi - dpsi * sp, wy = dth * cr + dpsi * (cp * sr), wz = dpsi * (cp * cr) - dth * sr;
+    const double u = vb[0][i], v = vb[1][i], w = vb[2][i];
+    /* a_b = dv_b/dt + w_nb_b x v_b */
+    const double ax = vbd[0][i] + (wy * w - wz * v), ay = vbd[1][i] + (wz * u - wx * w),
+                 az = vbd[2][i] + (wx * v - wy * u);
+    io->w_nb_b_rps[i] = nav_vec3_make(wx, wy, wz);
+    io->v_ned_mps[i] = nav_vec3_make(C->m[0][0] * u + C->m[0][1] * v + C->m[0][2] * w,
+                                     C->m[1][0] * u + C->m[1][1] * v + C->m[1][2] * w,
+                                     C->m[2][0] * u + C->m[2][1] * v + C->m[2][2] * w);
+    io->a_ned_mps2[i] = nav_vec3_make(C->m[0][0] * ax + C->m[0][1] * ay + C->m[0][2] * az,
+                                      C->m[1][0] * ax + C->m[1][1] * ay + C->m[1][2] * az,
+                                      C->m[2][0] * ax + C->m[2][1] * ay + C->m[2][2] * az);
   }
   io->has_pos = false;
   return NAV_OK;
@@ -763,6 +805,17 @@ nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io) {
 
 static void seg_destroy(void *self) {
   seg_free(self);
+}
+
+/* A zeroed model with empty caches. */
+static seg_model *seg_alloc(void) {
+  seg_model *m = calloc(1, sizeof *m);
+  if (!m) return NULL;
+  for (int c = 0; c < CH_N; ++c)
+    m->hint[c] = m->st_hint[c] = m->vel_hint[c] = -1;
+  for (int i = 0; i < 3; ++i)
+    m->vel_ang[i] = NAN;
+  return m;
 }
 
 static double gravity_of(const nav_scene *scene) {
@@ -775,7 +828,7 @@ nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_i
                                        char *msg, size_t msg_size) {
   if (msg && msg_size) msg[0] = '\0';
   if (!scene || !info) return NAV_ERR_INVALID_ARG;
-  seg_model *m = calloc(1, sizeof *m);
+  seg_model *m = seg_alloc();
   if (!m) return NAV_ERR_NO_MEMORY;
   m->g_mps2 = gravity_of(scene);
   const nav_status st = plan(scene, m, bad_index, msg, msg_size);
@@ -790,7 +843,7 @@ nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_tra
   seg_model *m = NULL;
   nav_status st = NAV_OK;
   if (msg && msg_size) msg[0] = '\0';
-  m = calloc(1, sizeof *m);
+  m = seg_alloc();
   if (!m) return NAV_ERR_NO_MEMORY;
   m->g_mps2 = gravity_of(scene);
   if (!(m->g_mps2 > 0.0)) {
@@ -842,8 +895,6 @@ nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_tra
   out->self = m;
   out->eval_local = seg_eval;
   out->destroy = seg_destroy;
-  for (int c = 0; c < CH_N; ++c)
-    m->hint[c] = -1;
   m = NULL;
 cleanup:
   seg_free(m);

@@ -19,6 +19,7 @@ struct nav_traj {
   nav_gravity_model gravity;
   nav_vec3 g_l_mps2; /* flat Earth: uniform gravity in l */
   double dt_s;       /* IMU interval of the create call (sample grid k dt) */
+  double inv_m_lat, inv_m_lon; /* 1 / frame.m_per_rad_lat, 1 / frame.m_per_rad_lon (0 if that is 0) */
   /* Node evaluator of the model for the ideal IMU (traj_kin_internal.h), or NULL. */
   nav_status (*nodes)(void *self, nav_kin_nodes *io);
   /* Quadrature rule of the last increment and, for it, A[i][j] = int_{-1}^{x_i} L_j(s) ds (L_j:
@@ -152,6 +153,8 @@ nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **o
   tr->gravity = scene->earth.gravity_model;
   tr->g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
   tr->dt_s = dt_s;
+  tr->inv_m_lat = 1.0 / tr->frame.m_per_rad_lat;
+  tr->inv_m_lon = tr->frame.m_per_rad_lon != 0.0 ? 1.0 / tr->frame.m_per_rad_lon : 0.0;
   nav_status st = NAV_ERR_INVALID_ARG;
   switch (scene->trajectory.type) {
   case NAV_TRAJ_PARAMETRIC:
@@ -319,7 +322,8 @@ static nav_status increment_by_nodes(nav_traj *traj, double t0_s, double t1_s, i
 
 /* Make (x, w) the rule of the position chain: the integration matrix, and a new chain. */
 static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
-  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 && memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
+  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 &&
+      memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
     return;
   tr->q_n = n;
   memcpy(tr->q_x, x, (size_t)n * sizeof *x);
@@ -440,35 +444,38 @@ static nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) 
 }
 
 /*
- * WGS-84, NED form (E3.9) at one node, as in nav_traj_inertial with normal gravity, from the
- * local kinematics and the attitude as a DCM; sin and cos of the latitude are shared by the
- * radii, the Earth rate and gravity.
+ * WGS-84, NED form (E3.9) at one node, as nav_traj_inertial with normal gravity, from the local
+ * kinematics, the attitude as a DCM, sin/cos of the latitude lat = lat0 + N / m_lat (shared by
+ * the radii, the Earth rate and gravity) and inv_sq = 1/sqrt(1 - e^2 sin^2 lat), which the
+ * radii and gravity share.
  */
-static void ned_inertial(const nav_traj *tr, nav_vec3 r, nav_vec3 v, nav_vec3 a, const nav_mat3 *C_b_n,
-                         nav_vec3 w_nb_b, nav_vec3 *f_b, nav_vec3 *w_ib_b) {
-  const nav_frame *fr = &tr->frame;
-  const double sy = fr->m_per_rad_lon != 0.0 ? 1.0 / fr->m_per_rad_lon : 0.0;
-  const double lat = fr->origin.lat_rad + r.x / fr->m_per_rad_lat, h = fr->origin.h_m - r.z;
-  const double dlat = v.x / fr->m_per_rad_lat, dlon = v.y * sy, dh = -v.z;
-  const double ddlat = a.x / fr->m_per_rad_lat, ddlon = a.y * sy, ddh = -a.z;
-  const double sl = sin(lat), cl = cos(lat);
+static void ned_inertial(const nav_frame *fr, double inv_m_lat, double inv_m_lon, nav_vec3 r, nav_vec3 v,
+                         nav_vec3 a, const nav_mat3 *C_b_n, nav_vec3 w_nb_b, double sl, double cl,
+                         double inv_sq, nav_vec3 *f_b, nav_vec3 *w_ib_b) {
+  const double h = fr->origin.h_m - r.z;
+  const double dlat = v.x * inv_m_lat, dlon = v.y * inv_m_lon, dh = -v.z;
+  const double ddlat = a.x * inv_m_lat, ddlon = a.y * inv_m_lon, ddh = -a.z;
   /* Groves (2.105), (2.106); numerics.md E3.9. */
-  const double den = 1.0 - NAV_WGS84_E2 * sl * sl, sq = sqrt(den);
-  const double RN = NAV_WGS84_A_M / sq, RM = NAV_WGS84_A_M * (1.0 - NAV_WGS84_E2) / (den * sq);
-  const double dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl / den * dlat;
-  const double dRN = NAV_WGS84_E2 * RN * sl * cl / den * dlat;
+  const double s2 = sl * sl;
+  const double inv_den = inv_sq * inv_sq;
+  const double RN = NAV_WGS84_A_M * inv_sq, RM = NAV_WGS84_A_M * (1.0 - NAV_WGS84_E2) * inv_den * inv_sq;
+  const double dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl * inv_den * dlat;
+  const double dRN = NAV_WGS84_E2 * RN * sl * cl * inv_den * dlat;
   const nav_vec3 v_n = nav_vec3_make((RM + h) * dlat, (RN + h) * cl * dlon, -dh);
-  const nav_vec3 dv_n = nav_vec3_make((dRM + dh) * dlat + (RM + h) * ddlat,
-                                      (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon, -ddh);
+  const nav_vec3 dv_n =
+      nav_vec3_make((dRM + dh) * dlat + (RM + h) * ddlat,
+                    (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon, -ddh);
   const nav_vec3 w_en_n = nav_vec3_make(dlon * cl, -dlat, -dlon * sl);
   const nav_vec3 w_ie_n = nav_vec3_make(NAV_WGS84_OMEGA_IE_RPS * cl, 0.0, -NAV_WGS84_OMEGA_IE_RPS * sl);
   /* Normal gravity: TR8350.2 (4-1), (4-3); numerics.md E3.10-E3.11. */
-  const double s2 = sl * sl, ea = NAV_WGS84_A_M;
+  const double ea = NAV_WGS84_A_M;
   const double lin = (2.0 / ea) * (1.0 + NAV_WGS84_F + NAV_WGS84_M - 2.0 * NAV_WGS84_F * s2);
   const double quad = 3.0 / (ea * ea);
-  const double g = NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) / sq * (1.0 - lin * h + quad * h * h);
-  const nav_vec3 f_n = nav_vec3_sub(
-      nav_vec3_add(dv_n, nav_vec3_cross(nav_vec3_add(nav_vec3_scale(w_ie_n, 2.0), w_en_n), v_n)), nav_vec3_make(0.0, 0.0, g));
+  const double g =
+      NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) * inv_sq * (1.0 - lin * h + quad * h * h);
+  const nav_vec3 f_n =
+      nav_vec3_sub(nav_vec3_add(dv_n, nav_vec3_cross(nav_vec3_add(nav_vec3_scale(w_ie_n, 2.0), w_en_n), v_n)),
+                   nav_vec3_make(0.0, 0.0, g));
   *f_b = nav_mat3_tmul_vec(*C_b_n, f_n);
   *w_ib_b = nav_vec3_add(w_nb_b, nav_mat3_tmul_vec(*C_b_n, nav_vec3_add(w_ie_n, w_en_n)));
 }
@@ -501,6 +508,34 @@ nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s,
     st = chain_positions(traj, &nd, half);
     if (st != NAV_OK) return st;
   }
+  /* Latitudes of the nodes differ by micro-radians: sin/cos of the first, the others by angle
+   * addition (nav_kin_sincos_near); likewise 1/sqrt(D), D = 1 - e^2 sin^2 lat: directly at the
+   * first node, at the others as (1/sqrt(D0)) (1 + e)^(-1/2), e = (D - D0)/D0, by its series
+   * 1 - e/2 + 3e^2/8 while |e| <= 1e-6 (omitted 5e^3/16 < 4e-19; e is ~1e-10 at vehicle speeds). */
+  double sl[NAV_KIN_MAX_NODES], cl[NAV_KIN_MAX_NODES], isq[NAV_KIN_MAX_NODES];
+  const nav_frame *fr = &traj->frame;
+  const double inv_m_lat = traj->inv_m_lat, inv_m_lon = traj->inv_m_lon;
+  if (!flat) {
+    const double lat0 = fr->origin.lat_rad + nd.r_ned_m[0].x * inv_m_lat;
+    sl[0] = sin(lat0);
+    cl[0] = cos(lat0);
+    const double den0 = 1.0 - NAV_WGS84_E2 * sl[0] * sl[0];
+    isq[0] = 1.0 / sqrt(den0);
+    const double inv_den0 = isq[0] * isq[0];
+    for (int i = 1; i < n; ++i) {
+      const double lat = fr->origin.lat_rad + nd.r_ned_m[i].x * inv_m_lat;
+      if (fabs(lat - lat0) <= NAV_KIN_NEAR_RAD) {
+        nav_kin_sincos_near(sl[0], cl[0], lat - lat0, &sl[i], &cl[i]);
+      } else {
+        sl[i] = sin(lat);
+        cl[i] = cos(lat);
+      }
+      /* D - D0 = -e^2 (s - s0)(s + s0), without the cancellation of 1 - e^2 s^2. */
+      const double e = -NAV_WGS84_E2 * (sl[i] - sl[0]) * (sl[i] + sl[0]) * inv_den0;
+      isq[i] = fabs(e) <= 1e-6 ? isq[0] * (1.0 - 0.5 * e + 0.375 * e * e)
+                               : 1.0 / sqrt(1.0 - NAV_WGS84_E2 * sl[i] * sl[i]);
+    }
+  }
   nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
   for (int i = 0; i < n; ++i) {
     nav_vec3 f_b, w_b;
@@ -509,7 +544,8 @@ nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s,
       f_b = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
       w_b = nd.w_nb_b_rps[i];
     } else {
-      ned_inertial(traj, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i], nd.w_nb_b_rps[i], &f_b, &w_b);
+      ned_inertial(fr, inv_m_lat, inv_m_lon, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i],
+                   nd.w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b, &w_b);
     }
     const double wgt = w[i] * half;
     dv = nav_vec3_axpy(dv, wgt, f_b);

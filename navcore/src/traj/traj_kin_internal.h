@@ -151,10 +151,16 @@ nav_status nav_kin_channel_add_step(nav_kin_channel *c, double t0_s, double len_
 nav_jet nav_kin_channel_eval(const nav_kin_channel *c, double t_s);
 /** y = int_0^t x and its derivatives (y, x, r, r'). */
 nav_jet nav_kin_channel_eval_integral(const nav_kin_channel *c, double t_s);
+/** nav_kin_channel_eval through a cached step index @p hint (start with -1; the same numbers). */
+nav_jet nav_kin_channel_eval_hint(const nav_kin_channel *c, double t_s, ptrdiff_t *hint);
 /** x, its rate r and r' at t (the numbers of nav_kin_channel_eval). @p hint caches the step
  *  index between calls (start with -1); it only saves the search and never changes a result. */
 void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
                                double *r1);
+/** nav_kin_channel_eval_rate at the ascending times t_s[0..n-1] (a channel at rest over the
+ *  whole span is evaluated once). */
+void nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
+                                 double *x, double *r, double *r1);
 /** Rate after the last ramp. */
 double nav_kin_channel_final_rate(const nav_kin_channel *c);
 /** Time the last ramp ends (0 if none). */
@@ -289,14 +295,30 @@ nav_status nav_traj_waypoints_nodes(void *self, nav_kin_nodes *io);
 /**
  * sin and cos of a0 + d from s0 = sin a0 and c0 = cos a0, for |d| <= NAV_KIN_NEAR_RAD: angle
  * addition with sin d and cos d - 1 by their Taylor series through d^11 and d^12 (truncation
- * below d^13 / 13! = 2e-27 at the bound, far under rounding), added as small corrections so
- * that the result is as accurate as a direct sin/cos (about one ulp).
+ * below d^13 / 13! = 2e-27 at the bound, far under rounding), or through d^3 and d^4 below
+ * |d| = 1e-4, added as small corrections so that the result is as accurate as a direct
+ * sin/cos (about one ulp).
  */
 static inline void nav_kin_sincos_near(double s0, double c0, double d, double *s, double *c) {
   const double d2 = d * d;
-  const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0 * (1.0 - d2 / 110.0)))));
+  if (d2 < 1e-8) {
+    /* |d| < 1e-4: through d^3 and d^4 (omitted d^5/120, d^6/720 < 1e-22). */
+    const double sd4 = d * (1.0 - d2 * (1.0 / 6.0)), cm4 = -0.5 * d2 * (1.0 - d2 * (1.0 / 12.0));
+    *s = s0 + (c0 * sd4 + s0 * cm4);
+    *c = c0 + (c0 * cm4 - s0 * sd4);
+    return;
+  }
+  const double sd =
+      d * (1.0 - d2 * (1.0 / 6.0) *
+                     (1.0 - d2 * (1.0 / 20.0) *
+                                (1.0 - d2 * (1.0 / 42.0) *
+                                           (1.0 - d2 * (1.0 / 72.0) * (1.0 - d2 * (1.0 / 110.0))))));
   const double cm1 =
-      -0.5 * d2 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0 * (1.0 - d2 / 90.0 * (1.0 - d2 / 132.0)))));
+      -0.5 * d2 *
+      (1.0 -
+       d2 * (1.0 / 12.0) *
+           (1.0 - d2 * (1.0 / 30.0) *
+                      (1.0 - d2 * (1.0 / 56.0) * (1.0 - d2 * (1.0 / 90.0) * (1.0 - d2 * (1.0 / 132.0))))));
   *s = s0 + (c0 * sd + s0 * cm1);
   *c = c0 + (c0 * cm1 - s0 * sd);
 }

@@ -72,6 +72,9 @@ typedef struct wp_model {
   int n_wp;
   double *breaks;
   size_t n_breaks;
+  /* Cached indices of the node evaluation (speed only): piece, speed, turn, Euler channels. */
+  size_t piece_hint;
+  ptrdiff_t ch_hint[5];
 } wp_model;
 
 typedef struct wplan {
@@ -598,17 +601,121 @@ static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
   return wp_kin(self, t_s, out, true);
 }
 
-/* Ideal-IMU nodes: wp_eval without the position (the caller integrates the velocity), with
- * the attitude as a DCM. */
+/* find_piece through a cached index (the same piece; sequential times rarely search). */
+static const wp_piece *find_piece_hint(wp_model *m, double t) {
+  const size_t h = m->piece_hint;
+  if (h < m->n_pieces && m->pieces[h].t0 <= t && (h + 1 == m->n_pieces || t < m->pieces[h + 1].t0))
+    return &m->pieces[h];
+  const wp_piece *p = find_piece(m, t);
+  m->piece_hint = (size_t)(p - m->pieces);
+  return p;
+}
+
+/*
+ * Ideal-IMU nodes: wp_eval without the position (the caller integrates the velocity) and without
+ * the angular acceleration, with the attitude as a DCM. The jets of wp_eval are written out to
+ * the orders needed (the unit tangent T to its second derivative only for the aircraft bank), and
+ * the sines and cosines of the heading and pitch are the components of T themselves
+ * (cos psi = T_N / T_h, sin psi = T_E / T_h, cos theta = T_h / |T|, sin theta = -T_D / |T|,
+ * T_h = |(T_N, T_E)|), so a node costs at most one sincos (of the turn angle, by angle addition
+ * from the first node within a turn).
+ */
 nav_status nav_traj_waypoints_nodes(void *self, nav_kin_nodes *io) {
-  for (int i = 0; i < io->n; ++i) {
-    nav_local_kin k;
-    const nav_status st = wp_kin(self, io->t_s[i], &k, false);
-    if (st != NAV_OK) return st;
-    io->C_b_n[i] = nav_quat_to_dcm(k.q_b_n);
-    io->w_nb_b_rps[i] = k.w_nb_b_rps;
-    io->v_ned_mps[i] = k.v_ned_mps;
-    io->a_ned_mps2[i] = k.a_ned_mps2;
+  wp_model *m = self;
+  const int n = io->n;
+  double V[NAV_KIN_MAX_NODES], V1[NAV_KIN_MAX_NODES], V2[NAV_KIN_MAX_NODES];
+  nav_kin_channel_eval_rate_n(&m->speed, io->t_s, n, &m->ch_hint[0], V, V1, V2);
+  double sb0 = 0.0, cb0 = 1.0, b0v = 0.0;
+  const wp_piece *p0 = NULL;
+  for (int i = 0; i < n; ++i) {
+    const double t = io->t_s[i];
+    const wp_piece *p = find_piece_hint(m, t);
+    /* Unit tangent and its derivatives (tangent()). */
+    double T[3], T1[3], T2[3];
+    if (p->kind != P_TURN) {
+      T[0] = p->u.x, T[1] = p->u.y, T[2] = p->u.z;
+      T1[0] = T1[1] = T1[2] = T2[0] = T2[1] = T2[2] = 0.0;
+    } else {
+      double bx, b1, b2;
+      nav_kin_channel_eval_rate(&m->turn, t, &m->ch_hint[1], &bx, &b1, &b2);
+      const double b = bx - p->b0;
+      double sb, cb;
+      if (p == p0 && fabs(b - b0v) <= NAV_KIN_NEAR_RAD) {
+        nav_kin_sincos_near(sb0, cb0, b - b0v, &sb, &cb);
+      } else {
+        sb = sin(b);
+        cb = cos(b);
+        p0 = p;
+        sb0 = sb;
+        cb0 = cb;
+        b0v = b;
+      }
+      const double u[3] = {p->u.x, p->u.y, p->u.z}, w[3] = {p->w.x, p->w.y, p->w.z};
+      for (int a = 0; a < 3; ++a) {
+        const double d = -sb * u[a] + cb * w[a]; /* dT/db */
+        T[a] = cb * u[a] + sb * w[a];
+        T1[a] = b1 * d;
+        T2[a] = b2 * d - b1 * b1 * T[a];
+      }
+    }
+    io->v_ned_mps[i] = nav_vec3_make(V[i] * T[0], V[i] * T[1], V[i] * T[2]);
+    io->a_ned_mps2[i] =
+        nav_vec3_make(V1[i] * T[0] + V[i] * T1[0], V1[i] * T[1] + V[i] * T1[1], V1[i] * T[2] + V[i] * T1[2]);
+    /* Euler angles as sin/cos and their rates (roll, pitch, yaw). */
+    double sr = 0.0, cr = 1.0, sp, cp, sy, cy, droll = 0.0, dpitch = 0.0, dyaw = 0.0;
+    switch (m->mode) {
+    case NAV_WP_ATT_GROUND:
+    case NAV_WP_ATT_AIRCRAFT: {
+      const double h2 = T[0] * T[0] + T[1] * T[1], th = sqrt(h2), tn = sqrt(h2 + T[2] * T[2]);
+      cy = T[0] / th;
+      sy = T[1] / th;
+      cp = th / tn;
+      sp = -T[2] / tn;
+      const double num = T[0] * T1[1] - T[1] * T1[0];
+      dyaw = num / h2;
+      const double th1 = (T[0] * T1[0] + T[1] * T1[1]) / th;
+      dpitch = (th * -T1[2] + T[2] * th1) / (h2 + T[2] * T[2]);
+      if (m->mode == NAV_WP_ATT_AIRCRAFT) {
+        /* roll = atan(z), z = V psi' / g; roll' = z' / (1 + z^2). */
+        const double num1 = T[0] * T2[1] - T[1] * T2[0];
+        const double ddyaw = num1 / h2 - num * 2.0 * (T[0] * T1[0] + T[1] * T1[1]) / (h2 * h2);
+        const double gi = 1.0 / m->g_mps2;
+        const double z0 = V[i] * dyaw * gi, z1 = (V1[i] * dyaw + V[i] * ddyaw) * gi;
+        cr = 1.0 / sqrt(1.0 + z0 * z0);
+        sr = z0 * cr;
+        droll = cr * cr * z1;
+      }
+      break;
+    }
+    case NAV_WP_ATT_EULER: {
+      double ang[3], rate[3], r1;
+      for (int c = 0; c < 3; ++c)
+        nav_kin_channel_eval_rate(&m->eul[c], t, &m->ch_hint[2 + c], &ang[c], &rate[c], &r1);
+      sr = sin(ang[0]), cr = cos(ang[0]), sp = sin(ang[1]), cp = cos(ang[1]), sy = sin(ang[2]),
+      cy = cos(ang[2]);
+      droll = rate[0], dpitch = rate[1], dyaw = rate[2];
+      break;
+    }
+    case NAV_WP_ATT_FIXED:
+    default:
+      sr = sin(m->fixed.roll_rad), cr = cos(m->fixed.roll_rad);
+      sp = sin(m->fixed.pitch_rad), cp = cos(m->fixed.pitch_rad);
+      sy = sin(m->fixed.yaw_rad), cy = cos(m->fixed.yaw_rad);
+      break;
+    }
+    /* C_b_n = R_z(yaw) R_y(pitch) R_x(roll) (nav_euler_to_dcm); omega_nb_b by E3.4. */
+    nav_mat3 *C = &io->C_b_n[i];
+    C->m[0][0] = cp * cy;
+    C->m[0][1] = -cr * sy + sr * sp * cy;
+    C->m[0][2] = sr * sy + cr * sp * cy;
+    C->m[1][0] = cp * sy;
+    C->m[1][1] = cr * cy + sr * sp * sy;
+    C->m[1][2] = -sr * cy + cr * sp * sy;
+    C->m[2][0] = -sp;
+    C->m[2][1] = sr * cp;
+    C->m[2][2] = cr * cp;
+    io->w_nb_b_rps[i] =
+        nav_vec3_make(droll - dyaw * sp, dpitch * cr + dyaw * (cp * sr), dyaw * (cp * cr) - dpitch * sr);
   }
   io->has_pos = false;
   return NAV_OK;
@@ -696,6 +803,8 @@ nav_status nav_traj_waypoints_create(const nav_scene *scene, double dt_s, nav_tr
   out->self = m;
   out->eval_local = wp_eval;
   out->destroy = wp_destroy;
+  for (int c = 0; c < 5; ++c)
+    m->ch_hint[c] = -1;
   m = NULL;
 cleanup:
   wp_free(m);

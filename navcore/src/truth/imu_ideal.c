@@ -126,7 +126,8 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (st != NAV_OK) return st;
   /* Gauss-Legendre over the interval, all nodes at once (nav_traj_inertial_increment). */
   nav_vec3 dv, dth;
-  st = nav_traj_inertial_increment(truth->traj, t0, t1, truth->n_nodes, truth->nodes, truth->weights, &dv, &dth);
+  st = nav_traj_inertial_increment(truth->traj, t0, t1, truth->n_nodes, truth->nodes, truth->weights, &dv,
+                                   &dth);
   if (st != NAV_OK) return st;
   if (!closed) r.dtheta_b_rad = dth;
   r.dv_b_mps = dv;
