@@ -137,6 +137,33 @@ static nav_analytic_imu_spec vertical_spec(const nav_analytic_imu_spec *h, const
   return v;
 }
 
+/*
+ * Schuler-bounded one-sigma of a level channel (north, E1.18/E1.20) for the random constants of
+ * the spec: initial position, velocity and tilt errors, accelerometer and gyro biases, each as a
+ * zero-mean random constant of the given sigma; the responses to independent sources add in
+ * squares. White noise, GM and random-walk terms are not in these closed forms (they are in the
+ * short-time table and in the covariance analysis).
+ */
+static nav_analytic_schuler_error schuler_sd(const nav_analytic_imu_spec *sp, double radius_m, double t) {
+  double p2 = 0.0, v2 = 0.0;
+  for (int src = 0; src < 5; ++src) {
+    nav_analytic_schuler_channel ch;
+    memset(&ch, 0, sizeof ch);
+    ch.g_mps2 = sp->g_mps2;
+    ch.radius_m = radius_m;
+    if (src == 0) ch.dr0_m = sp->init_pos_sd_m;
+    if (src == 1) ch.dv0_mps = sp->init_vel_sd_mps;
+    if (src == 2) ch.accel_bias_mps2 = sp->accel_bias_mps2;
+    if (src == 3) ch.tilt0_rad = sp->init_tilt_sd_rad;
+    if (src == 4) ch.gyro_bias_rps = sp->gyro_bias_rps;
+    const nav_analytic_schuler_error e = nav_analytic_schuler_north(&ch, t);
+    p2 += e.pos_m * e.pos_m;
+    v2 += e.vel_mps * e.vel_mps;
+  }
+  nav_analytic_schuler_error r = {sqrt(p2), sqrt(v2)};
+  return r;
+}
+
 typedef struct cov_rows {
   nav_cov_point *p;
   size_t n, cap;
@@ -349,6 +376,9 @@ int navsim_estimate(int argc, char **argv) {
   }
   if (acfg.with_gyrofree)
     fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_pos_m", f);
+  const bool schuler = sc.earth.model == NAV_EARTH_WGS84;
+  const double schuler_r = nav_analytic_schuler_radius_m(sc.earth.origin_lat_rad, sc.earth.origin_h_m);
+  if (schuler) fputs(",analytic_schuler_pos_sd_m,analytic_schuler_vel_sd_mps", f);
   fputc('\n', f);
   for (size_t i = 0; i < nt; ++i) {
     fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
@@ -368,6 +398,10 @@ int navsim_estimate(int argc, char **argv) {
     if (acfg.with_gyrofree)
       fprintf(f, ",%.17g,%.17g,%.17g,%d,%.17g", ana[i].gyrofree.pos_sd_m, ana[i].gyrofree.vel_sd_mps,
               ana[i].gyrofree.att_sd_rad, ana[i].gyrofree_small_angle_ok ? 1 : 0, ana[i].gyrofree_paper_pos_m);
+    if (schuler) {
+      const nav_analytic_schuler_error e = schuler_sd(&acfg.imu, schuler_r, times[i]);
+      fprintf(f, ",%.17g,%.17g", e.pos_m, e.vel_mps);
+    }
     fputc('\n', f);
   }
   const bool bad = ferror(f) != 0;
