@@ -101,10 +101,62 @@ static void test_peer_error_model_long_drive(void **state) {
   assert_true(out.stats.pos_err_h_m.max > 10.0 * full.stats.pos_err_h_m.max);
 }
 
+static nav_callback_result keep_sigma(void *user, const nav_cov_point *p) {
+  double *s = user; /* s[t] at whole seconds 0..90 */
+  const long t = lround(p->t_s);
+  if (fabs(p->t_s - (double)t) < 1e-9 && t >= 0 && t <= 90) s[t] = p->pos_h_sd_m;
+  return NAV_CONTINUE;
+}
+
+/* A segment marked gnss_visible: false (a tunnel) is a GNSS outage of the receiver: no fixes
+ * while the vehicle is in it, in the simulation and in the covariance analysis. */
+static void test_segment_tied_outage(void **state) {
+  (void)state;
+  nav_scene *sc = malloc(sizeof *sc);
+  *sc = nav_scene_default();
+  sc->earth.model = NAV_EARTH_WGS84;
+  sc->trajectory.type = NAV_TRAJ_SEGMENTS;
+  sc->trajectory.duration_s = 90.0;
+  sc->trajectory.segments.count = 3;
+  sc->trajectory.segments.v0_b_mps = nav_vec3_make(10.0, 0.0, 0.0);
+  for (int i = 0; i < 3; ++i) {
+    sc->trajectory.segments.items[i].kind = NAV_SEG_HOLD;
+    sc->trajectory.segments.items[i].duration_s = 30.0;
+    sc->trajectory.segments.items[i].gnss_visible = i != 1;
+  }
+  sc->imu.rate_hz = 100.0;
+  sc->output.rate_hz = 10.0;
+  sc->navigation.scheme = NAV_SCHEME_INS_GNSS;
+  sc->imu.model.gyro.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc->imu.model.gyro.arw_rad_per_sqrt_s = nav_vec3_make(1e-4, 1e-4, 1e-4);
+  sc->imu.model.gyro.bias_turn_on_sd_rps = nav_vec3_make(5e-5, 5e-5, 5e-5);
+  sc->imu.model.accel.terms = NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_TURN_ON;
+  sc->imu.model.accel.vrw_mps_per_sqrt_s = nav_vec3_make(1e-3, 1e-3, 1e-3);
+  sc->imu.model.accel.bias_turn_on_sd_mps2 = nav_vec3_make(5e-3, 5e-3, 5e-3);
+  sc->gnss.enabled = true;
+  sc->gnss.model.terms = NAV_GNSS_TERM_POS_WHITE | NAV_GNSS_TERM_VEL_WHITE;
+  sc->gnss.model.pos_white_sd_m = nav_vec3_make(1.0, 1.0, 2.0);
+  sc->gnss.model.vel_sd_mps = nav_vec3_make(0.05, 0.05, 0.1);
+  sc->initial_errors.pos_sd_m = nav_vec3_make(1.0, 1.0, 2.0);
+  sc->initial_errors.vel_sd_mps = nav_vec3_make(0.1, 0.1, 0.1);
+  sc->initial_errors.att_sd_rad = nav_vec3_make(1e-3, 1e-3, 1e-2);
+  nav_sim *sim = NULL;
+  assert_int_equal(nav_sim_create(sc, &sim), NAV_OK);
+  double sig[91] = {0};
+  assert_int_equal(nav_sim_covariance(sim, keep_sigma, sig), NAV_OK);
+  print_message("segment-tied outage: horizontal sigma %.3f m at 29 s, %.3f m at 59 s (blocked 30-60 s), %.3f m at 89 s\n",
+                sig[29], sig[59], sig[89]);
+  assert_true(sig[59] > 5.0 * sig[29]); /* free inertial drift while blocked */
+  assert_true(sig[89] < 0.5 * sig[59]); /* fixes again after the tunnel */
+  nav_sim_destroy(sim);
+  free(sc);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ideal_closed_loop),
       cmocka_unit_test(test_peer_error_model_long_drive),
+      cmocka_unit_test(test_segment_tied_outage),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

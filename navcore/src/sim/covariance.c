@@ -65,7 +65,13 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   int64_t out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
   if (out_stride < 1) out_stride = 1;
   const bool gnss = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
-  const nav_gnss_model_config *g = &sc->gnss.model;
+  nav_gnss_model_config gcfg;
+  st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &gcfg, msg, sizeof msg);
+  if (st != NAV_OK) {
+    nav_sim_set_error(sim, msg);
+    goto cleanup;
+  }
+  const nav_gnss_model_config *g = &gcfg;
   const bool gm_states = (xc.filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
   int64_t next_epoch = 0;
   nav_cov_point p0 = make_point(0.0, kf);

@@ -24,6 +24,7 @@
 #include "navcore/nav_truth.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
+#include "traj/traj_internal.h"
 
 /* Values kept per metric for the statistics (runs x epochs / stride): bounded memory
  * (5 metrics x 8 bytes x 4e6 = 160 MB worst case). */
@@ -115,6 +116,7 @@ typedef struct job {
   nav_mutex err_lock;
   bool err_set;
   bool gm_states; /* INS/GNSS: the filter carries GNSS GM error states */
+  nav_gnss_model_config gnss_cfg; /* the scene's receiver plus segment-tied outages */
   /* Truth shared by every run (Monte Carlo): ideal increments k = 1..n and states k = 0..n,
    * computed once; NULL when the job has one run or would need too much memory. */
   nav_imu_increment *shared_imu;
@@ -168,6 +170,49 @@ static nav_ins_state initial_state(const nav_scene *sc, const nav_frame *fr, con
   const nav_vec3 phi_f = nav_mat3_tmul_vec(v.C_f_n, phi_n);
   s0.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_rotvec(nav_vec3_scale(phi_f, -1.0)), ts->q_b_f));
   return s0;
+}
+
+/*
+ * The receiver configuration a run uses: the scene's, plus an outage for every segment of a
+ * segment script marked gnss_visible: false (tunnels, bridges of motion-definition files), from
+ * the planned segment boundaries. Outages beyond NAV_GNSS_MAX_OUTAGES are an error.
+ */
+nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
+                               size_t msg_size) {
+  *out = sc->gnss.model;
+  if (sc->trajectory.type != NAV_TRAJ_SEGMENTS) return NAV_OK;
+  bool any = false;
+  for (int i = 0; i < sc->trajectory.segments.count; ++i)
+    if (!sc->trajectory.segments.items[i].gnss_visible) any = true;
+  if (!any) return NAV_OK;
+  nav_traj *tr = NULL;
+  nav_status st = nav_traj_create_msg(sc, dt_s, &tr, msg, msg_size);
+  if (st != NAV_OK) return st;
+  static const size_t cap = NAV_MAX_SEGMENTS + 1;
+  double *b = malloc(cap * sizeof *b);
+  if (!b) {
+    nav_traj_destroy(tr);
+    return NAV_ERR_NO_MEMORY;
+  }
+  const size_t nb = nav_traj_segment_boundaries(tr, b, cap);
+  for (int i = 0; i < sc->trajectory.segments.count && (size_t)i + 1 < nb; ++i) {
+    if (sc->trajectory.segments.items[i].gnss_visible) continue;
+    const double t0 = b[i], t1 = b[i + 1];
+    /* Merge with the previous blocked segment when they touch. */
+    if (out->outage_count > 0 && fabs(out->outages[out->outage_count - 1].t1_s - t0) < 1e-9) {
+      out->outages[out->outage_count - 1].t1_s = t1;
+      continue;
+    }
+    if (out->outage_count >= NAV_GNSS_MAX_OUTAGES) {
+      if (msg) snprintf(msg, msg_size, "more than %d GNSS outages (segments with gnss_visible: false)", NAV_GNSS_MAX_OUTAGES);
+      st = NAV_ERR_OUT_OF_RANGE;
+      break;
+    }
+    if (t1 > t0) out->outages[out->outage_count++] = (nav_gnss_outage){t0, t1};
+  }
+  free(b);
+  nav_traj_destroy(tr);
+  return st;
 }
 
 /* Per-run state of the INS/GNSS scheme: the receiver model and the closed-loop integration. */
@@ -329,7 +374,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
   if (integrated) {
     /* --ideal: the receiver is perfect too (same epochs and outages, no error terms). */
-    nav_gnss_model_config gcfg = sc->gnss.model;
+    nav_gnss_model_config gcfg = j->gnss_cfg;
     if (j->ideal) gcfg.terms = 0;
     st = nav_gnss_model_create(&gcfg, &frame, sc->simulation.seed, (uint64_t)run, &aid_kf.gnss);
     if (st != NAV_OK) {
@@ -490,8 +535,15 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   j.ideal = opts->ideal;
   /* Ideal runs are identical: one is enough. */
   j.runs = opts->ideal ? 1 : sc->simulation.runs;
-  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS)
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS) {
     j.gm_states = (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
+    char gmsg[200];
+    st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &j.gnss_cfg, gmsg, sizeof gmsg);
+    if (st != NAV_OK) {
+      snprintf(sim->last_error, sizeof sim->last_error, "GNSS outages: %s", gmsg);
+      return st;
+    }
+  }
 
   char msg[200];
   st = nav_truth_create_msg(sc, &probe, msg, sizeof msg);

@@ -2,6 +2,9 @@
 #ifndef NAV_SIM_INTERNAL_H
 #define NAV_SIM_INTERNAL_H
 
+#include <stddef.h>
+
+#include "navcore/nav_sensor_config.h"
 #include "navcore/nav_sim.h"
 
 /** Set the message returned by nav_sim_last_error(). */
@@ -51,5 +54,9 @@ nav_status nav_sim_gyrofree_step(nav_sim_gyrofree *g, int64_t k, nav_imu_increme
 /** Navigation state after the last step (borrowed). */
 const nav_ins_state *nav_sim_gyrofree_state(const nav_sim_gyrofree *g);
 const char *nav_sim_gyrofree_last_error(const nav_sim_gyrofree *g);
+
+/** The receiver configuration of a scene with segment-tied outages added (gnss_visible: false). */
+nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
+                               size_t msg_size);
 
 #endif /* NAV_SIM_INTERNAL_H */

@@ -17,6 +17,7 @@ struct nav_traj {
   nav_traj_model m;
   nav_frame frame;
   nav_gravity_model gravity;
+  int type_segments; /* the model is a segment script (nav_traj_segment_boundaries) */
   nav_vec3 g_l_mps2; /* flat Earth: uniform gravity in l */
   double dt_s;       /* IMU interval of the create call (sample grid k dt) */
   double inv_m_lat, inv_m_lon; /* 1 / frame.m_per_rad_lat, 1 / frame.m_per_rad_lon (0 if that is 0) */
@@ -169,6 +170,7 @@ nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **o
   case NAV_TRAJ_SEGMENTS:
     st = nav_traj_segments_create(scene, dt_s, &tr->m, msg, msg_size);
     tr->nodes = nav_traj_segments_nodes;
+    tr->type_segments = 1;
     break;
   case NAV_TRAJ_RECORDED: st = nav_traj_recorded_create(scene, dt_s, &tr->m, msg, msg_size); break;
   default:
@@ -289,6 +291,11 @@ nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2, 
   *f_ib_b_mps2 = nav_quat_rotate(q_n_b, f_n);
   *w_ib_b_rps = nav_vec3_add(g.w_nb_b_rps, nav_quat_rotate(q_n_b, nav_vec3_add(w_ie_n, nk.w_en_n)));
   return NAV_OK;
+}
+
+size_t nav_traj_segment_boundaries(const nav_traj *traj, double *out, size_t cap) {
+  if (!traj || traj->type_segments == 0) return 0;
+  return nav_traj_segments_boundaries(traj->m.self, out, cap);
 }
 
 nav_status nav_traj_rate_integral(const nav_traj *traj, double t0_s, double t1_s, nav_vec3 *out,

@@ -75,4 +75,7 @@ nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_tra
 nav_status nav_traj_recorded_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
                                     size_t msg_size);
 
+/** Segment boundaries B_0 .. B_count of a segment-script trajectory (0 for other models). */
+size_t nav_traj_segment_boundaries(const nav_traj *traj, double *out, size_t cap);
+
 #endif /* NAV_TRAJ_INTERNAL_H */
