@@ -183,6 +183,10 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opt,
 
   vtkNew<vtkContextView> view;
   view->GetRenderWindow()->SetOffScreenRendering(1);
+  // A headless chart needs no interactor. vtkContextView creates one, and the first Render()
+  // initialises it (vtkXRenderWindowInteractor::Initialize -> XSync), which crashed
+  // intermittently under Xvfb (7th of 40 runs under load; backtrace in XSync). Detach it.
+  view->GetRenderWindow()->SetInteractor(nullptr);
   view->GetRenderWindow()->SetSize(opt.width_px, opt.height_px);
   view->GetRenderWindow()->SetMultiSamples(8);
   view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
