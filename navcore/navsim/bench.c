@@ -98,12 +98,7 @@ static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
     snprintf(row->error, sizeof row->error, "truth state evaluation failed");
     goto cleanup;
   }
-  nav_ins_config cfg = nav_ins_config_default();
-  cfg.earth_model = sc->earth.model;
-  cfg.algorithm = sc->navigation.algorithm;
-  cfg.mech_frame = sc->navigation.frame;
-  cfg.gravity_model = sc->earth.gravity_model;
-  cfg.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
+  const nav_ins_config cfg = nav_ins_config_from_scene(sc);
   const nav_ins_state s0 = {0.0, ts0.r_fb_f_m, ts0.v_fb_f_mps, ts0.q_b_f};
   double times[16];
   if (reps > 16) reps = 16;

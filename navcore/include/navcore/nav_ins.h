@@ -105,6 +105,10 @@ typedef struct nav_ins nav_ins;
  *  no vertical clamp, predictor-corrector gravity. */
 NAV_API nav_ins_config nav_ins_config_default(void);
 
+/** The mechanization a scene selects: Earth and gravity model, algorithm, frame, flat gravity;
+ *  the other fields at their defaults. */
+NAV_API nav_ins_config nav_ins_config_from_scene(const nav_scene *scene);
+
 /**
  * Create a mechanization starting at @p initial.
  * @param[in]  cfg     configuration (copied)

@@ -92,12 +92,7 @@ static nav_filter_config filter_config(const nav_scene *sc) {
 nav_ins_gnss_config nav_ins_gnss_config_from_scene(const nav_scene *sc) {
   nav_ins_gnss_config c;
   memset(&c, 0, sizeof c);
-  c.ins = nav_ins_config_default();
-  c.ins.earth_model = sc->earth.model;
-  c.ins.algorithm = sc->navigation.algorithm;
-  c.ins.mech_frame = sc->navigation.frame;
-  c.ins.gravity_model = sc->earth.gravity_model;
-  c.ins.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
+  c.ins = nav_ins_config_from_scene(sc);
   c.filter = filter_config(sc);
   c.r_ba_b_m = sc->gnss.model.r_ba_b_m;
   c.pos_sd_floor_m = 1e-3;

@@ -402,6 +402,16 @@ static nav_status ins_init(nav_ins *ins, const nav_ins_config *cfg, const nav_in
   return NAV_OK;
 }
 
+nav_ins_config nav_ins_config_from_scene(const nav_scene *scene) {
+  nav_ins_config c = nav_ins_config_default();
+  c.earth_model = scene->earth.model;
+  c.algorithm = scene->navigation.algorithm;
+  c.mech_frame = scene->navigation.frame;
+  c.gravity_model = scene->earth.gravity_model;
+  c.g_l_mps2 = nav_vec3_make(0.0, 0.0, scene->earth.flat_gravity_mps2);
+  return c;
+}
+
 nav_status nav_ins_create(const nav_ins_config *cfg, const nav_ins_state *initial, nav_ins **out) {
   if (!cfg || !initial || !out) return NAV_ERR_INVALID_ARG;
   nav_ins *ins = calloc(1, sizeof *ins);

@@ -359,12 +359,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   else st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
   const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
-  nav_ins_config icfg = nav_ins_config_default();
-  icfg.earth_model = sc->earth.model;
-  icfg.algorithm = sc->navigation.algorithm;
-  icfg.mech_frame = sc->navigation.frame;
-  icfg.gravity_model = sc->earth.gravity_model;
-  icfg.g_l_mps2 = nav_vec3_make(0.0, 0.0, sc->earth.flat_gravity_mps2);
+  const nav_ins_config icfg = nav_ins_config_from_scene(sc);
   st = nav_ins_create(&icfg, &s0, &ins);
   if (st != NAV_OK) {
     job_error(j, "run %ld: navigation set-up: %s", run, nav_status_str(st));
