@@ -8,6 +8,11 @@ NAV_PACKAGES=(
   libcmocka-dev libfyaml-dev libgeographiclib-dev
   libvtk9-dev fonts-dejavu-core
   xvfb xauth
+  libvtk9-qt-dev qtbase5-dev        # navstudio (Qt5 + QVTKOpenGLNativeWidget; toolchain.md section 4)
+  libopenmpi-dev openmpi-bin        # MPI Monte Carlo campaigns (issue 9)
+  clang libfuzzer-14-dev            # libFuzzer targets (tests/fuzz)
+  chromium                          # navsim report check (headless screenshot)
+  python-cartopy-data gmt-gshhg-low # offline map background (coastlines, borders)
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
