@@ -6,6 +6,7 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
+  libexpat1-dev libxml2-utils       # GPX/KML import (expat); xmllint checks exported KML in tests
   libvtk9-dev fonts-dejavu-core
   xvfb xauth
   libvtk9-qt-dev qtbase5-dev        # navstudio (Qt5 + QVTKOpenGLNativeWidget; toolchain.md section 4)
@@ -39,12 +40,26 @@ nav_ensure_packages() {
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# navstudio (editor/) is built when Qt5 and VTK's Qt support are installed, in the plain build
+# only: not in the sanitizer builds (Qt and Mesa are outside our code) nor without the viewer.
+nav_editor_args() {
+  case " $* " in *NAV_SANITIZE=ON*|*NAV_TSAN=ON*|*NAV_BUILD_VIEWER=OFF*) return 0 ;; esac
+  if compgen -G "/usr/lib/*/cmake/Qt5/Qt5Config.cmake" >/dev/null && [ -f /usr/include/vtk-9.1/QVTKOpenGLNativeWidget.h ]; then
+    echo "-DNAV_BUILD_EDITOR=ON"
+  fi
+}
+
 # Configure once, then build incrementally. Extra cmake arguments may be passed.
 nav_build() {
+  local editor
+  editor="$(nav_editor_args "$@")"
   if [ ! -f "$NAV_BUILD/build.ninja" ]; then
     nav_log "configuring $NAV_BUILD"
     cmake -S "$NAV_ROOT" -B "$NAV_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNAV_WERROR=ON \
-      -DNAV_BUILD_VIEWER=ON "$@" >/dev/null
+      -DNAV_BUILD_VIEWER=ON $editor "$@" >/dev/null
+  elif [ -n "$editor" ] && ! grep -q '^NAV_BUILD_EDITOR:BOOL=ON' "$NAV_BUILD/CMakeCache.txt" 2>/dev/null; then
+    nav_log "enabling navstudio in $NAV_BUILD"
+    cmake "$NAV_BUILD" $editor >/dev/null
   fi
   cmake --build "$NAV_BUILD" -- -j"$(nproc)" >&2
 }

@@ -15,9 +15,12 @@ namespace {
 
 void Usage(FILE *f) {
   std::fprintf(f,
-               "usage: navview RESULT_DIR [--png FILE] [--chart FILE] [--size WxH] [--time T]\n"
+               "usage: navview RESULT_DIR [--view 3d|top|map|errors|noise] [--png FILE] [--chart FILE]\n"
+               "               [--size WxH] [--time T]\n"
                "               [--exaggerate K] [options]\n"
                "       navview --bench [--bench-epochs N] [--bench-paths M] [--size WxH]\n"
+               "       navview --speed-vs-error bench.csv --png out.png\n"
+               "       navview --allan allan.csv --png out.png\n"
                "\n"
                "Show the result directory written by `navsim run`: reference and estimated paths,\n"
                "attitude triads, the error-envelope tube, ground grid with scale, NED axes and legend.\n"
@@ -26,17 +29,34 @@ void Usage(FILE *f) {
                "jobs under xvfb-run -a.\n"
                "\n"
                "options:\n"
-               "  --png FILE          write the 3D view as PNG\n"
+               "  --png FILE          write the view chosen by --view as PNG (default the 3D view)\n"
+               "  --view NAME         3d | oblique | top (3D view), map (geodetic map), errors (error\n"
+               "                      charts), noise (simulated sensor errors, imu_errors.csv)\n"
+               "  --map               same as --view map\n"
+               "  --map-span KM       map width [km] (default: fit the tracks); e.g. 4000 continent, 0.5 street\n"
+               "  --map-center LAT,LON  map centre [deg] (default: the tracks' centre)\n"
+               "  --movie DIR         playback movie: DIR/frame_NNNN.png over the run (fixed camera) and\n"
+               "                      DIR/playback.ogv (Ogg Theora); --movie-frames N (120), --movie-fps F\n"
+               "                      (24), --movie-no-video (PNG frames only)\n"
+               "  --allan ALLAN_CSV   Allan deviation chart of navsim allan's allan.csv (with --png; no DIR)\n"
+               "  --speed-vs-error BENCH_CSV  speed-vs-error chart of navsim bench's bench.csv (with --png)\n"
                "  --chart FILE        write the error-vs-time charts as PNG\n"
                "  --size WxH          image/window size in pixels (default 1000x700; charts 900x800)\n"
                "  --time T            playback time of the vehicle glyph and read-out [s] (default: end)\n"
                "  --exaggerate K      attitude-error exaggeration of the estimated triads (default 1)\n"
                "  --envelope-k K      tube radius = K x sigma_h (default 3)\n"
-               "  --envelope SRC      auto | run | mc | none (default auto: mc when mc_stats.csv exists)\n"
+               "  --envelope SRC      auto | run | mc | filter | cov | none: tube and ellipsoid sigma from\n"
+               "                      run-0 errors, Monte Carlo RMS, the filter's reported sigma (mc_stats),\n"
+               "                      or the covariance analysis (estimate.csv in DIR or DIR-estimate);\n"
+               "                      default auto: mc, else cov, else run\n"
+               "  --ellipsoids N      covariance ellipsoids at N epochs spread over the run (default 6)\n"
+               "  --ellipsoid-times T1,T2,...  ellipsoid epochs [s] instead\n"
+               "  --vehicle KIND      auto | car | aircraft | generic (default auto: from the scene name)\n"
+               "  --no-gnss           hide GNSS fixes and outage highlighting (gnss.csv)\n"
                "  --triad-interval S  seconds between triads (default: about 24 along the run)\n"
                "  --triad-size M      triad arrow length [m] (default: from the scene extent)\n"
                "  --color-by-error    colour the estimated path by horizontal error (with a scalar bar)\n"
-               "  --view NAME         oblique | top (default oblique)\n"
+
                "  --no-text           no labels, legend or read-out\n"
                "  --msaa N            multisample anti-aliasing samples, 0 = off (default: 8 for PNG,\n"
                "                      0 for the interactive window and --bench)\n"
@@ -152,11 +172,15 @@ std::shared_ptr<NavResult> SyntheticResult(size_t epochs, int paths) {
 } // namespace
 
 int main(int argc, char **argv) {
-  std::string dir, png, chart;
+  std::string dir, png, chart, view_kind = "3d", allan_csv, bench_csv;
   NavViewOptions opt;
   NavChartOptions copt;
+  NavMapOptions mopt;
   bool size_given = false, bench = false, msaa_given = false;
-  int bench_frames = 60, bench_paths = 20;
+  int bench_frames = 60, bench_paths = 20, movie_frames = 120;
+  std::string movie_dir;
+  double movie_fps = 24.0;
+  bool movie_video = true;
   long bench_epochs = 720000;
 
   for (int i = 1; i < argc; ++i) {
@@ -209,6 +233,10 @@ int main(int argc, char **argv) {
         opt.envelope_source = NavEnvelopeSource::RunErrors;
       else if (s == "mc")
         opt.envelope_source = NavEnvelopeSource::MonteCarlo;
+      else if (s == "filter")
+        opt.envelope_source = NavEnvelopeSource::Filter;
+      else if (s == "cov" || s == "covariance")
+        opt.envelope_source = NavEnvelopeSource::Covariance;
       else if (s == "none")
         opt.envelope_source = NavEnvelopeSource::None;
       else
@@ -221,16 +249,82 @@ int main(int argc, char **argv) {
       const char *s = need("M [m]");
       if (!ParseDouble(s, &v) || v <= 0.0) bad(s);
       opt.triad_size_m = v;
+    } else if (a == "--ellipsoids") {
+      const char *s = need("N");
+      if (!ParseDouble(s, &v) || v < 0 || v > 1000) bad(s);
+      opt.ellipsoid_count = static_cast<int>(v);
+    } else if (a == "--ellipsoid-times") {
+      const std::string s = need("T1,T2,...");
+      opt.ellipsoid_times_s.clear();
+      size_t p = 0;
+      while (p <= s.size()) {
+        const size_t c = s.find(',', p);
+        const std::string tok = s.substr(p, c == std::string::npos ? std::string::npos : c - p);
+        if (!ParseDouble(tok.c_str(), &v)) bad(s.c_str());
+        opt.ellipsoid_times_s.push_back(v);
+        if (c == std::string::npos) break;
+        p = c + 1;
+      }
+    } else if (a == "--vehicle") {
+      const std::string s = need("auto|car|aircraft|generic");
+      if (s == "auto")
+        opt.vehicle = NavVehicleKind::Auto;
+      else if (s == "car")
+        opt.vehicle = NavVehicleKind::Car;
+      else if (s == "aircraft")
+        opt.vehicle = NavVehicleKind::Aircraft;
+      else if (s == "generic")
+        opt.vehicle = NavVehicleKind::Generic;
+      else
+        bad(s.c_str());
+    } else if (a == "--no-gnss") {
+      opt.show_gnss = false;
     } else if (a == "--color-by-error") {
       opt.color_by_error = true;
     } else if (a == "--view") {
-      const std::string s = need("oblique|top");
-      if (s == "oblique")
+      const std::string s = need("3d|oblique|top|map|errors|noise");
+      if (s == "oblique" || s == "3d") {
         opt.camera = NavCameraPreset::Oblique;
-      else if (s == "top")
+        view_kind = "3d";
+      } else if (s == "top") {
         opt.camera = NavCameraPreset::Top;
-      else
+        view_kind = "3d";
+      } else if (s == "map" || s == "errors" || s == "noise") {
+        view_kind = s;
+      } else {
         bad(s.c_str());
+      }
+    } else if (a == "--map") {
+      view_kind = "map";
+    } else if (a == "--map-span") {
+      const char *s = need("KM");
+      if (!ParseDouble(s, &v) || v <= 0.0 || v > 50000.0) bad(s);
+      mopt.span_km = v;
+    } else if (a == "--map-center") {
+      const std::string s = need("LAT,LON [deg]");
+      const size_t c = s.find(',');
+      double la = 0, lo = 0;
+      if (c == std::string::npos || !ParseDouble(s.substr(0, c).c_str(), &la) ||
+          !ParseDouble(s.substr(c + 1).c_str(), &lo) || std::fabs(la) > 90 || std::fabs(lo) > 360)
+        bad(s.c_str());
+      mopt.center_lat_deg = la;
+      mopt.center_lon_deg = lo;
+    } else if (a == "--movie") {
+      movie_dir = need("DIR");
+    } else if (a == "--movie-frames") {
+      const char *s = need("N");
+      if (!ParseDouble(s, &v) || v < 1 || v > 100000) bad(s);
+      movie_frames = static_cast<int>(v);
+    } else if (a == "--movie-fps") {
+      const char *s = need("F");
+      if (!ParseDouble(s, &v) || v <= 0 || v > 240) bad(s);
+      movie_fps = v;
+    } else if (a == "--movie-no-video") {
+      movie_video = false;
+    } else if (a == "--allan") {
+      allan_csv = need("ALLAN_CSV");
+    } else if (a == "--speed-vs-error") {
+      bench_csv = need("BENCH_CSV");
     } else if (a == "--msaa") {
       const char *s = need("N");
       if (!ParseDouble(s, &v) || v < 0 || v > 16) bad(s);
@@ -272,6 +366,30 @@ int main(int argc, char **argv) {
     copt.width_px = 900;
     copt.height_px = 800;
   }
+  mopt.width_px = opt.width_px;
+  mopt.height_px = opt.height_px;
+  mopt.show_text = opt.show_text;
+  mopt.show_gnss = opt.show_gnss;
+  mopt.multisamples = opt.multisamples;
+  // Chart-only modes: no result directory.
+  if (!allan_csv.empty() || !bench_csv.empty()) {
+    if (png.empty()) {
+      std::fprintf(stderr, "navview: --allan / --speed-vs-error need --png FILE\n");
+      return 2;
+    }
+    if (!size_given) {
+      copt.width_px = 900;
+      copt.height_px = allan_csv.empty() ? 600 : 800;
+    }
+    std::string e2;
+    const bool ok = allan_csv.empty() ? NavRenderSpeedVsErrorPng(bench_csv, copt, png, &e2)
+                                      : NavRenderAllanChartPng(allan_csv, copt, png, &e2);
+    if (!ok) {
+      std::fprintf(stderr, "navview: %s\n", e2.c_str());
+      return 1;
+    }
+    return 0;
+  }
   if (dir.empty() && !bench) {
     Usage(stderr);
     return 2;
@@ -279,7 +397,7 @@ int main(int argc, char **argv) {
 
   // Multisampling costs about a factor three in frame rate on llvmpipe: PNGs get 8 samples,
   // the interactive window and the benchmark none unless --msaa says otherwise.
-  if (!msaa_given && (bench || (png.empty() && chart.empty()))) opt.multisamples = 0;
+  if (!msaa_given && (bench || (png.empty() && chart.empty() && movie_dir.empty()))) opt.multisamples = 0;
 
   std::string err;
   std::shared_ptr<NavResult> result;
@@ -313,10 +431,28 @@ int main(int argc, char **argv) {
         "navview bench: build + first frame %.2f s, %.1f frames/s over %d frames (%.1f ms CPU per frame, "
         "all threads)\n",
         b.build_s, b.fps, b.frames, 1e3 * b.cpu_s_per_frame);
+    // One machine-readable line (navsim bench and scripts parse it): key=value, space-separated.
+    std::printf("navview_bench fps=%.3f frames=%d build_s=%.3f cpu_ms_per_frame=%.3f epochs=%zu paths=%zu "
+                "drawn_vertices=%zu tol_m=%.4g width=%d height=%d msaa=%d\n",
+                b.fps, b.frames, b.build_s, 1e3 * b.cpu_s_per_frame,
+                result->truth.Size(), 1 + result->extra_runs.size(), b.drawn_points, b.tol_m, opt.width_px,
+                opt.height_px, opt.multisamples);
     if (png.empty() && chart.empty()) return 0;
   }
   int rc = 0;
-  if (!png.empty()) {
+  if (!png.empty() && view_kind != "3d") {
+    bool ok = false;
+    if (view_kind == "map")
+      ok = NavRenderMapPng(*result, mopt, png, &err);
+    else if (view_kind == "errors")
+      ok = NavRenderErrorChartPng(*result, copt, png, &err);
+    else
+      ok = NavRenderSensorErrorChartPng(*result, copt, png, &err);
+    if (!ok) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      rc = 1;
+    }
+  } else if (!png.empty()) {
     if (!view.RenderPng(png, &err)) {
       std::fprintf(stderr, "navview: %s\n", err.c_str());
       rc = 1;
@@ -328,7 +464,13 @@ int main(int argc, char **argv) {
       rc = 1;
     }
   }
-  if (png.empty() && chart.empty() && !bench) {
+  if (!movie_dir.empty()) {
+    if (!view.RenderMovie(movie_dir, movie_frames, movie_fps, movie_video, &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      rc = 1;
+    }
+  }
+  if (png.empty() && chart.empty() && !bench && movie_dir.empty()) {
     if (!view.RunInteractive(&err)) {
       std::fprintf(stderr, "navview: %s\n", err.c_str());
       return 1;

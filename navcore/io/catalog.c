@@ -276,6 +276,7 @@ enum imu_col {
   I_BIAS_MODEL,
   I_SOURCE,
   I_VERIFIED,
+  I_COST_CLASS,
   I_COUNT
 };
 
@@ -297,11 +298,12 @@ static const char *const imu_cols[I_COUNT] = {"name",
                                               "bias_corr_time_s",
                                               "bias_model",
                                               "source",
-                                              "verified_in_corpus"};
+                                              "verified_in_corpus",
+                                              "cost_class"};
 static const bool imu_required[I_COUNT] = {
     [I_NAME] = true, [I_GRADE] = true, [I_SOURCE] = true, [I_VERIFIED] = true};
 
-enum gnss_col { G_MODE, G_H_SD, G_V_SD, G_CORR, G_VEL_SD, G_RATE, G_SOURCE, G_VERIFIED, G_COUNT };
+enum gnss_col { G_MODE, G_H_SD, G_V_SD, G_CORR, G_VEL_SD, G_RATE, G_SOURCE, G_VERIFIED, G_COST_CLASS, G_COUNT };
 
 static const char *const gnss_cols[G_COUNT] = {"mode",
                                                "horizontal_sigma_per_axis_m",
@@ -310,7 +312,8 @@ static const char *const gnss_cols[G_COUNT] = {"mode",
                                                "velocity_sigma_per_axis_m_per_s",
                                                "update_rate_hz",
                                                "source",
-                                               "verified_in_corpus"};
+                                               "verified_in_corpus",
+                                               "cost_class"};
 static const bool gnss_required[G_COUNT] = {[G_MODE] = true, [G_H_SD] = true,   [G_V_SD] = true,
                                             [G_RATE] = true, [G_SOURCE] = true, [G_VERIFIED] = true};
 
@@ -464,6 +467,19 @@ static void text(row *w, int k, char *dst, size_t size, bool required) {
   memcpy(dst, f->s, strlen(f->s) + 1);
 }
 
+/* Optional cost class (column cost_class): an integer 1..NAV_CATALOG_COST_CLASS_MAX; 0 when the
+ * column is absent or the cell empty. */
+static int cost_class(row *w, int k) {
+  field *f = cell(w, k);
+  if (!f || f->s[0] == '\0') return 0;
+  const char *s = f->s;
+  if (s[0] >= '1' && s[0] <= '0' + NAV_CATALOG_COST_CLASS_MAX && s[1] == '\0') return s[0] - '0';
+  diag(w->c, f->line, f->col, w->cols[k], "'%s': expected an integer cost class from 1 to %d", s,
+       NAV_CATALOG_COST_CLASS_MAX);
+  w->ok = false;
+  return 0;
+}
+
 static nav_catalog_verification verification(row *w, int k, const char *s) {
   char word[16];
   size_t n = 0;
@@ -514,6 +530,7 @@ static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_
   text(w, I_SOURCE, e->source, sizeof e->source, true);
   text(w, I_VERIFIED, e->verified_text, sizeof e->verified_text, true);
   e->verified = verification(w, I_VERIFIED, e->verified_text);
+  e->cost_class = cost_class(w, I_COST_CLASS);
 
   e->bias_model = NAV_CATALOG_BIAS_ALLAN_MIN;
   const field *bm = cell(w, I_BIAS_MODEL);
@@ -647,6 +664,7 @@ static void convert_gnss(row *w, nav_catalog_gnss_entry *e) {
   text(w, G_SOURCE, e->source, sizeof e->source, true);
   text(w, G_VERIFIED, e->verified_text, sizeof e->verified_text, true);
   e->verified = verification(w, G_VERIFIED, e->verified_text);
+  e->cost_class = cost_class(w, G_COST_CLASS);
   nav_gnss_model_config cfg = nav_gnss_model_config_default();
   bool has_h = false, has_v = false, has_t = false, has_vel = false, has_rate = false;
   const double h = number(w, G_H_SD, false, &has_h);
@@ -853,6 +871,17 @@ const nav_catalog_gnss_entry *nav_catalog_find_gnss(const nav_catalog *cat, cons
   for (size_t i = 0; i < cat->count; ++i)
     if (equal_nocase(cat->gnss[i].name, name)) return &cat->gnss[i];
   return NULL;
+}
+
+const char *nav_catalog_cost_band(int cost_class) {
+  switch (cost_class) {
+  case 1: return "< 100 USD";
+  case 2: return "100 USD - 1 kUSD";
+  case 3: return "1 - 10 kUSD";
+  case 4: return "10 - 100 kUSD";
+  case 5: return "> 100 kUSD";
+  default: return "not given";
+  }
 }
 
 const char *nav_catalog_verification_name(nav_catalog_verification v) {

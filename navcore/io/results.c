@@ -1,8 +1,9 @@
 /* Result directories (atomic) and the CSV / JSON exporters of a run. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* renameat2 (RENAME_EXCHANGE) */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -56,6 +57,28 @@ static void fsync_path(const char *path) {
   }
 }
 
+/* Remove the temporaries ".BASE.tmp-PID-*" in @p dir (dir_len bytes of @p path; "" = ".") left by
+ * a process PID that no longer exists (killed while writing). A PID that is alive, even if
+ * reused by another program, keeps its directory. */
+static void remove_stale(const char *path, int dir_len, const char *base) {
+  char dir[PATH_CAP], prefix[PATH_CAP], child[PATH_CAP];
+  snprintf(dir, sizeof dir, "%.*s", dir_len > 0 ? dir_len : 1, dir_len > 0 ? path : ".");
+  if (snprintf(prefix, sizeof prefix, ".%s.tmp-", base) >= (int)sizeof prefix) return;
+  const size_t np = strlen(prefix);
+  DIR *d = opendir(dir);
+  if (!d) return;
+  struct dirent *e;
+  while ((e = readdir(d)) != NULL) {
+    if (strncmp(e->d_name, prefix, np) != 0) continue;
+    char *end = NULL;
+    const long pid = strtol(e->d_name + np, &end, 10);
+    if (pid <= 0 || !end || *end != '-' || pid == (long)getpid()) continue;
+    if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+    if (snprintf(child, sizeof child, "%s/%s", dir, e->d_name) < (int)sizeof child) remove_tree(child);
+  }
+  closedir(d);
+}
+
 nav_status nav_resultdir_begin(const char *final_dir, nav_resultdir **out) {
   if (!final_dir || !*final_dir || !out) return NAV_ERR_INVALID_ARG;
   nav_resultdir *rd = calloc(1, sizeof *rd);
@@ -68,10 +91,11 @@ nav_status nav_resultdir_begin(const char *final_dir, nav_resultdir **out) {
   const char *slash = strrchr(rd->final_dir, '/');
   const char *base = slash ? slash + 1 : rd->final_dir;
   const int dir_len = slash ? (int)(slash - rd->final_dir) + 1 : 0;
-  if (snprintf(rd->tmp_dir, sizeof rd->tmp_dir, "%.*s.%s.tmp-XXXXXX", dir_len, rd->final_dir, base) >=
-      (int)sizeof rd->tmp_dir)
+  if (snprintf(rd->tmp_dir, sizeof rd->tmp_dir, "%.*s.%s.tmp-%ld-XXXXXX", dir_len, rd->final_dir, base,
+               (long)getpid()) >= (int)sizeof rd->tmp_dir)
     goto fail;
   if (make_parents(rd->tmp_dir) != 0 || !mkdtemp(rd->tmp_dir)) goto fail;
+  remove_stale(rd->final_dir, dir_len, base);
   *out = rd;
   return NAV_OK;
 fail:
@@ -103,6 +127,16 @@ nav_status nav_resultdir_commit(nav_resultdir *rd) {
   }
   fsync_path(rd->tmp_dir);
   struct stat stt;
+#ifdef RENAME_EXCHANGE
+  /* Linux: swap the new directory with the previous result in one step, so the final name holds
+     the old or the new result at every instant (a kill never leaves neither). The temporary name
+     then holds the previous result, which is removed. */
+  if (stat(rd->final_dir, &stt) == 0 && S_ISDIR(stt.st_mode) &&
+      renameat2(AT_FDCWD, rd->tmp_dir, AT_FDCWD, rd->final_dir, RENAME_EXCHANGE) == 0) {
+    remove_tree(rd->tmp_dir);
+    goto done;
+  }
+#endif
   if (stat(rd->final_dir, &stt) == 0) {
     /* Move the previous result aside first; rename(2) cannot replace a non-empty directory. */
     snprintf(old, sizeof old, "%s.old-%ld", rd->tmp_dir, (long)getpid());
@@ -262,7 +296,10 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   json_stat(f, "vel_err_mps", sum->stats.vel_err_mps, false);
   json_stat(f, "att_err_rad", sum->stats.att_err_rad, false);
   json_stat(f, "yaw_err_rad", sum->stats.yaw_err_rad, true);
-  fputs("  }\n}\n", f);
+  fputs("  },\n  \"requirements\": ", f);
+  if (nav_requirements_write_json(f, info->requirements, info->requirements ? info->n_requirements : 0, 2) != NAV_OK)
+    fputs("[]", f);
+  fputs("\n}\n", f);
   const bool bad = ferror(f) != 0;
   if (fclose(f) != 0 || bad) return NAV_ERR_IO;
   return NAV_OK;

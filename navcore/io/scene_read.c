@@ -71,6 +71,9 @@ _Static_assert(sizeof(nav_mech_frame) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_nav_scheme) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_bi_convention) == sizeof(int), "enum storage");
 _Static_assert(sizeof(nav_array_layout_kind) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_req_metric) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_req_statistic) == sizeof(int), "enum storage");
+_Static_assert(sizeof(nav_req_unit) == sizeof(int), "enum storage");
 
 #define PATH_MAX_LEN ((size_t)sizeof(((nav_diag *)0)->path))
 #define MAX_SECTION_FIELDS 64 /* descriptors per section; checked when a section is read */
@@ -548,6 +551,17 @@ static const nav_io_field k_navigation[] = {
      .kind = NAV_IO_BOOL,
      .offset = OFF(navigation.aid_vertical),
      .comment = "free INS: height and vertical velocity from the reference"},
+    {.key = "cov_decimation",
+     .kind = NAV_IO_INT,
+     .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = OFF(navigation.cov_decimation),
+     .min = 0.0,
+     .max = 1000.0,
+     .comment = "ins_gnss: filter covariance propagated once every N IMU steps (0 or 1: every step)"},
+    {.key = "estimate_scale_factors",
+     .kind = NAV_IO_BOOL,
+     .offset = OFF(navigation.estimate_scale_factors),
+     .comment = "ins_gnss: 21-state filter with gyro and accelerometer scale-factor states"},
 };
 DEFINE_SECTION(k_navigation_section, k_navigation);
 
@@ -572,6 +586,60 @@ static const nav_io_field k_simulation[] = {
 };
 DEFINE_SECTION(k_simulation_section, k_simulation);
 
+/* ---------------------------------------------------------------- requirements (nav_requirements.h) */
+
+/* requirements: a list of {id, metric, statistic, limit, unit, time_s (at_time only)}; the
+   cross-field rules (unit vs metric, cep, ids) are nav_requirements_validate's. */
+static void read_requirements(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                              const nav_io_node *value, void *base);
+static nav_status write_requirements(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
+static bool same_requirements(const nav_io_field *f, const void *a, const void *b);
+static bool requirements_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                                 const void *def);
+static bool req_time_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
+
+static const nav_io_enum_value k_req_metrics[] = {{"horizontal_position", NAV_REQ_HORIZONTAL_POSITION},
+                                                  {"vertical_position", NAV_REQ_VERTICAL_POSITION},
+                                                  {"position_3d", NAV_REQ_POSITION_3D},
+                                                  {"velocity", NAV_REQ_VELOCITY},
+                                                  {"roll_pitch", NAV_REQ_ROLL_PITCH},
+                                                  {"yaw", NAV_REQ_YAW},
+                                                  {NULL, 0}};
+static const nav_io_enum_value k_req_statistics[] = {
+    {"rms", NAV_REQ_RMS},       {"max", NAV_REQ_MAX},     {"p95", NAV_REQ_P95},     {"at_time", NAV_REQ_AT_TIME},
+    {"outage_end", NAV_REQ_OUTAGE_END}, {"cep50", NAV_REQ_CEP50}, {"cep95", NAV_REQ_CEP95}, {NULL, 0}};
+static const nav_io_enum_value k_req_units[] = {
+    {"m", NAV_REQ_UNIT_M},         {"cm", NAV_REQ_UNIT_CM},         {"km", NAV_REQ_UNIT_KM},
+    {"m/s", NAV_REQ_UNIT_MPS},     {"cm/s", NAV_REQ_UNIT_CMPS},     {"deg", NAV_REQ_UNIT_DEG},
+    {"arcmin", NAV_REQ_UNIT_ARCMIN}, {"arcsec", NAV_REQ_UNIT_ARCSEC}, {"mrad", NAV_REQ_UNIT_MRAD},
+    {"rad", NAV_REQ_UNIT_RAD},     {NULL, 0}};
+
+#define RQ(member) offsetof(nav_requirement, member)
+static const nav_io_field k_requirement[] = {
+    {.key = "id", .kind = NAV_IO_STRING, .flags = NAV_IO_REQUIRED, .offset = RQ(id), .size = NAV_REQ_ID_MAX},
+    {.key = "metric", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(metric), .enums = k_req_metrics},
+    {.key = "statistic",
+     .kind = NAV_IO_ENUM,
+     .flags = NAV_IO_REQUIRED,
+     .offset = RQ(statistic),
+     .enums = k_req_statistics},
+    {.key = "limit",
+     .kind = NAV_IO_DOUBLE,
+     .flags = POSITIVE | NAV_IO_REQUIRED,
+     .offset = RQ(limit),
+     .scale = 1.0,
+     .mark_as = "limit"},
+    {.key = "unit", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(unit), .enums = k_req_units},
+    {.key = "time_s",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NONNEG,
+     .offset = RQ(time_s),
+     .scale = 1.0,
+     .write_if = req_time_written},
+};
+#undef RQ
+DEFINE_SECTION(k_requirement_section, k_requirement);
+
 static const nav_io_field k_root[] = {
     {.key = "format_version",
      .kind = NAV_IO_CUSTOM,
@@ -588,6 +656,12 @@ static const nav_io_field k_root[] = {
     {.key = "navigation", .kind = NAV_IO_SECTION, .section = &k_navigation_section},
     {.key = "output", .kind = NAV_IO_SECTION, .section = &k_output_section},
     {.key = "simulation", .kind = NAV_IO_SECTION, .section = &k_simulation_section},
+    {.key = "requirements",
+     .kind = NAV_IO_CUSTOM,
+     .read = read_requirements,
+     .write = write_requirements,
+     .same = same_requirements,
+     .write_if = requirements_written},
 };
 _Static_assert(COUNT(k_root) <= MAX_SECTION_FIELDS, "k_root: too many fields");
 const nav_io_section nav_io_scene_schema = {k_root, COUNT(k_root), NULL};
@@ -2592,7 +2666,23 @@ static void on_validate_issue(void *user, const char *path, const char *message)
   for (int i = 0; i < r->nerr_paths; ++i)
     if (path_related(r->err_paths[i], path)) return;
   int line = 0, col = 0;
-  find_mark(r, path, &line, &col);
+  if (!find_mark(r, path, &line, &col) && message != NULL) {
+    /* The field keeps a default the file does not spell out: point at another field the
+       message names ("must not exceed imu.rate_hz"), else at the top of the document. */
+    for (const char *p = message; *p && line == 0; ++p) {
+      if (!(*p >= 'a' && *p <= 'z') || (p > message && p[-1] != ' ' && p[-1] != '(')) continue;
+      char tok[PATH_MAX_LEN];
+      size_t n = 0;
+      while (n + 1 < sizeof tok && ((p[n] >= 'a' && p[n] <= 'z') || (p[n] >= '0' && p[n] <= '9') ||
+                                    p[n] == '_' || p[n] == '.'))
+        ++n;
+      while (n > 0 && p[n - 1] == '.') --n;
+      memcpy(tok, p, n);
+      tok[n] = '\0';
+      if (strchr(tok, '.') != NULL) find_mark(r, tok, &line, &col);
+    }
+    if (line == 0 && !find_mark(r, "format_version", &line, &col)) line = col = 1;
+  }
   emit(r, line, col, path, message != NULL ? message : "invalid value");
 }
 
@@ -2762,4 +2852,86 @@ cleanup:
   free(buf);
   if (fp != NULL) fclose(fp);
   return st;
+}
+
+/* ---------------------------------------------------------------- requirements */
+
+static void read_requirements(nav_io_reader *r, const nav_io_field *f, const nav_io_node *key,
+                              const nav_io_node *v, void *base) {
+  (void)f;
+  nav_scene *s = base;
+  if (reject_special(r, key, v)) return;
+  if (v->kind != Y_SEQ) {
+    nav_io_expected(r, key, v,
+                    "a list of requirements (- {id, metric, statistic, limit, unit, time_s for at_time})");
+    return;
+  }
+  if (v->count > NAV_SCENE_MAX_REQUIREMENTS) {
+    nav_io_reader_error(r, v, key, "at most %d requirements are supported (got %zu)", NAV_SCENE_MAX_REQUIREMENTS,
+                        v->count);
+    return;
+  }
+  s->n_requirements = (int)v->count;
+  size_t i = 0;
+  for (const nav_io_node *item = v->child; item != NULL; item = item->next, ++i) {
+    const size_t saved = path_push_index(r, i);
+    mark_path(r, item, v);
+    memset(&s->requirements[i], 0, sizeof s->requirements[i]);
+    if (reject_special(r, v, item)) {
+      /* reported */
+    } else if (item->kind != Y_MAP) {
+      nav_io_expected(r, v, item, "a requirement {id, metric, statistic, limit, unit}");
+    } else {
+      nav_requirement *q = &s->requirements[i];
+      q->time_s = NAN; /* at_time without time_s is reported by nav_requirements_validate */
+      nav_io_read_section(r, &k_requirement_section, v, item, q);
+      const nav_io_node *tk = NULL;
+      const nav_io_node *tv = nav_io_map_get(item, "time_s", &tk);
+      if (tv != NULL && q->statistic != NAV_REQ_AT_TIME) {
+        const size_t s1 = nav_io_path_push_key(r, "time_s");
+        nav_io_reader_error(r, tk, item, "applies to statistic at_time only (this requirement's statistic is %s)",
+                            nav_req_statistic_name(q->statistic));
+        path_pop(r, s1);
+      }
+    }
+    path_pop(r, saved);
+  }
+}
+
+static nav_status write_requirements(nav_io_writer *w, const nav_io_field *f, const void *base, int indent) {
+  (void)f;
+  const nav_scene *s = base;
+  static const nav_requirement zero; /* every key but time_s is written */
+  if (s->n_requirements <= 0) return nav_io_writef(w, " []");
+  nav_status st = NAV_OK;
+  for (int i = 0; i < s->n_requirements && i < NAV_SCENE_MAX_REQUIREMENTS && st == NAV_OK; ++i) {
+    st = nav_io_writef(w, "\n%*s- ", indent + 2, "");
+    if (st == NAV_OK) st = nav_io_write_flow(w, &k_requirement_section, &s->requirements[i], &zero);
+  }
+  return st;
+}
+
+static bool same_requirements(const nav_io_field *f, const void *a, const void *b) {
+  (void)f;
+  const nav_scene *A = a, *B = b;
+  if (A->n_requirements != B->n_requirements) return false;
+  for (int i = 0; i < A->n_requirements && i < NAV_SCENE_MAX_REQUIREMENTS; ++i)
+    if (!nav_io_section_same(&k_requirement_section, &A->requirements[i], &B->requirements[i])) return false;
+  return true;
+}
+
+static bool requirements_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                                 const void *def) {
+  (void)w;
+  (void)def;
+  (void)f;
+  return ((const nav_scene *)base)->n_requirements > 0;
+}
+
+/* time_s: for at_time only (the reader refuses it elsewhere). */
+static bool req_time_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)w;
+  (void)f;
+  (void)def;
+  return ((const nav_requirement *)base)->statistic == NAV_REQ_AT_TIME;
 }

@@ -8,6 +8,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "bench.h"
+#include "bench_internal.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -25,7 +26,7 @@
 #include "navcore/nav_ins.h"
 #include "navcore/nav_truth.h"
 
-static double now_s(void) {
+double bench_now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -41,26 +42,9 @@ static double median(double *v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-typedef struct bench_row {
-  char case_name[64];
-  char variant[64];
-  const char *algorithm;
-  const char *earth_model;
-  const char *frame;
-  double rate_hz;
-  long long samples;
-  double truth_sps, mech_sps, wall_s;
-  double pos_err_m, vel_err_mps, att_err_rad;
-  double rms_h_m; /* whole-pipeline cases: RMS horizontal error over epochs (and runs) */
-  /* Replay cases: the peers' published figures on the same data (README of the data set). */
-  const char *peer;
-  double peer_wall_s, peer_error_m, error_m;
-  bool ok;
-  char error[256];
-} bench_row;
 
 /* Run one scene: time truth generation and mechanization separately; closure at the end. */
-static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
+void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
   nav_truth *truth = NULL;
   nav_ins *ins = NULL;
   nav_imu_increment *imu = NULL;
@@ -82,7 +66,7 @@ static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
     snprintf(row->error, sizeof row->error, "out of memory for %lld increments", (long long)n);
     goto cleanup;
   }
-  double t0 = now_s();
+  double t0 = bench_now_s();
   for (int64_t k = 1; k <= n; ++k) {
     st = nav_truth_imu(truth, k, &imu[k - 1]);
     if (st != NAV_OK) {
@@ -90,7 +74,7 @@ static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
       goto cleanup;
     }
   }
-  const double truth_s = now_s() - t0;
+  const double truth_s = bench_now_s() - t0;
   row->truth_sps = (double)n / truth_s;
 
   nav_traj_state ts0, ts1;
@@ -108,12 +92,12 @@ static void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
       snprintf(row->error, sizeof row->error, "mechanization: %s", nav_status_str(st));
       goto cleanup;
     }
-    t0 = now_s();
+    t0 = bench_now_s();
     for (int64_t k = 0; k < n; ++k) {
       st = nav_ins_step(ins, &imu[k]);
       if (st != NAV_OK) break;
     }
-    times[r] = now_s() - t0;
+    times[r] = bench_now_s() - t0;
     if (st != NAV_OK) {
       snprintf(row->error, sizeof row->error, "mechanization step: %s", nav_status_str(st));
       goto cleanup;
@@ -142,7 +126,7 @@ cleanup:
  * Whole-pipeline case through nav_sim (truth, sensor models, navigation, errors, statistics):
  * wall time of the run, samples per second over all runs, final and RMS horizontal error.
  */
-static void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row) {
+void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row) {
   nav_sim *sim = NULL;
   row->ok = false;
   row->algorithm = nav_mech_algorithm_name(sc->navigation.algorithm);
@@ -159,9 +143,9 @@ static void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *r
   o.ideal = ideal;
   o.threads = threads;
   nav_sim_summary sum;
-  const double t0 = now_s();
+  const double t0 = bench_now_s();
   st = nav_sim_run(sim, &o, &sum);
-  const double wall = now_s() - t0;
+  const double wall = bench_now_s() - t0;
   if (st != NAV_OK) {
     snprintf(row->error, sizeof row->error, "%s", nav_sim_last_error(sim));
     nav_sim_destroy(sim);
@@ -183,7 +167,7 @@ static void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *r
  * identical inputs: horizontal RMS over all 193 034 epochs, the whole replay timed (parsing
  * included). Peer figures from the data set's README (KF-GINS 3.3 s wall on this machine).
  */
-static void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, bench_row *row) {
+void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, bench_row *row) {
   char imu[4400], gnss[4400], ref[4400];
   snprintf(imu, sizeof imu, "%s/IMU.txt", data_dir);
   snprintf(gnss, sizeof gnss, "%s/%s", data_dir, gnss_file);
@@ -201,9 +185,9 @@ static void bench_replay(const char *data_dir, const char *gnss_file, const nav_
   rc.nav = nav_ins_gnss_config_from_scene(cfg_scene);
   nav_replay_summary sum;
   nav_diag d;
-  const double t0 = now_s();
+  const double t0 = bench_now_s();
   const nav_status st = nav_replay_run(&rc, &sum, &d);
-  const double wall = now_s() - t0;
+  const double wall = bench_now_s() - t0;
   if (st != NAV_OK) {
     snprintf(row->error, sizeof row->error, "replay: %.200s", d.message[0] ? d.message : nav_status_str(st));
     return;
@@ -232,7 +216,7 @@ static void bench_replay(const char *data_dir, const char *gnss_file, const nav_
 }
 
 /* A scene of the library, found next to the resources directory. */
-static bool load_library_scene(const char *name, nav_scene *sc) {
+bool bench_load_library_scene(const char *name, nav_scene *sc) {
   char res[4096], path[4200];
   if (!navsim_find_resources_dir(res, sizeof res)) return false;
   snprintf(path, sizeof path, "%s/../scenes/%s", res, name);
@@ -292,7 +276,7 @@ static int build_cases(bench_case *cases, int cap, bool full) {
   return n;
 }
 
-static int make_dir(const char *path) {
+int bench_make_dir(const char *path) {
   char buf[1024];
   if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return -1;
   for (char *p = buf + 1; *p; ++p) {
@@ -329,6 +313,9 @@ int navsim_bench(int argc, char **argv) {
       return 0;
     } else if (strcmp(a, "--quiet") == 0) {
       quiet = true;
+    } else if (strcmp(a, "--stage") == 0 && i + 3 < argc && strcmp(argv[i + 2], "--steps") == 0) {
+      /* Hidden: one stage for the FLOP counts under valgrind (bench_report.c). */
+      return bench_stage_main(argv[i + 1], atol(argv[i + 3]));
     } else if ((strcmp(a, "--suite") == 0 || strcmp(a, "--out") == 0) && i + 1 < argc) {
       const char *v = argv[++i];
       if (a[2] == 'o') {
@@ -344,7 +331,8 @@ int navsim_bench(int argc, char **argv) {
       return 2;
     }
   }
-  enum { CAP = 64 };
+  const double suite_t0 = bench_now_s();
+  enum { CAP = 160 };
   bench_case *cases = calloc(CAP, sizeof *cases);
   bench_row *rows = calloc(CAP, sizeof *rows);
   if (!cases || !rows) {
@@ -365,8 +353,11 @@ int navsim_bench(int argc, char **argv) {
   int n_all = n;
   {
     nav_scene *sc = malloc(sizeof *sc);
-    if (sc && load_library_scene("long-drive.yaml", sc)) {
-      /* Closure of the 965 s-class drive with ideal sensors (target <= 1 mm horizontal). */
+    if (sc && bench_load_library_scene("long-drive.yaml", sc)) {
+      /* Closure of the 965 s-class drive with ideal sensors (target <= 1 mm horizontal). The library
+       * scene is integrated (INS/GNSS with a catalog IMU): the closure is that of the free INS. */
+      sc->navigation.scheme = NAV_SCHEME_FREE_INS;
+      sc->gnss.enabled = false;
       snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-closure");
       snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "ideal/%s", nav_mech_algorithm_name(sc->navigation.algorithm));
       bench_sim(sc, true, 1, &rows[n_all++]);
@@ -378,10 +369,18 @@ int navsim_bench(int argc, char **argv) {
                nav_mech_frame_name(sc->navigation.frame), sc->imu.rate_hz);
       bench_scene(sc, 3, &rows[n_all++]);
     }
-    if (sc && load_library_scene("pedestrian-walk.yaml", sc)) {
+    if (sc && bench_load_library_scene("pedestrian-walk.yaml", sc)) {
       /* What modelling the Earth costs and buys on a short, slow walk: the same scene with the flat
        * model and with WGS-84 (truth and mechanization always use the same model). */
       const nav_earth_model models[2] = {NAV_EARTH_FLAT, NAV_EARTH_WGS84};
+      /* The library scene is an INS/GNSS walk with a catalog IMU: this case measures the Earth model
+       * alone, with the free INS and perfect sensors. */
+      sc->navigation.scheme = NAV_SCHEME_FREE_INS;
+      sc->gnss.enabled = false;
+      sc->imu.model.gyro.terms = 0;
+      sc->imu.model.accel.terms = 0;
+      memset(&sc->initial_errors, 0, sizeof sc->initial_errors);
+      sc->simulation.runs = 1;
       for (int m = 0; m < 2; ++m) {
         sc->earth.model = models[m];
         snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "pedestrian-earth-model");
@@ -389,18 +388,18 @@ int navsim_bench(int argc, char **argv) {
         bench_sim(sc, false, 1, &rows[n_all++]);
       }
     }
-    if (sc && load_library_scene("urban-drive-outages.yaml", sc)) {
+    if (sc && bench_load_library_scene("urban-drive.yaml", sc)) {
       /* Monte Carlo throughput against thread count (results are bit-identical). */
-      sc->simulation.runs = full ? 16 : 4;
+      sc->simulation.runs = full ? 16 : 2;
       const int threads[3] = {1, 2, 4};
-      for (int t = 0; t < 3; ++t) {
+      for (int t = 0; t < (full ? 3 : 2); ++t) {
         snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "monte-carlo-threads");
         snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%ld runs/%d threads", sc->simulation.runs, threads[t]);
         bench_sim(sc, false, threads[t], &rows[n_all++]);
       }
     }
     /* Peer comparison on the shared recording, when the data set is present next to the project. */
-    if (sc && load_library_scene("long-drive-replay.yaml", sc)) {
+    if (sc && bench_load_library_scene("long-drive-replay.yaml", sc)) {
       char res[4096], data[4200];
       if (navsim_find_resources_dir(res, sizeof res)) {
         snprintf(data, sizeof data, "%s/../../shared/data/gnss-ins-sim-long-drive", res);
@@ -415,6 +414,14 @@ int navsim_bench(int argc, char **argv) {
             snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-replay");
             snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%s", files[q]);
             bench_replay(data, files[q], sc, &rows[n_all++]);
+            /* The same figures against the second peer (pyins, README of the data set). */
+            if (rows[n_all - 1].ok) {
+              rows[n_all] = rows[n_all - 1];
+              rows[n_all].peer = "pyins";
+              rows[n_all].peer_wall_s = 85.0;
+              rows[n_all].peer_error_m = q == 0 ? 0.0222 : 6.742;
+              n_all++;
+            }
           }
         } else {
           snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-replay");
@@ -429,48 +436,107 @@ int navsim_bench(int argc, char **argv) {
     free(sc);
   }
   if (!quiet) fputc('\n', stderr);
+  /* Covariance rate, long-drive per algorithm and rate, MPI ranks, viewer fps, memory (bench_cases2.c). */
+  bench_cases2(full, out_dir, rows, &n_all, CAP, quiet);
 
   int rc = 0;
-  char path[1200];
+  char path[1200], tmp[1300];
   FILE *csv = NULL, *md = NULL;
-  if (make_dir(out_dir) != 0) {
+  if (bench_make_dir(out_dir) != 0) {
     fprintf(stderr, "navsim bench: cannot create \"%s\": %s\n", out_dir, strerror(errno));
     rc = 1;
     goto done;
   }
+  /* bench.csv, written to a temporary name and renamed (atomic). */
   snprintf(path, sizeof path, "%s/bench.csv", out_dir);
-  csv = fopen(path, "w");
-  snprintf(path, sizeof path, "%s/bench.md", out_dir);
-  md = fopen(path, "w");
-  if (!csv || !md) {
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  csv = fopen(tmp, "w");
+  if (!csv) {
     fprintf(stderr, "navsim bench: cannot write into \"%s\"\n", out_dir);
     rc = 1;
     goto done;
   }
   fputs("case,variant,algorithm,earth_model,frame,rate_hz,samples,wall_s,samples_per_s,truth_samples_per_s,"
-        "mech_samples_per_s,pos_err_m,vel_err_mps,att_err_rad,peer,peer_wall_s,peer_error,error,status\n",
+        "mech_samples_per_s,pos_err_m,vel_err_mps,att_err_rad,peer,peer_wall_s,peer_error,error,rms_h_m,peak_rss_mb,"
+        "fps,status\n",
         csv);
-  fputs("| case | algorithm | earth | frame | rate [Hz] | samples | truth [samples/s] | mechanization [samples/s] | "
-        "pos err [m] | vel err [m/s] | att err [rad] |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-        md);
   for (int i = 0; i < n_all; ++i) {
     const bench_row *r = &rows[i];
     if (r->ok) {
       fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,%.6g,%.6g,%.6g,%.6g,%.6e,%.6e,%.6e,", r->case_name, r->variant, r->algorithm,
-              r->earth_model, r->frame, r->rate_hz, r->samples, r->wall_s, (double)r->samples / r->wall_s, r->truth_sps,
-              r->mech_sps, r->pos_err_m, r->vel_err_mps, r->att_err_rad);
+              r->earth_model, r->frame, r->rate_hz, r->samples, r->wall_s,
+              r->wall_s > 0 ? (double)r->samples / r->wall_s : 0.0, r->truth_sps, r->mech_sps, r->pos_err_m,
+              r->vel_err_mps, r->att_err_rad);
       if (r->peer)
-        fprintf(csv, "%s,%.6g,%.6g,%.6g,ok\n", r->peer, r->peer_wall_s, r->peer_error_m, r->error_m);
+        fprintf(csv, "%s,%.6g,%.6g,%.6g,", r->peer, r->peer_wall_s, r->peer_error_m, r->error_m);
       else
-        fputs(",,,,ok\n", csv);
-      fprintf(md, "| %s | %s | %s | %s | %g | %lld | %.3g | %.3g | %.3e | %.3e | %.3e |\n", r->case_name, r->algorithm,
-              r->earth_model, r->frame, r->rate_hz, r->samples, r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps,
-              r->att_err_rad);
+        fputs(",,,,", csv);
+      fprintf(csv, "%.6g,%.6g,%.6g,ok\n", r->rms_h_m, r->peak_rss_mb, r->fps);
     } else {
-      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,,,,,,,,,,,,\"failed: %s\"\n", r->case_name, r->variant, r->algorithm,
-              r->earth_model, r->frame, r->rate_hz, r->samples, r->error);
-      fprintf(md, "| %s | %s | %s | %s | %g | | failed: %s | | | | |\n", r->case_name, r->algorithm, r->earth_model,
-              r->frame, r->rate_hz, r->error);
+      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,,,,,,,,,,,,,,,\"failed: %s\"\n", r->case_name, r->variant,
+              r->algorithm ? r->algorithm : "-", r->earth_model ? r->earth_model : "-", r->frame ? r->frame : "-",
+              r->rate_hz, r->samples, r->error);
+    }
+  }
+  {
+    const bool bad = ferror(csv) != 0;
+    const int cl = fclose(csv);
+    csv = NULL;
+    if (bad || cl != 0 || rename(tmp, path) != 0) {
+      fprintf(stderr, "navsim bench: writing %s failed\n", path);
+      remove(tmp);
+      rc = 1;
+      goto done;
+    }
+  }
+  /* speed_vs_error.png from bench.csv through the viewer, then bench.md (atomic too). */
+  char png_note[400];
+  bench_report_png(out_dir, png_note, sizeof png_note);
+  snprintf(path, sizeof path, "%s/bench.md", out_dir);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  md = fopen(tmp, "w");
+  if (!md) {
+    fprintf(stderr, "navsim bench: cannot write into \"%s\"\n", out_dir);
+    rc = 1;
+    goto done;
+  }
+  fprintf(md, "# navsim bench --suite %s\n\n", full ? "full" : "quick");
+  fputs("| case | variant | algorithm | earth | frame | rate [Hz] | samples | wall [s] | truth [samples/s] | "
+        "nav [samples/s] | pos err [m] | vel err [m/s] | att err [rad] | peer |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        md);
+  for (int i = 0; i < n_all; ++i) {
+    const bench_row *r = &rows[i];
+    if (r->ok) {
+      char peer[160] = "";
+      if (r->peer)
+        snprintf(peer, sizeof peer, "%s: %.4g m in %.3g s (ours %.4g m)", r->peer, r->peer_error_m, r->peer_wall_s,
+                 r->error_m);
+      else if (r->peak_rss_mb > 0)
+        snprintf(peer, sizeof peer, "peak RSS %.1f MB", r->peak_rss_mb);
+      else if (r->fps > 0)
+        snprintf(peer, sizeof peer, "%.1f fps", r->fps);
+      fprintf(md, "| %s | %s | %s | %s | %s | %g | %lld | %.3g | %.3g | %.3g | %.3e | %.3e | %.3e | %s%s%s |\n",
+              r->case_name, r->variant, r->algorithm, r->earth_model, r->frame, r->rate_hz, r->samples, r->wall_s,
+              r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps, r->att_err_rad, peer,
+              r->note[0] && peer[0] ? "; " : "", r->note);
+    } else {
+      fprintf(md, "| %s | %s | %s | %s | %s | %g | | | | | | | | failed: %s |\n", r->case_name, r->variant,
+              r->algorithm ? r->algorithm : "-", r->earth_model ? r->earth_model : "-", r->frame ? r->frame : "-",
+              r->rate_hz, r->error);
+    }
+  }
+  fprintf(md, "\n%s\n", png_note);
+  bench_report_md(md, full, out_dir, rows, n_all, bench_now_s() - suite_t0);
+  {
+    const bool bad = ferror(md) != 0;
+    const int cl = fclose(md);
+    md = NULL;
+    if (bad || cl != 0 || rename(tmp, path) != 0) {
+      fprintf(stderr, "navsim bench: writing %s failed\n", path);
+      remove(tmp);
+      rc = 1;
+      goto done;
     }
   }
   if (!quiet) {
@@ -490,7 +556,7 @@ int navsim_bench(int argc, char **argv) {
                rows[i].error_m, rows[i].wall_s, rows[i].peer, rows[i].peer_error_m, rows[i].peer_wall_s);
     printf("(nav_sps: mechanization alone for the closure cases; the whole pipeline - truth, sensors, navigation,\n"
            " errors - for the scene cases, where truth_sps is not separate; pos_err_m: final error)\n");
-    printf("results    %s/bench.csv, %s/bench.md\n", out_dir, out_dir);
+    printf("results    %s/bench.csv, %s/bench.md (%s)\n", out_dir, out_dir, png_note);
   }
 done:
   if (csv && fclose(csv) != 0) rc = 1;

@@ -122,7 +122,8 @@ static int load(const char *dir, const char *file, const nav_catalog_options *op
 static void imu_csv(const nav_catalog *cat) {
   printf("name,grade,gyro_arw_rad_per_sqrt_s,gyro_bias_gm_sd_rps,gyro_bias_gm_tau_s,gyro_bias_turn_on_sd_rps,"
          "gyro_scale_factor_sd,accel_vrw_mps_per_sqrt_s,accel_bias_gm_sd_mps2,accel_bias_gm_tau_s,"
-         "accel_bias_turn_on_sd_mps2,accel_scale_factor_sd,misalignment_sd_rad,bias_model,verified,source\n");
+         "accel_bias_turn_on_sd_mps2,accel_scale_factor_sd,misalignment_sd_rad,bias_model,cost_class,cost_band,verified,"
+         "source\n");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_imu_entry *e = nav_catalog_imu_at(cat, i);
     const nav_gyro_error_config *g = &e->config.gyro;
@@ -141,7 +142,7 @@ static void imu_csv(const nav_catalog *cat) {
     csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_TURN_ON, a->bias_turn_on_sd_mps2.x);
     csv_num(stdout, a->terms & NAV_IMU_TERM_SCALE_FACTOR, a->scale_factor_sd.x);
     csv_num(stdout, g->terms & NAV_IMU_TERM_MISALIGNMENT, g->misalignment_sd_rad.m[0][1]);
-    printf(",%s,", nav_catalog_bias_model_name(e->bias_model));
+    printf(",%s,%d,%s,", nav_catalog_bias_model_name(e->bias_model), e->cost_class, nav_catalog_cost_band(e->cost_class));
     csv_text(stdout, e->verified_text);
     fputc(',', stdout);
     csv_text(stdout, e->source);
@@ -150,7 +151,7 @@ static void imu_csv(const nav_catalog *cat) {
 }
 
 static void gnss_csv(const nav_catalog *cat) {
-  printf("mode,pos_sd_n_m,pos_sd_e_m,pos_sd_d_m,pos_tau_s,vel_sd_mps,update_rate_hz,verified,source\n");
+  printf("mode,pos_sd_n_m,pos_sd_e_m,pos_sd_d_m,pos_tau_s,vel_sd_mps,update_rate_hz,cost_class,cost_band,verified,source\n");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_gnss_entry *e = nav_catalog_gnss_at(cat, i);
     const nav_gnss_model_config *c = &e->config;
@@ -161,7 +162,7 @@ static void gnss_csv(const nav_catalog *cat) {
     csv_num(stdout, true, c->pos_gm_tau_s.x);
     csv_num(stdout, c->terms & NAV_GNSS_TERM_VEL_WHITE, c->vel_sd_mps.x);
     csv_num(stdout, true, c->update_rate_hz);
-    fputc(',', stdout);
+    printf(",%d,%s,", e->cost_class, nav_catalog_cost_band(e->cost_class));
     csv_text(stdout, e->verified_text);
     fputc(',', stdout);
     csv_text(stdout, e->source);
@@ -181,10 +182,10 @@ static void imu_table(const nav_catalog *cat, const char *path, const nav_catalo
       nav_bi_convention_name(opt->convention),
       opt->convention == NAV_BI_ALLAN_PEAK ? "sigma = B / 0.61736" : "sigma = B", opt->default_tau_min_mems_s,
       opt->default_tau_min_nav_s);
-  printf("%-40s %-34s |%9s %9s %7s %9s %7s |%9s %9s %7s %9s %7s |%7s  %-10s %s\n", "", "", "ARW", "GM bias",
-         "T", "turn-on", "SF", "VRW", "GM bias", "T", "turn-on", "SF", "misal.", "bias", "verified");
-  printf("%-40s %-34s |%9s %9s %7s %9s %7s |%9s %9s %7s %9s %7s |%7s  %-10s\n", "name", "grade", "deg/rt-h",
-         "deg/h", "s", "deg/h", "ppm", "m/s/rt-h", "ug", "s", "mg", "ppm", "mrad", "model");
+  printf("%-40s %-34s |%9s %9s %7s %9s %7s |%9s %9s %7s %9s %7s |%7s  %-10s %-4s %s\n", "", "", "ARW", "GM bias",
+         "T", "turn-on", "SF", "VRW", "GM bias", "T", "turn-on", "SF", "misal.", "bias", "cost", "verified");
+  printf("%-40s %-34s |%9s %9s %7s %9s %7s |%9s %9s %7s %9s %7s |%7s  %-10s %-4s\n", "name", "grade", "deg/rt-h",
+         "deg/h", "s", "deg/h", "ppm", "m/s/rt-h", "ug", "s", "mg", "ppm", "mrad", "model", "cls");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_imu_entry *e = nav_catalog_imu_at(cat, i);
     const nav_gyro_error_config *g = &e->config.gyro;
@@ -203,15 +204,21 @@ static void imu_table(const nav_catalog *cat, const char *path, const nav_catalo
     col_num(a->terms & NAV_IMU_TERM_SCALE_FACTOR, a->scale_factor_sd.x * 1e6, 7);
     printf(" |");
     col_num(g->terms & NAV_IMU_TERM_MISALIGNMENT, g->misalignment_sd_rad.m[0][1] * 1e3, 6);
-    printf("  %-10s %s\n", nav_catalog_bias_model_name(e->bias_model), verified_label(e->verified));
+    printf("  %-10s %-4d %s\n", nav_catalog_bias_model_name(e->bias_model), e->cost_class, verified_label(e->verified));
   }
+}
+
+/* The cost-class legend under both tables. */
+static void cost_legend(void) {
+  printf("\ncost class (indicative unit-price band by grade, not a quote; resources/README.md):");
+  for (int k = 1; k <= NAV_CATALOG_COST_CLASS_MAX; ++k) printf(" %d %s%s", k, nav_catalog_cost_band(k), k < 5 ? "," : "\n");
 }
 
 static void gnss_table(const nav_catalog *cat, const char *path) {
   printf("GNSS receiver catalog %s: %zu entries\n", path, nav_catalog_count(cat));
   printf("Position error per axis: first-order Gauss-Markov (tau 0 = white); velocity error white.\n\n");
-  printf("%-58s %8s %8s %7s %8s %6s  %s\n", "", "pos N/E", "pos D", "tau", "vel", "rate", "verified");
-  printf("%-58s %8s %8s %7s %8s %6s\n", "mode", "m", "m", "s", "m/s", "Hz");
+  printf("%-58s %8s %8s %7s %8s %6s  %-4s %s\n", "", "pos N/E", "pos D", "tau", "vel", "rate", "cost", "verified");
+  printf("%-58s %8s %8s %7s %8s %6s  %-4s\n", "mode", "m", "m", "s", "m/s", "Hz", "cls");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_gnss_entry *e = nav_catalog_gnss_at(cat, i);
     const nav_gnss_model_config *c = &e->config;
@@ -221,7 +228,7 @@ static void gnss_table(const nav_catalog *cat, const char *path) {
     col_num(true, c->pos_gm_tau_s.x, 7);
     col_num(c->terms & NAV_GNSS_TERM_VEL_WHITE, c->vel_sd_mps.x, 8);
     col_num(true, c->update_rate_hz, 6);
-    printf("  %s\n", verified_label(e->verified));
+    printf("  %-4d %s\n", e->cost_class, verified_label(e->verified));
   }
 }
 
@@ -298,6 +305,7 @@ int navsim_catalog(int argc, char **argv, const char *resources_dir) {
       gnss_table(cat, path);
     nav_catalog_destroy(cat);
   }
+  if (!csv) cost_legend();
   if (fflush(stdout) != 0) {
     fprintf(stderr, "navsim catalog: cannot write the output\n");
     return EXIT_FAIL;

@@ -54,7 +54,9 @@ static const char *k_usage_estimate =
     "                 WGS-84); then each row of E1.6-E1.17 per axis: pos_sd_m_<term>,\n"
     "                 vel_sd_mps_<term>, att_sd_rad_<term> (e.g. pos_sd_m_E1.10_accel_bias)\n"
     "  estimate.json  the final values (totals and every term), the conventions, and the verdict\n"
-    "                 for each requirement of the scene (\"requirements\": [] until scenes carry them)\n"
+    "                 for each requirement of the scene (\"requirements\": predicted from the covariance\n"
+    "                 analysis: rms, at_time, outage_end, p95/cep of horizontal, vertical and yaw;\n"
+    "                 value null where sigmas do not determine the statistic, e.g. max)\n"
     "  summary.json   scene, timing, final analytic and covariance values\n"
     "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
@@ -200,12 +202,13 @@ static void json_text(FILE *f, const char *s) {
 /*
  * estimate.json: the final values of the analytic estimate (totals and every term), the
  * covariance analysis when available, the conventions, and one verdict per requirement of the
- * scene. Scenes carry no requirements yet (issue 6), so the list is empty.
+ * scene predicted from the covariance analysis (nav_req_predict).
  * @return 0, or -1 when the file cannot be written.
  */
 static int write_estimate_json(const char *path, const nav_scene *sc, const char *scene_path,
                                const nav_analytic_gyro_ins_table *tab, const nav_analytic_estimate_point *al,
-                               double pos_v_m, bool pos_v_valid, const nav_cov_point *cov) {
+                               double pos_v_m, bool pos_v_valid, const nav_cov_point *cov,
+                               const nav_requirement_verdict *pred, int n_pred) {
   FILE *f = path ? fopen(path, "w") : NULL;
   if (!f) return -1;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
@@ -246,7 +249,11 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
             cov->pos_h_sd_m, cov->pos_sd_n_m.z, cov->vel_sd_n_mps.x, cov->vel_sd_n_mps.y, cov->att_sd_rad.z);
   else
     fputs("  \"covariance_final\": null,\n", f);
-  fputs("  \"requirements\": []\n}\n", f);
+  /* Predicted verdicts from the covariance analysis (nav_req_predict; value null where the
+     statistic cannot be predicted from sigmas, or without a covariance analysis). */
+  fputs("  \"requirements\": ", f);
+  if (nav_requirements_write_json(f, pred, pred ? n_pred : 0, 2) != NAV_OK) fputs("[]", f);
+  fputs("\n}\n", f);
   const bool bad = ferror(f) != 0;
   return (fclose(f) != 0 || bad) ? -1 : 0;
 }
@@ -293,6 +300,7 @@ int navsim_estimate(int argc, char **argv) {
   nav_sim *sim = NULL;
   nav_resultdir *rd = NULL;
   cov_rows cov = {NULL, 0, 0};
+  nav_requirement_verdict *pred = NULL; /* predicted requirement verdicts */
   nav_analytic_estimate_point *ana = NULL;
   nav_analytic_gyro_ins_table *tab = NULL;
   double *pos_v = NULL;
@@ -355,6 +363,20 @@ int navsim_estimate(int argc, char **argv) {
       goto cleanup;
     }
     have_cov = cov.n == nt;
+  }
+
+  if (sc.n_requirements > 0) {
+    /* Requirements predicted from the covariance analysis; not evaluated without one. */
+    pred = calloc((size_t)sc.n_requirements, sizeof *pred);
+    if (!pred) goto cleanup;
+    /* The covariance analysis plus the truth's scale factors the filter does not estimate
+       (nav_req_predict_scene, as navsim select predicts); nothing without a covariance analysis. */
+    st = have_cov ? nav_req_predict_scene(&sc, pred) : nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0,
+                                                                       NULL, 0, pred);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: predicting the requirements failed: %s\n", nav_status_str(st));
+      goto cleanup;
+    }
   }
 
   if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
@@ -443,7 +465,7 @@ int navsim_estimate(int argc, char **argv) {
   }
   f = NULL;
   if (write_estimate_json(nav_resultdir_file(rd, "estimate.json"), &sc, scene_path, &tab[nt - 1], al, pos_v[nt - 1],
-                          times[nt - 1] < t_v_max_s, have_cov ? &cov.p[nt - 1] : NULL) != 0) {
+                          times[nt - 1] < t_v_max_s, have_cov ? &cov.p[nt - 1] : NULL, pred, sc.n_requirements) != 0) {
     fprintf(stderr, "navsim estimate: writing estimate.json failed\n");
     goto cleanup;
   }
@@ -502,6 +524,10 @@ int navsim_estimate(int argc, char **argv) {
                tf->term[top[r]].pos_m);
       printf(" (of %.4g m, root-sum-square)\n", tf->rss.pos_m);
     }
+    if (pred) {
+      printf("predicted  from the covariance analysis (expected Monte Carlo values; see estimate.json):\n");
+      nav_requirements_print(stdout, pred, sc.n_requirements);
+    }
     printf("computed   analytic %.3g s, covariance %.3g s\n", t_analytic, t_cov);
     printf("results    %s/\n", out_dir);
   }
@@ -511,6 +537,7 @@ cleanup:
   nav_resultdir_abort(rd);
   nav_sim_destroy(sim);
   free(cov.p);
+  free(pred);
   free(tab);
   free(pos_v);
   free(ana);

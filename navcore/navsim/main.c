@@ -15,15 +15,22 @@
 
 #include "allan_cmd.h"
 #include "bench.h"
+#include "budget_cmd.h"
 #include "catalog_cmd.h"
+#include "mpi_run.h"
 #include "estimate_cmd.h"
+#include "gnss_out.h"
+#include "import_cmd.h"
+#include "interrupt.h"
+#include "select_cmd.h"
 #include "replay_cmd.h"
+#include "report_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_version.h"
 
-enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2, EXIT_REQUIREMENT = 3 };
 
 static const char *k_usage =
     "usage: navsim [--version] [--help] COMMAND [ARGS]\n"
@@ -34,11 +41,18 @@ static const char *k_usage =
     "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
     "  estimate SCENE   preliminary estimate: closed-form error growth and covariance analysis\n"
     "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
+    "  budget SCENE     error budget: each error source's share of each requirement\n"
     "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
-    "  render DIR       headless images of a result directory: 3D view and error charts (navview)\n"
+    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan or bench\n"
+    "                   view (navview)\n"
+    "  report DIR       HTML page with the figures, statistics and requirement verdicts of a result\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
     "  allan            Allan-deviation check of a catalog part or scene IMU against its spec\n"
+    "  import FILE      GPX / KML track or gnss-ins-sim motion definition -> scene file\n"
+    "  export DIR       KML (Google Earth) and CSV tracks of a result directory\n"
+    "  select SCENE     cheapest catalog IMU / receiver / scheme meeting the scene's requirements\n"
+    "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -55,7 +69,8 @@ static const char *k_usage_check =
     "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static const char *k_usage_run =
-    "usage: navsim run SCENE [--out DIR] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
+    "usage: navsim run SCENE [--out DIR] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet] [--kml]\n"
+    "                  [--strict]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -78,11 +93,19 @@ static const char *k_usage_run =
     "  --runs N      Monte Carlo runs, overriding simulation.runs (1 .. 1000000)\n"
     "  --threads N   worker threads (default: simulation.threads, or one per core); results are\n"
     "                bit-identical for any thread count\n"
+    "                Under mpirun (navsim built with NAV_MPI), the runs are split across the\n"
+    "                ranks, each with N threads, and the results are bit-identical to one process;\n"
+    "                only rank 0 writes DIR: mpirun -np K navsim run SCENE --runs R --threads N\n"
     "  --ideal       perfect sensors and perfect initial state (a single run)\n"
     "  --quiet       print nothing but errors\n"
+    "  --strict      exit 3 when a requirement of the scene fails (verdicts are in summary.json\n"
+    "                \"requirements\" and the terminal summary either way)\n"
+    "  --kml         also write tracks.kml (reference, estimate of run 0, GNSS fixes; KML 2.2 for\n"
+    "                Google Earth) and tracks.csv (see navsim export --help)\n"
     "  -h, --help    print this help\n"
     "\n"
-    "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
+    "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
+    "            2 invalid scene or options; 1 other failure\n";
 
 static double now_s(void) {
   struct timespec ts;
@@ -146,6 +169,7 @@ typedef struct run_out {
   bool quiet_progress;
   double t_last_print;
   FILE *imu_err; /* imu_errors.csv, or NULL when not written */
+  navsim_gnss_out *gnss; /* gnss.csv (INS/GNSS scenes), or NULL */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -168,6 +192,13 @@ static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   run_out *o = user;
   for (int i = 0; i < 3; ++i) {
     const nav_status st = nav_csv_write_row(o->f[i], (nav_csv_table)i, r);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  if (o->gnss) {
+    const nav_status st = navsim_gnss_out_record(o->gnss, r);
     if (st != NAV_OK) {
       o->st = st;
       return NAV_STOP;
@@ -222,13 +253,17 @@ static void safe_name(char *out, size_t cap, const char *name) {
 
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool ideal = false, quiet = false, have_seed = false;
+  bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (is_help(a)) {
       fputs(k_usage_run, stdout);
       return EXIT_OK;
+    } else if (strcmp(a, "--kml") == 0) {
+      kml = true;
+    } else if (strcmp(a, "--strict") == 0) {
+      strict = true;
     } else if (strcmp(a, "--ideal") == 0) {
       ideal = true;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -280,6 +315,9 @@ static int cmd_run(int argc, char **argv) {
   if (have_seed) scene.simulation.seed = seed;
   if (runs > 0) scene.simulation.runs = (long)runs;
   if (threads == 0) threads = scene.simulation.threads > 0 ? (uint64_t)scene.simulation.threads : (uint64_t)cores();
+  /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */
+  int mpi_rc = EXIT_OK;
+  if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) return mpi_rc;
 
   char default_dir[600];
   if (!out_dir) {
@@ -291,7 +329,9 @@ static int cmd_run(int argc, char **argv) {
 
   nav_sim *sim = NULL;
   nav_resultdir *rd = NULL;
-  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, NULL};
+  nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
+  nav_requirement_verdict *verdicts = NULL;
+  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, NULL, NULL};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -299,6 +339,7 @@ static int cmd_run(int argc, char **argv) {
     rc = EXIT_FAIL;
     goto cleanup;
   }
+  navsim_interrupt_arm(sim); /* SIGINT / SIGTERM: cancel, remove the temporary directory */
   st = nav_resultdir_begin(out_dir, &rd);
   if (st != NAV_OK) {
     fprintf(stderr, "navsim run: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
@@ -324,16 +365,47 @@ static int cmd_run(int argc, char **argv) {
     }
   }
 
+  {
+    /* gnss.csv (fixes of run 0) and gnss_outages.csv for the viewer; INS/GNSS scenes only. */
+    const char *gf = nav_resultdir_file(rd, "gnss.csv");
+    char of[4200];
+    snprintf(of, sizeof of, "%s", gf ? gf : "");
+    const char *ofile = nav_resultdir_file(rd, "gnss_outages.csv");
+    const nav_status gst = (!gf || !ofile) ? NAV_ERR_IO : navsim_gnss_out_begin(&scene, ideal, of, ofile, &o.gnss);
+    if (gst != NAV_OK) {
+      fprintf(stderr, "navsim run: cannot write gnss.csv / gnss_outages.csv in \"%s\": %s\n", out_dir,
+              nav_status_str(gst));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+
   nav_sim_options opts = nav_sim_options_default();
   opts.ideal = ideal;
   opts.threads = (int)threads;
   opts.record = on_record;
   opts.progress = on_progress;
   opts.user = &o;
+  nav_run_observer req_obs;
+  if (scene.n_requirements > 0) {
+    st = nav_req_evaluator_create_for_scene(&scene, ideal, &req_ev);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: %s: cannot set up the requirement evaluation: %s\n", scene_path,
+              nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+    req_obs = nav_req_evaluator_observer(req_ev);
+    opts.observer = &req_obs;
+  }
   nav_sim_summary sum;
   const double t0 = now_s();
-  st = nav_sim_run(sim, &opts, &sum);
+  st = navsim_mpi_sim_run(sim, &opts, &sum); /* nav_sim_run, over every MPI rank when under mpirun */
   const double wall = now_s() - t0;
+  if (navsim_interrupted()) {
+    rc = 128 + navsim_interrupted();
+    goto cleanup;
+  }
   if (st != NAV_OK || o.st != NAV_OK) {
     if (o.st != NAV_OK) fprintf(stderr, "navsim run: writing results failed: %s\n", nav_status_str(o.st));
     else fprintf(stderr, "navsim run: %s: %s\n", scene_path, nav_sim_last_error(sim));
@@ -360,6 +432,13 @@ static int cmd_run(int argc, char **argv) {
       goto cleanup;
     }
   }
+  if (!navsim_gnss_out_end(o.gnss)) {
+    o.gnss = NULL;
+    fprintf(stderr, "navsim run: writing gnss.csv failed\n");
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  o.gnss = NULL;
   if (sum.runs > 1) {
     /* Monte Carlo statistics over runs per output epoch, and the final errors of every run. */
     size_t ne = 0, nf = 0;
@@ -402,11 +481,30 @@ static int cmd_run(int argc, char **argv) {
       goto cleanup;
     }
   }
-  nav_run_info info = {scene_path, scene.simulation.seed, ideal, wall};
+  if (kml && navsim_run_tracks(rd, out_dir) != 0) {
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  nav_run_info info = {scene_path, scene.simulation.seed, ideal, wall, NULL, 0};
+  if (req_ev) {
+    verdicts = calloc((size_t)scene.n_requirements, sizeof *verdicts);
+    st = verdicts ? nav_req_evaluator_finish(req_ev, verdicts) : NAV_ERR_NO_MEMORY;
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: evaluating the requirements failed: %s\n", nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+    info.requirements = verdicts;
+    info.n_requirements = scene.n_requirements;
+  }
   st = nav_summary_write_json(nav_resultdir_file(rd, "summary.json"), &scene, &info, &sum);
   if (st != NAV_OK) {
     fprintf(stderr, "navsim run: writing summary.json failed\n");
     rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  if (navsim_interrupted()) {
+    rc = 128 + navsim_interrupted();
     goto cleanup;
   }
   st = nav_resultdir_commit(rd);
@@ -434,74 +532,30 @@ static int cmd_run(int argc, char **argv) {
     printf("rms        horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
            sum.stats.pos_err_h_m.rms, sum.stats.pos_err_v_m.rms, sum.stats.vel_err_mps.rms,
            sum.stats.att_err_rad.rms);
+    nav_requirements_print(stdout, verdicts, info.n_requirements);
     printf("results    %s/\n", out_dir);
   }
   rc = EXIT_OK;
+  if (verdicts && !nav_req_all_pass(verdicts, info.n_requirements)) {
+    if (strict) {
+      if (quiet) nav_requirements_print(stderr, verdicts, info.n_requirements); /* why the gate failed */
+      rc = EXIT_REQUIREMENT;
+    }
+  }
 
 cleanup:
   for (int i = 0; i < 3; ++i)
     if (o.f[i]) fclose(o.f[i]);
   if (o.imu_err) fclose(o.imu_err);
+  (void)navsim_gnss_out_end(o.gnss);
   nav_resultdir_abort(rd);
+  navsim_interrupt_disarm();
+  if (rc > 128) fprintf(stderr, "navsim run: interrupted by signal %d; no results written\n", rc - 128);
+  navsim_mpi_abandon(); /* rank 0 failed before the runs: release the other ranks */
   nav_sim_destroy(sim);
+  nav_req_evaluator_destroy(req_ev);
+  free(verdicts);
   return rc;
-}
-
-static const char *k_usage_render =
-    "usage: navsim render RESULT_DIR [--png FILE] [--chart FILE] [navview options]\n"
-    "\n"
-    "Render a result directory of navsim run with the VTK viewer (navview): --png writes the 3D\n"
-    "view (reference and estimated paths, attitude triads, error tube), --chart the error charts.\n"
-    "Defaults: RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
-    "(navview --help). Rendering needs an X server: without DISPLAY it runs under xvfb-run.\n"
-    "\n"
-    "exit codes: those of navview: 0 success, 2 bad options, 1 unreadable result directory or other failure\n";
-
-/* Run navview (built with the viewer, or on PATH) on a result directory, under xvfb-run when
- * there is no display. navsim stays free of VTK: the viewer is a separate program. */
-static int cmd_render(int argc, char **argv) {
-  if (argc < 1 || is_help(argv[0])) {
-    fputs(k_usage_render, argc < 1 ? stderr : stdout);
-    return argc < 1 ? EXIT_INVALID : EXIT_OK;
-  }
-#ifdef NAVVIEW_EXE
-  const char *viewer = NAVVIEW_EXE;
-#else
-  const char *viewer = "navview";
-#endif
-  char png[4200], chart[4200];
-  bool has_png = false, has_chart = false;
-  for (int i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--png") == 0) has_png = true;
-    if (strcmp(argv[i], "--chart") == 0) has_chart = true;
-  }
-  snprintf(png, sizeof png, "%s/view.png", argv[0]);
-  snprintf(chart, sizeof chart, "%s/errors.png", argv[0]);
-  char **args = calloc((size_t)argc + 10, sizeof *args);
-  if (!args) return EXIT_FAIL;
-  int n = 0;
-  const bool need_x = getenv("DISPLAY") == NULL || getenv("DISPLAY")[0] == '\0';
-  if (need_x) {
-    args[n++] = "xvfb-run";
-    args[n++] = "-a";
-    args[n++] = "-s";
-    args[n++] = "-screen 0 1280x1024x24";
-  }
-  args[n++] = (char *)viewer;
-  for (int i = 0; i < argc; ++i) args[n++] = argv[i];
-  if (!has_png && !has_chart) {
-    args[n++] = "--png";
-    args[n++] = png;
-    args[n++] = "--chart";
-    args[n++] = chart;
-  }
-  args[n] = NULL;
-  fflush(stdout);
-  execvp(args[0], args);
-  fprintf(stderr, "navsim render: cannot start %s: %s%s\n", args[0], strerror(errno),
-          need_x ? " (no DISPLAY: xvfb-run is needed)" : "");
-  free(args);
-  return EXIT_FAIL;
 }
 
 int main(int argc, char **argv) {
@@ -521,10 +575,16 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
   if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
   if (strcmp(cmd, "estimate") == 0) return navsim_estimate(argc - 2, argv + 2);
+  if (strcmp(cmd, "budget") == 0) return navsim_budget(argc - 2, argv + 2);
   if (strcmp(cmd, "replay") == 0) return navsim_replay(argc - 2, argv + 2);
-  if (strcmp(cmd, "render") == 0) return cmd_render(argc - 2, argv + 2);
+  if (strcmp(cmd, "render") == 0) return navsim_render(argc - 2, argv + 2);
+  if (strcmp(cmd, "report") == 0) return navsim_report(argc - 2, argv + 2);
   if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
   if (strcmp(cmd, "allan") == 0) return navsim_allan(argc - 2, argv + 2);
+  if (strcmp(cmd, "import") == 0) return navsim_import(argc - 2, argv + 2);
+  if (strcmp(cmd, "export") == 0) return navsim_export(argc - 2, argv + 2);
+  if (strcmp(cmd, "select") == 0) return navsim_select(argc - 2, argv + 2);
+  if (strcmp(cmd, "sweep") == 0) return navsim_sweep(argc - 2, argv + 2);
   if (strcmp(cmd, "catalog") == 0) {
     char res[4096];
     return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);

@@ -733,9 +733,11 @@ static void test_validation_messages_are_placed(void **state) {
   expect_one("format_version: 1\nimu:\n  quadrature_nodes: 0\n", 3, 21, "imu.quadrature_nodes", "must be");
   /* Validation names lat_deg; the file wrote lat_rad: the value is still found. */
   expect_one("format_version: 1\nearth:\n  origin: {lat_rad: 2.0}\n", 3, 21, "earth.origin.lat_deg", "90");
-  /* The path is not in the file: its nearest parent is, else line 0. */
+  /* The path is not in the file: its nearest parent is, else the other field the message names
+     (imu.rate_hz, at 2:16), else format_version: every diagnostic has a place. */
   expect_one("format_version: 1\nimu: {rate_hz: 5}\noutput:\n", 3, 1, "output.rate_hz", "imu.rate_hz");
-  expect_one("format_version: 1\nimu: {rate_hz: 5}\n", 0, 0, "output.rate_hz", "imu.rate_hz");
+  expect_one("format_version: 1\nimu: {rate_hz: 5}\n", 2, 16, "output.rate_hz", "imu.rate_hz");
+  expect_one("format_version: 1\nimu: {rate_hz: 0.01}\noutput: {rate_hz: 0.01}\n", 1, 17, "trajectory.duration_s", "shorter than one IMU interval");
 }
 
 static void test_diag_format(void **state) {

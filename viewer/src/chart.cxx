@@ -3,6 +3,7 @@
 #include "navview/nav_view_chart.h"
 
 #include "navview_internal.h"
+#include "navview/nav_view_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +36,8 @@ struct Series {
   std::string name;
   std::vector<double> y;
   unsigned char rgb[3];
+  int pen = vtkPen::SOLID_LINE;
+  float width = 1.5f;
 };
 
 // Rows to draw: per bucket of consecutive epochs, the first, last, minimum and maximum of every
@@ -117,7 +120,8 @@ void FillChart(vtkChartXY *chart, const std::string &title, const std::string &y
     vtkPlot *line = chart->AddPlot(vtkChart::LINE);
     line->SetInputData(table, 0, static_cast<vtkIdType>(k + 1));
     line->SetColor(series[k].rgb[0], series[k].rgb[1], series[k].rgb[2], 255);
-    line->SetWidth(1.5f);
+    line->SetWidth(series[k].width);
+    line->GetPen()->SetLineType(series[k].pen);
     line->SetLabel(series[k].name);
   }
   chart->SetTitle(opt.show_text ? title : std::string());
@@ -182,6 +186,7 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opt,
   }
 
   vtkNew<vtkContextView> view;
+  NavAttachDisplay(view->GetRenderWindow());
   view->GetRenderWindow()->SetOffScreenRendering(1);
   // A headless chart needs no interactor. vtkContextView creates one, and the first Render()
   // initialises it (vtkXRenderWindowInteractor::Initialize -> XSync), which crashed
@@ -213,16 +218,55 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opt,
   std::snprintf(buf, sizeof buf, "\u00b1%g\u00d7 RMS attitude error", k);
   const std::string aband = buf;
   const std::string who = result.scene_name.empty() ? std::string() : result.scene_name + ": ";
-  FillChart(ch, who + "horizontal position error", "horizontal [m]", false, e.t_s,
-            {{"run 0", e.pos_err_h_m, {214, 39, 40}}}, mc ? &zero : nullptr, mc ? &h_hi : nullptr, band, opt,
-            font);
-  FillChart(cv, "vertical position error", "vertical [m]", false, e.t_s,
-            {{"run 0", e.pos_err_v_m, {214, 39, 40}}}, mc ? &zero : nullptr, mc ? &v_hi : nullptr, band, opt,
-            font);
+  std::vector<Series> hs = {{"run 0", e.pos_err_h_m, {214, 39, 40}}};
+  std::vector<Series> vs = {{"run 0", e.pos_err_v_m, {214, 39, 40}}};
+  std::vector<Series> as = {{"roll", roll, {204, 20, 20}}, {"pitch", pitch, {20, 140, 30}}, {"yaw", yaw, {20, 60, 210}}};
+  // Further k-sigma curves: the filter's reported sigma (mean over runs) and the covariance
+  // analysis, when the result carries them.
+  const NavEnvelopeSource more[2] = {NavEnvelopeSource::Filter, NavEnvelopeSource::Covariance};
+  const unsigned char more_rgb[2][3] = {{20, 120, 200}, {120, 60, 170}};
+  for (int m = 0; m < 2; ++m) {
+    std::vector<double> sh(n), sv(n);
+    bool ok = true;
+    for (size_t i = 0; i < n && ok; ++i) {
+      double s3[3];
+      ok = NavSigmaNed(result, more[m], e.t_s[i], s3);
+      if (!ok) break;
+      sh[i] = k * std::hypot(s3[0], s3[1]);
+      sv[i] = k * s3[2];
+    }
+    if (!ok) continue;
+    std::snprintf(buf, sizeof buf, "%g\u00d7 %s", k, NavEnvelopeSourceName(more[m]));
+    Series a{buf, sh, {more_rgb[m][0], more_rgb[m][1], more_rgb[m][2]}, vtkPen::DASH_LINE, 1.5f};
+    hs.push_back(a);
+    a.y = sv;
+    vs.push_back(a);
+  }
+  // Requirement limits as lines (summary.json "requirements").
+  for (const NavRequirementVerdict &r : result.requirements) {
+    std::vector<Series> *dst = nullptr;
+    double scale = 1.0;
+    if (r.metric == "horizontal_position") dst = &hs;
+    else if (r.metric == "vertical_position") dst = &vs;
+    else if (r.metric == "roll_pitch" || r.metric == "yaw") {
+      dst = &as;
+      scale = kRadToDeg;
+    }
+    if (!dst || !(r.limit_si > 0.0)) continue;
+    std::snprintf(buf, sizeof buf, "limit %s: %s %g %s (%s)", r.id.c_str(), r.statistic.c_str(), r.limit,
+                  r.unit.c_str(), r.pass ? "pass" : "FAIL");
+    dst->push_back(Series{buf, std::vector<double>(n, r.limit_si * scale),
+                          {static_cast<unsigned char>(r.pass ? 30 : 200), static_cast<unsigned char>(r.pass ? 30 : 0),
+                           static_cast<unsigned char>(r.pass ? 30 : 0)},
+                          vtkPen::DASH_DOT_LINE, 2.0f});
+  }
+  FillChart(ch, who + "horizontal position error", "horizontal [m]", false, e.t_s, hs, mc ? &zero : nullptr,
+            mc ? &h_hi : nullptr, band, opt, font);
+  FillChart(cv, "vertical position error", "vertical [m]", false, e.t_s, vs, mc ? &zero : nullptr,
+            mc ? &v_hi : nullptr, band, opt, font);
   const bool att_band = mc && !env.att_rms_rad.empty();
-  FillChart(ca, "attitude error (run 0)", "attitude [\u00b0]", true, e.t_s,
-            {{"roll", roll, {204, 20, 20}}, {"pitch", pitch, {20, 140, 30}}, {"yaw", yaw, {20, 60, 210}}},
-            att_band ? &a_lo : nullptr, att_band ? &a_hi : nullptr, aband, opt, font);
+  FillChart(ca, "attitude error (run 0)", "attitude [\u00b0]", true, e.t_s, as, att_band ? &a_lo : nullptr,
+            att_band ? &a_hi : nullptr, aband, opt, font);
   view->Render();
   return NavWriteWindowPng(view->GetRenderWindow(), path, error);
 }

@@ -3,6 +3,7 @@
 #include "navview/nav_view_model.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -69,6 +70,86 @@ void QuatOut(const nav_mat3 &c_b_n, std::vector<double> *q_out) {
 }
 
 } // namespace
+
+NavEnvelopeSource NavResolveEnvelopeSource(const NavResult &result, NavEnvelopeSource src) {
+  if (src != NavEnvelopeSource::Auto) return src;
+  if (result.envelope.Size() > 0) return NavEnvelopeSource::MonteCarlo;
+  if (result.covariance.Size() > 0) return NavEnvelopeSource::Covariance;
+  if (result.errors.Size() > 0) return NavEnvelopeSource::RunErrors;
+  return NavEnvelopeSource::None;
+}
+
+const char *NavEnvelopeSourceName(NavEnvelopeSource src) {
+  switch (src) {
+  case NavEnvelopeSource::MonteCarlo: return "Monte Carlo RMS";
+  case NavEnvelopeSource::Filter: return "filter sigma";
+  case NavEnvelopeSource::Covariance: return "covariance analysis";
+  case NavEnvelopeSource::RunErrors: return "run-0 error";
+  default: return "none";
+  }
+}
+
+bool NavSigmaNed(const NavResult &r, NavEnvelopeSource src, double t, double s[3]) {
+  switch (src) {
+  case NavEnvelopeSource::MonteCarlo:
+    if (r.envelope.Size() == 0) return false;
+    for (int k = 0; k < 3; ++k)
+      s[k] = NavInterpolate(r.envelope.t_s, r.envelope.pos_rms_ned_m, 3, k, t);
+    return true;
+  case NavEnvelopeSource::Filter:
+    if (r.envelope.pos_sd_reported_ned_m.empty()) return false;
+    for (int k = 0; k < 3; ++k)
+      s[k] = NavInterpolate(r.envelope.t_s, r.envelope.pos_sd_reported_ned_m, 3, k, t);
+    return true;
+  case NavEnvelopeSource::Covariance:
+    if (r.covariance.Size() == 0) return false;
+    for (int k = 0; k < 3; ++k)
+      s[k] = NavInterpolate(r.covariance.t_s, r.covariance.pos_sd_ned_m, 3, k, t);
+    return true;
+  case NavEnvelopeSource::RunErrors:
+    if (r.errors.Size() == 0) return false;
+    for (int k = 0; k < 3; ++k)
+      s[k] = std::fabs(NavInterpolate(r.errors.t_s, r.errors.pos_err_ned_m, 3, k, t));
+    return true;
+  default: return false;
+  }
+}
+
+double NavSigmaH(const NavResult &r, NavEnvelopeSource src, double t) {
+  switch (src) {
+  case NavEnvelopeSource::MonteCarlo:
+    return r.envelope.Size() ? NavInterpolate(r.envelope.t_s, r.envelope.pos_h_rms_m, 1, 0, t) : NAN;
+  case NavEnvelopeSource::Covariance:
+    return r.covariance.Size() ? NavInterpolate(r.covariance.t_s, r.covariance.pos_h_sd_m, 1, 0, t) : NAN;
+  case NavEnvelopeSource::RunErrors:
+    return r.errors.Size() ? NavInterpolate(r.errors.t_s, r.errors.pos_err_h_m, 1, 0, t) : NAN;
+  case NavEnvelopeSource::Filter: {
+    double s[3];
+    return NavSigmaNed(r, src, t, s) ? std::hypot(s[0], s[1]) : NAN;
+  }
+  default: return NAN;
+  }
+}
+
+std::vector<double> NavEllipsoidTimes(const NavResult &result, const NavViewOptions &opt) {
+  if (!opt.ellipsoid_times_s.empty()) return opt.ellipsoid_times_s;
+  std::vector<double> times;
+  if (opt.ellipsoid_count <= 0 || result.truth.Size() == 0) return times;
+  const double t0 = result.truth.t_s.front(), t1 = result.truth.t_s.back();
+  for (int i = 0; i < opt.ellipsoid_count; ++i)
+    times.push_back(t0 + (t1 - t0) * (i + 1.0) / opt.ellipsoid_count);
+  // Plus the last reference epoch inside each GNSS outage: where the uncertainty peaks.
+  const NavGnss &g = result.gnss;
+  for (size_t o = 0; o < g.outage_t0_s.size(); ++o) {
+    const size_t i = NavTimeIndex(result.truth.t_s, g.outage_t1_s[o]);
+    size_t j = i;
+    if (j > 0 && result.truth.t_s[j] >= g.outage_t1_s[o]) --j;
+    const double t = result.truth.t_s[j];
+    if (t >= g.outage_t0_s[o] && t < g.outage_t1_s[o]) times.push_back(t);
+  }
+  std::sort(times.begin(), times.end());
+  return times;
+}
 
 double NavNiceGridSpacing(double extent_m) {
   return NiceCeil(extent_m / 10.0);
@@ -155,6 +236,18 @@ bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &opt, doub
   m.grid_r[3] = std::ceil((b[3] + 0.3 * s) / s) * s;
   m.ground_z_r = b[4] - 0.002 * extent;
 
+  m.vehicle = opt.vehicle;
+  if (m.vehicle == NavVehicleKind::Auto) {
+    std::string n = result.scene_name;
+    std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    auto has = [&](const char *w) { return n.find(w) != std::string::npos; };
+    if (has("aircraft") || has("flight") || has("uav") || has("climb") || has("plane"))
+      m.vehicle = NavVehicleKind::Aircraft;
+    else if (has("car") || has("drive") || has("vehicle") || has("road"))
+      m.vehicle = NavVehicleKind::Car;
+    else
+      m.vehicle = NavVehicleKind::Generic;
+  }
   m.triad_size_m = opt.triad_size_m > 0.0 ? opt.triad_size_m : 0.06 * extent_h;
   const double duration = m.t_end_s - m.t_begin_s;
   m.triad_interval_s = opt.triad_interval_s > 0.0 ? opt.triad_interval_s : NiceCeil(duration / 24.0);
@@ -191,10 +284,18 @@ bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &opt, doub
 
   // Error envelope: radius k * sigma at the reference epochs, decimated in (x, y, z, radius) so
   // both the centre line and the radius stay within tol_m.
-  NavEnvelopeSource src = opt.envelope_source;
-  if (src == NavEnvelopeSource::Auto)
-    src = result.envelope.Size() > 0 ? NavEnvelopeSource::MonteCarlo
-                                     : (have_errors ? NavEnvelopeSource::RunErrors : NavEnvelopeSource::None);
+  const NavEnvelopeSource src = NavResolveEnvelopeSource(result, opt.envelope_source);
+  m.envelope_source = src;
+  if (src == NavEnvelopeSource::Filter && result.envelope.pos_sd_reported_ned_m.empty()) {
+    *error = "the filter-sigma envelope was requested but mc_stats.csv has no reported sigma (INS/GNSS "
+             "Monte Carlo only)";
+    return false;
+  }
+  if (src == NavEnvelopeSource::Covariance && result.covariance.Size() == 0) {
+    *error = "the covariance-analysis envelope was requested but no estimate.csv was found (run navsim "
+             "estimate SCENE --out DIR-estimate)";
+    return false;
+  }
   if (src == NavEnvelopeSource::MonteCarlo && result.envelope.Size() == 0) {
     *error = "the Monte Carlo envelope was requested but mc_stats.csv was not loaded";
     return false;
@@ -208,9 +309,7 @@ bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &opt, doub
     std::vector<double> sigma(n), p4(4 * n);
     for (size_t i = 0; i < n; ++i) {
       const double t = result.truth.t_s[i];
-      sigma[i] = src == NavEnvelopeSource::MonteCarlo
-                     ? NavInterpolate(result.envelope.t_s, result.envelope.pos_h_rms_m, 1, 0, t)
-                     : NavInterpolate(result.errors.t_s, result.errors.pos_err_h_m, 1, 0, t);
+      sigma[i] = NavSigmaH(result, src, t);
       for (int k = 0; k < 3; ++k)
         p4[4 * i + static_cast<size_t>(k)] = ref_r[3 * i + static_cast<size_t>(k)];
       p4[4 * i + 3] = opt.envelope_k * sigma[i];
@@ -226,9 +325,65 @@ bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &opt, doub
     char buf[160];
     if (src == NavEnvelopeSource::MonteCarlo)
       std::snprintf(buf, sizeof buf, "%g\u00d7 RMS horizontal error (%d runs)", opt.envelope_k, result.runs);
+    else if (src == NavEnvelopeSource::Filter)
+      std::snprintf(buf, sizeof buf, "%g\u00d7 filter horizontal sigma", opt.envelope_k);
+    else if (src == NavEnvelopeSource::Covariance)
+      std::snprintf(buf, sizeof buf, "%g\u00d7 covariance-analysis horizontal sigma", opt.envelope_k);
     else
       std::snprintf(buf, sizeof buf, "%g\u00d7 horizontal error (run 0)", opt.envelope_k);
     m.envelope_label = buf;
+  }
+
+  // Covariance ellipsoids at chosen epochs, centred on the estimate (where the filter thinks it
+  // is), semi-axes k sigma per N/E/D axis.
+  if (src != NavEnvelopeSource::None && opt.envelope_k > 0.0) {
+    for (double t : NavEllipsoidTimes(result, opt)) {
+      NavEllipsoid e;
+      if (!NavSigmaNed(result, src, t, e.sigma_ned_m)) break;
+      e.t_s = t;
+      NavTrackSample(result.nav, t, e.center_r, nullptr);
+      double k_ned[3];
+      for (int k = 0; k < 3; ++k)
+        k_ned[k] = opt.envelope_k * e.sigma_ned_m[k];
+      // Semi-axes are lengths: the N/E/D -> r map permutes them (signs drop out).
+      NavNedToRender(k_ned, e.semi_axes_r);
+      for (double &a : e.semi_axes_r)
+        a = std::fabs(a);
+      // An ellipsoid wider than the whole scene would hide it (a stationary alignment with
+      // hundreds of metres of sigma): counted, not drawn; the legend says so.
+      if (2.0 * std::max(e.semi_axes_r[0], e.semi_axes_r[1]) > extent_h) {
+        ++m.ellipsoids_too_large;
+        continue;
+      }
+      m.ellipsoids.push_back(e);
+    }
+  }
+
+  // GNSS fixes and the reference path inside each outage.
+  if (opt.show_gnss) {
+    const NavGnss &g = result.gnss;
+    for (size_t i = 0; i < g.Size(); ++i) {
+      double r[3];
+      NavNedToRender(&g.pos_ned_m[3 * i], r);
+      m.gnss_r.insert(m.gnss_r.end(), r, r + 3);
+    }
+    for (size_t o = 0; o < g.outage_t0_s.size(); ++o) {
+      std::vector<double> seg;
+      double p[3];
+      const double t0 = std::max(g.outage_t0_s[o], m.t_begin_s), t1 = std::min(g.outage_t1_s[o], m.t_end_s);
+      if (!(t1 > t0)) continue;
+      NavTrackSample(result.truth, t0, p, nullptr);
+      seg.insert(seg.end(), p, p + 3);
+      for (size_t i = NavTimeIndex(result.truth.t_s, t0); i < result.truth.Size(); ++i) {
+        const double t = result.truth.t_s[i];
+        if (t <= t0) continue;
+        if (t >= t1) break;
+        seg.insert(seg.end(), &ref_r[3 * i], &ref_r[3 * i] + 3);
+      }
+      NavTrackSample(result.truth, t1, p, nullptr);
+      seg.insert(seg.end(), p, p + 3);
+      m.outage_segments.push_back(DecimateToPolyline(seg, nullptr, 0.0, tol_m));
+    }
   }
 
   // Triads at t0 + k * interval (computed, never accumulated).

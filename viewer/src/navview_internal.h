@@ -23,6 +23,10 @@ void NavApplyFont(vtkTextProperty *tprop);
  *  that the viewer fails with a message instead. */
 bool NavCheckDisplay(std::string *error);
 
+/** Give @p window the process's X connection (opened by NavCheckDisplay, which must have
+ *  succeeded first), so that VTK opens no connection of its own. */
+void NavAttachDisplay(vtkRenderWindow *window);
+
 /** Read the back buffer of @p window and write it as an RGB PNG. */
 bool NavWriteWindowPng(vtkRenderWindow *window, const std::string &path, std::string *error);
 

@@ -74,6 +74,15 @@ bool LoadTrack(const std::string &path, NavTrack *out, std::string *error) {
       track.euler_rad[3 * r + static_cast<size_t>(k)] = t.At(r, c[4 + k]) * kDegToRad;
     }
   }
+  const int clat = t.Column("lat_deg"), clon = t.Column("lon_deg"), ch = t.Column("h_m");
+  if (clat >= 0 && clon >= 0 && ch >= 0) {
+    track.geo.resize(3 * t.rows);
+    for (size_t r = 0; r < t.rows; ++r) {
+      track.geo[3 * r] = t.At(r, clat) * kDegToRad;
+      track.geo[3 * r + 1] = t.At(r, clon) * kDegToRad;
+      track.geo[3 * r + 2] = t.At(r, ch);
+    }
+  }
   *out = std::move(track);
   return true;
 }
@@ -132,8 +141,114 @@ bool LoadEnvelope(const std::string &path, NavEnvelope *out, std::string *error)
     e.pos_h_rms_m[r] = t.At(r, c[4]);
     if (att >= 0) e.att_rms_rad[r] = t.At(r, att);
   }
+  const int sd = t.Column("pos_sd_reported_n_m");
+  if (sd >= 0 && t.Column("pos_sd_reported_e_m") == sd + 1 && t.Column("pos_sd_reported_d_m") == sd + 2) {
+    bool any = false;
+    std::vector<double> v(3 * n);
+    for (size_t r = 0; r < n; ++r)
+      for (int k = 0; k < 3; ++k) {
+        v[3 * r + static_cast<size_t>(k)] = t.At(r, sd + k);
+        any = any || v[3 * r + static_cast<size_t>(k)] > 0.0;
+      }
+    if (any) e.pos_sd_reported_ned_m = std::move(v);
+  }
   *out = std::move(e);
   return true;
+}
+
+bool LoadGnss(const std::string &path, const std::string &outages, NavGnss *out, std::string *error) {
+  NavCsvTable t;
+  if (!NavCsvReadFile(path, &t, error)) return false;
+  std::vector<int> c;
+  if (!RequireColumns(t, path,
+                      {"t_s", "lat_deg", "lon_deg", "h_m", "pos_n_m", "pos_e_m", "pos_d_m", "pos_sd_n_m",
+                       "pos_sd_e_m", "pos_sd_d_m"},
+                      &c, error))
+    return false;
+  if (!CheckTimes(t, c[0], path, error)) return false;
+  NavGnss g;
+  const size_t n = t.rows;
+  g.t_s.resize(n);
+  g.pos_ned_m.resize(3 * n);
+  g.geo.resize(3 * n);
+  g.pos_sd_ned_m.resize(3 * n);
+  for (size_t r = 0; r < n; ++r) {
+    g.t_s[r] = t.At(r, c[0]);
+    g.geo[3 * r] = t.At(r, c[1]) * kDegToRad;
+    g.geo[3 * r + 1] = t.At(r, c[2]) * kDegToRad;
+    g.geo[3 * r + 2] = t.At(r, c[3]);
+    for (int k = 0; k < 3; ++k) {
+      g.pos_ned_m[3 * r + static_cast<size_t>(k)] = t.At(r, c[4 + k]);
+      g.pos_sd_ned_m[3 * r + static_cast<size_t>(k)] = t.At(r, c[7 + k]);
+    }
+  }
+  if (FileExists(outages)) {
+    NavCsvTable o;
+    if (!NavCsvReadFile(outages, &o, error)) return false;
+    if (!RequireColumns(o, outages, {"t0_s", "t1_s"}, &c, error)) return false;
+    for (size_t r = 0; r < o.rows; ++r) {
+      g.outage_t0_s.push_back(o.At(r, c[0]));
+      g.outage_t1_s.push_back(o.At(r, c[1]));
+    }
+  }
+  *out = std::move(g);
+  return true;
+}
+
+bool LoadImuErrors(const std::string &path, NavImuErrors *out, std::string *error) {
+  NavCsvTable t;
+  if (!NavCsvReadFile(path, &t, error)) return false;
+  std::vector<int> c;
+  if (!RequireColumns(t, path,
+                      {"t_s", "gyro_err_x_dps", "gyro_err_y_dps", "gyro_err_z_dps", "accel_err_x_mps2",
+                       "accel_err_y_mps2", "accel_err_z_mps2"},
+                      &c, error))
+    return false;
+  NavImuErrors e;
+  const size_t n = t.rows;
+  e.t_s.resize(n);
+  e.gyro_rps.resize(3 * n);
+  e.accel_mps2.resize(3 * n);
+  for (size_t r = 0; r < n; ++r) {
+    e.t_s[r] = t.At(r, c[0]);
+    for (int k = 0; k < 3; ++k) {
+      e.gyro_rps[3 * r + static_cast<size_t>(k)] = t.At(r, c[1 + k]) * kDegToRad;
+      e.accel_mps2[3 * r + static_cast<size_t>(k)] = t.At(r, c[4 + k]);
+    }
+  }
+  *out = std::move(e);
+  return true;
+}
+
+// estimate.csv of navsim estimate: only the covariance columns; empty fields (flat Earth scenes)
+// make the parse fail, which the caller records as a note.
+bool LoadCovariance(const std::string &path, NavCovariance *out, std::string *error) {
+  NavCsvTable t;
+  if (!NavCsvReadFile(path, &t, error)) return false;
+  std::vector<int> c;
+  if (!RequireColumns(t, path, {"t_s", "cov_pos_n_sd_m", "cov_pos_e_sd_m", "cov_pos_d_sd_m", "cov_pos_h_sd_m"}, &c,
+                      error))
+    return false;
+  NavCovariance v;
+  for (size_t r = 0; r < t.rows; ++r) {
+    v.t_s.push_back(t.At(r, c[0]));
+    for (int k = 0; k < 3; ++k)
+      v.pos_sd_ned_m.push_back(t.At(r, c[1 + k]));
+    v.pos_h_sd_m.push_back(t.At(r, c[4]));
+  }
+  *out = std::move(v);
+  return true;
+}
+
+double UnitToSi(const std::string &u) {
+  if (u == "m" || u == "m/s" || u == "rad") return 1.0;
+  if (u == "cm" || u == "cm/s") return 0.01;
+  if (u == "km") return 1000.0;
+  if (u == "deg") return kDegToRad;
+  if (u == "arcmin") return kDegToRad / 60.0;
+  if (u == "arcsec") return kDegToRad / 3600.0;
+  if (u == "mrad") return 1e-3;
+  return 1.0;
 }
 
 // summary.json is navsim's own, flat and machine-written: two fields are picked out by key
@@ -157,6 +272,64 @@ int JsonIntAfter(const std::string &text, const std::string &key, int fallback) 
   if (q == std::string::npos) return fallback;
   const long v = std::strtol(text.c_str() + q + 1, nullptr, 10);
   return v > 0 && v < 100000000 ? static_cast<int>(v) : fallback;
+}
+
+std::string JsonStringIn(const std::string &obj, const std::string &key) {
+  return JsonStringAfter(obj, key);
+}
+
+double JsonNumberIn(const std::string &obj, const std::string &key) {
+  const size_t k = obj.find("\"" + key + "\"");
+  if (k == std::string::npos) return NAN;
+  const size_t q = obj.find(':', k);
+  if (q == std::string::npos) return NAN;
+  char *end = nullptr;
+  const double v = std::strtod(obj.c_str() + q + 1, &end);
+  return end == obj.c_str() + q + 1 ? NAN : v;
+}
+
+// "requirements": [ {...}, ... ] of summary.json (the requirements contract); objects may nest.
+std::vector<NavRequirementVerdict> ParseRequirements(const std::string &text) {
+  std::vector<NavRequirementVerdict> out;
+  const size_t k = text.find("\"requirements\"");
+  if (k == std::string::npos) return out;
+  size_t p = text.find('[', k);
+  if (p == std::string::npos) return out;
+  int depth = 0;
+  size_t obj_begin = 0;
+  bool in_str = false;
+  for (size_t i = p + 1; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (in_str) {
+      if (ch == '\\') ++i;
+      else if (ch == '"') in_str = false;
+      continue;
+    }
+    if (ch == '"') in_str = true;
+    else if (ch == '{' || ch == '[') {
+      if (depth == 0 && ch == '{') obj_begin = i;
+      ++depth;
+    } else if (ch == '}' || ch == ']') {
+      if (depth == 0) break; // end of the requirements array
+      --depth;
+      if (depth == 0 && ch == '}') {
+        const std::string obj = text.substr(obj_begin, i - obj_begin + 1);
+        NavRequirementVerdict v;
+        v.id = JsonStringIn(obj, "id");
+        v.metric = JsonStringIn(obj, "metric");
+        v.statistic = JsonStringIn(obj, "statistic");
+        v.unit = JsonStringIn(obj, "unit");
+        v.limit = JsonNumberIn(obj, "limit");
+        v.value = JsonNumberIn(obj, "value");
+        v.limit_si = v.limit * UnitToSi(v.unit);
+        const size_t ps = obj.find("\"pass\"");
+        v.pass = ps != std::string::npos && obj.find("true", ps) != std::string::npos &&
+                 obj.find("true", ps) < obj.find_first_of(",}", ps);
+        out.push_back(v);
+      }
+    }
+  }
+  return out;
 }
 
 } // namespace
@@ -200,6 +373,28 @@ bool NavLoadResultDir(const std::string &dir, NavResult *out, std::string *error
     if (!LoadEnvelope(env_path, &r.envelope, error)) return false;
   }
 
+  const std::string gnss_path = Join(dir, "gnss.csv");
+  if (FileExists(gnss_path)) {
+    if (!LoadGnss(gnss_path, Join(dir, "gnss_outages.csv"), &r.gnss, error)) return false;
+  }
+  const std::string imu_path = Join(dir, "imu_errors.csv");
+  if (FileExists(imu_path)) {
+    if (!LoadImuErrors(imu_path, &r.imu_errors, error)) return false;
+  }
+  // Covariance analysis: estimate.csv in the directory, else in DIR-estimate (navsim estimate's
+  // default next to navsim run's). Optional: a failure is a note, not an error.
+  {
+    std::string d = dir;
+    while (d.size() > 1 && d.back() == '/')
+      d.pop_back();
+    for (const std::string &cand : {Join(dir, "estimate.csv"), d + "-estimate/estimate.csv"}) {
+      if (!FileExists(cand)) continue;
+      std::string cerr;
+      if (LoadCovariance(cand, &r.covariance, &cerr)) break;
+      r.notes.push_back(cerr + " (covariance analysis not used)");
+    }
+  }
+
   const std::string sum_path = Join(dir, "summary.json");
   std::ifstream sum(sum_path);
   if (sum) {
@@ -209,6 +404,8 @@ bool NavLoadResultDir(const std::string &dir, NavResult *out, std::string *error
     const size_t scene = text.find("\"scene\"");
     if (scene != std::string::npos) r.scene_name = JsonStringAfter(text.substr(scene), "name");
     r.runs = JsonIntAfter(text, "runs", 1);
+    r.requirements = ParseRequirements(text);
+    r.summary_json = text;
   } else {
     r.notes.push_back(sum_path + ": not found");
   }

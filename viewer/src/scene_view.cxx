@@ -24,6 +24,9 @@
 #include <vtkGlyph3DMapper.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
+#include <vtkOggTheoraWriter.h>
+#include <vtkWindowToImageFilter.h>
+#include <sys/stat.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -59,6 +62,9 @@ const double kVehicleColor[3] = {1.00, 0.62, 0.05};
 const double kTriadRGB[3][3] = {{0.85, 0.05, 0.05}, {0.05, 0.62, 0.10}, {0.05, 0.25, 0.90}};
 const double kTriadRefGrey[3] = {0.42, 0.42, 0.46};
 const double kTextColor[3] = {0.05, 0.05, 0.08};
+const double kGnssColor[3] = {0.10, 0.62, 0.20};
+const double kOutageColor[3] = {0.96, 0.50, 0.80}; // pink: the vehicle is orange
+const double kEllipsoidColor[3] = {0.45, 0.25, 0.80};
 
 // Perceptually ordered colour map for the error magnitude (viridis control points).
 const double kViridis[5][3] = {{0.267, 0.005, 0.329},
@@ -144,6 +150,56 @@ vtkSmartPointer<vtkPolyData> VehicleShape() {
   return pd;
 }
 
+// An aircraft in body axes (FRD, unit length 1 along x): fuselage, wings, tailplane and fin.
+vtkSmartPointer<vtkPolyData> AircraftShape() {
+  vtkNew<vtkAppendPolyData> app;
+  auto box = [&](double lx, double ly, double lz, double cx, double cy, double cz) {
+    vtkNew<vtkCubeSource> c;
+    c->SetXLength(lx);
+    c->SetYLength(ly);
+    c->SetZLength(lz);
+    c->SetCenter(cx, cy, cz);
+    c->Update();
+    app->AddInputData(c->GetOutput());
+  };
+  box(0.85, 0.11, 0.11, -0.05, 0.0, 0.0);   // fuselage
+  box(0.22, 0.95, 0.025, 0.02, 0.0, 0.0);   // wings (span along y)
+  box(0.12, 0.36, 0.02, -0.42, 0.0, 0.0);   // tailplane
+  box(0.14, 0.02, 0.20, -0.42, 0.0, -0.12); // fin (up is -z)
+  vtkNew<vtkConeSource> nose;
+  nose->SetResolution(12);
+  nose->SetHeight(0.16);
+  nose->SetRadius(0.055);
+  nose->SetCenter(0.45, 0.0, 0.0);
+  nose->SetDirection(1.0, 0.0, 0.0);
+  nose->Update();
+  app->AddInputData(nose->GetOutput());
+  app->Update();
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->ShallowCopy(app->GetOutput());
+  return pd;
+}
+
+// A generic vehicle: an arrowhead (four-sided cone) along body x, flattened along z.
+vtkSmartPointer<vtkPolyData> GenericShape() {
+  vtkNew<vtkConeSource> cone;
+  cone->SetResolution(4);
+  cone->SetHeight(1.0);
+  cone->SetRadius(0.3);
+  cone->SetCenter(0.0, 0.0, 0.0);
+  cone->SetDirection(1.0, 0.0, 0.0);
+  vtkNew<vtkTransform> tf;
+  tf->Scale(1.0, 1.0, 0.35);
+  tf->RotateX(45.0);
+  vtkNew<vtkTransformPolyDataFilter> f;
+  f->SetTransform(tf);
+  f->SetInputConnection(cone->GetOutputPort());
+  f->Update();
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->ShallowCopy(f->GetOutput());
+  return pd;
+}
+
 void StyleText(vtkTextProperty *tp, int size, bool bold = false) {
   NavApplyFont(tp);
   tp->SetFontSize(size);
@@ -188,6 +244,7 @@ bool NavSceneViewImpl::EnsureWindow(bool offscreen, std::string *error) {
   if (!NavCheckDisplay(error)) return false;
   if (Window) Window->Finalize();
   Window = vtkSmartPointer<vtkRenderWindow>::New();
+  NavAttachDisplay(Window);
   Window->SetOffScreenRendering(offscreen ? 1 : 0);
   Window->SetMultiSamples(Options.multisamples);
   Window->SetSize(Options.width_px, Options.height_px);
@@ -380,11 +437,14 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
   PickRadiusM = 12.0 * m_per_px;
 
   AddGrid();
-  AddEnvelope();
+  AddGnss();
   AddPaths();
   if (Options.show_triads) AddTriads();
   if (Options.show_axes) AddAxesAndScale();
   AddVehicle();
+  // Blended surfaces last, in this order (they are drawn in the opaque pass: AddEnvelope).
+  AddEllipsoids();
+  AddEnvelope();
   if (Options.show_text) AddText();
   Built = true;
   if (!std::isfinite(TimeS)) TimeS = std::isfinite(Options.time_s) ? Options.time_s : Model.t_end_s;
@@ -397,7 +457,8 @@ void NavSceneViewImpl::AddPaths() {
   for (size_t r = 0; r < Model.extra_runs.size(); ++r) {
     auto pd = MakePolyline(Model.extra_runs[r].xyz_r);
     auto a = LineActor(pd, kRunColor, 1.0);
-    a->GetProperty()->SetOpacity(0.7);
+    // Opaque (a light colour instead of opacity): any translucent actor makes VTK 9.1 run its
+    // order-independent-translucency fallback, about 11 ms per 1000x700 frame on llvmpipe.
     Renderer->AddActor(a);
   }
   auto ref = MakePolyline(Model.reference.xyz_r);
@@ -463,9 +524,86 @@ void NavSceneViewImpl::AddEnvelope() {
   actor->SetMapper(mapper);
   actor->GetProperty()->SetColor(kTubeColor[0], kTubeColor[1], kTubeColor[2]);
   actor->GetProperty()->SetOpacity(0.28);
+  // Blended in the opaque pass (ForceOpaque) instead of VTK's order-independent-translucency
+  // fallback, which cost about 11 ms per 1000x700 frame on llvmpipe (the default view went from
+  // 27 to 16 ms CPU per frame without it). Correct because the tube is drawn last (BuildScene
+  // adds it after every opaque actor, after the ellipsoids) and only its front faces are drawn,
+  // so each pixel is tinted once.
+  actor->ForceOpaqueOn();
+  actor->GetProperty()->BackfaceCullingOn();
   actor->GetProperty()->SetSpecular(0.0);
   actor->GetProperty()->SetAmbient(0.25);
   Renderer->AddActor(actor);
+}
+
+void NavSceneViewImpl::AddGnss() {
+  // Outages: a wide pink band under the reference path.
+  for (const NavPolyline &seg : Model.outage_segments) {
+    if (seg.Size() < 2) continue;
+    auto a = LineActor(MakePolyline(seg.xyz_r), kOutageColor, 9.0); // opaque: see AddPaths
+    Renderer->AddActor(a);
+  }
+  // Fixes: small green spheres (points rendered as spheres keep their pixel size at any zoom).
+  const size_t n = Model.gnss_r.size() / 3;
+  if (n == 0) return;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> verts;
+  // Display thinning: fixes closer than three dot diameters on screen to the last one drawn are
+  // skipped, so the paths stay visible between them (1 Hz fixes of a car at city scale would
+  // otherwise cover the estimate).
+  const float dot_px = std::max(4.0f, static_cast<float>(Options.height_px) / 130.0f);
+  const double min_gap = 3.0 * dot_px * std::max(MetresPerPixel(), 0.0);
+  const double *last = nullptr;
+  GnssDrawn = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double *p = &Model.gnss_r[3 * i];
+    if (last && std::sqrt(Sq(p[0] - last[0]) + Sq(p[1] - last[1]) + Sq(p[2] - last[2])) < min_gap) continue;
+    last = p;
+    const vtkIdType id = pts->InsertNextPoint(p);
+    verts->InsertNextCell(1, &id);
+    ++GnssDrawn;
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetVerts(verts);
+  vtkNew<vtkPolyDataMapper> m;
+  m->SetInputData(pd);
+  m->ScalarVisibilityOff();
+  vtkNew<vtkActor> a;
+  a->SetMapper(m);
+  a->GetProperty()->SetColor(kGnssColor[0], kGnssColor[1], kGnssColor[2]);
+  a->GetProperty()->SetPointSize(dot_px);
+  a->GetProperty()->SetRenderPointsAsSpheres(true);
+  // Mostly flat colour: shaded sphere impostors of a few pixels come out nearly black.
+  a->GetProperty()->SetAmbient(0.75);
+  a->GetProperty()->SetDiffuse(0.35);
+  a->GetProperty()->SetSpecular(0.0);
+  Renderer->AddActor(a);
+}
+
+void NavSceneViewImpl::AddEllipsoids() {
+  for (const NavEllipsoid &e : Model.ellipsoids) {
+    vtkNew<vtkSphereSource> sphere;
+    sphere->SetRadius(1.0);
+    sphere->SetThetaResolution(28);
+    sphere->SetPhiResolution(16);
+    vtkNew<vtkPolyDataMapper> m;
+    m->SetInputConnection(sphere->GetOutputPort());
+    vtkNew<vtkActor> a;
+    a->SetMapper(m);
+    // A floor far below a pixel keeps a zero sigma from collapsing the matrix.
+    const double fl = 1e-6 * std::max(Model.triad_size_m, 1e-9);
+    a->SetScale(std::max(e.semi_axes_r[0], fl), std::max(e.semi_axes_r[1], fl), std::max(e.semi_axes_r[2], fl));
+    a->SetPosition(e.center_r[0], e.center_r[1], e.center_r[2]);
+    a->GetProperty()->SetColor(kEllipsoidColor[0], kEllipsoidColor[1], kEllipsoidColor[2]);
+    a->GetProperty()->SetOpacity(0.45);
+    a->ForceOpaqueOn(); // blended in the opaque pass, before the tube: see AddEnvelope
+    a->GetProperty()->BackfaceCullingOn();
+    a->GetProperty()->SetSpecular(0.2);
+    a->GetProperty()->SetAmbient(0.3);
+    Renderer->AddActor(a);
+  }
 }
 
 void NavSceneViewImpl::AddTriads() {
@@ -626,7 +764,9 @@ void NavSceneViewImpl::AddAxesAndScale() {
 void NavSceneViewImpl::AddVehicle() {
   if (!Options.show_vehicle) return;
   vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputData(VehicleShape());
+  mapper->SetInputData(Model.vehicle == NavVehicleKind::Aircraft
+                           ? AircraftShape()
+                           : (Model.vehicle == NavVehicleKind::Car ? VehicleShape() : GenericShape()));
   Vehicle = vtkSmartPointer<vtkActor>::New();
   Vehicle->SetMapper(mapper);
   Vehicle->GetProperty()->SetColor(kVehicleColor[0], kVehicleColor[1], kVehicleColor[2]);
@@ -649,7 +789,7 @@ void NavSceneViewImpl::AddVehicle() {
 
 void NavSceneViewImpl::AddText() {
   Title = vtkSmartPointer<vtkTextActor>::New();
-  char buf[256];
+  char buf[512];
   if (Result->runs > 1)
     std::snprintf(buf, sizeof buf, "%s \u00b7 run 0 of %d", Result->scene_name.c_str(), Result->runs);
   else
@@ -677,14 +817,21 @@ void NavSceneViewImpl::AddText() {
     else
       std::snprintf(buf, sizeof buf, "%g m", sp);
     grid = buf;
+    char gbuf[160] = "";
+    int gn = 0;
+    if (GnssDrawn > 0 && GnssDrawn < Model.gnss_r.size() / 3)
+      gn = std::snprintf(gbuf, sizeof gbuf, "\nGNSS fixes: %zu of %zu drawn", GnssDrawn, Model.gnss_r.size() / 3);
+    if (Model.ellipsoids_too_large > 0 && gn >= 0 && gn < static_cast<int>(sizeof gbuf))
+      std::snprintf(gbuf + gn, sizeof gbuf - static_cast<size_t>(gn), "\n%zu ellipsoid%s wider than the scene\nnot drawn",
+                    Model.ellipsoids_too_large, Model.ellipsoids_too_large == 1 ? "" : "s");
     size_t drawn = Model.reference.Size() + Model.estimate.Size();
     for (const NavPolyline &p : Model.extra_runs)
       drawn += p.Size();
     std::snprintf(buf, sizeof buf,
                   "grid %s, scale bar one cell\ntriads every %g s\ndrawn %zu of %zu epochs\n(tolerance %.2g "
-                  "px = %.3g m)",
+                  "px = %.3g m)%s",
                   grid.c_str(), Model.triad_interval_s, drawn, Model.full_points, Options.decimate_px,
-                  Model.decimation_tol_m);
+                  Model.decimation_tol_m, gbuf);
     Info->SetInput(buf);
   }
 
@@ -714,17 +861,21 @@ void NavSceneViewImpl::AddPanel() {
   if (!Result->extra_runs.empty())
     e.push_back({Sym::Line, std::to_string(Result->extra_runs.size()) + " further runs", kRunColor, 1.5});
   // The tube label is known once the model has its envelope; recompute the source here.
-  NavEnvelopeSource src = Options.envelope_source;
-  if (src == NavEnvelopeSource::Auto)
-    src = Result->envelope.Size() > 0
-              ? NavEnvelopeSource::MonteCarlo
-              : (Result->errors.Size() > 0 ? NavEnvelopeSource::RunErrors : NavEnvelopeSource::None);
+  const NavEnvelopeSource src = NavResolveEnvelopeSource(*Result, Options.envelope_source);
   char buf[160];
+  if (Options.show_gnss && Result->gnss.Size() > 0)
+    e.push_back({Sym::Dot, "GNSS fixes (run 0)", kGnssColor, 0.0});
+  if (Options.show_gnss && !Result->gnss.outage_t0_s.empty()) {
+    std::snprintf(buf, sizeof buf, "GNSS outage (%zu)", Result->gnss.outage_t0_s.size());
+    e.push_back({Sym::Line, buf, kOutageColor, 7.0});
+  }
   if (src != NavEnvelopeSource::None && Options.envelope_k > 0.0) {
     // The largest radius tells why a tube may be invisible (an ideal run has micrometres).
-    const std::vector<double> &sig =
-        src == NavEnvelopeSource::MonteCarlo ? Result->envelope.pos_h_rms_m : Result->errors.pos_err_h_m;
-    const double rmax = sig.empty() ? 0.0 : Options.envelope_k * *std::max_element(sig.begin(), sig.end());
+    double rmax = 0.0;
+    for (size_t i = 0; i < Result->truth.Size(); i += std::max<size_t>(1, Result->truth.Size() / 4000)) {
+      const double sh = NavSigmaH(*Result, src, Result->truth.t_s[i]);
+      if (std::isfinite(sh)) rmax = std::max(rmax, Options.envelope_k * sh);
+    }
     char rbuf[32];
     if (rmax >= 0.01 || rmax == 0.0)
       std::snprintf(rbuf, sizeof rbuf, "%.3g m", rmax);
@@ -733,10 +884,24 @@ void NavSceneViewImpl::AddPanel() {
     if (src == NavEnvelopeSource::MonteCarlo)
       std::snprintf(buf, sizeof buf, "tube: %g\u00d7 RMS horizontal error\nover %d runs (\u2264 %s)",
                     Options.envelope_k, Result->runs, rbuf);
+    else if (src == NavEnvelopeSource::Filter)
+      std::snprintf(buf, sizeof buf, "tube: %g\u00d7 filter horizontal\n\u03c3, mean of %d runs (\u2264 %s)",
+                    Options.envelope_k, Result->runs, rbuf);
+    else if (src == NavEnvelopeSource::Covariance)
+      std::snprintf(buf, sizeof buf, "tube: %g\u00d7 horizontal \u03c3 of the\ncovariance analysis (\u2264 %s)",
+                    Options.envelope_k, rbuf);
     else
       std::snprintf(buf, sizeof buf, "tube: %g\u00d7 horizontal error\nof run 0 (\u2264 %s)",
                     Options.envelope_k, rbuf);
     e.push_back({Sym::Box, buf, kTubeColor, 0.0});
+    const size_t n_ell = NavEllipsoidTimes(*Result, Options).size();
+    if (n_ell > 0) {
+      std::snprintf(buf, sizeof buf, "ellipsoids: %g\u03c3 N/E/D\n(%s), at %zu epochs%s", Options.envelope_k,
+                    NavEnvelopeSourceName(src), n_ell,
+                    Options.ellipsoid_times_s.empty() && !Result->gnss.outage_t0_s.empty() ? "\nincl. outage ends"
+                                                                                         : "");
+      e.push_back({Sym::Box, buf, kEllipsoidColor, 0.0});
+    }
   }
   if (Options.show_triads) {
     e.push_back({Sym::Arrow, "reference attitude", kTriadRefGrey, 2.0});
@@ -745,7 +910,11 @@ void NavSceneViewImpl::AddPanel() {
     e.push_back({Sym::Triad, buf, kTriadRGB[0], 2.0});
   }
   if (Options.show_vehicle) {
-    e.push_back({Sym::Box, "vehicle at t (reference)", kVehicleColor, 0.0});
+    const NavVehicleKind vk = Model.vehicle;
+    e.push_back({Sym::Box,
+                 vk == NavVehicleKind::Aircraft ? "aircraft at t (reference)"
+                                                : (vk == NavVehicleKind::Car ? "car at t (reference)" : "vehicle at t (reference)"),
+                 kVehicleColor, 0.0});
     e.push_back({Sym::Dot, "estimated position at t", kEstColor, 0.0});
   }
 
@@ -815,7 +984,7 @@ void NavSceneViewImpl::AddPanel() {
           pts->InsertNextPoint(xc + hw, yc + hh, 0.0), pts->InsertNextPoint(xc - hw, yc + hh, 0.0)};
       cells->InsertNextCell(4, ids);
       pd->SetPolys(cells);
-      add_2d(pd, x.rgb, 1.0, x.sym == Sym::Box && x.rgb == kTubeColor ? 0.45 : 1.0);
+      add_2d(pd, x.rgb, 1.0, x.sym == Sym::Box && (x.rgb == kTubeColor || x.rgb == kEllipsoidColor) ? 0.45 : 1.0);
     } else if (x.sym == Sym::Arrow) {
       seg(x0, yc, x1, yc);
       seg(x1, yc, x1 - 0.35 * fs, yc + 0.3 * fs);
@@ -880,7 +1049,9 @@ void NavSceneViewImpl::AddPanel() {
     StyleText(ScalarBar->GetLabelTextProperty(), fs, false);
     const double h = Options.height_px;
     const double y_top = 1.0 - (legend_bottom_px + 2.2 * fs) / h;
-    const double bar_h = std::max(0.15, std::min(0.45, y_top - 0.05));
+    // Keep clear of the notes at the bottom of the panel (four or five lines).
+    const double notes_h = (5.6 * 1.3 * FontSize(0.75)) / h + 0.02;
+    const double bar_h = std::max(0.12, std::min(0.45, y_top - notes_h));
     ScalarBar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     ScalarBar->GetPositionCoordinate()->SetValue(pad / panel_w, y_top - bar_h);
     ScalarBar->SetWidth(std::min(0.9, 6.5 * fs / panel_w));
@@ -932,7 +1103,8 @@ void NavSceneViewImpl::UpdateTime() {
 
   if (Readout) {
     char buf[256];
-    int n = std::snprintf(buf, sizeof buf, "t = %.1f s", TimeS);
+    int n = std::snprintf(buf, sizeof buf, "t = %.1f s%s", TimeS,
+                          Result->gnss.InOutage(TimeS) ? "  \u2013 GNSS outage" : "");
     const NavErrorSeries &er = Result->errors;
     if (er.Size() > 0 && n > 0 && n < static_cast<int>(sizeof buf)) {
       const double eh = NavInterpolate(er.t_s, er.pos_err_h_m, 1, 0, TimeS);
@@ -991,6 +1163,56 @@ bool NavSceneView::RenderPng(const std::string &path, std::string *error) {
   }
   Impl->Window->Render();
   return NavWriteWindowPng(Impl->Window, path, error);
+}
+
+bool NavSceneView::RenderMovie(const std::string &dir, int frames, double fps, bool video, std::string *error) {
+  if (frames < 1 || frames > 100000 || !(fps > 0.0)) {
+    *error = "movie: frames must be 1..100000 and fps > 0";
+    return false;
+  }
+  mkdir(dir.c_str(), 0755);
+  struct stat st;
+  if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    *error = dir + ": error: cannot create the movie directory";
+    return false;
+  }
+  if (!Impl->Built || !Impl->Offscreen) {
+    if (!Impl->BuildScene(true, error)) return false;
+  }
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(Impl->Window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  vtkNew<vtkOggTheoraWriter> ogv;
+  const std::string ogv_path = dir + "/playback.ogv";
+  if (video) {
+    ogv->SetInputConnection(grab->GetOutputPort());
+    ogv->SetFileName(ogv_path.c_str());
+    ogv->SetRate(std::max(1, static_cast<int>(std::lround(fps))));
+    ogv->SetQuality(2);
+  }
+  const double t0 = Impl->Model.t_begin_s, t1 = Impl->Model.t_end_s;
+  for (int i = 0; i < frames; ++i) {
+    Impl->TimeS = frames > 1 ? t0 + (t1 - t0) * i / (frames - 1.0) : t1;
+    Impl->UpdateTime();
+    Impl->Window->Render();
+    char name[64];
+    std::snprintf(name, sizeof name, "/frame_%04d.png", i);
+    if (!NavWriteWindowPng(Impl->Window, dir + name, error)) return false;
+    if (video) {
+      grab->Modified();
+      if (i == 0) ogv->Start();
+      ogv->Write();
+    }
+  }
+  if (video) {
+    ogv->End();
+    if (ogv->GetError()) {
+      *error = ogv_path + ": error: the Ogg Theora writer failed";
+      return false;
+    }
+  }
+  return true;
 }
 
 bool NavSceneView::PickNearest(const double xyz_r[3], NavPickResult *out) const {

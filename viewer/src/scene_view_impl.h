@@ -49,6 +49,7 @@ public:
   double VehiclePosR[3] = {0, 0, 0};
   bool VehiclePlaced = false;
   double PickRadiusM = 0.0;
+  size_t GnssDrawn = 0; /**< GNSS fixes drawn after display thinning */
 
   /** Create (or re-create, when the on/offscreen mode changes) the window and renderer. */
   bool EnsureWindow(bool offscreen, std::string *error);
@@ -63,6 +64,8 @@ public:
 
   void AddPaths();
   void AddEnvelope();
+  void AddGnss();
+  void AddEllipsoids();
   void AddTriads();
   void AddGrid();
   void AddAxesAndScale();

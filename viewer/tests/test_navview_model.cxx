@@ -17,8 +17,11 @@ extern "C" {
 #include <cmocka.h>
 }
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <sys/stat.h>
 #include <memory>
 #include <random>
 #include <string>
@@ -27,6 +30,7 @@ extern "C" {
 #include "nav_test.h"
 #include "navview/nav_view_decimate.h"
 #include "navview/nav_view_frame.h"
+#include "navview/nav_view_map.h"
 #include "navview/nav_view_model.h"
 #include "navview/nav_view_result.h"
 #include "navview/nav_view_scene.h"
@@ -279,6 +283,200 @@ void test_grid_spacing(void **) {
   assert_near(NavNiceGridSpacing(0.0), 1.0, 0.0);
 }
 
+// Filter sigma and covariance analysis: tube radius = k * horizontal sigma fed in; ellipsoid
+// semi-axes = k * sigma N/E/D fed in, mapped to x = east, y = north, z = up.
+void test_envelope_sources_and_ellipsoids(void **) {
+  NavResult r = load_tiny();
+  const size_t n = r.envelope.Size();
+  r.envelope.pos_sd_reported_ned_m.resize(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    r.envelope.pos_sd_reported_ned_m[3 * i] = 0.4 + 0.01 * static_cast<double>(i);
+    r.envelope.pos_sd_reported_ned_m[3 * i + 1] = 0.2 + 0.03 * static_cast<double>(i);
+    r.envelope.pos_sd_reported_ned_m[3 * i + 2] = 0.9;
+  }
+  r.covariance.t_s = r.envelope.t_s;
+  for (size_t i = 0; i < n; ++i) {
+    const double sn = 1.0 + 0.02 * static_cast<double>(i), se = 0.5, sd = 2.0;
+    r.covariance.pos_sd_ned_m.insert(r.covariance.pos_sd_ned_m.end(), {sn, se, sd});
+    r.covariance.pos_h_sd_m.push_back(std::hypot(sn, se));
+  }
+  NavViewOptions opt;
+  opt.envelope_k = 3.0;
+  opt.ellipsoid_times_s = {0.0, 30.0, 61.0, 120.0}; // 61 s: between epochs, interpolated
+  NavSceneModel m;
+  std::string err;
+  for (NavEnvelopeSource src : {NavEnvelopeSource::Filter, NavEnvelopeSource::Covariance}) {
+    opt.envelope_source = src;
+    assert_true(NavBuildSceneModel(r, opt, 0.05, &m, &err));
+    assert_true(m.envelope_source == src);
+    assert_true(m.envelope.Size() >= 2);
+    for (size_t i = 0; i < m.envelope.Size(); ++i) {
+      const size_t k = m.envelope.source_index[i];
+      const double sh = src == NavEnvelopeSource::Filter
+                            ? std::hypot(r.envelope.pos_sd_reported_ned_m[3 * k], r.envelope.pos_sd_reported_ned_m[3 * k + 1])
+                            : r.covariance.pos_h_sd_m[k];
+      assert_near(m.envelope.sigma_m[i], sh, 1e-15 * sh);
+      assert_near(m.envelope.radius_m[i], 3.0 * sh, 1e-14 * sh);
+    }
+    assert_int_equal(m.ellipsoids.size(), 4);
+    for (const NavEllipsoid &e : m.ellipsoids) {
+      const std::vector<double> &sig =
+          src == NavEnvelopeSource::Filter ? r.envelope.pos_sd_reported_ned_m : r.covariance.pos_sd_ned_m;
+      for (int a = 0; a < 3; ++a) {
+        const double s_in = NavInterpolate(r.envelope.t_s, sig, 3, a, e.t_s);
+        assert_near(e.sigma_ned_m[a], s_in, 1e-15 * s_in);
+      }
+      // N -> y, E -> x, D -> z (lengths).
+      assert_near(e.semi_axes_r[0], 3.0 * e.sigma_ned_m[1], 1e-15);
+      assert_near(e.semi_axes_r[1], 3.0 * e.sigma_ned_m[0], 1e-15);
+      assert_near(e.semi_axes_r[2], 3.0 * e.sigma_ned_m[2], 1e-15);
+      // Centred on the estimate at its epoch.
+      double p[3];
+      assert_true(NavTrackSample(r.nav, e.t_s, p, nullptr));
+      assert_vec3_near((nav_vec3{e.center_r[0], e.center_r[1], e.center_r[2]}), (nav_vec3{p[0], p[1], p[2]}), 0.0);
+    }
+  }
+  // A requested source without data is an error that names what is missing.
+  NavResult bare = load_tiny();
+  opt.envelope_source = NavEnvelopeSource::Filter;
+  assert_false(NavBuildSceneModel(bare, opt, 0.05, &m, &err));
+  assert_true(err.find("reported sigma") != std::string::npos);
+  opt.envelope_source = NavEnvelopeSource::Covariance;
+  assert_false(NavBuildSceneModel(bare, opt, 0.05, &m, &err));
+  assert_true(err.find("estimate.csv") != std::string::npos);
+  // Evenly spread ellipsoids: count and times.
+  opt.envelope_source = NavEnvelopeSource::MonteCarlo;
+  opt.ellipsoid_times_s.clear();
+  opt.ellipsoid_count = 5;
+  assert_true(NavBuildSceneModel(bare, opt, 0.05, &m, &err));
+  assert_int_equal(m.ellipsoids.size(), 5);
+  assert_near(m.ellipsoids.back().t_s, 120.0, 1e-12);
+  assert_near(m.ellipsoids.front().t_s, 24.0, 1e-12);
+}
+
+// tiny-gnss: gnss.csv, gnss_outages.csv, imu_errors.csv and summary.json "requirements" load;
+// the outage segment follows the reference inside [40, 70) s; the vehicle kind follows the name.
+void test_gnss_outages_requirements(void **) {
+  NavResult r;
+  std::string err;
+  if (!NavLoadResultDir(NAVVIEW_TEST_DATA_DIR "/tiny-gnss", &r, &err)) fail_msg("%s", err.c_str());
+  assert_int_equal(r.gnss.Size(), 46);
+  assert_int_equal(r.gnss.outage_t0_s.size(), 1);
+  assert_true(r.gnss.InOutage(40.0) && r.gnss.InOutage(69.9) && !r.gnss.InOutage(70.0) && !r.gnss.InOutage(39.9));
+  for (double t : r.gnss.t_s)
+    assert_false(r.gnss.InOutage(t));
+  assert_int_equal(r.imu_errors.Size(), 120);
+  assert_near(r.imu_errors.gyro_rps[0], (0.02 + 0.01 * std::sin(1.3)) * 3.14159265358979323846 / 180.0, 1e-8);
+  assert_int_equal(r.requirements.size(), 3);
+  assert_string_equal(r.requirements[0].id.c_str(), "h-rms");
+  assert_near(r.requirements[0].limit_si, 2.5, 1e-12); // 250 cm
+  assert_true(r.requirements[0].pass);
+  assert_string_equal(r.requirements[1].metric.c_str(), "vertical_position");
+  assert_false(r.requirements[1].pass); // nested "outages" array does not confuse the parser
+  assert_near(r.requirements[2].limit_si, 3.0 * 3.14159265358979323846 / 180.0, 1e-12);
+  assert_true(r.truth.HasGeodetic());
+  assert_near(r.truth.geo[0], 48.137 * 3.14159265358979323846 / 180.0, 1e-12);
+
+  NavViewOptions opt;
+  NavSceneModel m;
+  assert_true(NavBuildSceneModel(r, opt, 0.01, &m, &err));
+  assert_int_equal(m.gnss_r.size(), 3 * r.gnss.Size());
+  double p[3];
+  NavNedToRender(&r.gnss.pos_ned_m[0], p);
+  assert_vec3_near((nav_vec3{m.gnss_r[0], m.gnss_r[1], m.gnss_r[2]}), (nav_vec3{p[0], p[1], p[2]}), 0.0);
+  assert_int_equal(m.outage_segments.size(), 1);
+  const NavPolyline &seg = m.outage_segments[0];
+  double a[3], b[3];
+  NavTrackSample(r.truth, 40.0, a, nullptr);
+  NavTrackSample(r.truth, 70.0, b, nullptr);
+  assert_vec3_near((nav_vec3{seg.xyz_r[0], seg.xyz_r[1], seg.xyz_r[2]}), (nav_vec3{a[0], a[1], a[2]}), 0.0);
+  const size_t last = seg.Size() - 1;
+  assert_vec3_near((nav_vec3{seg.xyz_r[3 * last], seg.xyz_r[3 * last + 1], seg.xyz_r[3 * last + 2]}),
+                   (nav_vec3{b[0], b[1], b[2]}), 0.0);
+  assert_true(m.vehicle == NavVehicleKind::Generic); // "tiny-figure-eight-gnss"
+  // Default ellipsoids: 6 evenly spread plus the last epoch inside the outage [40, 70): 69 s.
+  const std::vector<double> et = NavEllipsoidTimes(r, opt);
+  assert_int_equal(et.size(), 7);
+  assert_true(std::find(et.begin(), et.end(), 69.0) != et.end());
+  assert_int_equal(m.ellipsoids.size(), 7);
+  r.scene_name = "urban-drive";
+  assert_true(NavBuildSceneModel(r, opt, -1.0, &m, &err));
+  assert_true(m.vehicle == NavVehicleKind::Car);
+  r.scene_name = "aircraft-climb-turn";
+  assert_true(NavBuildSceneModel(r, opt, -1.0, &m, &err));
+  assert_true(m.vehicle == NavVehicleKind::Aircraft);
+  opt.show_gnss = false;
+  assert_true(NavBuildSceneModel(r, opt, 0.01, &m, &err));
+  assert_true(m.gnss_r.empty() && m.outage_segments.empty());
+}
+
+// The shapefile reader on a hand-made file: one polygon record with two parts.
+void test_shapefile_and_graticule(void **) {
+  std::vector<unsigned char> b(100, 0);
+  auto be32 = [&](size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i)
+      b[at + static_cast<size_t>(i)] = static_cast<unsigned char>(v >> (24 - 8 * i));
+  };
+  auto le32 = [&](int32_t v) {
+    for (int i = 0; i < 4; ++i)
+      b.push_back(static_cast<unsigned char>(static_cast<uint32_t>(v) >> (8 * i)));
+  };
+  auto lef = [&](double d) {
+    uint64_t u;
+    std::memcpy(&u, &d, 8);
+    for (int i = 0; i < 8; ++i)
+      b.push_back(static_cast<unsigned char>(u >> (8 * i)));
+  };
+  be32(0, 9994);
+  const double pts[5][2] = {{10, 50}, {11, 50}, {11, 51}, {-20.5, 64}, {-21, 65.25}};
+  const size_t content = 4 + 32 + 4 + 4 + 2 * 4 + 5 * 16;
+  b.resize(108, 0);
+  be32(100, 1);
+  be32(104, static_cast<uint32_t>(content / 2));
+  le32(5);
+  for (double d : {-21.0, 50.0, 11.0, 65.25})
+    lef(d);
+  le32(2);
+  le32(5);
+  le32(0);
+  le32(3);
+  for (const auto &p : pts) {
+    lef(p[0]);
+    lef(p[1]);
+  }
+  const std::string path = std::string(NAVVIEW_TEST_OUT_DIR) + "/navview_test.shp";
+  FILE *f = std::fopen(path.c_str(), "wb");
+  if (!f) {
+    std::string d = NAVVIEW_TEST_OUT_DIR;
+    for (size_t q = 1; q != std::string::npos; q = d.find('/', q + 1))
+      mkdir(d.substr(0, q).c_str(), 0755);
+    mkdir(d.c_str(), 0755);
+    f = std::fopen(path.c_str(), "wb");
+  }
+  assert_non_null(f);
+  std::fwrite(b.data(), 1, b.size(), f);
+  std::fclose(f);
+  std::vector<std::vector<double>> parts;
+  std::string err;
+  assert_true(NavReadShapefile(path, &parts, &err));
+  assert_int_equal(parts.size(), 2);
+  assert_int_equal(parts[0].size(), 6);
+  assert_int_equal(parts[1].size(), 4);
+  assert_near(parts[1][2], -21.0, 0.0);
+  assert_near(parts[1][3], 65.25, 0.0);
+  // A truncated file is an error, not a crash.
+  f = std::fopen(path.c_str(), "wb");
+  std::fwrite(b.data(), 1, b.size() - 7, f);
+  std::fclose(f);
+  parts.clear();
+  assert_false(NavReadShapefile(path, &parts, &err));
+  assert_true(err.find("truncated") != std::string::npos);
+  std::remove(path.c_str());
+  // Graticule: 3 or more lines across.
+  for (double span : {360.0, 36.0, 5.0, 0.7, 0.013})
+    assert_true(span / NavGraticuleStepDeg(span) >= 3.0 && span / NavGraticuleStepDeg(span) < 16.0);
+}
+
 } // namespace
 
 int main(void) {
@@ -292,6 +490,9 @@ int main(void) {
       cmocka_unit_test(test_triad_orientation),
       cmocka_unit_test(test_pick_full_rate),
       cmocka_unit_test(test_grid_spacing),
+      cmocka_unit_test(test_envelope_sources_and_ellipsoids),
+      cmocka_unit_test(test_gnss_outages_requirements),
+      cmocka_unit_test(test_shapefile_and_graticule),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

@@ -30,6 +30,10 @@ NavViewOptions BaseOptions() {
   o.time_s = 60.0;
   o.triad_interval_s = 15.0;
   o.triad_size_m = 9.0;
+  // The first baselines predate these: keep them off (scene_gnss shows them).
+  o.ellipsoid_count = 0;
+  o.show_gnss = false;
+  o.vehicle = NavVehicleKind::Car;
   return o;
 }
 
@@ -52,7 +56,8 @@ void SetCamera(NavViewOptions *o, double px, double py, double pz, double fx, do
 int main(int argc, char **argv) {
   if (argc != 2) {
     std::fprintf(stderr,
-                 "usage: test_navview_render scene_oblique|scene_top_error|scene_exaggerated|chart_errors\n");
+                 "usage: test_navview_render scene_oblique|scene_top_error|scene_exaggerated|scene_gnss|chart_errors|\n"
+                 "       chart_errors_req|chart_noise|chart_allan|chart_bench|map_local|map_region\n");
     return 2;
   }
   const std::string name = argv[1];
@@ -69,18 +74,40 @@ int main(int argc, char **argv) {
 
   auto result = std::make_shared<NavResult>();
   std::string err;
-  if (!NavLoadResultDir(NAVVIEW_TEST_DATA_DIR "/tiny", result.get(), &err)) {
+  // tiny-gnss: tiny plus GNSS fixes, an outage [40, 70) s, sensor errors and requirements.
+  const bool gnss = name == "scene_gnss" || name == "map_local" || name == "map_region" || name == "chart_noise" ||
+                    name == "chart_errors_req";
+  if (!NavLoadResultDir(gnss ? NAVVIEW_TEST_DATA_DIR "/tiny-gnss" : NAVVIEW_TEST_DATA_DIR "/tiny", result.get(),
+                        &err)) {
     std::fprintf(stderr, "%s\n", err.c_str());
     return 1;
   }
 
   bool ok = false;
-  if (name == "chart_errors") {
-    NavChartOptions c;
-    c.width_px = kSize;
-    c.height_px = kSize;
-    c.show_text = false;
+  NavChartOptions c;
+  c.width_px = kSize;
+  c.height_px = kSize;
+  c.show_text = false;
+  NavMapOptions mo;
+  mo.width_px = kSize;
+  mo.height_px = kSize;
+  mo.show_text = false;
+  if (name == "chart_errors" || name == "chart_errors_req") {
+    // chart_errors_req: requirement limits as lines (h-rms 2.5 m pass, v-max 0.6 m FAIL, yaw 3 deg).
     ok = NavRenderErrorChartPng(*result, c, actual, &err);
+  } else if (name == "chart_noise") {
+    ok = NavRenderSensorErrorChartPng(*result, c, actual, &err);
+  } else if (name == "chart_allan") {
+    ok = NavRenderAllanChartPng(NAVVIEW_TEST_DATA_DIR "/allan.csv", c, actual, &err);
+  } else if (name == "chart_bench") {
+    ok = NavRenderSpeedVsErrorPng(NAVVIEW_TEST_DATA_DIR "/bench.csv", c, actual, &err);
+  } else if (name == "map_local") {
+    // Street scale: fitted to the 120 m figure eight, local metric grid, outage band, fixes.
+    ok = NavRenderMapPng(*result, mo, actual, &err);
+  } else if (name == "map_region") {
+    // 600 km around Munich: relief raster and GSHHS coastlines (python-cartopy-data), graticule.
+    mo.span_km = 600.0;
+    ok = NavRenderMapPng(*result, mo, actual, &err);
   } else {
     NavViewOptions o = BaseOptions();
     if (name == "scene_oblique") {
@@ -108,6 +135,15 @@ int main(int argc, char **argv) {
       o.triad_interval_s = 90.0; // triads at 0 s (no error yet) and 90 s (n = -60 m, e = 0)
       o.triad_size_m = 12.0;
       SetCamera(&o, -16.0, -88.0, 36.0, -1.0, -60.0, -5.0);
+    } else if (name == "scene_gnss") {
+      // GNSS fixes (green), the outage [40, 70) s highlighted, four MC ellipsoids (k = 2),
+      // aircraft glyph at t = 60 s.
+      o.show_gnss = true;
+      o.ellipsoid_times_s = {20.0, 50.0, 80.0, 110.0};
+      o.envelope_k = 2.0;
+      o.vehicle = NavVehicleKind::Aircraft;
+      o.show_triads = false;
+      SetCamera(&o, -95.0, -205.0, 165.0, 0.0, -10.0, -8.0);
     } else {
       std::fprintf(stderr, "unknown case '%s'\n", name.c_str());
       return 2;

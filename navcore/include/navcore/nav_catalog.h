@@ -56,6 +56,12 @@ NAV_BEGIN_DECLS
 #define NAV_CATALOG_VERIFIED_MAX 96      /**< bytes of a verification status text */
 #define NAV_CATALOG_MAX_ENTRIES 1000     /**< rows per file */
 #define NAV_CATALOG_MAX_BYTES (4u << 20) /**< largest file accepted (4 MiB) */
+/**
+ * Indicative cost classes (column cost_class, optional; resources/README.md): order-of-magnitude
+ * unit price bands by grade, not quotes: 1 < 100 USD (consumer MEMS chips, standalone receiver
+ * modules), 2 100 USD - 1 kUSD, 3 1-10 kUSD, 4 10-100 kUSD, 5 > 100 kUSD (navigation grade).
+ */
+#define NAV_CATALOG_COST_CLASS_MAX 5
 
 /** Which catalog a file holds (recognised from its header). */
 typedef enum nav_catalog_kind {
@@ -98,6 +104,7 @@ typedef struct nav_catalog_imu_entry {
   char verified_text[NAV_CATALOG_VERIFIED_MAX]; /**< verified_in_corpus, verbatim */
   nav_catalog_verification verified;
   nav_catalog_bias_model bias_model;
+  int cost_class;              /**< indicative cost class 1..NAV_CATALOG_COST_CLASS_MAX; 0: not given */
   int line;                    /**< 1-based line of the row in the file */
   nav_imu_model_config config; /**< the converted model (terms on for given values) */
 } nav_catalog_imu_entry;
@@ -108,6 +115,7 @@ typedef struct nav_catalog_gnss_entry {
   char source[NAV_CATALOG_SOURCE_MAX];
   char verified_text[NAV_CATALOG_VERIFIED_MAX];
   nav_catalog_verification verified;
+  int cost_class; /**< indicative cost class 1..NAV_CATALOG_COST_CLASS_MAX; 0: not given */
   int line;
   nav_gnss_model_config config; /**< the converted model */
 } nav_catalog_gnss_entry;
@@ -164,6 +172,9 @@ NAV_API const nav_catalog_imu_entry *nav_catalog_find_imu(const nav_catalog *cat
 
 /** GNSS entry by mode name (ASCII case-insensitive); NULL if absent. Borrowed until destroy. */
 NAV_API const nav_catalog_gnss_entry *nav_catalog_find_gnss(const nav_catalog *cat, const char *name);
+
+/** Price band of a cost class ("< 100 USD" ... "> 100 kUSD"; "not given" for 0 or out of range). */
+NAV_API const char *nav_catalog_cost_band(int cost_class);
 
 /** "yes", "partly", "derived", "no". */
 NAV_API const char *nav_catalog_verification_name(nav_catalog_verification v);

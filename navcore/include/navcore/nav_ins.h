@@ -161,6 +161,25 @@ NAV_API NAV_NODISCARD nav_status nav_ins_set_state(nav_ins *ins, const nav_ins_s
  */
 NAV_API const nav_ins_state *nav_ins_get_state(const nav_ins *ins);
 
+/** The geodetic state a WGS-84 NED mechanization integrates (no conversion). Plain value. */
+typedef struct nav_ins_ned {
+  double t_s;         /**< time of the state [s] */
+  nav_geodetic pos;   /**< latitude, longitude [rad] (wrapped to (-pi, pi]), ellipsoidal height [m] */
+  nav_vec3 v_n_mps;   /**< velocity relative to the Earth, NED [m/s] */
+  nav_quat q_b_n;     /**< attitude, body to NED */
+  double sin_lat;     /**< sin(lat), as the mechanization has it */
+  double cos_lat;     /**< cos(lat) */
+} nav_ins_ned;
+
+/**
+ * The NED state itself when the mechanization is WGS-84 in NED (what nav_ins_get_state()
+ * converts to the e frame), for callers that need geodetic quantities at every step (the
+ * INS/GNSS filter) without an ECEF round trip.
+ * @return true and *out filled for a WGS-84 NED mechanization; false otherwise (use
+ *         nav_ins_get_state()).
+ */
+NAV_API bool nav_ins_get_ned(const nav_ins *ins, nav_ins_ned *out);
+
 /**
  * Detailed message of the last failure on this handle ("" if none), e.g. which latitude made
  * the NED mechanization refuse. Borrowed; valid until the next non-const call or destroy.

@@ -20,6 +20,7 @@
 #include "nav_frames.h"
 #include "nav_ins.h"
 #include "nav_scene.h"
+#include "nav_smoother.h"
 #include "nav_status.h"
 #include "nav_truth.h"
 
@@ -31,6 +32,13 @@ typedef struct nav_ins_gnss_config {
   nav_vec3 r_ba_b_m;        /**< GNSS antenna relative to the IMU, body axes [m] */
   double pos_sd_floor_m;    /**< lower bound of the position sigma used in R [m] (default 1e-3) */
   double vel_sd_floor_mps;  /**< lower bound of the velocity sigma used in R [m/s] (default 1e-3) */
+  /**
+   * Optional RTS smoother recorder (nav_smoother.h), BORROWED: not owned, must outlive the
+   * object, one nav_ins_gnss per smoother. When set, create calls nav_smoother_begin(), every
+   * step nav_smoother_step() and every update nav_smoother_update(); mark output epochs with
+   * nav_smoother_mark() and run the backward pass with nav_smoother_run(). NULL (default): none.
+   */
+  nav_smoother *smoother;
 } nav_ins_gnss_config;
 
 /** One GNSS measurement as the integration consumes it. */
@@ -68,8 +76,14 @@ NAV_API NAV_NODISCARD nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_
 NAV_API const nav_ins_state *nav_ins_gnss_state(const nav_ins_gnss *x);
 /** Current bias estimates (subtracted from the raw increments). */
 NAV_API void nav_ins_gnss_biases(const nav_ins_gnss *x, nav_vec3 *b_g_rps, nav_vec3 *b_a_mps2);
+/** The current scale-factor estimates (zero unless the filter has scale-factor states):
+ *  the INS compensates raw increments as (raw - b dt) / (1 + s), per axis. Either pointer may be NULL. */
+NAV_API void nav_ins_gnss_scale_factors(const nav_ins_gnss *x, nav_vec3 *s_g, nav_vec3 *s_a);
 /** The filter (borrowed, for P, innovations and NIS). */
 NAV_API const nav_filter *nav_ins_gnss_filter(const nav_ins_gnss *x);
+
+/** The strapdown INS inside (borrowed; e.g. for nav_ins_get_ned()). NULL for NULL. */
+NAV_API const nav_ins *nav_ins_gnss_ins(const nav_ins_gnss *x);
 /** Number of GNSS fixes applied so far. */
 NAV_API long nav_ins_gnss_updates(const nav_ins_gnss *x);
 /** Last failure message ("" if none). */

@@ -46,11 +46,24 @@ typedef struct nav_run_info {
   uint64_t seed;
   bool ideal;
   double wall_s;
+  const nav_requirement_verdict *requirements; /**< verdicts for summary.json "requirements" (may be NULL) */
+  int n_requirements;
 } nav_run_info;
 
 /** Write summary.json for a run. */
 NAV_API NAV_NODISCARD nav_status nav_summary_write_json(const char *path, const nav_scene *scene,
                                                         const nav_run_info *info, const nav_sim_summary *sum);
+
+/**
+ * Write requirement verdicts as a JSON list (the "requirements" value of summary.json: objects
+ * {id, metric, statistic, limit, unit, value, pass, samples} plus time_s for at_time and
+ * outages [{t0_s, t1_s, t_s, value}] for outage_end; value null when not evaluated). The list
+ * starts at the current position; items are indented by @p indent + 2 spaces.
+ */
+NAV_API NAV_NODISCARD nav_status nav_requirements_write_json(FILE *f, const nav_requirement_verdict *v, int count,
+                                                             int indent);
+/** Terminal summary of the verdicts: "requirements N of M pass" and one line per requirement. */
+NAV_API void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count);
 
 NAV_END_DECLS
 

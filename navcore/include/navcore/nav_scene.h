@@ -17,6 +17,7 @@
 
 #include "nav_export.h"
 #include "nav_math.h"
+#include "nav_requirements.h"
 #include "nav_sensor_config.h"
 #include "nav_status.h"
 
@@ -438,6 +439,12 @@ typedef struct nav_scene_navigation {
   nav_mech_algorithm algorithm;
   nav_mech_frame frame; /**< WGS-84 only */
   bool aid_vertical;    /**< free INS: height and vertical velocity from the reference (baro-like aiding) */
+  /** ins_gnss: propagate the filter covariance once every this many IMU steps
+   *  (nav_filter_config.cov_decimation; 0, the default, or 1: every step). */
+  int cov_decimation;
+  /** ins_gnss: estimate gyro and accelerometer scale factors (21-state filter); their initial
+   *  sigma is the scene's scale-factor sigma (with its fixed part), random constants. */
+  bool estimate_scale_factors;
 } nav_scene_navigation;
 
 typedef struct nav_scene_output {
@@ -521,6 +528,10 @@ typedef struct nav_scene {
   nav_scene_navigation navigation;
   nav_scene_output output;
   nav_scene_simulation simulation;
+  /* ==== BEGIN requirements (owned by the requirements work; nav_requirements.h) ==== */
+  int n_requirements;                                   /**< 0..NAV_SCENE_MAX_REQUIREMENTS */
+  nav_requirement requirements[NAV_SCENE_MAX_REQUIREMENTS]; /**< accuracy requirements, file order */
+  /* ==== END requirements ==== */
 } nav_scene;
 
 /** @return a scene with every field at its default (T3.1 parametric trajectory, flat Earth). */

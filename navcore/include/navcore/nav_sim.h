@@ -66,6 +66,9 @@ typedef struct nav_sim_options {
   nav_progress_fn progress; /**< may be NULL; called on the running thread at a bounded rate */
   nav_record_fn record;     /**< may be NULL; called at each output epoch */
   void *user;               /**< passed to both callbacks */
+  /** May be NULL: sees every run (any thread) and its output-epoch errors, e.g. the requirement
+   *  evaluator's nav_req_evaluator_observer() (nav_requirements.h). */
+  const nav_run_observer *observer;
 } nav_sim_options;
 
 NAV_API nav_sim_options nav_sim_options_default(void);

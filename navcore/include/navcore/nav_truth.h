@@ -40,10 +40,12 @@ typedef struct nav_truth nav_truth;
 NAV_API NAV_NODISCARD nav_status nav_truth_create(const nav_scene *scene, nav_truth **out);
 NAV_API void nav_truth_destroy(nav_truth *truth);
 
-/** Ideal increments over [t_(k-1), t_k], t_k = k dt (k >= 1). */
+/** Ideal increments over [t_(k-1), t_k], t_k = k dt (k >= 1). NAV_ERR_NUMERIC when the
+ *  trajectory yields a non-finite increment (numerical guard; *out untouched). */
 NAV_API NAV_NODISCARD nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out);
 
-/** Reference state at t_s (a borrowed evaluation of the owned trajectory). */
+/** Reference state at t_s (a borrowed evaluation of the owned trajectory). NAV_ERR_NUMERIC when
+ *  the position, velocity or attitude evaluates non-finite (numerical guard). */
 NAV_API NAV_NODISCARD nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out);
 
 /** IMU interval [s]. */

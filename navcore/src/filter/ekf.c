@@ -3,15 +3,20 @@
  * @brief The error-state Kalman filter object: time update (second-order or Van Loan, optional
  *        covariance decimation), measurement updates (Cholesky of S, Joseph form), checks.
  *
- * Cost notes (n = 15, the hot path at IMU rate): F has 66 non-zeros of 225 and Phi of the
- * second-order form about 120, so every product with Phi runs over its non-zero entries only
- * (row lists rebuilt per step; skipping exact zeros changes no value). The second-order step is
- * fused into one sandwich, P+ = Phi (P + Q/2) Phi^T + Q/2, which is E6.2 rearranged:
- * Phi P Phi^T + (Phi Q Phi^T + Q)/2 with Q = G Q_c G^T T. With Phi = I + FT + (FT)^2/2 (one
- * sparse-times-dense product) a predict costs about 3800 multiply-adds - one dense 15 x 15
- * product is 3375 - plus the Cholesky check (~600). Measured: ~54k instructions, 4-8 us per
- * predict on the development VM. Measurement updates run at GNSS rate and use dense Joseph
- * products (~8 us at n = 15).
+ * Cost notes (n = 15, the hot path at IMU rate). The non-zero patterns of F T and of the
+ * second-order Phi are structural (fixed by the layout: computed once at create), so products
+ * with Phi run over them only: F has 66 non-zeros of 225, Phi about 140 (its bias rows are a
+ * single diagonal entry). The second-order step is fused into one sandwich,
+ * P+ = Phi (P + Q/2) Phi^T + Q/2, which is E6.2 rearranged: Phi P Phi^T + (Phi Q Phi^T + Q)/2
+ * with Q = G Q_c G^T T. The sandwich runs row-wise on zero-padded rows of 16 (24 above 16
+ * states) doubles, W = Phi S then the upper triangle of Phi W^T, each row an unrolled
+ * multiply-add that the compiler vectorises (an AVX2 clone is picked at load time on x86-64;
+ * same values). Positivity is checked by a right-looking Cholesky (vectorisable updates).
+ * Measured with callgrind (n = 15, every IMU step): 25k instructions per predict, of which
+ * sandwich 7.8k, Cholesky check 5.1k + finiteness 1.8k, Phi 1.7k, F and sums 2k (the previous
+ * row-list version: 54k). With cov_decimation N the step runs every N-th call and the calls in
+ * between only accumulate the sums of struct pending (~150 instructions). Measurement updates
+ * (GNSS rate) use the Joseph form as (A P) A^T with A = I - K H never formed: O(n^2 m).
  */
 #include <assert.h>
 #include <math.h>
@@ -33,12 +38,29 @@
  * rule 4). */
 #define MIN_COS_LAT 1e-6
 
-/* Row lists of the non-zero entries of a dense n x n matrix. */
-typedef struct sparse_rows {
-  size_t start[NMAX + 1];
-  size_t col[NN];
-  double val[NN];
-} sparse_rows;
+/* Column indices of the (structurally) non-zero entries of each row. */
+typedef struct row_pattern {
+  unsigned char cnt[NMAX];
+  unsigned char col[NMAX][NMAX];
+} row_pattern;
+
+/*
+ * Sums over a decimated covariance interval (numerics.md 6.3 with cov_decimation > 1). The
+ * blocks of F that vary at IMU rate are linear in C_b_n, C_b_n f and C_b_n diag(f or w), so
+ * their interval means are exact from these sums; the other blocks (Earth curvature, transport
+ * and Coriolis terms) depend on lat, h and v only, which change by parts in 1e6 over a
+ * covariance interval, and are evaluated once at the interval means of lat, h and v (the mean
+ * F to second order in the interval). G Q_c G^T is C diag(q) C^T: q I when q is isotropic,
+ * else summed.
+ */
+typedef struct pending {
+  unsigned count;
+  double T, lat_T, h_T;
+  double last_lat, last_h; /* the last interval's values: a single-step interval uses them as */
+  nav_vec3 last_v;         /* they are (no rounding through the sums) */
+  nav_vec3 v_T, fn_T;
+  nav_mat3 C_T, Cf_T, Cw_T, Qa_T, Qg_T;
+} pending;
 
 struct nav_filter {
   nav_filter_config cfg;
@@ -50,16 +72,19 @@ struct nav_filter {
   double x[NMAX];
   double P[NN];
 
-  /* Pending (decimated) covariance step: sums of F dt and G Q_c G^T dt. */
-  unsigned pend_count;
-  double pend_FT[NN];
-  double pend_QT[NN];
+  /* Pending (decimated) covariance step: the sums over the interval of everything F and
+   * G Q_c G^T need (see pending_add). */
+  pending pend;
+  bool q_isotropic; /* q of ARW and VRW equal on the three axes: G Q_c G^T blocks are q I */
+
+  /* Structural non-zero pattern of F T and of the second-order Phi (fixed by the layout). */
+  row_pattern a_pat, phi_pat;
+  size_t ld; /* row stride of the padded work matrices: n rounded up to a multiple of 4 */
 
   /* Scratch, sized for the largest state; nothing is allocated after create. */
-  double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], Pn[NN], L[NN];
+  double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], Pn[NN], L[NN], A[NN], Wt[NN];
   double H[MMAX * NMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
   double xn[NMAX];
-  sparse_rows sp;
   double vl_work[VL_WORK];
 
   nav_filter_innovation innov;
@@ -78,6 +103,8 @@ set_error(nav_filter *f, const char *fmt, ...) {
 }
 
 /* ---------------------------------------------------------------- create / destroy */
+
+static void init_patterns(nav_filter *f);
 
 /* Process model of one triad: F diagonal and q per numerics.md 6.2. */
 static void triad_process(nav_filter *f, size_t idx, unsigned terms, nav_vec3 gm_sd, nav_vec3 gm_tau,
@@ -145,6 +172,12 @@ nav_status nav_filter_create(const nav_filter_config *cfg, nav_filter **out) {
     set_p0_block(f, NAV_FILTER_IDX_SA, cfg->init.accel_sf_sd);
   }
   if (f->lay.has_gnss_pos_gm) set_p0_block(f, f->lay.idx_gnss_pos, cfg->init.gnss_pos_sd_m);
+  f->q_isotropic = true;
+  for (size_t i = 1; i < 3; ++i)
+    if (f->qc[NAV_FILTER_IDX_DV + i] != f->qc[NAV_FILTER_IDX_DV] ||
+        f->qc[NAV_FILTER_IDX_PHI + i] != f->qc[NAV_FILTER_IDX_PHI])
+      f->q_isotropic = false;
+  init_patterns(f);
   f->innov.m = 0;
   f->last_error[0] = '\0';
   *out = f;
@@ -163,63 +196,40 @@ nav_filter_layout nav_filter_get_layout(const nav_filter *f) {
 
 /* ---------------------------------------------------------------- sparse helpers */
 
-/* y += a x over n contiguous elements, unrolled by four so that GCC's -O2 SLP vectoriser packs
- * the body (its -O2 cost model skips loops of unknown trip count). Each element is still
- * computed as y_c + a x_c, so the values are exactly those of the plain loop. */
-static void axpy(double *restrict y, double a, const double *restrict x, size_t n) {
-  size_t c = 0;
-  for (; c + 4 <= n; c += 4) {
-    y[c] += a * x[c];
-    y[c + 1] += a * x[c + 1];
-    y[c + 2] += a * x[c + 2];
-    y[c + 3] += a * x[c + 3];
-  }
-  for (; c < n; ++c)
-    y[c] += a * x[c];
-}
+/* On x86-64 with GCC the hot kernels are also compiled for AVX2 and picked at load time
+ * (ifunc): the same elementwise multiplies and adds, four doubles at a time instead of two, so
+ * the values are bit-identical on every machine (no FMA: -ffp-contract=off, and the avx2 target
+ * has none). */
+/* Not under ThreadSanitizer: its instrumented ifunc resolver runs before the TSan runtime is
+ * initialised and crashes every program at load time. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(__SANITIZE_THREAD__)
+#define NAV_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define NAV_KERNEL_CLONES
+#endif
 
-static void build_rows(sparse_rows *sp, const double *a, size_t n) {
-  size_t k = 0;
-  for (size_t i = 0; i < n; ++i) {
-    sp->start[i] = k;
-    for (size_t j = 0; j < n; ++j)
-      if (a[i * n + j] != 0.0) {
-        sp->col[k] = j;
-        sp->val[k] = a[i * n + j];
-        ++k;
-      }
-  }
-  sp->start[n] = k;
-}
-
-/* out = A S A^T for a symmetric S, with A given by its row lists; W is n x n scratch. The upper
- * triangle is computed and mirrored, so out is exactly symmetric. */
-static void sparse_sandwich(double *out, const sparse_rows *sp, const double *s, size_t n, double *w) {
-  for (size_t i = 0; i < n; ++i) {
-    double *wi = w + i * n;
-    for (size_t c = 0; c < n; ++c)
-      wi[c] = 0.0;
-    for (size_t p = sp->start[i]; p < sp->start[i + 1]; ++p)
-      axpy(wi, sp->val[p], s + sp->col[p] * n, n);
-  }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i; j < n; ++j) {
-      double sum = 0.0;
-      for (size_t p = sp->start[j]; p < sp->start[j + 1]; ++p)
-        sum += w[i * n + sp->col[p]] * sp->val[p];
-      out[i * n + j] = sum;
-      out[j * n + i] = sum;
+/* Is the symmetric n x n matrix p positive definite? Right-looking Cholesky (as Gaussian
+ * elimination, pivots a_kk = L_kk^2) on a copy of the upper triangle (outer-product updates of the trailing block are independent of each other, so
+ * the check runs at multiply-add throughput instead of the latency of one long dot product per
+ * entry): a strictly positive, finite pivot at every step is the criterion (numerics.md 6.5);
+ * the factor itself is not kept. NaN fails (the comparisons are false). a is n x n scratch. */
+NAV_KERNEL_CLONES static bool chol_ok(const double *p, size_t n, double *a) {
+  memcpy(a, p, n * n * sizeof *a);
+  for (size_t k = 0; k < n; ++k) {
+    const double d = a[k * n + k];
+    if (!(d > 0.0) || !(d < INFINITY)) return false;
+    const double inv = 1.0 / d;
+    /* a_ij -= a_ki a_kj / a_kk for k < i <= j (the upper trailing block; rows are contiguous). */
+    const double *restrict ak = a + k * n;
+    for (size_t i = k + 1; i < n; ++i) {
+      const double f = ak[i] * inv;
+      double *restrict ai = a + i * n;
+      for (size_t j = i; j < n; ++j)
+        ai[j] -= f * ak[j];
     }
-}
-
-/* y = A x with A given by its row lists. */
-static void sparse_mul_vec(double *y, const sparse_rows *sp, const double *x, size_t n) {
-  for (size_t i = 0; i < n; ++i) {
-    double sum = 0.0;
-    for (size_t p = sp->start[i]; p < sp->start[i + 1]; ++p)
-      sum += sp->val[p] * x[sp->col[p]];
-    y[i] = sum;
   }
+  return true;
 }
 
 /* Check a covariance candidate: every entry finite, Cholesky succeeds (which implies a
@@ -232,7 +242,7 @@ static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
       set_error(f, "%s: P(%zu,%zu) = %g is not finite", what, i / n, i % n, p[i]);
       return NAV_ERR_NUMERIC;
     }
-  if (nav_matn_cholesky(f->L, p, n) == NAV_OK) return NAV_OK;
+  if (chol_ok(p, n, f->L)) return NAV_OK;
   size_t k = 1;
   for (; k <= n; ++k) {
     for (size_t i = 0; i < k; ++i)
@@ -249,46 +259,244 @@ static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
 
 /* ---------------------------------------------------------------- time update */
 
-/* One covariance step over the integrated FT = sum F dt and QT = sum G Q_c G^T dt. Commits x and
+/* Row pattern of the non-zeros of an n x n matrix given as flags. */
+static void pattern_of(row_pattern *pt, const unsigned char *nz, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    unsigned char c = 0;
+    for (size_t j = 0; j < n; ++j)
+      if (nz[i * n + j]) pt->col[i][c++] = (unsigned char)j;
+    pt->cnt[i] = c;
+  }
+}
+
+/*
+ * The structural non-zeros of F T and of the second-order Phi = I + F T + (F T)^2/2: F built at
+ * a generic point (every term non-zero), every state diagonal flagged. The patterns depend on
+ * the layout only; entries outside them are exactly zero for every navigation state (build_F
+ * writes fixed positions), so products over them skip only exact zeros.
+ */
+static void init_patterns(nav_filter *f) {
+  const size_t n = f->n;
+  nav_filter_nav g;
+  g.lat_rad = 0.61;
+  g.h_m = 123.0;
+  g.v_eb_n_mps = nav_vec3_make(3.1, -4.2, 0.53);
+  const nav_euler e = {0.11, -0.23, 0.37};
+  g.C_b_n = nav_euler_to_dcm(e);
+  g.f_ib_b_mps2 = nav_vec3_make(0.31, -0.22, -9.7);
+  g.w_ib_b_rps = nav_vec3_make(0.011, -0.027, 0.033);
+  double pd[NMAX];
+  for (size_t i = 0; i < n; ++i)
+    pd[i] = -1.0;
+  const nav_filter_earth_terms et = nav_filter_earth_terms_wgs84(g.lat_rad, g.h_m);
+  nav_filter_build_F(f->F, &f->lay, &g, &et, pd);
+  unsigned char a[NN], p[NN];
+  for (size_t i = 0; i < n * n; ++i)
+    a[i] = f->F[i] != 0.0 || i % (n + 1) == 0;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      unsigned char v = a[i * n + j];
+      for (size_t k = 0; k < n && !v; ++k)
+        v = a[i * n + k] && a[k * n + j];
+      p[i * n + j] = v;
+    }
+  pattern_of(&f->a_pat, a, n);
+  pattern_of(&f->phi_pat, p, n);
+  f->ld = n <= 16 ? 16 : 24; /* the two instantiations of sandwich_ld */
+}
+
+/* Copy an n x n matrix into a zero-padded one of row stride ld. */
+static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
+  for (size_t i = 0; i < n; ++i) {
+    memcpy(dst + i * ld, src + i * n, n * sizeof *dst);
+    for (size_t c = n; c < ld; ++c)
+      dst[i * ld + c] = 0.0;
+  }
+}
+
+/* y += a x over LD elements, LD a multiple of 4 known at compile time after inlining (the
+ * loop is then unrolled and vectorised; elementwise y_c + a x_c, so the values are those of a
+ * plain loop whatever the vector width). */
+#if defined(__GNUC__) || defined(__clang__)
+#define NAV_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define NAV_ALWAYS_INLINE inline
+#endif
+#if defined(__GNUC__) && !defined(__clang__)
+#define NAV_UNROLL _Pragma("GCC unroll 8")
+#else
+#define NAV_UNROLL
+#endif
+static NAV_ALWAYS_INLINE void axpy_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
+  NAV_UNROLL
+  for (size_t c = 0; c < len; c += 4) {
+    y[c] += a * x[c];
+    y[c + 1] += a * x[c + 1];
+    y[c + 2] += a * x[c + 2];
+    y[c + 3] += a * x[c + 3];
+  }
+}
+
+/*
+ * Pn = Phi S Phi^T + Qh for a symmetric S (numerics.md 6.3), Phi given padded (stride LD) with
+ * the row pattern @p pt. W = Phi S row by row (rows of S scaled by the non-zeros of Phi: each
+ * an LD-wide multiply-add), then the upper triangle of Phi W^T the same way from the rows of
+ * W^T, mirrored. Bias rows of Phi (a single diagonal entry) cost one row scaling each. Pn is
+ * n x n (not padded); S, W, Wt are padded scratch. LD is a compile-time constant in the
+ * instantiations below.
+ */
+/* y = a x over len elements (the first term of a row: no zeroing pass, which the compiler turns
+ * into a rep stos with a large start-up cost at these sizes). */
+static NAV_ALWAYS_INLINE void scal_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
+  NAV_UNROLL
+  for (size_t c = 0; c < len; c += 4) {
+    y[c] = a * x[c];
+    y[c + 1] = a * x[c + 1];
+    y[c + 2] = a * x[c + 2];
+    y[c + 3] = a * x[c + 3];
+  }
+}
+
+static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
+                                          const double *Qh, size_t n, double *W, double *Wt, const size_t LD) {
+  for (size_t i = 0; i < n; ++i) {
+    double *wi = W + i * LD;
+    const double *phi_i = Phi + i * LD;
+    /* Every row has its diagonal in the pattern, so cnt >= 1. */
+    scal_fixed(wi, phi_i[pt->col[i][0]], S + pt->col[i][0] * LD, LD);
+    for (unsigned p = 1; p < pt->cnt[i]; ++p) {
+      const size_t k = pt->col[i][p];
+      axpy_fixed(wi, phi_i[k], S + k * LD, LD);
+    }
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      Wt[j * LD + i] = W[i * LD + j];
+  double row[NMAX + 4];
+  for (size_t i = 0; i < n; ++i) {
+    /* Full rows (only j >= i is used): a fixed width unrolls completely, which costs less than
+     * the loop control of a shorter variable-length row. */
+    const double *phi_i = Phi + i * LD;
+    scal_fixed(row, phi_i[pt->col[i][0]], Wt + pt->col[i][0] * LD, LD);
+    for (unsigned p = 1; p < pt->cnt[i]; ++p) {
+      const size_t k = pt->col[i][p];
+      axpy_fixed(row, phi_i[k], Wt + k * LD, LD);
+    }
+    for (size_t j = i; j < n; ++j) {
+      const double v = row[j] + Qh[i * n + j];
+      Pn[i * n + j] = v;
+      Pn[j * n + i] = v;
+    }
+  }
+}
+
+/* Phi = I + A + A^2/2 over the pattern of A (padded, stride LD). */
+static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pattern *ap, size_t n,
+                                      const size_t LD) {
+  for (size_t i = 0; i < n; ++i) {
+    double *phi_i = Phi + i * LD;
+    const double *ai = A + i * LD;
+    scal_fixed(phi_i, 0.5 * ai[ap->col[i][0]], A + ap->col[i][0] * LD, LD);
+    for (unsigned p = 1; p < ap->cnt[i]; ++p) {
+      const size_t k = ap->col[i][p];
+      axpy_fixed(phi_i, 0.5 * ai[k], A + k * LD, LD);
+    }
+    axpy_fixed(phi_i, 1.0, ai, LD);
+    phi_i[i] += 1.0;
+  }
+}
+
+/* The instantiations: LD 16 (up to 16 states: the 15-state core) and 24 (the rest), each also
+ * as an AVX2 clone (NAV_KERNEL_CLONES). */
+NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
+                             const double *Qh, size_t n, size_t ld, double *W, double *Wt) {
+  if (ld == 16)
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 16);
+  else
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 24);
+}
+
+NAV_KERNEL_CLONES static void phi_second_order(double *Phi, const double *A, const row_pattern *ap, size_t n, size_t ld) {
+  if (ld == 16)
+    phi2_ld(Phi, A, ap, n, 16);
+  else
+    phi2_ld(Phi, A, ap, n, 24);
+}
+
+/* y = Phi x over the pattern. */
+static void pattern_mul_vec(double *y, const double *Phi, const row_pattern *pt, const double *x, size_t ld,
+                            size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    double sum = 0.0;
+    for (unsigned p = 0; p < pt->cnt[i]; ++p) {
+      const size_t k = pt->col[i][p];
+      sum += Phi[i * ld + k] * x[k];
+    }
+    y[i] = sum;
+  }
+}
+
+/* Row pattern of the non-zero values of a padded matrix (the Van Loan Phi is dense in general). */
+static void pattern_of_values(row_pattern *pt, const double *a, size_t n, size_t ld) {
+  for (size_t i = 0; i < n; ++i) {
+    unsigned char c = 0;
+    for (size_t j = 0; j < n; ++j)
+      if (a[i * ld + j] != 0.0) pt->col[i][c++] = (unsigned char)j;
+    pt->cnt[i] = c;
+  }
+}
+
+/* One covariance step over the integrated FT = int F dt and QT = int G Q_c G^T dt. Commits x and
  * P only on success. */
 static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
-  const size_t n = f->n;
+  const size_t n = f->n, ld = f->ld;
+  const row_pattern *pt = &f->phi_pat;
+  row_pattern dyn;
   if (f->cfg.discretisation == NAV_FILTER_DISC_VAN_LOAN) {
-    const nav_status st = nav_filter_van_loan(f->Phi, f->Qd, FT, QT, n, f->vl_work, NULL);
+    const nav_status st = nav_filter_van_loan(f->Qd, f->Pn, FT, QT, n, f->vl_work, NULL);
     if (st != NAV_OK) {
       set_error(f, "predict: Van Loan matrix exponential failed (%s)", nav_status_str(st));
       return st == NAV_ERR_INVALID_ARG ? NAV_ERR_INVALID_ARG : NAV_ERR_NUMERIC;
     }
-    build_rows(&f->sp, f->Phi, n);
-    sparse_sandwich(f->Pn, &f->sp, f->P, n, f->W);
-    for (size_t i = 0; i < n * n; ++i)
-      f->Pn[i] += f->Qd[i];
+    /* Phi (in Qd for the moment) to the padded Phi; Q_d (in Pn) to Qd. */
+    pad_copy(f->Phi, f->Qd, n, ld);
+    memcpy(f->Qd, f->Pn, n * n * sizeof *f->Qd);
+    pattern_of_values(&dyn, f->Phi, n, ld);
+    pt = &dyn;
+    pad_copy(f->S, f->P, n, ld);
   } else {
-    /* E6.2: Phi = I + FT + (FT)^2/2 with the square over the non-zeros of FT. */
-    build_rows(&f->sp, FT, n);
+    /* E6.2: Phi = I + A + A^2/2, A = F T, the square over the structural non-zeros of A. */
+    double *A = f->A;
     for (size_t i = 0; i < n; ++i) {
-      double *phi_i = f->Phi + i * n;
-      for (size_t c = 0; c < n; ++c)
-        phi_i[c] = 0.0;
-      for (size_t p = f->sp.start[i]; p < f->sp.start[i + 1]; ++p)
-        axpy(phi_i, 0.5 * f->sp.val[p], FT + f->sp.col[p] * n, n);
-      axpy(phi_i, 1.0, FT + i * n, n);
-      phi_i[i] += 1.0;
+      double *ai = A + i * ld;
+      for (size_t c = 0; c < ld; ++c)
+        ai[c] = 0.0;
+      for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
+        const size_t k = f->a_pat.col[i][p];
+        ai[k] = FT[i * n + k];
+      }
     }
-    build_rows(&f->sp, f->Phi, n);
+#ifndef NDEBUG
+    for (size_t i = 0; i < n; ++i)
+      for (size_t k = 0; k < n; ++k)
+        assert(FT[i * n + k] == A[i * ld + k]);
+#endif
+    phi_second_order(f->Phi, A, &f->a_pat, n, ld);
     /* Fused E6.2: P+ = Phi (P + Q/2) Phi^T + Q/2. */
-    for (size_t i = 0; i < n * n; ++i) {
-      f->Qd[i] = 0.5 * QT[i];
-      f->S[i] = f->P[i] + f->Qd[i];
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t j = 0; j < n; ++j) {
+        const double q = 0.5 * QT[i * n + j];
+        f->Qd[i * n + j] = q;
+        f->S[i * ld + j] = f->P[i * n + j] + q;
+      }
+      for (size_t c = n; c < ld; ++c)
+        f->S[i * ld + c] = 0.0;
     }
-    sparse_sandwich(f->Pn, &f->sp, f->S, n, f->W);
-    for (size_t i = 0; i < n * n; ++i)
-      f->Pn[i] += f->Qd[i];
   }
-  nav_matn_symmetrize(f->Pn, n);
+  pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt);
   const nav_status st = check_cov(f, f->Pn, "predict");
   if (st != NAV_OK) return st;
-  sparse_mul_vec(f->xn, &f->sp, f->x, n);
+  pattern_mul_vec(f->xn, f->Phi, pt, f->x, ld, n);
   memcpy(f->P, f->Pn, n * n * sizeof *f->P);
   memcpy(f->x, f->xn, n * sizeof *f->x);
   return NAV_OK;
@@ -301,6 +509,9 @@ static bool mat3_isfinite(const nav_mat3 *m) {
   return true;
 }
 
+/* |lat| below this has cos(lat) > 0.07, far from the MIN_COS_LAT limit: no cos needed. */
+#define LAT_SAFE_RAD 1.5
+
 static nav_status check_nav(nav_filter *f, const nav_filter_nav *nav, const char *what) {
   if (!isfinite(nav->lat_rad) || !isfinite(nav->h_m) || !nav_vec3_isfinite(nav->v_eb_n_mps) ||
       !mat3_isfinite(&nav->C_b_n) || !nav_vec3_isfinite(nav->f_ib_b_mps2) ||
@@ -308,13 +519,110 @@ static nav_status check_nav(nav_filter *f, const nav_filter_nav *nav, const char
     set_error(f, "%s: the navigation state (lat, h, v, C_b_n, f_b or w_ib_b) is not finite", what);
     return NAV_ERR_NUMERIC;
   }
-  if (!(fabs(cos(nav->lat_rad)) >= MIN_COS_LAT)) {
+  if (!(fabs(nav->lat_rad) <= LAT_SAFE_RAD) && !(fabs(cos(nav->lat_rad)) >= MIN_COS_LAT)) {
     set_error(
         f, "%s: latitude %.17g rad is within cos(lat) < %g of a pole; the NED error model is singular there",
         what, nav->lat_rad, MIN_COS_LAT);
     return NAV_ERR_OUT_OF_RANGE;
   }
   return NAV_OK;
+}
+
+static nav_mat3 mat3_axpy(nav_mat3 y, double a, nav_mat3 x) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      y.m[i][j] += a * x.m[i][j];
+  return y;
+}
+
+/* C diag(q) C^T with exactly symmetric off-diagonal entries (as nav_filter_build_GQG). */
+static nav_mat3 cqct(nav_mat3 C, const double *q) {
+  nav_mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      double s = 0.0;
+      for (int k = 0; k < 3; ++k)
+        s += C.m[i][k] * q[k] * C.m[j][k];
+      r.m[i][j] = s;
+      r.m[j][i] = s;
+    }
+  return r;
+}
+
+/* Add one IMU interval to the pending sums (struct pending). */
+static void pending_add(const nav_filter *f, pending *pd, const nav_filter_nav *nav, double dt) {
+  const nav_mat3 C = nav->C_b_n;
+  pd->count++;
+  pd->T += dt;
+  pd->lat_T += nav->lat_rad * dt;
+  pd->h_T += nav->h_m * dt;
+  pd->v_T = nav_vec3_axpy(pd->v_T, dt, nav->v_eb_n_mps);
+  pd->last_lat = nav->lat_rad;
+  pd->last_h = nav->h_m;
+  pd->last_v = nav->v_eb_n_mps;
+  pd->fn_T = nav_vec3_axpy(pd->fn_T, dt, nav_mat3_mul_vec(C, nav->f_ib_b_mps2));
+  pd->C_T = mat3_axpy(pd->C_T, dt, C);
+  if (f->lay.has_scale_factors)
+    for (int i = 0; i < 3; ++i) {
+      pd->Cf_T.m[i][0] += C.m[i][0] * nav->f_ib_b_mps2.x * dt;
+      pd->Cf_T.m[i][1] += C.m[i][1] * nav->f_ib_b_mps2.y * dt;
+      pd->Cf_T.m[i][2] += C.m[i][2] * nav->f_ib_b_mps2.z * dt;
+      pd->Cw_T.m[i][0] += C.m[i][0] * nav->w_ib_b_rps.x * dt;
+      pd->Cw_T.m[i][1] += C.m[i][1] * nav->w_ib_b_rps.y * dt;
+      pd->Cw_T.m[i][2] += C.m[i][2] * nav->w_ib_b_rps.z * dt;
+    }
+  if (!f->q_isotropic) {
+    pd->Qa_T = mat3_axpy(pd->Qa_T, dt, cqct(C, f->qc + NAV_FILTER_IDX_DV));
+    pd->Qg_T = mat3_axpy(pd->Qg_T, dt, cqct(C, f->qc + NAV_FILTER_IDX_PHI));
+  }
+}
+
+/* Write the 3x3 block b (times s) into a (n columns) at (r, c). */
+static void put_block(double *a, size_t n, size_t r, size_t c, nav_mat3 b, double s) {
+  for (size_t i = 0; i < 3; ++i)
+    for (size_t j = 0; j < 3; ++j)
+      a[(r + i) * n + c + j] = s * b.m[i][j];
+}
+
+/* F T and G Q_c G^T T of the pending interval into f->FT, f->QT. */
+static void pending_integrals(nav_filter *f, const pending *pd) {
+  const size_t n = f->n;
+  const double T = pd->T;
+  nav_filter_nav m;
+  memset(&m, 0, sizeof m);
+  if (pd->count == 1) {
+    m.lat_rad = pd->last_lat;
+    m.h_m = pd->last_h;
+    m.v_eb_n_mps = pd->last_v;
+  } else {
+    m.lat_rad = pd->lat_T / T;
+    m.h_m = pd->h_T / T;
+    m.v_eb_n_mps = nav_vec3_scale(pd->v_T, 1.0 / T);
+  }
+  const nav_filter_earth_terms earth = nav_filter_earth_terms_wgs84(m.lat_rad, m.h_m);
+  nav_filter_build_F(f->F, &f->lay, &m, &earth, f->proc_diag);
+  for (size_t i = 0; i < n * n; ++i)
+    f->FT[i] = f->F[i] * T;
+  /* The blocks linear in C_b_n: their exact integrals. */
+  put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_PHI, nav_mat3_skew(pd->fn_T), 1.0);
+  put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_BA, pd->C_T, 1.0);
+  put_block(f->FT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_BG, pd->C_T, -1.0);
+  if (f->lay.has_scale_factors) {
+    put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_SA, pd->Cf_T, 1.0);
+    put_block(f->FT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_SG, pd->Cw_T, -1.0);
+  }
+  memset(f->QT, 0, n * n * sizeof *f->QT);
+  if (f->q_isotropic) {
+    for (size_t i = 0; i < 3; ++i) {
+      f->QT[(NAV_FILTER_IDX_DV + i) * (n + 1)] = f->qc[NAV_FILTER_IDX_DV] * T;
+      f->QT[(NAV_FILTER_IDX_PHI + i) * (n + 1)] = f->qc[NAV_FILTER_IDX_PHI] * T;
+    }
+  } else {
+    put_block(f->QT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_DV, pd->Qa_T, 1.0);
+    put_block(f->QT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_PHI, pd->Qg_T, 1.0);
+  }
+  for (size_t i = NAV_FILTER_IDX_BG; i < n; ++i)
+    f->QT[i * (n + 1)] = f->qc[i] * T;
 }
 
 nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double dt_s) {
@@ -330,39 +638,26 @@ nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double d
   }
   nav_status st = check_nav(f, nav, "predict");
   if (st != NAV_OK) return st;
-
-  const size_t n = f->n;
-  const nav_filter_earth_terms earth = nav_filter_earth_terms_wgs84(nav->lat_rad, nav->h_m);
-  nav_filter_build_F(f->F, &f->lay, nav, &earth, f->proc_diag);
-  nav_filter_build_GQG(f->GQG, &f->lay, nav->C_b_n, f->qc);
-
-  const bool pending = f->pend_count > 0;
-  if (f->pend_count + 1u < f->cfg.cov_decimation) {
-    /* Accumulate only (n^2 additions); the covariance step comes later. */
-    for (size_t i = 0; i < n * n; ++i) {
-      f->pend_FT[i] = (pending ? f->pend_FT[i] : 0.0) + f->F[i] * dt_s;
-      f->pend_QT[i] = (pending ? f->pend_QT[i] : 0.0) + f->GQG[i] * dt_s;
-    }
-    f->pend_count++;
+  /* Accumulate into a copy: a failing covariance step leaves the pending sums untouched. */
+  pending pd = f->pend;
+  pending_add(f, &pd, nav, dt_s);
+  if (pd.count < f->cfg.cov_decimation) {
+    f->pend = pd;
     return NAV_OK;
   }
-  /* Last step of the covariance interval: totals into FT/QT so that a failure leaves the pending
-   * sums untouched. */
-  for (size_t i = 0; i < n * n; ++i) {
-    f->FT[i] = (pending ? f->pend_FT[i] : 0.0) + f->F[i] * dt_s;
-    f->QT[i] = (pending ? f->pend_QT[i] : 0.0) + f->GQG[i] * dt_s;
-  }
+  pending_integrals(f, &pd);
   st = cov_step(f, f->FT, f->QT);
-  if (st == NAV_OK) f->pend_count = 0;
+  if (st == NAV_OK) memset(&f->pend, 0, sizeof f->pend);
   return st;
 }
 
 nav_status nav_filter_flush(nav_filter *f) {
   assert(f != NULL);
   if (f == NULL) return NAV_ERR_INVALID_ARG;
-  if (f->pend_count == 0) return NAV_OK;
-  const nav_status st = cov_step(f, f->pend_FT, f->pend_QT);
-  if (st == NAV_OK) f->pend_count = 0;
+  if (f->pend.count == 0) return NAV_OK;
+  pending_integrals(f, &f->pend);
+  const nav_status st = cov_step(f, f->FT, f->QT);
+  if (st == NAV_OK) memset(&f->pend, 0, sizeof f->pend);
   return st;
 }
 
@@ -395,14 +690,22 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
       hx += H[r * n + j] * f->x[j];
     y[r] = z[r] - hx;
   }
-  /* P H^T (n x m), skipping the zeros of H (most of it). */
+  /* The columns of H with a non-zero entry (a position or velocity update touches 3 to 9 of
+   * the n): the products with H run over them only, without a test per entry (adding the exact
+   * zeros of the other rows changes no sum: every P entry is finite). */
+  size_t hc[NMAX], nhc = 0;
+  for (size_t j = 0; j < n; ++j) {
+    bool nz = false;
+    for (size_t r = 0; r < m; ++r)
+      nz = nz || H[r * n + j] != 0.0;
+    if (nz) hc[nhc++] = j;
+  }
+  /* P H^T (n x m). */
   for (size_t i = 0; i < n; ++i)
     for (size_t r = 0; r < m; ++r) {
       double sum = 0.0;
-      for (size_t j = 0; j < n; ++j) {
-        const double h = H[r * n + j];
-        if (h != 0.0) sum += f->P[i * n + j] * h;
-      }
+      for (size_t q = 0; q < nhc; ++q)
+        sum += f->P[i * n + hc[q]] * H[r * n + hc[q]];
       f->PHt[i * m + r] = sum;
     }
   /* S = H P H^T + R, symmetrised. */
@@ -434,15 +737,33 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
       sum += f->K[j * m + r] * y[r];
     f->xn[j] = sum;
   }
-  /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T. A = I - K H goes to Phi. */
+  /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T, evaluated as (A P) A^T with
+   * A = I - K H without forming A: A P = P - K (H P) with H P = (P H^T)^T, then
+   * (A P) A^T = A P - ((A P) H^T) K^T over the non-zero columns of H. The same product in
+   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, (A P) H^T to PHt's
+   * companion Kt (both n x m or larger scratch). */
+  double *B = f->Phi, *BHt = f->S;
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j) {
       double sum = 0.0;
       for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * H[r * n + j];
-      f->Phi[i * n + j] = (i == j ? 1.0 : 0.0) - sum;
+        sum += f->K[i * m + r] * f->PHt[j * m + r];
+      B[i * n + j] = f->P[i * n + j] - sum;
     }
-  nav_matn_sandwich(f->Pn, f->Phi, f->P, n, n, f->W);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t r = 0; r < m; ++r) {
+      double sum = 0.0;
+      for (size_t q = 0; q < nhc; ++q)
+        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
+      BHt[i * m + r] = sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (size_t r = 0; r < m; ++r)
+        sum += BHt[i * m + r] * f->K[j * m + r];
+      f->Pn[i * n + j] = B[i * n + j] - sum;
+    }
   /* K R K^T: W = K R (n x m), then the upper triangle of W K^T mirrored. */
   for (size_t i = 0; i < n; ++i)
     for (size_t c = 0; c < m; ++c) {

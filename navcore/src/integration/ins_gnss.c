@@ -16,12 +16,16 @@ struct nav_ins_gnss {
   nav_ins *ins;
   nav_filter *kf;
   nav_vec3 b_g_rps, b_a_mps2;  /* estimated biases, subtracted from the raw increments */
+  nav_vec3 s_g, s_a;           /* estimated scale factors: compensated = (raw - b dt) / (1 + s) */
   nav_imu_increment last;      /* compensated increment of the last step */
   nav_vec3 w_prev_rps;         /* mean rate of the step before it */
   bool have_step, have_prev;
+  bool sf_on;                  /* the filter estimates scale factors */
   long updates;
   char err[256];
 };
+
+static nav_filter_ins_state nominal_of(const nav_ins_gnss *x);
 
 /* Largest element of a vector. */
 static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
@@ -36,6 +40,7 @@ static double rss3(double a, double b, double c) { return sqrt(a * a + b * b + c
  */
 static nav_filter_config filter_config(const nav_scene *sc) {
   nav_filter_config c = nav_filter_config_default();
+  if (sc->navigation.cov_decimation > 1) c.cov_decimation = (unsigned)sc->navigation.cov_decimation;
   const nav_gyro_error_config *g = &sc->imu.model.gyro;
   const nav_accel_error_config *a = &sc->imu.model.accel;
   if (g->terms & NAV_IMU_TERM_NOISE) c.gyro_arw_rad_per_sqrt_s = g->arw_rad_per_sqrt_s;
@@ -76,6 +81,20 @@ static nav_filter_config filter_config(const nav_scene *sc) {
     nav_vec3_set(&c.init.vel_sd_mps, i, fmax(nav_vec3_get(sc->initial_errors.vel_sd_mps, i), 1e-4));
     nav_vec3_set(&c.init.att_sd_rad, i, fmax(nav_vec3_get(sc->initial_errors.att_sd_rad, i), 1e-6));
   }
+  if (sc->navigation.estimate_scale_factors) {
+    /* Scale factors as random constants with the scene's sigma (fixed part included), floored
+     * at 1 ppm so P0 stays positive definite for a perfect sensor. */
+    c.states |= NAV_FILTER_STATE_SCALE_FACTORS;
+    c.gyro_sf_terms = 0;
+    c.accel_sf_terms = 0;
+    const bool gs = (g->terms & NAV_IMU_TERM_SCALE_FACTOR) != 0, as = (a->terms & NAV_IMU_TERM_SCALE_FACTOR) != 0;
+    for (int i = 0; i < 3; ++i) {
+      const double sgs = gs ? hypot(nav_vec3_get(g->scale_factor_sd, i), nav_vec3_get(g->scale_factor_fixed, i)) : 0.0;
+      const double sas = as ? hypot(nav_vec3_get(a->scale_factor_sd, i), nav_vec3_get(a->scale_factor_fixed, i)) : 0.0;
+      nav_vec3_set(&c.init.gyro_sf_sd, i, fmax(sgs, 1e-6));
+      nav_vec3_set(&c.init.accel_sf_sd, i, fmax(sas, 1e-6));
+    }
+  }
   /* A time-correlated GNSS error gets its own GM states when tau >> update interval
    * (numerics.md 6.4 (a)); white R on correlated errors would make the filter overconfident. */
   const nav_gnss_model_config *gm = &sc->gnss.model;
@@ -111,6 +130,11 @@ nav_status nav_ins_gnss_create(const nav_ins_gnss_config *cfg, const nav_ins_sta
   x->frame.model = NAV_EARTH_WGS84;
   nav_status st = nav_ins_create(&cfg->ins, initial, &x->ins);
   if (st == NAV_OK) st = nav_filter_create(&cfg->filter, &x->kf);
+  if (st == NAV_OK) x->sf_on = nav_filter_get_layout(x->kf).has_scale_factors;
+  if (st == NAV_OK && cfg->smoother) {
+    const nav_filter_ins_state nom = nominal_of(x);
+    st = nav_smoother_begin(cfg->smoother, initial->t_s, &nom, nav_filter_get_cov(x->kf), nav_filter_get_state(x->kf));
+  }
   if (st != NAV_OK) {
     nav_ins_gnss_destroy(x);
     return st;
@@ -128,6 +152,7 @@ void nav_ins_gnss_destroy(nav_ins_gnss *x) {
 
 const nav_ins_state *nav_ins_gnss_state(const nav_ins_gnss *x) { return x ? nav_ins_get_state(x->ins) : NULL; }
 const nav_filter *nav_ins_gnss_filter(const nav_ins_gnss *x) { return x ? x->kf : NULL; }
+const nav_ins *nav_ins_gnss_ins(const nav_ins_gnss *x) { return x ? x->ins : NULL; }
 long nav_ins_gnss_updates(const nav_ins_gnss *x) { return x ? x->updates : 0; }
 const char *nav_ins_gnss_last_error(const nav_ins_gnss *x) { return x ? x->err : ""; }
 
@@ -137,14 +162,49 @@ void nav_ins_gnss_biases(const nav_ins_gnss *x, nav_vec3 *b_g_rps, nav_vec3 *b_a
   if (b_a_mps2) *b_a_mps2 = x->b_a_mps2;
 }
 
-/* Filter inputs from the INS state and the compensated increment of the step just taken. */
-static nav_filter_nav filter_nav(const nav_frame *fr, const nav_ins_state *s, const nav_imu_increment *imu) {
-  const nav_local_view v = nav_frame_view(fr, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+void nav_ins_gnss_scale_factors(const nav_ins_gnss *x, nav_vec3 *s_g, nav_vec3 *s_a) {
+  if (!x) return;
+  if (s_g) *s_g = x->s_g;
+  if (s_a) *s_a = x->s_a;
+}
+
+/* The current navigation state in NED terms with the bias estimates (smoother records). */
+static nav_filter_ins_state nominal_of(const nav_ins_gnss *x) {
+  const nav_ins_state *s = nav_ins_get_state(x->ins);
+  const nav_local_view v = nav_frame_view(&x->frame, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+  nav_filter_ins_state o;
+  memset(&o, 0, sizeof o);
+  o.lat_rad = v.pos.lat_rad;
+  o.lon_rad = v.pos.lon_rad;
+  o.h_m = v.pos.h_m;
+  o.v_eb_n_mps = v.v_n_mps;
+  o.q_b_n = v.q_b_n;
+  o.b_g_rps = x->b_g_rps;
+  o.b_a_mps2 = x->b_a_mps2;
+  o.s_g = x->s_g;
+  o.s_a = x->s_a;
+  return o;
+}
+
+/* Filter inputs from the INS and the compensated increment of the step just taken. A NED
+ * mechanization hands over its geodetic state directly (no ECEF round trip at IMU rate); the
+ * ECEF one through the frame view. */
+static nav_filter_nav filter_nav(const nav_frame *fr, const nav_ins *ins, const nav_imu_increment *imu) {
   nav_filter_nav n;
-  n.lat_rad = v.pos.lat_rad;
-  n.h_m = v.pos.h_m;
-  n.v_eb_n_mps = v.v_n_mps;
-  n.C_b_n = nav_quat_to_dcm(v.q_b_n);
+  nav_ins_ned ned;
+  if (nav_ins_get_ned(ins, &ned)) {
+    n.lat_rad = ned.pos.lat_rad;
+    n.h_m = ned.pos.h_m;
+    n.v_eb_n_mps = ned.v_n_mps;
+    n.C_b_n = nav_quat_to_dcm(ned.q_b_n);
+  } else {
+    const nav_ins_state *s = nav_ins_get_state(ins);
+    const nav_local_view v = nav_frame_view(fr, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+    n.lat_rad = v.pos.lat_rad;
+    n.h_m = v.pos.h_m;
+    n.v_eb_n_mps = v.v_n_mps;
+    n.C_b_n = nav_quat_to_dcm(v.q_b_n);
+  }
   n.f_ib_b_mps2 = nav_vec3_scale(imu->dv_b_mps, 1.0 / imu->dt_s);
   n.w_ib_b_rps = nav_vec3_scale(imu->dtheta_b_rad, 1.0 / imu->dt_s);
   return n;
@@ -155,16 +215,30 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
   nav_imu_increment m = *raw;
   m.dtheta_b_rad = nav_vec3_axpy(m.dtheta_b_rad, -m.dt_s, x->b_g_rps);
   m.dv_b_mps = nav_vec3_axpy(m.dv_b_mps, -m.dt_s, x->b_a_mps2);
+  if (x->sf_on) {
+    m.dtheta_b_rad = nav_vec3_make(m.dtheta_b_rad.x / (1.0 + x->s_g.x), m.dtheta_b_rad.y / (1.0 + x->s_g.y),
+                                   m.dtheta_b_rad.z / (1.0 + x->s_g.z));
+    m.dv_b_mps = nav_vec3_make(m.dv_b_mps.x / (1.0 + x->s_a.x), m.dv_b_mps.y / (1.0 + x->s_a.y),
+                               m.dv_b_mps.z / (1.0 + x->s_a.z));
+  }
   nav_status st = nav_ins_step(x->ins, &m);
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "strapdown navigation stopped at t = %.6f s: %s", m.t_s, nav_ins_last_error(x->ins));
     return st;
   }
-  const nav_filter_nav n = filter_nav(&x->frame, nav_ins_get_state(x->ins), &m);
+  const nav_filter_nav n = filter_nav(&x->frame, x->ins, &m);
   st = nav_filter_predict(x->kf, &n, m.dt_s);
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m.t_s, nav_filter_last_error(x->kf));
     return st;
+  }
+  if (x->cfg.smoother) {
+    const nav_filter_ins_state nom = nominal_of(x);
+    st = nav_smoother_step(x->cfg.smoother, m.t_s, &n, m.dt_s, &nom);
+    if (st != NAV_OK) {
+      snprintf(x->err, sizeof x->err, "%s", nav_smoother_last_error(x->cfg.smoother));
+      return st;
+    }
   }
   if (x->have_step) {
     x->w_prev_rps = nav_vec3_scale(x->last.dtheta_b_rad, 1.0 / x->last.dt_s);
@@ -183,7 +257,7 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   }
   const nav_ins_state *s = nav_ins_get_state(x->ins);
   const nav_local_view v = nav_frame_view(&x->frame, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
-  nav_filter_nav n = filter_nav(&x->frame, s, &x->last);
+  nav_filter_nav n = filter_nav(&x->frame, x->ins, &x->last);
   /* The lever-arm velocity needs the angular rate AT the fix epoch; the increments give interval
    * means at mid-intervals, so extrapolate linearly from the last two: w(t_k) = 1.5 w_(k-1/2) -
    * 0.5 w_(k-3/2), an O(dt^2) error instead of the O(dt) of the plain mean (which, while
@@ -211,6 +285,9 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   nav_filter_error dx;
   st = nav_filter_get_error(x->kf, &dx);
   if (st != NAV_OK) return st;
+  double x_before[NAV_FILTER_MAX_STATES];
+  const size_t nx = nav_filter_get_layout(x->kf).n_states;
+  if (x->cfg.smoother) memcpy(x_before, nav_filter_get_state(x->kf), nx * sizeof *x_before);
   nav_filter_ins_state fs;
   fs.lat_rad = v.pos.lat_rad;
   fs.lon_rad = v.pos.lon_rad;
@@ -219,8 +296,8 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   fs.q_b_n = v.q_b_n;
   fs.b_g_rps = x->b_g_rps;
   fs.b_a_mps2 = x->b_a_mps2;
-  fs.s_g = nav_vec3_zero();
-  fs.s_a = nav_vec3_zero();
+  fs.s_g = x->s_g;
+  fs.s_a = x->s_a;
   nav_filter_apply_correction(&fs, &fs, &dx);
   const nav_geodetic p = {fs.lat_rad, fs.lon_rad, fs.h_m};
   const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
@@ -236,6 +313,22 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   }
   x->b_g_rps = fs.b_g_rps;
   x->b_a_mps2 = fs.b_a_mps2;
+  if (x->sf_on) {
+    x->s_g = fs.s_g;
+    x->s_a = fs.s_a;
+  }
   x->updates++;
+  if (x->cfg.smoother) {
+    /* The correction fed back is what the reset removed from the error state. */
+    const double *x_after = nav_filter_get_state(x->kf);
+    for (size_t i = 0; i < nx; ++i) x_before[i] -= x_after[i];
+    const nav_filter_ins_state nom = nominal_of(x);
+    st = nav_smoother_update(x->cfg.smoother, &nom, nav_filter_get_cov(x->kf), x_after, x_before);
+    if (st != NAV_OK) {
+      snprintf(x->err, sizeof x->err, "smoother record at t = %.6f s: %s", fix->t_s,
+               nav_smoother_last_error(x->cfg.smoother));
+      return st;
+    }
+  }
   return NAV_OK;
 }

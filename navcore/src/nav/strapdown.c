@@ -466,6 +466,20 @@ const nav_ins_state *nav_ins_get_state(const nav_ins *ins) {
   return &ins->s;
 }
 
+bool nav_ins_get_ned(const nav_ins *ins, nav_ins_ned *out) {
+  if (!ins || !out || ins->cfg.earth_model != NAV_EARTH_WGS84 || ins->cfg.mech_frame != NAV_MECH_NED)
+    return false;
+  out->t_s = ins->s.t_s;
+  out->pos.lat_rad = ins->lat_rad;
+  out->pos.lon_rad = ins->lon_rad;
+  out->pos.h_m = ins->h_m;
+  out->v_n_mps = ins->v_n_mps;
+  out->q_b_n = ins->q_b_n;
+  out->sin_lat = ins->et.sl;
+  out->cos_lat = ins->et.cl;
+  return true;
+}
+
 const char *nav_ins_last_error(const nav_ins *ins) {
   return ins ? ins->msg : "";
 }

@@ -470,6 +470,14 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
     issue(&c, "simulation.threads", "must be an integer in [0, 256] (got %g)", (double)s->simulation.threads);
   if (s->simulation.runs < 1 || s->simulation.runs > NAV_SCENE_MAX_RUNS)
     issue(&c, "simulation.runs", "must be an integer in [1, 1000000] (got %g)", (double)s->simulation.runs);
+  {
+    /* requirements (nav_requirements.h) */
+    prefixed pr = {"", report, user, 0};
+    if (nav_requirements_validate(s->requirements, s->n_requirements, report_prefixed, &pr) != NAV_OK &&
+        pr.count == 0)
+      issue_text(&c, "requirements", "invalid requirements");
+    c.count += pr.count;
+  }
   return c.count ? NAV_ERR_INVALID_ARG : NAV_OK;
 }
 

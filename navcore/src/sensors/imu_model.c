@@ -187,6 +187,9 @@ nav_status nav_imu_model_config_validate(const nav_imu_model_config *cfg, nav_sc
 
 /* Cholesky factor of the covariance of (bias step e1, integral e2) for one axis; see the header.
  * b_k = phi b + l11 u1;  I_k = c_int b + l21 u1 + l22 u2. */
+/* Slots of the interval cache of a model (power of two). */
+#define DT_CACHE_SLOTS 16
+
 typedef struct pair_coef {
   double phi, c_int, l11, l21, l22;
 } pair_coef;
@@ -219,6 +222,15 @@ struct nav_imu_model {
   bool ideal; /* no term on at all: apply() is a checked copy */
   nav_mat3 g_sens;
   double dt_cached; /* 0 until the first sample: dt must be > 0, so 0 never matches */
+  /* Coefficients of recently seen intervals. The increments' dt = t_k - t_(k-1) of a uniform
+   * grid differs from sample to sample in its last bits (t_k = k dt rounded), which made
+   * set_dt (two exp/expm1 per GM axis) run at nearly every sample; the few distinct values
+   * are cached by their exact bits, so the coefficients are exactly those set_dt computes. */
+  struct dt_slot {
+    double dt; /* 0: empty */
+    pair_coef gm_c[2][3], rw_c[2][3];
+    double n_sd[2][3];
+  } dt_cache[DT_CACHE_SLOTS];
   nav_imu_run_constants consts;
   nav_imu_bias_state bias;
   char last_error[256];
@@ -281,7 +293,36 @@ static pair_coef rw_pair(double k, double dt) {
   return c;
 }
 
+static void set_dt_compute(nav_imu_model *m, double dt);
+
+/* The coefficients for interval dt: from the cache when this exact dt was seen, else computed
+ * and cached (the slot from the bits of dt). */
 static void set_dt(nav_imu_model *m, double dt) {
+  uint64_t bits;
+  memcpy(&bits, &dt, sizeof bits);
+  bits ^= bits >> 29;
+  bits *= 0x9E3779B97F4A7C15ull;
+  struct dt_slot *e = &m->dt_cache[bits >> 60 & (DT_CACHE_SLOTS - 1)];
+  triad *t[2] = {&m->gyro, &m->accel};
+  if (e->dt == dt) {
+    for (int s = 0; s < 2; ++s) {
+      memcpy(t[s]->gm_c, e->gm_c[s], sizeof e->gm_c[s]);
+      memcpy(t[s]->rw_c, e->rw_c[s], sizeof e->rw_c[s]);
+      memcpy(t[s]->n_sd, e->n_sd[s], sizeof e->n_sd[s]);
+    }
+    m->dt_cached = dt;
+    return;
+  }
+  set_dt_compute(m, dt);
+  e->dt = dt;
+  for (int s = 0; s < 2; ++s) {
+    memcpy(e->gm_c[s], t[s]->gm_c, sizeof e->gm_c[s]);
+    memcpy(e->rw_c[s], t[s]->rw_c, sizeof e->rw_c[s]);
+    memcpy(e->n_sd[s], t[s]->n_sd, sizeof e->n_sd[s]);
+  }
+}
+
+static void set_dt_compute(nav_imu_model *m, double dt) {
   triad *t[2] = {&m->gyro, &m->accel};
   for (int s = 0; s < 2; ++s) {
     const double sdt = sqrt(dt);

@@ -24,11 +24,16 @@
 #include "navcore/nav_truth.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
+#include "sim/sim_partial_internal.h"
 #include "traj/traj_internal.h"
 
-/* Values kept per metric for the statistics (runs x epochs / stride): bounded memory
- * (5 metrics x 8 bytes x 4e6 = 160 MB worst case). */
+/* Values kept for the envelopes (runs x output epochs x ENV_VALUES): bounded memory. */
 #define STATS_MAX_VALUES 4000000LL
+/* Values kept per metric for the statistics over runs and epochs (runs x epochs / stride, a
+ * uniform subsample for the percentiles; RMS and max come from the same values): 5 metrics x
+ * 8 bytes x 2e6 = 80 MB worst case, plus one metric's copy while reducing, so that a 1000-run,
+ * one-hour 200 Hz campaign stays within 200 MB with its shared truth (54 MB of increments). */
+#define METRIC_MAX_VALUES 2000000LL
 #define PROGRESS_EVERY 65536
 #define N_METRICS 5
 
@@ -40,6 +45,7 @@ struct nav_sim {
   size_t envelope_count;
   nav_sim_run_final *finals; /* per run, from the last run */
   size_t finals_count;
+  nav_sim_range_hook hook; /* sim_partial.c: a range of runs, or a merge of ranges */
 };
 
 /* Values per output epoch and run kept for the envelopes: N, E, D, |dv|, attitude angle, and for
@@ -87,6 +93,12 @@ void nav_sim_request_cancel(nav_sim *sim) {
 
 const char *nav_sim_last_error(const nav_sim *sim) { return sim ? sim->last_error : ""; }
 
+void nav_sim_set_range_hook(nav_sim *sim, const nav_sim_range_hook *hook) {
+  if (!sim) return;
+  if (hook) sim->hook = *hook;
+  else memset(&sim->hook, 0, sizeof sim->hook);
+}
+
 const nav_scene *nav_sim_scene(const nav_sim *sim) { return sim ? &sim->scene : NULL; }
 
 void nav_sim_set_error(nav_sim *sim, const char *msg) {
@@ -112,6 +124,7 @@ typedef struct job {
   int64_t *samples_done;   /* [runs] */
   nav_status *status;      /* [runs] */
   atomic_long next_run;
+  long run_end; /* runs [.., run_end) are executed (range hook: r1) */
   atomic_long runs_done;
   nav_mutex err_lock;
   bool err_set;
@@ -120,12 +133,24 @@ typedef struct job {
   /* Truth shared by every run (Monte Carlo): ideal increments k = 1..n and states k = 0..n,
    * computed once; NULL when the job has one run or would need too much memory. */
   nav_imu_increment *shared_imu;
-  nav_traj_state *shared_ts;
+  nav_traj_state *shared_ts; /* the states of the samples that need one (ts_map), compact */
+  int32_t *ts_map;           /* [n + 1]: index into shared_ts, or -1 (state not kept) */
   nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
 } job;
 
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
 #define SHARED_TRUTH_MAX_SAMPLES 4000000LL
+
+/* The shared reference state of sample k, or NULL when it is not kept: only the samples whose
+ * errors are computed (statistics samples, output epochs, the first and the last) keep one, so
+ * the shared truth is the increments (72 B per sample) plus a few states, not 232 B per sample
+ * (175 MB for one hour at 200 Hz). Other samples (GNSS epochs off those) are evaluated by the
+ * run's own truth object at the same time (k dt): the same numbers. */
+static const nav_traj_state *shared_state(const job *j, int64_t k) {
+  if (!j->shared_ts || k < 0 || k > j->n) return NULL;
+  const int32_t i = j->ts_map[k];
+  return i >= 0 ? &j->shared_ts[i] : NULL;
+}
 
 /* Keep the first failure's message (of any run) for nav_sim_last_error. */
 #if defined(__GNUC__)
@@ -243,8 +268,10 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     nav_status st = NAV_OK;
     const double kf = t_fix / imu->dt_s;
     const int64_t kk = (int64_t)llround(kf);
-    if (j->shared_ts && fabs(kf - (double)kk) < 1e-9 && kk >= 0 && kk <= j->n) ts = j->shared_ts[kk];
-    else st = nav_truth_state(truth, t_fix, &ts);
+    const bool on_grid = j->shared_ts && fabs(kf - (double)kk) < 1e-9 && kk >= 0 && kk <= j->n;
+    const nav_traj_state *sh = on_grid ? shared_state(j, kk) : NULL;
+    if (sh) ts = *sh;
+    else st = nav_truth_state(truth, on_grid ? (double)kk * nav_truth_dt(truth) : t_fix, &ts);
     if (st != NAV_OK) return st;
     nav_gnss_fix fix;
     bool has_fix = false;
@@ -338,6 +365,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   nav_sim_gyrofree *gf = NULL; /* gyro-free scheme (sim_gyrofree.c): replaces the IMU */
   aiding aid_kf;
   memset(&aid_kf, 0, sizeof aid_kf);
+  const nav_run_observer *obs = j->opts->observer; /* requirements (nav_requirements.h) */
+  void *obs_ctx = obs && obs->begin ? obs->begin(obs->user, run) : NULL;
   char msg[200];
   nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
   if (st != NAV_OK) {
@@ -355,7 +384,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     }
   }
   nav_traj_state ts;
-  if (j->shared_ts) ts = j->shared_ts[0];
+  if (shared_state(j, 0)) ts = *shared_state(j, 0);
   else st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
   const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
@@ -396,6 +425,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
   store_env(j, run, 0, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_ins_get_state(ins));
+  if (obs_ctx) obs->epoch(obs_ctx, &err);
   if (record) {
     nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -447,10 +477,24 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         goto cleanup;
       }
     }
+    /* The errors are needed only at the statistics samples, the output epochs and the end: the
+     * reference state, the navigation state's e-frame view and the errors (together more than
+     * the navigation step itself) are not computed in between. */
+    const bool stats_k = k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run;
+    const bool out_k = k % j->out_stride == 0 || k == j->n;
+    if (!stats_k && !out_k && !(aid && !integrated)) {
+      if (caller_thread && j->opts->progress && k % PROGRESS_EVERY == 0) {
+        const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
+        nav_progress p = {"run", run, done / (double)j->runs, meas.t_s};
+        if (j->opts->progress(j->opts->user, &p) == NAV_STOP) stop = true;
+      }
+      continue;
+    }
     const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x)
                                    : gf       ? nav_sim_gyrofree_state(gf)
                                               : nav_ins_get_state(ins);
-    if (j->shared_ts) ts = j->shared_ts[k];
+    const nav_traj_state *sh = shared_state(j, k);
+    if (sh) ts = *sh;
     else st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
     if (aid && !integrated) {
@@ -463,6 +507,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     err = nav_errors_compute(&frame, &ts, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     store_env(j, run, k, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_now);
+    if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
     if (record && (k % j->out_stride == 0 || k == j->n)) {
       nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -479,6 +524,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   if (stop) atomic_store(&sim->cancel, true); /* a stop in run 0 stops the whole job */
 
 cleanup:
+  if (obs_ctx) obs->end(obs->user, obs_ctx, st == NAV_OK);
   aiding_destroy(&aid_kf);
   nav_sim_gyrofree_destroy(gf);
   nav_imu_model_destroy(imu_model);
@@ -493,7 +539,7 @@ static int worker(void *arg) {
   job *j = arg;
   for (;;) {
     const long run = atomic_fetch_add(&j->next_run, 1);
-    if (run >= j->runs) break;
+    if (run >= j->run_end) break;
     if (atomic_load(&j->sim->cancel)) {
       j->status[run] = NAV_ERR_CANCELLED;
       continue;
@@ -548,34 +594,60 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   }
   j.n = nav_truth_sample_count(probe);
   const double dt = nav_truth_dt(probe);
-  if (j.runs > 1 && j.n <= SHARED_TRUTH_MAX_SAMPLES) {
-    /* Generate the truth once for all runs (the same numbers every run would compute). */
+  /* Range hook: runs [r0, r1) only (a merge runs none). */
+  const long r0 = sim->hook.active ? (sim->hook.r0 < j.runs ? sim->hook.r0 : j.runs) : 0;
+  j.run_end = sim->hook.active ? (sim->hook.r1 < j.runs ? sim->hook.r1 : j.runs) : j.runs;
+  j.out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
+  if (j.out_stride < 1) j.out_stride = 1;
+  const int64_t epochs = j.n + 1;
+  j.stats_stride = ((int64_t)j.runs * epochs + METRIC_MAX_VALUES - 1) / METRIC_MAX_VALUES;
+  if (j.stats_stride < 1) j.stats_stride = 1;
+  j.stats_per_run = j.n / j.stats_stride + 1;
+  if (j.runs > 1 && j.run_end > r0 && j.n <= SHARED_TRUTH_MAX_SAMPLES) {
+    /* Generate the truth once for all runs (the same numbers every run would compute): every
+     * ideal increment, and the states of the samples whose errors are computed (shared_state;
+     * all of them for the vertically aided free INS, which reads the reference every step). */
+    const bool every_state = sc->navigation.aid_vertical && sc->navigation.scheme != NAV_SCHEME_INS_GNSS;
+    j.ts_map = malloc((size_t)(j.n + 1) * sizeof *j.ts_map);
+    int64_t n_ts = 0;
+    if (j.ts_map)
+      for (int64_t k = 0; k <= j.n; ++k) {
+        const bool keep = every_state || k == 0 || k == j.n || k % j.out_stride == 0 ||
+                          (k % j.stats_stride == 0 && k / j.stats_stride < j.stats_per_run);
+        j.ts_map[k] = keep ? (int32_t)n_ts++ : -1;
+      }
     j.shared_imu = malloc((size_t)j.n * sizeof *j.shared_imu);
-    j.shared_ts = malloc((size_t)(j.n + 1) * sizeof *j.shared_ts);
+    j.shared_ts = j.ts_map ? malloc((size_t)n_ts * sizeof *j.shared_ts) : NULL;
     if (j.shared_imu && j.shared_ts) {
       st = nav_truth_state(probe, 0.0, &j.shared_ts[0]);
+      int64_t k_fail = 0;
       for (int64_t k = 1; k <= j.n && st == NAV_OK; ++k) {
+        k_fail = k;
         st = nav_truth_imu(probe, k, &j.shared_imu[k - 1]);
-        if (st == NAV_OK) st = nav_truth_state(probe, (double)k * dt, &j.shared_ts[k]);
+        if (st == NAV_OK && j.ts_map[k] >= 0) st = nav_truth_state(probe, (double)k * dt, &j.shared_ts[j.ts_map[k]]);
         if (opts->progress && k % PROGRESS_EVERY == 0) {
           nav_progress p = {"truth", 0, 0.0, (double)k * dt};
           if (opts->progress(opts->user, &p) == NAV_STOP) st = NAV_ERR_CANCELLED;
         }
       }
       if (st != NAV_OK) {
-        snprintf(sim->last_error, sizeof sim->last_error, "reference trajectory: %s", nav_status_str(st));
+        snprintf(sim->last_error, sizeof sim->last_error,
+                 "reference trajectory (shared truth): %s in the state or ideal increment at t = %.6f s (sample %lld)",
+                 nav_status_str(st), (double)k_fail * dt, (long long)k_fail);
         nav_truth_destroy(probe);
         goto cleanup;
       }
     } else {
       free(j.shared_imu);
       free(j.shared_ts);
+      free(j.ts_map);
       j.shared_imu = NULL;
       j.shared_ts = NULL;
+      j.ts_map = NULL;
     }
   }
   nav_truth_destroy(probe);
-  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && j.runs > 1) {
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && j.runs > 1 && j.run_end > r0) {
     /* The ideal array increments are those of every run too: sampled once (sim_gyrofree.c). */
     st = nav_sim_gyrofree_truth_create(sc, &j.gf_truth, msg, sizeof msg);
     if (st != NAV_OK) {
@@ -584,13 +656,6 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       goto cleanup;
     }
   }
-  j.out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
-  if (j.out_stride < 1) j.out_stride = 1;
-  const int64_t epochs = j.n + 1;
-  j.stats_stride = ((int64_t)j.runs * epochs + STATS_MAX_VALUES - 1) / STATS_MAX_VALUES;
-  if (j.stats_stride < 1) j.stats_stride = 1;
-  j.stats_per_run = j.n / j.stats_stride + 1;
-
   j.n_out = j.n / j.out_stride + 1 + (j.n % j.out_stride != 0 ? 1 : 0);
   if ((double)j.runs * (double)j.n_out * ENV_VALUES <= (double)STATS_MAX_VALUES)
     j.env = malloc((size_t)j.runs * (size_t)j.n_out * ENV_VALUES * sizeof *j.env);
@@ -613,7 +678,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     goto cleanup;
   }
   lock_ok = true;
-  atomic_init(&j.next_run, 1);
+  atomic_init(&j.next_run, r0 > 0 ? r0 : 1);
   atomic_init(&j.runs_done, 0);
 
   /* Workers start first and take runs 1..N-1; run 0 runs on this thread (records, progress),
@@ -633,13 +698,13 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       ++started;
     }
   }
-  st = run_one(&j, 0, true);
+  if (r0 == 0 && j.run_end > 0) st = run_one(&j, 0, true);
   if (st != NAV_OK) atomic_store(&sim->cancel, true);
   if (j.runs > 1) {
     /* This thread works too, reporting progress between runs. */
     for (;;) {
       const long run = atomic_fetch_add(&j.next_run, 1);
-      if (run >= j.runs) break;
+      if (run >= j.run_end) break;
       if (atomic_load(&sim->cancel)) {
         j.status[run] = NAV_ERR_CANCELLED;
         continue;
@@ -652,6 +717,15 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     }
     for (int t = 1; t <= started; ++t) nav_thread_join(threads[t]);
     for (long r = 0; r < j.runs && st == NAV_OK; ++r) st = j.status[r];
+  }
+  if (sim->hook.active) {
+    /* sim_partial.c takes the tables of this range, or fills in those of the others. */
+    if (st != NAV_OK) goto cleanup;
+    nav_sim_tables tb = {j.runs, N_METRICS, j.stats_per_run, j.n_out, ENV_VALUES, j.metrics, j.env, j.final,
+                         j.samples_done, j.status};
+    st = sim->hook.tables(sim->hook.user, &tb);
+    for (long r = 0; r < j.runs && st == NAV_OK; ++r) st = j.status[r];
+    if (st != NAV_OK || !sim->hook.reduce) goto cleanup;
   }
   if (st != NAV_OK && st != NAV_ERR_CANCELLED) goto cleanup;
 
@@ -765,6 +839,7 @@ cleanup:
   free(j.env);
   free(j.shared_imu);
   free(j.shared_ts);
+  free(j.ts_map);
   nav_sim_gyrofree_truth_destroy(j.gf_truth);
   free(j.final);
   free(j.samples_done);

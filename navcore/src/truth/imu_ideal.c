@@ -111,7 +111,13 @@ nav_frame nav_truth_frame(const nav_truth *truth) { return truth->frame; }
 
 nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out) {
   if (!truth) return NAV_ERR_INVALID_ARG;
-  return nav_traj_eval(truth->traj, t_s, out);
+  const nav_status st = nav_traj_eval(truth->traj, t_s, out);
+  if (st != NAV_OK) return st;
+  /* Numerical guard (one test for all: any NaN or infinity propagates into the sum). */
+  if (!isfinite(out->r_fb_f_m.x + out->r_fb_f_m.y + out->r_fb_f_m.z + out->v_fb_f_mps.x + out->v_fb_f_mps.y +
+                out->v_fb_f_mps.z + out->q_b_f.w + out->q_b_f.x + out->q_b_f.y + out->q_b_f.z))
+    return NAV_ERR_NUMERIC;
+  return NAV_OK;
 }
 
 nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
@@ -131,6 +137,7 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (st != NAV_OK) return st;
   if (!closed) r.dtheta_b_rad = dth;
   r.dv_b_mps = dv;
+  if (!nav_vec3_isfinite(r.dtheta_b_rad) || !nav_vec3_isfinite(r.dv_b_mps)) return NAV_ERR_NUMERIC;
   *out = r;
   return NAV_OK;
 }

@@ -31,4 +31,28 @@ struct NavChartOptions {
 bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &options, const std::string &path,
                             std::string *error);
 
+/**
+ * Simulated sensor errors of run 0 (imu_errors.csv; the paper's Fig. 2): gyro errors [deg/h] and
+ * accelerometer errors [mg] per axis against time, two panels.
+ */
+bool NavRenderSensorErrorChartPng(const NavResult &result, const NavChartOptions &options, const std::string &path,
+                                  std::string *error);
+
+/**
+ * Allan deviation (allan.csv of `navsim allan`): log-log, gyros [deg/h] and accelerometers [mg] in
+ * two panels, measured per axis, the model curve dashed, and slope guides -1/2 (white noise),
+ * 0 (flicker floor) and +1/2 (random walk) through the curve's middle.
+ */
+bool NavRenderAllanChartPng(const std::string &allan_csv, const NavChartOptions &options, const std::string &path,
+                            std::string *error);
+
+/**
+ * Speed against error from bench.csv (`navsim bench`): log-log, x = mechanization samples per
+ * second (mech_samples_per_s, else samples_per_s), y = position error [m] (pos_err_m, else
+ * error); one marker series per variant (variant, else algorithm column). Rows with a status other
+ * than ok, or a non-positive value, are skipped.
+ */
+bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &options, const std::string &path,
+                              std::string *error);
+
 #endif /* NAV_VIEW_CHART_H */

@@ -20,8 +20,29 @@ enum class NavEnvelopeSource {
   Auto,       /**< Monte Carlo RMS when mc_stats.csv is present, else run 0 errors */
   RunErrors,  /**< k * horizontal error of run 0 (errors.csv) */
   MonteCarlo, /**< k * RMS over runs of the horizontal error (mc_stats.csv) */
+  Filter,     /**< k * the filter's reported horizontal sigma, mean over runs (mc_stats.csv) */
+  Covariance, /**< k * the predicted horizontal sigma of the covariance analysis (estimate.csv) */
   None        /**< no tube */
 };
+
+/** Vehicle glyph at the playback time. */
+enum class NavVehicleKind {
+  Auto,     /**< from the scene name: aircraft/flight/uav/climb -> aircraft, car/drive -> car */
+  Car,      /**< box body, cabin and a wedge nose */
+  Aircraft, /**< fuselage, wings and tail */
+  Generic   /**< an arrowhead (cone) along body x */
+};
+
+/** The envelope source actually used for @p result (Auto resolved; None when no data). */
+NavEnvelopeSource NavResolveEnvelopeSource(const NavResult &result, NavEnvelopeSource requested);
+/** Human-readable name of an envelope source ("MC RMS", "filter sigma", ...). */
+const char *NavEnvelopeSourceName(NavEnvelopeSource src);
+/** Per-axis 1-sigma N/E/D [m] at time @p t from @p src (MonteCarlo: RMS over runs per axis;
+ *  Filter: reported sigma; Covariance: predicted sigma; RunErrors: |error| of run 0).
+ *  @return false when the source has no data. */
+bool NavSigmaNed(const NavResult &result, NavEnvelopeSource src, double t, double sigma_ned[3]);
+/** Horizontal 1-sigma [m] at time @p t from @p src (NaN when the source has no data). */
+double NavSigmaH(const NavResult &result, NavEnvelopeSource src, double t);
 
 /** Camera presets of the 3D view. */
 enum class NavCameraPreset {
@@ -65,6 +86,26 @@ struct NavViewOptions {
   double camera_view_angle_deg = 30.0;
   /** Multisample anti-aliasing samples (0: off). */
   int multisamples = 8;
+  /** Covariance ellipsoids (semi-axes envelope_k x sigma N/E/D of the envelope source) at this
+   *  many epochs spread evenly over the run (0: none). */
+  int ellipsoid_count = 6;
+  /** Explicit ellipsoid epochs [s] (override ellipsoid_count when not empty). */
+  std::vector<double> ellipsoid_times_s;
+  /** GNSS fixes as points and outage intervals highlighted on the reference path. */
+  bool show_gnss = true;
+  NavVehicleKind vehicle = NavVehicleKind::Auto;
+};
+
+/** Epochs of the covariance ellipsoids: the options' explicit times, else ellipsoid_count epochs
+ *  spread evenly over the run plus the last reference epoch inside each GNSS outage. */
+std::vector<double> NavEllipsoidTimes(const NavResult &result, const NavViewOptions &opt);
+
+/** A covariance ellipsoid in frame r: axis-aligned with N/E/D (diagonal sigma). */
+struct NavEllipsoid {
+  double t_s = 0.0;
+  double center_r[3] = {0, 0, 0};
+  double sigma_ned_m[3] = {0, 0, 0}; /**< the sigma fed in [m] */
+  double semi_axes_r[3] = {0, 0, 0}; /**< k x sigma along x (east), y (north), z (up) [m] */
 };
 
 /** A decimated polyline in the render frame. */
@@ -101,6 +142,12 @@ struct NavSceneModel {
   NavTriadSet triads_est;
   NavTube envelope;
   std::string envelope_label;              /**< legend text of the tube, empty when there is none */
+  NavEnvelopeSource envelope_source = NavEnvelopeSource::None; /**< resolved source */
+  std::vector<NavEllipsoid> ellipsoids;
+  size_t ellipsoids_too_large = 0; /**< not drawn: wider than the scene's horizontal extent */
+  std::vector<double> gnss_r;                /**< 3 per GNSS fix: measured position in frame r [m] */
+  std::vector<NavPolyline> outage_segments; /**< reference path inside each GNSS outage */
+  NavVehicleKind vehicle = NavVehicleKind::Generic; /**< resolved vehicle glyph */
   double error_max_m = 0.0;                /**< colour range of the estimate [0, error_max_m] */
   double bounds_r[6] = {0, 0, 0, 0, 0, 0}; /**< xmin xmax ymin ymax zmin zmax of all paths [m] */
   double ground_z_r = 0.0;                 /**< z of the ground grid [m] */

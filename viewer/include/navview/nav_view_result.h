@@ -50,8 +50,53 @@ struct NavTrack {
   std::vector<double> t_s;       /**< epoch times [s], non-decreasing */
   std::vector<double> pos_ned_m; /**< 3 per epoch: north, east, down in frame l [m] */
   std::vector<double> euler_rad; /**< 3 per epoch: roll, pitch, yaw of C_b_n [rad]; may be empty */
+  /** 3 per epoch: latitude [rad], longitude [rad], height [m] (lat_deg, lon_deg, h_m columns);
+   *  may be empty (then the map view uses a local tangent plane). */
+  std::vector<double> geo;
   size_t Size() const { return t_s.size(); }
   bool HasAttitude() const { return !euler_rad.empty(); }
+  bool HasGeodetic() const { return !geo.empty(); }
+};
+
+/** gnss.csv and gnss_outages.csv (INS/GNSS results). Empty when absent. */
+struct NavGnss {
+  std::vector<double> t_s;          /**< fix times of validity [s] */
+  std::vector<double> pos_ned_m;    /**< 3 per fix: measured antenna position in frame l [m] */
+  std::vector<double> geo;          /**< 3 per fix: lat [rad], lon [rad], h [m] */
+  std::vector<double> pos_sd_ned_m; /**< 3 per fix: reported 1-sigma N/E/D [m] */
+  std::vector<double> outage_t0_s;  /**< outage intervals [t0, t1) [s] */
+  std::vector<double> outage_t1_s;
+  size_t Size() const { return t_s.size(); }
+  /** Whether @p t lies inside an outage interval. */
+  bool InOutage(double t) const {
+    for (size_t i = 0; i < outage_t0_s.size(); ++i)
+      if (t >= outage_t0_s[i] && t < outage_t1_s[i]) return true;
+    return false;
+  }
+};
+
+/** Predicted 1-sigma position errors of a covariance analysis (estimate.csv cov_* columns). */
+struct NavCovariance {
+  std::vector<double> t_s;
+  std::vector<double> pos_sd_ned_m; /**< 3 per epoch [m] */
+  std::vector<double> pos_h_sd_m;   /**< sqrt(sigma_N^2 + sigma_E^2) [m] */
+  size_t Size() const { return t_s.size(); }
+};
+
+/** imu_errors.csv: simulated sensor errors of run 0 (SI: rad/s and m/s^2). */
+struct NavImuErrors {
+  std::vector<double> t_s;
+  std::vector<double> gyro_rps;   /**< 3 per epoch [rad/s] */
+  std::vector<double> accel_mps2; /**< 3 per epoch [m/s^2] */
+  size_t Size() const { return t_s.size(); }
+};
+
+/** One requirement verdict of summary.json "requirements" (user units, as written). */
+struct NavRequirementVerdict {
+  std::string id, metric, statistic, unit;
+  double limit = 0.0, value = 0.0;
+  double limit_si = 0.0; /**< limit in SI (m, m/s, rad) for drawing on the charts */
+  bool pass = false;
 };
 
 /** errors.csv of run 0 (navigation minus reference), SI units. Empty when absent. */
@@ -71,6 +116,9 @@ struct NavEnvelope {
   std::vector<double> pos_rms_ned_m; /**< 3 per epoch: RMS over runs of the N, E, D errors [m] */
   std::vector<double> pos_h_rms_m;   /**< RMS over runs of the horizontal error [m] */
   std::vector<double> att_rms_rad;   /**< RMS over runs of the attitude error [rad]; may be empty */
+  /** 3 per epoch: mean over runs of the filter's reported position sigma N/E/D [m]; empty when
+   *  the column is absent or all zero (free INS). */
+  std::vector<double> pos_sd_reported_ned_m;
   size_t Size() const { return t_s.size(); }
 };
 
@@ -86,6 +134,11 @@ struct NavResult {
   std::vector<NavTrack> extra_runs;
   NavErrorSeries errors;          /**< errors.csv (run 0) */
   NavEnvelope envelope;           /**< mc_stats.csv */
+  NavGnss gnss;                   /**< gnss.csv, gnss_outages.csv */
+  NavCovariance covariance;       /**< estimate.csv in DIR or in DIR-estimate (navsim estimate) */
+  NavImuErrors imu_errors;        /**< imu_errors.csv */
+  std::vector<NavRequirementVerdict> requirements; /**< summary.json "requirements" */
+  std::string summary_json;       /**< the text of summary.json (empty when absent) */
   std::vector<std::string> notes; /**< non-fatal remarks (missing optional files) */
 };
 

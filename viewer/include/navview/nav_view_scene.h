@@ -82,6 +82,11 @@ public:
    *  camera, q = quit) and run its event loop until closed. Needs a display. */
   bool RunInteractive(std::string *error);
 
+  /** Playback movie for demos: @p frames frames from the start to the end of the run (fixed
+   *  camera, the vehicle, estimate marker and read-out moving), written as DIR/frame_NNNN.png and,
+   *  when @p video is set, as DIR/playback.ogv (Ogg Theora, vtkOggTheoraWriter) at @p fps. */
+  bool RenderMovie(const std::string &dir, int frames, double fps, bool video, std::string *error);
+
   /** Build the default view offscreen and render @p frames frames while orbiting the camera. */
   bool Benchmark(int frames, NavBenchResult *out, std::string *error);
 

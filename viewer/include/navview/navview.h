@@ -10,6 +10,7 @@
 #include "navview/nav_view_decimate.h"
 #include "navview/nav_view_frame.h"
 #include "navview/nav_view_image.h"
+#include "navview/nav_view_map.h"
 #include "navview/nav_view_model.h"
 #include "navview/nav_view_result.h"
 #include "navview/nav_view_scene.h"

@@ -1,0 +1,122 @@
+// navstudio: the scenario editor.
+//   navstudio [SCENE]                 open SCENE (default: a new drive)
+//   navstudio --screenshot PNG [SCENE] render the window once, save it as PNG and exit
+//   navstudio --bench-preview [N] [SCENE]  move a waypoint N times (default 20) and report the
+//                                     live-preview edit-to-picture latency (median, max) [ms]
+#include <QApplication>
+#include <QElapsedTimer>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <functional>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "main_window.h"
+
+namespace {
+void WaitFor(const std::function<bool()> &done, int timeout_ms) {
+  QElapsedTimer t;
+  t.start();
+  while (!done() && t.elapsed() < timeout_ms) QApplication::processEvents(QEventLoop::AllEvents, 20);
+}
+
+int BenchPreview(studio::MainWindow *w, int n) {
+  studio::SceneDocument *doc = w->Doc();
+  if (doc->Scene().trajectory.type != NAV_TRAJ_WAYPOINTS || doc->Scene().trajectory.waypoints.count < 2) {
+    std::fprintf(stderr, "navstudio: --bench-preview needs a waypoint scene\n");
+    return 2;
+  }
+  WaitFor([&] { return !w->PreviewWorker()->IsBusy() && !w->PreviewLatenciesMs().empty(); }, 60000);
+  const size_t before = w->PreviewLatenciesMs().size();
+  auto cpu_s = [] {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  };
+  const double cpu0 = cpu_s();
+  const int k = doc->Scene().trajectory.waypoints.count / 2;
+  for (int i = 0; i < n; ++i) {
+    nav_scene s = doc->Scene();
+    s.trajectory.waypoints.points[k].r_ned_m.y += (i % 2 ? -5.0 : 5.0);
+    doc->Preview(s);
+    const size_t want = before + static_cast<size_t>(i) + 1;
+    WaitFor([&] { return w->PreviewLatenciesMs().size() >= want; }, 30000);
+  }
+  std::vector<double> l(w->PreviewLatenciesMs().begin() + static_cast<long>(before), w->PreviewLatenciesMs().end());
+  if (l.empty()) {
+    std::fprintf(stderr, "navstudio: no preview completed\n");
+    return 1;
+  }
+  const double cpu_ms = (cpu_s() - cpu0) * 1e3 / n;
+  std::sort(l.begin(), l.end());
+  // CPU per edit (simulation + redraw, all threads) is what the latency would be on an idle
+  // machine with the simulation and the redraw not overlapping; the wall figures include load.
+  double load = 0.0;
+  if (FILE *f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = 0.0;
+    std::fclose(f);
+  }
+  std::printf("preview_latency_ms: samples=%zu median=%.1f p90=%.1f max=%.1f cpu_per_edit_ms=%.1f duration_s=%.1f "
+              "imu_rate_hz=%g loadavg=%.2f\n",
+              l.size(), l[l.size() / 2], l[std::min(l.size() - 1, l.size() * 9 / 10)], l.back(), cpu_ms,
+              doc->Scene().trajectory.duration_s, doc->Scene().imu.rate_hz, load);
+  return 0;
+}
+} // namespace
+
+int main(int argc, char **argv) {
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("navsim");
+  QApplication::setApplicationName("navstudio");
+  QString scene, shot;
+  int bench = 0;
+  const QStringList args = QApplication::arguments();
+  for (int i = 1; i < args.size(); ++i) {
+    if (args[i] == "--screenshot" && i + 1 < args.size()) {
+      shot = args[++i];
+    } else if (args[i] == "--bench-preview") {
+      bench = 20;
+      if (i + 1 < args.size() && args[i + 1].toInt() > 0) bench = args[++i].toInt();
+    } else if (args[i] == "--check" && i + 1 < args.size()) {
+      // The panels' validation of a scene, without a window.
+      studio::SceneDocument doc;
+      QStringList errors;
+      if (!doc.Load(args[i + 1], &errors)) {
+        for (const QString &e : errors) std::fprintf(stderr, "%s\n", e.toLocal8Bit().constData());
+        return 2;
+      }
+      const QVector<studio::Issue> issues = studio::Validate(doc.Scene());
+      for (const studio::Issue &is : issues) std::fprintf(stderr, "%s\n", is.Text().toLocal8Bit().constData());
+      return issues.isEmpty() ? 0 : 2;
+    } else if (args[i] == "--help" || args[i] == "-h") {
+      std::printf("usage: navstudio [SCENE] [--screenshot PNG] [--bench-preview [N]] | --check SCENE\n");
+      return 0;
+    } else if (args[i].startsWith("--")) {
+      std::fprintf(stderr, "navstudio: error: unknown option '%s' (see --help)\n", args[i].toLocal8Bit().constData());
+      return 2;
+    } else {
+      scene = args[i];
+    }
+  }
+  studio::MainWindow w;
+  if (!shot.isEmpty() || bench > 0) qputenv("NAVSTUDIO_NO_DIALOGS", "1");
+  w.show();
+  if (!scene.isEmpty() && !w.OpenFile(scene)) {
+    if (!shot.isEmpty() || bench > 0) return 2;
+  }
+  if (scene.isEmpty() && shot.isEmpty() && bench == 0) w.CheckRecovery();
+  if (bench > 0) return BenchPreview(&w, bench);
+  if (!shot.isEmpty()) {
+    WaitFor([&] { return !w.PreviewWorker()->IsBusy() && w.LastPreview() != nullptr; }, 20000);
+    QApplication::processEvents();
+    return w.grab().save(shot) ? 0 : 1;
+  }
+  return app.exec();
+}

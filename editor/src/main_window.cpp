@@ -1,0 +1,552 @@
+#include "main_window.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QCryptographicHash>
+#include <QDir>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QKeySequence>
+#include <QLabel>
+#include <QListWidget>
+#include <QMenuBar>
+#include <QProgressBar>
+#include <QSettings>
+#include <QSplitter>
+#include <QStandardPaths>
+#include <QStatusBar>
+#include <QTextBrowser>
+#include <QToolBar>
+#include <QUndoStack>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace studio {
+
+namespace {
+QString AutosaveDir() {
+  const QByteArray env = qgetenv("NAVSTUDIO_AUTOSAVE_DIR");
+  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
+  return QStandardPaths::writableLocation(QStandardPaths::AppLocalDataLocation) + "/autosave";
+}
+
+QString Fmt(double v, int prec = 3) { return std::isfinite(v) ? QString::number(v, 'g', prec) : QStringLiteral("—"); }
+} // namespace
+
+MainWindow::MainWindow(QWidget *parent) : QMainWindow(parent) {
+  setObjectName("navstudio");
+  ask_ = [this](const QString &title, const QString &text, QMessageBox::StandardButtons buttons) {
+    return QMessageBox::question(this, title, text, buttons);
+  };
+  // The live preview is started first after an edit (the worker thread then simulates while
+  // this thread redraws the views and panels).
+  connect(&doc_, &SceneDocument::Changed, this, [this] {
+    if (preview_act_ && preview_act_->isChecked()) StartPreview();
+  });
+  BuildUi();
+  BuildActions();
+  connect(&doc_, &SceneDocument::Changed, this, &MainWindow::OnSceneChanged);
+  connect(&doc_, &SceneDocument::FileStateChanged, this, &MainWindow::UpdateTitle);
+  connect(&worker_, &SimWorker::Progress, this, [this](double f) {
+    progress_->setValue(static_cast<int>(std::lround(1000.0 * f)));
+  });
+  connect(&worker_, &SimWorker::Finished, this, &MainWindow::OnFinished);
+  connect(&preview_, &SimWorker::Finished, this, &MainWindow::OnPreviewFinished);
+  preview_timer_.setSingleShot(true);
+  // A burst of edits (a drag) does not pile up previews: while one runs, only the newest edit
+  // waits (SimWorker queues one job); this timer only retries after a Monte Carlo run.
+  preview_timer_.setInterval(30);
+  connect(&preview_timer_, &QTimer::timeout, this, &MainWindow::StartPreview);
+  bool ok = false;
+  const int ms = qEnvironmentVariableIntValue("NAVSTUDIO_AUTOSAVE_MS", &ok);
+  autosave_timer_.setInterval(ok && ms > 0 ? ms : 30000);
+  connect(&autosave_timer_, &QTimer::timeout, this, &MainWindow::Autosave);
+  autosave_timer_.start();
+  UpdateTitle();
+  ShowIssues();
+}
+
+MainWindow::~MainWindow() {
+  // Stop the workers before the views they report to go away.
+  worker_.Cancel();
+  preview_.Cancel();
+  worker_.Join();
+  preview_.Join();
+}
+
+void MainWindow::BuildUi() {
+  resize(1500, 950);
+  panels_ = new ScenePanels(&doc_, &catalogs_);
+  panels_->setMinimumWidth(470);
+  map_ = new PathView(&doc_, PathView::Mode::Map);
+  view3d_ = new PathView(&doc_, PathView::Mode::ThreeD);
+  auto *views = new QSplitter(Qt::Horizontal);
+  views->addWidget(map_);
+  views->addWidget(view3d_);
+  views->setSizes({560, 440});
+
+  bottom_tabs_ = new QTabWidget;
+  bottom_tabs_->setObjectName("bottomTabs");
+  results_ = new QTextBrowser;
+  results_->setObjectName("resultsText");
+  results_->setHtml(tr("<p>Draw a drive on the map (click to add waypoints, drag to move them), choose the "
+                       "IMU and the GNSS receiver in the panels, then <b>Run</b> (F5).</p>"));
+  chart_ = new ErrorChart;
+  issues_ = new QListWidget;
+  issues_->setObjectName("issuesList");
+  bottom_tabs_->addTab(results_, tr("Results"));
+  bottom_tabs_->addTab(chart_, tr("Errors"));
+  bottom_tabs_->addTab(issues_, tr("Issues"));
+
+  auto *right = new QSplitter(Qt::Vertical);
+  right->addWidget(views);
+  right->addWidget(bottom_tabs_);
+  right->setSizes({620, 260});
+  auto *main = new QSplitter(Qt::Horizontal);
+  main->addWidget(panels_);
+  main->addWidget(right);
+  main->setSizes({480, 1020});
+  setCentralWidget(main);
+
+  status_ = new QLabel(tr("Ready"));
+  status_->setObjectName("statusText");
+  latency_label_ = new QLabel;
+  latency_label_->setObjectName("latencyLabel");
+  progress_ = new QProgressBar;
+  progress_->setObjectName("progress");
+  progress_->setRange(0, 1000);
+  progress_->setMaximumWidth(220);
+  progress_->setTextVisible(true);
+  progress_->setFormat("%p%");
+  progress_->setValue(0);
+  statusBar()->addWidget(status_, 1);
+  statusBar()->addPermanentWidget(latency_label_);
+  statusBar()->addPermanentWidget(progress_);
+
+  connect(map_, &PathView::CursorText, status_, &QLabel::setText);
+  connect(view3d_, &PathView::CursorText, status_, &QLabel::setText);
+  // Selection in sync: views and the table.
+  connect(map_, &PathView::SelectionChanged, this, [this](int i) {
+    view3d_->SetSelectedWaypoint(i);
+    panels_->SelectWaypoint(i);
+  });
+  connect(view3d_, &PathView::SelectionChanged, this, [this](int i) {
+    map_->SetSelectedWaypoint(i);
+    panels_->SelectWaypoint(i);
+  });
+  connect(panels_, &ScenePanels::WaypointSelected, this, [this](int i) {
+    map_->SetSelectedWaypoint(i);
+    view3d_->SetSelectedWaypoint(i);
+  });
+  connect(panels_, &ScenePanels::RunRequested, this, [this] { Run(); });
+  connect(panels_, &ScenePanels::CancelRequested, this, &MainWindow::Cancel);
+}
+
+void MainWindow::BuildActions() {
+  QMenu *file = menuBar()->addMenu(tr("&File"));
+  QMenu *edit = menuBar()->addMenu(tr("&Edit"));
+  QMenu *sim = menuBar()->addMenu(tr("&Simulation"));
+  QMenu *view = menuBar()->addMenu(tr("&View"));
+  QToolBar *tb = addToolBar(tr("Main"));
+  tb->setObjectName("mainToolBar");
+  tb->setToolButtonStyle(Qt::ToolButtonTextOnly);
+
+  auto act = [this](const QString &text, const QString &name, const QKeySequence &key) {
+    auto *a = new QAction(text, this);
+    a->setObjectName(name);
+    if (!key.isEmpty()) a->setShortcut(key);
+    return a;
+  };
+  QAction *nw = act(tr("&New drive"), "actionNew", QKeySequence::New);
+  QAction *open = act(tr("&Open..."), "actionOpen", QKeySequence::Open);
+  QAction *save = act(tr("&Save"), "actionSave", QKeySequence::Save);
+  QAction *saveas = act(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs);
+  QAction *shot = act(tr("Export &screenshot..."), "actionScreenshot", QKeySequence(tr("Ctrl+Shift+P")));
+  QAction *quit = act(tr("&Quit"), "actionQuit", QKeySequence::Quit);
+  connect(nw, &QAction::triggered, this, [this] { NewDrive(); });
+  connect(open, &QAction::triggered, this, [this] {
+    const QString p = QFileDialog::getOpenFileName(this, tr("Open scene"), ScenesDir(), tr("Scenes (*.yaml *.yml)"));
+    if (!p.isEmpty()) OpenFile(p);
+  });
+  connect(save, &QAction::triggered, this, [this] { Save(); });
+  connect(saveas, &QAction::triggered, this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene as"), doc_.FilePath(), tr("Scenes (*.yaml)"));
+    if (!p.isEmpty()) SaveAs(p);
+  });
+  connect(shot, &QAction::triggered, this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export screenshot"), "navstudio.png", tr("PNG (*.png)"));
+    if (!p.isEmpty()) grab().save(p);
+  });
+  connect(quit, &QAction::triggered, this, &QWidget::close);
+  file->addActions({nw, open});
+  recent_menu_ = file->addMenu(tr("Open &recent"));
+  file->addActions({save, saveas});
+  file->addSeparator();
+  file->addAction(shot);
+  file->addSeparator();
+  file->addAction(quit);
+  RebuildRecentMenu();
+
+  QAction *undo = doc_.UndoStack()->createUndoAction(this, tr("&Undo"));
+  undo->setObjectName("actionUndo");
+  undo->setShortcut(QKeySequence::Undo);
+  undo->setIconText(tr("Undo")); // the menu says "Undo <edit>", the toolbar stays short
+  QAction *redo = doc_.UndoStack()->createRedoAction(this, tr("&Redo"));
+  redo->setObjectName("actionRedo");
+  redo->setShortcut(QKeySequence::Redo);
+  redo->setIconText(tr("Redo"));
+  QAction *del = act(tr("&Delete waypoint"), "actionDeleteWaypoint", QKeySequence(Qt::CTRL | Qt::Key_Delete));
+  connect(del, &QAction::triggered, this, [this] { DeleteWaypoint(&doc_, map_->SelectedWaypoint()); });
+  edit->addActions({undo, redo, del});
+
+  run_act_ = act(tr("&Run"), "actionRun", QKeySequence(Qt::Key_F5));
+  cancel_act_ = act(tr("&Cancel"), "actionCancel", QKeySequence(Qt::Key_Escape));
+  cancel_act_->setEnabled(false);
+  preview_act_ = act(tr("&Live preview"), "actionLivePreview", QKeySequence(tr("Ctrl+L")));
+  preview_act_->setCheckable(true);
+  preview_act_->setChecked(true);
+  connect(run_act_, &QAction::triggered, this, [this] { Run(); });
+  connect(cancel_act_, &QAction::triggered, this, &MainWindow::Cancel);
+  connect(preview_act_, &QAction::toggled, this, [this](bool on) {
+    if (on) preview_timer_.start();
+  });
+  sim->addActions({run_act_, cancel_act_, preview_act_});
+
+  QAction *reset = act(tr("&Fit views"), "actionFit", QKeySequence(tr("Ctrl+0")));
+  connect(reset, &QAction::triggered, this, [this] {
+    map_->ResetCamera();
+    view3d_->ResetCamera();
+  });
+  view->addAction(reset);
+
+  tb->addActions({nw, open, save});
+  tb->addSeparator();
+  tb->addActions({undo, redo});
+  tb->addSeparator();
+  tb->addActions({run_act_, cancel_act_, preview_act_});
+}
+
+/* ---------------------------------------------------------------- files */
+
+void MainWindow::UpdateTitle() {
+  const QString name = doc_.FilePath().isEmpty() ? tr("untitled") : QFileInfo(doc_.FilePath()).fileName();
+  setWindowTitle(QStringLiteral("%1[*] — navstudio").arg(name));
+  setWindowModified(doc_.IsModified());
+}
+
+bool MainWindow::MaybeSave() {
+  if (!doc_.IsModified()) return true;
+  const auto b = ask_(tr("Unsaved changes"), tr("The scene has unsaved changes. Save them?"),
+                      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+  if (b == QMessageBox::Cancel) return false;
+  if (b == QMessageBox::Save) return Save();
+  RemoveAutosave();
+  return true;
+}
+
+bool MainWindow::OpenFile(const QString &path) {
+  if (!MaybeSave()) return false;
+  QStringList errors;
+  if (!doc_.Load(path, &errors)) {
+    const QString text = errors.isEmpty() ? tr("%1: cannot read the scene").arg(path) : errors.join("\n");
+    status_->setText(tr("Cannot open %1").arg(path));
+    issues_->clear();
+    issues_->addItems(errors);
+    bottom_tabs_->setCurrentWidget(issues_);
+    if (!qEnvironmentVariableIsSet("NAVSTUDIO_NO_DIALOGS"))
+      QMessageBox::warning(this, tr("Cannot open scene"), text);
+    else
+      std::fprintf(stderr, "%s\n", text.toLocal8Bit().constData());
+    return false;
+  }
+  AddRecent(doc_.FilePath());
+  map_->ResetCamera();
+  view3d_->ResetCamera();
+  status_->setText(tr("Opened %1").arg(doc_.FilePath()));
+  CheckRecovery();
+  return true;
+}
+
+bool MainWindow::NewDrive() {
+  if (!MaybeSave()) return false;
+  doc_.Reset(*NewDriveScene());
+  map_->ResetCamera();
+  view3d_->ResetCamera();
+  status_->setText(tr("New drive: click on the map to add waypoints"));
+  return true;
+}
+
+bool MainWindow::Save() {
+  if (doc_.FilePath().isEmpty()) {
+    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Scenes (*.yaml)"));
+    if (p.isEmpty()) return false;
+    return SaveAs(p);
+  }
+  return SaveAs(doc_.FilePath());
+}
+
+bool MainWindow::SaveAs(const QString &path) {
+  const QString old_autosave = AutosavePath();
+  QString err;
+  if (!doc_.Save(path, &err)) {
+    status_->setText(err);
+    if (!qEnvironmentVariableIsSet("NAVSTUDIO_NO_DIALOGS")) QMessageBox::warning(this, tr("Cannot save"), err);
+    return false;
+  }
+  QFile::remove(old_autosave);
+  RemoveAutosave();
+  AddRecent(doc_.FilePath());
+  status_->setText(tr("Saved %1").arg(doc_.FilePath()));
+  return true;
+}
+
+void MainWindow::closeEvent(QCloseEvent *e) {
+  if (MaybeSave()) {
+    worker_.Cancel();
+    preview_.Cancel();
+    e->accept();
+  } else {
+    e->ignore();
+  }
+}
+
+QString MainWindow::AutosavePath() const {
+  const QString key = doc_.FilePath().isEmpty() ? QStringLiteral("untitled") : doc_.FilePath();
+  const QByteArray h = QCryptographicHash::hash(key.toUtf8(), QCryptographicHash::Sha1).toHex().left(16);
+  return AutosaveDir() + "/autosave-" + QString::fromLatin1(h) + ".yaml";
+}
+
+void MainWindow::Autosave() {
+  if (!doc_.IsModified() || doc_.UndoStack()->index() == autosaved_index_) return;
+  QDir().mkpath(AutosaveDir());
+  QString err;
+  if (doc_.WriteCopy(AutosavePath(), &err)) {
+    autosaved_index_ = doc_.UndoStack()->index();
+    status_->setText(tr("Autosaved"));
+  }
+}
+
+void MainWindow::RemoveAutosave() {
+  QFile::remove(AutosavePath());
+  autosaved_index_ = -1;
+}
+
+bool MainWindow::CheckRecovery() {
+  const QString p = AutosavePath();
+  QFile f(p);
+  if (!f.exists() || !f.open(QIODevice::ReadOnly)) return false;
+  const QByteArray text = f.readAll();
+  f.close();
+  const auto b = ask_(tr("Recover autosave"),
+                      tr("navstudio found an autosaved version of this scene that was not saved (the program "
+                         "ended without saving). Recover it?"),
+                      QMessageBox::Yes | QMessageBox::No);
+  if (b != QMessageBox::Yes) {
+    QFile::remove(p);
+    return false;
+  }
+  QStringList errors;
+  if (!doc_.LoadText(text, p, doc_.FilePath(), &errors)) {
+    status_->setText(tr("The autosave cannot be read: %1").arg(errors.join("; ")));
+    return false;
+  }
+  map_->ResetCamera();
+  view3d_->ResetCamera();
+  status_->setText(tr("Recovered the autosave"));
+  return true;
+}
+
+QStringList MainWindow::RecentFiles() const { return QSettings().value("recentFiles").toStringList(); }
+
+void MainWindow::AddRecent(const QString &path) {
+  QStringList l = RecentFiles();
+  l.removeAll(path);
+  l.prepend(path);
+  while (l.size() > 10) l.removeLast();
+  QSettings().setValue("recentFiles", l);
+  RebuildRecentMenu();
+}
+
+void MainWindow::RebuildRecentMenu() {
+  recent_menu_->clear();
+  const QStringList l = RecentFiles();
+  for (int i = 0; i < l.size(); ++i) {
+    QAction *a = recent_menu_->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(l[i]));
+    const QString p = l[i];
+    connect(a, &QAction::triggered, this, [this, p] { OpenFile(p); });
+  }
+  recent_menu_->setEnabled(!l.isEmpty());
+}
+
+/* ---------------------------------------------------------------- simulation */
+
+void MainWindow::ShowIssues() {
+  const QVector<Issue> issues = Validate(doc_.Scene());
+  issues_->clear();
+  for (const Issue &i : issues) issues_->addItem(i.Text());
+  bottom_tabs_->setTabText(bottom_tabs_->indexOf(issues_),
+                           issues.isEmpty() ? tr("Issues") : tr("Issues (%1)").arg(issues.size()));
+}
+
+void MainWindow::OnSceneChanged() {
+  setWindowModified(doc_.IsModified());
+  ShowIssues();
+}
+
+bool MainWindow::SceneSmallForPreview() const {
+  const nav_scene &s = doc_.Scene();
+  return s.trajectory.duration_s <= 600.0 + 1e-9 && s.imu.rate_hz <= 100.0 + 1e-9;
+}
+
+void MainWindow::SetLivePreview(bool on) { preview_act_->setChecked(on); }
+
+void MainWindow::StartPreview() {
+  if (!preview_act_->isChecked() || worker_.IsBusy()) return;
+  if (!SceneSmallForPreview()) {
+    latency_label_->setText(tr("preview off: scene longer than 10 min at 100 Hz"));
+    return;
+  }
+  if (!Validate(doc_.Scene()).isEmpty()) return;
+  preview_started_ns_ = SceneDocument::NowNs();
+  preview_.Start(doc_.Scene(), 1, true, doc_.LastChangeNs(), false);
+}
+
+void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
+  if (r->status != NAV_OK) return; // cancelled by a newer edit, or failed (the issues list says why)
+  const qint64 arrived_ns = SceneDocument::NowNs();
+  last_preview_ = r;
+  map_->SetEstimate(r->nav_ned, true);
+  view3d_->SetEstimate(r->nav_ned, true);
+  if (r->scene_change_ns == doc_.LastChangeNs()) {
+    // The picture now shows the current scene: edit-to-picture latency.
+    const double ms = (SceneDocument::NowNs() - r->scene_change_ns) * 1e-6;
+    latencies_ms_.push_back(ms);
+    latency_label_->setText(tr("preview %1 ms (final error %2 m)").arg(ms, 0, 'f', 0).arg(Fmt(r->summary.final.pos_err_h_m)));
+    std::fprintf(stderr,
+                 "navstudio: preview latency %.1f ms (edit to picture: %.1f ms to the start of the preview, simulation "
+                 "%.1f ms for %lld samples, %.1f ms to draw)\n",
+                 ms, (preview_started_ns_ - r->scene_change_ns) * 1e-6, r->wall_s * 1e3,
+                 static_cast<long long>(r->summary.imu_samples), (SceneDocument::NowNs() - arrived_ns) * 1e-6);
+  }
+  emit ResultShown(true);
+}
+
+bool MainWindow::Run() {
+  const QVector<Issue> issues = Validate(doc_.Scene());
+  if (!issues.isEmpty()) {
+    ShowIssues();
+    bottom_tabs_->setCurrentWidget(issues_);
+    status_->setText(tr("Cannot run: %1").arg(issues.front().Text()));
+    return false;
+  }
+  if (worker_.IsBusy()) return false;
+  preview_.Cancel();
+  const long runs = doc_.Scene().simulation.runs;
+  worker_.Start(doc_.Scene(), runs, false, doc_.LastChangeNs(), false);
+  run_act_->setEnabled(false);
+  cancel_act_->setEnabled(true);
+  progress_->setValue(0);
+  status_->setText(tr("Running %1 Monte Carlo runs...").arg(runs));
+  return true;
+}
+
+void MainWindow::Cancel() {
+  if (!worker_.IsBusy()) return;
+  worker_.Cancel();
+  status_->setText(tr("Cancelling..."));
+}
+
+QString MainWindow::ResultsText() const { return results_->toPlainText(); }
+
+void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
+  run_act_->setEnabled(true);
+  cancel_act_->setEnabled(false);
+  if (preview_act_->isChecked() && (!last_preview_ || last_preview_->scene_change_ns != doc_.LastChangeNs()))
+    preview_timer_.start(); // edits made during the run
+  if (r->status != NAV_OK) {
+    progress_->setValue(0);
+    const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1) : r->message;
+    status_->setText(what);
+    results_->setHtml(QStringLiteral("<p><b>%1</b></p>").arg(what.toHtmlEscaped()));
+    emit ResultShown(false);
+    return;
+  }
+  last_result_ = r;
+  progress_->setValue(1000);
+  const nav_sim_summary &s = r->summary;
+  QString h;
+  h += tr("<h3>%1 — %2 Monte Carlo runs in %3 s</h3>")
+           .arg(QString::fromUtf8(doc_.Scene().name).toHtmlEscaped())
+           .arg(s.runs)
+           .arg(r->wall_s, 0, 'f', 1);
+  {
+    const nav_scene &sc = doc_.Scene();
+    h += tr("<p>%1 · IMU %2 · GNSS %3 · %4 GNSS outage(s) · %5 s at %6 Hz</p>")
+             .arg(QString::fromUtf8(nav_nav_scheme_name(sc.navigation.scheme)),
+                  sc.imu.catalog[0] ? QString::fromUtf8(sc.imu.catalog).toHtmlEscaped() : tr("(scene terms)"),
+                  !sc.gnss.enabled ? tr("off") : sc.gnss.catalog[0] ? QString::fromUtf8(sc.gnss.catalog).toHtmlEscaped() : tr("(scene values)"))
+             .arg(r->outages.size())
+             .arg(s.duration_s, 0, 'f', 0)
+             .arg(sc.imu.rate_hz);
+  }
+  if (!r->verdicts.empty()) {
+    int pass = 0;
+    for (const auto &v : r->verdicts) pass += v.pass ? 1 : 0;
+    const bool all = pass == static_cast<int>(r->verdicts.size());
+    h += QStringLiteral("<p style='font-size:13pt; color:%1'><b>%2</b></p>")
+             .arg(all ? "#148228" : "#c81e1e")
+             .arg(all ? tr("Requirement verdict: PASS (%1 of %1 met)").arg(r->verdicts.size())
+                      : tr("Requirement verdict: FAIL (%1 of %2 met)").arg(pass).arg(r->verdicts.size()));
+    h += "<table border=1 cellspacing=0 cellpadding=3><tr><th>requirement</th><th>metric</th><th>statistic</th>"
+         "<th>value</th><th>limit</th><th>verdict</th></tr>";
+    for (const auto &v : r->verdicts) {
+      const QString unit = QString::fromUtf8(nav_req_unit_name(v.unit));
+      h += QStringLiteral("<tr><td>%1</td><td>%2</td><td>%3</td><td>%4 %5</td><td>%6 %5</td><td style='color:%7'><b>%8</b></td></tr>")
+               .arg(QString::fromUtf8(v.id).toHtmlEscaped(), QString::fromUtf8(nav_req_metric_name(v.metric)),
+                    QString::fromUtf8(nav_req_statistic_name(v.statistic)), Fmt(v.value, 4), unit, Fmt(v.limit, 4),
+                    v.pass ? "#148228" : "#c81e1e", !v.evaluated ? tr("not evaluated") : v.pass ? tr("PASS") : tr("FAIL"));
+      for (int k = 0; k < v.outage_count && v.statistic == NAV_REQ_OUTAGE_END; ++k)
+        h += QStringLiteral("<tr><td></td><td colspan=2>outage %1–%2 s, end at %3 s</td><td>%4 %5</td><td></td><td></td></tr>")
+                 .arg(v.outage_t0_s[k]).arg(v.outage_t1_s[k]).arg(v.outage_end_t_s[k]).arg(Fmt(v.outage_value[k], 4)).arg(unit);
+    }
+    h += "</table>";
+  } else {
+    h += tr("<p>No requirements in the scene (add them in the Requirements panel).</p>");
+  }
+  const double r2d = 180.0 / M_PI;
+  h += tr("<p>Over all runs and epochs (RMS / 95th percentile / max):</p>");
+  h += "<table border=1 cellspacing=0 cellpadding=3><tr><th></th><th>RMS</th><th>p95</th><th>max</th></tr>";
+  auto row = [&](const QString &name, const nav_stat &st, double k, const QString &unit) {
+    h += QStringLiteral("<tr><td>%1 [%2]</td><td>%3</td><td>%4</td><td>%5</td></tr>")
+             .arg(name, unit, Fmt(st.rms * k), Fmt(st.p95 * k), Fmt(st.max * k));
+  };
+  row(tr("horizontal position"), s.stats.pos_err_h_m, 1.0, "m");
+  row(tr("vertical position"), s.stats.pos_err_v_m, 1.0, "m");
+  row(tr("velocity"), s.stats.vel_err_mps, 1.0, "m/s");
+  row(tr("attitude"), s.stats.att_err_rad, r2d, "deg");
+  row(tr("yaw"), s.stats.yaw_err_rad, r2d, "deg");
+  h += "</table>";
+  h += tr("<p>Final horizontal error: run 0 %1 m, RMS over runs %2 m (duration %3 s, %4 IMU samples per run).</p>")
+           .arg(Fmt(s.final.pos_err_h_m))
+           .arg(Fmt(s.final_rms.pos_err_h_m))
+           .arg(s.duration_s, 0, 'f', 1)
+           .arg(static_cast<long long>(s.imu_samples));
+  results_->setHtml(h);
+  bottom_tabs_->setCurrentWidget(results_);
+  chart_->SetResult(r);
+  panels_->SetVerdicts(r->verdicts);
+  map_->SetEstimate(r->nav_ned, false);
+  view3d_->SetEstimate(r->nav_ned, false);
+  QString verdict;
+  if (!r->verdicts.empty())
+    verdict = nav_req_all_pass(r->verdicts.data(), static_cast<int>(r->verdicts.size())) ? tr(" — verdict PASS")
+                                                                                          : tr(" — verdict FAIL");
+  status_->setText(tr("Done: %1 runs in %2 s%3").arg(s.runs).arg(r->wall_s, 0, 'f', 1).arg(verdict));
+  emit ResultShown(false);
+}
+
+} // namespace studio

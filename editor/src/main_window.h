@@ -1,0 +1,123 @@
+/*
+ * navstudio: the main window. Panels on the left, the map and 3D views on the right, results
+ * (verdicts, statistics, error chart, issues) below, a status bar with progress. Simulations run
+ * on SimWorker threads; the live preview re-simulates one run (debounced) after every edit of a
+ * scene of at most 10 min at 100 Hz and reports the edit-to-picture latency.
+ */
+#ifndef NAVSTUDIO_MAIN_WINDOW_H
+#define NAVSTUDIO_MAIN_WINDOW_H
+
+#include <QMainWindow>
+#include <QMessageBox>
+#include <QTimer>
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "error_chart.h"
+#include "panels.h"
+#include "path_view.h"
+#include "sim_worker.h"
+#include "studio_scene.h"
+
+class QAction;
+class QLabel;
+class QListWidget;
+class QMenu;
+class QProgressBar;
+class QTextBrowser;
+
+namespace studio {
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+public:
+  /** Asks the user a question (replaceable by tests); returns the button chosen. */
+  using AskFn = std::function<QMessageBox::StandardButton(const QString &title, const QString &text,
+                                                          QMessageBox::StandardButtons buttons)>;
+  explicit MainWindow(QWidget *parent = nullptr);
+  ~MainWindow() override;
+
+  /** Open a scene file (asks to save changes first); false with a message box on errors. */
+  bool OpenFile(const QString &path);
+  /** Start a new drive (asks to save changes first). */
+  bool NewDrive();
+  bool Save();
+  bool SaveAs(const QString &path);
+  /** Start the Monte Carlo run of the scene. false when the scene has issues. */
+  bool Run();
+  void Cancel();
+
+  /** Write the autosave copy now (when modified). */
+  void Autosave();
+  /** The autosave file of the current document. */
+  QString AutosavePath() const;
+  /** Offer to recover an autosave of the current document; true when recovered. */
+  bool CheckRecovery();
+
+  void SetAsk(AskFn fn) { ask_ = std::move(fn); }
+  void SetLivePreview(bool on);
+  SceneDocument *Doc() { return &doc_; }
+  PathView *MapView() { return map_; }
+  PathView *View3D() { return view3d_; }
+  ScenePanels *Panels() { return panels_; }
+  SimWorker *Worker() { return &worker_; }
+  SimWorker *PreviewWorker() { return &preview_; }
+  std::shared_ptr<const SimResult> LastResult() const { return last_result_; }
+  std::shared_ptr<const SimResult> LastPreview() const { return last_preview_; }
+  /** Edit-to-picture latencies of the live previews so far [ms]. */
+  const std::vector<double> &PreviewLatenciesMs() const { return latencies_ms_; }
+  QString ResultsText() const;
+  QStringList RecentFiles() const;
+
+signals:
+  /** A Monte Carlo result or a preview has been drawn. */
+  void ResultShown(bool preview);
+
+protected:
+  void closeEvent(QCloseEvent *e) override;
+
+private:
+  void BuildUi();
+  void BuildActions();
+  bool MaybeSave();
+  void UpdateTitle();
+  void OnSceneChanged();
+  void StartPreview();
+  void OnFinished(std::shared_ptr<const SimResult> r);
+  void OnPreviewFinished(std::shared_ptr<const SimResult> r);
+  void ShowIssues();
+  void AddRecent(const QString &path);
+  void RebuildRecentMenu();
+  void RemoveAutosave();
+  bool SceneSmallForPreview() const;
+
+  SceneDocument doc_;
+  Catalogs catalogs_;
+  SimWorker worker_;
+  SimWorker preview_;
+  ScenePanels *panels_ = nullptr;
+  PathView *map_ = nullptr;
+  PathView *view3d_ = nullptr;
+  ErrorChart *chart_ = nullptr;
+  QTextBrowser *results_ = nullptr;
+  QListWidget *issues_ = nullptr;
+  QTabWidget *bottom_tabs_ = nullptr;
+  QProgressBar *progress_ = nullptr;
+  QLabel *status_ = nullptr;
+  QLabel *latency_label_ = nullptr;
+  QAction *run_act_ = nullptr, *cancel_act_ = nullptr, *preview_act_ = nullptr;
+  QMenu *recent_menu_ = nullptr;
+  QTimer preview_timer_;
+  QTimer autosave_timer_;
+  int autosaved_index_ = -1;
+  qint64 preview_started_ns_ = 0;
+  AskFn ask_;
+  std::shared_ptr<const SimResult> last_result_, last_preview_;
+  std::vector<double> latencies_ms_;
+};
+
+} // namespace studio
+
+#endif

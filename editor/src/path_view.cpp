@@ -1,0 +1,678 @@
+#include "path_view.h"
+
+#include <QVBoxLayout>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <vtkActor.h>
+#include <vtkBillboardTextActor3D.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkGlyph3D.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkObjectFactory.h>
+#include <vtkPlaneSource.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+namespace studio {
+
+/* ---------------------------------------------------------------- waypoint edits */
+
+void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at) {
+  const nav_scene &cur = doc->Scene();
+  if (cur.trajectory.type == NAV_TRAJ_WAYPOINTS && cur.trajectory.waypoints.count >= NAV_MAX_WAYPOINTS) return;
+  doc->Edit(QObject::tr("Add waypoint"), [&](nav_scene &s) {
+    nav_traj_waypoints &w = s.trajectory.waypoints;
+    if (s.trajectory.type != NAV_TRAJ_WAYPOINTS) {
+      s.trajectory.type = NAV_TRAJ_WAYPOINTS;
+      w.count = 0;
+      w.timing = NAV_WP_TIMING_SPEED;
+      if (w.hold_start_s <= 0.0) w.hold_start_s = 30.0;
+    }
+    const double cruise = 10.0;
+    nav_waypoint p;
+    std::memset(&p, 0, sizeof p);
+    p.r_ned_m = nav_vec3{n, e, d};
+    int at = insert_at < 0 || insert_at > w.count ? w.count : insert_at;
+    if (at == w.count) {
+      // A new end point: the drive stops there; the former end point becomes a cruise point.
+      p.speed_mps = 0.0;
+      if (w.count >= 2 && w.points[w.count - 1].speed_mps == 0.0) w.points[w.count - 1].speed_mps = cruise;
+      if (w.count == 1) p.speed_mps = 0.0;
+    } else {
+      p.speed_mps = at == 0 ? 0.0 : cruise;
+      if (at == 0 && w.count > 0 && w.points[0].speed_mps == 0.0) w.points[0].speed_mps = cruise;
+    }
+    for (int i = w.count; i > at; --i) w.points[i] = w.points[i - 1];
+    w.points[at] = p;
+    w.count += 1;
+    if (w.timing == NAV_WP_TIMING_TIME) {
+      // Timing by time: keep the list increasing (new point 30 s after its predecessor).
+      for (int i = 1; i < w.count; ++i)
+        if (w.points[i].time_s <= w.points[i - 1].time_s) w.points[i].time_s = w.points[i - 1].time_s + 30.0;
+    }
+  });
+}
+
+void DeleteWaypoint(SceneDocument *doc, int index) {
+  const nav_scene &cur = doc->Scene();
+  if (cur.trajectory.type != NAV_TRAJ_WAYPOINTS || index < 0 || index >= cur.trajectory.waypoints.count) return;
+  doc->Edit(QObject::tr("Delete waypoint %1").arg(index), [&](nav_scene &s) {
+    nav_traj_waypoints &w = s.trajectory.waypoints;
+    for (int i = index; i + 1 < w.count; ++i) w.points[i] = w.points[i + 1];
+    w.count -= 1;
+    if (w.count >= 1) {
+      w.points[0].speed_mps = 0.0;
+      w.points[w.count - 1].speed_mps = 0.0;
+      w.points[0].time_s = 0.0;
+    }
+  });
+}
+
+/* ---------------------------------------------------------------- interactor style */
+
+class PathViewStyle : public vtkInteractorStyleTrackballCamera {
+public:
+  static PathViewStyle *New();
+  vtkTypeMacro(PathViewStyle, vtkInteractorStyleTrackballCamera)
+  PathView *view = nullptr;
+  bool map = false;
+
+  void OnLeftButtonDown() override {
+    vtkRenderWindowInteractor *i = GetInteractor();
+    const int *p = i->GetEventPosition();
+    px_ = p[0];
+    py_ = p[1];
+    down_ = true;
+    moved_ = false;
+    ctrl_ = i->GetControlKey() != 0;
+    if (view->OnPress(p[0], p[1], ctrl_, i->GetShiftKey() != 0)) {
+      consumed_ = true;
+      return;
+    }
+    consumed_ = false;
+    FindPokedRenderer(p[0], p[1]);
+    if (map)
+      StartPan();
+    else
+      vtkInteractorStyleTrackballCamera::OnLeftButtonDown();
+  }
+  void OnMouseMove() override {
+    vtkRenderWindowInteractor *i = GetInteractor();
+    const int *p = i->GetEventPosition();
+    if (consumed_) {
+      view->OnDrag(p[0], p[1], i->GetShiftKey() != 0);
+      return;
+    }
+    if (down_ && std::abs(p[0] - px_) + std::abs(p[1] - py_) > 3) moved_ = true;
+    view->OnHover(p[0], p[1]);
+    vtkInteractorStyleTrackballCamera::OnMouseMove();
+  }
+  void OnLeftButtonUp() override {
+    const bool was_down = down_;
+    down_ = false;
+    if (consumed_) {
+      consumed_ = false;
+      view->OnRelease();
+      return;
+    }
+    if (map)
+      EndPan();
+    else
+      vtkInteractorStyleTrackballCamera::OnLeftButtonUp();
+    if (was_down && !moved_) view->OnClick(px_, py_, ctrl_);
+  }
+  void OnKeyPress() override {
+    const char *sym = GetInteractor()->GetKeySym();
+    if (sym && (std::strcmp(sym, "Delete") == 0 || std::strcmp(sym, "BackSpace") == 0)) view->OnDeleteKey();
+  }
+  void OnChar() override {
+    // No VTK default keys ('q'/'e' would end the program, 'w'/'s' switch representations).
+    const char c = GetInteractor()->GetKeyCode();
+    if (c == 'r') view->ResetCamera();
+  }
+
+private:
+  bool consumed_ = false, down_ = false, moved_ = false, ctrl_ = false;
+  int px_ = 0, py_ = 0;
+};
+vtkStandardNewMacro(PathViewStyle)
+
+/* ---------------------------------------------------------------- helpers */
+
+namespace {
+vtkSmartPointer<vtkActor> MakeActor(vtkPolyData *pd, double r, double g, double b, double width) {
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(pd);
+  mapper->ScalarVisibilityOff();
+  auto a = vtkSmartPointer<vtkActor>::New();
+  a->SetMapper(mapper);
+  a->GetProperty()->SetColor(r, g, b);
+  a->GetProperty()->SetLineWidth(static_cast<float>(width));
+  a->GetProperty()->SetPointSize(static_cast<float>(width));
+  a->GetProperty()->LightingOff();
+  return a;
+}
+
+vtkPolyData *InputOf(vtkActor *a) {
+  return vtkPolyData::SafeDownCast(vtkPolyDataMapper::SafeDownCast(a->GetMapper())->GetInput());
+}
+
+void SetPolyline(vtkPolyData *pd, const std::vector<double> &ned, double lift) {
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  auto lines = vtkSmartPointer<vtkCellArray>::New();
+  const vtkIdType n = static_cast<vtkIdType>(ned.size() / 3);
+  pts->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i)
+    pts->SetPoint(i, ned[3 * i + 1], ned[3 * i], -ned[3 * i + 2] + lift);
+  if (n >= 2) {
+    lines->InsertNextCell(n);
+    for (vtkIdType i = 0; i < n; ++i) lines->InsertCellPoint(i);
+  }
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  pd->Modified();
+}
+
+double NiceStep(double x) {
+  const double p = std::pow(10.0, std::floor(std::log10(std::max(x, 1e-6))));
+  const double m = x / p;
+  return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
+}
+
+QString FormatLatLon(double lat, double lon) {
+  return QStringLiteral("%1°%2 %3°%4")
+      .arg(std::fabs(lat), 0, 'f', 5)
+      .arg(lat >= 0 ? "N" : "S")
+      .arg(std::fabs(lon), 0, 'f', 5)
+      .arg(lon >= 0 ? "E" : "W");
+}
+} // namespace
+
+/* ---------------------------------------------------------------- PathView */
+
+PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(parent), doc_(doc), mode_(mode) {
+  setObjectName(mode == Mode::Map ? "mapView" : "view3d");
+  auto *lay = new QVBoxLayout(this);
+  lay->setContentsMargins(0, 0, 0, 0);
+  widget_ = new QVTKOpenGLNativeWidget(this);
+  lay->addWidget(widget_);
+  window_ = vtkSmartPointer<vtkGenericOpenGLRenderWindow>::New();
+  widget_->setRenderWindow(window_);
+  renderer_ = vtkSmartPointer<vtkRenderer>::New();
+  window_->AddRenderer(renderer_);
+  if (mode == Mode::Map) {
+    renderer_->SetBackground(0.93, 0.95, 0.92);
+  } else {
+    renderer_->SetBackground(0.20, 0.22, 0.26);
+    renderer_->SetBackground2(0.55, 0.62, 0.72);
+    renderer_->GradientBackgroundOn();
+  }
+
+  grid_ = MakeActor(vtkNew<vtkPolyData>(), 0.70, 0.74, 0.70, 1.0);
+  if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.45, 0.50, 0.45);
+  renderer_->AddActor(grid_);
+  if (mode == Mode::ThreeD) {
+    vtkNew<vtkPlaneSource> plane;
+    plane->SetOrigin(-1, -1, -0.05);
+    plane->SetPoint1(1, -1, -0.05);
+    plane->SetPoint2(-1, 1, -0.05);
+    plane->Update();
+    auto pd = vtkSmartPointer<vtkPolyData>::New();
+    pd->DeepCopy(plane->GetOutput());
+    ground_ = MakeActor(pd, 0.36, 0.45, 0.33, 1.0);
+    ground_->GetProperty()->SetOpacity(0.55);
+    renderer_->AddActor(ground_);
+  }
+  path_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.10, 0.35, 0.85, 3.0);
+  estimate_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 2.0);
+  result_ = MakeActor(vtkNew<vtkPolyData>(), 0.85, 0.10, 0.45, 2.0);
+  previous_ = MakeActor(vtkNew<vtkPolyData>(), 0.45, 0.45, 0.45, 1.5); // the result before (A/B)
+  handles_ = MakeActor(vtkNew<vtkPolyData>(), 0.98, 0.98, 0.98, 1.0);
+  handles_->GetProperty()->LightingOn();
+  handles_->GetProperty()->SetColor(0.15, 0.15, 0.15);
+  selected_actor_ = MakeActor(vtkNew<vtkPolyData>(), 1.0, 0.80, 0.0, 1.0);
+  selected_actor_->GetProperty()->LightingOn();
+  bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
+  bad_actor_->GetProperty()->LightingOn();
+  for (auto &a : {previous_, path_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
+    renderer_->AddActor(a);
+
+  caption_ = vtkSmartPointer<vtkTextActor>::New();
+  caption_->GetTextProperty()->SetFontSize(14);
+  caption_->GetTextProperty()->SetColor(mode == Mode::Map ? 0.1 : 0.95, mode == Mode::Map ? 0.1 : 0.95,
+                                        mode == Mode::Map ? 0.1 : 0.95);
+  caption_->SetPosition(8, 8);
+  renderer_->AddViewProp(caption_);
+  problem_ = vtkSmartPointer<vtkTextActor>::New();
+  problem_->GetTextProperty()->SetFontSize(14);
+  problem_->GetTextProperty()->SetColor(0.85, 0.05, 0.05);
+  problem_->GetTextProperty()->SetBackgroundColor(1.0, 1.0, 1.0);
+  problem_->GetTextProperty()->SetBackgroundOpacity(0.8);
+  problem_->GetTextProperty()->SetVerticalJustificationToTop();
+  problem_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  problem_->SetPosition(0.01, 0.98);
+  renderer_->AddViewProp(problem_);
+
+  style_ = vtkSmartPointer<PathViewStyle>::New();
+  style_->view = this;
+  style_->map = mode == Mode::Map;
+  widget_->interactor()->SetInteractorStyle(style_);
+
+  if (mode == Mode::Map) renderer_->GetActiveCamera()->ParallelProjectionOn();
+  // Redraws are coalesced: a burst of changes (a drag, undo of several steps) draws once.
+  rebuild_timer_.setSingleShot(true);
+  rebuild_timer_.setInterval(0);
+  connect(&rebuild_timer_, &QTimer::timeout, this, &PathView::Rebuild);
+  connect(doc_, &SceneDocument::Changed, &rebuild_timer_, QOverload<>::of(&QTimer::start));
+  Rebuild();
+  ResetCamera();
+}
+
+PathView::~PathView() = default;
+
+vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor(); }
+
+void PathView::Render() {
+  if (window_) window_->Render();
+  widget_->update();
+}
+
+void PathView::UpdateGrid(double cx, double cy, double extent) {
+  const double step = NiceStep(extent / 12.0);
+  const double half = std::ceil(extent / step) * step;
+  const double x0 = std::floor((cx - half) / step) * step, x1 = std::ceil((cx + half) / step) * step;
+  const double y0 = std::floor((cy - half) / step) * step, y1 = std::ceil((cy + half) / step) * step;
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  auto lines = vtkSmartPointer<vtkCellArray>::New();
+  const double z = -0.02;
+  for (double x = x0; x <= x1 + 0.5 * step; x += step) {
+    const vtkIdType a = pts->InsertNextPoint(x, y0, z), b = pts->InsertNextPoint(x, y1, z);
+    lines->InsertNextCell(2);
+    lines->InsertCellPoint(a);
+    lines->InsertCellPoint(b);
+  }
+  for (double y = y0; y <= y1 + 0.5 * step; y += step) {
+    const vtkIdType a = pts->InsertNextPoint(x0, y, z), b = pts->InsertNextPoint(x1, y, z);
+    lines->InsertNextCell(2);
+    lines->InsertCellPoint(a);
+    lines->InsertCellPoint(b);
+  }
+  vtkPolyData *pd = InputOf(grid_);
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  pd->Modified();
+  if (ground_) {
+    vtkPolyData *g = InputOf(ground_);
+    vtkPoints *gp = g->GetPoints();
+    const double zz = -0.1;
+    gp->SetPoint(0, x0, y0, zz);
+    gp->SetPoint(1, x1, y0, zz);
+    gp->SetPoint(2, x0, y1, zz);
+    gp->SetPoint(3, x1, y1, zz);
+    gp->Modified();
+    g->Modified();
+  }
+  grid_cx_ = cx;
+  grid_cy_ = cy;
+  grid_extent_ = extent;
+  grid_step_ = step;
+}
+
+void PathView::ResetCamera() {
+  Path(); // a pending redraw first: the camera fits the current path
+  const nav_scene &s = doc_->Scene();
+  double xmin = -100, xmax = 100, ymin = -100, ymax = 100, zmax = 0;
+  auto grow = [&](double x, double y, double z) {
+    xmin = std::min(xmin, x);
+    xmax = std::max(xmax, x);
+    ymin = std::min(ymin, y);
+    ymax = std::max(ymax, y);
+    zmax = std::max(zmax, std::fabs(z));
+  };
+  for (size_t i = 0; i < path_.Size(); ++i) grow(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], path_.ned_m[3 * i + 2]);
+  if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
+    for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
+      const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+      grow(r.y, r.x, r.z);
+    }
+  const double cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
+  // An empty drive shows about a kilometre, a drawn one its extent.
+  const bool empty = s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2;
+  const double extent = std::max({xmax - xmin, ymax - ymin, empty ? 1000.0 : 200.0}) * 0.5 * 1.25;
+  UpdateGrid(cx, cy, extent * 2.0);
+  vtkCamera *cam = renderer_->GetActiveCamera();
+  if (mode_ == Mode::Map) {
+    cam->SetFocalPoint(cx, cy, 0.0);
+    cam->SetPosition(cx, cy, 10.0 * extent + 1000.0);
+    cam->SetViewUp(0, 1, 0);
+    cam->SetParallelScale(extent);
+    renderer_->ResetCameraClippingRange();
+  } else {
+    cam->SetFocalPoint(cx, cy, 0.0);
+    cam->SetPosition(cx - 0.8 * extent, cy - 2.0 * extent, 1.4 * extent + zmax);
+    cam->SetViewUp(0, 0, 1);
+    cam->SetViewAngle(30.0);
+    const double b[6] = {cx - extent, cx + extent, cy - extent, cy + extent, -zmax, zmax};
+    renderer_->ResetCamera(b);
+    cam->Zoom(2.2);
+    renderer_->ResetCameraClippingRange();
+  }
+  Rebuild();
+}
+
+const PathSamples &PathView::Path() {
+  if (rebuild_timer_.isActive()) Rebuild();
+  return path_;
+}
+
+size_t PathView::PathPointCount() { return Path().Size(); }
+
+void PathView::Rebuild() {
+  rebuild_timer_.stop();
+  const nav_scene &s = doc_->Scene();
+  QString msg;
+  if (!SamplePath(s, 1200, &path_, &msg)) path_ = PathSamples();
+  SetPolyline(InputOf(path_actor_), path_.ned_m, 0.3);
+
+  // Handle size: constant on screen in the map, a fraction of the grid in 3D.
+  const double radius = mode_ == Mode::Map ? renderer_->GetActiveCamera()->GetParallelScale() * 0.022
+                                           : std::max(grid_extent_, 100.0) * 0.010;
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetRadius(radius);
+  sphere->SetThetaResolution(16);
+  sphere->SetPhiResolution(12);
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  const bool wp = s.trajectory.type == NAV_TRAJ_WAYPOINTS;
+  const int count = wp ? s.trajectory.waypoints.count : 0;
+  for (int i = 0; i < count; ++i) {
+    const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+    pts->InsertNextPoint(r.y, r.x, -r.z + 0.5);
+  }
+  {
+    vtkNew<vtkPolyData> in;
+    in->SetPoints(pts);
+    vtkNew<vtkGlyph3D> g;
+    g->SetInputData(in);
+    g->SetSourceConnection(sphere->GetOutputPort());
+    g->ScalingOff();
+    g->Update();
+    InputOf(handles_)->DeepCopy(g->GetOutput());
+  }
+  {
+    vtkNew<vtkPolyData> in;
+    vtkNew<vtkPoints> sp;
+    if (selected_ >= count) selected_ = -1;
+    if (selected_ >= 0) {
+      double p[3];
+      pts->GetPoint(selected_, p);
+      sp->InsertNextPoint(p[0], p[1], p[2] + 0.1);
+    }
+    in->SetPoints(sp);
+    vtkNew<vtkSphereSource> big;
+    big->SetRadius(radius * 1.35);
+    big->SetThetaResolution(16);
+    big->SetPhiResolution(12);
+    vtkNew<vtkGlyph3D> g;
+    g->SetInputData(in);
+    g->SetSourceConnection(big->GetOutputPort());
+    g->ScalingOff();
+    g->Update();
+    InputOf(selected_actor_)->DeepCopy(g->GetOutput());
+  }
+  // Waypoints the planner rejects (infeasible turns, legs too short): red, with the message.
+  {
+    vtkNew<vtkPolyData> in;
+    vtkNew<vtkPoints> bp;
+    QString problem;
+    for (const Issue &is : Validate(s)) {
+      const QString pre = QStringLiteral("trajectory.waypoints.points[");
+      if (!is.path.startsWith(pre)) continue;
+      const int k = is.path.mid(pre.size()).section(']', 0, 0).toInt();
+      if (k >= 0 && k < count) {
+        double p[3];
+        pts->GetPoint(k, p);
+        bp->InsertNextPoint(p[0], p[1], p[2] + 0.2);
+      }
+      if (problem.isEmpty()) problem = is.message;
+    }
+    in->SetPoints(bp);
+    vtkNew<vtkSphereSource> bs;
+    bs->SetRadius(radius * 1.2);
+    vtkNew<vtkGlyph3D> g;
+    g->SetInputData(in);
+    g->SetSourceConnection(bs->GetOutputPort());
+    g->ScalingOff();
+    g->Update();
+    InputOf(bad_actor_)->DeepCopy(g->GetOutput());
+    // Wrapped to the view's width (about 8 px per character).
+    QString wrapped;
+    const int per_line = std::max(30, window_->GetSize()[0] / 9);
+    for (const QString &word : problem.split(' ')) {
+      const int line_len = static_cast<int>(wrapped.size() - wrapped.lastIndexOf('\n') - 1);
+      if (!wrapped.isEmpty()) wrapped += line_len + word.size() + 1 > per_line ? "\n" : " ";
+      wrapped += word;
+    }
+    problem_->SetInput(wrapped.isEmpty() ? "" : (tr("Not feasible: ") + wrapped).toUtf8().constData());
+    problem_->SetVisibility(!wrapped.isEmpty());
+  }
+  // Waypoint numbers.
+  while (static_cast<int>(labels_.size()) > count) {
+    renderer_->RemoveActor(labels_.back());
+    labels_.pop_back();
+  }
+  while (static_cast<int>(labels_.size()) < count && labels_.size() < 200) {
+    auto t = vtkSmartPointer<vtkBillboardTextActor3D>::New();
+    t->GetTextProperty()->SetFontSize(15);
+    t->GetTextProperty()->BoldOn();
+    t->GetTextProperty()->SetColor(0.05, 0.05, 0.05);
+    t->GetTextProperty()->SetBackgroundColor(1.0, 1.0, 0.85);
+    t->GetTextProperty()->SetBackgroundOpacity(0.85);
+    t->SetDisplayOffset(10, 8);
+    renderer_->AddActor(t);
+    labels_.push_back(t);
+  }
+  for (size_t i = 0; i < labels_.size(); ++i) {
+    double p[3];
+    pts->GetPoint(static_cast<vtkIdType>(i), p);
+    labels_[i]->SetPosition(p[0], p[1], p[2]);
+    labels_[i]->SetInput(std::to_string(i).c_str()); // 0-based, as navcore's messages count them
+  }
+
+  // Grows the grid when the path leaves it.
+  if (grid_extent_ > 0.0) {
+    double need = 0.0;
+    for (size_t i = 0; i < path_.Size(); ++i)
+      need = std::max({need, std::fabs(path_.ned_m[3 * i + 1] - grid_cx_), std::fabs(path_.ned_m[3 * i] - grid_cy_)});
+    if (need > 0.9 * grid_extent_) UpdateGrid(grid_cx_, grid_cy_, 2.0 * need);
+  }
+
+  double lat = 0, lon = 0, h = 0;
+  const double zero[3] = {0, 0, 0};
+  LocalToGeodetic(s, zero, &lat, &lon, &h);
+  QString cap = mode_ == Mode::Map ? tr("Map") : tr("3D");
+  cap += tr("  ·  origin %1  ·  grid %2 m").arg(FormatLatLon(lat, lon)).arg(grid_step_, 0, 'g', 6);
+  if (wp) cap += tr("  ·  %1 waypoints").arg(count);
+  if (path_.Size() > 0) cap += tr("  ·  %1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
+  if (mode_ == Mode::Map && (!wp || count < 4))
+    cap = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)") + "\n" + cap;
+  caption_->SetInput(cap.toUtf8().constData());
+  renderer_->ResetCameraClippingRange();
+  Render();
+}
+
+void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
+  if (!preview && InputOf(result_)->GetNumberOfPoints() > 1) {
+    // The Monte Carlo result being replaced stays as a grey overlay for comparison.
+    InputOf(previous_)->DeepCopy(InputOf(result_));
+  }
+  // Drawn above the reference (in the top-down map the lift is invisible; in 3D it is small).
+  SetPolyline(InputOf(preview ? estimate_ : result_), ned, mode_ == Mode::Map ? 5.0 : 0.004 * std::max(grid_extent_, 100.0));
+  if (preview) {
+    // A new preview supersedes the drawn Monte Carlo estimate of an older scene.
+    SetPolyline(InputOf(result_), std::vector<double>(), 0.0);
+  }
+  Render();
+}
+
+bool PathView::DisplayOf(double n, double e, double d, int *x, int *y) {
+  renderer_->SetWorldPoint(e, n, -d, 1.0);
+  renderer_->WorldToDisplay();
+  const double *p = renderer_->GetDisplayPoint();
+  *x = static_cast<int>(std::lround(p[0]));
+  *y = static_cast<int>(std::lround(p[1]));
+  const int *sz = window_->GetSize();
+  return p[2] >= 0.0 && p[2] <= 1.0 && *x >= 0 && *y >= 0 && *x < sz[0] && *y < sz[1];
+}
+
+bool PathView::GroundAt(int x, int y, double d_plane, double *n, double *e) {
+  double a[4], b[4];
+  renderer_->SetDisplayPoint(x, y, 0.0);
+  renderer_->DisplayToWorld();
+  renderer_->GetWorldPoint(a);
+  renderer_->SetDisplayPoint(x, y, 1.0);
+  renderer_->DisplayToWorld();
+  renderer_->GetWorldPoint(b);
+  if (a[3] == 0.0 || b[3] == 0.0) return false;
+  for (int k = 0; k < 3; ++k) {
+    a[k] /= a[3];
+    b[k] /= b[3];
+  }
+  const double z = -d_plane;
+  const double dz = b[2] - a[2];
+  if (std::fabs(dz) < 1e-12) return false;
+  const double t = (z - a[2]) / dz;
+  if (t < 0.0 || t > 1.0) return false;
+  *e = a[0] + t * (b[0] - a[0]);
+  *n = a[1] + t * (b[1] - a[1]);
+  return std::isfinite(*n) && std::isfinite(*e);
+}
+
+int PathView::PickWaypoint(int x, int y) {
+  const nav_scene &s = doc_->Scene();
+  if (s.trajectory.type != NAV_TRAJ_WAYPOINTS) return -1;
+  int best = -1;
+  double best_d2 = 12.0 * 12.0;
+  for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
+    const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+    int px = 0, py = 0;
+    if (!DisplayOf(r.x, r.y, r.z, &px, &py)) continue;
+    const double d2 = double(px - x) * (px - x) + double(py - y) * (py - y);
+    if (d2 <= best_d2) {
+      best_d2 = d2;
+      best = i;
+    }
+  }
+  return best;
+}
+
+void PathView::SetSelectedWaypoint(int i) {
+  if (i == selected_) return;
+  selected_ = i;
+  Rebuild();
+  emit SelectionChanged(i);
+}
+
+bool PathView::OnPress(int x, int y, bool ctrl, bool shift) {
+  (void)ctrl;
+  (void)shift;
+  const int i = PickWaypoint(x, y);
+  if (i < 0) return false;
+  SetSelectedWaypoint(i);
+  drag_index_ = i;
+  dragging_ = false;
+  press_x_ = x;
+  press_y_ = y;
+  drag_before_ = std::make_unique<nav_scene>(doc_->Scene());
+  drag_d_ = doc_->Scene().trajectory.waypoints.points[i].r_ned_m.z;
+  return true;
+}
+
+void PathView::OnDrag(int x, int y, bool shift) {
+  if (drag_index_ < 0 || !drag_before_) return;
+  if (!dragging_ && std::abs(x - press_x_) + std::abs(y - press_y_) < 2) return;
+  dragging_ = true;
+  nav_scene s = doc_->Scene();
+  nav_waypoint &p = s.trajectory.waypoints.points[drag_index_];
+  if (shift && mode_ == Mode::ThreeD) {
+    // Height: vertical mouse motion, scaled by the distance to the point.
+    vtkCamera *cam = renderer_->GetActiveCamera();
+    const double *cp = cam->GetPosition();
+    const nav_vec3 r = drag_before_->trajectory.waypoints.points[drag_index_].r_ned_m;
+    const double dist = std::sqrt((cp[0] - r.y) * (cp[0] - r.y) + (cp[1] - r.x) * (cp[1] - r.x) +
+                                  (cp[2] + r.z) * (cp[2] + r.z));
+    const int h = window_->GetSize()[1] > 0 ? window_->GetSize()[1] : 1;
+    const double m_per_px = 2.0 * dist * std::tan(cam->GetViewAngle() * M_PI / 360.0) / h;
+    p.r_ned_m.z = drag_d_ - (y - press_y_) * m_per_px;
+  } else {
+    double n = 0, e = 0;
+    if (!GroundAt(x, y, drag_d_, &n, &e)) return;
+    p.r_ned_m.x = n;
+    p.r_ned_m.y = e;
+  }
+  doc_->Preview(s);
+}
+
+void PathView::OnRelease() {
+  if (drag_before_ && dragging_) doc_->Commit(*drag_before_, tr("Move waypoint %1").arg(drag_index_));
+  drag_before_.reset();
+  drag_index_ = -1;
+  dragging_ = false;
+}
+
+void PathView::OnClick(int x, int y, bool ctrl) {
+  double n = 0, e = 0;
+  if (!GroundAt(x, y, 0.0, &n, &e)) return;
+  const nav_scene &s = doc_->Scene();
+  int insert_at = -1;
+  if (ctrl && s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count >= 2) {
+    // Insert into the nearest leg (distance to the straight segment between waypoints).
+    double best = 1e300;
+    for (int i = 0; i + 1 < s.trajectory.waypoints.count; ++i) {
+      const nav_vec3 a = s.trajectory.waypoints.points[i].r_ned_m, b = s.trajectory.waypoints.points[i + 1].r_ned_m;
+      const double vx = b.x - a.x, vy = b.y - a.y, l2 = vx * vx + vy * vy;
+      double t = l2 > 0 ? ((n - a.x) * vx + (e - a.y) * vy) / l2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double dx = a.x + t * vx - n, dy = a.y + t * vy - e, d2 = dx * dx + dy * dy;
+      if (d2 < best) {
+        best = d2;
+        insert_at = i + 1;
+      }
+    }
+  }
+  AddWaypoint(doc_, n, e, 0.0, insert_at);
+  const int idx = insert_at < 0 ? doc_->Scene().trajectory.waypoints.count - 1 : insert_at;
+  SetSelectedWaypoint(idx);
+}
+
+void PathView::OnHover(int x, int y) {
+  double n = 0, e = 0;
+  if (!GroundAt(x, y, 0.0, &n, &e)) return;
+  const double ned[3] = {n, e, 0.0};
+  double lat = 0, lon = 0, h = 0;
+  LocalToGeodetic(doc_->Scene(), ned, &lat, &lon, &h);
+  emit CursorText(tr("N %1 m  E %2 m  ·  %3").arg(n, 0, 'f', 1).arg(e, 0, 'f', 1).arg(FormatLatLon(lat, lon)));
+}
+
+void PathView::OnDeleteKey() {
+  if (selected_ < 0) return;
+  const int i = selected_;
+  selected_ = -1;
+  DeleteWaypoint(doc_, i);
+  emit SelectionChanged(-1);
+}
+
+} // namespace studio

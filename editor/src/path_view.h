@@ -1,0 +1,112 @@
+/*
+ * navstudio: the map view (top-down, parallel projection, local grid with geodetic read-out) and
+ * the 3D view (perspective, ground plane) of the scene, both plain VTK in a
+ * QVTKOpenGLNativeWidget. Click on the ground adds a waypoint (Ctrl+click inserts it into the
+ * nearest leg), dragging a waypoint's handle moves it (Shift+drag in 3D changes its height),
+ * Delete removes the selected one. The smooth path comes from navcore's waypoint model.
+ * World axes: x = East, y = North, z = Up, metres from the scene origin.
+ */
+#ifndef NAVSTUDIO_PATH_VIEW_H
+#define NAVSTUDIO_PATH_VIEW_H
+
+#include <QTimer>
+#include <QWidget>
+
+#include <memory>
+#include <vector>
+
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+
+#include "studio_scene.h"
+
+class QVTKOpenGLNativeWidget;
+class vtkActor;
+class vtkBillboardTextActor3D;
+class vtkGenericOpenGLRenderWindow;
+class vtkPolyData;
+class vtkRenderer;
+class vtkRenderWindowInteractor;
+class vtkTextActor;
+
+namespace studio {
+
+class PathViewStyle;
+
+class PathView : public QWidget {
+  Q_OBJECT
+public:
+  enum class Mode { Map, ThreeD };
+  PathView(SceneDocument *doc, Mode mode, QWidget *parent = nullptr);
+  ~PathView() override;
+
+  Mode GetMode() const { return mode_; }
+  /** Rebuild waypoints and path from the document and render. */
+  void Rebuild();
+  /** Estimated path to draw over the reference (local NED, 3 per epoch); @p preview: live preview
+   *  colour, else the Monte Carlo result's (the one it replaces stays drawn in grey for A/B
+   *  comparison). Empty clears it. */
+  void SetEstimate(const std::vector<double> &ned, bool preview);
+  /** Fit the camera to the scene and rebuild the grid. */
+  void ResetCamera();
+  /** Render now. */
+  void Render();
+
+  /** VTK display coordinates (origin bottom-left) of a local N/E/D point; false if off-screen. */
+  bool DisplayOf(double n, double e, double d, int *x, int *y);
+  /** Ground point (local N, E at height -d_plane) under a VTK display point. */
+  bool GroundAt(int x, int y, double d_plane, double *n, double *e);
+  vtkRenderWindowInteractor *Interactor();
+  QVTKOpenGLNativeWidget *VtkWidget() { return widget_; }
+  int SelectedWaypoint() const { return selected_; }
+  void SetSelectedWaypoint(int i);
+  /** Number of points of the drawn reference path (tests). */
+  size_t PathPointCount();
+  /** The drawn reference path (brought up to date first). */
+  const PathSamples &Path();
+
+signals:
+  void SelectionChanged(int waypoint);
+  /** Cursor read-out text (status bar). */
+  void CursorText(const QString &text);
+
+private:
+  friend class PathViewStyle;
+  // Interaction (called by the interactor style).
+  bool OnPress(int x, int y, bool ctrl, bool shift);
+  void OnDrag(int x, int y, bool shift);
+  void OnRelease();
+  void OnClick(int x, int y, bool ctrl);
+  void OnHover(int x, int y);
+  void OnDeleteKey();
+  int PickWaypoint(int x, int y);
+  void UpdateGrid(double cx, double cy, double extent);
+
+  SceneDocument *doc_;
+  Mode mode_;
+  QVTKOpenGLNativeWidget *widget_ = nullptr;
+  vtkSmartPointer<vtkGenericOpenGLRenderWindow> window_;
+  vtkSmartPointer<vtkRenderer> renderer_;
+  vtkSmartPointer<PathViewStyle> style_;
+  vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
+  vtkSmartPointer<vtkTextActor> caption_, problem_;
+  std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
+  PathSamples path_;
+  int selected_ = -1;
+  // Drag state.
+  int drag_index_ = -1;
+  bool dragging_ = false;
+  int press_x_ = 0, press_y_ = 0;
+  double drag_d_ = 0.0;
+  std::unique_ptr<nav_scene> drag_before_;
+  QTimer rebuild_timer_;
+  double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;
+};
+
+/** Waypoint edits shared by the views and the table (each is one undo step). */
+void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at = -1);
+void DeleteWaypoint(SceneDocument *doc, int index);
+
+} // namespace studio
+
+#endif

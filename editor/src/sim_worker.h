@@ -1,0 +1,99 @@
+/*
+ * navstudio: simulation on a background thread (style.md section 7). The worker thread only
+ * calls navcore (nav_sim_run) and fills a plain SimResult; it never touches Qt widgets or VTK.
+ * Progress is published through atomics that the GUI thread polls; the result crosses to the GUI
+ * thread once, through a queued call, as a shared_ptr to an immutable SimResult.
+ */
+#ifndef NAVSTUDIO_SIM_WORKER_H
+#define NAVSTUDIO_SIM_WORKER_H
+
+#include <QObject>
+#include <QString>
+#include <QTimer>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+extern "C" {
+#include "navcore/nav_requirements.h"
+#include "navcore/nav_scene.h"
+#include "navcore/nav_sim.h"
+}
+
+namespace studio {
+
+/** What a simulation produced (plain data; immutable once published). */
+struct SimResult {
+  bool preview = false;       /**< a single-run live preview */
+  long runs = 0;              /**< runs requested */
+  int status = 0;             /**< nav_status of nav_sim_run */
+  QString message;            /**< failure text ("" on success) */
+  nav_sim_summary summary{};  /**< navcore's summary */
+  double wall_s = 0.0;        /**< wall time of the run [s] */
+  qint64 scene_change_ns = 0; /**< SceneDocument::LastChangeNs() of the scene that was run */
+  std::vector<double> t_s;        /**< run 0 output epochs */
+  std::vector<double> truth_ned;  /**< 3 per epoch: reference, local NED [m] */
+  std::vector<double> nav_ned;    /**< 3 per epoch: estimate of run 0, local NED [m] */
+  std::vector<double> err_h_m;    /**< horizontal error of run 0 [m] */
+  std::vector<double> env_t_s;    /**< Monte Carlo envelope epochs */
+  std::vector<double> env_h_rms_m; /**< RMS over runs of the horizontal error [m] */
+  std::vector<nav_requirement_verdict> verdicts; /**< one per scene requirement */
+  std::vector<nav_gnss_outage> outages;          /**< the scene's GNSS outages (for charts) */
+};
+
+/**
+ * Runs one simulation at a time on its own std::thread. Start() while running queues the new
+ * request (a later one replaces an earlier queued one) and, when @p preempt, cancels the running
+ * one. Finished(result) is emitted on the GUI thread.
+ */
+class SimWorker : public QObject {
+  Q_OBJECT
+public:
+  explicit SimWorker(QObject *parent = nullptr);
+  ~SimWorker() override;
+
+  /** Run @p scene (copied) with @p runs runs; @p stamp is echoed in the result. */
+  void Start(const nav_scene &scene, long runs, bool preview, qint64 stamp, bool preempt);
+  /** Ask the running simulation to stop (thread-safe, returns at once); drops a queued one. */
+  void Cancel();
+  bool IsBusy() const { return busy_; }
+  /** Fraction 0..1 of the running job. */
+  double Fraction() const { return fraction_.load(); }
+  /** Wait until the worker is idle (tests, shutdown); processes nothing. */
+  void Join();
+
+signals:
+  void Progress(double fraction);
+  void Finished(std::shared_ptr<const studio::SimResult> result);
+  void Started();
+
+private:
+  struct Job {
+    std::unique_ptr<nav_scene> scene;
+    long runs = 1;
+    bool preview = false;
+    qint64 stamp = 0;
+  };
+  void Launch(std::unique_ptr<Job> job);
+  void OnThreadDone(std::shared_ptr<const SimResult> r);
+  static void RunJob(SimWorker *self, Job *job, SimResult *out);
+
+  std::thread thread_;
+  std::unique_ptr<Job> running_;
+  std::unique_ptr<Job> queued_;
+  bool busy_ = false;
+  std::atomic<double> fraction_{0.0};
+  std::atomic<bool> cancel_{false};
+  std::mutex sim_mutex_;
+  nav_sim *sim_ = nullptr; /* guarded by sim_mutex_ */
+  QTimer poll_;
+};
+
+} // namespace studio
+
+Q_DECLARE_METATYPE(std::shared_ptr<const studio::SimResult>)
+
+#endif

@@ -1,0 +1,389 @@
+#include "studio_scene.h"
+
+#include <QCoreApplication>
+#include <QDir>
+#include <QFile>
+#include <QFileInfo>
+#include <QUndoCommand>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+extern "C" {
+#include "navcore/nav_frames.h"
+#include "navcore/nav_io.h"
+#include "navcore/nav_motiondef.h"
+#include "navcore/nav_traj.h"
+}
+
+namespace studio {
+
+QString ResourcesDir() {
+  const QByteArray env = qgetenv("NAV_RESOURCES_DIR");
+  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
+  return QStringLiteral(NAVSTUDIO_RESOURCES_DIR);
+}
+
+QString ScenesDir() { return QStringLiteral(NAVSTUDIO_SCENES_DIR); }
+
+void Normalize(nav_scene *s) {
+  // navigation.cov_decimation: 0 (nav_scene_default) and 1 both mean "every IMU step"
+  // (nav_scene.h), but the reader accepts only >= 1, so a scene written with 0 would not read
+  // back. Until navcore agrees with itself, the editor keeps the equivalent 1.
+  if (s->navigation.cov_decimation == 0) s->navigation.cov_decimation = 1;
+}
+
+std::unique_ptr<nav_scene> NewDriveScene() {
+  auto s = std::make_unique<nav_scene>(nav_scene_default());
+  Normalize(s.get());
+  std::snprintf(s->name, sizeof s->name, "%s", "new-drive");
+  s->earth.model = NAV_EARTH_WGS84;
+  s->earth.origin_lat_rad = 52.52 * M_PI / 180.0;
+  s->earth.origin_lon_rad = 13.405 * M_PI / 180.0;
+  s->earth.origin_h_m = 35.0;
+  s->trajectory.type = NAV_TRAJ_WAYPOINTS;
+  s->trajectory.initial_attitude = nav_euler{0.0, 0.0, 0.0};
+  nav_traj_waypoints &w = s->trajectory.waypoints;
+  w.count = 0;
+  w.timing = NAV_WP_TIMING_SPEED;
+  w.attitude_mode = NAV_WP_ATT_GROUND;
+  w.hold_start_s = 30.0;
+  w.hold_end_s = 5.0;
+  s->trajectory.duration_s = 60.0;
+  s->imu.rate_hz = 100.0;
+  s->gnss.enabled = true;
+  s->navigation.scheme = NAV_SCHEME_INS_GNSS;
+  s->navigation.algorithm = NAV_MECH_HIGH_ORDER;
+  s->navigation.frame = NAV_MECH_NED;
+  s->initial_errors.pos_sd_m = nav_vec3{2.0, 2.0, 4.0};
+  s->initial_errors.vel_sd_mps = nav_vec3{0.1, 0.1, 0.1};
+  const double d2r = M_PI / 180.0;
+  s->initial_errors.att_sd_rad = nav_vec3{0.5 * d2r, 0.5 * d2r, 3.0 * d2r};
+  s->output.rate_hz = 10.0;
+  s->simulation.seed = 1;
+  s->simulation.runs = 10;
+  return s;
+}
+
+namespace {
+struct IssueSink {
+  QVector<Issue> *out;
+};
+void CollectIssue(void *user, const char *path, const char *message) {
+  auto *sink = static_cast<IssueSink *>(user);
+  sink->out->push_back(Issue{QString::fromUtf8(path ? path : ""), QString::fromUtf8(message ? message : "")});
+}
+void CollectDiagIssue(void *user, const nav_diag *d) {
+  auto *sink = static_cast<IssueSink *>(user);
+  sink->out->push_back(Issue{QString::fromUtf8(d->path), QString::fromUtf8(d->message)});
+}
+bool IsScript(const nav_scene &s) {
+  return s.trajectory.type == NAV_TRAJ_WAYPOINTS || s.trajectory.type == NAV_TRAJ_SEGMENTS;
+}
+} // namespace
+
+QVector<Issue> Validate(const nav_scene &s) {
+  // The scene goes through navcore's writer and reader, so the panels report exactly what
+  // `navsim check` would report for the file the editor writes (field checks of the reader,
+  // then nav_scene_validate); the trajectory planner's verdict follows. The last answer is
+  // cached (one scene is validated by several widgets after each edit), and the file goes to
+  // /dev/shm where there is one: the writer fsyncs, which costs a disk flush elsewhere.
+  static std::vector<unsigned char> cached_scene;
+  static QVector<Issue> cached_issues;
+  if (cached_scene.size() == sizeof s && std::memcmp(cached_scene.data(), &s, sizeof s) == 0) return cached_issues;
+  QVector<Issue> out;
+  static const QByteArray tmp = QFile::encodeName(
+      QDir(QDir("/dev/shm").exists() ? QStringLiteral("/dev/shm") : QDir::tempPath())
+          .filePath(QStringLiteral("navstudio-check-%1.yaml").arg(QCoreApplication::applicationPid())));
+  if (nav_scene_write_file(tmp.constData(), &s) == NAV_OK) {
+    auto back = std::make_unique<nav_scene>();
+    IssueSink sink{&out};
+    const nav_status st = nav_scene_read_file(tmp.constData(), back.get(), CollectDiagIssue, &sink);
+    (void)st;
+    QFile::remove(QFile::decodeName(tmp));
+  } else {
+    IssueSink sink{&out};
+    const nav_status st = nav_scene_validate(&s, CollectIssue, &sink);
+    (void)st;
+  }
+  if (out.isEmpty() && IsScript(s)) {
+    nav_scene copy = s;
+    QString msg;
+    if (!UpdateDuration(&copy, &msg))
+      out.push_back(Issue{s.trajectory.type == NAV_TRAJ_WAYPOINTS ? QStringLiteral("trajectory.waypoints")
+                                                                  : QStringLiteral("trajectory.segments"),
+                          msg});
+  }
+  cached_scene.assign(reinterpret_cast<const unsigned char *>(&s), reinterpret_cast<const unsigned char *>(&s) + sizeof s);
+  cached_issues = out;
+  return out;
+}
+
+bool UpdateDuration(nav_scene *s, QString *msg) {
+  if (!IsScript(*s)) return true;
+  if (s->trajectory.type == NAV_TRAJ_WAYPOINTS && s->trajectory.waypoints.count < 2) {
+    if (msg) *msg = QStringLiteral("at least two waypoints are needed (click on the map to add them)");
+    return false;
+  }
+  nav_script_summary sum;
+  std::memset(&sum, 0, sizeof sum);
+  char buf[512] = "";
+  if (nav_motiondef_script_summary(s, &sum, buf, sizeof buf) != NAV_OK) {
+    if (msg) *msg = QString::fromUtf8(buf[0] ? buf : "the trajectory cannot be planned");
+    return false;
+  }
+  s->trajectory.duration_s = sum.duration_s;
+  if (msg) msg->clear();
+  return true;
+}
+
+bool SamplePath(const nav_scene &s, int max_points, PathSamples *out, QString *msg) {
+  out->t_s.clear();
+  out->ned_m.clear();
+  if (s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2) {
+    if (msg) *msg = QStringLiteral("at least two waypoints are needed");
+    return false;
+  }
+  const double dt = 1.0 / (s.imu.rate_hz > 0.0 && std::isfinite(s.imu.rate_hz) ? s.imu.rate_hz : 100.0);
+  nav_traj *traj = nullptr;
+  char buf[512] = "";
+  if (nav_traj_create_msg(&s, dt, &traj, buf, sizeof buf) != NAV_OK) {
+    if (msg) *msg = QString::fromUtf8(buf[0] ? buf : "the trajectory cannot be created");
+    return false;
+  }
+  const double dur = nav_traj_duration(traj);
+  const nav_frame fr = nav_traj_frame(traj);
+  const int n = std::max(2, max_points);
+  out->t_s.reserve(static_cast<size_t>(n));
+  out->ned_m.reserve(3u * static_cast<size_t>(n));
+  bool ok = true;
+  for (int i = 0; i < n; ++i) {
+    const double t = dur * i / (n - 1);
+    nav_traj_state st;
+    if (nav_traj_eval(traj, t, &st) != NAV_OK) {
+      ok = false;
+      if (msg) *msg = QStringLiteral("the trajectory cannot be evaluated at t = %1 s").arg(t);
+      break;
+    }
+    const nav_local_view v = nav_frame_view(&fr, st.r_fb_f_m, st.v_fb_f_mps, st.q_b_f);
+    out->t_s.push_back(t);
+    out->ned_m.push_back(v.r_ned_m.x);
+    out->ned_m.push_back(v.r_ned_m.y);
+    out->ned_m.push_back(v.r_ned_m.z);
+  }
+  nav_traj_destroy(traj);
+  if (ok && msg) msg->clear();
+  return ok;
+}
+
+QByteArray Pack(const nav_scene &s) {
+  return qCompress(reinterpret_cast<const uchar *>(&s), static_cast<int>(sizeof s), 1);
+}
+
+bool Unpack(const QByteArray &b, nav_scene *s) {
+  const QByteArray raw = qUncompress(b);
+  if (raw.size() != static_cast<int>(sizeof *s)) return false;
+  std::memcpy(s, raw.constData(), sizeof *s);
+  return true;
+}
+
+void LocalToGeodetic(const nav_scene &s, const double ned[3], double *lat_deg, double *lon_deg, double *h_m) {
+  const nav_frame fr = nav_frame_from_scene(&s);
+  const nav_geodetic g = nav_frame_local_to_geodetic(&fr, nav_vec3{ned[0], ned[1], ned[2]});
+  *lat_deg = g.lat_rad * 180.0 / M_PI;
+  *lon_deg = g.lon_rad * 180.0 / M_PI;
+  *h_m = g.h_m;
+}
+
+void GeodeticToLocal(const nav_scene &s, double lat_deg, double lon_deg, double h_m, double ned[3]) {
+  const nav_frame fr = nav_frame_from_scene(&s);
+  const nav_vec3 r = nav_frame_geodetic_to_local(&fr, nav_geodetic{lat_deg * M_PI / 180.0, lon_deg * M_PI / 180.0, h_m});
+  ned[0] = r.x;
+  ned[1] = r.y;
+  ned[2] = r.z;
+}
+
+/* ---------------------------------------------------------------- catalogs */
+
+namespace {
+void CollectDiag(void *user, const nav_diag *d) {
+  char buf[1600];
+  nav_diag_format(d, buf, sizeof buf);
+  auto *s = static_cast<QString *>(user);
+  s->append(QString::fromUtf8(buf) + "\n");
+}
+} // namespace
+
+Catalogs::Catalogs() {
+  const QString dir = ResourcesDir();
+  const QByteArray imu = QFile::encodeName(dir + "/imu_catalog.csv");
+  const QByteArray gnss = QFile::encodeName(dir + "/gnss_receivers.csv");
+  if (nav_catalog_load(imu.constData(), nullptr, &imu_, CollectDiag, &errors_) != NAV_OK) imu_ = nullptr;
+  if (nav_catalog_load(gnss.constData(), nullptr, &gnss_, CollectDiag, &errors_) != NAV_OK) gnss_ = nullptr;
+}
+
+Catalogs::~Catalogs() {
+  nav_catalog_destroy(imu_);
+  nav_catalog_destroy(gnss_);
+}
+
+QStringList Catalogs::ImuNames() const {
+  QStringList l;
+  for (size_t i = 0; i < nav_catalog_count(imu_); ++i) l << QString::fromUtf8(nav_catalog_imu_at(imu_, i)->name);
+  return l;
+}
+
+QStringList Catalogs::GnssNames() const {
+  QStringList l;
+  for (size_t i = 0; i < nav_catalog_count(gnss_); ++i) l << QString::fromUtf8(nav_catalog_gnss_at(gnss_, i)->name);
+  return l;
+}
+
+/* ---------------------------------------------------------------- document */
+
+namespace {
+class SceneCommand : public QUndoCommand {
+public:
+  SceneCommand(SceneDocument *doc, QByteArray before, QByteArray after, const QString &text)
+      : QUndoCommand(text), doc_(doc), before_(std::move(before)), after_(std::move(after)) {}
+  void undo() override { Apply(before_); }
+  void redo() override { Apply(after_); }
+
+private:
+  void Apply(const QByteArray &b) {
+    auto s = std::make_unique<nav_scene>();
+    if (Unpack(b, s.get())) doc_->SetSceneInternal(*s);
+  }
+  SceneDocument *doc_;
+  QByteArray before_, after_;
+};
+} // namespace
+
+SceneDocument::SceneDocument(QObject *parent) : QObject(parent), scene_(NewDriveScene()) {
+  undo_.setUndoLimit(500);
+  connect(&undo_, &QUndoStack::cleanChanged, this, &SceneDocument::FileStateChanged);
+  Touch();
+}
+
+SceneDocument::~SceneDocument() = default;
+
+qint64 SceneDocument::NowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+void SceneDocument::Touch() {
+  last_change_ns_ = NowNs();
+  QString msg;
+  nav_scene copy = *scene_;
+  plan_msg_.clear();
+  if (!UpdateDuration(&copy, &msg)) plan_msg_ = msg;
+}
+
+void SceneDocument::Edit(const QString &text, const std::function<void(nav_scene &)> &fn) {
+  auto after = std::make_unique<nav_scene>(*scene_);
+  fn(*after);
+  QString msg;
+  (void)UpdateDuration(after.get(), &msg);
+  if (std::memcmp(after.get(), scene_.get(), sizeof(nav_scene)) == 0) return; // nothing changed
+  undo_.push(new SceneCommand(this, Pack(*scene_), Pack(*after), text));
+}
+
+void SceneDocument::Preview(const nav_scene &s) {
+  *scene_ = s;
+  QString msg;
+  (void)UpdateDuration(scene_.get(), &msg);
+  Touch();
+  emit Changed();
+}
+
+void SceneDocument::Commit(const nav_scene &before, const QString &text) {
+  if (std::memcmp(&before, scene_.get(), sizeof(nav_scene)) == 0) return;
+  // The command's first redo() re-applies the current scene: harmless, and it emits Changed.
+  undo_.push(new SceneCommand(this, Pack(before), Pack(*scene_), text));
+}
+
+void SceneDocument::SetSceneInternal(const nav_scene &s) {
+  *scene_ = s;
+  Touch();
+  emit Changed();
+}
+
+namespace {
+struct DiagList {
+  QStringList *out;
+};
+void CollectDiagList(void *user, const nav_diag *d) {
+  char buf[1600];
+  nav_diag_format(d, buf, sizeof buf);
+  auto *l = static_cast<DiagList *>(user);
+  if (l->out) l->out->push_back(QString::fromUtf8(buf));
+}
+} // namespace
+
+bool SceneDocument::Load(const QString &path, QStringList *errors) {
+  auto s = std::make_unique<nav_scene>();
+  DiagList dl{errors};
+  const QByteArray p = QFile::encodeName(path);
+  if (nav_scene_read_file(p.constData(), s.get(), CollectDiagList, &dl) != NAV_OK) return false;
+  Normalize(s.get());
+  path_ = QFileInfo(path).absoluteFilePath();
+  undo_.clear();
+  *scene_ = *s;
+  Touch();
+  emit Changed();
+  emit FileStateChanged();
+  return true;
+}
+
+bool SceneDocument::LoadText(const QByteArray &text, const QString &display, const QString &path_for_save,
+                             QStringList *errors) {
+  auto s = std::make_unique<nav_scene>();
+  DiagList dl{errors};
+  const QByteArray name = display.toUtf8();
+  if (nav_scene_read_string(text.constData(), static_cast<size_t>(text.size()), name.constData(), s.get(),
+                            CollectDiagList, &dl) != NAV_OK)
+    return false;
+  Normalize(s.get());
+  path_ = path_for_save;
+  undo_.clear();
+  // A recovered document differs from its file: push the recovery as an edit so it is "modified".
+  const nav_scene before = *scene_;
+  *scene_ = *s;
+  undo_.push(new SceneCommand(this, Pack(before), Pack(*s), tr("Recover autosave")));
+  Touch();
+  emit Changed();
+  emit FileStateChanged();
+  return true;
+}
+
+void SceneDocument::Reset(const nav_scene &s) {
+  undo_.clear();
+  path_.clear();
+  *scene_ = s;
+  Normalize(scene_.get());
+  Touch();
+  emit Changed();
+  emit FileStateChanged();
+}
+
+bool SceneDocument::Save(const QString &path, QString *error) {
+  if (!WriteCopy(path, error)) return false;
+  path_ = QFileInfo(path).absoluteFilePath();
+  undo_.setClean();
+  emit FileStateChanged();
+  return true;
+}
+
+bool SceneDocument::WriteCopy(const QString &path, QString *error) const {
+  const QByteArray p = QFile::encodeName(path);
+  const nav_status st = nav_scene_write_file(p.constData(), scene_.get());
+  if (st != NAV_OK) {
+    if (error) *error = QStringLiteral("%1: error: cannot write the scene (%2)").arg(path, nav_status_str(st));
+    return false;
+  }
+  return true;
+}
+
+} // namespace studio

@@ -1,0 +1,446 @@
+// navstudio GUI tests (QTest under Xvfb): the "Done when" journey by injected clicks on the map
+// view, dragging a waypoint with the live preview, cancel mid-run, undo/redo, save/load round
+// trip and autosave recovery. Screenshots of the main window after each step go to
+// NAVSTUDIO_TEST_OUT_DIR/<test>-<step>.png.
+#include <QAction>
+#include <QComboBox>
+#include <QDir>
+#include <QElapsedTimer>
+#include <QFile>
+#include <QLabel>
+#include <QLineEdit>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QSurfaceFormat>
+#include <QTableWidget>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include <vtkCommand.h>
+#include <vtkRenderWindowInteractor.h>
+
+#include "main_window.h"
+
+using studio::MainWindow;
+using studio::PathView;
+
+namespace {
+
+void Shot(MainWindow *w, const QString &name) {
+  QDir().mkpath(NAVSTUDIO_TEST_OUT_DIR);
+  QApplication::processEvents();
+  const QString p = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR) + "/" + name + ".png";
+  QVERIFY2(w->grab().save(p), qPrintable("cannot write " + p));
+}
+
+bool WaitUntil(const std::function<bool()> &done, int timeout_ms) {
+  QElapsedTimer t;
+  t.start();
+  while (!done()) {
+    if (t.elapsed() > timeout_ms) return false;
+    QTest::qWait(20);
+  }
+  return true;
+}
+
+// Injected VTK events (toolchain.md section 4a): hover, press, optional drag steps, release.
+void ClickAt(PathView *v, int x, int y, bool ctrl = false) {
+  vtkRenderWindowInteractor *i = v->Interactor();
+  i->SetEventInformation(x, y, ctrl ? 1 : 0, 0);
+  i->InvokeEvent(vtkCommand::MouseMoveEvent);
+  i->InvokeEvent(vtkCommand::LeftButtonPressEvent);
+  i->InvokeEvent(vtkCommand::LeftButtonReleaseEvent);
+}
+
+void DragFromTo(PathView *v, int x0, int y0, int x1, int y1, int steps = 8) {
+  vtkRenderWindowInteractor *i = v->Interactor();
+  i->SetEventInformation(x0, y0, 0, 0);
+  i->InvokeEvent(vtkCommand::MouseMoveEvent);
+  i->InvokeEvent(vtkCommand::LeftButtonPressEvent);
+  for (int k = 1; k <= steps; ++k) {
+    i->SetEventInformation(x0 + (x1 - x0) * k / steps, y0 + (y1 - y0) * k / steps, 0, 0);
+    i->InvokeEvent(vtkCommand::MouseMoveEvent);
+    QApplication::processEvents();
+  }
+  i->InvokeEvent(vtkCommand::LeftButtonReleaseEvent);
+}
+
+// Click on the map at local north/east [m]; returns the pixel used.
+void ClickMap(PathView *v, double n, double e, bool ctrl = false) {
+  int x = 0, y = 0;
+  QVERIFY2(v->DisplayOf(n, e, 0.0, &x, &y), "target outside the map view");
+  ClickAt(v, x, y, ctrl);
+}
+
+// Metres per pixel of the map view at the centre (tolerance of a click).
+double MapMetresPerPixel(PathView *v) {
+  double n0 = 0, e0 = 0, n1 = 0, e1 = 0;
+  int x = 0, y = 0;
+  v->DisplayOf(0, 0, 0, &x, &y);
+  v->GroundAt(x, y, 0.0, &n0, &e0);
+  v->GroundAt(x + 1, y, 0.0, &n1, &e1);
+  return std::hypot(n1 - n0, e1 - e0);
+}
+
+void Choose(QComboBox *c, const QString &text) {
+  const int i = c->findText(text, Qt::MatchContains);
+  QVERIFY2(i >= 0, qPrintable("no entry " + text));
+  c->setCurrentIndex(i);
+  emit c->activated(i);
+}
+
+void TypeInto(QLineEdit *e, const QString &text) {
+  e->setFocus();
+  e->selectAll();
+  QTest::keyClicks(e, text);
+  QTest::keyClick(e, Qt::Key_Return);
+}
+
+std::unique_ptr<MainWindow> MakeWindow() {
+  auto w = std::make_unique<MainWindow>();
+  w->SetAsk([](const QString &, const QString &, QMessageBox::StandardButtons b) {
+    return (b & QMessageBox::Yes) ? QMessageBox::Yes : QMessageBox::Discard;
+  });
+  w->show();
+  if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
+  QTest::qWait(50);
+  return w;
+}
+
+// Four waypoints of a small drive (north, east in metres).
+const double kDrive[4][2] = {{-200.0, -300.0}, {-200.0, 150.0}, {150.0, 150.0}, {150.0, 400.0}};
+
+} // namespace
+
+class TestNavstudio : public QObject {
+  Q_OBJECT
+private slots:
+  void initTestCase() {
+    QVERIFY(tmp_.isValid());
+    qputenv("NAVSTUDIO_AUTOSAVE_DIR", QFile::encodeName(tmp_.path() + "/autosave"));
+    qputenv("NAVSTUDIO_NO_DIALOGS", "1");
+  }
+
+  // The "Done when" journey: draw four waypoints on the map, choose an IMU and a GNSS receiver
+  // with a 60 s outage, run 100 Monte Carlo runs and read the requirement verdict.
+  void journey() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    Shot(w.get(), "journey-01-new");
+    PathView *map = w->MapView();
+    const double mpp = MapMetresPerPixel(map);
+    QVERIFY(mpp > 0.0 && mpp < 5.0);
+    for (int k = 0; k < 4; ++k) {
+      ClickMap(map, kDrive[k][0], kDrive[k][1]);
+      const nav_scene &s = w->Doc()->Scene();
+      QCOMPARE(s.trajectory.waypoints.count, k + 1);
+      const nav_vec3 r = s.trajectory.waypoints.points[k].r_ned_m;
+      QVERIFY2(std::fabs(r.x - kDrive[k][0]) <= 1.5 * mpp && std::fabs(r.y - kDrive[k][1]) <= 1.5 * mpp,
+               qPrintable(QString("waypoint %1 at %2, %3").arg(k).arg(r.x).arg(r.y)));
+    }
+    QVERIFY2(w->Doc()->PlanMessage().isEmpty(), qPrintable(w->Doc()->PlanMessage()));
+    QVERIFY(map->PathPointCount() > 100);
+    QVERIFY(w->View3D()->PathPointCount() == map->PathPointCount()); // both views in sync
+    Shot(w.get(), "journey-02-four-waypoints");
+
+    auto *imu = w->findChild<QComboBox *>("imuCatalog");
+    QVERIFY(imu);
+    Choose(imu, "ADIS16465");
+    QCOMPARE(QString::fromUtf8(w->Doc()->Scene().imu.catalog), QString("ADIS16465-1"));
+    QVERIFY(w->Doc()->Scene().imu.model.gyro.terms != 0);
+    auto *rx = w->findChild<QComboBox *>("gnssReceiver");
+    QVERIFY(rx);
+    Choose(rx, "SBAS");
+    QVERIFY(QString::fromUtf8(w->Doc()->Scene().gnss.catalog).contains("SBAS"));
+    auto *add_outage = w->findChild<QPushButton *>("addOutage");
+    QVERIFY(add_outage);
+    w->Panels()->setCurrentIndex(2);
+    QTest::mouseClick(add_outage, Qt::LeftButton);
+    const nav_gnss_model_config &g = w->Doc()->Scene().gnss.model;
+    QCOMPARE(static_cast<int>(g.outage_count), 1);
+    QCOMPARE(g.outages[0].t1_s - g.outages[0].t0_s, 60.0);
+    QVERIFY(g.outages[0].t1_s < w->Doc()->Scene().trajectory.duration_s);
+    auto *add_req = w->findChild<QPushButton *>("addRequirement");
+    QVERIFY(add_req);
+    QTest::mouseClick(add_req, Qt::LeftButton);
+    QCOMPARE(w->Doc()->Scene().n_requirements, 1);
+    QCOMPARE(static_cast<int>(w->Doc()->Scene().requirements[0].statistic), static_cast<int>(NAV_REQ_OUTAGE_END));
+    auto *runs = w->findChild<QLineEdit *>("simulation.runs");
+    QVERIFY(runs);
+    TypeInto(runs, "100");
+    QCOMPARE(w->Doc()->Scene().simulation.runs, 100L);
+    Shot(w.get(), "journey-03-configured");
+
+    w->findChild<QAction *>("actionRun")->trigger();
+    QVERIFY(w->Worker()->IsBusy());
+    QVERIFY2(WaitUntil([&] { return !w->Worker()->IsBusy(); }, 600000), "the Monte Carlo run did not finish");
+    auto r = w->LastResult();
+    QVERIFY(r);
+    QCOMPARE(r->status, static_cast<int>(NAV_OK));
+    QCOMPARE(r->summary.runs, 100L);
+    QCOMPARE(static_cast<int>(r->verdicts.size()), 1);
+    const nav_requirement_verdict &v = r->verdicts[0];
+    QVERIFY(v.evaluated);
+    QCOMPARE(v.outage_count, 1);
+    QVERIFY(std::isfinite(v.value) && v.value > 0.0);
+    QCOMPARE(v.pass, v.value <= v.limit);
+    // The verdict as the user reads it: the Requirements panel's summary and the results text.
+    auto *summary = w->findChild<QLabel *>("verdictSummary");
+    QVERIFY(summary);
+    QVERIFY2(summary->text().startsWith(v.pass ? "PASS" : "FAIL"), qPrintable(summary->text()));
+    QVERIFY(w->ResultsText().contains(v.pass ? "verdict: PASS" : "verdict: FAIL"));
+    qInfo("journey: 100 runs in %.1f s, %s = %.3f m (limit %.1f m): %s", r->wall_s, v.id, v.value, v.limit,
+          v.pass ? "PASS" : "FAIL");
+    w->Panels()->setCurrentIndex(5); // the Requirements panel: the verdict per requirement
+    Shot(w.get(), "journey-04-verdict");
+    w->findChild<QTabWidget *>("bottomTabs")->setCurrentIndex(1);
+    Shot(w.get(), "journey-05-error-chart");
+  }
+
+  // Fields validate as the user types, with the messages of `navsim check`; nothing is
+  // committed until Enter, and a valid value then clears the message.
+  void validation() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    auto *arw = w->findChild<QLineEdit *>("imu.gyro.arw");
+    QVERIFY(arw);
+    auto *msg = w->findChild<QLabel *>("imu.gyro.arw.message");
+    QVERIFY(msg);
+    w->Panels()->setCurrentIndex(1);
+    arw->setFocus();
+    QTest::keyClicks(arw, "-1");
+    QVERIFY2(msg->text().contains("imu.gyro.arw_deg_per_sqrt_h: must be >= 0 (got -1)"), qPrintable(msg->text()));
+    QCOMPARE(w->Doc()->Scene().imu.model.gyro.terms & NAV_IMU_TERM_NOISE, 0u); // not committed yet
+    Shot(w.get(), "validation-01-negative-arw");
+    arw->selectAll();
+    QTest::keyClicks(arw, "x");
+    QVERIFY2(msg->text().contains("expected a number, got 'x'"), qPrintable(msg->text()));
+    arw->selectAll();
+    QTest::keyClicks(arw, "0.15");
+    QVERIFY(msg->text().isEmpty() || !msg->isVisible());
+    QTest::keyClick(arw, Qt::Key_Return);
+    QVERIFY(w->Doc()->Scene().imu.model.gyro.terms & NAV_IMU_TERM_NOISE);
+    QCOMPARE(w->Doc()->Scene().imu.model.gyro.arw_rad_per_sqrt_s.x, 0.15 * (M_PI / 180.0) / 60.0);
+    auto *rate = w->findChild<QLineEdit *>("gnss.update_rate");
+    QVERIFY(rate);
+    rate->setFocus();
+    rate->selectAll();
+    QTest::keyClicks(rate, "0");
+    QVERIFY2(w->findChild<QLabel *>("gnss.update_rate.message")->text().contains("gnss.update_rate_hz: must be > 0"),
+             qPrintable(w->findChild<QLabel *>("gnss.update_rate.message")->text()));
+  }
+
+  // An infeasible edit in the waypoint table: the planner's message (as navsim check prints it)
+  // names the waypoint, the run is refused, undo restores a feasible drive.
+  void infeasible_edit() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+    QVERIFY(w->Doc()->PlanMessage().isEmpty());
+    w->Panels()->setCurrentIndex(3);
+    QTableWidget *t = w->Panels()->WaypointTable();
+    QCOMPARE(t->rowCount(), 4);
+    t->item(1, 3)->setText("40"); // 40 m/s into a 90 deg corner 450 m after the start
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.points[1].speed_mps, 40.0);
+    QVERIFY(!w->Doc()->PlanMessage().isEmpty());
+    bool named = false;
+    for (const studio::Issue &i : studio::Validate(w->Doc()->Scene()))
+      named = named || (i.path == "trajectory.waypoints.points[1]" && i.message.contains("max_lateral_accel"));
+    QVERIFY(named);
+    QVERIFY(!w->Run());
+    Shot(w.get(), "infeasible-01-turn-too-fast");
+    w->findChild<QAction *>("actionUndo")->trigger();
+    QVERIFY(w->Doc()->PlanMessage().isEmpty());
+    QVERIFY(w->MapView()->PathPointCount() > 100);
+  }
+
+  // Dragging a waypoint moves it, redraws the path and updates the live preview.
+  void drag_waypoint() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    QVERIFY(w->NewDrive());
+    PathView *map = w->MapView();
+    for (auto &p : kDrive) ClickMap(map, p[0], p[1]);
+    QVERIFY(WaitUntil([&] { return w->LastPreview() && !w->PreviewWorker()->IsBusy(); }, 60000));
+    const std::vector<double> path_before = map->Path().ned_m;
+    const std::vector<double> est_before = w->LastPreview()->nav_ned;
+    const int undo_before = w->Doc()->UndoStack()->index();
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    QVERIFY(map->DisplayOf(kDrive[2][0], kDrive[2][1], 0, &x0, &y0));
+    QVERIFY(map->DisplayOf(kDrive[2][0] + 100.0, kDrive[2][1] + 50.0, 0, &x1, &y1));
+    DragFromTo(map, x0, y0, x1, y1);
+    const double mpp = MapMetresPerPixel(map);
+    const nav_vec3 r = w->Doc()->Scene().trajectory.waypoints.points[2].r_ned_m;
+    QVERIFY2(std::fabs(r.x - (kDrive[2][0] + 100.0)) <= 1.5 * mpp && std::fabs(r.y - (kDrive[2][1] + 50.0)) <= 1.5 * mpp,
+             qPrintable(QString("dragged to %1, %2").arg(r.x).arg(r.y)));
+    QCOMPARE(w->Doc()->UndoStack()->index(), undo_before + 1); // one undo step for the drag
+    QVERIFY(map->Path().ned_m != path_before);
+    QVERIFY(w->View3D()->Path().ned_m == map->Path().ned_m);
+    // The preview follows: a preview of the current scene arrives.
+    QVERIFY(WaitUntil([&] { return w->LastPreview() && w->LastPreview()->scene_change_ns == w->Doc()->LastChangeNs(); },
+                      60000));
+    QVERIFY(w->LastPreview()->nav_ned != est_before);
+    QVERIFY(!w->PreviewLatenciesMs().empty());
+    qInfo("drag: preview latency %.1f ms (edit to picture)", w->PreviewLatenciesMs().back());
+    Shot(w.get(), "drag-01-after-drag");
+  }
+
+  // Cancel mid-run: the worker stops promptly and the window reports it.
+  void cancel_run() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+    TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "5000");
+    QVERIFY(w->Run());
+    QVERIFY(WaitUntil([&] { return w->Worker()->Fraction() > 0.0; }, 120000));
+    Shot(w.get(), "cancel-01-running");
+    QElapsedTimer t;
+    t.start();
+    w->findChild<QAction *>("actionCancel")->trigger();
+    QVERIFY(WaitUntil([&] { return !w->Worker()->IsBusy(); }, 30000));
+    qInfo("cancel: stopped %lld ms after the request", static_cast<long long>(t.elapsed()));
+    QVERIFY(t.elapsed() < 10000);
+    QVERIFY(!w->LastResult()); // no result from a cancelled run
+    QVERIFY(w->findChild<QLabel *>("statusText")->text().startsWith("Cancelled"));
+    QVERIFY(w->findChild<QAction *>("actionRun")->isEnabled());
+    Shot(w.get(), "cancel-02-cancelled");
+  }
+
+  // Undo/redo of clicks, a catalog choice and a typed field; the modified marker follows.
+  void undo_redo() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    QVERIFY(!w->isWindowModified());
+    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+    QVERIFY(w->isWindowModified());
+    Choose(w->findChild<QComboBox *>("imuCatalog"), "STIM300");
+    TypeInto(w->findChild<QLineEdit *>("simulation.seed"), "42");
+    QCOMPARE(w->Doc()->Scene().simulation.seed, uint64_t(42));
+    QAction *undo = w->findChild<QAction *>("actionUndo");
+    QAction *redo = w->findChild<QAction *>("actionRedo");
+    undo->trigger();
+    QCOMPARE(w->Doc()->Scene().simulation.seed, uint64_t(1));
+    undo->trigger();
+    QCOMPARE(QString::fromUtf8(w->Doc()->Scene().imu.catalog), QString());
+    QCOMPARE(w->findChild<QComboBox *>("imuCatalog")->currentIndex(), 0);
+    undo->trigger();
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 3);
+    Shot(w.get(), "undo-01-three-waypoints");
+    for (int k = 0; k < 3; ++k) undo->trigger();
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 0);
+    QVERIFY(!w->isWindowModified()); // back to the clean state
+    for (int k = 0; k < 6; ++k) redo->trigger();
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 4);
+    QCOMPARE(QString::fromUtf8(w->Doc()->Scene().imu.catalog), QString("Safran Sensonor STIM300"));
+    QCOMPARE(w->Doc()->Scene().simulation.seed, uint64_t(42));
+    QVERIFY(w->isWindowModified());
+    Shot(w.get(), "undo-02-redone");
+  }
+
+  // Save, load in a fresh window, save again: identical files and scenes.
+  void save_load() {
+    const QString a = tmp_.path() + "/drive-a.yaml", b = tmp_.path() + "/drive-b.yaml";
+    nav_scene saved;
+    {
+      auto w = MakeWindow();
+      QVERIFY(w);
+      w->SetLivePreview(false);
+      QVERIFY(w->NewDrive());
+      for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+      Choose(w->findChild<QComboBox *>("imuCatalog"), "ADIS16465");
+      Choose(w->findChild<QComboBox *>("gnssReceiver"), "SBAS");
+      QTest::mouseClick(w->findChild<QPushButton *>("addOutage"), Qt::LeftButton);
+      QTest::mouseClick(w->findChild<QPushButton *>("addRequirement"), Qt::LeftButton);
+      QVERIFY(w->SaveAs(a));
+      QVERIFY(!w->isWindowModified());
+      QVERIFY(w->windowTitle().startsWith("drive-a.yaml"));
+      QVERIFY(w->RecentFiles().contains(QFileInfo(a).absoluteFilePath()));
+      saved = w->Doc()->Scene();
+    }
+    auto w2 = MakeWindow();
+    QVERIFY(w2);
+    w2->SetLivePreview(false);
+    QVERIFY(w2->OpenFile(a));
+    const nav_scene &s = w2->Doc()->Scene();
+    QCOMPARE(s.trajectory.waypoints.count, 4);
+    QVERIFY(std::memcmp(s.trajectory.waypoints.points, saved.trajectory.waypoints.points, 4 * sizeof(nav_waypoint)) == 0);
+    QVERIFY(std::memcmp(&s.imu.model, &saved.imu.model, sizeof s.imu.model) == 0);
+    QVERIFY(std::memcmp(&s.gnss.model, &saved.gnss.model, sizeof s.gnss.model) == 0);
+    QCOMPARE(s.n_requirements, 1);
+    QCOMPARE(s.trajectory.duration_s, saved.trajectory.duration_s);
+    QVERIFY(w2->SaveAs(b));
+    QFile fa(a), fb(b);
+    QVERIFY(fa.open(QIODevice::ReadOnly) && fb.open(QIODevice::ReadOnly));
+    QCOMPARE(fa.readAll(), fb.readAll());
+    // No temporary file is left next to the scene (atomic save: temp + rename).
+    const QStringList left = QDir(tmp_.path()).entryList(QStringList() << "*.tmp*", QDir::Files | QDir::Hidden);
+    QVERIFY2(left.isEmpty(), qPrintable(left.join(",")));
+    Shot(w2.get(), "save-01-reopened");
+  }
+
+  // An autosave left by a window that ended without saving is offered and recovered.
+  void autosave_recovery() {
+    int count = 0;
+    nav_vec3 last{};
+    QString autosave;
+    {
+      auto w = MakeWindow();
+      QVERIFY(w);
+      w->SetLivePreview(false);
+      QVERIFY(w->NewDrive());
+      for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+      Choose(w->findChild<QComboBox *>("imuCatalog"), "HG4930");
+      w->Autosave();
+      autosave = w->AutosavePath();
+      QVERIFY(QFile::exists(autosave));
+      count = w->Doc()->Scene().trajectory.waypoints.count;
+      last = w->Doc()->Scene().trajectory.waypoints.points[count - 1].r_ned_m;
+      // "Crash": the window goes away without asking to save; the autosave stays.
+      w->SetAsk([](const QString &, const QString &, QMessageBox::StandardButtons) { return QMessageBox::Cancel; });
+    }
+    QVERIFY(QFile::exists(autosave));
+    auto w2 = MakeWindow();
+    QVERIFY(w2);
+    w2->SetLivePreview(false);
+    QVERIFY(w2->CheckRecovery());
+    const nav_scene &s = w2->Doc()->Scene();
+    QCOMPARE(s.trajectory.waypoints.count, count);
+    QCOMPARE(s.trajectory.waypoints.points[count - 1].r_ned_m.x, last.x);
+    QCOMPARE(s.trajectory.waypoints.points[count - 1].r_ned_m.y, last.y);
+    QCOMPARE(QString::fromUtf8(s.imu.catalog), QString("Honeywell HG4930"));
+    QVERIFY(w2->isWindowModified()); // recovered, not yet saved
+    Shot(w2.get(), "autosave-01-recovered");
+    // Discarding the recovered changes removes the autosave.
+    QVERIFY(w2->NewDrive());
+    QVERIFY(!QFile::exists(autosave));
+  }
+
+private:
+  QTemporaryDir tmp_;
+};
+
+int main(int argc, char **argv) {
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("navstudio-test");
+  QApplication::setApplicationName("navstudio-test");
+  TestNavstudio t;
+  return QTest::qExec(&t, argc, argv);
+}
+
+#include "test_navstudio.moc"

@@ -1,0 +1,141 @@
+/**
+ * @file fast_number.h
+ * @brief Exact fast path for decimal text to double (navcore_io internal; header-only so that the
+ *        white-box test can include it). Used by the recorded-data readers (recorded.c), where
+ *        strtod was the largest single cost of `navsim replay`.
+ *
+ * The fast path is Clinger's (W. D. Clinger, "How to read floating point numbers accurately",
+ * PLDI 1990): a decimal d_1..d_k x 10^e whose significand M (the digits as an integer, leading
+ * zeros dropped) is at most 2^53 and whose scaled exponent q = e - (fraction digits) has
+ * |q| <= 22 is M * 10^q or M / 10^-q, where M and 10^|q| are exact doubles, so the result is a
+ * single correctly rounded IEEE operation, i.e. the double nearest to the decimal value: exactly
+ * what a correctly rounding strtod (glibc's is) returns, not merely within an ulp. Everything
+ * else (more than 19 significant digits, M > 2^53, |q| > 22, hexadecimal, nan/inf, any other
+ * character) is reported as "not handled" and the caller falls back to strtod, which also
+ * produces its error messages. Requires IEEE double arithmetic in round-to-nearest without
+ * extended precision (x86-64 SSE2, AArch64; not x87) and no FMA contraction (irrelevant here:
+ * there is a single operation).
+ */
+#ifndef NAV_IO_FAST_NUMBER_H
+#define NAV_IO_FAST_NUMBER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+/* 10^0 .. 10^22: all exactly representable as doubles (5^22 < 2^53). */
+static const double nav_fast_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                          1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                          1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/**
+ * Parse a number [+-]digits[.digits][(e|E)[+-]digits] (at least one significand digit) at the
+ * start of [s, end) when the exact fast path applies, stopping at the first character that
+ * cannot continue it.
+ * @return the end of the number and *out = the correctly rounded value; NULL when there is no
+ *         such number or it is outside the fast path (*out untouched). The caller checks what
+ *         follows (a field separator) and otherwise uses strtod.
+ */
+static inline const char *nav_fast_number_scan(const char *s, const char *end, double *out) {
+  const char *p = s;
+  if (p == end) return NULL;
+  bool neg = false;
+  if (*p == '+' || *p == '-') {
+    neg = *p == '-';
+    if (++p == end) return NULL;
+  }
+  uint64_t m = 0;
+  int sig = 0;     /* significant digits in m (leading zeros excluded) */
+  int frac = 0;    /* digits after the point */
+  int digits = 0;  /* all significand digits */
+  while (p != end && (unsigned)(*p - '0') < 10u) {
+    const unsigned d = (unsigned)(*p - '0');
+    if (m != 0 || d != 0) {
+      if (++sig > 19) return NULL;
+      m = m * 10u + d;
+    }
+    ++digits;
+    ++p;
+  }
+  if (p != end && *p == '.') {
+    ++p;
+    /* Eight fraction digits at a time once the significand has started (SWAR: the usual
+     * digit test and the three multiply-shift steps that combine 8 ASCII digits into their
+     * value); the byte loop below finishes. Reads only inside [p, end). */
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    while (m != 0 && sig <= 11 && end - p >= 8) {
+      uint64_t w;
+      memcpy(&w, p, 8);
+      if (((w & 0xF0F0F0F0F0F0F0F0ull) | (((w + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) !=
+          0x3333333333333333ull)
+        break;
+      w -= 0x3030303030303030ull; /* digit bytes, first digit in the lowest byte (little endian) */
+      w = (w * 10u) + (w >> 8);
+      w = (((w & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
+           (((w >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
+          32;
+      m = m * 100000000u + (w & 0xFFFFFFFFu);
+      sig += 8;
+      digits += 8;
+      frac += 8;
+      p += 8;
+    }
+#endif
+    while (p != end && (unsigned)(*p - '0') < 10u) {
+      const unsigned d = (unsigned)(*p - '0');
+      if (m != 0 || d != 0) {
+        if (++sig > 19) return NULL;
+        m = m * 10u + d;
+      }
+      ++digits;
+      ++frac;
+      ++p;
+    }
+  }
+  if (digits == 0) return NULL;
+  int e = 0;
+  if (p != end && (*p == 'e' || *p == 'E')) {
+    ++p;
+    bool eneg = false;
+    if (p != end && (*p == '+' || *p == '-')) {
+      eneg = *p == '-';
+      ++p;
+    }
+    int ed = 0;
+    while (p != end && (unsigned)(*p - '0') < 10u) {
+      if (++ed > 4) return NULL;
+      e = e * 10 + (*p - '0');
+      ++p;
+    }
+    if (ed == 0) return NULL;
+    if (eneg) e = -e;
+  }
+  if (m > ((uint64_t)1 << 53)) return NULL;
+  const int q = e - frac;
+  double v = (double)m; /* exact */
+  if (m != 0) {
+    if (q < -22 || q > 22) return NULL;
+    if (q < 0)
+      v = v / nav_fast_pow10[-q];
+    else
+      v = v * nav_fast_pow10[q];
+  }
+  *out = neg ? -v : v;
+  return p;
+}
+
+/**
+ * Parse the whole of [s, end) as one number when the exact fast path applies.
+ * @return true and *out = the correctly rounded value; false when the text is not exactly one
+ *         such number or outside the fast path (the caller then uses strtod); *out is untouched.
+ */
+static inline bool nav_fast_number(const char *s, const char *end, double *out) {
+  double v = 0.0;
+  const char *p = nav_fast_number_scan(s, end, &v);
+  if (p != end) return false;
+  *out = v;
+  return true;
+}
+
+#endif /* NAV_IO_FAST_NUMBER_H */

@@ -1,0 +1,91 @@
+/*
+ * Requirement verdicts in result files and on the terminal (nav_results.h): the "requirements"
+ * list of summary.json and the lines of the terminal summary, shared by navsim run, replay,
+ * estimate, select and sweep.
+ */
+#include <math.h>
+#include <stdio.h>
+
+#include "navcore/nav_results.h"
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
+    if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+    else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+    else fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+static void json_num(FILE *f, double v) {
+  if (isfinite(v)) fprintf(f, "%.17g", v);
+  else fputs("null", f);
+}
+
+nav_status nav_requirements_write_json(FILE *f, const nav_requirement_verdict *v, int count, int indent) {
+  if (!f || count < 0 || (count > 0 && !v)) return NAV_ERR_INVALID_ARG;
+  if (count == 0) {
+    fputs("[]", f);
+    return ferror(f) ? NAV_ERR_IO : NAV_OK;
+  }
+  fputs("[\n", f);
+  for (int i = 0; i < count; ++i) {
+    const nav_requirement_verdict *q = &v[i];
+    fprintf(f, "%*s{\"id\": ", indent + 2, "");
+    json_str(f, q->id);
+    fprintf(f, ", \"metric\": \"%s\", \"statistic\": \"%s\", \"limit\": ", nav_req_metric_name(q->metric),
+            nav_req_statistic_name(q->statistic));
+    json_num(f, q->limit);
+    fprintf(f, ", \"unit\": \"%s\", \"value\": ", nav_req_unit_name(q->unit));
+    json_num(f, q->value);
+    fprintf(f, ", \"pass\": %s, \"samples\": %ld", q->pass ? "true" : "false", q->samples);
+    if (q->statistic == NAV_REQ_AT_TIME) {
+      fputs(", \"time_s\": ", f);
+      json_num(f, q->at_time_s);
+    }
+    if (q->statistic == NAV_REQ_OUTAGE_END) {
+      fputs(", \"outages\": [", f);
+      for (int j = 0; j < q->outage_count && j < NAV_REQ_MAX_OUTAGES; ++j) {
+        fputs(j ? ", {\"t0_s\": " : "{\"t0_s\": ", f);
+        json_num(f, q->outage_t0_s[j]);
+        fputs(", \"t1_s\": ", f);
+        json_num(f, q->outage_t1_s[j]);
+        fputs(", \"t_s\": ", f);
+        json_num(f, q->outage_end_t_s[j]);
+        fputs(", \"value\": ", f);
+        json_num(f, q->outage_value[j]);
+        fputs("}", f);
+      }
+      fputs("]", f);
+    }
+    fprintf(f, "}%s\n", i + 1 < count ? "," : "");
+  }
+  fprintf(f, "%*s]", indent, "");
+  return ferror(f) ? NAV_ERR_IO : NAV_OK;
+}
+
+void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count) {
+  if (!f || count <= 0 || !v) return;
+  int pass = 0;
+  for (int i = 0; i < count; ++i) pass += v[i].pass ? 1 : 0;
+  fprintf(f, "requirements %d of %d pass\n", pass, count);
+  for (int i = 0; i < count; ++i) {
+    const nav_requirement_verdict *q = &v[i];
+    const char *u = nav_req_unit_name(q->unit);
+    fprintf(f, "  %s  %-20s %s %s", !q->evaluated && q->statistic != NAV_REQ_OUTAGE_END ? "N/A " : q->pass ? "PASS" : "FAIL",
+            q->id, nav_req_metric_name(q->metric), nav_req_statistic_name(q->statistic));
+    if (q->statistic == NAV_REQ_AT_TIME) fprintf(f, " (t = %g s)", q->at_time_s);
+    if (q->evaluated) fprintf(f, " = %.4g %s %s %.4g %s\n", q->value, u, q->pass ? "<=" : ">", q->limit, u);
+    else if (q->statistic == NAV_REQ_OUTAGE_END && q->outage_count == 0)
+      fprintf(f, ": no GNSS outage, nothing to evaluate (limit %.4g %s)\n", q->limit, u);
+    else fprintf(f, ": not evaluated (no data, or not predictable from sigmas), limit %.4g %s\n", q->limit, u);
+    if (q->statistic == NAV_REQ_OUTAGE_END)
+      for (int j = 0; j < q->outage_count && j < NAV_REQ_MAX_OUTAGES; ++j) {
+        if (isnan(q->outage_value[j])) fprintf(f, "        outage [%g, %g) s: no output epoch inside\n",
+                                               q->outage_t0_s[j], q->outage_t1_s[j]);
+        else fprintf(f, "        outage [%g, %g) s: %.4g %s at t = %g s\n", q->outage_t0_s[j], q->outage_t1_s[j],
+                     q->outage_value[j], u, q->outage_end_t_s[j]);
+      }
+  }
+}

@@ -1,0 +1,74 @@
+/* navsim bench internals shared by bench.c, bench_cases2.c and bench_report.c. */
+#ifndef NAVSIM_BENCH_INTERNAL_H
+#define NAVSIM_BENCH_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "navcore/nav_scene.h"
+
+typedef struct bench_row {
+  char case_name[64];
+  char variant[64];
+  const char *algorithm;
+  const char *earth_model;
+  const char *frame;
+  double rate_hz;
+  long long samples;
+  double truth_sps, mech_sps, wall_s;
+  double pos_err_m, vel_err_mps, att_err_rad;
+  double rms_h_m; /* whole-pipeline cases: RMS horizontal error over epochs (and runs) */
+  /* Replay cases: the peers' published figures on the same data (README of the data set). */
+  const char *peer;
+  double peer_wall_s, peer_error_m, error_m;
+  double peak_rss_mb; /* child-process cases: peak resident memory (0: not measured) */
+  double fps;         /* viewer case: frames per second */
+  char note[160];     /* shown in bench.md (e.g. why a case stopped early) */
+  bool ok;
+  char error[256];
+} bench_row;
+
+double bench_now_s(void);
+
+/* Child processes (bench_cases2.c): stdout+stderr into log_path, killed after timeout_s (0: none). */
+typedef struct child_result {
+  bool started, exited_ok, timed_out;
+  int exit_code;
+  double wall_s;
+  double maxrss_mb; /* of the child itself (wait4) */
+} child_result;
+
+child_result bench_run_child(char *const argv[], const char *log_path, double timeout_s);
+/* navview of this build, or NULL; whether an X display is set. */
+const char *bench_navview_exe(void);
+bool bench_have_display(void);
+int bench_make_dir(const char *path);
+bool bench_load_library_scene(const char *name, nav_scene *sc);
+
+/* Closure case: truth generation and mechanization timed separately (bench.c). */
+void bench_scene(const nav_scene *sc, int reps, bench_row *row);
+/* Whole pipeline through nav_sim (bench.c). */
+void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row);
+/* Replay of the shared long drive with the navigation settings of cfg_scene (bench.c). */
+void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, bench_row *row);
+
+/* Cases added by bench_cases2.c after bench.c's own: appends to rows[*n] (capacity cap). */
+void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int cap, bool quiet);
+
+/* Per-stage floating-point operation counts (bench_report.c). */
+typedef struct bench_flops {
+  const char *stage;
+  double flops_per_step; /* NAN: not counted */
+  const char *how;
+} bench_flops;
+
+/* bench.md sections after the table: targets met / not met, FLOPs and peak, memory (bench_report.c). */
+void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *rows, int n, double suite_wall_s);
+/* speed_vs_error.png through navview (bench_report.c); returns a one-line note for bench.md. */
+void bench_report_png(const char *out_dir, char *note, size_t note_size);
+
+/* Hidden `navsim bench --stage NAME --steps N`: run one stage N times (for the FLOP counts). */
+int bench_stage_main(const char *stage, long steps);
+
+#endif /* NAVSIM_BENCH_INTERNAL_H */

@@ -1,0 +1,483 @@
+/*
+ * navsim import FILE --out SCENE.yaml: GPX / KML tracks and gnss-ins-sim motion definitions as
+ * scene trajectories.
+ * navsim export RESULT_DIR --kml --csv: tracks.kml / tracks.csv of a result directory.
+ * navsim run --kml: the same inside the run's (temporary) result directory.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "import_cmd.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "navcore/nav_frames.h"
+#include "navcore/nav_io.h"
+#include "navcore/nav_motiondef.h"
+#include "navcore/nav_track_import.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
+
+static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
+
+typedef struct diag_sink {
+  int count;
+} diag_sink;
+
+static void print_diag(void *user, const nav_diag *d) {
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  fprintf(stderr, "%s\n", line);
+  ((diag_sink *)user)->count++;
+}
+
+static bool parse_pos(const char *s, double *out, bool allow_zero) {
+  if (!s || !*s) return false;
+  char *end = NULL;
+  errno = 0;
+  const double v = strtod(s, &end);
+  if (errno || !end || *end || !isfinite(v) || v < 0 || (!allow_zero && v == 0)) return false;
+  *out = v;
+  return true;
+}
+
+static const char *k_usage_import =
+    "usage: navsim import FILE --out SCENE.yaml [--speed M/S] [--name NAME] [--tolerance M] [--no-time]\n"
+    "                     [--no-merge] [--track NAME] [--format gpx|kml|motion_def] [--template SCENE] [--aircraft]\n"
+    "\n"
+    "Turn a track into a scene trajectory and write a complete scene file:\n"
+    "  GPX (.gpx)   <trk>/<trkseg>/<trkpt lat lon> with <ele> and <time> (or <rtept>)\n"
+    "  KML (.kml)   the first Placemark with a <LineString> or <gx:Track> (when/coord)\n"
+    "  CSV (.csv)   a gnss-ins-sim motion definition (segment script)\n"
+    "GPX/KML tracks become waypoint trajectories on WGS-84 with the origin at the first point: the\n"
+    "track is thinned (Douglas-Peucker, --tolerance, default 5 m) and flown through its points at\n"
+    "the track's speeds (from its times) when every point has a time, else at --speed (default\n"
+    "10 m/s).\n"
+    "The path flies by the interior waypoints with smooth turns within the limits of the scene\n"
+    "defaults (or --template). A turn that does not fit its legs (a dense curve thinned to short\n"
+    "chords) is merged with its neighbour into the corner where their outer legs meet, so the turn\n"
+    "there follows the curve; the largest distance of a track point from the flown path is printed.\n"
+    "Turns that stay infeasible are reported at the track point (FILE:LINE:COL), exit 2.\n"
+    "\n"
+    "options:\n"
+    "  --out FILE       scene file to write (atomically)\n"
+    "  --speed M/S      speed at every waypoint for untimed tracks (or with --no-time)\n"
+    "  --name NAME      scene name (default: the track's name, else the file name)\n"
+    "  --tolerance M    thinning tolerance in metres (0: keep every distinct point)\n"
+    "  --no-merge       report the first infeasible turn instead of merging turns\n"
+    "  --no-time        ignore the track's times; fly it at --speed\n"
+    "  --track NAME     KML: the Placemark with this name\n"
+    "  --format F       gpx, kml or motion_def (default: from the extension or content)\n"
+    "  --template SCENE take IMU, GNSS, navigation, output and simulation from SCENE\n"
+    "  --aircraft       aircraft attitude (coordinated bank in turns) instead of ground\n"
+    "\n"
+    "exit codes: 0 written; 2 invalid file or options; 1 I/O failure\n";
+
+static void base_name(char *out, size_t cap, const char *path) {
+  const char *b = strrchr(path, '/');
+  b = b ? b + 1 : path;
+  snprintf(out, cap, "%s", b);
+  char *dot = strrchr(out, '.');
+  if (dot && dot != out) *dot = '\0';
+}
+
+int navsim_import(int argc, char **argv) {
+  const char *in = NULL, *out = NULL, *name = NULL, *track_name = NULL, *fmt_s = NULL, *templ = NULL;
+  nav_track_import_options opt = nav_track_import_options_default();
+  bool speed_given = false;
+  for (int i = 0; i < argc; ++i) {
+    const char *a = argv[i];
+    if (is_help(a)) {
+      fputs(k_usage_import, stdout);
+      return EXIT_OK;
+    } else if (strcmp(a, "--no-merge") == 0) {
+      opt.max_merges = 0;
+    } else if (strcmp(a, "--no-time") == 0) {
+      opt.use_time = false;
+    } else if (strcmp(a, "--aircraft") == 0) {
+      opt.attitude_mode = NAV_WP_ATT_AIRCRAFT;
+    } else if (strcmp(a, "--out") == 0 || strcmp(a, "--speed") == 0 || strcmp(a, "--name") == 0 ||
+               strcmp(a, "--tolerance") == 0 || strcmp(a, "--track") == 0 || strcmp(a, "--format") == 0 ||
+               strcmp(a, "--template") == 0) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "navsim import: %s needs a value\n", a);
+        return EXIT_INVALID;
+      }
+      const char *v = argv[++i];
+      if (strcmp(a, "--out") == 0) out = v;
+      else if (strcmp(a, "--name") == 0) name = v;
+      else if (strcmp(a, "--track") == 0) track_name = v;
+      else if (strcmp(a, "--format") == 0) fmt_s = v;
+      else if (strcmp(a, "--template") == 0) templ = v;
+      else if (strcmp(a, "--speed") == 0) {
+        if (!parse_pos(v, &opt.speed_mps, false) || opt.speed_mps > 1000.0) {
+          fprintf(stderr, "navsim import: --speed: expected a speed in (0, 1000] m/s, got \"%s\"\n", v);
+          return EXIT_INVALID;
+        }
+        speed_given = true;
+      } else if (!parse_pos(v, &opt.tolerance_m, true) || opt.tolerance_m > 1e5) {
+        fprintf(stderr, "navsim import: --tolerance: expected a distance in [0, 1e5] m, got \"%s\"\n", v);
+        return EXIT_INVALID;
+      }
+    } else if (a[0] == '-' && a[1] != '\0') {
+      fprintf(stderr, "navsim import: unknown option \"%s\" (see navsim import --help)\n", a);
+      return EXIT_INVALID;
+    } else if (!in) {
+      in = a;
+    } else {
+      fprintf(stderr, "navsim import: only one FILE may be given (got \"%s\" and \"%s\")\n", in, a);
+      return EXIT_INVALID;
+    }
+  }
+  if (!in || !out) {
+    fprintf(stderr, "navsim import: %s\n%s", !in ? "missing FILE" : "missing --out SCENE.yaml", k_usage_import);
+    return EXIT_INVALID;
+  }
+  nav_track_format fmt = NAV_TRACK_FORMAT_AUTO;
+  if (fmt_s) {
+    if (strcmp(fmt_s, "gpx") == 0) fmt = NAV_TRACK_FORMAT_GPX;
+    else if (strcmp(fmt_s, "kml") == 0) fmt = NAV_TRACK_FORMAT_KML;
+    else if (strcmp(fmt_s, "motion_def") == 0) fmt = NAV_TRACK_FORMAT_MOTION_DEF;
+    else {
+      fprintf(stderr, "navsim import: --format: expected gpx, kml or motion_def, got \"%s\"\n", fmt_s);
+      return EXIT_INVALID;
+    }
+  }
+  if (name && (strlen(name) == 0 || strlen(name) >= NAV_SCENE_NAME_MAX)) {
+    fprintf(stderr, "navsim import: --name: expected 1 to %d characters\n", NAV_SCENE_NAME_MAX - 1);
+    return EXIT_INVALID;
+  }
+  if (fmt == NAV_TRACK_FORMAT_AUTO) {
+    char head[4096];
+    size_t n = 0;
+    FILE *f = fopen(in, "rb");
+    if (!f) {
+      fprintf(stderr, "%s: error: cannot open: %s\n", in, strerror(errno));
+      return EXIT_FAIL;
+    }
+    n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    fmt = nav_track_format_guess(in, head, n);
+    if (fmt == NAV_TRACK_FORMAT_AUTO) {
+      fprintf(stderr, "%s:1:1: error: unknown track format: expected GPX (.gpx), KML (.kml) or a gnss-ins-sim motion "
+                      "definition (.csv); use --format\n", in);
+      return EXIT_INVALID;
+    }
+  }
+
+  nav_scene *sc = malloc(sizeof *sc);
+  if (!sc) return EXIT_FAIL;
+  int rc = EXIT_OK;
+  diag_sink sink = {0};
+  if (templ) {
+    const nav_status st = nav_scene_read_file(templ, sc, print_diag, &sink);
+    if (st != NAV_OK) {
+      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", templ, nav_status_str(st));
+      free(sc);
+      return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
+    }
+  } else {
+    *sc = nav_scene_default();
+    sc->imu.rate_hz = 100.0;
+    sc->output.rate_hz = 10.0;
+    sc->navigation.algorithm = NAV_MECH_HIGH_ORDER;
+  }
+  sc->earth.model = NAV_EARTH_WGS84;
+  char default_name[NAV_SCENE_NAME_MAX];
+  base_name(default_name, sizeof default_name, in);
+
+  if (fmt == NAV_TRACK_FORMAT_MOTION_DEF) {
+    const nav_status st = nav_motiondef_read_file(in, sc, print_diag, &sink);
+    if (st != NAV_OK) {
+      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
+      rc = st == NAV_ERR_IO ? EXIT_FAIL : EXIT_INVALID;
+      goto done;
+    }
+    snprintf(sc->name, sizeof sc->name, "%s", name ? name : default_name);
+    printf("imported   %s: motion definition, %d segments, %.3f s\n", in, sc->trajectory.segments.count,
+           sc->trajectory.duration_s);
+  } else {
+    nav_geotrack tr = {0};
+    nav_status st = nav_geotrack_read_file(in, fmt, track_name, &tr, print_diag, &sink);
+    if (st != NAV_OK) {
+      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
+      rc = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
+      goto done;
+    }
+    if (!tr.all_timed && opt.use_time && !speed_given && tr.count > 0)
+      fprintf(stderr, "navsim import: %s: the track has no times on every point: flown at %g m/s (--speed)\n", in,
+              opt.speed_mps);
+    nav_track_import_report rep;
+    char msg[1024];
+    st = nav_geotrack_to_scene(&tr, &opt, sc, &rep, msg, sizeof msg);
+    if (st != NAV_OK) {
+      const char *hint = tr.all_timed && opt.use_time
+                             ? "; use a larger --tolerance, or --no-time with a lower --speed"
+                             : "; use a larger --tolerance or a lower --speed";
+      if (rep.bad_point >= 0 && (size_t)rep.bad_point < tr.count)
+        fprintf(stderr, "%s:%d:%d: error: trajectory.waypoints: %s%s\n", in, tr.points[rep.bad_point].line,
+                tr.points[rep.bad_point].col, msg, hint);
+      else
+        fprintf(stderr, "%s: error: trajectory.waypoints: %s%s\n", in, msg[0] ? msg : nav_status_str(st), hint);
+      nav_geotrack_free(&tr);
+      rc = st == NAV_ERR_NO_MEMORY ? EXIT_FAIL : EXIT_INVALID;
+      goto done;
+    }
+    snprintf(sc->name, sizeof sc->name, "%s", name ? name : (tr.name[0] ? tr.name : default_name));
+    for (char *p = sc->name; *p; ++p)
+      if ((unsigned char)*p < 0x20) *p = ' ';
+    printf("imported   %s: %zu points -> %d waypoints (tolerance %g m, %d turn%s merged), %.1f m, %s, %.3f s; "
+           "largest distance of a track point from the flown path %.2f m\n",
+           in, rep.points_in, rep.waypoints, opt.tolerance_m, rep.merged, rep.merged == 1 ? "" : "s", rep.length_m,
+           rep.timed ? "speeds from the track's times" : "constant speed", rep.duration_s, rep.max_dev_m);
+    nav_geotrack_free(&tr);
+  }
+  {
+    const nav_status st = nav_scene_write_file(out, sc);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim import: cannot write \"%s\": %s\n", out, nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto done;
+    }
+    /* The written file must read back as a valid scene. */
+    diag_sink s2 = {0};
+    const nav_status st2 = nav_scene_read_file(out, sc, print_diag, &s2);
+    if (st2 != NAV_OK) {
+      fprintf(stderr, "navsim import: the written scene \"%s\" does not read back: %s\n", out, nav_status_str(st2));
+      rc = EXIT_FAIL;
+      goto done;
+    }
+    printf("scene      %s (%s)\n", out, sc->name);
+  }
+done:
+  free(sc);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------------ export */
+
+typedef struct geo_series {
+  double *t;
+  nav_geodetic *p;
+  size_t n, cap;
+} geo_series;
+
+static void series_free(geo_series *s) {
+  free(s->t);
+  free(s->p);
+  memset(s, 0, sizeof *s);
+}
+
+static bool series_push(geo_series *s, double t, nav_geodetic p) {
+  if (s->n == s->cap) {
+    const size_t cap = s->cap ? 2 * s->cap : 1024;
+    double *t2 = realloc(s->t, cap * sizeof *t2);
+    if (!t2) return false;
+    s->t = t2;
+    nav_geodetic *p2 = realloc(s->p, cap * sizeof *p2);
+    if (!p2) return false;
+    s->p = p2;
+    s->cap = cap;
+  }
+  s->t[s->n] = t;
+  s->p[s->n] = p;
+  s->n++;
+  return true;
+}
+
+/* Read t_s, lat_deg, lon_deg, h_m from a CSV with a header (truth.csv, nav.csv, gnss.csv).
+ * Returns 0, 1 (cannot read), 2 (malformed: FILE:LINE:COL printed). */
+static int read_geo_csv(const char *path, geo_series *s) {
+  FILE *f = fopen(path, "r");
+  if (!f) return 1;
+  char *line = NULL;
+  size_t cap = 0;
+  ssize_t len;
+  int col_idx[4] = {-1, -1, -1, -1};
+  static const char *names[4] = {"t_s", "lat_deg", "lon_deg", "h_m"};
+  int ln = 0, rc = 0;
+  while ((len = getline(&line, &cap, f)) >= 0) {
+    ++ln;
+    while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) line[--len] = '\0';
+    if (ln == 1) {
+      int c = 0;
+      for (char *tok = line, *next; tok; tok = next, ++c) {
+        next = strchr(tok, ',');
+        if (next) *next++ = '\0';
+        for (int k = 0; k < 4; ++k)
+          if (strcmp(tok, names[k]) == 0) col_idx[k] = c;
+      }
+      for (int k = 0; k < 4; ++k)
+        if (col_idx[k] < 0) {
+          fprintf(stderr, "%s:1:1: error: header: expected a column %s\n", path, names[k]);
+          rc = 2;
+        }
+      if (rc) break;
+      continue;
+    }
+    if (len == 0) continue;
+    double v[4] = {NAN, NAN, NAN, NAN};
+    int c = 0;
+    char *p = line;
+    for (;;) {
+      char *comma = strchr(p, ',');
+      for (int k = 0; k < 4; ++k)
+        if (col_idx[k] == c) {
+          char *end = NULL;
+          v[k] = strtod(p, &end);
+          if (end == p || (end && *end != ',' && *end != '\0') || !isfinite(v[k])) {
+            fprintf(stderr, "%s:%d:%d: error: %s: expected a finite number\n", path, ln, (int)(p - line) + 1, names[k]);
+            rc = 2;
+          }
+        }
+      if (!comma || rc) break;
+      p = comma + 1;
+      ++c;
+    }
+    if (rc) break;
+    for (int k = 0; k < 4; ++k)
+      if (isnan(v[k])) {
+        fprintf(stderr, "%s:%d:%d: error: %s: missing column\n", path, ln, (int)len + 1, names[k]);
+        rc = 2;
+      }
+    if (rc) break;
+    if (!series_push(s, v[0], (nav_geodetic){v[1] * NAV_DEG2RAD, v[2] * NAV_DEG2RAD, v[3]})) {
+      rc = 1;
+      break;
+    }
+  }
+  free(line);
+  fclose(f);
+  return rc;
+}
+
+/* Write tracks.kml / tracks.csv of a directory (files named by @p file_of). */
+typedef const char *(*file_fn)(void *ctx, const char *name);
+
+static int write_tracks(file_fn file_of, void *ctx, const char *label, bool kml, bool csv) {
+  geo_series ref = {0}, est = {0}, gnss = {0};
+  int rc = 0;
+  const char *path = file_of(ctx, "truth.csv");
+  int r = path ? read_geo_csv(path, &ref) : 1;
+  if (r == 1) fprintf(stderr, "navsim: cannot read %s\n", path ? path : "truth.csv");
+  if (r) rc = r;
+  path = file_of(ctx, "nav.csv");
+  r = (rc == 0 && path) ? read_geo_csv(path, &est) : rc ? rc : 1;
+  if (r == 1 && rc == 0) fprintf(stderr, "navsim: cannot read %s\n", path ? path : "nav.csv");
+  if (r && !rc) rc = r;
+  if (!rc) {
+    path = file_of(ctx, "gnss.csv");
+    FILE *probe = path ? fopen(path, "r") : NULL;
+    if (probe) {
+      fclose(probe);
+      rc = read_geo_csv(path, &gnss);
+    }
+  }
+  if (!rc) {
+    nav_kml_track t[3];
+    size_t nt = 0;
+    t[nt++] = (nav_kml_track){"reference", "ff00ff00", 3.0, false, ref.t, ref.p, ref.n};
+    t[nt++] = (nav_kml_track){"estimate (run 0)", "ff0000ff", 2.0, false, est.t, est.p, est.n};
+    if (gnss.n > 0) t[nt++] = (nav_kml_track){"GNSS fixes (run 0)", "ff00ffff", 1.0, true, gnss.t, gnss.p, gnss.n};
+    if (kml) {
+      const char *kp = file_of(ctx, "tracks.kml");
+      const nav_status st = kp ? nav_kml_write_file(kp, label, t, nt, 20000) : NAV_ERR_INVALID_ARG;
+      if (st != NAV_OK) {
+        fprintf(stderr, "navsim: writing tracks.kml failed: %s\n", nav_status_str(st));
+        rc = 1;
+      }
+    }
+    if (csv && !rc) {
+      const char *cp = file_of(ctx, "tracks.csv");
+      const nav_status st = cp ? nav_tracks_csv_write_file(cp, t, nt) : NAV_ERR_INVALID_ARG;
+      if (st != NAV_OK) {
+        fprintf(stderr, "navsim: writing tracks.csv failed: %s\n", nav_status_str(st));
+        rc = 1;
+      }
+    }
+  }
+  series_free(&ref);
+  series_free(&est);
+  series_free(&gnss);
+  return rc;
+}
+
+static const char *rd_file(void *ctx, const char *name) { return nav_resultdir_file((nav_resultdir *)ctx, name); }
+
+/* The document name of a result directory's tracks: its last path component. */
+static const char *dir_label(const char *dir) {
+  static char buf[512];
+  snprintf(buf, sizeof buf, "%s", dir);
+  size_t n = strlen(buf);
+  while (n > 1 && buf[n - 1] == '/') buf[--n] = '\0';
+  const char *slash = strrchr(buf, '/');
+  return (slash && slash[1]) ? slash + 1 : buf;
+}
+
+int navsim_run_tracks(nav_resultdir *rd, const char *out_dir) {
+  /* gnss.csv (the receiver's fixes of run 0, INS/GNSS scenes) is already in the directory. */
+  return write_tracks(rd_file, rd, dir_label(out_dir), true, true) ? 1 : 0;
+}
+
+static const char *k_usage_export =
+    "usage: navsim export RESULT_DIR [--kml] [--csv]\n"
+    "\n"
+    "Write the tracks of a result directory of navsim run: the reference (truth.csv), the\n"
+    "estimate of run 0 (nav.csv) and, when present, the GNSS fixes of run 0 (gnss.csv, written by\n"
+    "navsim run --kml) as\n"
+    "  tracks.kml  KML 2.2 for Google Earth: reference (green line), estimate (red line), GNSS\n"
+    "              fixes (yellow points); lines thinned to at most 20000 vertices\n"
+    "  tracks.csv  track,t_s,lat_deg,lon_deg,h_m (every point)\n"
+    "Without --kml or --csv both are written. Files are replaced atomically.\n"
+    "\n"
+    "exit codes: 0 written; 2 invalid options or malformed files; 1 unreadable directory or I/O failure\n";
+
+typedef struct dir_ctx {
+  const char *dir;
+  char buf[4200];
+} dir_ctx;
+
+static const char *dir_file(void *ctx, const char *name) {
+  dir_ctx *d = ctx;
+  const int n = snprintf(d->buf, sizeof d->buf, "%s/%s", d->dir, name);
+  return (n < 0 || n >= (int)sizeof d->buf) ? NULL : d->buf;
+}
+
+int navsim_export(int argc, char **argv) {
+  const char *dir = NULL;
+  bool kml = false, csv = false;
+  for (int i = 0; i < argc; ++i) {
+    const char *a = argv[i];
+    if (is_help(a)) {
+      fputs(k_usage_export, stdout);
+      return EXIT_OK;
+    } else if (strcmp(a, "--kml") == 0) {
+      kml = true;
+    } else if (strcmp(a, "--csv") == 0) {
+      csv = true;
+    } else if (a[0] == '-' && a[1] != '\0') {
+      fprintf(stderr, "navsim export: unknown option \"%s\" (see navsim export --help)\n", a);
+      return EXIT_INVALID;
+    } else if (!dir) {
+      dir = a;
+    } else {
+      fprintf(stderr, "navsim export: only one RESULT_DIR may be given\n");
+      return EXIT_INVALID;
+    }
+  }
+  if (!dir) {
+    fprintf(stderr, "navsim export: missing RESULT_DIR\n%s", k_usage_export);
+    return EXIT_INVALID;
+  }
+  if (!kml && !csv) kml = csv = true;
+  dir_ctx ctx = {dir, ""};
+  const int rc = write_tracks(dir_file, &ctx, dir_label(dir), kml, csv);
+  if (rc == 0) {
+    if (kml) printf("written    %s/tracks.kml\n", dir);
+    if (csv) printf("written    %s/tracks.csv\n", dir);
+  }
+  return rc;
+}

@@ -1,0 +1,692 @@
+/*
+ * navsim render / navsim report (see report_cmd.h).
+ *
+ * Both drive the viewer program navview (built with -DNAV_BUILD_VIEWER=ON; NAVVIEW_EXE, else
+ * navview on PATH). Without DISPLAY every navview call runs under `xvfb-run -a`.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "report_cmd.h"
+
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "navcore/nav_version.h"
+
+enum { RC_OK = 0, RC_FAIL = 1, RC_INVALID = 2 };
+
+#ifdef NAVVIEW_EXE
+static const char *k_viewer = NAVVIEW_EXE;
+#else
+static const char *k_viewer = "navview";
+#endif
+
+static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
+
+static bool need_xvfb(void) {
+  const char *d = getenv("DISPLAY");
+  return d == NULL || d[0] == '\0';
+}
+
+static bool is_dir(const char *p) {
+  struct stat st;
+  return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+static bool is_file(const char *p) {
+  struct stat st;
+  return stat(p, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static long file_size(const char *p) {
+  struct stat st;
+  return stat(p, &st) == 0 && S_ISREG(st.st_mode) ? (long)st.st_size : -1;
+}
+
+/* argv of a navview call, with the xvfb-run prefix when needed. */
+typedef struct argvec {
+  char *a[96];
+  int n;
+} argvec;
+
+static void av_init(argvec *v) {
+  v->n = 0;
+  if (need_xvfb()) {
+    v->a[v->n++] = "xvfb-run";
+    v->a[v->n++] = "-a";
+    v->a[v->n++] = "-s";
+    v->a[v->n++] = "-screen 0 1920x1200x24";
+  }
+  v->a[v->n++] = (char *)k_viewer;
+  v->a[v->n] = NULL;
+}
+
+static void av_add(argvec *v, const char *s) {
+  if (v->n < 94) {
+    v->a[v->n++] = (char *)s;
+    v->a[v->n] = NULL;
+  }
+}
+
+/* Run a child to completion; its exit code, or 1 when it cannot start or dies. */
+static int run_child(char **args, bool quiet_stdout) {
+  fflush(stdout);
+  fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) {
+    fprintf(stderr, "navsim: cannot fork: %s\n", strerror(errno));
+    return RC_FAIL;
+  }
+  if (pid == 0) {
+    if (quiet_stdout) {
+      FILE *dn = freopen("/dev/null", "w", stdout);
+      (void)dn;
+    }
+    execvp(args[0], args);
+    fprintf(stderr, "navsim: cannot start %s: %s%s\n", args[0], strerror(errno),
+            need_xvfb() ? " (no DISPLAY: xvfb-run is needed)" : "");
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return RC_FAIL;
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status) == 127 ? RC_FAIL : WEXITSTATUS(status);
+  fprintf(stderr, "navsim: %s ended abnormally\n", args[0]);
+  return RC_FAIL;
+}
+
+/* Path to this navsim executable, for `navsim run` on a scene given to render. */
+static void self_exe(char *buf, size_t cap, const char *argv0) {
+  const ssize_t n = readlink("/proc/self/exe", buf, cap - 1);
+  if (n > 0) buf[n] = '\0';
+  else snprintf(buf, cap, "%s", argv0 ? argv0 : "navsim");
+}
+
+static const char *k_usage_render =
+    "usage: navsim render RESULT_DIR|SCENE [--view VIEW] [--out FILE.png] [--size WxH] [--time T_S]\n"
+    "                     [navview options]\n"
+    "\n"
+    "Render one view of a result directory of navsim run with the VTK viewer (navview):\n"
+    "  3d      reference and estimated paths, GNSS fixes and outages, attitude triads, error tube\n"
+    "          and covariance ellipsoids, vehicle, grid with scale, legend (default)\n"
+    "  top     the 3D view from above, estimate coloured by horizontal error\n"
+    "  map     geodetic map: tracks over an offline background, graticule, scale bar\n"
+    "  errors  error-vs-time charts with k-sigma bands and requirement limits\n"
+    "  noise   simulated sensor errors (imu_errors.csv)\n"
+    "  allan   Allan deviation of DIR/allan.csv (navsim allan --out DIR)\n"
+    "  bench   speed against error of DIR/bench.csv (navsim bench --out DIR)\n"
+    "--out defaults to RESULT_DIR/VIEW.png. A SCENE file is run first (navsim run --out\n"
+    "out/render-<file stem>). Without --view and --out (and with --png/--chart) the old form\n"
+    "writes RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
+    "(navview --help: --exaggerate, --envelope, --ellipsoids, --vehicle, --map-span, ...).\n"
+    "Rendering needs an X server: without DISPLAY it runs under xvfb-run.\n"
+    "\n"
+    "exit codes: those of navview: 0 success, 2 bad options, 1 unreadable result directory or other failure\n";
+
+int navsim_render(int argc, char **argv) {
+  if (argc < 1 || is_help(argv[0])) {
+    fputs(k_usage_render, argc < 1 ? stderr : stdout);
+    return argc < 1 ? RC_INVALID : RC_OK;
+  }
+  const char *view = NULL, *out = NULL;
+  bool has_png = false, has_chart = false;
+  argvec v;
+  av_init(&v);
+  const int base = v.n;
+  (void)base;
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s", argv[0]);
+  for (int i = 1; i < argc; ++i) {
+    if (is_help(argv[i])) {
+      fputs(k_usage_render, stdout);
+      return RC_OK;
+    }
+    if ((strcmp(argv[i], "--view") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 >= argc) {
+      fprintf(stderr, "navsim render: %s needs a value\n", argv[i]);
+      return RC_INVALID;
+    }
+    if (strcmp(argv[i], "--view") == 0) view = argv[++i];
+    else if (strcmp(argv[i], "--out") == 0) out = argv[++i];
+    else if (strcmp(argv[i], "--png") == 0) has_png = true;
+    else if (strcmp(argv[i], "--chart") == 0) has_chart = true;
+  }
+  if (view && strcmp(view, "3d") != 0 && strcmp(view, "top") != 0 && strcmp(view, "map") != 0 &&
+      strcmp(view, "errors") != 0 && strcmp(view, "noise") != 0 && strcmp(view, "allan") != 0 &&
+      strcmp(view, "bench") != 0) {
+    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan or bench, got \"%s\"\n", view);
+    return RC_INVALID;
+  }
+  /* A scene file: run it first. */
+  if (is_file(argv[0])) {
+    const char *base_name = strrchr(argv[0], '/');
+    base_name = base_name ? base_name + 1 : argv[0];
+    char stem[256];
+    snprintf(stem, sizeof stem, "%s", base_name);
+    char *dot = strrchr(stem, '.');
+    if (dot) *dot = '\0';
+    snprintf(dir, sizeof dir, "out/render-%s", stem);
+    char exe[4096];
+    self_exe(exe, sizeof exe, "navsim");
+    char *run_args[] = {exe, "run", argv[0], "--out", dir, "--quiet", NULL};
+    const int rc = run_child(run_args, false);
+    if (rc != 0) return rc;
+  } else if (!is_dir(argv[0])) {
+    fprintf(stderr, "%s: error: not a result directory or scene file\n", argv[0]);
+    return RC_FAIL;
+  }
+
+  char out_buf[4200], in_buf[4200], png2[4200];
+  const bool legacy = !view && !out;
+  if (legacy && !has_png && !has_chart) {
+    /* The old default: the 3D view and the error charts. */
+    snprintf(out_buf, sizeof out_buf, "%s/view.png", dir);
+    snprintf(png2, sizeof png2, "%s/errors.png", dir);
+    av_add(&v, dir);
+    for (int i = 1; i < argc; ++i)
+      av_add(&v, argv[i]);
+    av_add(&v, "--png");
+    av_add(&v, out_buf);
+    av_add(&v, "--chart");
+    av_add(&v, png2);
+    return run_child(v.a, false);
+  }
+  if (!view) view = "3d";
+  if (!out) {
+    snprintf(out_buf, sizeof out_buf, "%s/%s.png", dir, view);
+    out = out_buf;
+  }
+  if (strcmp(view, "allan") == 0 || strcmp(view, "bench") == 0) {
+    snprintf(in_buf, sizeof in_buf, "%s/%s.csv", dir, view);
+    av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : "--speed-vs-error");
+    av_add(&v, in_buf);
+  } else {
+    av_add(&v, dir);
+    av_add(&v, "--view");
+    av_add(&v, view);
+  }
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--view") == 0 || strcmp(argv[i], "--out") == 0) {
+      ++i;
+      continue;
+    }
+    av_add(&v, argv[i]);
+  }
+  av_add(&v, "--png");
+  av_add(&v, out);
+  return run_child(v.a, false);
+}
+
+/* ------------------------------------------------------------------------------------ report */
+
+static char *read_all(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 1 << 16, n = 0;
+  char *b = malloc(cap + 1);
+  while (b) {
+    const size_t r = fread(b + n, 1, cap - n, f);
+    n += r;
+    if (n < cap) break;
+    cap *= 2;
+    char *nb = realloc(b, cap + 1);
+    if (!nb) {
+      free(b);
+      b = NULL;
+    }
+    b = nb;
+  }
+  fclose(f);
+  if (!b) return NULL;
+  b[n] = '\0';
+  if (len) *len = n;
+  return b;
+}
+
+static void html_escape(FILE *f, const char *s, size_t n) {
+  for (size_t i = 0; i < n && s[i]; ++i) {
+    const char c = s[i];
+    if (c == '<') fputs("&lt;", f);
+    else if (c == '>') fputs("&gt;", f);
+    else if (c == '&') fputs("&amp;", f);
+    else if (c == '"') fputs("&quot;", f);
+    else fputc(c, f);
+  }
+}
+
+static void html_text(FILE *f, const char *s) { html_escape(f, s, strlen(s)); }
+
+static void base64(FILE *f, const unsigned char *p, size_t n) {
+  static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  for (size_t i = 0; i < n; i += 3) {
+    const unsigned v = (unsigned)p[i] << 16 | (i + 1 < n ? (unsigned)p[i + 1] << 8 : 0u) | (i + 2 < n ? p[i + 2] : 0u);
+    fputc(t[(v >> 18) & 63], f);
+    fputc(t[(v >> 12) & 63], f);
+    fputc(i + 1 < n ? t[(v >> 6) & 63] : '=', f);
+    fputc(i + 2 < n ? t[v & 63] : '=', f);
+  }
+}
+
+/* The string value of "key" at or after p (within a JSON text written by navsim). */
+static bool json_str(const char *p, const char *key, char *out, size_t cap) {
+  char k[128];
+  snprintf(k, sizeof k, "\"%s\"", key);
+  const char *q = p ? strstr(p, k) : NULL;
+  if (!q) return false;
+  q = strchr(q + strlen(k), ':');
+  if (!q) return false;
+  while (*++q == ' ') {
+  }
+  if (*q != '"') return false;
+  ++q;
+  size_t n = 0;
+  while (*q && *q != '"' && n + 1 < cap) {
+    if (*q == '\\' && q[1]) ++q;
+    out[n++] = *q++;
+  }
+  out[n] = '\0';
+  return true;
+}
+
+static bool json_num(const char *p, const char *key, double *out) {
+  char k[128];
+  snprintf(k, sizeof k, "\"%s\"", key);
+  const char *q = p ? strstr(p, k) : NULL;
+  if (!q) return false;
+  q = strchr(q + strlen(k), ':');
+  if (!q) return false;
+  char *end = NULL;
+  const double v = strtod(q + 1, &end);
+  if (end == q + 1) return false;
+  *out = v;
+  return true;
+}
+
+/* The text of the object or array that follows "key", up to its matching bracket (copied). */
+static char *json_block(const char *text, const char *key) {
+  char k[128];
+  snprintf(k, sizeof k, "\"%s\"", key);
+  const char *q = strstr(text, k);
+  if (!q) return NULL;
+  q = strchr(q + strlen(k), ':');
+  if (!q) return NULL;
+  while (*++q == ' ') {
+  }
+  if (*q != '{' && *q != '[') return NULL;
+  int depth = 0;
+  bool str = false;
+  for (const char *e = q; *e; ++e) {
+    if (str) {
+      if (*e == '\\' && e[1]) ++e;
+      else if (*e == '"') str = false;
+      continue;
+    }
+    if (*e == '"') str = true;
+    else if (*e == '{' || *e == '[') ++depth;
+    else if ((*e == '}' || *e == ']') && --depth == 0) {
+      const size_t n = (size_t)(e - q) + 1;
+      char *b = malloc(n + 1);
+      if (!b) return NULL;
+      memcpy(b, q, n);
+      b[n] = '\0';
+      return b;
+    }
+  }
+  return NULL;
+}
+
+typedef struct figure {
+  const char *key;   /* file stem */
+  const char *title; /* caption */
+  const char *what;  /* one-line explanation */
+  bool ok;
+} figure;
+
+static const char *k_usage_report =
+    "usage: navsim report RESULT_DIR [--out DIR|FILE.html] [--size WxH]\n"
+    "\n"
+    "Write an HTML page about a result directory of navsim run, for presentations: the scene\n"
+    "summary, the statistics table, the requirement verdicts (summary.json \"requirements\") and\n"
+    "every figure the directory supports (3D view, plan view coloured by error, map, error charts,\n"
+    "simulated sensor errors, and allan.csv / bench.csv when present), rendered by navview.\n"
+    "The page is self-contained (figures embedded); the PNG files are kept next to it.\n"
+    "--out: a directory (the page is DIR/report.html) or a FILE.html (figures in its directory);\n"
+    "default RESULT_DIR/report/. Rendering needs an X server: without DISPLAY, xvfb-run.\n"
+    "\n"
+    "exit codes: 0 success; 1 a figure or the page could not be written; 2 bad command line\n";
+
+static int mkdir_p(const char *path) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s", path);
+  for (char *p = tmp + 1; *p; ++p)
+    if (*p == '/') {
+      *p = '\0';
+      if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+      *p = '/';
+    }
+  if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+  return 0;
+}
+
+int navsim_report(int argc, char **argv) {
+  if (argc < 1 || is_help(argv[0])) {
+    fputs(k_usage_report, argc < 1 ? stderr : stdout);
+    return argc < 1 ? RC_INVALID : RC_OK;
+  }
+  const char *dir = argv[0], *out = NULL, *size = "1200x800";
+  for (int i = 1; i < argc; ++i) {
+    if (is_help(argv[i])) {
+      fputs(k_usage_report, stdout);
+      return RC_OK;
+    } else if ((strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--size") == 0) && i + 1 < argc) {
+      if (argv[i][2] == 'o') out = argv[++i];
+      else size = argv[++i];
+    } else {
+      fprintf(stderr, "navsim report: unknown or incomplete option \"%s\" (see navsim report --help)\n", argv[i]);
+      return RC_INVALID;
+    }
+  }
+  if (!is_dir(dir)) {
+    fprintf(stderr, "%s: error: not a result directory (navsim run --out DIR writes one)\n", dir);
+    return RC_FAIL;
+  }
+  char out_dir[4096], page[4300], tmp_page[4400];
+  const size_t ol = out ? strlen(out) : 0;
+  if (out && ol > 5 && strcmp(out + ol - 5, ".html") == 0) {
+    snprintf(page, sizeof page, "%s", out);
+    snprintf(out_dir, sizeof out_dir, "%s", out);
+    char *slash = strrchr(out_dir, '/');
+    if (slash) *slash = '\0';
+    else snprintf(out_dir, sizeof out_dir, ".");
+  } else {
+    snprintf(out_dir, sizeof out_dir, "%s", out ? out : dir);
+    if (!out) strncat(out_dir, "/report", sizeof out_dir - strlen(out_dir) - 1);
+    snprintf(page, sizeof page, "%s/report.html", out_dir);
+  }
+  if (mkdir_p(out_dir) != 0) {
+    fprintf(stderr, "navsim report: cannot create \"%s\": %s\n", out_dir, strerror(errno));
+    return RC_FAIL;
+  }
+
+  char path[4300], in_csv[4300];
+  snprintf(path, sizeof path, "%s/summary.json", dir);
+  char *summary = read_all(path, NULL);
+  snprintf(path, sizeof path, "%s/imu_errors.csv", dir);
+  const bool have_imu = is_file(path);
+  snprintf(path, sizeof path, "%s/allan.csv", dir);
+  const bool have_allan = is_file(path);
+  snprintf(path, sizeof path, "%s/bench.csv", dir);
+  const bool have_bench = is_file(path);
+  snprintf(path, sizeof path, "%s/truth.csv", dir);
+  const bool have_truth = is_file(path);
+
+  figure figs[] = {
+      {"3d", "3D view", "Reference (black) and estimated path (red), GNSS fixes (green) and outages (pink), "
+                        "attitude triads (error exaggerated 20\xc3\x97), error-envelope tube and covariance "
+                        "ellipsoids, the vehicle at the end of the run.", false},
+      {"top", "Plan view, estimate coloured by horizontal error", "The estimated path coloured by the "
+                                                                  "horizontal error of run 0, with its scale.", false},
+      {"map", "Geodetic map", "Tracks in latitude/longitude over the offline background (Natural Earth / "
+                              "GSHHS), graticule or local metric grid, scale bar.", false},
+      {"map-region", "Geodetic map, regional scale", "Where the run is: 600 km across.", false},
+      {"errors", "Errors against time", "Run 0 with the k\xcf\x83 bands (Monte Carlo RMS, filter \xcf\x83, "
+                                        "covariance analysis) and the requirement limits.", false},
+      {"noise", "Simulated sensor errors", "Measured minus ideal IMU output of run 0 (gyros, accelerometers).",
+       false},
+      {"allan", "Allan deviation", "Log-log, with slope guides.", false},
+      {"bench", "Speed against error", "navsim bench: one marker per variant.", false},
+  };
+  const int nfig = (int)(sizeof figs / sizeof figs[0]);
+  int failures = 0;
+  for (int k = 0; k < nfig; ++k) {
+    figure *fg = &figs[k];
+    const bool applicable = (strcmp(fg->key, "noise") == 0   ? have_imu
+                             : strcmp(fg->key, "allan") == 0 ? have_allan
+                             : strcmp(fg->key, "bench") == 0 ? have_bench
+                                                             : have_truth);
+    if (!applicable) continue;
+    snprintf(path, sizeof path, "%s/%s.png", out_dir, fg->key);
+    argvec v;
+    av_init(&v);
+    if (strcmp(fg->key, "allan") == 0 || strcmp(fg->key, "bench") == 0) {
+      snprintf(in_csv, sizeof in_csv, "%s/%s.csv", dir, fg->key);
+      av_add(&v, fg->key[0] == 'a' ? "--allan" : "--speed-vs-error");
+      av_add(&v, in_csv);
+    } else {
+      av_add(&v, dir);
+      av_add(&v, "--view");
+      av_add(&v, strcmp(fg->key, "map-region") == 0 ? "map" : fg->key);
+      if (strcmp(fg->key, "3d") == 0) {
+        av_add(&v, "--exaggerate");
+        av_add(&v, "20");
+      } else if (strcmp(fg->key, "top") == 0) {
+        av_add(&v, "--color-by-error");
+      } else if (strcmp(fg->key, "map-region") == 0) {
+        av_add(&v, "--map-span");
+        av_add(&v, "600");
+      }
+    }
+    av_add(&v, "--size");
+    av_add(&v, size);
+    av_add(&v, "--png");
+    av_add(&v, path);
+    const int rc = run_child(v.a, true);
+    fg->ok = rc == 0 && file_size(path) > 1000;
+    if (!fg->ok) {
+      fprintf(stderr, "navsim report: figure %s failed (navview exit %d)\n", fg->key, rc);
+      ++failures;
+    }
+  }
+
+  snprintf(tmp_page, sizeof tmp_page, "%s.tmp-%ld", page, (long)getpid());
+  FILE *f = fopen(tmp_page, "w");
+  if (!f) {
+    fprintf(stderr, "navsim report: cannot write \"%s\": %s\n", tmp_page, strerror(errno));
+    free(summary);
+    return RC_FAIL;
+  }
+  char name[512] = "", buf[512];
+  if (!summary || !json_str(strstr(summary, "\"scene\""), "name", name, sizeof name)) {
+    const char *s = strrchr(dir, '/');
+    snprintf(name, sizeof name, "%s", s && s[1] ? s + 1 : dir);
+  }
+  fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>navsim report: ", f);
+  html_text(f, name);
+  fputs("</title>\n<style>\nbody{font-family:'DejaVu Sans',sans-serif;margin:2em auto;max-width:1250px;color:#112;}\n"
+        "h1{font-size:1.6em;margin-bottom:0.2em}h2{font-size:1.25em;margin-top:1.6em;border-bottom:1px solid #ccd}\n"
+        "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #ccd;padding:0.25em 0.7em;"
+        "text-align:right}th{background:#eef0f6}td.l,th.l{text-align:left}\n.pass{color:#070;font-weight:bold}"
+        ".fail{color:#b00;font-weight:bold}\nfigure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #dde}"
+        "figcaption{color:#334;margin-top:0.3em}\npre{background:#f6f7fa;padding:0.8em;overflow:auto;font-size:0.85em}"
+        "\n</style>\n<script>\n"
+        "/* Marks every figure as loaded (naturalWidth > 0) for the headless check. */\n"
+        "window.addEventListener('load', function () {\n"
+        "  var n = 0; for (var i = 0; i < document.images.length; ++i) {\n"
+        "    var im = document.images[i]; var ok = im.complete && im.naturalWidth > 0;\n"
+        "    im.setAttribute('data-loaded', ok ? 'yes' : 'no'); if (ok) ++n; }\n"
+        "  document.body.setAttribute('data-images-loaded', String(n));\n"
+        "});\n</script>\n</head><body>\n",
+        f);
+  fputs("<h1>", f);
+  html_text(f, name);
+  fputs("</h1>\n<p>navsim ", f);
+  html_text(f, nav_version_string());
+  fputs(" report of <code>", f);
+  html_text(f, dir);
+  fputs("</code></p>\n", f);
+
+  /* Scene summary. */
+  fputs("<h2>Scene</h2>\n<table>\n", f);
+  static const char *skeys[] = {"seed", "runs", "earth_model", "gravity_model", "algorithm", "mechanization_frame",
+                                "trajectory", "duration_s", "imu_rate_hz", "output_rate_hz"};
+  if (summary) {
+    for (size_t i = 0; i < sizeof skeys / sizeof skeys[0]; ++i) {
+      double x;
+      if (json_str(summary, skeys[i], buf, sizeof buf)) {
+      } else if (json_num(summary, skeys[i], &x)) {
+        snprintf(buf, sizeof buf, "%.10g", x);
+      } else {
+        continue;
+      }
+      fprintf(f, "<tr><th class=\"l\">%s</th><td class=\"l\">", skeys[i]);
+      html_text(f, buf);
+      fputs("</td></tr>\n", f);
+    }
+  } else {
+    fputs("<tr><td class=\"l\">summary.json not found</td></tr>\n", f);
+  }
+  fputs("</table>\n", f);
+
+  /* Statistics. */
+  char *stats = summary ? json_block(summary, "stats") : NULL;
+  if (stats) {
+    static const struct {
+      const char *key, *label, *unit;
+    } rows[] = {{"pos_err_h_m", "horizontal position", "m"},
+                {"pos_err_v_m", "vertical position", "m"},
+                {"vel_err_mps", "velocity", "m/s"},
+                {"att_err_rad", "attitude", "rad"},
+                {"yaw_err_rad", "yaw", "rad"}};
+    fputs("<h2>Error statistics</h2>\n<p>Over every run and epoch (summary.json <code>stats</code>).</p>\n"
+          "<table>\n<tr><th class=\"l\">error</th><th>RMS</th><th>max</th><th>95 %</th><th class=\"l\">unit</th>"
+          "</tr>\n",
+          f);
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+      char *blk = json_block(stats, rows[i].key);
+      if (!blk) continue;
+      double rms = 0, mx = 0, p95 = 0;
+      json_num(blk, "rms", &rms);
+      json_num(blk, "max", &mx);
+      json_num(blk, "p95", &p95);
+      fprintf(f, "<tr><td class=\"l\">%s</td><td>%.4g</td><td>%.4g</td><td>%.4g</td><td class=\"l\">%s</td></tr>\n",
+              rows[i].label, rms, mx, p95, rows[i].unit);
+      free(blk);
+    }
+    fputs("</table>\n", f);
+    char *fin = json_block(summary, "final");
+    char *finr = json_block(summary, "final_rms_over_runs");
+    if (fin) {
+      double h = 0, vv = 0, ve = 0, at = 0;
+      json_num(fin, "pos_err_h_m", &h);
+      json_num(fin, "pos_err_v_m", &vv);
+      json_num(fin, "vel_err_mps", &ve);
+      json_num(fin, "att_err_rad", &at);
+      fprintf(f, "<p>Final errors of run 0: horizontal %.4g m, vertical %.4g m, velocity %.4g m/s, attitude %.4g rad",
+              h, vv, ve, at);
+      if (finr && json_num(finr, "pos_err_h_m", &h) && json_num(finr, "pos_err_v_m", &vv))
+        fprintf(f, "; RMS over runs: horizontal %.4g m, vertical %.4g m", h, vv);
+      fputs(".</p>\n", f);
+    }
+    free(fin);
+    free(finr);
+    free(stats);
+  }
+
+  /* Requirement verdicts. */
+  fputs("<h2>Requirements</h2>\n", f);
+  char *req = summary ? json_block(summary, "requirements") : NULL;
+  int nreq = 0, nfail = 0;
+  if (req) {
+    const char *p = req + 1;
+    int depth = 0;
+    const char *obj = NULL;
+    bool str = false;
+    for (; *p; ++p) {
+      if (str) {
+        if (*p == '\\' && p[1]) ++p;
+        else if (*p == '"') str = false;
+        continue;
+      }
+      if (*p == '"') str = true;
+      else if (*p == '{' || *p == '[') {
+        if (depth++ == 0 && *p == '{') obj = p;
+      } else if (*p == '}' || *p == ']') {
+        if (depth == 0) break;
+        if (--depth == 0 && *p == '}' && obj) {
+          const size_t n = (size_t)(p - obj) + 1;
+          char *o = malloc(n + 1);
+          if (!o) break;
+          memcpy(o, obj, n);
+          o[n] = '\0';
+          char id[128] = "", metric[64] = "", stat[64] = "", unit[32] = "";
+          double limit = 0, value = 0;
+          json_str(o, "id", id, sizeof id);
+          json_str(o, "metric", metric, sizeof metric);
+          json_str(o, "statistic", stat, sizeof stat);
+          json_str(o, "unit", unit, sizeof unit);
+          json_num(o, "limit", &limit);
+          const bool have_value = json_num(o, "value", &value);
+          const char *ps = strstr(o, "\"pass\"");
+          const bool pass = ps && strncmp(ps + 6 + strspn(ps + 6, ": "), "true", 4) == 0;
+          if (nreq == 0)
+            fputs("<table>\n<tr><th class=\"l\">id</th><th class=\"l\">metric</th><th class=\"l\">statistic</th>"
+                  "<th>value</th><th>limit</th><th class=\"l\">unit</th><th class=\"l\">verdict</th></tr>\n",
+                  f);
+          fputs("<tr><td class=\"l\">", f);
+          html_text(f, id);
+          fputs("</td><td class=\"l\">", f);
+          html_text(f, metric);
+          fputs("</td><td class=\"l\">", f);
+          html_text(f, stat);
+          if (have_value) fprintf(f, "</td><td>%.4g</td>", value);
+          else fputs("</td><td>&ndash;</td>", f);
+          fprintf(f, "<td>%.4g</td><td class=\"l\">", limit);
+          html_text(f, unit);
+          fprintf(f, "</td><td class=\"l %s\">%s</td></tr>\n", pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+          ++nreq;
+          if (!pass) ++nfail;
+          free(o);
+          obj = NULL;
+        }
+      }
+    }
+    if (nreq > 0) fprintf(f, "</table>\n<p>%d of %d requirements met.</p>\n", nreq - nfail, nreq);
+    free(req);
+  }
+  if (nreq == 0) fputs("<p>The scene states no requirements.</p>\n", f);
+
+  /* Figures, embedded. */
+  fputs("<h2>Figures</h2>\n", f);
+  for (int k = 0; k < nfig; ++k) {
+    if (!figs[k].ok) continue;
+    snprintf(path, sizeof path, "%s/%s.png", out_dir, figs[k].key);
+    size_t n = 0;
+    char *png = read_all(path, &n);
+    if (!png) continue;
+    fprintf(f, "<figure id=\"fig-%s\"><img alt=\"", figs[k].key);
+    html_text(f, figs[k].title);
+    fputs("\" src=\"data:image/png;base64,", f);
+    base64(f, (const unsigned char *)png, n);
+    fputs("\"><figcaption><b>", f);
+    html_text(f, figs[k].title);
+    fputs(".</b> ", f);
+    html_text(f, figs[k].what);
+    fprintf(f, " (<code>%s.png</code>)</figcaption></figure>\n", figs[k].key);
+    free(png);
+  }
+  if (summary) {
+    fputs("<h2>summary.json</h2>\n<details><summary>show</summary><pre>", f);
+    html_text(f, summary);
+    fputs("</pre></details>\n", f);
+  }
+  fputs("</body></html>\n", f);
+  const bool bad = ferror(f) != 0;
+  if (fclose(f) != 0 || bad || rename(tmp_page, page) != 0) {
+    fprintf(stderr, "navsim report: writing \"%s\" failed\n", page);
+    remove(tmp_page);
+    free(summary);
+    return RC_FAIL;
+  }
+  free(summary);
+  int nok = 0;
+  for (int k = 0; k < nfig; ++k)
+    nok += figs[k].ok ? 1 : 0;
+  printf("report     %s (%d figure%s%s)\n", page, nok, nok == 1 ? "" : "s", failures ? ", some failed" : "");
+  return failures ? RC_FAIL : RC_OK;
+}

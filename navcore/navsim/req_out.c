@@ -1,0 +1,56 @@
+#include "req_out.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+void navsim_req_buffer_add(navsim_req_buffer *b, const nav_epoch_errors *e) {
+  if (b->failed) return;
+  if (b->n == b->cap) {
+    const size_t nc = b->cap ? 2 * b->cap : 4096;
+    nav_epoch_errors *g = realloc(b->e, nc * sizeof *g);
+    if (!g) {
+      b->failed = true;
+      return;
+    }
+    b->e = g;
+    b->cap = nc;
+  }
+  b->e[b->n++] = *e;
+}
+
+void navsim_req_buffer_free(navsim_req_buffer *b) {
+  free(b->e);
+  b->e = NULL;
+  b->n = b->cap = 0;
+}
+
+nav_status navsim_req_replay_verdicts(const nav_requirement *reqs, int n, const navsim_req_buffer *b,
+                                      const nav_replay_summary *sum, nav_requirement_verdict *out) {
+  if (b->failed) return NAV_ERR_NO_MEMORY;
+  const double t0 = sum->t_first_s;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  for (long g = 0; g < sum->gap_count && g < NAV_REPLAY_MAX_GAPS && ni < NAV_REQ_MAX_OUTAGES; ++g) {
+    const nav_replay_gap *gp = &sum->gaps[g];
+    iv[ni].t0_s = gp->t0_s - t0;
+    iv[ni].t1_s = gp->open ? nextafter(gp->t1_s - t0, INFINITY) : gp->t1_s - t0;
+    ++ni;
+  }
+  nav_req_evaluator *ev = NULL;
+  nav_status st = nav_req_evaluator_create(reqs, n, 1, iv, ni, &ev);
+  if (st != NAV_OK) return st;
+  nav_req_run *r = NULL;
+  st = nav_req_run_begin(ev, 0, &r);
+  for (size_t i = 0; i < b->n && st == NAV_OK; ++i) {
+    nav_epoch_errors e = b->e[i];
+    e.t_s -= t0;
+    st = nav_req_run_add(r, &e);
+  }
+  if (r) {
+    const nav_status st2 = nav_req_run_end(ev, r);
+    if (st == NAV_OK) st = st2;
+  }
+  if (st == NAV_OK) st = nav_req_evaluator_finish(ev, out);
+  nav_req_evaluator_destroy(ev);
+  return st;
+}

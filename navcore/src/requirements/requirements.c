@@ -1,0 +1,856 @@
+/*
+ * Accuracy requirements (nav_requirements.h): names, validation and the streaming evaluator.
+ *
+ * Evaluator layout. Each run accumulates into its own nav_req_run: per requirement a few doubles
+ * (sum of squares, count, maximum; the at_time candidate; the last value inside each outage) and,
+ * for the quantile statistics, the run's metric values. nav_req_run_end copies the small part into
+ * the run's row of a runs x width table and appends the quantile values to a shared store under a
+ * mutex. nav_req_evaluator_finish reduces the table in run order, and a quantile does not depend
+ * on the order of its values, so the verdicts are bit-identical for any thread schedule.
+ *
+ * Quantile store: exact values while the evaluator's total stays within NAV_REQ_EXACT_BUDGET
+ * (split evenly between its quantile requirements); past that share, a requirement moves all its
+ * values into a logarithmic histogram (bins of relative width NAV_REQ_HIST_REL_WIDTH over
+ * [HIST_LO, HIST_HI] SI, one under- and one overflow bin) and keeps the exact minimum and maximum.
+ * The set of values is the same whatever the order, so the final state is too.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "navcore/nav_errors.h"
+#include "navcore/nav_requirements.h"
+#include "navcore/nav_scene.h"
+#include "navcore/nav_sim.h"
+#include "requirements/budget_internal.h"
+#include "sim/nav_thread_internal.h"
+#include "sim/sim_internal.h"
+
+#define HIST_LO 1e-12
+#define HIST_HI 1e12
+
+/* ================================================================ names and units */
+
+static const char *const k_metric_names[NAV_REQ_METRIC_COUNT] = {
+    "horizontal_position", "vertical_position", "position_3d", "velocity", "roll_pitch", "yaw"};
+static const char *const k_statistic_names[NAV_REQ_STATISTIC_COUNT] = {"rms",        "max",   "p95",  "at_time",
+                                                                       "outage_end", "cep50", "cep95"};
+static const char *const k_unit_names[NAV_REQ_UNIT_COUNT] = {"m",   "cm",     "km",     "m/s",  "cm/s",
+                                                             "deg", "arcmin", "arcsec", "mrad", "rad"};
+
+const char *nav_req_metric_name(nav_req_metric m) {
+  return (int)m >= 0 && (int)m < NAV_REQ_METRIC_COUNT ? k_metric_names[m] : "unknown";
+}
+const char *nav_req_statistic_name(nav_req_statistic s) {
+  return (int)s >= 0 && (int)s < NAV_REQ_STATISTIC_COUNT ? k_statistic_names[s] : "unknown";
+}
+const char *nav_req_unit_name(nav_req_unit u) {
+  return (int)u >= 0 && (int)u < NAV_REQ_UNIT_COUNT ? k_unit_names[u] : "unknown";
+}
+
+static int find_name(const char *const *names, int n, const char *name) {
+  if (name == NULL) return -1;
+  for (int i = 0; i < n; ++i)
+    if (strcmp(names[i], name) == 0) return i;
+  return -1;
+}
+bool nav_req_metric_from_name(const char *name, nav_req_metric *out) {
+  const int i = find_name(k_metric_names, NAV_REQ_METRIC_COUNT, name);
+  if (i < 0) return false;
+  if (out) *out = (nav_req_metric)i;
+  return true;
+}
+bool nav_req_statistic_from_name(const char *name, nav_req_statistic *out) {
+  const int i = find_name(k_statistic_names, NAV_REQ_STATISTIC_COUNT, name);
+  if (i < 0) return false;
+  if (out) *out = (nav_req_statistic)i;
+  return true;
+}
+bool nav_req_unit_from_name(const char *name, nav_req_unit *out) {
+  const int i = find_name(k_unit_names, NAV_REQ_UNIT_COUNT, name);
+  if (i < 0) return false;
+  if (out) *out = (nav_req_unit)i;
+  return true;
+}
+
+double nav_req_unit_to_si(nav_req_unit u) {
+  switch (u) {
+  case NAV_REQ_UNIT_M: return 1.0;
+  case NAV_REQ_UNIT_CM: return 0.01;
+  case NAV_REQ_UNIT_KM: return 1000.0;
+  case NAV_REQ_UNIT_MPS: return 1.0;
+  case NAV_REQ_UNIT_CMPS: return 0.01;
+  case NAV_REQ_UNIT_DEG: return NAV_PI / 180.0;
+  case NAV_REQ_UNIT_ARCMIN: return NAV_PI / 10800.0;
+  case NAV_REQ_UNIT_ARCSEC: return NAV_PI / 648000.0;
+  case NAV_REQ_UNIT_MRAD: return 1e-3;
+  case NAV_REQ_UNIT_RAD: return 1.0;
+  }
+  return NAN;
+}
+
+nav_req_quantity nav_req_unit_quantity(nav_req_unit u) {
+  switch (u) {
+  case NAV_REQ_UNIT_M:
+  case NAV_REQ_UNIT_CM:
+  case NAV_REQ_UNIT_KM: return NAV_REQ_LENGTH;
+  case NAV_REQ_UNIT_MPS:
+  case NAV_REQ_UNIT_CMPS: return NAV_REQ_SPEED;
+  default: return NAV_REQ_ANGLE;
+  }
+}
+
+nav_req_quantity nav_req_metric_quantity(nav_req_metric m) {
+  switch (m) {
+  case NAV_REQ_HORIZONTAL_POSITION:
+  case NAV_REQ_VERTICAL_POSITION:
+  case NAV_REQ_POSITION_3D: return NAV_REQ_LENGTH;
+  case NAV_REQ_VELOCITY: return NAV_REQ_SPEED;
+  default: return NAV_REQ_ANGLE;
+  }
+}
+
+double nav_req_metric_value(nav_req_metric m, const nav_epoch_errors *e) {
+  const nav_vec3 p = e->pos_err_n_m, v = e->vel_err_n_mps;
+  switch (m) {
+  case NAV_REQ_HORIZONTAL_POSITION: return hypot(p.x, p.y);
+  case NAV_REQ_VERTICAL_POSITION: return fabs(p.z);
+  case NAV_REQ_POSITION_3D: return sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+  case NAV_REQ_VELOCITY: return sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  case NAV_REQ_ROLL_PITCH: return fmax(fabs(e->euler_err.roll_rad), fabs(e->euler_err.pitch_rad));
+  case NAV_REQ_YAW: return fabs(e->euler_err.yaw_rad);
+  }
+  return NAN;
+}
+
+bool nav_req_statistic_is_quantile(nav_req_statistic s) {
+  return s == NAV_REQ_P95 || s == NAV_REQ_CEP50 || s == NAV_REQ_CEP95;
+}
+
+/* Percent of a quantile statistic. */
+static int quantile_percent(nav_req_statistic s) { return s == NAV_REQ_CEP50 ? 50 : 95; }
+
+/* ================================================================ validation */
+
+static void req_issue(nav_req_issue_fn report, void *user, int *count, int i, const char *field, const char *fmt,
+                      ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+
+static void req_issue(nav_req_issue_fn report, void *user, int *count, int i, const char *field, const char *fmt,
+                      ...) {
+  char path[96], msg[256];
+  if (i < 0) snprintf(path, sizeof path, "requirements");
+  else if (field == NULL) snprintf(path, sizeof path, "requirements[%d]", i);
+  else snprintf(path, sizeof path, "requirements[%d].%s", i, field);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  ++*count;
+  if (report) report(user, path, msg);
+}
+
+static const char *units_of(nav_req_quantity q) {
+  switch (q) {
+  case NAV_REQ_LENGTH: return "m, cm, km";
+  case NAV_REQ_SPEED: return "m/s, cm/s";
+  case NAV_REQ_ANGLE: return "deg, arcmin, arcsec, mrad, rad";
+  }
+  return "?";
+}
+
+nav_status nav_requirements_validate(const nav_requirement *reqs, int count, nav_req_issue_fn report, void *user) {
+  int n = 0;
+  if (count < 0 || count > NAV_SCENE_MAX_REQUIREMENTS) {
+    req_issue(report, user, &n, -1, NULL, "at most %d requirements are supported (got %d)",
+              NAV_SCENE_MAX_REQUIREMENTS, count);
+    return NAV_ERR_INVALID_ARG;
+  }
+  if (count > 0 && reqs == NULL) return NAV_ERR_INVALID_ARG;
+  for (int i = 0; i < count; ++i) {
+    const nav_requirement *q = &reqs[i];
+    size_t len = 0;
+    while (len < NAV_REQ_ID_MAX && q->id[len] != '\0') ++len;
+    if (len == 0 || len >= NAV_REQ_ID_MAX) {
+      req_issue(report, user, &n, i, "id", "must be 1 to %d characters of A-Z a-z 0-9 _ . -", NAV_REQ_ID_MAX - 1);
+    } else {
+      bool ok = true;
+      for (size_t k = 0; k < len; ++k) {
+        const char c = q->id[k];
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '.' ||
+              c == '-'))
+          ok = false;
+      }
+      if (!ok)
+        req_issue(report, user, &n, i, "id", "\"%s\": only the characters A-Z a-z 0-9 _ . - are allowed", q->id);
+      for (int j = 0; j < i && ok; ++j)
+        if (strncmp(reqs[j].id, q->id, NAV_REQ_ID_MAX) == 0) {
+          req_issue(report, user, &n, i, "id", "\"%s\" is already the id of requirements[%d]; ids must be unique",
+                    q->id, j);
+          break;
+        }
+    }
+    const bool metric_ok = (int)q->metric >= 0 && (int)q->metric < NAV_REQ_METRIC_COUNT;
+    const bool stat_ok = (int)q->statistic >= 0 && (int)q->statistic < NAV_REQ_STATISTIC_COUNT;
+    const bool unit_ok = (int)q->unit >= 0 && (int)q->unit < NAV_REQ_UNIT_COUNT;
+    if (!metric_ok) req_issue(report, user, &n, i, "metric", "unknown metric %d", (int)q->metric);
+    if (!stat_ok) req_issue(report, user, &n, i, "statistic", "unknown statistic %d", (int)q->statistic);
+    if (!unit_ok) req_issue(report, user, &n, i, "unit", "unknown unit %d", (int)q->unit);
+    if (!(isfinite(q->limit) && q->limit > 0.0))
+      req_issue(report, user, &n, i, "limit", "must be a finite number > 0 (got %g)", q->limit);
+    if (metric_ok && unit_ok && nav_req_unit_quantity(q->unit) != nav_req_metric_quantity(q->metric))
+      req_issue(report, user, &n, i, "unit", "%s is not a unit of %s: expected one of %s", nav_req_unit_name(q->unit),
+                nav_req_metric_name(q->metric), units_of(nav_req_metric_quantity(q->metric)));
+    if (metric_ok && stat_ok && (q->statistic == NAV_REQ_CEP50 || q->statistic == NAV_REQ_CEP95) &&
+        q->metric != NAV_REQ_HORIZONTAL_POSITION)
+      req_issue(report, user, &n, i, "statistic", "%s applies to metric horizontal_position only (got %s)",
+                nav_req_statistic_name(q->statistic), nav_req_metric_name(q->metric));
+    if (stat_ok && q->statistic == NAV_REQ_AT_TIME && !(isfinite(q->time_s) && q->time_s >= 0.0))
+      req_issue(report, user, &n, i, "time_s", "statistic at_time needs time_s, a finite time >= 0 [s] (got %g)",
+                q->time_s);
+  }
+  return n ? NAV_ERR_INVALID_ARG : NAV_OK;
+}
+
+bool nav_req_all_pass(const nav_requirement_verdict *v, int count) {
+  for (int i = 0; i < count; ++i)
+    if (!v[i].pass) return false;
+  return true;
+}
+
+/* ================================================================ quantile store */
+
+typedef struct qstore {
+  double *exact;
+  size_t n, cap, budget;
+  uint64_t *hist; /* NULL while exact */
+  size_t nbins;
+  uint64_t total;
+  double min, max;
+} qstore;
+
+static double hist_ratio(void) { return 1.0 + NAV_REQ_HIST_REL_WIDTH; }
+
+static size_t hist_bins(void) {
+  /* bin 0: below HIST_LO; 1..m: [LO r^(i-1), LO r^i); m + 1: at or above HIST_HI */
+  return (size_t)ceil(log(HIST_HI / HIST_LO) / log1p(NAV_REQ_HIST_REL_WIDTH)) + 2;
+}
+
+static size_t hist_index(const qstore *q, double x) {
+  if (!(x >= HIST_LO)) return 0;
+  if (x >= HIST_HI) return q->nbins - 1;
+  size_t i = (size_t)floor(log(x / HIST_LO) / log1p(NAV_REQ_HIST_REL_WIDTH)) + 1;
+  if (i > q->nbins - 2) i = q->nbins - 2;
+  return i;
+}
+
+static nav_status qstore_to_hist(qstore *q) {
+  q->nbins = hist_bins();
+  q->hist = calloc(q->nbins, sizeof *q->hist);
+  if (!q->hist) return NAV_ERR_NO_MEMORY;
+  for (size_t i = 0; i < q->n; ++i) q->hist[hist_index(q, q->exact[i])]++;
+  free(q->exact);
+  q->exact = NULL;
+  q->n = q->cap = 0;
+  return NAV_OK;
+}
+
+static nav_status qstore_add(qstore *q, const double *v, size_t count) {
+  for (size_t i = 0; i < count; ++i) {
+    if (q->total == 0 || v[i] < q->min) q->min = v[i];
+    if (q->total == 0 || v[i] > q->max) q->max = v[i];
+    q->total++;
+    if (q->hist) {
+      q->hist[hist_index(q, v[i])]++;
+      continue;
+    }
+    if (q->n == q->cap) {
+      if (q->n >= q->budget) {
+        const nav_status st = qstore_to_hist(q);
+        if (st != NAV_OK) return st;
+        q->hist[hist_index(q, v[i])]++;
+        continue;
+      }
+      size_t nc = q->cap ? 2 * q->cap : 4096;
+      if (nc > q->budget) nc = q->budget;
+      double *g = realloc(q->exact, nc * sizeof *g);
+      if (!g) return NAV_ERR_NO_MEMORY;
+      q->exact = g;
+      q->cap = nc;
+    }
+    q->exact[q->n++] = v[i];
+  }
+  return NAV_OK;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* Nearest-rank quantile: the k-th smallest value, k = ceil(pct N / 100). NaN when empty. */
+static double qstore_quantile(qstore *q, int pct) {
+  if (q->total == 0) return NAN;
+  uint64_t k = (q->total * (uint64_t)pct + 99) / 100;
+  if (k < 1) k = 1;
+  if (!q->hist) {
+    qsort(q->exact, q->n, sizeof *q->exact, cmp_double);
+    return q->exact[k - 1];
+  }
+  uint64_t c = 0;
+  for (size_t i = 0; i < q->nbins; ++i) {
+    c += q->hist[i];
+    if (c >= k) {
+      double x;
+      if (i == 0) x = q->min;
+      else if (i == q->nbins - 1) x = q->max;
+      else x = HIST_LO * pow(hist_ratio(), (double)(i - 1) + 0.5);
+      return fmin(fmax(x, q->min), q->max);
+    }
+  }
+  return q->max;
+}
+
+/* ================================================================ evaluator */
+
+/* Row layout per requirement (offsets into a run's row of doubles):
+ *   rms, max, quantiles: [sum of squares, count, max]
+ *   at_time:             [value, epoch time, |epoch time - time_s|]  (value NaN: no epoch)
+ *   outage_end:          [value, time] at the last epoch inside outage j, j = 0..n_outages-1 (NaN: none) */
+typedef struct req_layout {
+  size_t off, width;
+  int qindex; /* quantile store index, -1 */
+} req_layout;
+
+struct nav_req_evaluator {
+  nav_requirement reqs[NAV_SCENE_MAX_REQUIREMENTS];
+  req_layout lay[NAV_SCENE_MAX_REQUIREMENTS];
+  int count;
+  long runs;
+  nav_req_interval outages[NAV_REQ_MAX_OUTAGES];
+  int n_outages;
+  size_t width; /* doubles per run row */
+  double *table; /* runs x width */
+  unsigned char *done; /* per run: merged */
+  qstore q[NAV_SCENE_MAX_REQUIREMENTS];
+  int nq;
+  nav_mutex lock;
+  bool lock_ok;
+  nav_status failed; /* first merge failure */
+};
+
+struct nav_req_run {
+  long run;
+  const nav_req_evaluator *ev;
+  double *row;
+  double *qv[NAV_SCENE_MAX_REQUIREMENTS]; /* quantile values of this run */
+  size_t qn[NAV_SCENE_MAX_REQUIREMENTS], qcap[NAV_SCENE_MAX_REQUIREMENTS];
+  nav_status st;
+};
+
+nav_status nav_req_evaluator_create(const nav_requirement *reqs, int count, long runs,
+                                    const nav_req_interval *outages, int n_outages, nav_req_evaluator **out) {
+  if (!out) return NAV_ERR_INVALID_ARG;
+  *out = NULL;
+  if (runs < 1 || n_outages < 0 || (n_outages > 0 && !outages)) return NAV_ERR_INVALID_ARG;
+  if (nav_requirements_validate(reqs, count, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
+  if (n_outages > NAV_REQ_MAX_OUTAGES) n_outages = NAV_REQ_MAX_OUTAGES;
+  nav_req_evaluator *ev = calloc(1, sizeof *ev);
+  if (!ev) return NAV_ERR_NO_MEMORY;
+  ev->count = count;
+  ev->runs = runs;
+  ev->n_outages = n_outages;
+  for (int j = 0; j < n_outages; ++j) ev->outages[j] = outages[j];
+  int nq = 0;
+  for (int i = 0; i < count; ++i)
+    if (nav_req_statistic_is_quantile(reqs[i].statistic)) ++nq;
+  size_t w = 0;
+  for (int i = 0; i < count; ++i) {
+    ev->reqs[i] = reqs[i];
+    ev->lay[i].off = w;
+    ev->lay[i].qindex = -1;
+    ev->lay[i].width = reqs[i].statistic == NAV_REQ_OUTAGE_END ? 2 * (size_t)n_outages : 3;
+    if (nav_req_statistic_is_quantile(reqs[i].statistic)) {
+      ev->lay[i].qindex = ev->nq;
+      ev->q[ev->nq].budget = (size_t)(NAV_REQ_EXACT_BUDGET / nq);
+      ev->nq++;
+    }
+    w += ev->lay[i].width;
+  }
+  ev->width = w;
+  if (w > 0 && (size_t)runs > SIZE_MAX / sizeof(double) / w) {
+    free(ev);
+    return NAV_ERR_NO_MEMORY;
+  }
+  ev->table = calloc((size_t)runs * (w ? w : 1), sizeof *ev->table);
+  ev->done = calloc((size_t)runs, 1);
+  ev->lock_ok = nav_mutex_init(&ev->lock);
+  if (!ev->table || !ev->done || !ev->lock_ok) {
+    nav_req_evaluator_destroy(ev);
+    return NAV_ERR_NO_MEMORY;
+  }
+  *out = ev;
+  return NAV_OK;
+}
+
+nav_status nav_req_scene_outages(const nav_scene *scene, nav_req_interval *out, int cap, int *n) {
+  if (!scene || !n || (cap > 0 && !out)) return NAV_ERR_INVALID_ARG;
+  *n = 0;
+  if (!scene->gnss.enabled) return NAV_OK;
+  nav_gnss_model_config g;
+  char msg[200];
+  const nav_status st = nav_sim_gnss_config(scene, 1.0 / scene->imu.rate_hz, &g, msg, sizeof msg);
+  if (st != NAV_OK) return st;
+  for (size_t i = 0; i < g.outage_count && (int)i < cap; ++i) {
+    out[i].t0_s = g.outages[i].t0_s;
+    out[i].t1_s = g.outages[i].t1_s;
+    ++*n;
+  }
+  return NAV_OK;
+}
+
+nav_status nav_req_evaluator_create_for_scene(const nav_scene *scene, bool ideal, nav_req_evaluator **out) {
+  if (!scene || !out) return NAV_ERR_INVALID_ARG;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int n = 0;
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS) {
+    const nav_status st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &n);
+    if (st != NAV_OK) return st;
+  }
+  return nav_req_evaluator_create(scene->requirements, scene->n_requirements, ideal ? 1 : scene->simulation.runs, iv,
+                                  n, out);
+}
+
+void nav_req_evaluator_destroy(nav_req_evaluator *ev) {
+  if (!ev) return;
+  for (int i = 0; i < ev->nq; ++i) {
+    free(ev->q[i].exact);
+    free(ev->q[i].hist);
+  }
+  if (ev->lock_ok) nav_mutex_destroy(&ev->lock);
+  free(ev->table);
+  free(ev->done);
+  free(ev);
+}
+
+int nav_req_evaluator_count(const nav_req_evaluator *ev) { return ev ? ev->count : 0; }
+
+nav_status nav_req_run_begin(nav_req_evaluator *ev, long run, nav_req_run **out) {
+  if (!ev || !out || run < 0 || run >= ev->runs) return NAV_ERR_INVALID_ARG;
+  nav_req_run *r = calloc(1, sizeof *r);
+  if (!r) return NAV_ERR_NO_MEMORY;
+  r->row = calloc(ev->width ? ev->width : 1, sizeof *r->row);
+  if (!r->row) {
+    free(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  r->run = run;
+  r->ev = ev;
+  for (int i = 0; i < ev->count; ++i) {
+    double *row = r->row + ev->lay[i].off;
+    if (ev->reqs[i].statistic == NAV_REQ_AT_TIME) {
+      row[0] = NAN;
+      row[1] = NAN;
+      row[2] = INFINITY;
+    } else if (ev->reqs[i].statistic == NAV_REQ_OUTAGE_END) {
+      for (size_t j = 0; j < ev->lay[i].width; ++j) row[j] = NAN;
+    }
+  }
+  *out = r;
+  return NAV_OK;
+}
+
+nav_status nav_req_run_add(nav_req_run *r, const nav_epoch_errors *e) {
+  if (!r || !e) return NAV_ERR_INVALID_ARG;
+  if (r->st != NAV_OK) return r->st;
+  const nav_req_evaluator *ev = r->ev;
+  for (int i = 0; i < ev->count; ++i) {
+    const nav_requirement *q = &ev->reqs[i];
+    const double x = nav_req_metric_value(q->metric, e);
+    double *row = r->row + ev->lay[i].off;
+    switch (q->statistic) {
+    case NAV_REQ_AT_TIME: {
+      const double d = fabs(e->t_s - q->time_s);
+      if (d < row[2]) {
+        row[0] = x;
+        row[1] = e->t_s;
+        row[2] = d;
+      }
+      break;
+    }
+    case NAV_REQ_OUTAGE_END:
+      for (int j = 0; j < ev->n_outages; ++j)
+        if (e->t_s >= ev->outages[j].t0_s && e->t_s < ev->outages[j].t1_s) {
+          row[2 * j] = x;
+          row[2 * j + 1] = e->t_s;
+        }
+      break;
+    default: {
+      row[0] += x * x;
+      row[1] += 1.0;
+      if (row[1] == 1.0 || x > row[2] || isnan(x)) row[2] = x;
+      const int k = ev->lay[i].qindex;
+      if (k >= 0) {
+        if (r->qn[k] == r->qcap[k]) {
+          const size_t nc = r->qcap[k] ? 2 * r->qcap[k] : 1024;
+          double *g = realloc(r->qv[k], nc * sizeof *g);
+          if (!g) return r->st = NAV_ERR_NO_MEMORY;
+          r->qv[k] = g;
+          r->qcap[k] = nc;
+        }
+        r->qv[k][r->qn[k]++] = x;
+      }
+      break;
+    }
+    }
+  }
+  return NAV_OK;
+}
+
+void nav_req_run_discard(nav_req_run *r) {
+  if (!r) return;
+  for (int k = 0; k < NAV_SCENE_MAX_REQUIREMENTS; ++k) free(r->qv[k]);
+  free(r->row);
+  free(r);
+}
+
+nav_status nav_req_run_end(nav_req_evaluator *ev, nav_req_run *r) {
+  if (!ev || !r || r->ev != ev) {
+    nav_req_run_discard(r);
+    return NAV_ERR_INVALID_ARG;
+  }
+  nav_status st = r->st;
+  nav_mutex_lock(&ev->lock);
+  if (st == NAV_OK && ev->done[r->run]) st = NAV_ERR_INVALID_ARG; /* ended twice */
+  if (st == NAV_OK) {
+    for (int k = 0; k < ev->nq && st == NAV_OK; ++k) st = qstore_add(&ev->q[k], r->qv[k], r->qn[k]);
+  }
+  if (st == NAV_OK) {
+    memcpy(ev->table + (size_t)r->run * ev->width, r->row, ev->width * sizeof *r->row);
+    ev->done[r->run] = 1;
+  } else if (ev->failed == NAV_OK) {
+    ev->failed = st;
+  }
+  nav_mutex_unlock(&ev->lock);
+  nav_req_run_discard(r);
+  return st;
+}
+
+nav_status nav_req_evaluator_finish(nav_req_evaluator *ev, nav_requirement_verdict *out) {
+  if (!ev || (!out && ev->count > 0)) return NAV_ERR_INVALID_ARG;
+  if (ev->failed != NAV_OK) return ev->failed;
+  for (int i = 0; i < ev->count; ++i) {
+    const nav_requirement *q = &ev->reqs[i];
+    nav_requirement_verdict *v = &out[i];
+    memset(v, 0, sizeof *v);
+    snprintf(v->id, sizeof v->id, "%s", q->id);
+    v->metric = q->metric;
+    v->statistic = q->statistic;
+    v->limit = q->limit;
+    v->unit = q->unit;
+    v->at_time_s = NAN;
+    const double k = nav_req_unit_to_si(q->unit);
+    const size_t off = ev->lay[i].off;
+    double value = NAN;
+    long samples = 0;
+    switch (q->statistic) {
+    case NAV_REQ_RMS:
+    case NAV_REQ_MAX:
+    case NAV_REQ_P95:
+    case NAV_REQ_CEP50:
+    case NAV_REQ_CEP95: {
+      double s2 = 0.0, n = 0.0, mx = NAN;
+      for (long r = 0; r < ev->runs; ++r) {
+        if (!ev->done[r]) continue;
+        const double *row = ev->table + (size_t)r * ev->width + off;
+        if (row[1] == 0.0) continue;
+        s2 += row[0];
+        n += row[1];
+        if (isnan(mx) || row[2] > mx || isnan(row[2])) mx = row[2];
+      }
+      samples = (long)n;
+      if (n > 0.0) {
+        if (q->statistic == NAV_REQ_RMS) value = sqrt(s2 / n);
+        else if (q->statistic == NAV_REQ_MAX) value = mx;
+        else value = qstore_quantile(&ev->q[ev->lay[i].qindex], quantile_percent(q->statistic));
+      }
+      break;
+    }
+    case NAV_REQ_AT_TIME: {
+      double s2 = 0.0;
+      long n = 0;
+      for (long r = 0; r < ev->runs; ++r) {
+        if (!ev->done[r]) continue;
+        const double *row = ev->table + (size_t)r * ev->width + off;
+        if (isnan(row[1])) continue;
+        if (n == 0) v->at_time_s = row[1];
+        s2 += row[0] * row[0];
+        ++n;
+      }
+      samples = n;
+      if (n > 0) value = sqrt(s2 / (double)n);
+      break;
+    }
+    case NAV_REQ_OUTAGE_END: {
+      v->outage_count = ev->n_outages;
+      for (int j = 0; j < ev->n_outages; ++j) {
+        double s2 = 0.0;
+        long n = 0;
+        v->outage_t0_s[j] = ev->outages[j].t0_s;
+        v->outage_t1_s[j] = ev->outages[j].t1_s;
+        v->outage_end_t_s[j] = NAN;
+        for (long r = 0; r < ev->runs; ++r) {
+          if (!ev->done[r]) continue;
+          const double *cell = ev->table + (size_t)r * ev->width + off + 2 * (size_t)j;
+          const double x = cell[0];
+          if (isnan(cell[1])) continue;
+          if (n == 0) v->outage_end_t_s[j] = cell[1];
+          s2 += x * x;
+          ++n;
+        }
+        v->outage_value[j] = n > 0 ? sqrt(s2 / (double)n) / k : NAN;
+        samples += n;
+        if (n > 0 && (isnan(value) || v->outage_value[j] * k > value)) value = v->outage_value[j] * k;
+      }
+      break;
+    }
+    }
+    v->samples = samples;
+    v->evaluated = !isnan(value);
+    v->value = v->evaluated ? value / k : NAN;
+    /* No data fails, except outage_end without any outage: nothing to violate it. */
+    v->pass = v->evaluated ? v->value <= v->limit : (q->statistic == NAV_REQ_OUTAGE_END && ev->n_outages == 0);
+  }
+  return NAV_OK;
+}
+
+/* ---------------------------------------------------------------- observer */
+
+static void *obs_begin(void *user, long run) {
+  nav_req_run *r = NULL;
+  return nav_req_run_begin(user, run, &r) == NAV_OK ? r : NULL;
+}
+static void obs_epoch(void *ctx, const nav_epoch_errors *e) {
+  if (ctx && nav_req_run_add(ctx, e) != NAV_OK) {
+    /* recorded in the run; nav_req_run_end reports it to the evaluator */
+  }
+}
+static void obs_end(void *user, void *ctx, bool complete) {
+  if (!ctx) return;
+  if (complete) {
+    if (nav_req_run_end(user, ctx) != NAV_OK) {
+      /* kept in the evaluator: nav_req_evaluator_finish returns it */
+    }
+  }
+  else nav_req_run_discard(ctx);
+}
+
+nav_run_observer nav_req_evaluator_observer(nav_req_evaluator *ev) {
+  nav_run_observer o = {obs_begin, obs_epoch, obs_end, ev};
+  return o;
+}
+
+/* ================================================================ prediction from covariance */
+
+/* P(|x| <= r), x ~ N(0, s^2). */
+static double cdf_abs_normal(double r, double s) {
+  if (!(s > 0.0)) return r >= 0.0 ? 1.0 : 0.0;
+  return erf(r / (sqrt(2.0) * s));
+}
+
+/* P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2) independent: with x = r sin(u),
+ * P = int phi(r sin u / a) / a * erf(r cos u / (sqrt 2 b)) r cos u du over |r sin u| <= 9 a (a >= b),
+ * composite Simpson on 256 intervals (smooth in u). Degenerate sigmas reduce to 1-D. */
+static double cdf_radius(double r, double a, double b) {
+  if (r <= 0.0) return 0.0;
+  if (a < b) {
+    const double t = a;
+    a = b;
+    b = t;
+  }
+  if (!(a > 0.0)) return 1.0;
+  if (!(b > 0.0) || b < 1e-9 * a) return cdf_abs_normal(r, a);
+  /* |x| beyond 9 a carries < 1e-18: integrate u over [-U, U], r sin U = min(r, 9 a). */
+  const double umax = 9.0 * a < r ? asin(9.0 * a / r) : 0.5 * NAV_PI;
+  const int n = 256;
+  const double h = 2.0 * umax / n;
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i) {
+    const double u = -umax + h * i;
+    const double x = r * sin(u), c = r * cos(u);
+    const double f = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * erf(c / (sqrt(2.0) * b)) * c;
+    sum += f * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
+  }
+  return fmin(1.0, sum * h / 3.0);
+}
+
+typedef struct pred_point {
+  double a, b; /* sigmas of the 1-D (a) or 2-D (a, b) Gaussian of the metric */
+  bool radial; /* 2-D radius, else |1-D| */
+} pred_point;
+
+static double mixture_cdf(const pred_point *p, size_t n, double r) {
+  double s = 0.0;
+  for (size_t i = 0; i < n; ++i) s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b) : cdf_abs_normal(r, p[i].a);
+  return s / (double)n;
+}
+
+/* Smallest r with mixture CDF >= q (bisection to 1e-9 relative). */
+static double mixture_quantile(const pred_point *p, size_t n, double q) {
+  double hi = 0.0;
+  for (size_t i = 0; i < n; ++i) hi = fmax(hi, p[i].radial ? hypot(p[i].a, p[i].b) : p[i].a);
+  if (!(hi > 0.0)) return 0.0;
+  hi *= 10.0; /* P(|x| > 10 sigma_max) < 1e-20 */
+  double lo = 0.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mixture_cdf(p, n, mid) >= q) hi = mid;
+    else lo = mid;
+  }
+  return hi;
+}
+
+/* E[metric^2] at one covariance epoch (NaN: not predicted). */
+static double mean_square(nav_req_metric m, const nav_cov_point *c) {
+  const nav_vec3 p = c->pos_sd_n_m, v = c->vel_sd_n_mps, a = c->att_sd_rad;
+  switch (m) {
+  case NAV_REQ_HORIZONTAL_POSITION: return p.x * p.x + p.y * p.y;
+  case NAV_REQ_VERTICAL_POSITION: return p.z * p.z;
+  case NAV_REQ_POSITION_3D: return p.x * p.x + p.y * p.y + p.z * p.z;
+  case NAV_REQ_VELOCITY: return v.x * v.x + v.y * v.y + v.z * v.z;
+  case NAV_REQ_ROLL_PITCH: return a.x * a.x + a.y * a.y;
+  case NAV_REQ_YAW: return a.z * a.z;
+  }
+  return NAN;
+}
+
+nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov_point *pts, size_t npts,
+                           const nav_req_interval *outages, int n_outages, nav_requirement_verdict *out) {
+  if ((count > 0 && (!reqs || !out)) || (npts > 0 && !pts) || n_outages < 0 || (n_outages > 0 && !outages))
+    return NAV_ERR_INVALID_ARG;
+  if (nav_requirements_validate(reqs, count, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
+  if (n_outages > NAV_REQ_MAX_OUTAGES) n_outages = NAV_REQ_MAX_OUTAGES;
+  pred_point *pp = NULL;
+  for (int i = 0; i < count; ++i) {
+    const nav_requirement *q = &reqs[i];
+    nav_requirement_verdict *v = &out[i];
+    memset(v, 0, sizeof *v);
+    snprintf(v->id, sizeof v->id, "%s", q->id);
+    v->metric = q->metric;
+    v->statistic = q->statistic;
+    v->limit = q->limit;
+    v->unit = q->unit;
+    v->at_time_s = NAN;
+    const double k = nav_req_unit_to_si(q->unit);
+    double value = NAN;
+    long samples = 0;
+    if (npts == 0) {
+      /* nothing to predict from */
+    } else if (q->statistic == NAV_REQ_RMS) {
+      double s = 0.0;
+      for (size_t j = 0; j < npts; ++j) s += mean_square(q->metric, &pts[j]);
+      value = sqrt(s / (double)npts);
+      samples = (long)npts;
+    } else if (q->statistic == NAV_REQ_AT_TIME) {
+      size_t best = 0;
+      for (size_t j = 1; j < npts; ++j)
+        if (fabs(pts[j].t_s - q->time_s) < fabs(pts[best].t_s - q->time_s)) best = j;
+      v->at_time_s = pts[best].t_s;
+      value = sqrt(mean_square(q->metric, &pts[best]));
+      samples = 1;
+    } else if (q->statistic == NAV_REQ_OUTAGE_END) {
+      v->outage_count = n_outages;
+      for (int o = 0; o < n_outages; ++o) {
+        v->outage_t0_s[o] = outages[o].t0_s;
+        v->outage_t1_s[o] = outages[o].t1_s;
+        v->outage_end_t_s[o] = NAN;
+        v->outage_value[o] = NAN;
+        for (size_t j = 0; j < npts; ++j)
+          if (pts[j].t_s >= outages[o].t0_s && pts[j].t_s < outages[o].t1_s) {
+            v->outage_end_t_s[o] = pts[j].t_s;
+            v->outage_value[o] = sqrt(mean_square(q->metric, &pts[j])) / k;
+          }
+        if (!isnan(v->outage_value[o])) {
+          ++samples;
+          if (isnan(value) || v->outage_value[o] * k > value) value = v->outage_value[o] * k;
+        }
+      }
+    } else if (nav_req_statistic_is_quantile(q->statistic) &&
+               (q->metric == NAV_REQ_HORIZONTAL_POSITION || q->metric == NAV_REQ_VERTICAL_POSITION ||
+                q->metric == NAV_REQ_YAW)) {
+      if (!pp) {
+        pp = malloc(npts * sizeof *pp);
+        if (!pp) return NAV_ERR_NO_MEMORY;
+      }
+      for (size_t j = 0; j < npts; ++j) {
+        pp[j].radial = q->metric == NAV_REQ_HORIZONTAL_POSITION;
+        pp[j].a = q->metric == NAV_REQ_HORIZONTAL_POSITION ? pts[j].pos_sd_n_m.x
+                  : q->metric == NAV_REQ_VERTICAL_POSITION  ? pts[j].pos_sd_n_m.z
+                                                            : pts[j].att_sd_rad.z;
+        pp[j].b = pts[j].pos_sd_n_m.y;
+      }
+      value = mixture_quantile(pp, npts, quantile_percent(q->statistic) / 100.0);
+      samples = (long)npts;
+    }
+    v->samples = samples;
+    v->evaluated = isfinite(value);
+    v->value = v->evaluated ? value / k : NAN;
+    v->pass = v->evaluated ? v->value <= v->limit : (q->statistic == NAV_REQ_OUTAGE_END && n_outages == 0);
+  }
+  free(pp);
+  return NAV_OK;
+}
+
+typedef struct cov_buf {
+  nav_cov_point *p;
+  size_t n, cap;
+  bool failed;
+} cov_buf;
+
+static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
+  cov_buf *b = user;
+  nav_cov_point q;
+  memset(&q, 0, sizeof q);
+  q.t_s = e->t_s;
+  q.pos_sd_n_m = nav_vec3_make(sqrt(e->total.v[0]), sqrt(e->total.v[1]), sqrt(e->total.v[2]));
+  q.pos_h_sd_m = hypot(q.pos_sd_n_m.x, q.pos_sd_n_m.y);
+  q.vel_sd_n_mps = nav_vec3_make(sqrt(e->total.v[3]), sqrt(e->total.v[4]), sqrt(e->total.v[5]));
+  q.att_sd_rad = nav_vec3_make(sqrt(e->total.v[6]), sqrt(e->total.v[7]), sqrt(e->total.v[8]));
+  const nav_cov_point *p = &q;
+  if (b->n == b->cap) {
+    const size_t nc = b->cap ? 2 * b->cap : 1024;
+    nav_cov_point *g = realloc(b->p, nc * sizeof *g);
+    if (!g) {
+      b->failed = true;
+      return NAV_STOP;
+    }
+    b->p = g;
+    b->cap = nc;
+  }
+  b->p[b->n++] = *p;
+  return NAV_CONTINUE;
+}
+
+nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
+  if (!scene || (scene->n_requirements > 0 && !out)) return NAV_ERR_INVALID_ARG;
+  if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE)
+    return NAV_ERR_INVALID_ARG;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  nav_status st = NAV_OK;
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS) st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni);
+  if (st != NAV_OK) return st;
+  if (nav_scene_validate(scene, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
+  cov_buf b = {NULL, 0, 0, false};
+  st = nav_budget_run(scene, false, keep_point, &b, NULL, NULL, 0);
+  if (b.failed) st = NAV_ERR_NO_MEMORY;
+  if (st == NAV_OK) st = nav_req_predict(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, out);
+  free(b.p);
+  return st;
+}

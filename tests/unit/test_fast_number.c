@@ -1,0 +1,196 @@
+#define _POSIX_C_SOURCE 200809L
+/*
+ * The exact fast path of the recorded-data readers (navcore/io/fast_number.h): whenever it
+ * accepts a field, the double must be bit-identical to strtod's (glibc's strtod is correctly
+ * rounded); everything outside the fast path must be declined (the readers then use strtod).
+ * Random decimal strings of every shape the data files use and many they do not, the digits of
+ * the shared long-drive files themselves, and the reader's file:line:col report of a malformed
+ * field after the change.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fast_number.h"
+#include "nav_test.h"
+#include "navcore/nav_recorded.h"
+#include "navcore/nav_rng.h"
+
+typedef struct tally {
+  long fast, declined;
+} tally;
+
+/* Compare one string: accepted -> identical to strtod; returns whether it was accepted. */
+static bool check_one(const char *s, tally *t) {
+  double v = 0.0;
+  const size_t n = strlen(s);
+  if (!nav_fast_number(s, s + n, &v)) {
+    t->declined++;
+    return false;
+  }
+  char *end = NULL;
+  const double ref = strtod(s, &end);
+  if (end != s + n) fail_msg("fast path accepted \"%s\", which strtod does not consume fully", s);
+  if (memcmp(&v, &ref, sizeof v) != 0)
+    fail_msg("\"%s\": fast path %.17g (%a), strtod %.17g (%a)", s, v, v, ref, ref);
+  t->fast++;
+  return true;
+}
+
+static uint64_t next_u(nav_rng *r, uint64_t n) {
+  return nav_rng_next_u64(r) % n;
+}
+
+/* Random strings built digit by digit: sign, 0..14 integer digits (leading zeros allowed),
+ * optional point with 0..16 fraction digits, optional exponent -40..40 with optional sign. */
+static void test_random_digit_strings(void **state) {
+  (void)state;
+  nav_rng r;
+  nav_rng_init(&r, 20261122u, 0u, 0u);
+  tally t = {0, 0};
+  char s[96];
+  for (int it = 0; it < 400000; ++it) {
+    size_t p = 0;
+    const uint64_t sign = next_u(&r, 4);
+    if (sign == 1) s[p++] = '-';
+    if (sign == 2) s[p++] = '+';
+    const int int_digits = (int)next_u(&r, 15);
+    for (int i = 0; i < int_digits; ++i)
+      s[p++] = (char)('0' + next_u(&r, 10));
+    const bool point = next_u(&r, 4) != 0;
+    int frac_digits = 0;
+    if (point) {
+      s[p++] = '.';
+      frac_digits = (int)next_u(&r, 17);
+      for (int i = 0; i < frac_digits; ++i)
+        s[p++] = (char)('0' + next_u(&r, 10));
+    }
+    if (int_digits + frac_digits == 0) s[p++] = '7';
+    if (next_u(&r, 3) == 0) {
+      s[p++] = next_u(&r, 2) ? 'e' : 'E';
+      const uint64_t es = next_u(&r, 3);
+      if (es == 1) s[p++] = '-';
+      if (es == 2) s[p++] = '+';
+      p += (size_t)snprintf(s + p, sizeof s - p, "%d", (int)next_u(&r, 41));
+    }
+    s[p] = '\0';
+    check_one(s, &t);
+  }
+  print_message("[ fastnum  ] random digit strings: %ld on the fast path (bit-identical to strtod), %ld "
+                "declined\n",
+                t.fast, t.declined);
+  /* Most of these are within the fast path; the rest exercise the decline. */
+  assert_true(t.fast > 200000);
+  assert_true(t.declined > 10000);
+}
+
+/* printf renderings of random doubles in the formats of recorded data (%.Nf, %.Ne, %.Ng). */
+static void test_random_printf_values(void **state) {
+  (void)state;
+  nav_rng r;
+  nav_rng_init(&r, 77u, 1u, 0u);
+  tally t = {0, 0};
+  char s[96];
+  static const char *const fmts[] = {"%.6f", "%.3f", "%.11f", "%.4f", "%.12e", "%.9e", "%.15g", "%.17g", "%.3e"};
+  for (int it = 0; it < 300000; ++it) {
+    const double mag = pow(10.0, -8.0 + 14.0 * nav_rng_uniform(&r));
+    const double v = (nav_rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * mag * nav_rng_uniform(&r);
+    snprintf(s, sizeof s, fmts[it % (int)(sizeof fmts / sizeof fmts[0])], v);
+    check_one(s, &t);
+  }
+  print_message("[ fastnum  ] printf renderings: %ld fast, %ld declined\n", t.fast, t.declined);
+  assert_true(t.fast > 250000);
+}
+
+/* Edge cases: exact results at the limits of the fast path, signed zeros, and the texts that
+ * must be declined. */
+static void test_edges(void **state) {
+  (void)state;
+  tally t = {0, 0};
+  static const char *const accepted[] = {
+      "0",     "-0",   "+0.0", "0.000", "-0.0e5",  ".5",    "5.",    "1e22",  "1e-22", "9007199254740992",
+      "9007199254740992e22", "9007199254740992e-22", "4503599627370497e-1", "0.1", "0.2", "0.3",
+      "100000.005000", "-177.000000", "3.550682422333e-06", "-4.911053131454e-02", "31.50818300000",
+      "0000000000000000000000001.5", "1.000000000000000"};
+  for (size_t i = 0; i < sizeof accepted / sizeof accepted[0]; ++i)
+    if (!check_one(accepted[i], &t)) fail_msg("\"%s\" should be on the fast path", accepted[i]);
+  double v = 1.0;
+  assert_true(nav_fast_number("-0", "-0" + 2, &v));
+  assert_true(v == 0.0 && signbit(v));
+  static const char *const declined[] = {"",      "-",      "+",        ".",      "e5",     "1e",    "1e+",
+                                         "1e-",   "0x1p3",  "nan",      "inf",    "-inf",   "1.2.3", "1,5",
+                                         "12a",   "1e99999", "9007199254740993", "1e23", "1e-23", "--1",
+                                         "1e+-2", " 1",     "1 ",       "12345678901234567890"};
+  for (size_t i = 0; i < sizeof declined / sizeof declined[0]; ++i) {
+    const char *s = declined[i];
+    v = 42.0;
+    if (nav_fast_number(s, s + strlen(s), &v)) fail_msg("\"%s\" should be declined (got %.17g)", s, v);
+    assert_true(v == 42.0); /* untouched */
+  }
+}
+
+/* Every field of the first lines of the shared long-drive files: all on the fast path and
+ * identical to strtod. Skipped when the shared data is not there. */
+static void test_shared_files(void **state) {
+  (void)state;
+  static const char *const files[] = {"IMU.txt", "truth.nav", "GNSS_outage.txt"};
+  for (size_t fi = 0; fi < 3; ++fi) {
+    char path[512];
+    snprintf(path, sizeof path, "%s/data/gnss-ins-sim-long-drive/%s", NAV_SHARED_DIR, files[fi]);
+    FILE *f = fopen(path, "r");
+    if (!f) {
+      print_message("[ fastnum  ] %s not found: skipped\n", path);
+      continue;
+    }
+    char line[512];
+    tally t = {0, 0};
+    for (int l = 0; l < 20000 && fgets(line, sizeof line, f); ++l) {
+      char *save = NULL;
+      for (char *tok = strtok_r(line, " \t\r\n", &save); tok; tok = strtok_r(NULL, " \t\r\n", &save))
+        check_one(tok, &t);
+    }
+    fclose(f);
+    /* Declined: values below 1e-10 with 13 digits (10^-23 and beyond is not exact), rare. */
+    print_message("[ fastnum  ] %s: %ld fields identical to strtod on the fast path, %ld declined (strtod)\n",
+                  files[fi], t.fast, t.declined);
+    assert_true(t.fast > 0);
+    assert_true(t.declined * 1000 < t.fast);
+  }
+}
+
+/* A malformed field is still reported with its line and column (the slow path words it). */
+static void test_malformed_reported(void **state) {
+  (void)state;
+  static const char text[] = "100.000 1e-6 2e-6 3e-6 0.1 0.2 9.8\n"
+                             "100.005 1e-6 2e-6 3e-6 0.1 0x0.2p1 9.8\n";
+  nav_rec_reader *r = NULL;
+  assert_int_equal(nav_rec_reader_open_memory(text, sizeof text - 1, "mem.txt", NAV_REC_IMU, &r), NAV_OK);
+  nav_imu_increment inc;
+  bool got = false;
+  assert_int_equal(nav_rec_read_imu(r, &inc, &got), NAV_OK);
+  assert_true(got);
+  assert_true(inc.dv_b_mps.z == strtod("9.8", NULL));
+  assert_int_equal(nav_rec_read_imu(r, &inc, &got), NAV_ERR_PARSE);
+  const nav_diag *d = nav_rec_reader_diag(r);
+  assert_string_equal(d->file, "mem.txt");
+  assert_int_equal(d->line, 2);
+  assert_int_equal(d->col, 28);
+  assert_non_null(strstr(d->message, "0x0.2p1"));
+  nav_rec_reader_destroy(r);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_random_digit_strings), cmocka_unit_test(test_random_printf_values),
+      cmocka_unit_test(test_edges),                cmocka_unit_test(test_shared_files),
+      cmocka_unit_test(test_malformed_reported),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

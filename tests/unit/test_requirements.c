@@ -1,0 +1,583 @@
+/*
+ * Requirements (nav_requirements.h): statistics with known answers on constructed error series
+ * (RMS, max, p95, at_time, outage_end, CEP50/CEP95 of a circular Gaussian), order independence,
+ * the histogram beyond the exact budget, validation, and the scene-file syntax (errors with
+ * FILE:LINE:COL and did-you-mean, exact round trip).
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "nav_test.h"
+#include "navcore/nav_errors.h"
+#include "navcore/nav_io.h"
+#include "navcore/nav_requirements.h"
+#include "navcore/nav_scene.h"
+#include "navcore/nav_sim.h"
+
+static nav_requirement req(const char *id, nav_req_metric m, nav_req_statistic s, double limit, nav_req_unit u) {
+  nav_requirement q;
+  memset(&q, 0, sizeof q);
+  snprintf(q.id, sizeof q.id, "%s", id);
+  q.metric = m;
+  q.statistic = s;
+  q.limit = limit;
+  q.unit = u;
+  q.time_s = NAN;
+  return q;
+}
+
+/* An epoch with horizontal error h along the direction angle a (N = h cos a, E = h sin a). */
+static nav_epoch_errors epoch_h(double t, double h, double a) {
+  nav_epoch_errors e;
+  memset(&e, 0, sizeof e);
+  e.t_s = t;
+  e.pos_err_n_m = nav_vec3_make(h * cos(a), h * sin(a), 0.0);
+  e.pos_err_h_m = h;
+  return e;
+}
+
+/* Feed one run of epochs. */
+static void feed_run(nav_req_evaluator *ev, long run, const nav_epoch_errors *e, size_t n) {
+  nav_req_run *r = NULL;
+  assert_int_equal(nav_req_run_begin(ev, run, &r), NAV_OK);
+  for (size_t i = 0; i < n; ++i) assert_int_equal(nav_req_run_add(r, &e[i]), NAV_OK);
+  assert_int_equal(nav_req_run_end(ev, r), NAV_OK);
+}
+
+static void test_names_and_units(void **state) {
+  (void)state;
+  for (int i = 0; i < NAV_REQ_METRIC_COUNT; ++i) {
+    nav_req_metric m;
+    assert_true(nav_req_metric_from_name(nav_req_metric_name((nav_req_metric)i), &m));
+    assert_int_equal((int)m, i);
+  }
+  for (int i = 0; i < NAV_REQ_STATISTIC_COUNT; ++i) {
+    nav_req_statistic s;
+    assert_true(nav_req_statistic_from_name(nav_req_statistic_name((nav_req_statistic)i), &s));
+    assert_int_equal((int)s, i);
+  }
+  for (int i = 0; i < NAV_REQ_UNIT_COUNT; ++i) {
+    nav_req_unit u;
+    assert_true(nav_req_unit_from_name(nav_req_unit_name((nav_req_unit)i), &u));
+    assert_int_equal((int)u, i);
+  }
+  assert_false(nav_req_metric_from_name("horizontal", NULL));
+  assert_string_equal(nav_req_unit_name(NAV_REQ_UNIT_MPS), "m/s");
+  assert_near(nav_req_unit_to_si(NAV_REQ_UNIT_ARCMIN) * 60.0, nav_req_unit_to_si(NAV_REQ_UNIT_DEG), 1e-18);
+  assert_near(nav_req_unit_to_si(NAV_REQ_UNIT_ARCSEC) * 3600.0, NAV_PI / 180.0, 1e-18);
+  assert_near(nav_req_unit_to_si(NAV_REQ_UNIT_CM), 0.01, 0.0);
+
+  /* Metrics of one epoch. */
+  nav_epoch_errors e;
+  memset(&e, 0, sizeof e);
+  e.pos_err_n_m = nav_vec3_make(3.0, -4.0, 12.0);
+  e.vel_err_n_mps = nav_vec3_make(-2.0, 3.0, 6.0);
+  e.euler_err.roll_rad = 0.01;
+  e.euler_err.pitch_rad = -0.03;
+  e.euler_err.yaw_rad = -0.2;
+  assert_near(nav_req_metric_value(NAV_REQ_HORIZONTAL_POSITION, &e), 5.0, 1e-15);
+  assert_near(nav_req_metric_value(NAV_REQ_VERTICAL_POSITION, &e), 12.0, 0.0);
+  assert_near(nav_req_metric_value(NAV_REQ_POSITION_3D, &e), 13.0, 1e-14);
+  assert_near(nav_req_metric_value(NAV_REQ_VELOCITY, &e), 7.0, 1e-15);
+  assert_near(nav_req_metric_value(NAV_REQ_ROLL_PITCH, &e), 0.03, 0.0);
+  assert_near(nav_req_metric_value(NAV_REQ_YAW, &e), 0.2, 0.0);
+}
+
+/* h = 1, 2, ..., 100 m over 4 runs of 25 epochs, fed in two different run orders:
+ * rms = sqrt(338350 / 100), max = 100, p95 (nearest rank 95) = 95 m = 9500 cm. */
+static void test_rms_max_p95_known(void **state) {
+  (void)state;
+  nav_requirement q[4] = {
+      req("rms", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_RMS, 60.0, NAV_REQ_UNIT_M),
+      req("max", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_MAX, 99.0, NAV_REQ_UNIT_M),
+      req("p95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_P95, 9500.0, NAV_REQ_UNIT_CM),
+      req("p95km", NAV_REQ_POSITION_3D, NAV_REQ_P95, 0.094, NAV_REQ_UNIT_KM),
+  };
+  nav_requirement_verdict v[2][4];
+  const long order[2][4] = {{0, 1, 2, 3}, {3, 1, 0, 2}};
+  for (int o = 0; o < 2; ++o) {
+    nav_req_evaluator *ev = NULL;
+    assert_int_equal(nav_req_evaluator_create(q, 4, 4, NULL, 0, &ev), NAV_OK);
+    assert_int_equal(nav_req_evaluator_count(ev), 4);
+    for (int k = 0; k < 4; ++k) {
+      const long run = order[o][k];
+      nav_epoch_errors e[25];
+      /* run r holds h = r + 1, r + 5, ...: every value once over the runs */
+      for (int i = 0; i < 25; ++i) e[i] = epoch_h(0.1 * i, (double)(run + 1 + 4 * i), 0.7 * i);
+      feed_run(ev, run, e, 25);
+    }
+    assert_int_equal(nav_req_evaluator_finish(ev, v[o]), NAV_OK);
+    nav_req_evaluator_destroy(ev);
+  }
+  assert_rel_near(v[0][0].value, sqrt(338350.0 / 100.0), 1e-15);
+  assert_true(v[0][0].pass); /* 58.17 <= 60 */
+  assert_int_equal(v[0][0].samples, 100);
+  assert_near(v[0][1].value, 100.0, 1e-13);
+  assert_false(v[0][1].pass);
+  assert_near(v[0][2].value, 9500.0, 1e-10);
+  assert_true(v[0][2].pass); /* equal to the limit passes */
+  assert_near(v[0][3].value, 0.095, 1e-15);
+  assert_false(v[0][3].pass);
+  /* Bit-identical whatever the order of the runs. */
+  for (int i = 0; i < 4; ++i) assert_memory_equal(&v[0][i].value, &v[1][i].value, sizeof(double));
+  assert_true(nav_req_all_pass(v[0], 1));
+  assert_false(nav_req_all_pass(v[0], 4));
+}
+
+/* at_time: epochs t = 0..10 s; the nearest epoch to 6.2 s is 6 s, a tie at 2.5 s takes 2 s. */
+static void test_at_time_known(void **state) {
+  (void)state;
+  nav_requirement q[3] = {req("t62", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_AT_TIME, 10.0, NAV_REQ_UNIT_M),
+                          req("t25", NAV_REQ_VELOCITY, NAV_REQ_AT_TIME, 1.0, NAV_REQ_UNIT_CMPS),
+                          req("t99", NAV_REQ_YAW, NAV_REQ_AT_TIME, 1.0, NAV_REQ_UNIT_DEG)};
+  q[0].time_s = 6.2;
+  q[1].time_s = 2.5;
+  q[2].time_s = 99.0; /* beyond the end: the last epoch */
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(q, 3, 2, NULL, 0, &ev), NAV_OK);
+  for (long run = 0; run < 2; ++run) {
+    nav_epoch_errors e[11];
+    for (int i = 0; i <= 10; ++i) {
+      /* run 0: h = t, run 1: h = 2 t; velocity (t/100) m/s (run 1 doubled); yaw t mrad */
+      e[i] = epoch_h((double)i, (double)(run + 1) * i, 0.3);
+      e[i].vel_err_n_mps = nav_vec3_make(0.0, 0.0, (double)(run + 1) * i / 100.0);
+      e[i].euler_err.yaw_rad = -(double)i * 1e-3 * (double)(run + 1);
+    }
+    feed_run(ev, run, e, 11);
+  }
+  nav_requirement_verdict v[3];
+  assert_int_equal(nav_req_evaluator_finish(ev, v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  assert_near(v[0].at_time_s, 6.0, 0.0);
+  assert_rel_near(v[0].value, sqrt((36.0 + 144.0) / 2.0), 1e-15);
+  assert_true(v[0].pass);
+  assert_near(v[1].at_time_s, 2.0, 0.0);
+  assert_rel_near(v[1].value, sqrt((4.0 + 16.0) / 2.0), 1e-14); /* cm/s */
+  assert_false(v[1].pass);
+  assert_near(v[2].at_time_s, 10.0, 0.0);
+  assert_rel_near(v[2].value, sqrt((0.01 * 0.01 + 0.02 * 0.02) / 2.0) * 180.0 / NAV_PI, 1e-14);
+  assert_true(v[2].pass);
+}
+
+/* outage_end: outages [2, 5) and [7, 9.5) on epochs t = 0..10 s: last epochs 4 s and 9 s; an
+ * outage between epochs is reported without a value. */
+static void test_outage_end_known(void **state) {
+  (void)state;
+  nav_requirement q = req("h-end", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_OUTAGE_END, 12.0, NAV_REQ_UNIT_M);
+  const nav_req_interval out[3] = {{2.0, 5.0}, {7.0, 9.5}, {10.2, 10.6}};
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(&q, 1, 2, out, 3, &ev), NAV_OK);
+  for (long run = 1; run >= 0; --run) {
+    nav_epoch_errors e[11];
+    for (int i = 0; i <= 10; ++i) e[i] = epoch_h((double)i, (double)(run + 1) * i, 1.0);
+    feed_run(ev, run, e, 11);
+  }
+  nav_requirement_verdict v;
+  assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  assert_int_equal(v.outage_count, 3);
+  assert_near(v.outage_end_t_s[0], 4.0, 0.0);
+  assert_near(v.outage_end_t_s[1], 9.0, 0.0);
+  assert_rel_near(v.outage_value[0], sqrt((16.0 + 64.0) / 2.0), 1e-15);
+  assert_rel_near(v.outage_value[1], sqrt((81.0 + 324.0) / 2.0), 1e-15);
+  assert_true(isnan(v.outage_value[2]));
+  assert_rel_near(v.value, sqrt(202.5), 1e-15);
+  assert_false(v.pass); /* 14.2 > 12 */
+  assert_true(v.evaluated);
+
+  /* No outage at all: not evaluated, and nothing violates it (passes). */
+  assert_int_equal(nav_req_evaluator_create(&q, 1, 1, NULL, 0, &ev), NAV_OK);
+  nav_epoch_errors e = epoch_h(0.0, 1.0, 0.0);
+  feed_run(ev, 0, &e, 1);
+  assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  assert_false(v.evaluated);
+  assert_true(v.pass);
+  assert_true(isnan(v.value));
+  /* Outages without an epoch inside: not evaluated, fails. */
+  const nav_req_interval late = {20.0, 30.0};
+  assert_int_equal(nav_req_evaluator_create(&q, 1, 1, &late, 1, &ev), NAV_OK);
+  feed_run(ev, 0, &e, 1);
+  assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  assert_false(v.evaluated);
+  assert_false(v.pass);
+  /* Any other statistic without data fails. */
+  nav_requirement q2 = req("rms", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_RMS, 12.0, NAV_REQ_UNIT_M);
+  assert_int_equal(nav_req_evaluator_create(&q2, 1, 1, NULL, 0, &ev), NAV_OK);
+  assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  assert_false(v.evaluated);
+  assert_false(v.pass);
+}
+
+/* CEP of a circular Gaussian (sigma per axis): CEP50 = sigma sqrt(2 ln 2) = 1.1774 sigma,
+ * CEP95 = sigma sqrt(2 ln 20) = 2.4477 sigma. Deterministic points: radii at the Rayleigh
+ * quantiles (i - 1/2) / N, golden-angle directions, spread over 8 runs fed out of order. */
+static void test_cep_circular_gaussian(void **state) {
+  (void)state;
+  const double sigma = 3.0;
+  const int N = 40000, runs = 8, per = N / runs;
+  nav_requirement q[3] = {req("cep50", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP50, 3.6, NAV_REQ_UNIT_M),
+                          req("cep95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 7.0, NAV_REQ_UNIT_M),
+                          req("rms", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_RMS, 1.0, NAV_REQ_UNIT_M)};
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(q, 3, runs, NULL, 0, &ev), NAV_OK);
+  nav_epoch_errors *e = malloc((size_t)per * sizeof *e);
+  assert_non_null(e);
+  const long order[8] = {5, 0, 7, 2, 1, 6, 3, 4};
+  for (int k = 0; k < runs; ++k) {
+    const long run = order[k];
+    for (int j = 0; j < per; ++j) {
+      const int i = (int)run + runs * j; /* 0..N-1 */
+      const double p = (i + 0.5) / N;
+      const double r = sigma * sqrt(-2.0 * log1p(-p));
+      e[j] = epoch_h(0.01 * j, r, 2.399963229728653 * i);
+    }
+    feed_run(ev, run, e, (size_t)per);
+  }
+  free(e);
+  nav_requirement_verdict v[3];
+  assert_int_equal(nav_req_evaluator_finish(ev, v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  /* nearest rank k = N/2 and 0.95 N: the point with p = (k - 1/2) / N */
+  const double k50 = N / 2, k95 = 0.95 * N;
+  assert_rel_near(v[0].value, sigma * sqrt(-2.0 * log1p(-(k50 - 0.5) / N)), 1e-12);
+  assert_rel_near(v[1].value, sigma * sqrt(-2.0 * log1p(-(k95 - 0.5) / N)), 1e-12);
+  assert_rel_near(v[0].value, 1.1774 * sigma, 1e-4);
+  assert_rel_near(v[1].value, 2.4477 * sigma, 1e-4);
+  assert_true(v[0].pass);  /* 3.532 <= 3.6 */
+  assert_false(v[1].pass); /* 7.343 > 7 */
+  /* and the RMS radius of the sample is sigma sqrt 2 (to the quantile-grid discretisation) */
+  assert_rel_near(v[2].value, sigma * sqrt(2.0), 2e-3);
+}
+
+/* Beyond the exact budget the quantile comes from the log histogram: relative error below half
+ * a bin width. h_i = (i + 1) mm, i < 4.5e6 in 5 runs: p95 (nearest rank) = 4275 m exactly. */
+static void test_quantile_histogram_beyond_budget(void **state) {
+  (void)state;
+  const long n = 4500000, runs = 5, per = n / runs;
+  assert_true(n > NAV_REQ_EXACT_BUDGET);
+  nav_requirement q = req("p95", NAV_REQ_VERTICAL_POSITION, NAV_REQ_P95, 5000.0, NAV_REQ_UNIT_M);
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(&q, 1, runs, NULL, 0, &ev), NAV_OK);
+  for (long run = 0; run < runs; ++run) {
+    nav_req_run *r = NULL;
+    assert_int_equal(nav_req_run_begin(ev, run, &r), NAV_OK);
+    nav_epoch_errors e;
+    memset(&e, 0, sizeof e);
+    for (long j = 0; j < per; ++j) {
+      e.t_s = (double)j;
+      e.pos_err_n_m.z = -1e-3 * (double)(run * per + j + 1);
+      assert_int_equal(nav_req_run_add(r, &e), NAV_OK);
+    }
+    assert_int_equal(nav_req_run_end(ev, r), NAV_OK);
+  }
+  nav_requirement_verdict v;
+  assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  const double exact = 1e-3 * (double)((n * 95 + 99) / 100);
+  assert_rel_near(v.value, exact, 0.5 * NAV_REQ_HIST_REL_WIDTH);
+  assert_true(v.pass);
+  assert_int_equal(v.samples, n);
+}
+
+typedef struct issues {
+  int n;
+  char text[16][200];
+} issues;
+
+static void collect(void *user, const char *path, const char *message) {
+  issues *is = user;
+  if (is->n < 16) snprintf(is->text[is->n], sizeof is->text[0], "%s: %s", path, message);
+  is->n++;
+}
+
+static bool has_issue(const issues *is, const char *prefix) {
+  for (int i = 0; i < is->n && i < 16; ++i)
+    if (strncmp(is->text[i], prefix, strlen(prefix)) == 0) return true;
+  return false;
+}
+
+static void test_validate(void **state) {
+  (void)state;
+  nav_requirement q[6] = {
+      req("ok.1_a-b", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 5.0, NAV_REQ_UNIT_M),
+      req("ok.1_a-b", NAV_REQ_YAW, NAV_REQ_RMS, 1.0, NAV_REQ_UNIT_DEG),   /* duplicate id */
+      req("v", NAV_REQ_VELOCITY, NAV_REQ_MAX, 1.0, NAV_REQ_UNIT_M),        /* wrong unit */
+      req("cep", NAV_REQ_VERTICAL_POSITION, NAV_REQ_CEP50, 1.0, NAV_REQ_UNIT_M), /* cep not horizontal */
+      req("t", NAV_REQ_ROLL_PITCH, NAV_REQ_AT_TIME, 0.0, NAV_REQ_UNIT_ARCMIN),   /* no time_s, limit 0 */
+      req("a b", NAV_REQ_ROLL_PITCH, NAV_REQ_RMS, 1.0, NAV_REQ_UNIT_MRAD),       /* bad id */
+  };
+  issues is = {0};
+  assert_int_equal(nav_requirements_validate(q, 1, collect, &is), NAV_OK);
+  assert_int_equal(is.n, 0);
+  assert_int_equal(nav_requirements_validate(q, 6, collect, &is), NAV_ERR_INVALID_ARG);
+  assert_true(has_issue(&is, "requirements[1].id: "));
+  assert_true(has_issue(&is, "requirements[2].unit: m is not a unit of velocity"));
+  assert_true(has_issue(&is, "requirements[3].statistic: cep50 applies to metric horizontal_position"));
+  assert_true(has_issue(&is, "requirements[4].time_s: "));
+  assert_true(has_issue(&is, "requirements[4].limit: "));
+  assert_true(has_issue(&is, "requirements[5].id: "));
+  assert_int_equal(is.n, 6);
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(q, 6, 1, NULL, 0, &ev), NAV_ERR_INVALID_ARG);
+  assert_null(ev);
+}
+
+/* ---------------------------------------------------------------- scene files */
+
+typedef struct diags {
+  int n;
+  char text[16][600];
+} diags;
+
+static void on_diag(void *user, const nav_diag *d) {
+  diags *ds = user;
+  if (ds->n < 16) nav_diag_format(d, ds->text[ds->n], sizeof ds->text[0]);
+  ds->n++;
+}
+
+static const char *find_diag(const diags *ds, const char *needle) {
+  for (int i = 0; i < ds->n && i < 16; ++i)
+    if (strstr(ds->text[i], needle)) return ds->text[i];
+  return NULL;
+}
+
+static void test_scene_errors(void **state) {
+  (void)state;
+  static const char text[] = "format_version: 1\n"
+                             "requirements:\n"
+                             "  - {id: a, metric: horizontal_position, statistic: rms, limit: 1, unit: m}\n"
+                             "  - {id: b, metric: yaw, statistic: max, limit: 1, unit: arcmin}\n"
+                             "  - {id: c, metric: horizontal_positon, statistic: p96, limit: 1, unit: mps}\n"
+                             "  - {id: d, metric: velocity, statistic: rms, limit: 0.5, unit: m/s, time_s: 3}\n"
+                             "  - {id: e, metric: velocity, statistic: at_time, limit: 1, unit: m/s}\n"
+                             "  - {id: a, metric: velocity, statistic: rms, unit: m/s}\n";
+  nav_scene s;
+  diags ds = {0};
+  assert_int_equal(nav_scene_read_string(text, strlen(text), "req.yaml", &s, on_diag, &ds), NAV_ERR_PARSE);
+  const char *m = find_diag(&ds, "requirements[2].metric");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "req.yaml:5:21: error: requirements[2].metric: expected one of"));
+  assert_non_null(strstr(m, "did you mean \"horizontal_position\""));
+  m = find_diag(&ds, "requirements[2].statistic");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "did you mean \"p95\""));
+  m = find_diag(&ds, "requirements[2].unit");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "did you mean \"m/s\""));
+  m = find_diag(&ds, "requirements[3].time_s");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "req.yaml:6:"));
+  assert_non_null(strstr(m, "at_time only"));
+  m = find_diag(&ds, "requirements[5].limit");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "missing required key"));
+
+  /* Errors found by nav_scene_validate are placed at the field too. */
+  static const char text2[] = "format_version: 1\n"
+                              "requirements:\n"
+                              "  - id: a\n"
+                              "    metric: yaw\n"
+                              "    statistic: at_time\n"
+                              "    limit: 1\n"
+                              "    unit: m\n"
+                              "  - {id: a, metric: vertical_position, statistic: cep95, limit: 1, unit: m}\n";
+  memset(&ds, 0, sizeof ds);
+  assert_int_equal(nav_scene_read_string(text2, strlen(text2), "r2.yaml", &s, on_diag, &ds), NAV_ERR_PARSE);
+  m = find_diag(&ds, "requirements[0].unit");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "r2.yaml:7:11: error: requirements[0].unit: m is not a unit of yaw"));
+  assert_non_null(find_diag(&ds, "requirements[0].time_s: statistic at_time needs time_s"));
+  assert_non_null(find_diag(&ds, "requirements[1].id: \"a\" is already the id of requirements[0]"));
+  assert_non_null(find_diag(&ds, "requirements[1].statistic: cep95 applies to metric horizontal_position only"));
+}
+
+static char *read_all(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  static char buf[1 << 20];
+  const size_t n = fread(buf, 1, sizeof buf - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  char *copy = malloc(n + 1);
+  if (copy) memcpy(copy, buf, n + 1);
+  return copy;
+}
+
+static void test_scene_round_trip(void **state) {
+  (void)state;
+  static const char text[] = "format_version: 1\n"
+                             "requirements:\n"
+                             "  - id: h-outage-end\n"
+                             "    metric: horizontal_position\n"
+                             "    statistic: outage_end\n"
+                             "    limit: 5.0\n"
+                             "    unit: m\n"
+                             "  - {id: yaw.300, metric: yaw, statistic: at_time, time_s: 300.1, limit: 0.1, unit: deg}\n"
+                             "  - {id: cep_95, metric: horizontal_position, statistic: cep95, limit: 0.3, unit: cm}\n"
+                             "  - {id: v, metric: velocity, statistic: p95, limit: 1e-3, unit: cm/s}\n"
+                             "  - {id: rp, metric: roll_pitch, statistic: max, limit: 0.7, unit: arcsec}\n"
+                             "  - {id: t0, metric: position_3d, statistic: at_time, time_s: 0, limit: 2, unit: km}\n";
+  nav_scene a, b;
+  diags ds = {0};
+  assert_int_equal(nav_scene_read_string(text, strlen(text), "rt.yaml", &a, on_diag, &ds), NAV_OK);
+  assert_int_equal(a.n_requirements, 6);
+  assert_string_equal(a.requirements[1].id, "yaw.300");
+  assert_int_equal(a.requirements[1].statistic, NAV_REQ_AT_TIME);
+  assert_near(a.requirements[1].time_s, 300.1, 0.0);
+  assert_int_equal(a.requirements[3].unit, NAV_REQ_UNIT_CMPS);
+  assert_near(a.requirements[3].limit, 1e-3, 0.0);
+  assert_true(isnan(a.requirements[0].time_s));
+  char dir[] = "/tmp/nav_req_rt_XXXXXX";
+  assert_non_null(mkdtemp(dir));
+  char p1[256], p2[256];
+  snprintf(p1, sizeof p1, "%s/a.yaml", dir);
+  snprintf(p2, sizeof p2, "%s/b.yaml", dir);
+  assert_int_equal(nav_scene_write_file(p1, &a), NAV_OK);
+  const nav_status rst = nav_scene_read_file(p1, &b, on_diag, &ds);
+  for (int i = 0; i < ds.n && i < 16; ++i) print_message("%s\n", ds.text[i]);
+  assert_int_equal(rst, NAV_OK);
+  assert_int_equal(ds.n, 0);
+  assert_int_equal(b.n_requirements, a.n_requirements);
+  for (int i = 0; i < a.n_requirements; ++i) {
+    assert_string_equal(a.requirements[i].id, b.requirements[i].id);
+    assert_int_equal(a.requirements[i].metric, b.requirements[i].metric);
+    assert_int_equal(a.requirements[i].statistic, b.requirements[i].statistic);
+    assert_int_equal(a.requirements[i].unit, b.requirements[i].unit);
+    assert_memory_equal(&a.requirements[i].limit, &b.requirements[i].limit, sizeof(double));
+    assert_memory_equal(&a.requirements[i].time_s, &b.requirements[i].time_s, sizeof(double));
+  }
+  assert_int_equal(nav_scene_write_file(p2, &b), NAV_OK);
+  char *t1 = read_all(p1), *t2 = read_all(p2);
+  assert_non_null(t1);
+  assert_non_null(t2);
+  assert_string_equal(t1, t2);
+  assert_non_null(strstr(t1, "requirements:\n  - {id: \"h-outage-end\", metric: horizontal_position"));
+  free(t1);
+  free(t2);
+  unlink(p1);
+  unlink(p2);
+  rmdir(dir);
+
+  /* A scene without requirements writes none. */
+  nav_scene d = nav_scene_default();
+  assert_int_equal(d.n_requirements, 0);
+}
+
+
+/* Prediction from sigmas: a circular Gaussian (sigma per axis) at every epoch gives CEP50 =
+ * sigma sqrt(2 ln 2), CEP95 = sigma sqrt(2 ln 20), horizontal RMS = sigma sqrt 2; the vertical
+ * p95 of N(0, sD^2) is 1.959964 sD; a degenerate ellipse (sE = 0) gives the 1-D quantile. */
+static void test_predict_known(void **state) {
+  (void)state;
+  const double sigma = 2.0, sd = 3.0;
+  nav_cov_point pts[50];
+  memset(pts, 0, sizeof pts);
+  for (int i = 0; i < 50; ++i) {
+    pts[i].t_s = i;
+    pts[i].pos_sd_n_m = nav_vec3_make(sigma, sigma, sd);
+    pts[i].pos_h_sd_m = sigma * sqrt(2.0);
+    pts[i].att_sd_rad = nav_vec3_make(0.0, 0.0, 1e-3 * (i < 25 ? 1.0 : 2.0));
+  }
+  nav_requirement q[7] = {req("c50", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP50, 5.0, NAV_REQ_UNIT_M),
+                          req("c95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 5.0, NAV_REQ_UNIT_M),
+                          req("rms", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_RMS, 5.0, NAV_REQ_UNIT_M),
+                          req("v95", NAV_REQ_VERTICAL_POSITION, NAV_REQ_P95, 5.0, NAV_REQ_UNIT_M),
+                          req("max", NAV_REQ_VERTICAL_POSITION, NAV_REQ_MAX, 5.0, NAV_REQ_UNIT_M),
+                          req("end", NAV_REQ_YAW, NAV_REQ_OUTAGE_END, 0.1, NAV_REQ_UNIT_DEG),
+                          req("yaw", NAV_REQ_YAW, NAV_REQ_RMS, 1.0, NAV_REQ_UNIT_MRAD)};
+  const nav_req_interval out[2] = {{10.0, 20.0}, {30.5, 40.0}};
+  nav_requirement_verdict v[7];
+  assert_int_equal(nav_req_predict(q, 7, pts, 50, out, 2, v), NAV_OK);
+  assert_rel_near(v[0].value, sigma * sqrt(2.0 * log(2.0)), 1e-7);
+  assert_true(v[0].pass);
+  assert_rel_near(v[1].value, sigma * sqrt(2.0 * log(20.0)), 1e-7);
+  assert_true(v[1].pass); /* 4.895 <= 5 */
+  assert_rel_near(v[2].value, sigma * sqrt(2.0), 1e-15);
+  assert_rel_near(v[3].value, 1.959963984540054 * sd, 1e-7);
+  assert_false(v[3].pass);
+  assert_false(v[4].evaluated);
+  assert_false(v[4].pass);
+  assert_near(v[5].outage_end_t_s[0], 19.0, 0.0);
+  assert_near(v[5].outage_end_t_s[1], 39.0, 0.0);
+  assert_rel_near(v[5].outage_value[0], 1e-3 * 180.0 / NAV_PI, 1e-14);
+  assert_rel_near(v[5].value, 2e-3 * 180.0 / NAV_PI, 1e-14);
+  assert_rel_near(v[6].value, sqrt(2.5), 1e-14); /* mrad */
+  /* Degenerate ellipse: the horizontal radius is |N(0, sigma^2)|. */
+  for (int i = 0; i < 50; ++i) pts[i].pos_sd_n_m.y = 0.0;
+  assert_int_equal(nav_req_predict(q, 2, pts, 50, NULL, 0, v), NAV_OK);
+  assert_rel_near(v[1].value, 1.959963984540054 * sigma, 1e-7);
+  /* Slightly elliptical: between the 1-D and the circular answers, and continuous. */
+  for (int i = 0; i < 50; ++i) pts[i].pos_sd_n_m.y = 0.5 * sigma;
+  assert_int_equal(nav_req_predict(q, 2, pts, 50, NULL, 0, v), NAV_OK);
+  assert_true(v[1].value > 1.959963984540054 * sigma && v[1].value < sigma * sqrt(2.0 * log(20.0)));
+}
+
+
+/* The outages of a scene as the simulation applies them: gnss.outages plus the segments with
+ * gnss_visible: false (merged when they touch). */
+static void test_scene_outages(void **state) {
+  (void)state;
+  static const char text[] = "format_version: 1\n"
+                             "earth: {model: wgs84, origin: {lat_deg: 45, lon_deg: 7, h_m: 0}}\n"
+                             "trajectory:\n"
+                             "  type: segments\n"
+                             "  segments:\n"
+                             "    v0_b_mps: [5, 0, 0]\n"
+                             "    items:\n"
+                             "      - {kind: hold, duration_s: 10}\n"
+                             "      - {kind: hold, duration_s: 5, gnss_visible: false}\n"
+                             "      - {kind: hold, duration_s: 3, gnss_visible: false}\n"
+                             "      - {kind: hold, duration_s: 12}\n"
+                             "gnss: {enabled: true, outages: [[25, 27]]}\n"
+                             "navigation: {scheme: ins_gnss}\n"
+                             "requirements:\n"
+                             "  - {id: e, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n";
+  nav_scene *sc = malloc(sizeof *sc);
+  assert_non_null(sc);
+  diags ds = {0};
+  assert_int_equal(nav_scene_read_string(text, strlen(text), "o.yaml", sc, on_diag, &ds), NAV_OK);
+  nav_req_interval iv[8];
+  int n = 0;
+  assert_int_equal(nav_req_scene_outages(sc, iv, 8, &n), NAV_OK);
+  assert_int_equal(n, 2);
+  double t0[2] = {iv[0].t0_s, iv[1].t0_s}, t1[2] = {iv[0].t1_s, iv[1].t1_s};
+  const int a = t0[0] < t0[1] ? 0 : 1, b = 1 - a;
+  assert_near(t0[a], 10.0, 1e-9);
+  assert_near(t1[a], 18.0, 1e-9);
+  assert_near(t0[b], 25.0, 0.0);
+  assert_near(t1[b], 27.0, 0.0);
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create_for_scene(sc, false, &ev), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  free(sc);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_names_and_units),
+      cmocka_unit_test(test_rms_max_p95_known),
+      cmocka_unit_test(test_at_time_known),
+      cmocka_unit_test(test_outage_end_known),
+      cmocka_unit_test(test_cep_circular_gaussian),
+      cmocka_unit_test(test_quantile_histogram_beyond_budget),
+      cmocka_unit_test(test_predict_known),
+      cmocka_unit_test(test_validate),
+      cmocka_unit_test(test_scene_errors),
+      cmocka_unit_test(test_scene_round_trip),
+      cmocka_unit_test(test_scene_outages),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
