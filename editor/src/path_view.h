@@ -9,6 +9,7 @@
 #ifndef NAVSTUDIO_PATH_VIEW_H
 #define NAVSTUDIO_PATH_VIEW_H
 
+#include <QStringList>
 #include <QTimer>
 #include <QWidget>
 
@@ -65,6 +66,17 @@ public:
   /** The drawn reference path (brought up to date first). */
   const PathSamples &Path();
 
+  /** Map view: centre the camera on local N/E [m] showing @p half_height_m above and below. */
+  void SetMapExtent(double n, double e, double half_height_m);
+  /** Map background (tests): coastline and graticule polylines drawn, graticule labels, and
+   *  whether the local metric grid is shown (street scale). */
+  size_t CoastlineCount() const { return coast_count_; }
+  size_t GraticuleCount() const { return graticule_count_; }
+  QStringList GraticuleLabels() const;
+  bool MetricGridShown() const;
+  /** Bring the map background up to date with the camera now (normally deferred). */
+  void UpdateBackground();
+
 signals:
   void SelectionChanged(int waypoint);
   /** Cursor read-out text (status bar). */
@@ -81,6 +93,8 @@ private:
   void OnDeleteKey();
   int PickWaypoint(int x, int y);
   void UpdateGrid(double cx, double cy, double extent);
+  void UpdateCaption();
+  void resizeEvent(QResizeEvent *e) override;
 
   SceneDocument *doc_;
   Mode mode_;
@@ -100,6 +114,14 @@ private:
   double drag_d_ = 0.0;
   std::unique_ptr<nav_scene> drag_before_;
   QTimer rebuild_timer_;
+  // Map background (coastlines, graticule and its labels), rebuilt when the view moves.
+  vtkSmartPointer<vtkActor> coast_, graticule_;
+  std::vector<vtkSmartPointer<vtkTextActor>> geo_labels_;
+  QTimer bg_timer_;
+  double bg_key_[5] = {0, 0, 0, 0, 0};
+  bool street_ = true;
+  size_t coast_count_ = 0, graticule_count_ = 0;
+  QString bg_note_;
   double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;
 };
 

@@ -296,6 +296,27 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   json_stat(f, "vel_err_mps", sum->stats.vel_err_mps, false);
   json_stat(f, "att_err_rad", sum->stats.att_err_rad, false);
   json_stat(f, "yaw_err_rad", sum->stats.yaw_err_rad, true);
+  if (sum->has_smoothed) {
+    /* navigation.smoother: RTS-smoothed errors at the output epochs of every run, and the forward
+     * filter's at the same epochs. */
+    fprintf(f,
+            "  },\n  \"stats_smoothed\": {\n    \"method\": \"Rauch-Tung-Striebel backward pass per run over "
+            "the output and GNSS epochs (nav_smoother.h)\",\n    \"epochs\": %lld,\n    \"output_stride\": %lld,\n"
+            "    \"smoother_bytes_max\": %zu,\n",
+            (long long)sum->smoothed_epochs, (long long)sum->smoothed_stride, sum->smoother_bytes_max);
+    json_stat(f, "pos_err_h_m", sum->stats_smoothed.pos_err_h_m, false);
+    json_stat(f, "pos_err_v_m", sum->stats_smoothed.pos_err_v_m, false);
+    json_stat(f, "vel_err_mps", sum->stats_smoothed.vel_err_mps, false);
+    json_stat(f, "att_err_rad", sum->stats_smoothed.att_err_rad, false);
+    json_stat(f, "yaw_err_rad", sum->stats_smoothed.yaw_err_rad, false);
+    fputs("    \"forward_same_epochs\": {\n", f);
+    json_stat(f, "pos_err_h_m", sum->stats_forward_out.pos_err_h_m, false);
+    json_stat(f, "pos_err_v_m", sum->stats_forward_out.pos_err_v_m, false);
+    json_stat(f, "vel_err_mps", sum->stats_forward_out.vel_err_mps, false);
+    json_stat(f, "att_err_rad", sum->stats_forward_out.att_err_rad, false);
+    json_stat(f, "yaw_err_rad", sum->stats_forward_out.yaw_err_rad, true);
+    fputs("    }\n", f);
+  }
   fputs("  },\n  \"requirements\": ", f);
   if (nav_requirements_write_json(f, info->requirements, info->requirements ? info->n_requirements : 0, 2) != NAV_OK)
     fputs("[]", f);

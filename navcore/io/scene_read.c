@@ -562,6 +562,10 @@ static const nav_io_field k_navigation[] = {
      .kind = NAV_IO_BOOL,
      .offset = OFF(navigation.estimate_scale_factors),
      .comment = "ins_gnss: 21-state filter with gyro and accelerometer scale-factor states"},
+    {.key = "smoother",
+     .kind = NAV_IO_BOOL,
+     .offset = OFF(navigation.smoother),
+     .comment = "ins_gnss: RTS smoother per run (nav_smoothed.csv, smoothed_errors.csv, stats_smoothed)"},
 };
 DEFINE_SECTION(k_navigation_section, k_navigation);
 

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include <math.h>
 
 #include "allan_cmd.h"
 #include "bench.h"
@@ -25,6 +26,7 @@
 #include "select_cmd.h"
 #include "replay_cmd.h"
 #include "report_cmd.h"
+#include "run_smooth_out.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -168,8 +170,11 @@ typedef struct run_out {
   nav_status st;
   bool quiet_progress;
   double t_last_print;
+  double t_start;  /* wall clock at the start of the simulation, for the ETA */
+  long runs;       /* Monte Carlo runs of the job */
   FILE *imu_err; /* imu_errors.csv, or NULL when not written */
   navsim_gnss_out *gnss; /* gnss.csv (INS/GNSS scenes), or NULL */
+  navsim_run_smooth *smooth; /* navigation.smoother: nav_smoothed.csv, smoothed_errors.csv */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -214,12 +219,32 @@ static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   return NAV_CONTINUE;
 }
 
+static nav_callback_result on_smoothed(void *user, const nav_sim_record *r) {
+  run_out *o = user;
+  const nav_status st = navsim_run_smooth_record(o->smooth, r);
+  if (st != NAV_OK) {
+    o->st = st;
+    return NAV_STOP;
+  }
+  return NAV_CONTINUE;
+}
+
 static nav_callback_result on_progress(void *user, const nav_progress *p) {
   run_out *o = user;
   if (o->quiet_progress) return NAV_CONTINUE;
   const double t = now_s();
   if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
-    fprintf(stderr, "\r  simulating: %5.1f %%  (t = %.1f s)", 100.0 * p->fraction, p->sim_time_s);
+    /* Runs done and the time left, extrapolated from the fraction of the job done so far. */
+    const long done = (long)floor(p->fraction * (double)o->runs + 1e-9);
+    const double el = t - o->t_start;
+    if (p->fraction > 0.0 && p->fraction < 1.0) {
+      const double eta = el * (1.0 - p->fraction) / p->fraction;
+      fprintf(stderr, "\r  simulating: %5.1f %%  runs %ld/%ld  elapsed %.0f s  ETA %.0f s   ", 100.0 * p->fraction,
+              done, o->runs, el, eta);
+    } else {
+      fprintf(stderr, "\r  simulating: %5.1f %%  runs %ld/%ld  elapsed %.0f s             ", 100.0 * p->fraction,
+              done, o->runs, el);
+    }
     if (p->fraction >= 1.0) fputc('\n', stderr);
     o->t_last_print = t;
   }
@@ -331,7 +356,8 @@ static int cmd_run(int argc, char **argv) {
   nav_resultdir *rd = NULL;
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
-  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, NULL, NULL};
+  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, now_s(), scene.simulation.runs,
+               NULL, NULL, NULL};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -380,10 +406,17 @@ static int cmd_run(int argc, char **argv) {
     }
   }
 
+  if (scene.navigation.smoother && navsim_run_smooth_begin(rd, &o.smooth) != NAV_OK) {
+    fprintf(stderr, "navsim run: cannot write nav_smoothed.csv / smoothed_errors.csv in \"%s\"\n", out_dir);
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+
   nav_sim_options opts = nav_sim_options_default();
   opts.ideal = ideal;
   opts.threads = (int)threads;
   opts.record = on_record;
+  if (o.smooth) opts.smoothed_record = on_smoothed;
   opts.progress = on_progress;
   opts.user = &o;
   nav_run_observer req_obs;
@@ -439,6 +472,13 @@ static int cmd_run(int argc, char **argv) {
     goto cleanup;
   }
   o.gnss = NULL;
+  st = navsim_run_smooth_end(o.smooth);
+  o.smooth = NULL;
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim run: writing nav_smoothed.csv / smoothed_errors.csv failed\n");
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
   if (sum.runs > 1) {
     /* Monte Carlo statistics over runs per output epoch, and the final errors of every run. */
     size_t ne = 0, nf = 0;
@@ -532,6 +572,7 @@ static int cmd_run(int argc, char **argv) {
     printf("rms        horizontal %.3e m, vertical %.3e m, velocity %.3e m/s, attitude %.3e rad\n",
            sum.stats.pos_err_h_m.rms, sum.stats.pos_err_v_m.rms, sum.stats.vel_err_mps.rms,
            sum.stats.att_err_rad.rms);
+    navsim_run_smooth_print(&sum);
     nav_requirements_print(stdout, verdicts, info.n_requirements);
     printf("results    %s/\n", out_dir);
   }
@@ -548,6 +589,7 @@ cleanup:
     if (o.f[i]) fclose(o.f[i]);
   if (o.imu_err) fclose(o.imu_err);
   (void)navsim_gnss_out_end(o.gnss);
+  navsim_run_smooth_abort(o.smooth);
   nav_resultdir_abort(rd);
   navsim_interrupt_disarm();
   if (rc > 128) fprintf(stderr, "navsim run: interrupted by signal %d; no results written\n", rc - 128);

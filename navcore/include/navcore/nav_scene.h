@@ -445,6 +445,9 @@ typedef struct nav_scene_navigation {
   /** ins_gnss: estimate gyro and accelerometer scale factors (21-state filter); their initial
    *  sigma is the scene's scale-factor sigma (with its fixed part), random constants. */
   bool estimate_scale_factors;
+  /** ins_gnss only: every Monte Carlo run also runs the RTS smoother (nav_smoother.h) over its
+   *  output and GNSS epochs; smoothed errors at the output epochs (nav_sim.h). Default false. */
+  bool smoother;
 } nav_scene_navigation;
 
 typedef struct nav_scene_output {

@@ -69,6 +69,11 @@ typedef struct nav_sim_options {
   /** May be NULL: sees every run (any thread) and its output-epoch errors, e.g. the requirement
    *  evaluator's nav_req_evaluator_observer() (nav_requirements.h). */
   const nav_run_observer *observer;
+  /** May be NULL. Scenes with navigation.smoother (ins_gnss): called for run 0 only, on the
+   *  caller's thread, after that run's RTS backward pass (nav_smoother.h), once per output
+   *  epoch in time order with the SMOOTHED navigation state (nav) and its errors (err); truth
+   *  and frame as for @c record, the IMU increments NULL. NAV_STOP cancels the job. */
+  nav_record_fn smoothed_record;
 } nav_sim_options;
 
 NAV_API nav_sim_options nav_sim_options_default(void);
@@ -95,6 +100,16 @@ typedef struct nav_sim_summary {
   int64_t stats_epochs;    /**< epochs entering the statistics */
   int64_t stats_stride;    /**< every stats_stride-th IMU epoch enters the statistics */
   bool partial;            /**< the run was stopped early (cancel / callback) */
+  /** Scenes with navigation.smoother and a complete job: statistics of the RTS-smoothed errors
+   *  pooled over every run and output epoch (every smoothed_stride-th output epoch when runs x
+   *  output epochs would exceed 2e6 values), reduced in run order like @c stats. The matching
+   *  forward figures over the same epochs are in stats_forward_out. */
+  bool has_smoothed;
+  nav_sim_stats stats_smoothed;
+  nav_sim_stats stats_forward_out; /**< forward (filtered) errors at the same output epochs */
+  int64_t smoothed_epochs;         /**< values per metric entering stats_smoothed */
+  int64_t smoothed_stride;         /**< every smoothed_stride-th output epoch of each run */
+  size_t smoother_bytes_max;       /**< largest smoother memory of one run (records + results) */
 } nav_sim_summary;
 
 /** Monte Carlo envelope at one output epoch: statistics over runs (numerics.md T6.6). */

@@ -466,6 +466,8 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
     issue_text(&c, "navigation.scheme", "ins_gnss needs the wgs84 Earth model");
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->navigation.aid_vertical)
     issue_text(&c, "navigation.aid_vertical", "applies to the free INS only; ins_gnss is aided by GNSS");
+  if (s->navigation.smoother && s->navigation.scheme != NAV_SCHEME_INS_GNSS)
+    issue_text(&c, "navigation.smoother", "applies to the ins_gnss scheme only (the RTS smoother needs the filter)");
   if (s->simulation.threads < 0 || s->simulation.threads > 256)
     issue(&c, "simulation.threads", "must be an integer in [0, 256] (got %g)", (double)s->simulation.threads);
   if (s->simulation.runs < 1 || s->simulation.runs > NAV_SCENE_MAX_RUNS)

@@ -21,6 +21,7 @@
 #include "navcore/nav_rng.h"
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_sim.h"
+#include "navcore/nav_smoother.h"
 #include "navcore/nav_truth.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
@@ -36,6 +37,11 @@
 #define METRIC_MAX_VALUES 2000000LL
 #define PROGRESS_EVERY 65536
 #define N_METRICS 5
+/* navigation.smoother: values kept per metric plane (2 x 5 planes, smoothed and forward errors at
+ * the output epochs; every sm_stride-th output epoch beyond this): 10 x 8 B x 4e5 = 32 MB. */
+#define SMOOTH_MAX_VALUES 400000LL
+/* The smoother's discretisation groups (nav_smoother_config.group_steps), as navsim replay. */
+#define SMOOTH_GROUP_STEPS 10u
 
 struct nav_sim {
   nav_scene scene;
@@ -136,6 +142,12 @@ typedef struct job {
   nav_traj_state *shared_ts; /* the states of the samples that need one (ts_map), compact */
   int32_t *ts_map;           /* [n + 1]: index into shared_ts, or -1 (state not kept) */
   nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
+  /* navigation.smoother (INS/GNSS): per-run RTS smoothing over the output and GNSS epochs. */
+  bool smooth;
+  int64_t sm_stride;  /* every sm_stride-th output slot enters the smoothed statistics */
+  int64_t sm_per_run; /* values per run and plane */
+  double *sm_metrics; /* [2 N_METRICS][runs][sm_per_run]: smoothed planes, then forward planes */
+  int64_t *sm_bytes;  /* [runs]: smoother memory of the run (records + results) */
 } job;
 
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
@@ -313,6 +325,64 @@ static int64_t out_slot(const job *j, int64_t k) {
   return k == j->n ? j->n_out - 1 : -1;
 }
 
+/* Smoothed (forward = false) or forward errors of output slot @p slot into the smoothing table. */
+static void store_sm(job *j, long run, int64_t slot, bool forward, const nav_epoch_errors *e) {
+  if (!j->sm_metrics || slot < 0 || slot % j->sm_stride != 0 || slot / j->sm_stride >= j->sm_per_run) return;
+  const double v[N_METRICS] = {e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad,
+                               fabs(e->euler_err.yaw_rad)};
+  const int64_t plane = (int64_t)j->runs * j->sm_per_run;
+  const int64_t row = (int64_t)run * j->sm_per_run + slot / j->sm_stride;
+  for (int m = 0; m < N_METRICS; ++m) j->sm_metrics[(int64_t)(m + (forward ? N_METRICS : 0)) * plane + row] = v[m];
+}
+
+/* A smoother state (geodetic, NED) as a state in the WGS-84 scene frame F = e. */
+static nav_ins_state smoothed_in_frame(const nav_filter_ins_state *s, double t_s) {
+  const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
+  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
+  nav_ins_state o;
+  o.t_s = t_s;
+  o.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
+  o.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, s->v_eb_n_mps);
+  o.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), s->q_b_n));
+  return o;
+}
+
+/*
+ * End of a run with navigation.smoother: the backward pass over the run's records, then the
+ * smoothed errors at every output slot (record sm_rec[slot]) against the reference (sm_ts, or the
+ * shared truth) into the smoothing table, and for run 0 to the smoothed_record callback.
+ */
+static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t *sm_rec,
+                                const nav_traj_state *sm_ts, const nav_frame *frame, bool record) {
+  nav_status st = nav_smoother_run(sm);
+  if (st != NAV_OK) {
+    job_error(j, "run %ld: RTS smoother: %s", run, nav_smoother_last_error(sm));
+    return st;
+  }
+  j->sm_bytes[run] = (int64_t)nav_smoother_memory_bytes(sm);
+  const double dt = 1.0 / j->sim->scene.imu.rate_hz;
+  for (int64_t e = 0; e < j->n_out; ++e) {
+    const int64_t k = e == j->n_out - 1 ? j->n : e * j->out_stride;
+    nav_smoother_epoch ep;
+    st = nav_smoother_get(sm, sm_rec[e], &ep);
+    if (st != NAV_OK) return st;
+    const nav_traj_state *ts = sm_ts ? &sm_ts[e] : shared_state(j, k);
+    if (!ts || fabs(ep.t_s - (double)k * dt) > 1e-6 * (1.0 + fabs(ep.t_s))) {
+      job_error(j, "run %ld: RTS smoother: record %zu at t = %.6f s does not match output epoch t = %.6f s", run,
+                sm_rec[e], ep.t_s, (double)k * dt);
+      return NAV_ERR_STATE;
+    }
+    const nav_ins_state s = smoothed_in_frame(&ep.smoothed, ts->t_s);
+    const nav_epoch_errors err = nav_errors_compute(frame, ts, &s);
+    store_sm(j, run, e, false, &err);
+    if (record) {
+      nav_sim_record rec = {run, frame, ts, &s, &err, NULL, NULL};
+      if (j->opts->smoothed_record(j->opts->user, &rec) == NAV_STOP) return NAV_ERR_CANCELLED;
+    }
+  }
+  return NAV_OK;
+}
+
 /*
  * NEES of the 9 navigation error states against the filter's covariance (numerics.md T6.5):
  * e = (dr_n, dv_n, phi) with phi from C_true C_est^T = I + [phi x] (E0.1), resolved in n.
@@ -363,6 +433,9 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   nav_ins *ins = NULL;
   nav_imu_model *imu_model = NULL;
   nav_sim_gyrofree *gf = NULL; /* gyro-free scheme (sim_gyrofree.c): replaces the IMU */
+  nav_smoother *sm = NULL;        /* navigation.smoother: the run's RTS smoother */
+  size_t *sm_rec = NULL;          /* [n_out]: smoother record of each output slot */
+  nav_traj_state *sm_ts = NULL;   /* [n_out]: reference at each output slot (no shared truth) */
   aiding aid_kf;
   memset(&aid_kf, 0, sizeof aid_kf);
   const nav_run_observer *obs = j->opts->observer; /* requirements (nav_requirements.h) */
@@ -405,7 +478,22 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       job_error(j, "run %ld: GNSS receiver model: %s", run, nav_status_str(st));
       goto cleanup;
     }
-    const nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
+    nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
+    if (j->smooth) {
+      /* Records at the output and GNSS epochs only (nav_smoother.h: ~4.3 KiB each at 15 states). */
+      nav_smoother_config scfg = nav_smoother_config_default();
+      scfg.filter = xc.filter;
+      scfg.group_steps = SMOOTH_GROUP_STEPS;
+      st = nav_smoother_create(&scfg, &sm);
+      sm_rec = st == NAV_OK ? malloc((size_t)j->n_out * sizeof *sm_rec) : NULL;
+      sm_ts = st == NAV_OK && !j->shared_ts ? malloc((size_t)j->n_out * sizeof *sm_ts) : NULL;
+      if (st == NAV_OK && (!sm_rec || (!j->shared_ts && !sm_ts))) st = NAV_ERR_NO_MEMORY;
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: RTS smoother set-up: %s", run, nav_status_str(st));
+        goto cleanup;
+      }
+      xc.smoother = sm;
+    }
     st = nav_ins_gnss_create(&xc, &s0, &aid_kf.x);
     if (st != NAV_OK) {
       job_error(j, "run %ld: INS/GNSS set-up: %s", run, nav_status_str(st));
@@ -426,6 +514,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   store_metrics(j, run, 0, &err);
   store_env(j, run, 0, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_ins_get_state(ins));
   if (obs_ctx) obs->epoch(obs_ctx, &err);
+  if (sm) {
+    sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
+    if (sm_ts) sm_ts[0] = ts;
+    store_sm(j, run, 0, true, &err);
+  }
   if (record) {
     nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -508,6 +601,18 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     store_env(j, run, k, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_now);
     if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
+    if (sm && out_k) {
+      /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
+      st = nav_smoother_mark(sm);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: RTS smoother record at t = %.6f s: %s", run, meas.t_s, nav_smoother_last_error(sm));
+        goto cleanup;
+      }
+      const int64_t slot = out_slot(j, k);
+      sm_rec[slot] = nav_smoother_count(sm) - 1;
+      if (sm_ts) sm_ts[slot] = ts;
+      store_sm(j, run, slot, true, &err);
+    }
     if (record && (k % j->out_stride == 0 || k == j->n)) {
       nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
@@ -520,12 +625,21 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   j->final[run] = err;
   j->samples_done[run] = k - 1;
+  if (sm && !stop) {
+    const bool sm_record = caller_thread && run == 0 && j->opts->smoothed_record;
+    st = smooth_finish(j, run, sm, sm_rec, sm_ts, &frame, sm_record);
+    if (st == NAV_ERR_CANCELLED) stop = true;
+    else if (st != NAV_OK) goto cleanup;
+  }
   st = stop ? NAV_ERR_CANCELLED : NAV_OK;
   if (stop) atomic_store(&sim->cancel, true); /* a stop in run 0 stops the whole job */
 
 cleanup:
   if (obs_ctx) obs->end(obs->user, obs_ctx, st == NAV_OK);
   aiding_destroy(&aid_kf);
+  nav_smoother_destroy(sm); /* after the nav_ins_gnss that borrowed it */
+  free(sm_rec);
+  free(sm_ts);
   nav_sim_gyrofree_destroy(gf);
   nav_imu_model_destroy(imu_model);
   nav_ins_destroy(ins);
@@ -576,6 +690,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   j.ideal = opts->ideal;
   /* Ideal runs are identical: one is enough. */
   j.runs = opts->ideal ? 1 : sc->simulation.runs;
+  j.smooth = sc->navigation.smoother && sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
   if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS) {
     j.gm_states = (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
     char gmsg[200];
@@ -667,6 +782,18 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   j.final = calloc((size_t)j.runs, sizeof *j.final);
   j.samples_done = calloc((size_t)j.runs, sizeof *j.samples_done);
   j.status = calloc((size_t)j.runs, sizeof *j.status);
+  if (j.smooth) {
+    j.sm_stride = ((int64_t)j.runs * j.n_out + SMOOTH_MAX_VALUES - 1) / SMOOTH_MAX_VALUES;
+    if (j.sm_stride < 1) j.sm_stride = 1;
+    j.sm_per_run = (j.n_out - 1) / j.sm_stride + 1;
+    j.sm_metrics = malloc((size_t)(2 * N_METRICS) * (size_t)j.runs * (size_t)j.sm_per_run * sizeof *j.sm_metrics);
+    j.sm_bytes = calloc((size_t)j.runs, sizeof *j.sm_bytes);
+    if (!j.sm_metrics || !j.sm_bytes) {
+      snprintf(sim->last_error, sizeof sim->last_error, "out of memory for the smoothed errors of %ld runs", j.runs);
+      st = NAV_ERR_NO_MEMORY;
+      goto cleanup;
+    }
+  }
   if (!j.metrics || !j.final || !j.samples_done || !j.status) {
     snprintf(sim->last_error, sizeof sim->last_error, "out of memory for %ld runs x %lld epochs", j.runs,
              (long long)j.stats_per_run);
@@ -721,8 +848,9 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   if (sim->hook.active) {
     /* sim_partial.c takes the tables of this range, or fills in those of the others. */
     if (st != NAV_OK) goto cleanup;
-    nav_sim_tables tb = {j.runs, N_METRICS, j.stats_per_run, j.n_out, ENV_VALUES, j.metrics, j.env, j.final,
-                         j.samples_done, j.status};
+    nav_sim_tables tb = {j.runs,  N_METRICS,      j.stats_per_run, j.n_out,        ENV_VALUES,
+                         j.metrics, j.env,         j.final,         j.samples_done, j.status,
+                         j.smooth ? j.sm_per_run : 0, j.sm_metrics, j.sm_bytes};
     st = sim->hook.tables(sim->hook.user, &tb);
     for (long r = 0; r < j.runs && st == NAV_OK; ++r) st = j.status[r];
     if (st != NAV_OK || !sim->hook.reduce) goto cleanup;
@@ -757,6 +885,35 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
              nav_status_str(sst));
     st = sst;
     goto cleanup;
+  }
+  if (j.smooth && !sum.partial) {
+    /* Smoothed and forward errors at the output epochs, reduced in run order (deterministic). */
+    nav_stat_acc_destroy(acc);
+    acc = NULL;
+    sst = nav_stat_acc_create((size_t)j.runs * (size_t)j.sm_per_run, &acc);
+    const size_t sm_plane = (size_t)j.runs * (size_t)j.sm_per_run;
+    nav_stat *sdst[2 * N_METRICS] = {
+        &sum.stats_smoothed.pos_err_h_m,    &sum.stats_smoothed.pos_err_v_m,    &sum.stats_smoothed.vel_err_mps,
+        &sum.stats_smoothed.att_err_rad,    &sum.stats_smoothed.yaw_err_rad,    &sum.stats_forward_out.pos_err_h_m,
+        &sum.stats_forward_out.pos_err_v_m, &sum.stats_forward_out.vel_err_mps, &sum.stats_forward_out.att_err_rad,
+        &sum.stats_forward_out.yaw_err_rad};
+    for (int m = 0; m < 2 * N_METRICS && sst == NAV_OK; ++m) {
+      nav_stat_acc_reset(acc);
+      for (long r = 0; r < j.runs && sst == NAV_OK; ++r)
+        sst = add_values(j.sm_metrics + (size_t)m * sm_plane + (size_t)r * (size_t)j.sm_per_run, j.sm_per_run, acc);
+      *sdst[m] = nav_stat_acc_result(acc);
+    }
+    if (sst != NAV_OK) {
+      snprintf(sim->last_error, sizeof sim->last_error, "smoothed error statistics: %s (non-finite smoothed errors)",
+               nav_status_str(sst));
+      st = sst;
+      goto cleanup;
+    }
+    sum.has_smoothed = true;
+    sum.smoothed_epochs = (int64_t)j.runs * j.sm_per_run;
+    sum.smoothed_stride = j.sm_stride;
+    for (long r = 0; r < j.runs; ++r)
+      if ((size_t)j.sm_bytes[r] > sum.smoother_bytes_max) sum.smoother_bytes_max = (size_t)j.sm_bytes[r];
   }
   sum.runs = sum.partial ? complete_runs : j.runs;
   sum.imu_samples = j.samples_done[0];
@@ -836,6 +993,8 @@ cleanup:
   free(calls);
   if (lock_ok) nav_mutex_destroy(&j.err_lock);
   free(j.metrics);
+  free(j.sm_metrics);
+  free(j.sm_bytes);
   free(j.env);
   free(j.shared_imu);
   free(j.shared_ts);

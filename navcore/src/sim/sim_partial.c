@@ -11,6 +11,7 @@
  * Packed layout (native byte order; 8-byte aligned sections):
  *   header | metrics [n_metrics][count][stats_per_run] | env [count][n_out][env_values] (if any)
  *   | final [count] nav_epoch_errors | samples_done [count] int64 | status [count] int64
+ *   | smoothed [2 n_metrics][count][sm_per_run] and smoother bytes [count] int64 (navigation.smoother)
  */
 #include "navcore/nav_sim_partial.h"
 
@@ -21,13 +22,14 @@
 #include "sim/sim_internal.h"
 #include "sim/sim_partial_internal.h"
 
-#define PARTIAL_MAGIC "NAVSIMP1"
+#define PARTIAL_MAGIC "NAVSIMP2"
 
 typedef struct partial_header {
   char magic[8];
   uint64_t sizeof_errors; /* sizeof(nav_epoch_errors) of the build that packed it */
   int64_t runs, r0, r1;
   int64_t n_metrics, stats_per_run, n_out, env_values, has_env;
+  int64_t sm_per_run; /* navigation.smoother: values per run and plane; 0: no smoothed section */
   uint64_t total_size;
 } partial_header;
 
@@ -37,7 +39,7 @@ struct nav_sim_partial {
 };
 
 typedef struct layout {
-  size_t metrics, env, final, samples, status, end;
+  size_t metrics, env, final, samples, status, sm, sm_bytes, end;
 } layout;
 
 static size_t align8(size_t x) { return (x + 7u) & ~(size_t)7u; }
@@ -47,9 +49,10 @@ static bool partial_layout(const partial_header *h, layout *l) {
   const double count = (double)(h->r1 - h->r0);
   const double bytes = sizeof(partial_header) + count * (double)h->n_metrics * (double)h->stats_per_run * 8.0 +
                        (h->has_env ? count * (double)h->n_out * (double)h->env_values * 8.0 : 0.0) +
-                       count * ((double)sizeof(nav_epoch_errors) + 24.0);
+                       count * ((double)sizeof(nav_epoch_errors) + 24.0) +
+                       count * (2.0 * (double)h->n_metrics * (double)h->sm_per_run + 1.0) * 8.0;
   if (h->r1 < h->r0 || h->n_metrics < 0 || h->stats_per_run < 0 || h->n_out < 0 || h->env_values < 0 ||
-      bytes > (double)SIZE_MAX / 2)
+      h->sm_per_run < 0 || bytes > (double)SIZE_MAX / 2)
     return false;
   const size_t c = (size_t)(h->r1 - h->r0);
   l->metrics = align8(sizeof(partial_header));
@@ -57,7 +60,10 @@ static bool partial_layout(const partial_header *h, layout *l) {
   l->final = l->env + (h->has_env ? c * (size_t)h->n_out * (size_t)h->env_values * sizeof(double) : 0);
   l->samples = align8(l->final + c * sizeof(nav_epoch_errors));
   l->status = l->samples + c * sizeof(int64_t);
-  l->end = l->status + c * sizeof(int64_t);
+  l->sm = l->status + c * sizeof(int64_t);
+  const size_t sm_values = h->sm_per_run > 0 ? 2 * (size_t)h->n_metrics * c * (size_t)h->sm_per_run : 0;
+  l->sm_bytes = l->sm + sm_values * sizeof(double);
+  l->end = l->sm_bytes + (h->sm_per_run > 0 ? c * sizeof(int64_t) : 0);
   return true;
 }
 
@@ -82,6 +88,7 @@ static nav_status take_rows(void *user, nav_sim_tables *t) {
   h.n_out = t->n_out;
   h.env_values = t->env_values;
   h.has_env = t->env != NULL;
+  h.sm_per_run = t->sm_metrics ? t->sm_per_run : 0;
   layout l;
   if (!partial_layout(&h, &l)) return NAV_ERR_NO_MEMORY;
   h.total_size = l.end;
@@ -106,6 +113,13 @@ static nav_status take_rows(void *user, nav_sim_tables *t) {
     const int64_t sd = t->samples_done[(size_t)h.r0 + i], s = (int64_t)t->status[(size_t)h.r0 + i];
     memcpy(b + l.samples + i * sizeof(int64_t), &sd, sizeof sd);
     memcpy(b + l.status + i * sizeof(int64_t), &s, sizeof s);
+  }
+  if (h.sm_per_run > 0 && count > 0) {
+    for (int64_t m = 0; m < 2 * h.n_metrics; ++m)
+      memcpy(b + l.sm + (size_t)m * count * (size_t)h.sm_per_run * sizeof(double),
+             t->sm_metrics + ((size_t)m * (size_t)t->runs + (size_t)h.r0) * (size_t)h.sm_per_run,
+             count * (size_t)h.sm_per_run * sizeof(double));
+    memcpy(b + l.sm_bytes, t->sm_bytes + h.r0, count * sizeof(int64_t));
   }
   p->buf = b;
   p->size = l.end;
@@ -188,7 +202,7 @@ static nav_status put_rows(void *user, nav_sim_tables *t) {
     layout l;
     if (h->runs != t->runs || h->r0 != next || h->n_metrics != t->n_metrics || h->stats_per_run != t->stats_per_run ||
         h->n_out != t->n_out || h->env_values != t->env_values || h->has_env != (t->env != NULL) ||
-        !partial_layout(h, &l))
+        h->sm_per_run != (t->sm_metrics ? t->sm_per_run : 0) || !partial_layout(h, &l))
       return NAV_ERR_INVALID_ARG;
     const size_t count = (size_t)(h->r1 - h->r0);
     for (int64_t m = 0; m < h->n_metrics; ++m)
@@ -206,6 +220,13 @@ static nav_status put_rows(void *user, nav_sim_tables *t) {
       memcpy(&s, b + l.status + i * sizeof(int64_t), sizeof s);
       t->samples_done[(size_t)h->r0 + i] = sd;
       t->status[(size_t)h->r0 + i] = (nav_status)s;
+    }
+    if (h->sm_per_run > 0 && count > 0) {
+      for (int64_t m = 0; m < 2 * h->n_metrics; ++m)
+        memcpy(t->sm_metrics + ((size_t)m * (size_t)t->runs + (size_t)h->r0) * (size_t)h->sm_per_run,
+               b + l.sm + (size_t)m * count * (size_t)h->sm_per_run * sizeof(double),
+               count * (size_t)h->sm_per_run * sizeof(double));
+      memcpy(t->sm_bytes + h->r0, b + l.sm_bytes, count * sizeof(int64_t));
     }
     next = h->r1;
   }

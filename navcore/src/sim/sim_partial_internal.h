@@ -20,6 +20,10 @@ typedef struct nav_sim_tables {
   nav_epoch_errors *final;  /**< [runs] */
   int64_t *samples_done;    /**< [runs] */
   nav_status *status;       /**< [runs] */
+  /** navigation.smoother: values per run and plane of sm_metrics (0: no smoothing) */
+  int64_t sm_per_run;
+  double *sm_metrics;       /**< [2 n_metrics][runs][sm_per_run] (smoothed, then forward), or NULL */
+  int64_t *sm_bytes;        /**< [runs] smoother memory per run, or NULL */
 } nav_sim_tables;
 
 /**

@@ -1,0 +1,49 @@
+/*
+ * navstudio: the offline background of the map view: GSHHS coastlines and lakes (read through
+ * libnavview's shapefile reader from Debian's python-cartopy-data) and a lat/lon graticule with
+ * labels, both in the view's local frame (x = East, y = North, metres from the scene origin).
+ * Plain data; PathView turns it into VTK actors. GUI thread only.
+ */
+#ifndef NAVSTUDIO_MAP_BACKGROUND_H
+#define NAVSTUDIO_MAP_BACKGROUND_H
+
+#include <QString>
+
+#include <string>
+#include <vector>
+
+extern "C" {
+#include "navcore/nav_scene.h"
+}
+
+namespace studio {
+
+struct MapLabel {
+  std::string text;
+  double x = 0.0, y = 0.0; /**< local East/North of the label's anchor [m] */
+  bool latitude = false;   /**< a parallel (anchored on the right edge), else a meridian (top edge) */
+};
+
+struct MapBackground {
+  std::vector<std::vector<double>> coast;     /**< polylines, x/y pairs [m] */
+  std::vector<std::vector<double>> graticule; /**< polylines, x/y pairs [m] */
+  std::vector<MapLabel> labels;
+  double lat_step_deg = 0.0, lon_step_deg = 0.0;
+  QString note; /**< "" or why there is no coastline (data missing) */
+};
+
+/** Views narrower than this [m] are "street scale": the local metric grid, no graticule. */
+constexpr double kStreetScaleSpanM = 20e3;
+/** Views wider than this [m] show the coastlines (GSHHS crude, ~25 km). */
+constexpr double kCoastSpanM = 15e3;
+
+/** The cartopy data directory: $NAVVIEW_MAP_DATA, else /usr/share/cartopy/data. */
+std::string MapDataDir();
+
+/** Coastlines (when the rectangle is wider than kCoastSpanM) and the graticule with labels for
+ *  the local rectangle [x0, x1] x [y0, y1] (East, North [m]) of the scene @p s. */
+void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out);
+
+} // namespace studio
+
+#endif
