@@ -39,7 +39,31 @@ int BenchPreview(studio::MainWindow *w, int n) {
     getrusage(RUSAGE_SELF, &ru);
     return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   };
+  {
+    // Cost of the GUI thread's per-edit work (validation, path sampling, one render per view).
+    QElapsedTimer t;
+    t.start();
+    for (int i = 0; i < 5; ++i) {
+      nav_scene v = doc->Scene(); // a different scene each time: the validation cache misses
+      v.trajectory.waypoints.points[0].r_ned_m.x += 1e-3 * (i + 1);
+      (void)studio::Validate(v);
+    }
+    const double v_ms = t.nsecsElapsed() * 1e-6 / 5;
+    t.restart();
+    studio::PathSamples ps;
+    for (int i = 0; i < 5; ++i) studio::SamplePath(doc->Scene(), 1200, &ps, nullptr);
+    const double s_ms = t.nsecsElapsed() * 1e-6 / 5;
+    t.restart();
+    for (int i = 0; i < 5; ++i) w->MapView()->Render();
+    const double rm_ms = t.nsecsElapsed() * 1e-6 / 5;
+    t.restart();
+    for (int i = 0; i < 5; ++i) w->View3D()->Render();
+    const double r3_ms = t.nsecsElapsed() * 1e-6 / 5;
+    std::printf("preview_parts_ms: validate=%.1f sample_path_1200=%.1f render_map=%.1f render_3d=%.1f\n", v_ms, s_ms,
+                rm_ms, r3_ms);
+  }
   const double cpu0 = cpu_s();
+  const long renders0 = w->MapView()->RenderCount() + w->View3D()->RenderCount();
   const int k = doc->Scene().trajectory.waypoints.count / 2;
   for (int i = 0; i < n; ++i) {
     nav_scene s = doc->Scene();
@@ -62,9 +86,10 @@ int BenchPreview(studio::MainWindow *w, int n) {
     if (std::fscanf(f, "%lf", &load) != 1) load = 0.0;
     std::fclose(f);
   }
-  std::printf("preview_latency_ms: samples=%zu median=%.1f p90=%.1f max=%.1f cpu_per_edit_ms=%.1f duration_s=%.1f "
-              "imu_rate_hz=%g loadavg=%.2f\n",
-              l.size(), l[l.size() / 2], l[std::min(l.size() - 1, l.size() * 9 / 10)], l.back(), cpu_ms,
+  const double renders = double(w->MapView()->RenderCount() + w->View3D()->RenderCount() - renders0) / n;
+  std::printf("preview_latency_ms: samples=%zu median=%.1f p90=%.1f max=%.1f cpu_per_edit_ms=%.1f "
+              "renders_per_edit=%.1f duration_s=%.1f imu_rate_hz=%g loadavg=%.2f\n",
+              l.size(), l[l.size() / 2], l[std::min(l.size() - 1, l.size() * 9 / 10)], l.back(), cpu_ms, renders,
               doc->Scene().trajectory.duration_s, doc->Scene().imu.rate_hz, load);
   return 0;
 }

@@ -1,4 +1,5 @@
 #include "main_window.h"
+#include "track_import.h"
 
 #include <QAction>
 #include <QApplication>
@@ -102,10 +103,12 @@ void MainWindow::BuildUi() {
   bottom_tabs_->addTab(chart_, tr("Errors"));
   bottom_tabs_->addTab(issues_, tr("Issues"));
 
+  profile_ = new ProfileChart(&doc_);
   auto *right = new QSplitter(Qt::Vertical);
   right->addWidget(views);
+  right->addWidget(profile_);
   right->addWidget(bottom_tabs_);
-  right->setSizes({620, 260});
+  right->setSizes({520, 150, 210});
   auto *main = new QSplitter(Qt::Horizontal);
   main->addWidget(panels_);
   main->addWidget(right);
@@ -165,6 +168,12 @@ void MainWindow::BuildActions() {
   QAction *open = act(tr("&Open..."), "actionOpen", QKeySequence::Open);
   QAction *save = act(tr("&Save"), "actionSave", QKeySequence::Save);
   QAction *saveas = act(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs);
+  QAction *import = act(tr("&Import track..."), "actionImportTrack", QKeySequence(tr("Ctrl+I")));
+  connect(import, &QAction::triggered, this, [this] {
+    const QString p = QFileDialog::getOpenFileName(this, tr("Import track"), QString(),
+                                                   tr("Tracks (*.gpx *.kml *.csv);;All files (*)"));
+    if (!p.isEmpty()) ImportTrack(p);
+  });
   QAction *shot = act(tr("Export &screenshot..."), "actionScreenshot", QKeySequence(tr("Ctrl+Shift+P")));
   QAction *quit = act(tr("&Quit"), "actionQuit", QKeySequence::Quit);
   connect(nw, &QAction::triggered, this, [this] { NewDrive(); });
@@ -186,6 +195,7 @@ void MainWindow::BuildActions() {
   recent_menu_ = file->addMenu(tr("Open &recent"));
   file->addActions({save, saveas});
   file->addSeparator();
+  file->addAction(import);
   file->addAction(shot);
   file->addSeparator();
   file->addAction(quit);
@@ -212,8 +222,10 @@ void MainWindow::BuildActions() {
   connect(run_act_, &QAction::triggered, this, [this] { Run(); });
   connect(cancel_act_, &QAction::triggered, this, &MainWindow::Cancel);
   connect(preview_act_, &QAction::toggled, this, [this](bool on) {
+    UpdateLiveRenderDelay();
     if (on) preview_timer_.start();
   });
+  UpdateLiveRenderDelay();
   sim->addActions({run_act_, cancel_act_, preview_act_});
 
   QAction *reset = act(tr("&Fit views"), "actionFit", QKeySequence(tr("Ctrl+0")));
@@ -268,6 +280,30 @@ bool MainWindow::OpenFile(const QString &path) {
   view3d_->ResetCamera();
   status_->setText(tr("Opened %1").arg(doc_.FilePath()));
   CheckRecovery();
+  return true;
+}
+
+bool MainWindow::ImportTrack(const QString &path, QStringList *errors_out) {
+  auto s = std::make_unique<nav_scene>(doc_.Scene());
+  QStringList errors;
+  QString summary;
+  if (!ImportTrackInto(path, s.get(), &errors, &summary)) {
+    status_->setText(tr("Cannot import %1").arg(path));
+    issues_->clear();
+    issues_->addItems(errors);
+    bottom_tabs_->setCurrentWidget(issues_);
+    if (!qEnvironmentVariableIsSet("NAVSTUDIO_NO_DIALOGS"))
+      QMessageBox::warning(this, tr("Cannot import track"), errors.join("\n"));
+    else
+      std::fprintf(stderr, "%s\n", errors.join("\n").toLocal8Bit().constData());
+    if (errors_out) *errors_out = errors;
+    return false;
+  }
+  doc_.Edit(tr("Import track %1").arg(QFileInfo(path).fileName()), [&](nav_scene &x) { x = *s; });
+  map_->ResetCamera();
+  view3d_->ResetCamera();
+  status_->setText(tr("Imported %1: %2").arg(QFileInfo(path).fileName(), summary));
+  if (errors_out) errors_out->clear();
   return true;
 }
 
@@ -404,6 +440,26 @@ bool MainWindow::SceneSmallForPreview() const {
 
 void MainWindow::SetLivePreview(bool on) { preview_act_->setChecked(on); }
 
+void MainWindow::UpdateLiveRenderDelay() {
+  const int ms = preview_act_ && preview_act_->isChecked() ? kLiveRenderDelayMs : 0;
+  map_->SetLiveRenderDelay(ms);
+  view3d_->SetLiveRenderDelay(ms);
+}
+
+std::unique_ptr<nav_scene> PreviewScene(const nav_scene &scene) {
+  // The preview is one run of a lighter scene: the filter covariance propagated every 10th IMU
+  // step, the IMU at 50 Hz instead of 100 Hz (noise densities are per root hertz: the error
+  // growth stays alike) and output at 10 Hz at most. A lighter scene that navcore rejects (rates
+  // that no longer divide) falls back to the scene itself.
+  auto s = std::make_unique<nav_scene>(scene);
+  if (s->navigation.cov_decimation < kPreviewCovDecimation) s->navigation.cov_decimation = kPreviewCovDecimation;
+  if (s->imu.rate_hz > kPreviewImuHz && std::fmod(s->imu.rate_hz, kPreviewImuHz) == 0.0) s->imu.rate_hz = kPreviewImuHz;
+  if (s->output.rate_hz > kPreviewOutputHz && std::fmod(s->imu.rate_hz, kPreviewOutputHz) == 0.0)
+    s->output.rate_hz = kPreviewOutputHz;
+  if (nav_scene_validate(s.get(), nullptr, nullptr) != NAV_OK) *s = scene;
+  return s;
+}
+
 void MainWindow::StartPreview() {
   if (!preview_act_->isChecked() || worker_.IsBusy()) return;
   if (!SceneSmallForPreview()) {
@@ -412,7 +468,7 @@ void MainWindow::StartPreview() {
   }
   if (!Validate(doc_.Scene()).isEmpty()) return;
   preview_started_ns_ = SceneDocument::NowNs();
-  preview_.Start(doc_.Scene(), 1, true, doc_.LastChangeNs(), false);
+  preview_.Start(*PreviewScene(doc_.Scene()), 1, true, doc_.LastChangeNs(), false);
 }
 
 void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {

@@ -17,6 +17,7 @@
 
 #include "error_chart.h"
 #include "panels.h"
+#include "profile_chart.h"
 #include "path_view.h"
 #include "sim_worker.h"
 #include "studio_scene.h"
@@ -29,6 +30,15 @@ class QProgressBar;
 class QTextBrowser;
 
 namespace studio {
+
+/** Live preview simplifications (MainWindow::StartPreview). */
+constexpr int kPreviewCovDecimation = 10;
+constexpr double kPreviewOutputHz = 10.0;
+constexpr double kPreviewImuHz = 50.0;
+/** During a live drag the path waits at most this long for its preview to be drawn with it. */
+constexpr int kLiveRenderDelayMs = 100;
+/** The lighter scene the live preview simulates (a copy of @p scene). */
+std::unique_ptr<nav_scene> PreviewScene(const nav_scene &scene);
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -44,6 +54,10 @@ public:
   /** Start a new drive (asks to save changes first). */
   bool NewDrive();
   bool Save();
+  /** File > Import track...: replace the trajectory by a GPX/KML track or a motion definition
+   *  (one undo step). false with the diagnostics (FILE:LINE:COL: error: ...) in a message box and
+   *  in @p errors. */
+  bool ImportTrack(const QString &path, QStringList *errors = nullptr);
   bool SaveAs(const QString &path);
   /** Start the Monte Carlo run of the scene. false when the scene has issues. */
   bool Run();
@@ -61,6 +75,7 @@ public:
   SceneDocument *Doc() { return &doc_; }
   PathView *MapView() { return map_; }
   PathView *View3D() { return view3d_; }
+  ProfileChart *Profile() { return profile_; }
   ScenePanels *Panels() { return panels_; }
   SimWorker *Worker() { return &worker_; }
   SimWorker *PreviewWorker() { return &preview_; }
@@ -92,6 +107,7 @@ private:
   void RebuildRecentMenu();
   void RemoveAutosave();
   bool SceneSmallForPreview() const;
+  void UpdateLiveRenderDelay();
 
   SceneDocument doc_;
   Catalogs catalogs_;
@@ -101,6 +117,7 @@ private:
   PathView *map_ = nullptr;
   PathView *view3d_ = nullptr;
   ErrorChart *chart_ = nullptr;
+  ProfileChart *profile_ = nullptr;
   QTextBrowser *results_ = nullptr;
   QListWidget *issues_ = nullptr;
   QTabWidget *bottom_tabs_ = nullptr;

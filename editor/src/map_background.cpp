@@ -1,5 +1,7 @@
 #include "map_background.h"
 
+#include <QObject>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -186,7 +188,9 @@ void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, dou
             l->y = y;
           }
         }
-      return std::isfinite(best) && best > (lat ? x0 + 0.7 * (x1 - x0) : y0 + 0.7 * (y1 - y0));
+      // Labels at the right edge stay below the top ones; those at the top stay left of the right ones.
+      const bool clear = lat ? l->y < y0 + 0.93 * (y1 - y0) : l->x < x0 + 0.93 * (x1 - x0);
+      return std::isfinite(best) && clear && best > (lat ? x0 + 0.7 * (x1 - x0) : y0 + 0.7 * (y1 - y0));
     };
     for (double la = std::ceil(la0 / lat_step) * lat_step; la <= la1 + 1e-9; la += lat_step) {
       if (std::fabs(la) > 89.999) continue;

@@ -63,6 +63,8 @@ public:
   void SetSelectedWaypoint(int i);
   /** Number of points of the drawn reference path (tests). */
   size_t PathPointCount();
+  /** Samples of the drawn path over a vehicle limit (coloured red; tests). */
+  size_t OverLimitPointCount();
   /** The drawn reference path (brought up to date first). */
   const PathSamples &Path();
 
@@ -74,6 +76,11 @@ public:
   size_t GraticuleCount() const { return graticule_count_; }
   QStringList GraticuleLabels() const;
   bool MetricGridShown() const;
+  /** During a live drag, draw a changed path with the next estimate (SetEstimate), at most
+   *  @p ms later; 0: at once (live preview off). */
+  void SetLiveRenderDelay(int ms) { live_render_delay_ms_ = ms; }
+  /** Number of renders of this view so far (benchmarks, tests). */
+  long RenderCount() const { return render_count_; }
   /** Bring the map background up to date with the camera now (normally deferred). */
   void UpdateBackground();
 
@@ -102,7 +109,7 @@ private:
   vtkSmartPointer<vtkGenericOpenGLRenderWindow> window_;
   vtkSmartPointer<vtkRenderer> renderer_;
   vtkSmartPointer<PathViewStyle> style_;
-  vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
+  vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, over_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
   vtkSmartPointer<vtkTextActor> caption_, problem_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
   PathSamples path_;
@@ -122,6 +129,10 @@ private:
   bool street_ = true;
   size_t coast_count_ = 0, graticule_count_ = 0;
   QString bg_note_;
+  double graticule_step_deg_ = 0.0;
+  long render_count_ = 0;
+  int live_render_delay_ms_ = 0;
+  QTimer render_timer_;
   double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;
 };
 

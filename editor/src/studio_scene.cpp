@@ -139,8 +139,9 @@ bool UpdateDuration(nav_scene *s, QString *msg) {
 }
 
 bool SamplePath(const nav_scene &s, int max_points, PathSamples *out, QString *msg) {
-  out->t_s.clear();
-  out->ned_m.clear();
+  *out = PathSamples();
+  if (s.trajectory.type == NAV_TRAJ_WAYPOINTS) out->limits = s.trajectory.waypoints.limits;
+  if (s.trajectory.type == NAV_TRAJ_SEGMENTS) out->limits = s.trajectory.segments.limits;
   if (s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2) {
     if (msg) *msg = QStringLiteral("at least two waypoints are needed");
     return false;
@@ -171,10 +172,34 @@ bool SamplePath(const nav_scene &s, int max_points, PathSamples *out, QString *m
     out->ned_m.push_back(v.r_ned_m.x);
     out->ned_m.push_back(v.r_ned_m.y);
     out->ned_m.push_back(v.r_ned_m.z);
+    // Profile: speed, acceleration along the velocity, course rate (v x a over v^2, horizontal),
+    // in local level (the transport-rate term of d(v_n)/dt, v^2/R, is negligible here).
+    const nav_vec3 vn = v.v_n_mps, an = nav_mat3_mul_vec(v.C_f_n, st.a_fb_f_mps2);
+    const double speed = nav_vec3_norm(vn), vh2 = vn.x * vn.x + vn.y * vn.y;
+    const double acc = speed > 1e-3 ? nav_vec3_dot(vn, an) / speed : 0.0;
+    const double turn = vh2 > 0.25 ? (vn.x * an.y - vn.y * an.x) / vh2 : 0.0;
+    out->speed_mps.push_back(speed);
+    out->accel_mps2.push_back(acc);
+    out->turn_rps.push_back(turn);
+    unsigned char bits = 0;
+    const nav_traj_limits &L = out->limits;
+    auto over = [](double x, double lim) { return lim > 0.0 && std::fabs(x) > lim * (1.0 + 1e-3) + 1e-9; };
+    if (over(acc, L.max_accel_mps2)) bits |= kOverAccel;
+    if (over(turn, L.max_rate_rps)) bits |= kOverTurnRate;
+    if (over(std::sqrt(vh2) * turn, L.max_lateral_accel_mps2)) bits |= kOverLateral;
+    out->over.push_back(bits);
   }
   nav_traj_destroy(traj);
   if (ok && msg) msg->clear();
   return ok;
+}
+
+QString OverLimitText(unsigned bits) {
+  QStringList l;
+  if (bits & kOverAccel) l << QObject::tr("acceleration");
+  if (bits & kOverTurnRate) l << QObject::tr("turn rate");
+  if (bits & kOverLateral) l << QObject::tr("lateral acceleration");
+  return l.join(", ");
 }
 
 QByteArray Pack(const nav_scene &s) {
@@ -291,6 +316,7 @@ void SceneDocument::Edit(const QString &text, const std::function<void(nav_scene
 }
 
 void SceneDocument::Preview(const nav_scene &s) {
+  live_ = true;
   *scene_ = s;
   QString msg;
   (void)UpdateDuration(scene_.get(), &msg);
@@ -299,12 +325,17 @@ void SceneDocument::Preview(const nav_scene &s) {
 }
 
 void SceneDocument::Commit(const nav_scene &before, const QString &text) {
-  if (std::memcmp(&before, scene_.get(), sizeof(nav_scene)) == 0) return;
+  live_ = false;
+  if (std::memcmp(&before, scene_.get(), sizeof(nav_scene)) == 0) {
+    emit Changed(); // no undo step, but the views leave their live-drag drawing
+    return;
+  }
   // The command's first redo() re-applies the current scene: harmless, and it emits Changed.
   undo_.push(new SceneCommand(this, Pack(before), Pack(*scene_), text));
 }
 
 void SceneDocument::SetSceneInternal(const nav_scene &s) {
+  live_ = false;
   *scene_ = s;
   Touch();
   emit Changed();
@@ -330,6 +361,7 @@ bool SceneDocument::Load(const QString &path, QStringList *errors) {
   Normalize(s.get());
   path_ = QFileInfo(path).absoluteFilePath();
   undo_.clear();
+  live_ = false;
   *scene_ = *s;
   Touch();
   emit Changed();
@@ -350,6 +382,7 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
   undo_.clear();
   // A recovered document differs from its file: push the recovery as an edit so it is "modified".
   const nav_scene before = *scene_;
+  live_ = false;
   *scene_ = *s;
   undo_.push(new SceneCommand(this, Pack(before), Pack(*s), tr("Recover autosave")));
   Touch();
@@ -361,6 +394,7 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
 void SceneDocument::Reset(const nav_scene &s) {
   undo_.clear();
   path_.clear();
+  live_ = false;
   *scene_ = s;
   Normalize(scene_.get());
   Touch();

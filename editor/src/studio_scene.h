@@ -37,8 +37,19 @@ struct Issue {
 struct PathSamples {
   std::vector<double> t_s;
   std::vector<double> ned_m; /**< 3 per sample */
+  // The kinematic profile along the path (from navcore's trajectory evaluation), per sample:
+  std::vector<double> speed_mps;    /**< |v| */
+  std::vector<double> accel_mps2;   /**< longitudinal acceleration (along the velocity) */
+  std::vector<double> turn_rps;     /**< horizontal turn rate (course rate; + = right) */
+  std::vector<unsigned char> over;  /**< bits of the limits exceeded there (kOver*) */
+  nav_traj_limits limits{};         /**< the vehicle limits of the trajectory (0: none) */
   size_t Size() const { return t_s.size(); }
 };
+
+/** Limit bits of PathSamples::over. */
+enum : unsigned char { kOverAccel = 1, kOverTurnRate = 2, kOverLateral = 4 };
+/** Text of the limits in @p bits ("acceleration", "turn rate", "lateral acceleration"). */
+QString OverLimitText(unsigned bits);
 
 /** Directory holding imu_catalog.csv and gnss_receivers.csv ($NAV_RESOURCES_DIR or the source tree's). */
 QString ResourcesDir();
@@ -128,6 +139,9 @@ public:
   qint64 LastChangeNs() const { return last_change_ns_; }
   static qint64 NowNs();
 
+  /** A live edit (drag) is in progress: Preview() since the last Commit() or other change. */
+  bool IsLive() const { return live_; }
+
   /** Last feasibility message of the trajectory planner ("" when feasible). */
   QString PlanMessage() const { return plan_msg_; }
 
@@ -144,6 +158,7 @@ private:
   QString path_;
   QString plan_msg_;
   qint64 last_change_ns_ = 0;
+  bool live_ = false;
 };
 
 } // namespace studio

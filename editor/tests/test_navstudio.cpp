@@ -10,6 +10,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QSignalSpy>
 #include <QSurfaceFormat>
 #include <QTableWidget>
@@ -428,6 +429,178 @@ private slots:
     // Discarding the recovered changes removes the autosave.
     QVERIFY(w2->NewDrive());
     QVERIFY(!QFile::exists(autosave));
+  }
+
+  // File > Import track: a GPX drive becomes waypoints (one undo step), a motion definition a
+  // segment script, a broken file an error at FILE:LINE:COL.
+  void import_track() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    const QString dir = tmp_.path();
+    auto write = [&](const QString &name, const QByteArray &text) {
+      QFile f(dir + "/" + name);
+      if (!f.open(QIODevice::WriteOnly)) return QString();
+      f.write(text);
+      return f.fileName();
+    };
+    // An L-shaped drive in Munich: 400 m north, then 400 m east (no times: constant speed).
+    const QString gpx = write("drive.gpx", "<?xml version=\"1.0\"?>\n"
+                                           "<gpx version=\"1.1\" creator=\"t\" xmlns=\"http://www.topografix.com/GPX/1/1\">\n"
+                                           "<trk><name>l drive</name><trkseg>\n"
+                                           "<trkpt lat=\"48.137\" lon=\"11.575\"/>\n"
+                                           "<trkpt lat=\"48.1406\" lon=\"11.575\"/>\n"
+                                           "<trkpt lat=\"48.1406\" lon=\"11.5804\"/>\n"
+                                           "</trkseg></trk></gpx>\n");
+    QVERIFY(!gpx.isEmpty());
+    const int before = w->Doc()->UndoStack()->count();
+    QStringList errors;
+    QVERIFY2(w->ImportTrack(gpx, &errors), qPrintable(errors.join("\n")));
+    const nav_scene &s = w->Doc()->Scene();
+    QCOMPARE(int(s.trajectory.type), int(NAV_TRAJ_WAYPOINTS));
+    QVERIFY(s.trajectory.waypoints.count >= 3);
+    QCOMPARE(int(s.earth.model), int(NAV_EARTH_WGS84));
+    QVERIFY(std::fabs(s.earth.origin_lat_rad * 180.0 / M_PI - 48.137) < 1e-9);
+    // The last waypoint is about 400 m north and 400 m east of the first.
+    const nav_vec3 last = s.trajectory.waypoints.points[s.trajectory.waypoints.count - 1].r_ned_m;
+    QVERIFY2(std::fabs(last.x - 400.4) < 5.0 && std::fabs(last.y - 401.5) < 5.0,
+             qPrintable(QString("%1 %2").arg(last.x).arg(last.y)));
+    QCOMPARE(w->Doc()->UndoStack()->count(), before + 1);
+    QVERIFY(w->MapView()->PathPointCount() > 10);
+    Shot(w.get(), "import-01-gpx");
+    // Undoable: back to the empty drive, and redo.
+    w->Doc()->UndoStack()->undo();
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 0);
+    w->Doc()->UndoStack()->redo();
+    QVERIFY(w->Doc()->Scene().trajectory.waypoints.count >= 3);
+
+    // A broken GPX: the error names the file, line and column; the scene is unchanged.
+    const QString bad = write("bad.gpx", "<?xml version=\"1.0\"?>\n"
+                                         "<gpx version=\"1.1\" creator=\"t\" xmlns=\"http://www.topografix.com/GPX/1/1\">\n"
+                                         "<trk><trkseg>\n"
+                                         "<trkpt lat=\"48.137\" lon=\"11.575\"/>\n"
+                                         "<trkpt lat=\"148.2\" lon=\"11.575\"/>\n"
+                                         "</trkseg></trk></gpx>\n");
+    const int count = w->Doc()->UndoStack()->count();
+    QVERIFY(!w->ImportTrack(bad, &errors));
+    QVERIFY(!errors.isEmpty());
+    QVERIFY2(errors.first().contains(QRegularExpression("bad\\.gpx:5:\\d+: error: ")), qPrintable(errors.join("\n")));
+    QCOMPARE(w->Doc()->UndoStack()->count(), count);
+    QVERIFY(w->Doc()->Scene().trajectory.waypoints.count >= 3);
+    Shot(w.get(), "import-02-error");
+
+    // A gnss-ins-sim motion definition: a segment script.
+    const QString md = write("motion.csv",
+                             "ini lat (deg),ini lon (deg),ini alt (m),ini vx_body (m/s),ini vy_body (m/s),ini vz_body (m/s),"
+                             "ini yaw (deg),ini pitch (deg),ini roll (deg)\n"
+                             "32,120,0,0,0,0,0,0,0\n"
+                             "command type,yaw (deg),pitch (deg),roll (deg),vx_body (m/s),vy_body (m/s),vz_body (m/s),"
+                             "command duration (s),GPS visibility\n"
+                             "1,0,0,0,0,0,0,20,1\n"
+                             "2,0,0,0,1,0,0,10,1\n"
+                             "1,0,0,0,0,0,0,30,1\n");
+    QVERIFY2(w->ImportTrack(md, &errors), qPrintable(errors.join("\n")));
+    QCOMPARE(int(w->Doc()->Scene().trajectory.type), int(NAV_TRAJ_SEGMENTS));
+    QVERIFY(w->Doc()->Scene().trajectory.segments.count >= 3);
+    QVERIFY(w->MapView()->PathPointCount() > 10);
+    Shot(w.get(), "import-03-motiondef");
+    w->Doc()->UndoStack()->undo();
+    QCOMPARE(int(w->Doc()->Scene().trajectory.type), int(NAV_TRAJ_WAYPOINTS));
+  }
+
+  // The profile chart: speed, acceleration and turn rate along the planned drive, within the
+  // vehicle limits; a motion definition whose type-1 turn exceeds them is coloured and explained.
+  void profile_chart() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    QVERIFY(!w->Profile()->Message().isEmpty() || w->Profile()->Profile().Size() == 0);
+    for (const auto &p : kDrive) studio::AddWaypoint(w->Doc(), p[0], p[1], 0.0);
+    const studio::PathSamples &pr = w->Profile()->Profile();
+    QVERIFY(pr.Size() >= 100);
+    QVERIFY2(w->Profile()->Message().isEmpty(), qPrintable(w->Profile()->Message()));
+    double vmax = 0.0, turn_abs = 0.0, tmin = 0.0, tmax = 0.0;
+    for (size_t i = 0; i < pr.Size(); ++i) {
+      vmax = std::max(vmax, pr.speed_mps[i]);
+      tmin = std::min(tmin, pr.turn_rps[i]);
+      tmax = std::max(tmax, pr.turn_rps[i]);
+      if (i > 0) turn_abs += 0.5 * (std::fabs(pr.turn_rps[i]) + std::fabs(pr.turn_rps[i - 1])) * (pr.t_s[i] - pr.t_s[i - 1]);
+    }
+    // The drive: east, a left turn to north, a right turn back to east, at the 10 m/s cruise speed.
+    const double cruise = w->Doc()->Scene().trajectory.waypoints.points[1].speed_mps;
+    QVERIFY(std::fabs(vmax - cruise) < 0.01 * cruise);
+    QVERIFY(tmin < 0.0 && tmax > 0.0);
+    QVERIFY2(std::fabs(turn_abs - M_PI) < 0.03 * M_PI, qPrintable(QString::number(turn_abs * 180 / M_PI)));
+    double ua = 0, ut = 0, ul = 0;
+    w->Profile()->Utilisation(&ua, &ut, &ul);
+    QVERIFY(ua > 0.0 && ua <= 1.001);
+    QVERIFY(ut > 0.0 && ut <= 1.001);
+    QVERIFY(ul > 0.0 && ul <= 1.001);
+    QCOMPARE(w->MapView()->OverLimitPointCount(), size_t(0));
+    Shot(w.get(), "profile-01-drive");
+
+    // A motion definition: accelerate to 10 m/s, then a 90 deg/s yaw rate for 1 s (type 1 is
+    // not limited by gnss-ins-sim): 15.7 m/s² sideways, over the lateral-acceleration limit.
+    QFile f(tmp_.path() + "/sharp.csv");
+    QVERIFY(f.open(QIODevice::WriteOnly));
+    f.write("ini lat (deg),ini lon (deg),ini alt (m),ini vx_body (m/s),ini vy_body (m/s),ini vz_body (m/s),"
+            "ini yaw (deg),ini pitch (deg),ini roll (deg)\n"
+            "52.5,13.4,0,0,0,0,0,0,0\n"
+            "command type,yaw (deg),pitch (deg),roll (deg),vx_body (m/s),vy_body (m/s),vz_body (m/s),"
+            "command duration (s),GPS visibility\n"
+            "1,0,0,0,0,0,0,5,1\n"
+            "1,0,0,0,1,0,0,10,1\n"
+            "1,90,0,0,0,0,0,1,1\n"
+            "1,0,0,0,0,0,0,10,1\n");
+    f.close();
+    QStringList errors;
+    QVERIFY2(w->ImportTrack(f.fileName(), &errors), qPrintable(errors.join("\n")));
+    const studio::PathSamples &p2 = w->Profile()->Profile();
+    QVERIFY(p2.Size() >= 100);
+    unsigned bits = 0;
+    for (unsigned char b : p2.over) bits |= b;
+    QVERIFY2(bits & studio::kOverLateral, qPrintable(studio::OverLimitText(bits)));
+    QVERIFY(w->MapView()->OverLimitPointCount() > 0);
+    QVERIFY(w->View3D()->OverLimitPointCount() > 0);
+    Shot(w.get(), "profile-02-over-limit");
+  }
+
+  // Map background: at street scale the metric grid; zoomed out, GSHHS coastlines (the Baltic
+  // coast north of the Berlin origin) and a labelled lat/lon graticule.
+  void map_background() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    PathView *map = w->MapView();
+    map->UpdateBackground();
+    QVERIFY(map->MetricGridShown());
+    QCOMPARE(map->GraticuleCount(), size_t(0));
+    QVERIFY(map->GraticuleLabels().isEmpty());
+    Shot(w.get(), "map-01-street");
+    map->SetMapExtent(0.0, 0.0, 250e3);
+    QVERIFY(!map->MetricGridShown());
+    QVERIFY2(map->CoastlineCount() > 0, "no coastline in a 500 km view of Berlin");
+    QVERIFY(map->GraticuleCount() >= 4);
+    const QStringList labels = map->GraticuleLabels();
+    QVERIFY2(labels.filter(QRegularExpression("^5[0-5]°N$")).size() >= 2, qPrintable(labels.join(", ")));
+    QVERIFY2(labels.filter(QRegularExpression("^1[0-6]°E$")).size() >= 2, qPrintable(labels.join(", ")));
+    // The labelled parallels are where the frame puts those latitudes: the label's point maps back.
+    const nav_scene &s = w->Doc()->Scene();
+    double ned[3];
+    studio::GeodeticToLocal(s, 54.0, 13.4, 0.0, ned); // on the Baltic coast (Greifswald)
+    QVERIFY(ned[0] > 100e3 && ned[0] < 250e3);
+    Shot(w.get(), "map-02-regional");
+    // Continental scale, then back to street scale: the grid returns, the graticule goes.
+    map->SetMapExtent(0.0, 0.0, 2000e3);
+    QVERIFY(map->CoastlineCount() > 10);
+    Shot(w.get(), "map-03-continental");
+    map->SetMapExtent(0.0, 0.0, 400.0);
+    QVERIFY(map->MetricGridShown());
+    QCOMPARE(map->GraticuleCount(), size_t(0));
+    QCOMPARE(map->CoastlineCount(), size_t(0));
   }
 
 private:

@@ -794,13 +794,16 @@ static void drop_waypoint(nav_traj_waypoints *W, int *src_of, int j) {
   W->count--;
 }
 
-/* Largest distance of a track point from the flown path (sampled every 0.1 s). */
+/* Largest distance of a track point from the flown path, sampled every 0.1 s, or at most 10^5
+ * times for long plans (then every T / 10^5 s, measured against the chords between samples), so
+ * time and memory stay bounded whatever the track's duration. */
 static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t n, double *out) {
   nav_traj *tr = NULL;
   nav_status st = nav_traj_create(sc, 0.01, &tr);
   if (st != NAV_OK) return st;
   const double T = sc->trajectory.duration_s;
-  const size_t m = (size_t)ceil(T / 0.1) + 1;
+  const double h = fmax(0.1, T / 1e5);
+  const size_t m = (size_t)ceil(T / h) + 1;
   nav_vec3 *f = malloc(m * sizeof *f);
   if (!f) {
     nav_traj_destroy(tr);
@@ -809,7 +812,7 @@ static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t
   const nav_frame fr = nav_traj_frame(tr);
   for (size_t i = 0; i < m && st == NAV_OK; ++i) {
     nav_traj_state ts;
-    st = nav_traj_eval(tr, fmin(T, 0.1 * (double)i), &ts);
+    st = nav_traj_eval(tr, fmin(T, h * (double)i), &ts);
     if (st == NAV_OK) f[i] = nav_frame_view(&fr, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f).r_ned_m;
   }
   double worst = 0;

@@ -446,7 +446,9 @@ typedef struct nav_scene_navigation {
    *  sigma is the scene's scale-factor sigma (with its fixed part), random constants. */
   bool estimate_scale_factors;
   /** ins_gnss only: every Monte Carlo run also runs the RTS smoother (nav_smoother.h) over its
-   *  output and GNSS epochs; smoothed errors at the output epochs (nav_sim.h). Default false. */
+   *  output and GNSS epochs; smoothed errors at the output epochs (nav_sim.h). Default false.
+   *  Memory per run in flight (one per thread): one record per output or GNSS epoch, about
+   *  7 KiB at 18 states (38 MiB for the 513 s urban-drive at 10 Hz output); never per IMU step. */
   bool smoother;
 } nav_scene_navigation;
 

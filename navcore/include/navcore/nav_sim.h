@@ -102,7 +102,7 @@ typedef struct nav_sim_summary {
   bool partial;            /**< the run was stopped early (cancel / callback) */
   /** Scenes with navigation.smoother and a complete job: statistics of the RTS-smoothed errors
    *  pooled over every run and output epoch (every smoothed_stride-th output epoch when runs x
-   *  output epochs would exceed 2e6 values), reduced in run order like @c stats. The matching
+   *  output epochs would exceed 4e5 values), reduced in run order like @c stats. The matching
    *  forward figures over the same epochs are in stats_forward_out. */
   bool has_smoothed;
   nav_sim_stats stats_smoothed;

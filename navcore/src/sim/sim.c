@@ -9,6 +9,15 @@
  *
  * Run 0 executes on the calling thread first, so the record callback (the CSV writer of navsim)
  * sees one run, in order, on the caller's thread; the other runs then share the worker threads.
+ *
+ * navigation.smoother (INS/GNSS): each run attaches its own nav_smoother to its nav_ins_gnss,
+ * marks the output epochs (the GNSS epochs are recorded by the updates), runs the backward pass
+ * at the end of the run and stores the smoothed and the forward errors of its output epochs in
+ * its rows of a per-run table (sm_metrics), reduced in run order like the other statistics and
+ * carried by the partial results of sim_partial.c (MPI stays bit-identical). Memory: one
+ * smoother per run in flight (records at the output and GNSS epochs only, nav_smoother.h), the
+ * output-epoch references of the run when the truth is not shared, and the table (at most
+ * SMOOTH_MAX_VALUES values per plane).
  */
 #include <stdarg.h>
 #include <stdatomic.h>

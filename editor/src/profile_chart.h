@@ -1,0 +1,44 @@
+/*
+ * navstudio: the profile chart under the views: speed, longitudinal acceleration and turn rate
+ * along the planned path against time (navcore's trajectory evaluation through SamplePath), with
+ * the vehicle limits as dashed lines (turn rate: the lesser of the rate limit and the lateral
+ * acceleration limit over the speed); samples over a limit are red. An infeasible plan shows the
+ * planner's message instead. QPainter only; GUI thread.
+ */
+#ifndef NAVSTUDIO_PROFILE_CHART_H
+#define NAVSTUDIO_PROFILE_CHART_H
+
+#include <QString>
+#include <QTimer>
+#include <QWidget>
+
+#include "studio_scene.h"
+
+namespace studio {
+
+class ProfileChart : public QWidget {
+  Q_OBJECT
+public:
+  explicit ProfileChart(SceneDocument *doc, QWidget *parent = nullptr);
+  QSize sizeHint() const override { return QSize(600, 150); }
+  /** The profile drawn (brought up to date first; tests). */
+  const PathSamples &Profile();
+  /** "" or why there is no profile (planner message). */
+  QString Message();
+  /** Largest |value| / limit over the path for acceleration, turn rate, lateral acceleration. */
+  void Utilisation(double *accel, double *turn, double *lateral);
+
+protected:
+  void paintEvent(QPaintEvent *e) override;
+
+private:
+  void Recompute();
+  SceneDocument *doc_;
+  PathSamples prof_;
+  QString msg_;
+  QTimer timer_;
+};
+
+} // namespace studio
+
+#endif
