@@ -240,7 +240,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     vtkNew<vtkCallbackCommand> cb;
     cb->SetClientData(&render_count_);
     cb->SetCallback([](vtkObject *, unsigned long, void *client, void *) { ++*static_cast<long *>(client); });
-    renderer_->AddObserver(vtkCommand::StartEvent, cb);
+    render_observer_ = renderer_->AddObserver(vtkCommand::StartEvent, cb);
   }
   if (mode == Mode::Map) {
     renderer_->SetBackground(0.93, 0.95, 0.92);
@@ -324,13 +324,17 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     vtkNew<vtkCallbackCommand> cb;
     cb->SetClientData(&bg_timer_);
     cb->SetCallback([](vtkObject *, unsigned long, void *client, void *) { static_cast<QTimer *>(client)->start(); });
-    renderer_->GetActiveCamera()->AddObserver(vtkCommand::ModifiedEvent, cb);
+    camera_observer_ = renderer_->GetActiveCamera()->AddObserver(vtkCommand::ModifiedEvent, cb);
   }
   Rebuild();
   ResetCamera();
 }
 
-PathView::~PathView() = default;
+PathView::~PathView() {
+  // The observers point into this object; the renderer and its camera may outlive it.
+  if (camera_observer_) renderer_->GetActiveCamera()->RemoveObserver(camera_observer_);
+  if (render_observer_) renderer_->RemoveObserver(render_observer_);
+}
 
 vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor(); }
 

@@ -131,6 +131,7 @@ private:
   QString bg_note_;
   double graticule_step_deg_ = 0.0;
   long render_count_ = 0;
+  unsigned long camera_observer_ = 0, render_observer_ = 0;
   int live_render_delay_ms_ = 0;
   QTimer render_timer_;
   double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;

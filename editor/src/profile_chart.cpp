@@ -10,6 +10,7 @@ namespace studio {
 
 namespace {
 constexpr int kProfilePoints = 500;
+constexpr int kLiveIntervalMs = 250;
 }
 
 ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
@@ -17,9 +18,15 @@ ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent
   setMinimumHeight(120);
   // Coalesced like the views: a drag redraws the chart once per event-loop pass.
   timer_.setSingleShot(true);
-  timer_.setInterval(0);
   connect(&timer_, &QTimer::timeout, this, &ProfileChart::Recompute);
-  connect(doc_, &SceneDocument::Changed, &timer_, QOverload<>::of(&QTimer::start));
+  // During a live drag the chart follows at most every kLiveIntervalMs (a repaint of a widget
+  // recomposes the whole window, OpenGL views included, which software rendering pays for).
+  connect(doc_, &SceneDocument::Changed, this, [this] {
+    if (!doc_->IsLive())
+      timer_.start(0);
+    else if (!timer_.isActive())
+      timer_.start(kLiveIntervalMs);
+  });
   Recompute();
 }
 

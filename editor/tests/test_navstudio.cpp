@@ -567,6 +567,64 @@ private slots:
     Shot(w.get(), "profile-02-over-limit");
   }
 
+  // Live-preview cost cuts: the preview simulates a lighter scene (covariance every 10th IMU
+  // step, IMU at 50 Hz, output at 10 Hz), and during a live drag each view draws one frame per
+  // preview (the path waits for its estimate); the committed edit is drawn at once.
+  void live_preview_cost() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(true);
+    QVERIFY(w->NewDrive());
+    for (const auto &p : kDrive) studio::AddWaypoint(w->Doc(), p[0], p[1], 0.0);
+    studio::SceneDocument *doc = w->Doc();
+    auto settled = [&] {
+      return !w->PreviewWorker()->IsBusy() && w->LastPreview() && w->LastPreview()->scene_change_ns == doc->LastChangeNs();
+    };
+    QVERIFY(WaitUntil(settled, 60000));
+    const nav_scene &s = doc->Scene();
+    QCOMPARE(s.imu.rate_hz, 100.0);
+    auto light = studio::PreviewScene(s);
+    QCOMPARE(light->imu.rate_hz, studio::kPreviewImuHz);
+    QVERIFY(light->navigation.cov_decimation >= studio::kPreviewCovDecimation);
+    QVERIFY(light->output.rate_hz <= studio::kPreviewOutputHz);
+    QCOMPARE(light->trajectory.waypoints.count, s.trajectory.waypoints.count);
+    // A scene whose IMU rate 50 Hz does not divide keeps it.
+    nav_scene odd = s;
+    odd.imu.rate_hz = 64.0;
+    odd.output.rate_hz = 8.0;
+    QCOMPARE(studio::PreviewScene(odd)->imu.rate_hz, 64.0);
+    // The preview of the lighter scene: estimates at 10 Hz over the whole drive.
+    const auto pv = w->LastPreview();
+    QVERIFY(std::fabs(double(pv->t_s.size()) - (s.trajectory.duration_s * 10.0 + 1.0)) <= 2.0);
+
+    PathView *views[2] = {w->MapView(), w->View3D()};
+    for (PathView *v : views) v->SetLiveRenderDelay(60000); // the mechanism, not the machine's speed
+    long r0[2] = {views[0]->RenderCount(), views[1]->RenderCount()};
+    const size_t n0 = w->PreviewLatenciesMs().size();
+    const nav_scene before = s;
+    const int edits = 4;
+    for (int i = 0; i < edits; ++i) {
+      nav_scene e = doc->Scene();
+      e.trajectory.waypoints.points[1].r_ned_m.y += 5.0;
+      doc->Preview(e);
+      QVERIFY(doc->IsLive());
+      QVERIFY(WaitUntil([&] { return w->PreviewLatenciesMs().size() >= n0 + size_t(i) + 1; }, 30000));
+      QVERIFY(WaitUntil(settled, 30000));
+    }
+    for (int k = 0; k < 2; ++k) QCOMPARE(views[k]->RenderCount() - r0[k], long(edits));
+    // The path drawn is the edited one.
+    QCOMPARE(views[0]->Path().Size(), views[0]->PathPointCount());
+    Shot(w.get(), "live-01-dragging");
+    // Release: one undo step, drawn at once (not waiting for a preview).
+    const long r1 = views[0]->RenderCount();
+    doc->Commit(before, "Move waypoint 1");
+    QVERIFY(!doc->IsLive());
+    QTest::qWait(30);
+    QVERIFY(views[0]->RenderCount() > r1);
+    QVERIFY(WaitUntil(settled, 60000));
+    Shot(w.get(), "live-02-released");
+  }
+
   // Map background: at street scale the metric grid; zoomed out, GSHHS coastlines (the Baltic
   // coast north of the Berlin origin) and a labelled lat/lon graticule.
   void map_background() {

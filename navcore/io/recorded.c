@@ -891,6 +891,12 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
           !(cfg->has_end && inc.t_s > cfg->t_end_s + tol))
         break;
     }
+    if (!got && sum->imu_records == 0) {
+      /* End of the IMU file before its first record: an empty or comment-only file. */
+      diag_set(diag, cfg->imu_path, 1, 1, "", "the IMU file holds no records; expected lines of %s", k_expect_imu);
+      st = NAV_ERR_PARSE;
+      goto cleanup;
+    }
     if (!got || !p.ref_have || (cfg->has_end && inc.t_s > cfg->t_end_s + tol)) {
       diag_set(
           diag, cfg->imu_path, 0, 0, "",
