@@ -648,15 +648,9 @@ nav_replay_config nav_replay_config_default(void) {
 }
 
 /* Running RMS / max of the metrics (streaming: memory does not grow with the epochs). */
-enum { M_POS_H, M_POS_V, M_VEL_H, M_VEL_V, M_ROLL, M_PITCH, M_YAW, M_ATT, N_M };
+enum { N_M = 8 };
 
-typedef struct stats_acc {
-  long n;
-  double sum_sq[N_M], max[N_M], t_max[N_M];
-  nav_vec3 sum_pos, sum_vel;
-} stats_acc;
-
-static void stats_add(stats_acc *a, const nav_epoch_errors *e) {
+void nav_replay_stats_add(nav_replay_stats_acc *a, const nav_epoch_errors *e) {
   const double v[N_M] = {e->pos_err_h_m,
                          e->pos_err_v_m,
                          hypot(e->vel_err_n_mps.x, e->vel_err_n_mps.y),
@@ -677,7 +671,7 @@ static void stats_add(stats_acc *a, const nav_epoch_errors *e) {
   a->n++;
 }
 
-static nav_replay_stats stats_result(const stats_acc *a) {
+nav_replay_stats nav_replay_stats_result(const nav_replay_stats_acc *a) {
   nav_replay_stats s;
   memset(&s, 0, sizeof s);
   s.epochs = a->n;
@@ -937,7 +931,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (st != NAV_OK) goto cleanup;
 
   /* 2. Every following increment. */
-  stats_acc acc, acc_out;
+  nav_replay_stats_acc acc, acc_out;
   memset(&acc, 0, sizeof acc);
   memset(&acc_out, 0, sizeof acc_out);
   const double t_first = inc.t_s;
@@ -1029,8 +1023,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     if (output) last_out = j;
     if (has_ref) {
       err = errors_at(&frame, &p.ref_row, &nav);
-      stats_add(&acc, &err);
-      if (output) stats_add(&acc_out, &err);
+      nav_replay_stats_add(&acc, &err);
+      if (output) nav_replay_stats_add(&acc_out, &err);
       sum->final = err;
       gap_max_h = fmax(gap_max_h, err.pos_err_h_m);
     }
@@ -1068,8 +1062,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const nav_progress pr = {"replay", 0, 1.0, sum->t_last_s};
     (void)cfg->progress(cfg->user, &pr);
   }
-  sum->stats = stats_result(&acc);
-  sum->stats_output = stats_result(&acc_out);
+  sum->stats = nav_replay_stats_result(&acc);
+  sum->stats_output = nav_replay_stats_result(&acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
   *out = *sum;
@@ -1090,7 +1084,7 @@ nav_status nav_replay_score_pva(const char *ref_path, const char *est_path, bool
                                 nav_diag *diag) {
   if (!ref_path || !est_path || !out || !(sync_tol_s > 0.0)) return NAV_ERR_INVALID_ARG;
   nav_rec_reader *ref = NULL, *est = NULL;
-  stats_acc acc;
+  nav_replay_stats_acc acc;
   memset(&acc, 0, sizeof acc);
   nav_status st = nav_rec_reader_open(ref_path, NAV_REC_PVA, &ref, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(est_path, NAV_REC_PVA, &est, diag);
@@ -1128,7 +1122,7 @@ nav_status nav_replay_score_pva(const char *ref_path, const char *est_path, bool
     const nav_traj_state ts = nav_rec_pva_to_state(&rr), es = nav_rec_pva_to_state(&er);
     const nav_ins_state s = {es.t_s, es.r_fb_f_m, es.v_fb_f_mps, es.q_b_f};
     const nav_epoch_errors e = nav_errors_compute(&frame, &ts, &s);
-    stats_add(&acc, &e);
+    nav_replay_stats_add(&acc, &e);
   }
   if (acc.n == 0) {
     diag_set(diag, est_path, 0, 0, "", "no row coincides with a row of the reference %s (within %.3g s)",
@@ -1136,7 +1130,7 @@ nav_status nav_replay_score_pva(const char *ref_path, const char *est_path, bool
     st = NAV_ERR_INVALID_ARG;
     goto cleanup;
   }
-  *out = stats_result(&acc);
+  *out = nav_replay_stats_result(&acc);
   st = NAV_OK;
 cleanup:
   nav_rec_reader_destroy(ref);

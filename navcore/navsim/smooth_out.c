@@ -14,14 +14,6 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_errors.h"
 
-enum { N_M = 8 };
-
-typedef struct acc {
-  long n;
-  double sum_sq[N_M], max[N_M], t_max[N_M];
-  nav_vec3 sum_pos, sum_vel;
-} acc;
-
 /* A kept output epoch with a reference. */
 typedef struct kept {
   double t_s;
@@ -106,44 +98,6 @@ nav_status smooth_out_on_record(smooth_out *o, const nav_replay_record *r) {
   return NAV_OK;
 }
 
-static void acc_add(acc *a, const nav_epoch_errors *e) {
-  const double v[N_M] = {e->pos_err_h_m,
-                         e->pos_err_v_m,
-                         hypot(e->vel_err_n_mps.x, e->vel_err_n_mps.y),
-                         fabs(e->vel_err_n_mps.z),
-                         fabs(e->euler_err.roll_rad),
-                         fabs(e->euler_err.pitch_rad),
-                         fabs(e->euler_err.yaw_rad),
-                         e->att_err_rad};
-  for (int m = 0; m < N_M; ++m) {
-    a->sum_sq[m] += v[m] * v[m];
-    if (a->n == 0 || v[m] > a->max[m]) {
-      a->max[m] = v[m];
-      a->t_max[m] = e->t_s;
-    }
-  }
-  a->sum_pos = nav_vec3_add(a->sum_pos, e->pos_err_n_m);
-  a->sum_vel = nav_vec3_add(a->sum_vel, e->vel_err_n_mps);
-  a->n++;
-}
-
-static nav_replay_stats acc_result(const acc *a) {
-  nav_replay_stats s;
-  memset(&s, 0, sizeof s);
-  s.epochs = a->n;
-  if (a->n == 0) return s;
-  nav_replay_stat *dst[N_M] = {&s.pos_h_m,  &s.pos_v_m,   &s.vel_h_mps, &s.vel_v_mps,
-                               &s.roll_rad, &s.pitch_rad, &s.yaw_rad,   &s.att_rad};
-  for (int m = 0; m < N_M; ++m) {
-    dst[m]->rms = sqrt(a->sum_sq[m] / (double)a->n);
-    dst[m]->max = a->max[m];
-    dst[m]->t_max_s = a->t_max[m];
-  }
-  s.pos_mean_n_m = nav_vec3_scale(a->sum_pos, 1.0 / (double)a->n);
-  s.vel_mean_n_mps = nav_vec3_scale(a->sum_vel, 1.0 / (double)a->n);
-  return s;
-}
-
 /* The smoothed state in the replay's frame (ECEF), as nav_ins_gnss writes its feedback. */
 static nav_ins_state to_ecef(const nav_filter_ins_state *s, double t_s) {
   const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
@@ -172,12 +126,12 @@ nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const
         "fwd_sd_n_m,fwd_sd_e_m,fwd_sd_d_m,sd_yaw_deg,fwd_sd_yaw_deg,gnss_update,pos_err_h_m,fwd_pos_err_h_m,"
         "yaw_err_deg,fwd_yaw_err_deg\n",
         f);
-  acc a_sm, a_fwd;
+  nav_replay_stats_acc a_sm, a_fwd;
   memset(&a_sm, 0, sizeof a_sm);
   memset(&a_fwd, 0, sizeof a_fwd);
   /* Gaps with their end errors (closed gaps only). */
   o->n_gaps = 0;
-  acc g_sm[NAV_REPLAY_MAX_GAPS], g_fwd[NAV_REPLAY_MAX_GAPS];
+  nav_replay_stats_acc g_sm[NAV_REPLAY_MAX_GAPS], g_fwd[NAV_REPLAY_MAX_GAPS];
   for (long i = 0; i < sum->gap_count && i < NAV_REPLAY_MAX_GAPS; ++i) {
     const nav_replay_gap *g = &sum->gaps[i];
     gap_cmp *c = &o->gaps[o->n_gaps];
@@ -204,16 +158,16 @@ nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const
     if (has_ref) {
       const nav_ins_state s = to_ecef(&e.smoothed, e.t_s);
       es = nav_errors_compute(&o->frame, &o->k[j].ref, &s);
-      acc_add(&a_sm, &es);
-      acc_add(&a_fwd, &o->k[j].fwd);
+      nav_replay_stats_add(&a_sm, &es);
+      nav_replay_stats_add(&a_fwd, &o->k[j].fwd);
       const double sd_sm = hypot(e.sd_smoothed[0], e.sd_smoothed[1]);
       const double sd_fw = hypot(e.sd_forward[0], e.sd_forward[1]);
       for (long g = 0; g < o->n_gaps; ++g) {
         gap_cmp *c = &o->gaps[g];
         if (fabs(e.t_s - c->t1_s) <= 1e-6) c->sm_end_h_m = es.pos_err_h_m;
         if (e.t_s > c->t0_s + 1e-6 && e.t_s < c->t1_s - 1e-6) {
-          acc_add(&g_sm[g], &es);
-          acc_add(&g_fwd[g], &o->k[j].fwd);
+          nav_replay_stats_add(&g_sm[g], &es);
+          nav_replay_stats_add(&g_fwd[g], &o->k[j].fwd);
           c->fwd_sd_h_max_m = fmax(c->fwd_sd_h_max_m, sd_fw);
           c->sm_sd_h_max_m = fmax(c->sm_sd_h_max_m, sd_sm);
         }
@@ -238,10 +192,10 @@ nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const
   const bool bad = ferror(f) != 0;
   if (fclose(f) != 0 || bad) return NAV_ERR_IO;
   if (st != NAV_OK) return st;
-  o->st_sm = acc_result(&a_sm);
-  o->st_fwd = acc_result(&a_fwd);
+  o->st_sm = nav_replay_stats_result(&a_sm);
+  o->st_fwd = nav_replay_stats_result(&a_fwd);
   for (long g = 0; g < o->n_gaps; ++g) {
-    const nav_replay_stats s = acc_result(&g_sm[g]), fw = acc_result(&g_fwd[g]);
+    const nav_replay_stats s = nav_replay_stats_result(&g_sm[g]), fw = nav_replay_stats_result(&g_fwd[g]);
     o->gaps[g].epochs = s.epochs;
     o->gaps[g].sm_max_h_m = s.pos_h_m.max;
     o->gaps[g].sm_rms_h_m = s.pos_h_m.rms;

@@ -191,6 +191,21 @@ typedef struct nav_replay_stats {
   nav_vec3 vel_mean_n_mps;   /**< signed mean velocity error N, E, D [m/s] */
 } nav_replay_stats;
 
+/**
+ * Streaming accumulator of nav_replay_stats (memory does not grow with the epochs). Zero it
+ * (memset or = {0}) before the first nav_replay_stats_add(). Plain value; not synchronised.
+ */
+typedef struct nav_replay_stats_acc {
+  long n;
+  double sum_sq[8], max[8], t_max[8]; /**< per metric, in the order of nav_replay_stats */
+  nav_vec3 sum_pos, sum_vel;
+} nav_replay_stats_acc;
+
+/** Add the errors of one epoch. */
+NAV_API void nav_replay_stats_add(nav_replay_stats_acc *a, const nav_epoch_errors *e);
+/** RMS, max and time of max of each metric, and the signed means, over the epochs added. */
+NAV_API nav_replay_stats nav_replay_stats_result(const nav_replay_stats_acc *a);
+
 /** Largest number of GNSS gaps nav_replay_summary lists (further ones are only counted). */
 #define NAV_REPLAY_MAX_GAPS 64
 

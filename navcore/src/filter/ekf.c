@@ -106,25 +106,6 @@ set_error(nav_filter *f, const char *fmt, ...) {
 
 static void init_patterns(nav_filter *f);
 
-/* Process model of one triad: F diagonal and q per numerics.md 6.2. */
-static void triad_process(nav_filter *f, size_t idx, unsigned terms, nav_vec3 gm_sd, nav_vec3 gm_tau,
-                          nav_vec3 rw) {
-  for (int i = 0; i < 3; ++i) {
-    double fd = 0.0, q = 0.0;
-    if ((terms & NAV_FILTER_PROC_GM) != 0u) {
-      const double sd = nav_vec3_get(gm_sd, i), tau = nav_vec3_get(gm_tau, i);
-      fd = -1.0 / tau;
-      q += 2.0 * sd * sd / tau;
-    }
-    if ((terms & NAV_FILTER_PROC_RW) != 0u) {
-      const double k = nav_vec3_get(rw, i);
-      q += k * k;
-    }
-    f->proc_diag[idx + (size_t)i] = fd;
-    f->qc[idx + (size_t)i] = q;
-  }
-}
-
 static void set_p0_block(nav_filter *f, size_t idx, nav_vec3 sd) {
   for (int i = 0; i < 3; ++i) {
     const double s = nav_vec3_get(sd, i);
@@ -142,25 +123,7 @@ nav_status nav_filter_create(const nav_filter_config *cfg, nav_filter **out) {
   f->lay = nav_filter_layout_of(cfg->states);
   f->n = f->lay.n_states;
 
-  for (int i = 0; i < 3; ++i) {
-    const double na = nav_vec3_get(cfg->accel_vrw_mps_per_sqrt_s, i);
-    const double ng = nav_vec3_get(cfg->gyro_arw_rad_per_sqrt_s, i);
-    f->qc[NAV_FILTER_IDX_DV + (size_t)i] = na * na;  /* VRW: q_a = N_a^2 [m^2/s^3] */
-    f->qc[NAV_FILTER_IDX_PHI + (size_t)i] = ng * ng; /* ARW: q_g = N_g^2 [rad^2/s] */
-  }
-  triad_process(f, NAV_FILTER_IDX_BG, cfg->gyro_bias_terms, cfg->gyro_bias_gm_sd_rps, cfg->gyro_bias_gm_tau_s,
-                cfg->gyro_bias_rw_rps_per_sqrt_s);
-  triad_process(f, NAV_FILTER_IDX_BA, cfg->accel_bias_terms, cfg->accel_bias_gm_sd_mps2,
-                cfg->accel_bias_gm_tau_s, cfg->accel_bias_rw_mps2_per_sqrt_s);
-  if (f->lay.has_scale_factors) {
-    triad_process(f, NAV_FILTER_IDX_SG, cfg->gyro_sf_terms, cfg->gyro_sf_gm_sd, cfg->gyro_sf_gm_tau_s,
-                  cfg->gyro_sf_rw_per_sqrt_s);
-    triad_process(f, NAV_FILTER_IDX_SA, cfg->accel_sf_terms, cfg->accel_sf_gm_sd, cfg->accel_sf_gm_tau_s,
-                  cfg->accel_sf_rw_per_sqrt_s);
-  }
-  if (f->lay.has_gnss_pos_gm)
-    triad_process(f, f->lay.idx_gnss_pos, NAV_FILTER_PROC_GM, cfg->gnss_pos_gm_sd_m, cfg->gnss_pos_gm_tau_s,
-                  nav_vec3_zero());
+  nav_filter_process_model(cfg, &f->lay, f->proc_diag, f->qc);
 
   set_p0_block(f, NAV_FILTER_IDX_DR, cfg->init.pos_sd_m);
   set_p0_block(f, NAV_FILTER_IDX_DV, cfg->init.vel_sd_mps);

@@ -67,6 +67,16 @@ typedef struct nav_filter_earth_terms {
   double w_ie_rps; /**< Earth rotation rate [rad/s] */
 } nav_filter_earth_terms;
 
+/**
+ * The process model of numerics.md 6.2 from a configuration: spectral densities q_c (VRW q_a =
+ * N_a^2 on dv, ARW q_g = N_g^2 on phi; GM q = 2 sigma^2 / T and random walk q = K^2 on the sensor
+ * and GNSS blocks) and the F diagonal of those blocks (-1/T for GM states). Writes the entries
+ * of the blocks @p lay has and leaves the others (dr, the phi/dv diagonal) untouched.
+ * The filter and the smoother build their models here, so the two cannot drift apart.
+ */
+void nav_filter_process_model(const nav_filter_config *cfg, const nav_filter_layout *lay, double *proc_diag,
+                              double *qc);
+
 /** WGS-84 radii R_M(lat), R_N(lat), normal gravity gamma(lat, h), omega_ie. */
 nav_filter_earth_terms nav_filter_earth_terms_wgs84(double lat_rad, double h_m);
 

@@ -144,6 +144,48 @@ nav_status nav_filter_config_validate(const nav_filter_config *cfg, nav_scene_is
   return ck.problems == 0 ? NAV_OK : NAV_ERR_INVALID_ARG;
 }
 
+/* F diagonal and q of one triad (numerics.md 6.2). */
+static void triad_process(double *proc_diag, double *qc, size_t idx, unsigned terms, nav_vec3 gm_sd,
+                          nav_vec3 gm_tau, nav_vec3 rw) {
+  for (int i = 0; i < 3; ++i) {
+    double fd = 0.0, q = 0.0;
+    if ((terms & NAV_FILTER_PROC_GM) != 0u) {
+      const double sd = nav_vec3_get(gm_sd, i), tau = nav_vec3_get(gm_tau, i);
+      fd = -1.0 / tau;
+      q += 2.0 * sd * sd / tau;
+    }
+    if ((terms & NAV_FILTER_PROC_RW) != 0u) {
+      const double k = nav_vec3_get(rw, i);
+      q += k * k;
+    }
+    proc_diag[idx + (size_t)i] = fd;
+    qc[idx + (size_t)i] = q;
+  }
+}
+
+void nav_filter_process_model(const nav_filter_config *cfg, const nav_filter_layout *lay, double *proc_diag,
+                              double *qc) {
+  for (int i = 0; i < 3; ++i) {
+    const double na = nav_vec3_get(cfg->accel_vrw_mps_per_sqrt_s, i);
+    const double ng = nav_vec3_get(cfg->gyro_arw_rad_per_sqrt_s, i);
+    qc[NAV_FILTER_IDX_DV + (size_t)i] = na * na;  /* VRW: q_a = N_a^2 [m^2/s^3] */
+    qc[NAV_FILTER_IDX_PHI + (size_t)i] = ng * ng; /* ARW: q_g = N_g^2 [rad^2/s] */
+  }
+  triad_process(proc_diag, qc, NAV_FILTER_IDX_BG, cfg->gyro_bias_terms, cfg->gyro_bias_gm_sd_rps,
+                cfg->gyro_bias_gm_tau_s, cfg->gyro_bias_rw_rps_per_sqrt_s);
+  triad_process(proc_diag, qc, NAV_FILTER_IDX_BA, cfg->accel_bias_terms, cfg->accel_bias_gm_sd_mps2,
+                cfg->accel_bias_gm_tau_s, cfg->accel_bias_rw_mps2_per_sqrt_s);
+  if (lay->has_scale_factors) {
+    triad_process(proc_diag, qc, NAV_FILTER_IDX_SG, cfg->gyro_sf_terms, cfg->gyro_sf_gm_sd, cfg->gyro_sf_gm_tau_s,
+                  cfg->gyro_sf_rw_per_sqrt_s);
+    triad_process(proc_diag, qc, NAV_FILTER_IDX_SA, cfg->accel_sf_terms, cfg->accel_sf_gm_sd,
+                  cfg->accel_sf_gm_tau_s, cfg->accel_sf_rw_per_sqrt_s);
+  }
+  if (lay->has_gnss_pos_gm)
+    triad_process(proc_diag, qc, lay->idx_gnss_pos, NAV_FILTER_PROC_GM, cfg->gnss_pos_gm_sd_m,
+                  cfg->gnss_pos_gm_tau_s, nav_vec3_zero());
+}
+
 nav_filter_layout nav_filter_layout_of(unsigned states) {
   nav_filter_layout l;
   l.has_scale_factors = (states & NAV_FILTER_STATE_SCALE_FACTORS) != 0u;

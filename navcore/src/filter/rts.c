@@ -99,24 +99,6 @@ nav_smoother_config nav_smoother_config_default(void) {
   return c;
 }
 
-/* F diagonal and q of one triad (numerics.md 6.2), as the filter builds them. */
-static void triad(nav_smoother *s, size_t idx, unsigned terms, nav_vec3 gm_sd, nav_vec3 gm_tau, nav_vec3 rw) {
-  for (int i = 0; i < 3; ++i) {
-    double fd = 0.0, q = 0.0;
-    if ((terms & NAV_FILTER_PROC_GM) != 0u) {
-      const double sd = nav_vec3_get(gm_sd, i), tau = nav_vec3_get(gm_tau, i);
-      fd = -1.0 / tau;
-      q += 2.0 * sd * sd / tau;
-    }
-    if ((terms & NAV_FILTER_PROC_RW) != 0u) {
-      const double k = nav_vec3_get(rw, i);
-      q += k * k;
-    }
-    s->proc_diag[idx + (size_t)i] = fd;
-    s->qc[idx + (size_t)i] = q;
-  }
-}
-
 nav_status nav_smoother_create(const nav_smoother_config *cfg, nav_smoother **out) {
   assert(cfg != NULL && out != NULL);
   if (cfg == NULL || out == NULL) return NAV_ERR_INVALID_ARG;
@@ -128,26 +110,7 @@ nav_status nav_smoother_create(const nav_smoother_config *cfg, nav_smoother **ou
   s->lay = nav_filter_layout_of(cfg->filter.states);
   s->n = s->lay.n_states;
   s->ntri = s->n * (s->n + 1) / 2;
-  const nav_filter_config *f = &cfg->filter;
-  for (int i = 0; i < 3; ++i) {
-    const double na = nav_vec3_get(f->accel_vrw_mps_per_sqrt_s, i);
-    const double ng = nav_vec3_get(f->gyro_arw_rad_per_sqrt_s, i);
-    s->qc[NAV_FILTER_IDX_DV + (size_t)i] = na * na;
-    s->qc[NAV_FILTER_IDX_PHI + (size_t)i] = ng * ng;
-  }
-  triad(s, NAV_FILTER_IDX_BG, f->gyro_bias_terms, f->gyro_bias_gm_sd_rps, f->gyro_bias_gm_tau_s,
-        f->gyro_bias_rw_rps_per_sqrt_s);
-  triad(s, NAV_FILTER_IDX_BA, f->accel_bias_terms, f->accel_bias_gm_sd_mps2, f->accel_bias_gm_tau_s,
-        f->accel_bias_rw_mps2_per_sqrt_s);
-  if (s->lay.has_scale_factors) {
-    triad(s, NAV_FILTER_IDX_SG, f->gyro_sf_terms, f->gyro_sf_gm_sd, f->gyro_sf_gm_tau_s,
-          f->gyro_sf_rw_per_sqrt_s);
-    triad(s, NAV_FILTER_IDX_SA, f->accel_sf_terms, f->accel_sf_gm_sd, f->accel_sf_gm_tau_s,
-          f->accel_sf_rw_per_sqrt_s);
-  }
-  if (s->lay.has_gnss_pos_gm)
-    triad(s, s->lay.idx_gnss_pos, NAV_FILTER_PROC_GM, f->gnss_pos_gm_sd_m, f->gnss_pos_gm_tau_s,
-          nav_vec3_zero());
+  nav_filter_process_model(&cfg->filter, &s->lay, s->proc_diag, s->qc);
   *out = s;
   return NAV_OK;
 }
