@@ -62,14 +62,52 @@ static void diag_set(nav_diag *d, const char *file, int line, int col, const cha
 }
 
 /* Printable excerpt of a field for a message: control bytes become '?', long text is cut. */
+/* Length of the well-formed UTF-8 sequence at s[0..n) (RFC 3629: no overlong forms, surrogates
+ * or code points above U+10FFFF), or 0 when it is not one. */
+static size_t utf8_len(const unsigned char *s, size_t n) {
+  const unsigned char c = s[0];
+  size_t len;
+  unsigned char lo = 0x80, hi = 0xbf; /* range of the second byte */
+  if (c >= 0xc2 && c <= 0xdf) len = 2;
+  else if (c >= 0xe0 && c <= 0xef) {
+    len = 3;
+    if (c == 0xe0) lo = 0xa0;
+    if (c == 0xed) hi = 0x9f;
+  } else if (c >= 0xf0 && c <= 0xf4) {
+    len = 4;
+    if (c == 0xf0) lo = 0x90;
+    if (c == 0xf4) hi = 0x8f;
+  } else
+    return 0;
+  if (len > n || s[1] < lo || s[1] > hi) return 0;
+  for (size_t k = 2; k < len; ++k)
+    if ((s[k] & 0xc0) != 0x80) return 0;
+  return len;
+}
+
+/* A field as shown in a message: at most 32 bytes, control characters and bytes that are not
+ * well-formed UTF-8 as '?', a multi-byte character never cut, "..." when shortened. */
 static void excerpt(char *dst, size_t cap, const char *s, size_t n) {
   size_t j = 0;
   const size_t max = cap > 40 ? 32 : cap - 4;
-  for (size_t i = 0; i < n && j < max; ++i) {
+  size_t i = 0;
+  for (; i < n && j < max; ++i) {
     const unsigned char c = (unsigned char)s[i];
+    if (c >= 0x80) {
+      const size_t len = utf8_len((const unsigned char *)s + i, n - i);
+      if (len == 0) {
+        dst[j++] = '?';
+        continue;
+      }
+      if (j + len > max) break;
+      memcpy(dst + j, s + i, len);
+      j += len;
+      i += len - 1;
+      continue;
+    }
     dst[j++] = (c < 0x20 || c == 0x7f) ? '?' : (char)c;
   }
-  if (n > max) {
+  if (i < n) {
     memcpy(dst + j, "...", 3);
     j += 3;
   }
@@ -995,6 +1033,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
             g.pos_h_end_m = e.pos_err_h_m;
             g.pos_v_end_m = e.pos_err_v_m;
             g.pos_h_max_m = fmax(gap_max_h, e.pos_err_h_m);
+            g.end_errors = e;
           }
           if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
           sum->gap_count++;
@@ -1055,6 +1094,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     g.pos_h_end_m = sum->final.pos_err_h_m;
     g.pos_v_end_m = sum->final.pos_err_v_m;
     g.pos_h_max_m = gap_max_h;
+    g.end_errors = sum->final;
     if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
     sum->gap_count++;
   }

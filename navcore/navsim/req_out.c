@@ -41,7 +41,22 @@ nav_status navsim_req_replay_verdicts(const nav_requirement *reqs, int n, const 
   if (st != NAV_OK) return st;
   nav_req_run *r = NULL;
   st = nav_req_run_begin(ev, 0, &r);
-  for (size_t i = 0; i < b->n && st == NAV_OK; ++i) {
+  /* A closed gap's end is the epoch of the fix that ends it, before the fix is applied: its errors
+   * enter the evaluation 1 ulp before that epoch, inside the half-open interval [t0, t1) and before
+   * the output epoch that may coincide with the fix (which holds the errors after the update). */
+  long g = 0;
+  for (size_t i = 0; i <= b->n && st == NAV_OK; ++i) {
+    const double t_next = i < b->n ? b->e[i].t_s - t0 : INFINITY;
+    for (; g < sum->gap_count && g < NAV_REPLAY_MAX_GAPS && st == NAV_OK; ++g) {
+      const nav_replay_gap *gp = &sum->gaps[g];
+      if (gp->open || !gp->has_end_errors) continue;
+      const double t_end = nextafter(gp->t1_s - t0, -INFINITY);
+      if (t_end >= t_next) break;
+      nav_epoch_errors e = gp->end_errors;
+      e.t_s = t_end;
+      st = nav_req_run_add(r, &e);
+    }
+    if (i == b->n || st != NAV_OK) break;
     nav_epoch_errors e = b->e[i];
     e.t_s -= t0;
     st = nav_req_run_add(r, &e);

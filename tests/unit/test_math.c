@@ -537,6 +537,21 @@ static void test_wrap_pi(void **state) {
   assert_near(nav_wrap_pi(100.0), 100.0 - 32.0 * NAV_PI, 1e-14);
   assert_true(isnan(nav_wrap_pi(NAN)));
   assert_true(isnan(nav_wrap_pi(INFINITY)));
+  /* The in-range shortcut is bit-identical to the definition (remainder, -pi folded to +pi) on
+   * 1e6 values spread over [-4 pi, 4 pi] and on the neighbours of +-pi. */
+  uint64_t u = 20261122u;
+  for (int i = 0; i < 1000000; ++i) {
+    u = u * 6364136223846793005ull + 1442695040888963407ull;
+    const double a = ((double)(u >> 11) * 0x1.0p-53 - 0.5) * 8.0 * NAV_PI;
+    double ref = remainder(a, NAV_TWO_PI);
+    if (ref == -NAV_PI) ref = NAV_PI;
+    const double got = nav_wrap_pi(a);
+    if (memcmp(&ref, &got, sizeof ref) != 0) fail_msg("nav_wrap_pi(%a) = %a, remainder gives %a", a, got, ref);
+  }
+  for (double a = NAV_PI, k = 0; k < 64; ++k, a = nextafter(a, 0.0)) {
+    assert_true(nav_wrap_pi(a) == remainder(a, NAV_TWO_PI));
+    assert_true(nav_wrap_pi(-a) == (remainder(-a, NAV_TWO_PI) == -NAV_PI ? NAV_PI : remainder(-a, NAV_TWO_PI)));
+  }
 }
 
 static void test_wrap_two_pi(void **state) {

@@ -331,6 +331,19 @@ static void test_imu_malformed(void **state) {
                      "time must increase from record to record: 1.000000 s is not after 1.000000 s (line 1)");
   expect_parse_error("2 0 0 0 0 0 0\n\n  1.5 0 0 0 0 0 0\n", NAV_REC_IMU, 3, 3, "column 1 (t_s)",
                      "1.500000 s is not after 2.000000 s (line 1)");
+  /* Bytes that are not UTF-8 are shown as '?', well-formed characters as they are, and a
+   * shortened excerpt never cuts a multi-byte character (the message stays valid UTF-8). */
+  expect_parse_error("1 \xff\xfe\xc3 3 4 5 6 7\n", NAV_REC_IMU, 1, 3, "column 2 (dtheta_x_rad)",
+                     "expected a number, found \"???\"");
+  expect_parse_error("1 \xc3\xa9t\xc3\xa9 3 4 5 6 7\n", NAV_REC_IMU, 1, 3, "column 2 (dtheta_x_rad)",
+                     "expected a number, found \"\xc3\xa9t\xc3\xa9\"");
+  expect_parse_error("1 \xed\xa0\x80 3 4 5 6 7\n", NAV_REC_IMU, 1, 3, "column 2 (dtheta_x_rad)",
+                     "found \"???\"");
+  expect_parse_error("1 x\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9"
+                     "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9 3 4 5 6 7\n",
+                     NAV_REC_IMU, 1, 3, "column 2 (dtheta_x_rad)",
+                     "found \"x\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9"
+                     "\xc3\xa9\xc3\xa9\xc3\xa9...\"");
   /* A NUL byte inside a field (binary data). */
   const char nul[] = "1 2\0003 4 5 6 7 8\n";
   expect_parse_error_len(nul, sizeof nul - 1, NAV_REC_IMU, 1, 3, "column 2 (dtheta_x_rad)",

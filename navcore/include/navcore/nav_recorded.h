@@ -221,6 +221,7 @@ typedef struct nav_replay_gap {
   double pos_h_end_m;  /**< horizontal error at t1_s, before the fix is applied [m] */
   double pos_v_end_m;  /**< vertical error at t1_s, before the fix [m] */
   double pos_h_max_m;  /**< largest horizontal error over the scored epochs of the gap [m] */
+  nav_epoch_errors end_errors; /**< all errors at t1_s before the fix (valid if has_end_errors) */
 } nav_replay_gap;
 
 /** What a replay did, and how well. */

@@ -112,6 +112,13 @@ typedef struct nav_sim_summary {
   size_t smoother_bytes_max;       /**< largest smoother memory of one run (records + results) */
 } nav_sim_summary;
 
+/** Bounds of the Monte Carlo engine's tables (what a campaign keeps in memory; navsim bench's
+ *  memory projection uses them): values per error metric kept for the statistics over runs and
+ *  epochs (a uniform subsample, every stats_stride-th epoch, beyond this), and values kept for
+ *  the per-epoch envelopes (runs x output epochs x 9; no envelopes beyond this). */
+#define NAV_SIM_METRIC_MAX_VALUES 2000000LL
+#define NAV_SIM_ENV_MAX_VALUES 4000000LL
+
 /** Monte Carlo envelope at one output epoch: statistics over runs (numerics.md T6.6). */
 typedef struct nav_sim_envelope_point {
   double t_s;

@@ -30,6 +30,8 @@
 #define MAX_NEWTON_STEPS 64
 
 double nav_earth_wrap_lon(double lon_rad) {
+  /* Inside (-pi, pi] remainder() returns its argument unchanged: skip the libm call. */
+  if (lon_rad > -NAV_PI && lon_rad <= NAV_PI) return lon_rad;
   /* remainder() is exact and returns [-pi, pi] for the double nearest 2 pi; fold -pi to +pi. */
   double w = remainder(lon_rad, NAV_TWO_PI);
   if (w <= -NAV_PI) w = NAV_PI;

@@ -403,6 +403,9 @@ nav_euler nav_quat_to_euler(nav_quat q, bool *gimbal_lock) {
 /* ---------------------------------------------------------------- angle wrapping */
 
 double nav_wrap_pi(double a_rad) {
+  /* Inside (-pi, pi] remainder() would return its argument unchanged (|a| < 2pi / 2, and pi itself
+   * is a tie rounded to the even quotient 0), so the common case skips the libm call. */
+  if (a_rad > -NAV_PI && a_rad <= NAV_PI) return a_rad;
   /* remainder() is exact and returns a value in [-pi, pi] (pi as the double NAV_PI); only the
    * end point -pi has to be moved to +pi. Signed zeros pass through unchanged. */
   double r = remainder(a_rad, NAV_TWO_PI);

@@ -38,12 +38,12 @@
 #include "traj/traj_internal.h"
 
 /* Values kept for the envelopes (runs x output epochs x ENV_VALUES): bounded memory. */
-#define STATS_MAX_VALUES 4000000LL
+#define STATS_MAX_VALUES NAV_SIM_ENV_MAX_VALUES
 /* Values kept per metric for the statistics over runs and epochs (runs x epochs / stride, a
  * uniform subsample for the percentiles; RMS and max come from the same values): 5 metrics x
  * 8 bytes x 2e6 = 80 MB worst case, plus one metric's copy while reducing, so that a 1000-run,
  * one-hour 200 Hz campaign stays within 200 MB with its shared truth (54 MB of increments). */
-#define METRIC_MAX_VALUES 2000000LL
+#define METRIC_MAX_VALUES NAV_SIM_METRIC_MAX_VALUES
 #define PROGRESS_EVERY 65536
 #define N_METRICS 5
 /* navigation.smoother: values kept per metric plane (2 x 5 planes, smoothed and forward errors at
