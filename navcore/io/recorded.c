@@ -39,6 +39,7 @@ struct nav_rec_reader {
   long prev_line;
   int64_t k;
   int gnss_cols;      /* column count fixed by the first GNSS record (0 before) */
+  long cut_line;      /* a last line without a line end (the file may have been cut), else 0 */
   locale_t c_numeric; /* "C" numbers for strtod, whatever the process locale (a GUI may set one) */
 };
 
@@ -200,6 +201,8 @@ const nav_diag *nav_rec_reader_diag(const nav_rec_reader *r) {
 long nav_rec_reader_line(const nav_rec_reader *r) {
   return r ? r->rec_line : 0;
 }
+long nav_rec_reader_cut_line(const nav_rec_reader *r) { return r ? r->cut_line : 0; }
+
 double nav_rec_reader_fraction(const nav_rec_reader *r) {
   if (!r || !(r->total > 0.0)) return 0.0;
   return fmin(1.0, r->consumed / r->total);
@@ -251,6 +254,7 @@ static nav_status next_line(nav_rec_reader *r, char **line, size_t *n) {
       r->pos += nl ? len + 1 : len;
       r->consumed += (double)(nl ? len + 1 : len);
       r->line++;
+      if (!nl) r->cut_line = r->line;
       *line = start;
       *n = len;
       return NAV_OK;
@@ -1106,6 +1110,9 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->stats_output = nav_replay_stats_result(&acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
+  sum->imu_cut_line = nav_rec_reader_cut_line(p.imu);
+  sum->gnss_cut_line = nav_rec_reader_cut_line(p.gnss);
+  sum->ref_cut_line = nav_rec_reader_cut_line(p.ref);
   *out = *sum;
   st = stop ? NAV_ERR_CANCELLED : NAV_OK;
 

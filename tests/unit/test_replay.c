@@ -301,6 +301,34 @@ static void test_empty_and_comment_only(void **state) {
   }
 }
 
+/* A last line without a line end is read, and reported as possibly cut (its line number), only
+ * once it has been read; a file ending in a line end is not. */
+static void test_cut_last_line(void **state) {
+  (void)state;
+  const char cut[] = "1 0 0 0 0 0 0\n# c\n2 0 0 0 0 0 0.0049";
+  const char whole[] = "1 0 0 0 0 0 0\n# c\n2 0 0 0 0 0 0.0049\n";
+  nav_rec_reader *r = open_text(cut, sizeof cut - 1, NAV_REC_IMU);
+  nav_imu_increment m;
+  bool got = false;
+  assert_int_equal(nav_rec_read_imu(r, &m, &got), NAV_OK);
+  assert_true(got);
+  assert_int_equal(nav_rec_reader_cut_line(r), 0);
+  assert_int_equal(nav_rec_read_imu(r, &m, &got), NAV_OK);
+  assert_true(got);
+  assert_true(m.dv_b_mps.z == 0.0049);
+  assert_int_equal(nav_rec_reader_cut_line(r), 3);
+  assert_int_equal(nav_rec_read_imu(r, &m, &got), NAV_OK);
+  assert_false(got);
+  assert_int_equal(nav_rec_reader_cut_line(r), 3);
+  nav_rec_reader_destroy(r);
+  r = open_text(whole, sizeof whole - 1, NAV_REC_IMU);
+  do
+    assert_int_equal(nav_rec_read_imu(r, &m, &got), NAV_OK);
+  while (got);
+  assert_int_equal(nav_rec_reader_cut_line(r), 0);
+  nav_rec_reader_destroy(r);
+}
+
 /* ---------------------------------------------------------------- readers: malformed input */
 
 static void test_imu_malformed(void **state) {
@@ -809,6 +837,7 @@ int main(void) {
       cmocka_unit_test(test_streaming_across_refills),
       cmocka_unit_test(test_numbers_ignore_process_locale),
       cmocka_unit_test(test_empty_and_comment_only),
+      cmocka_unit_test(test_cut_last_line),
       cmocka_unit_test(test_imu_malformed),
       cmocka_unit_test(test_gnss_malformed),
       cmocka_unit_test(test_pva_malformed),

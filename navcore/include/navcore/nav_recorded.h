@@ -134,6 +134,10 @@ NAV_API const nav_diag *nav_rec_reader_diag(const nav_rec_reader *r);
 /** 1-based line of the record last returned (0 before the first). */
 NAV_API long nav_rec_reader_line(const nav_rec_reader *r);
 
+/** Line number of a last line that has no line end, once it has been read, else 0: the file may
+ *  have been cut short, and a number cut inside its digits cannot be told from a shorter one. */
+NAV_API long nav_rec_reader_cut_line(const nav_rec_reader *r);
+
 /** Fraction of the input consumed, 0..1 (for progress display). */
 NAV_API double nav_rec_reader_fraction(const nav_rec_reader *r);
 
@@ -251,6 +255,9 @@ typedef struct nav_replay_summary {
   nav_vec3 b_g_rps;  /**< final gyro bias estimate [rad/s] (0 for the free INS) */
   nav_vec3 b_a_mps2; /**< final accelerometer bias estimate [m/s^2] */
   bool partial;      /**< stopped by a callback */
+  /** Line of an input's last line without a line end, when the replay read it (else 0):
+   *  nav_rec_reader_cut_line() of the IMU, GNSS and reference files. */
+  long imu_cut_line, gnss_cut_line, ref_cut_line;
 } nav_replay_summary;
 
 /** One output epoch of a replay; pointers valid only during the callback. */
