@@ -25,8 +25,9 @@ void Usage(FILE *f) {
                "Show the result directory written by `navsim run`: reference and estimated paths,\n"
                "attitude triads, the error-envelope tube, ground grid with scale, NED axes and legend.\n"
                "With --png and/or --chart it renders headless and exits; with neither it opens an\n"
-               "interactive window (needs a display). Rendering always needs an X server: run headless\n"
-               "jobs under xvfb-run -a.\n"
+               "interactive window (needs a display): the 3D view, or with --view map the geodetic map\n"
+               "(drag = pan, wheel or +/- = zoom, r = reset, q = quit). Rendering always needs an X\n"
+               "server: run headless jobs under xvfb-run -a.\n"
                "\n"
                "options:\n"
                "  --png FILE          write the view chosen by --view as PNG (default the 3D view)\n"
@@ -470,7 +471,12 @@ int main(int argc, char **argv) {
       rc = 1;
     }
   }
-  if (png.empty() && chart.empty() && !bench && movie_dir.empty()) {
+  if (png.empty() && chart.empty() && !bench && movie_dir.empty() && view_kind == "map") {
+    if (!NavRunMapInteractive(*result, mopt, &err)) {
+      std::fprintf(stderr, "navview: %s\n", err.c_str());
+      return 1;
+    }
+  } else if (png.empty() && chart.empty() && !bench && movie_dir.empty()) {
     if (!view.RunInteractive(&err)) {
       std::fprintf(stderr, "navview: %s\n", err.c_str());
       return 1;

@@ -2,6 +2,8 @@
 // graticule or local metric grid, scale bar; rendered offscreen to PNG.
 #include "navview/nav_view_map.h"
 
+#include "map_interactive_internal.h"
+
 #include "navview_internal.h"
 
 #include <algorithm>
@@ -240,7 +242,8 @@ bool NavReadShapefile(const std::string &path, std::vector<std::vector<double>> 
   return true;
 }
 
-bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const std::string &path, std::string *error) {
+bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer *ren, NavMapExtent *extent,
+                 std::string *error) {
   const NavTrack &ref = result.truth;
   if (!ref.HasGeodetic() || ref.Size() == 0) {
     *error = (result.dir.empty() ? std::string("result") : result.dir) +
@@ -251,7 +254,6 @@ bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const st
     *error = "map size out of range (64..8192 pixels)";
     return false;
   }
-  if (!NavCheckDisplay(error)) return false;
 
   // Centre: the mean direction of the tracks (no seam at the date line or the poles); extent:
   // the tracks projected about it.
@@ -286,13 +288,6 @@ bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const st
   const double lon_lo = pr.lon0 - dlon, lon_hi = pr.lon0 + dlon;
   const double span_deg_y = (lat_hi - lat_lo) / kD2R, span_deg_x = 2.0 * dlon / kD2R;
 
-  vtkNew<vtkRenderWindow> win;
-  NavAttachDisplay(win);
-  win->SetOffScreenRendering(1);
-  win->SetSize(opt.width_px, opt.height_px);
-  win->SetMultiSamples(opt.multisamples);
-  vtkNew<vtkRenderer> ren;
-  win->AddRenderer(ren);
   const bool street = span_x < 20e3;
   ren->SetBackground(street ? 0.97 : 0.86, street ? 0.97 : 0.91, street ? 0.95 : 0.96); // sea tint when zoomed out
   std::vector<std::string> notes;
@@ -618,6 +613,26 @@ bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const st
     leg->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     leg->GetPositionCoordinate()->SetValue(0.985, 0.015);
     ren->AddViewProp(leg);
+  }
+  if (extent) {
+    extent->span_x_m = span_x;
+    extent->span_y_m = span_y;
+  }
+  return true;
+}
+
+bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const std::string &path, std::string *error) {
+  if (!NavCheckDisplay(error)) return false;
+  vtkNew<vtkRenderWindow> win;
+  NavAttachDisplay(win);
+  win->SetOffScreenRendering(1);
+  win->SetSize(opt.width_px, opt.height_px);
+  win->SetMultiSamples(opt.multisamples);
+  vtkNew<vtkRenderer> ren;
+  win->AddRenderer(ren);
+  if (!NavBuildMap(result, opt, ren, nullptr, error)) {
+    win->Finalize();
+    return false;
   }
   win->Render();
   const bool ok = NavWriteWindowPng(win, path, error);

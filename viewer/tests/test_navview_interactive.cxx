@@ -19,8 +19,11 @@
 #include <vtkRenderer.h>
 #include <vtkSliderRepresentation2D.h>
 #include <vtkSliderWidget.h>
+#include <vtkNew.h>
+#include <vtkUnsignedCharArray.h>
 
 #include "interactive_internal.h"
+#include "map_interactive_internal.h"
 #include "navview/navview.h"
 #include "navview_internal.h"
 #include "scene_view_impl.h"
@@ -185,12 +188,79 @@ void test_pick(void **state) {
   std::printf("screenshot: %s\n", shot.c_str());
 }
 
+// The interactive map (navview DIR --view map without --png): pan by a drag, zoom by the wheel
+// and keys, reset; the window shows the tracks (dark reference pixels on the light map).
+void test_map_window(void **state) {
+  Fixture *f = static_cast<Fixture *>(*state);
+  NavMapOptions o;
+  o.width_px = 640;
+  o.height_px = 420;
+  o.multisamples = 0;
+  NavMapInteractive m;
+  std::string err;
+  if (!m.Open(*f->result, o, &err)) fail_msg("map window: %s", err.c_str());
+  const double s0 = m.Scale();
+  assert_true(s0 > 0.0);
+  assert_near(s0, 0.5 * m.Extent.span_y_m, 1e-9 * s0);
+  // Wheel forward zooms in by 1.25 about the centre; "minus" zooms out by 2; "r" resets.
+  m.Iren->InvokeEvent(vtkCommand::MouseWheelForwardEvent);
+  assert_near(m.Scale(), s0 / 1.25, 1e-9 * s0);
+  m.Iren->SetKeySym("minus");
+  m.Iren->InvokeEvent(vtkCommand::KeyPressEvent);
+  assert_near(m.Scale(), 2.0 * s0 / 1.25, 1e-9 * s0);
+  // A drag of (+50, +20) pixels moves the map with the pointer: the camera by (-50, -20) pixels.
+  const double mpp = 2.0 * m.Scale() / o.height_px;
+  m.Iren->SetEventPosition(100, 100);
+  m.Iren->InvokeEvent(vtkCommand::LeftButtonPressEvent);
+  m.Iren->SetEventPosition(150, 120);
+  m.Iren->InvokeEvent(vtkCommand::MouseMoveEvent);
+  m.Iren->InvokeEvent(vtkCommand::LeftButtonReleaseEvent);
+  double fp[3], dir[3];
+  m.Renderer->GetActiveCamera()->GetFocalPoint(fp);
+  assert_near(fp[0], -50.0 * mpp, 1e-9 * s0);
+  assert_near(fp[1], -20.0 * mpp, 1e-9 * s0);
+  // No rotation: still looking straight down, north up.
+  m.Renderer->GetActiveCamera()->GetDirectionOfProjection(dir);
+  assert_near(dir[2], -1.0, 1e-12);
+  m.Iren->SetEventPosition(300, 200);
+  m.Iren->InvokeEvent(vtkCommand::MouseMoveEvent); // no button: no pan
+  double fp2[3];
+  m.Renderer->GetActiveCamera()->GetFocalPoint(fp2);
+  assert_near(fp2[0], fp[0], 0.0);
+  assert_true(m.Key("r"));
+  m.Renderer->GetActiveCamera()->GetFocalPoint(fp);
+  assert_near(fp[0], 0.0, 0.0);
+  assert_near(fp[1], 0.0, 0.0);
+  assert_near(m.Scale(), s0, 1e-9 * s0);
+  assert_false(m.Key("w"));
+  // Zoom is bounded: 100 wheel steps out stop at 50 x the fitted half-height.
+  for (int i = 0; i < 100; ++i)
+    m.Zoom(1.0 / 1.25);
+  assert_near(m.Scale(), 50.0 * s0, 1e-9 * s0);
+  m.Key("r");
+
+  // The picture: the reference track is drawn in near-black over the light map background.
+  m.Window->Render();
+  vtkNew<vtkUnsignedCharArray> px;
+  m.Window->GetPixelData(0, 0, o.width_px - 1, o.height_px - 1, 0, px);
+  long dark = 0;
+  for (vtkIdType i = 0; i < px->GetNumberOfTuples(); ++i) {
+    const unsigned char *c = px->GetPointer(3 * i);
+    if (c[0] < 60 && c[1] < 60 && c[2] < 70) dark++;
+  }
+  std::printf("map window: %ld dark pixels of %d\n", dark, o.width_px * o.height_px);
+  assert_true(dark > 300);
+  const std::string shot = std::string(NAVVIEW_TEST_OUT_DIR) + "/navview_map_interactive.png";
+  assert_true(NavWriteWindowPng(m.Window, shot, &err));
+  std::printf("screenshot: %s\n", shot.c_str());
+}
+
 } // namespace
 
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_playback),    cmocka_unit_test(test_slider), cmocka_unit_test(test_follow),
-      cmocka_unit_test(test_option_keys), cmocka_unit_test(test_pick),
+      cmocka_unit_test(test_option_keys), cmocka_unit_test(test_pick),   cmocka_unit_test(test_map_window),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -40,6 +40,10 @@ double NavGraticuleStepDeg(double span_deg);
 bool NavRenderMapPng(const NavResult &result, const NavMapOptions &options, const std::string &path,
                      std::string *error);
 
+/** Open the map of @p result in an interactive window (drag = pan, wheel or +/- = zoom, r = reset,
+ *  q = quit) and run its event loop until it is closed. Needs an X server. */
+bool NavRunMapInteractive(const NavResult &result, const NavMapOptions &options, std::string *error);
+
 /** Read the polylines (parts of polygon or arc shapes) of an ESRI shapefile (.shp), lon/lat in
  *  degrees, 2 per point. For the map background; public for its unit test. */
 bool NavReadShapefile(const std::string &shp_path, std::vector<std::vector<double>> *parts, std::string *error);
