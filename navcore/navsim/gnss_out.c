@@ -2,9 +2,11 @@
  * gnss.csv / gnss_outages.csv writer (see gnss_out.h).
  *
  * gnss.csv:          t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,pos_sd_n_m,pos_sd_e_m,pos_sd_d_m
- *                    one row per fix of run 0 whose time of validity is an output epoch: the
- *                    measured antenna position (geodetic and NED about the scene origin) and the
- *                    reported 1-sigma.
+ *                    one row per fix of run 0 (every fix up to the last output epoch, at the
+ *                    receiver's rate whatever the output rate): the measured antenna position
+ *                    (geodetic and NED about the scene origin) and the reported 1-sigma. The
+ *                    receiver model is evaluated on the reference at each fix's time of validity
+ *                    (its own truth object), as the simulation does.
  * gnss_outages.csv:  t0_s,t1_s   every outage interval of the receiver (scene outages and the
  *                    segment-tied ones), no fix has its time of validity in [t0_s, t1_s).
  */
@@ -17,10 +19,12 @@
 #include "navcore/nav_frames.h"
 #include "navcore/nav_math.h"
 #include "navcore/nav_sensors.h"
+#include "navcore/nav_truth.h"
 
 struct navsim_gnss_out {
   FILE *f;
   nav_gnss_model *model;
+  nav_truth *truth; /* the reference at the fix times */
   int64_t next_epoch;
   bool bad;
 };
@@ -50,10 +54,17 @@ nav_status navsim_gnss_out_begin(const nav_scene *scene, bool ideal, const char 
     free(g);
     return st;
   }
+  st = nav_truth_create_msg(scene, &g->truth, msg, sizeof msg);
+  if (st != NAV_OK) {
+    nav_gnss_model_destroy(g->model);
+    free(g);
+    return st;
+  }
   g->f = fopen(gnss_path, "w");
   if (!g->f || fputs("t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,pos_sd_n_m,pos_sd_e_m,pos_sd_d_m\n", g->f) < 0) {
     if (g->f) fclose(g->f);
     nav_gnss_model_destroy(g->model);
+    nav_truth_destroy(g->truth);
     free(g);
     return NAV_ERR_IO;
   }
@@ -68,15 +79,20 @@ nav_status navsim_gnss_out_record(navsim_gnss_out *g, const nav_sim_record *r) {
     const double t_fix = nav_gnss_model_epoch_time_s(g->model, g->next_epoch);
     if (t_fix > t + 1e-6) break;
     const int64_t epoch = g->next_epoch++;
-    if (fabs(t_fix - t) > 1e-6) continue; /* between output epochs: no truth here */
-    nav_traj_state ts = *r->truth;
-    ts.t_s = t_fix;
+    nav_traj_state ts;
+    if (fabs(t_fix - t) <= 1e-6) {
+      ts = *r->truth;
+      ts.t_s = t_fix;
+    } else {
+      const nav_status tst = nav_truth_state(g->truth, t_fix, &ts);
+      if (tst != NAV_OK) return tst;
+    }
     nav_gnss_fix fix;
     bool has_fix = false;
     const nav_status st = nav_gnss_model_measure(g->model, epoch, &ts, &fix, &has_fix);
     if (st != NAV_OK) return st;
     if (!has_fix) continue;
-    const nav_local_view v = nav_frame_view(r->frame, fix.r_fa_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
+    const nav_local_view v = nav_frame_view(r->frame, fix.r_fa_f_m, ts.v_fb_f_mps, ts.q_b_f);
     if (fprintf(g->f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g\n", fix.t_s,
                 fix.pos.lat_rad * NAV_RAD2DEG, fix.pos.lon_rad * NAV_RAD2DEG, fix.pos.h_m, v.r_ned_m.x, v.r_ned_m.y,
                 v.r_ned_m.z, fix.pos_sd_m.x, fix.pos_sd_m.y, fix.pos_sd_m.z) < 0)
@@ -90,6 +106,7 @@ bool navsim_gnss_out_end(navsim_gnss_out *g) {
   bool ok = ferror(g->f) == 0;
   if (fclose(g->f) != 0) ok = false;
   nav_gnss_model_destroy(g->model);
+  nav_truth_destroy(g->truth);
   free(g);
   return ok;
 }
