@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "fast_format.h"
+#include "navcore/nav_filter.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 
@@ -175,18 +176,24 @@ static const char *k_error_header =
     "t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,vel_err_e_mps,"
     "vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg\n";
 
+static const char *k_smoothed_header =
+    "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,"
+    "roll_deg,pitch_deg,yaw_deg,sd_n_m,sd_e_m,sd_d_m,fwd_sd_n_m,fwd_sd_e_m,fwd_sd_d_m,sd_yaw_deg,fwd_sd_yaw_deg\n";
+
 nav_status nav_csv_write_header(FILE *f, nav_csv_table table) {
   if (!f) return NAV_ERR_INVALID_ARG;
-  const char *h = table == NAV_CSV_ERRORS ? k_error_header : k_state_header;
+  const char *h = table == NAV_CSV_ERRORS     ? k_error_header
+                  : table == NAV_CSV_NAV_SMOOTHED ? k_smoothed_header
+                                                  : k_state_header;
   return fputs(h, f) < 0 ? NAV_ERR_IO : NAV_OK;
 }
 
 /* One CSV row of numbers as printf("%.17g,...\n") would write it (fast_format.h: byte-identical,
  * several times faster than glibc's printf), in one fwrite. @return < 0 on an I/O error. */
 static int write_numbers(FILE *f, const double *v, int n) {
-  char row[16 * (NAV_FMT_G17_SIZE + 1)];
+  char row[24 * (NAV_FMT_G17_SIZE + 1)];
   size_t len = 0;
-  for (int i = 0; i < n && i < 16; ++i) {
+  for (int i = 0; i < n && i < 24; ++i) {
     len += (size_t)nav_fmt_g17(row + len, v[i]);
     row[len++] = i + 1 < n ? ',' : '\n';
   }
@@ -195,7 +202,8 @@ static int write_numbers(FILE *f, const double *v, int n) {
 
 /* One state row in the local-level view: geodetic position, curvilinear NED about the origin,
  * velocity in n, Euler angles of C_b_n. */
-static int write_state(FILE *f, const nav_frame *fr, double t, nav_vec3 r, nav_vec3 v, nav_quat q) {
+static int write_state(FILE *f, const nav_frame *fr, double t, nav_vec3 r, nav_vec3 v, nav_quat q,
+                       const double *sd_s, const double *sd_f) {
   const nav_local_view w = nav_frame_view(fr, r, v, q);
   const nav_euler e = nav_quat_to_euler(w.q_b_n, NULL);
   const double vals[13] = {t,
@@ -211,7 +219,16 @@ static int write_state(FILE *f, const nav_frame *fr, double t, nav_vec3 r, nav_v
                            e.roll_rad * NAV_RAD2DEG,
                            e.pitch_rad * NAV_RAD2DEG,
                            e.yaw_rad * NAV_RAD2DEG};
-  return write_numbers(f, vals, 13);
+  if (!sd_s || !sd_f) return write_numbers(f, vals, 13);
+  double all[21];
+  memcpy(all, vals, sizeof vals);
+  for (int k = 0; k < 3; ++k) {
+    all[13 + k] = sd_s[NAV_FILTER_IDX_DR + k];
+    all[16 + k] = sd_f[NAV_FILTER_IDX_DR + k];
+  }
+  all[19] = sd_s[NAV_FILTER_IDX_PHI + 2] * NAV_RAD2DEG;
+  all[20] = sd_f[NAV_FILTER_IDX_PHI + 2] * NAV_RAD2DEG;
+  return write_numbers(f, all, 21);
 }
 
 nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record *r) {
@@ -219,10 +236,16 @@ nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record 
   int n = 0;
   switch (table) {
   case NAV_CSV_TRUTH:
-    n = write_state(f, r->frame, r->truth->t_s, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
+    n = write_state(f, r->frame, r->truth->t_s, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f, NULL,
+                    NULL);
     break;
   case NAV_CSV_NAV:
-    n = write_state(f, r->frame, r->nav->t_s, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f);
+    n = write_state(f, r->frame, r->nav->t_s, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f, NULL, NULL);
+    break;
+  case NAV_CSV_NAV_SMOOTHED:
+    if (!r->sd_smoothed || !r->sd_forward) return NAV_ERR_INVALID_ARG;
+    n = write_state(f, r->frame, r->nav->t_s, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f, r->sd_smoothed,
+                    r->sd_forward);
     break;
   case NAV_CSV_ERRORS: {
     const nav_epoch_errors *e = r->err;

@@ -9,7 +9,7 @@ struct navsim_run_smooth {
 };
 
 static const char *k_names[2] = {"nav_smoothed.csv", "smoothed_errors.csv"};
-static const nav_csv_table k_tables[2] = {NAV_CSV_NAV, NAV_CSV_ERRORS};
+static const nav_csv_table k_tables[2] = {NAV_CSV_NAV_SMOOTHED, NAV_CSV_ERRORS};
 
 nav_status navsim_run_smooth_begin(nav_resultdir *rd, navsim_run_smooth **out) {
   if (!rd || !out) return NAV_ERR_INVALID_ARG;

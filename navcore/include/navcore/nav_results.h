@@ -33,7 +33,15 @@ NAV_API NAV_NODISCARD nav_status nav_resultdir_commit(nav_resultdir *rd);
 NAV_API void nav_resultdir_abort(nav_resultdir *rd);
 
 /** Which of the per-epoch CSV tables. Headers carry units in the column names. */
-typedef enum nav_csv_table { NAV_CSV_TRUTH = 0, NAV_CSV_NAV = 1, NAV_CSV_ERRORS = 2 } nav_csv_table;
+/** NAV_CSV_NAV_SMOOTHED: the NAV_CSV_NAV columns of an RTS-smoothed solution plus the smoothed and
+ *  forward 1-sigma of position N/E/D and yaw (sd_n_m ... fwd_sd_yaw_deg; records with sd_smoothed
+ *  and sd_forward, i.e. from nav_sim_options.smoothed_record). */
+typedef enum nav_csv_table {
+  NAV_CSV_TRUTH = 0,
+  NAV_CSV_NAV = 1,
+  NAV_CSV_ERRORS = 2,
+  NAV_CSV_NAV_SMOOTHED = 3
+} nav_csv_table;
 
 /** Write the header line of @p table. */
 NAV_API NAV_NODISCARD nav_status nav_csv_write_header(FILE *f, nav_csv_table table);

@@ -56,6 +56,11 @@ typedef struct nav_sim_record {
    *  scene's sensor errors). NULL at t = 0. Their difference is the simulated sensor error. */
   const nav_imu_increment *imu_ideal;
   const nav_imu_increment *imu_measured;
+  /** smoothed_record only (else NULL): sqrt(diag P) of the RTS-smoothed and of the forward
+   *  filter at this epoch, in the filter's state order (nav_filter.h: NAV_FILTER_IDX_DR position
+   *  N/E/D [m], NAV_FILTER_IDX_PHI attitude [rad], ...). */
+  const double *sd_smoothed;
+  const double *sd_forward;
 } nav_sim_record;
 
 typedef nav_callback_result (*nav_record_fn)(void *user, const nav_sim_record *r);
