@@ -385,7 +385,7 @@ static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t
     const nav_epoch_errors err = nav_errors_compute(frame, ts, &s);
     store_sm(j, run, e, false, &err);
     if (record) {
-      nav_sim_record rec = {run, frame, ts, &s, &err, NULL, NULL};
+      nav_sim_record rec = {run, frame, ts, &s, &err, NULL, NULL, ep.sd_smoothed, ep.sd_forward};
       if (j->opts->smoothed_record(j->opts->user, &rec) == NAV_STOP) return NAV_ERR_CANCELLED;
     }
   }
@@ -529,7 +529,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     store_sm(j, run, 0, true, &err);
   }
   if (record) {
-    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL};
+    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
   }
   int64_t k = 1;
@@ -623,7 +623,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       store_sm(j, run, slot, true, &err);
     }
     if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw};
+      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw, NULL, NULL};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
     }
     if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
