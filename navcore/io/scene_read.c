@@ -59,6 +59,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_sensors.h"
+#include "scene_bounds.h"
 #include "scene_io_internal.h"
 
 /* Enums are stored through int pointers by the table-driven reader and writer. */
@@ -94,6 +95,25 @@ _Static_assert(sizeof(nav_req_unit) == sizeof(int), "enum storage");
 
 #define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE) /* with .min = 0 */
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
+/* Plausibility bounds of the sensor error terms (scene_bounds.h), in the key's file unit: NONNEG_LE
+   with .max = B, SIGNED_LE with PM(B) (.min = -B, .max = B). MAXU converts a bound b given in the
+   unit of factor k0 to a key of scale sc (exactly b for that unit itself). */
+#define NONNEG_LE (NONNEG | NAV_IO_MAX_LE)
+#define SIGNED_LE (NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE)
+#define MAXU(b, k0, sc) ((sc) == (k0) ? (b) : (b) * (k0) / (sc))
+#define PM(b) .min = -(b), .max = (b)
+/* The bound of each quantity for a key of scale sc. */
+#define B_ARW(sc) MAXU(NAV_SCENE_MAX_GYRO_ARW_DEG_PER_SQRT_H, K_DEG_PER_SQRT_H, sc)
+#define B_GBIAS(sc) MAXU(NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H, K_DEG_PER_H, sc)
+#define B_GBI(sc) MAXU(NAV_SCENE_MAX_GYRO_BI_DEG_PER_H, K_DEG_PER_H, sc)
+#define B_RRW(sc) MAXU(NAV_SCENE_MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H, K_DEG_PER_H_PER_SQRT_H, sc)
+#define B_GSENS(sc) MAXU(NAV_SCENE_MAX_G_SENSITIVITY_DEG_PER_H_PER_G, K_DEG_PER_H_PER_G, sc)
+#define B_VRW(sc) MAXU(NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H, K_PER_SQRT_H, sc)
+#define B_ABIAS(sc) MAXU(NAV_SCENE_MAX_ACCEL_BIAS_MG, K_MG, sc)
+#define B_ABI(sc) MAXU(NAV_SCENE_MAX_ACCEL_BI_UG, K_UG, sc)
+#define B_ABRW(sc) MAXU(NAV_SCENE_MAX_ACCEL_BIAS_RW_M_PER_S2_PER_SQRT_H, K_PER_SQRT_H, sc)
+#define B_SF(sc) MAXU(NAV_SCENE_MAX_SCALE_FACTOR_PPM, K_PPM, sc)
+#define B_MIS(sc) MAXU(NAV_SCENE_MAX_MISALIGNMENT_MRAD, K_MRAD, sc)
 
 /* Datasheet units -> SI: file value x factor, the factor being the nav_unit_* helper of
    nav_sensors.h applied to 1 (the helpers are inline functions, not constant expressions):
@@ -213,6 +233,12 @@ DEFINE_SECTION(k_earth_section, k_earth);
 /* An input kept in the reader state (bias instability and the location of the Allan minimum). */
 #define QS(k, fl, member, sc)                                                                                \
   { .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc) }
+/* A bounded one (flags with NAV_IO_MAX_LE). */
+#define QSB(k, fl, member, sc, mx)                                                                           \
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc),   \
+    .max = (mx)                                                                                              \
+  }
 #define G_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.gyro.terms)
 #define A_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.accel.terms)
 #define GM(m) imu.model.gyro.m
@@ -226,60 +252,63 @@ DEFINE_SECTION(k_earth_section, k_earth);
  * writer writes the resulting bias_gm_sigma_* and bias_gm_tau_s.
  */
 static const nav_io_field k_gyro[] = {
-    Q("arw_deg_per_sqrt_h", NAV_IO_VEC3S, NONNEG, GM(arw_rad_per_sqrt_s), K_DEG_PER_SQRT_H,
-      G_TERM(NAV_IMU_TERM_NOISE)),
-    Q("arw_rad_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(arw_rad_per_sqrt_s), 1.0,
-      G_TERM(NAV_IMU_TERM_NOISE)),
-    Q("noise_density_deg_per_s_per_sqrt_hz", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(arw_rad_per_sqrt_s),
-      NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_NOISE)),
-    Q("bias_turn_on_deg_per_h", NAV_IO_VEC3S, NONNEG, GM(bias_turn_on_sd_rps), K_DEG_PER_H,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_rps"),
-    Q("bias_turn_on_dps", NAV_IO_VEC3S, NONNEG | ALTS, GM(bias_turn_on_sd_rps), NAV_DEG2RAD,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_turn_on_sd_rps), 1.0,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_fixed_deg_per_h", NAV_IO_VEC3S, NAV_IO_FINITE, GM(bias_turn_on_fixed_rps), K_DEG_PER_H,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_fixed_dps", NAV_IO_VEC3S, NAV_IO_FINITE | ALTS, GM(bias_turn_on_fixed_rps), NAV_DEG2RAD,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_fixed_rps", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, GM(bias_turn_on_fixed_rps), 1.0,
-      G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    QS("bias_instability_deg_per_h", NONNEG, bi[0], K_DEG_PER_H),
-    QS("bias_instability_rps", NONNEG | NAV_IO_ALT, bi[0], 1.0),
+    Q("arw_deg_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, GM(arw_rad_per_sqrt_s), K_DEG_PER_SQRT_H,
+      .max = B_ARW(K_DEG_PER_SQRT_H), G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("arw_rad_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(arw_rad_per_sqrt_s), 1.0,
+      .max = B_ARW(1.0), G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_deg_per_s_per_sqrt_hz", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(arw_rad_per_sqrt_s),
+      NAV_DEG2RAD, .max = B_ARW(NAV_DEG2RAD), G_TERM(NAV_IMU_TERM_NOISE)),
+    Q("bias_turn_on_deg_per_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_turn_on_sd_rps), K_DEG_PER_H,
+      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_rps"),
+    Q("bias_turn_on_dps", NAV_IO_VEC3S, NONNEG_LE | ALTS, GM(bias_turn_on_sd_rps), NAV_DEG2RAD,
+      .max = B_GBIAS(NAV_DEG2RAD), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_rps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_turn_on_sd_rps), 1.0,
+      .max = B_GBIAS(1.0), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_deg_per_h", NAV_IO_VEC3S, SIGNED_LE, GM(bias_turn_on_fixed_rps), K_DEG_PER_H,
+      PM(B_GBIAS(K_DEG_PER_H)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_dps", NAV_IO_VEC3S, SIGNED_LE | ALTS, GM(bias_turn_on_fixed_rps), NAV_DEG2RAD,
+      PM(B_GBIAS(NAV_DEG2RAD)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_rps", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, GM(bias_turn_on_fixed_rps), 1.0,
+      PM(B_GBIAS(1.0)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    QSB("bias_instability_deg_per_h", NONNEG_LE, bi[0], K_DEG_PER_H, B_GBI(K_DEG_PER_H)),
+    QSB("bias_instability_rps", NONNEG_LE | NAV_IO_ALT, bi[0], 1.0, B_GBI(1.0)),
     QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[0], 1.0),
-    Q("bias_gm_sigma_deg_per_h", NAV_IO_VEC3S, NONNEG, GM(bias_gm_sd_rps), K_DEG_PER_H,
-      G_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_rps"),
-    Q("bias_gm_sigma_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_gm_sd_rps), 1.0,
+    Q("bias_gm_sigma_deg_per_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_gm_sd_rps), K_DEG_PER_H,
+      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_rps"),
+    Q("bias_gm_sigma_rps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_gm_sd_rps), 1.0, .max = B_GBIAS(1.0),
       G_TERM(NAV_IMU_TERM_BIAS_GM)),
     Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, GM(bias_gm_tau_s), 1.0, G_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("rrw_deg_per_h_per_sqrt_h", NAV_IO_VEC3S, NONNEG, GM(bias_rw_rps_per_sqrt_s), K_DEG_PER_H_PER_SQRT_H,
-      G_TERM(NAV_IMU_TERM_BIAS_RW), .mark_as = "bias_rw_rps_per_sqrt_s"),
-    Q("rrw_rps_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(bias_rw_rps_per_sqrt_s), 1.0,
-      G_TERM(NAV_IMU_TERM_BIAS_RW)),
-    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, GM(scale_factor_sd), K_PPM,
+    Q("rrw_deg_per_h_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_rw_rps_per_sqrt_s), K_DEG_PER_H_PER_SQRT_H,
+      .max = B_RRW(K_DEG_PER_H_PER_SQRT_H), G_TERM(NAV_IMU_TERM_BIAS_RW),
+      .mark_as = "bias_rw_rps_per_sqrt_s"),
+    Q("rrw_rps_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_rw_rps_per_sqrt_s), 1.0,
+      .max = B_RRW(1.0), G_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG_LE, GM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
       G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, GM(scale_factor_sd), 1.0,
+    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(scale_factor_sd), 1.0, .max = B_SF(1.0),
       G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, GM(scale_factor_fixed), K_PPM,
+    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, SIGNED_LE, GM(scale_factor_fixed), K_PPM, PM(B_SF(K_PPM)),
       G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_fixed", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, GM(scale_factor_fixed), 1.0,
+    Q("scale_factor_fixed", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, GM(scale_factor_fixed), 1.0, PM(B_SF(1.0)),
       G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG, GM(misalignment_sd_rad), K_MRAD,
-      G_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
-    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG | NAV_IO_ALT, GM(misalignment_sd_rad), 1.0,
-      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, GM(misalignment_fixed_rad), K_MRAD,
-      G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, GM(misalignment_fixed_rad),
-      1.0, G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("g_sensitivity_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NONNEG, GM(g_sensitivity_sd_rps_per_mps2),
-      K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY), .mark_as = "g_sensitivity_sd_rps_per_mps2"),
-    Q("g_sensitivity_rps_per_mps2", NAV_IO_MAT3_DIAG, NONNEG | NAV_IO_ALT, GM(g_sensitivity_sd_rps_per_mps2),
-      1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
-    Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NAV_IO_FINITE,
-      GM(g_sensitivity_fixed_rps_per_mps2), K_DEG_PER_H_PER_G, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
-    Q("g_sensitivity_fixed_rps_per_mps2", NAV_IO_MAT3_DIAG, NAV_IO_FINITE | NAV_IO_ALT,
-      GM(g_sensitivity_fixed_rps_per_mps2), 1.0, G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE, GM(misalignment_sd_rad), K_MRAD,
+      .max = B_MIS(K_MRAD), G_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE | NAV_IO_ALT, GM(misalignment_sd_rad), 1.0,
+      .max = B_MIS(1.0), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE, GM(misalignment_fixed_rad), K_MRAD,
+      PM(B_MIS(K_MRAD)), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE | NAV_IO_ALT, GM(misalignment_fixed_rad), 1.0,
+      PM(B_MIS(1.0)), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("g_sensitivity_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NONNEG_LE, GM(g_sensitivity_sd_rps_per_mps2),
+      K_DEG_PER_H_PER_G, .max = B_GSENS(K_DEG_PER_H_PER_G), G_TERM(NAV_IMU_TERM_G_SENSITIVITY),
+      .mark_as = "g_sensitivity_sd_rps_per_mps2"),
+    Q("g_sensitivity_rps_per_mps2", NAV_IO_MAT3_DIAG, NONNEG_LE | NAV_IO_ALT,
+      GM(g_sensitivity_sd_rps_per_mps2), 1.0, .max = B_GSENS(1.0), G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, SIGNED_LE,
+      GM(g_sensitivity_fixed_rps_per_mps2), K_DEG_PER_H_PER_G, PM(B_GSENS(K_DEG_PER_H_PER_G)),
+      G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+    Q("g_sensitivity_fixed_rps_per_mps2", NAV_IO_MAT3_DIAG, SIGNED_LE | NAV_IO_ALT,
+      GM(g_sensitivity_fixed_rps_per_mps2), 1.0, PM(B_GSENS(1.0)), G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
     Q("quantisation_rad", NAV_IO_VEC3S, POSITIVE, GM(quant_step_rad), 1.0, G_TERM(NAV_IMU_TERM_QUANTISATION),
       .mark_as = "quant_step_rad"),
     Q("range_dps", NAV_IO_VEC3S, POSITIVE, GM(range_rps), NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_SATURATION)),
@@ -289,48 +318,48 @@ DEFINE_SECTION_FINISH(k_gyro_section, k_gyro, finish_gyro);
 
 /* Accelerometer triad (nav_accel_error_config); as the gyro, in g-based datasheet units. */
 static const nav_io_field k_accel[] = {
-    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_VEC3S, NONNEG, AM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
-      A_TERM(NAV_IMU_TERM_NOISE)),
-    Q("vrw_mps_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), 1.0,
-      A_TERM(NAV_IMU_TERM_NOISE)),
-    Q("noise_density_ug_per_sqrt_hz", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), K_UG,
-      A_TERM(NAV_IMU_TERM_NOISE)),
-    Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG, AM(bias_turn_on_sd_mps2), K_MG,
+    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, AM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
+      .max = B_VRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("vrw_mps_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), 1.0,
+      .max = B_VRW(1.0), A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_ug_per_sqrt_hz", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), K_UG,
+      .max = B_VRW(K_UG), A_TERM(NAV_IMU_TERM_NOISE)),
+    Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG_LE, AM(bias_turn_on_sd_mps2), K_MG, .max = B_ABIAS(K_MG),
       A_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2"),
-    Q("bias_turn_on_mps2", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_turn_on_sd_mps2), 1.0,
+    Q("bias_turn_on_mps2", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_turn_on_sd_mps2), 1.0,
+      .max = B_ABIAS(1.0), A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_turn_on_fixed_mg", NAV_IO_VEC3S, SIGNED_LE, AM(bias_turn_on_fixed_mps2), K_MG, PM(B_ABIAS(K_MG)),
       A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_fixed_mg", NAV_IO_VEC3S, NAV_IO_FINITE, AM(bias_turn_on_fixed_mps2), K_MG,
-      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_turn_on_fixed_mps2", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, AM(bias_turn_on_fixed_mps2), 1.0,
-      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    QS("bias_instability_ug", NONNEG, bi[1], K_UG),
-    QS("bias_instability_mps2", NONNEG | NAV_IO_ALT, bi[1], 1.0),
+    Q("bias_turn_on_fixed_mps2", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, AM(bias_turn_on_fixed_mps2), 1.0,
+      PM(B_ABIAS(1.0)), A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    QSB("bias_instability_ug", NONNEG_LE, bi[1], K_UG, B_ABI(K_UG)),
+    QSB("bias_instability_mps2", NONNEG_LE | NAV_IO_ALT, bi[1], 1.0, B_ABI(1.0)),
     QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[1], 1.0),
-    Q("bias_gm_sigma_ug", NAV_IO_VEC3S, NONNEG, AM(bias_gm_sd_mps2), K_UG, A_TERM(NAV_IMU_TERM_BIAS_GM),
-      .mark_as = "bias_gm_sd_mps2"),
-    Q("bias_gm_sigma_mps2", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_gm_sd_mps2), 1.0,
-      A_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_sigma_ug", NAV_IO_VEC3S, NONNEG_LE, AM(bias_gm_sd_mps2), K_UG, .max = B_ABIAS(K_UG),
+      A_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2"),
+    Q("bias_gm_sigma_mps2", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_gm_sd_mps2), 1.0,
+      .max = B_ABIAS(1.0), A_TERM(NAV_IMU_TERM_BIAS_GM)),
     Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, AM(bias_gm_tau_s), 1.0, A_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("bias_rw_m_per_s2_per_sqrt_h", NAV_IO_VEC3S, NONNEG, AM(bias_rw_mps2_per_sqrt_s), K_PER_SQRT_H,
-      A_TERM(NAV_IMU_TERM_BIAS_RW)),
-    Q("bias_rw_mps2_per_sqrt_s", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(bias_rw_mps2_per_sqrt_s), 1.0,
-      A_TERM(NAV_IMU_TERM_BIAS_RW)),
-    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG, AM(scale_factor_sd), K_PPM,
+    Q("bias_rw_m_per_s2_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, AM(bias_rw_mps2_per_sqrt_s), K_PER_SQRT_H,
+      .max = B_ABRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("bias_rw_mps2_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_rw_mps2_per_sqrt_s), 1.0,
+      .max = B_ABRW(1.0), A_TERM(NAV_IMU_TERM_BIAS_RW)),
+    Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG_LE, AM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
       A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, AM(scale_factor_sd), 1.0,
+    Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(scale_factor_sd), 1.0, .max = B_SF(1.0),
       A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, NAV_IO_FINITE, AM(scale_factor_fixed), K_PPM,
+    Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, SIGNED_LE, AM(scale_factor_fixed), K_PPM, PM(B_SF(K_PPM)),
       A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("scale_factor_fixed", NAV_IO_VEC3S, NAV_IO_FINITE | NAV_IO_ALT, AM(scale_factor_fixed), 1.0,
+    Q("scale_factor_fixed", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, AM(scale_factor_fixed), 1.0, PM(B_SF(1.0)),
       A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
-    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG, AM(misalignment_sd_rad), K_MRAD,
-      A_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
-    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG | NAV_IO_ALT, AM(misalignment_sd_rad), 1.0,
-      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE, AM(misalignment_fixed_rad), K_MRAD,
-      A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
-    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, NAV_IO_FINITE | NAV_IO_ALT, AM(misalignment_fixed_rad),
-      1.0, A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE, AM(misalignment_sd_rad), K_MRAD,
+      .max = B_MIS(K_MRAD), A_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+    Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE | NAV_IO_ALT, AM(misalignment_sd_rad), 1.0,
+      .max = B_MIS(1.0), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE, AM(misalignment_fixed_rad), K_MRAD,
+      PM(B_MIS(K_MRAD)), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+    Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE | NAV_IO_ALT, AM(misalignment_fixed_rad), 1.0,
+      PM(B_MIS(1.0)), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("quantisation_mps", NAV_IO_VEC3S, POSITIVE, AM(quant_step_mps), 1.0, A_TERM(NAV_IMU_TERM_QUANTISATION),
       .mark_as = "quant_step_mps"),
     Q("range_g", NAV_IO_VEC3S, POSITIVE, AM(range_mps2), NAV_G0_MPS2, A_TERM(NAV_IMU_TERM_SATURATION)),
@@ -377,8 +406,10 @@ DEFINE_SECTION(k_imu_section, k_imu);
 #define NM(m) gnss.model.m
 
 static const nav_io_field k_reported[] = {
-    Q("position_m", NAV_IO_VEC3S, NONNEG | NAV_IO_REQUIRED, NM(reported_pos_sd_m), 1.0, .bit = 0),
-    Q("velocity_mps", NAV_IO_VEC3S, NONNEG | NAV_IO_REQUIRED, NM(reported_vel_sd_mps), 1.0, .bit = 0),
+    Q("position_m", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_REQUIRED, NM(reported_pos_sd_m), 1.0,
+      .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, .bit = 0),
+    Q("velocity_mps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_REQUIRED, NM(reported_vel_sd_mps), 1.0,
+      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, .bit = 0),
 };
 DEFINE_SECTION(k_reported_section, k_reported);
 
@@ -400,15 +431,18 @@ static const nav_io_field k_gnss[] = {
      .offset = OFF(NM(update_rate_hz)),
      .scale = 1.0,
      .max = NAV_SCENE_MAX_RATE_HZ},
-    Q("latency_s", NAV_IO_DOUBLE, NONNEG, NM(latency_s), 1.0, .bit = 0),
-    Q("position_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_gm_sd_m), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
-      .mark_as = "pos_gm_sd_m", .comment = "N, E, D; Gauss-Markov"),
+    Q("latency_s", NAV_IO_DOUBLE, NONNEG_LE, NM(latency_s), 1.0, .max = NAV_SCENE_MAX_GNSS_LATENCY_S,
+      .bit = 0),
+    Q("position_sigma_m", NAV_IO_VEC3S, NONNEG_LE, NM(pos_gm_sd_m), 1.0,
+      .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, N_TERM(NAV_GNSS_TERM_POS_GM), .mark_as = "pos_gm_sd_m",
+      .comment = "N, E, D; Gauss-Markov"),
     Q("position_corr_time_s", NAV_IO_VEC3S, NONNEG, NM(pos_gm_tau_s), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
       .mark_as = "pos_gm_tau_s", .comment = "0: white"),
-    Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG, NM(pos_white_sd_m), 1.0,
-      N_TERM(NAV_GNSS_TERM_POS_WHITE), .mark_as = "pos_white_sd_m"),
-    Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG, NM(vel_sd_mps), 1.0, N_TERM(NAV_GNSS_TERM_VEL_WHITE),
-      .mark_as = "vel_sd_mps"),
+    Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG_LE, NM(pos_white_sd_m), 1.0,
+      .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, N_TERM(NAV_GNSS_TERM_POS_WHITE),
+      .mark_as = "pos_white_sd_m"),
+    Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG_LE, NM(vel_sd_mps), 1.0,
+      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, N_TERM(NAV_GNSS_TERM_VEL_WHITE), .mark_as = "vel_sd_mps"),
     Q("lever_arm_b_m", NAV_IO_VEC3, NAV_IO_FINITE, NM(r_ba_b_m), 1.0, .mark_as = "r_ba_b_m",
       .comment = "antenna relative to the IMU, body axes"),
     {.key = "outages",
@@ -448,25 +482,25 @@ DEFINE_SECTION(k_gnss_section, k_gnss);
 #define RM(m) array.accel.m
 
 static const nav_io_field k_array_accel[] = {
-    Q("bias_turn_on_mg", NAV_IO_DOUBLE, NONNEG, RM(bias_turn_on_sd_mps2), K_MG,
+    Q("bias_turn_on_mg", NAV_IO_DOUBLE, NONNEG_LE, RM(bias_turn_on_sd_mps2), K_MG, .max = B_ABIAS(K_MG),
       R_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2",
       .comment = "1-sigma, drawn per sensor and run"),
-    Q("bias_turn_on_mps2", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(bias_turn_on_sd_mps2), 1.0,
-      R_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    Q("bias_gm_sigma_ug", NAV_IO_DOUBLE, NONNEG, RM(bias_gm_sd_mps2), K_UG, R_TERM(NAV_IMU_TERM_BIAS_GM),
-      .mark_as = "bias_gm_sd_mps2"),
-    Q("bias_gm_sigma_mps2", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(bias_gm_sd_mps2), 1.0,
-      R_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_turn_on_mps2", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(bias_turn_on_sd_mps2), 1.0,
+      .max = B_ABIAS(1.0), R_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+    Q("bias_gm_sigma_ug", NAV_IO_DOUBLE, NONNEG_LE, RM(bias_gm_sd_mps2), K_UG, .max = B_ABIAS(K_UG),
+      R_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2"),
+    Q("bias_gm_sigma_mps2", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(bias_gm_sd_mps2), 1.0,
+      .max = B_ABIAS(1.0), R_TERM(NAV_IMU_TERM_BIAS_GM)),
     Q("bias_gm_tau_s", NAV_IO_DOUBLE, POSITIVE, RM(bias_gm_tau_s), 1.0, R_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_DOUBLE, NONNEG, RM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
-      R_TERM(NAV_IMU_TERM_NOISE), .mark_as = "vrw_mps_per_sqrt_s"),
-    Q("vrw_mps_per_sqrt_s", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), 1.0,
-      R_TERM(NAV_IMU_TERM_NOISE)),
-    Q("noise_density_ug_per_sqrt_hz", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), K_UG,
-      R_TERM(NAV_IMU_TERM_NOISE)),
-    Q("scale_factor_ppm", NAV_IO_DOUBLE, NONNEG, RM(scale_factor_sd), K_PPM,
+    Q("vrw_m_per_s_per_sqrt_h", NAV_IO_DOUBLE, NONNEG_LE, RM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
+      .max = B_VRW(K_PER_SQRT_H), R_TERM(NAV_IMU_TERM_NOISE), .mark_as = "vrw_mps_per_sqrt_s"),
+    Q("vrw_mps_per_sqrt_s", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), 1.0,
+      .max = B_VRW(1.0), R_TERM(NAV_IMU_TERM_NOISE)),
+    Q("noise_density_ug_per_sqrt_hz", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), K_UG,
+      .max = B_VRW(K_UG), R_TERM(NAV_IMU_TERM_NOISE)),
+    Q("scale_factor_ppm", NAV_IO_DOUBLE, NONNEG_LE, RM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
       R_TERM(NAV_IMU_TERM_SCALE_FACTOR), .mark_as = "scale_factor_sd"),
-    Q("scale_factor_sd", NAV_IO_DOUBLE, NONNEG | NAV_IO_ALT, RM(scale_factor_sd), 1.0,
+    Q("scale_factor_sd", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(scale_factor_sd), 1.0, .max = B_SF(1.0),
       R_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
     {.key = "off",
      .kind = NAV_IO_CUSTOM,

@@ -42,6 +42,7 @@
 #include <time.h>
 
 #include "catalog_cmd.h"
+#include "cli_util.h"
 #include "navcore/nav_catalog.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
@@ -141,68 +142,8 @@ typedef struct chan_result {
   double gm_peak; /* 0.61736 sigma of the GM term (NaN when off) */
 } chan_result;
 
-static bool parse_u64(const char *s, uint64_t *out) {
-  if (!s || !*s || *s == '-' || *s == '+') return false;
-  for (const char *p = s; *p; ++p)
-    if (*p < '0' || *p > '9') return false;
-  errno = 0;
-  char *end = NULL;
-  const unsigned long long v = strtoull(s, &end, 10);
-  if (errno != 0 || !end || *end) return false;
-  *out = (uint64_t)v;
-  return true;
-}
-
-static bool parse_pos(const char *s, double *out) {
-  if (!s || !*s) return false;
-  char *end = NULL;
-  errno = 0;
-  const double v = strtod(s, &end);
-  if (errno != 0 || !end || *end || !isfinite(v) || !(v > 0.0)) return false;
-  *out = v;
-  return true;
-}
-
-static void safe_name(char *out, size_t cap, const char *name) {
-  size_t j = 0;
-  for (const char *p = name; *p && j + 1 < cap; ++p) {
-    const char c = *p;
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
-                    c == '_' || c == '.';
-    out[j++] = ok ? c : '_';
-  }
-  out[j] = '\0';
-  if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", "imu");
-}
-
-static void json_str(FILE *f, const char *s) {
-  fputc('"', f);
-  for (; *s; ++s) {
-    const unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\')
-      fprintf(f, "\\%c", c);
-    else if (c < 0x20)
-      fprintf(f, "\\u%04x", c);
-    else
-      fputc(c, f);
-  }
-  fputc('"', f);
-}
-
 /* A JSON number, or null for NaN / inf. */
-static void json_num(FILE *f, double v) {
-  if (isfinite(v))
-    fprintf(f, "%.10g", v);
-  else
-    fputs("null", f);
-}
-
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ++*(int *)user;
-}
+static void json_num(FILE *f, double v) { navsim_json_number(f, v, 10); }
 
 /*
  * Allan variance of a first-order GM rate process (numerics.md E2.6, IEEE 952 Annex C):
@@ -278,8 +219,7 @@ typedef struct allan_args {
 static int parse_args(int argc, char **argv, allan_args *a) {
   for (int i = 0; i < argc; ++i) {
     const char *s = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0) {
+    if (navsim_is_help(s)) {
       fputs(k_usage_allan, stdout);
       return EXIT_OK;
     } else if (strcmp(s, "--strict") == 0) {
@@ -289,29 +229,26 @@ static int parse_args(int argc, char **argv, allan_args *a) {
     } else if (strcmp(s, "--imu") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--rate") == 0 ||
                strcmp(s, "--rate-hz") == 0 || strcmp(s, "--duration") == 0 ||
                strcmp(s, "--duration-s") == 0 || strcmp(s, "--seed") == 0 || strcmp(s, "--convention") == 0) {
-      if (!has_value) {
-        fprintf(stderr, "navsim allan: %s needs a value\n", s);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("allan", argc, i, s)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (strcmp(s, "--imu") == 0) {
         a->imu_name = v;
       } else if (strcmp(s, "--out") == 0) {
         a->out_dir = v;
       } else if (strncmp(s, "--rate", 6) == 0) {
-        if (!parse_pos(v, &a->rate_hz) || a->rate_hz < 1.0 || a->rate_hz > 1e5) {
+        if (!navsim_parse_positive(v, &a->rate_hz, false) || a->rate_hz < 1.0 || a->rate_hz > 1e5) {
           fprintf(stderr, "navsim allan: %s: expected a rate in [1, 100000] Hz, got \"%s\"\n", s, v);
           return EXIT_INVALID;
         }
         a->have_rate = true;
       } else if (strncmp(s, "--duration", 10) == 0) {
-        if (!parse_pos(v, &a->duration_s)) {
+        if (!navsim_parse_positive(v, &a->duration_s, false)) {
           fprintf(stderr, "navsim allan: %s: expected a duration > 0 s, got \"%s\"\n", s, v);
           return EXIT_INVALID;
         }
         a->have_duration = true;
       } else if (strcmp(s, "--seed") == 0) {
-        if (!parse_u64(v, &a->seed)) {
+        if (!navsim_parse_u64(v, &a->seed)) {
           fprintf(stderr, "navsim allan: --seed: expected an integer in [0, 2^64-1], got \"%s\"\n", v);
           return EXIT_INVALID;
         }
@@ -324,14 +261,9 @@ static int parse_args(int argc, char **argv, allan_args *a) {
         fprintf(stderr, "navsim allan: --convention: '%s' is neither allan_peak nor sigma_equals_b\n", v);
         return EXIT_INVALID;
       }
-    } else if (s[0] == '-' && s[1] != '\0') {
-      fprintf(stderr, "navsim allan: unknown option \"%s\" (see navsim allan --help)\n", s);
-      return EXIT_INVALID;
-    } else if (!a->scene_path) {
-      a->scene_path = s;
     } else {
-      fprintf(stderr, "navsim allan: only one SCENE may be given\n");
-      return EXIT_INVALID;
+      const int rc = navsim_scene_arg("allan", s, &a->scene_path);
+      if (rc != EXIT_OK) return rc;
     }
   }
   if ((a->imu_name != NULL) == (a->scene_path != NULL)) {
@@ -363,10 +295,10 @@ static int load_catalog_part(const allan_args *a, allan_source *src, chan_model 
   nav_catalog_options opt = nav_catalog_options_default();
   opt.convention = a->convention;
   nav_catalog *cat = NULL;
-  int nd = 0;
-  const nav_status st = nav_catalog_load(path, &opt, &cat, print_diag, &nd);
+  navsim_diag_sink nd = {0};
+  const nav_status st = nav_catalog_load(path, &opt, &cat, navsim_print_diag, &nd);
   if (st != NAV_OK) {
-    if (nd == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
+    if (nd.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
     return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
   }
   const nav_catalog_imu_entry *e = nav_catalog_find_imu(cat, a->imu_name);
@@ -423,10 +355,10 @@ static int write_json(const char *path, const allan_args *a, const allan_source 
   if (!f) return EXIT_FAIL;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"source\": {\"kind\": \"%s\", \"name\": ",
           nav_version_string(), src->kind);
-  json_str(f, src->name);
+  navsim_json_string(f, src->name);
   if (a->scene_path) {
     fputs(", \"file\": ", f);
-    json_str(f, a->scene_path);
+    navsim_json_string(f, a->scene_path);
   }
   if (src->bias_model)
     fprintf(f, ", \"bias_model\": \"%s\", \"verified\": \"%s\"", src->bias_model, src->verified);
@@ -605,12 +537,8 @@ int navsim_allan(int argc, char **argv) {
     if (rc != EXIT_OK) return rc;
   } else {
     nav_scene sc;
-    int nd = 0;
-    const nav_status st = nav_scene_read_file(a.scene_path, &sc, print_diag, &nd);
-    if (st != NAV_OK) {
-      if (nd == 0) fprintf(stderr, "%s: error: %s\n", a.scene_path, nav_status_str(st));
-      return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
-    }
+    const int lrc = navsim_load_scene(a.scene_path, &sc);
+    if (lrc != EXIT_OK) return lrc;
     snprintf(src.name, sizeof src.name, "%s", sc.imu.catalog[0] ? sc.imu.catalog : sc.name);
     src.kind = "scene";
     src.cfg = sc.imu.model;
@@ -639,7 +567,7 @@ int navsim_allan(int argc, char **argv) {
   char default_dir[600];
   if (!a.out_dir) {
     char nm[sizeof src.name];
-    safe_name(nm, sizeof nm, src.name);
+    navsim_safe_name(nm, sizeof nm, src.name, "imu");
     snprintf(default_dir, sizeof default_dir, "out/allan-%s", nm);
     a.out_dir = default_dir;
   }

@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "catalog_cmd.h"
+#include "cli_util.h"
 #include "navcore/nav_errors.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_ins_gnss.h"
@@ -26,11 +27,7 @@
 #include "navcore/nav_ins.h"
 #include "navcore/nav_truth.h"
 
-double bench_now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double bench_now_s(void) { return navsim_now_s(); }
 
 static int cmp_double(const void *a, const void *b) {
   const double x = *(const double *)a, y = *(const double *)b;
@@ -167,7 +164,32 @@ void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row) {
  * identical inputs: horizontal RMS over all 193 034 epochs, the whole replay timed (parsing
  * included). Peer figures from the data set's README (KF-GINS 3.3 s wall on this machine).
  */
-void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, bench_row *row) {
+/* Parsing alone: every record of the three files through the readers [s], or NAN. */
+static double replay_parse_s(const char *imu, const char *gnss, const char *ref) {
+  const double t0 = bench_now_s();
+  nav_rec_reader *r = NULL;
+  bool got = true;
+  nav_status st = nav_rec_reader_open(imu, NAV_REC_IMU, &r, NULL);
+  nav_imu_increment m;
+  while (st == NAV_OK && got) st = nav_rec_read_imu(r, &m, &got);
+  nav_rec_reader_destroy(r);
+  r = NULL;
+  got = true;
+  if (st == NAV_OK) st = nav_rec_reader_open(gnss, NAV_REC_GNSS, &r, NULL);
+  nav_ins_gnss_fix f;
+  while (st == NAV_OK && got) st = nav_rec_read_gnss(r, &f, &got);
+  nav_rec_reader_destroy(r);
+  r = NULL;
+  got = true;
+  if (st == NAV_OK) st = nav_rec_reader_open(ref, NAV_REC_PVA, &r, NULL);
+  nav_rec_pva row;
+  while (st == NAV_OK && got) st = nav_rec_read_pva(r, &row, &got);
+  nav_rec_reader_destroy(r);
+  return st == NAV_OK ? bench_now_s() - t0 : NAN;
+}
+
+void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, const char *out_dir,
+                  bench_row *row) {
   char imu[4400], gnss[4400], ref[4400];
   snprintf(imu, sizeof imu, "%s/IMU.txt", data_dir);
   snprintf(gnss, sizeof gnss, "%s/%s", data_dir, gnss_file);
@@ -185,16 +207,44 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
   rc.nav = nav_ins_gnss_config_from_scene(cfg_scene);
   nav_replay_summary sum;
   nav_diag d;
-  const double t0 = bench_now_s();
-  const nav_status st = nav_replay_run(&rc, &sum, &d);
-  const double wall = bench_now_s() - t0;
+  /* Best of 3 for the in-process parts (the machine is shared). */
+  double parse = INFINITY, inproc = INFINITY;
+  nav_status st = NAV_OK;
+  for (int rep = 0; rep < 3 && st == NAV_OK; ++rep) {
+    const double tp = replay_parse_s(imu, gnss, ref);
+    if (tp < parse) parse = tp;
+    const double t0 = bench_now_s();
+    st = nav_replay_run(&rc, &sum, &d);
+    const double t = bench_now_s() - t0;
+    if (t < inproc) inproc = t;
+  }
   if (st != NAV_OK) {
     snprintf(row->error, sizeof row->error, "replay: %.200s", d.message[0] ? d.message : nav_status_str(st));
     return;
   }
+  /* The whole program, as a user runs it (process start, scene, parsing, navigation, scoring,
+   * nav/truth/errors CSV and summary.json written atomically): best of 3. */
+  double whole = NAN;
+  char exe[4096], res[4096], scene[4400], outp[4400], log[4400];
+  snprintf(log, sizeof log, "%s/logs", out_dir);
+  if (bench_make_dir(log) == 0 && bench_self_exe(exe, sizeof exe) && navsim_find_resources_dir(res, sizeof res)) {
+    snprintf(scene, sizeof scene, "%s/../scenes/long-drive-replay.yaml", res);
+    snprintf(outp, sizeof outp, "%s/logs/replay-%s", out_dir, gnss_file);
+    snprintf(log, sizeof log, "%s/logs/replay-%s.log", out_dir, gnss_file);
+    char *argv[] = {exe,     "replay", "--imu", imu, "--gnss", gnss,    "--truth", ref,
+                    "--scene", scene,  "--out", outp, "--quiet", NULL};
+    for (int rep = 0; rep < 3; ++rep) {
+      const child_result c = bench_run_child(argv, log, 120.0);
+      if (c.started && c.exited_ok && !(c.wall_s >= whole)) whole = c.wall_s;
+    }
+  }
   row->samples = sum.imu_steps;
-  row->wall_s = wall;
-  row->mech_sps = (double)sum.imu_steps / wall;
+  row->wall_s = isfinite(whole) ? whole : inproc;
+  row->mech_sps = (double)sum.imu_steps / row->wall_s;
+  snprintf(row->note, sizeof row->note,
+           "%s %.3g s = parsing %.3g s + navigation and scoring %.3g s + start, outputs %.3g s",
+           isfinite(whole) ? "navsim replay" : "in-process replay (the child failed)", row->wall_s, parse,
+           inproc - parse, isfinite(whole) ? whole - inproc : 0.0);
   row->pos_err_m = sum.stats.pos_h_m.rms;
   row->att_err_rad = sum.stats.yaw_rad.rms;
   row->peer = "KF-GINS";
@@ -413,7 +463,7 @@ int navsim_bench(int argc, char **argv) {
           for (int q = 0; q < 2; ++q) {
             snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-replay");
             snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%s", files[q]);
-            bench_replay(data, files[q], sc, &rows[n_all++]);
+            bench_replay(data, files[q], sc, out_dir, &rows[n_all++]);
             /* The same figures against the second peer (pyins, README of the data set). */
             if (rows[n_all - 1].ok) {
               rows[n_all] = rows[n_all - 1];

@@ -80,7 +80,7 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
 }
 
 /* This executable (for the child runs). */
-static bool self_exe(char *buf, size_t cap) {
+bool bench_self_exe(char *buf, size_t cap) {
   const ssize_t n = readlink("/proc/self/exe", buf, cap - 1);
   if (n <= 0) return false;
   buf[n] = '\0';
@@ -227,7 +227,7 @@ static void case_mpi(bool full, const char *out_dir, bench_row *rows, int *n, in
   if (*n + 2 > cap) return;
 #ifdef NAVSIM_MPIEXEC
   char exe[4096], scene[4400], res[4096], log[4400], outp[4400];
-  if (!self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
+  if (!bench_self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
   snprintf(scene, sizeof scene, "%s/../scenes/urban-drive.yaml", res);
   const char *runs = full ? "16" : "2";
   double wall[2] = {0.0, 0.0};
@@ -348,7 +348,7 @@ static void case_campaign(const char *case_name, long runs, double rate_hz, doub
                           bench_row *rows, int *n, int cap) {
   if (*n >= cap) return;
   char exe[4096], res[4096], src[4400], scene[4400], log[4400], outp[4400];
-  if (!self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
+  if (!bench_self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
   snprintf(src, sizeof src, "%s/../scenes/bench-mc-1h.yaml", res);
   snprintf(scene, sizeof scene, "%s/logs/%s.yaml", out_dir, case_name);
   bench_row *r = &rows[*n];

@@ -51,7 +51,12 @@ void bench_scene(const nav_scene *sc, int reps, bench_row *row);
 /* Whole pipeline through nav_sim (bench.c). */
 void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row);
 /* Replay of the shared long drive with the navigation settings of cfg_scene (bench.c). */
-void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, bench_row *row);
+/* The long-drive replay: the whole `navsim replay` as a child process (the headline wall time),
+ * plus an in-process breakdown (parsing alone, the replay without output files). */
+void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, const char *out_dir,
+                  bench_row *row);
+/* This executable (/proc/self/exe). */
+bool bench_self_exe(char *buf, size_t cap);
 
 /* Cases added by bench_cases2.c after bench.c's own: appends to rows[*n] (capacity cap). */
 void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int cap, bool quiet);

@@ -5,6 +5,7 @@
  * share within each requirement) and budget.json, and prints the largest contributors.
  */
 #include "budget_cmd.h"
+#include "cli_util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -69,13 +70,6 @@ typedef struct req_budget {
   double all_ms;      /* Monte Carlo: every source on together (NaN for covariance) */
   double t_s;         /* epoch used, NaN: all */
 } req_budget;
-
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ++*(int *)user;
-}
 
 static nav_requirement default_req(const char *id, nav_req_metric m, nav_req_statistic s, nav_req_unit u) {
   nav_requirement q;
@@ -255,39 +249,29 @@ int navsim_budget(int argc, char **argv) {
   bool quiet = false;
   long runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
-    if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+    if (navsim_is_help(argv[i])) {
       fputs(k_usage_budget, stdout);
       return 0;
     } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
       quiet = true;
     } else if (strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--runs") == 0 || strcmp(argv[i], "--threads") == 0) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim budget: %s needs a value\n", argv[i]);
-        return 2;
-      }
+      if (!navsim_need_value("budget", argc, i, argv[i])) return 2;
       const char *opt = argv[i], *v = argv[++i];
       if (opt[2] == 'o') {
         out_dir = v;
         continue;
       }
-      char *end = NULL;
-      errno = 0;
-      const long x = strtol(v, &end, 10);
       const long max = opt[2] == 'r' ? NAV_SCENE_MAX_RUNS : 256;
-      if (errno != 0 || end == v || *end != '\0' || x < 1 || x > max) {
+      long x = 0;
+      if (!navsim_parse_long(v, 1, max, &x)) {
         fprintf(stderr, "navsim budget: %s: expected an integer in [1, %ld], got \"%s\"\n", opt, max, v);
         return 2;
       }
       if (opt[2] == 'r') runs = x;
       else threads = x;
-    } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-      fprintf(stderr, "navsim budget: unknown option \"%s\" (see navsim budget --help)\n", argv[i]);
-      return 2;
-    } else if (!scene_path) {
-      scene_path = argv[i];
     } else {
-      fprintf(stderr, "navsim budget: only one SCENE may be given\n");
-      return 2;
+      const int rc = navsim_scene_arg("budget", argv[i], &scene_path);
+      if (rc != 0) return rc;
     }
   }
   if (!scene_path) {
@@ -296,12 +280,10 @@ int navsim_budget(int argc, char **argv) {
   }
   nav_scene *sc = malloc(sizeof *sc);
   if (!sc) return 1;
-  int ndiag = 0;
-  const nav_status rst = nav_scene_read_file(scene_path, sc, print_diag, &ndiag);
-  if (rst != NAV_OK) {
-    if (ndiag == 0) fprintf(stderr, "%s: error: %s\n", scene_path, nav_status_str(rst));
+  const int lrc = navsim_load_scene(scene_path, sc);
+  if (lrc != 0) {
     free(sc);
-    return rst == NAV_ERR_PARSE ? 2 : 1;
+    return lrc;
   }
   if (runs > 0) sc->simulation.runs = runs;
   if (threads == 0) {

@@ -5,6 +5,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "catalog_cmd.h"
+#include "cli_util.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,13 +66,6 @@ bool navsim_find_resources_dir(char *buf, size_t size) {
   return false;
 }
 
-static void print_diag(void *user, const nav_diag *d) {
-  (void)user;
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-}
-
 /* One CSV cell: quoted when it holds a comma, quote or leading/trailing blank. */
 static void csv_text(FILE *f, const char *s) {
   const size_t n = strlen(s);
@@ -112,7 +106,7 @@ static int load(const char *dir, const char *file, const nav_catalog_options *op
     fprintf(stderr, "navsim catalog: resources path too long\n");
     return EXIT_FAIL;
   }
-  const nav_status st = nav_catalog_load(path, opt, cat, print_diag, NULL);
+  const nav_status st = nav_catalog_load(path, opt, cat, navsim_print_diag, NULL);
   if (st == NAV_OK) return EXIT_OK;
   if (st == NAV_ERR_PARSE) return EXIT_INVALID;
   if (st != NAV_ERR_IO) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));

@@ -19,6 +19,7 @@
  *   1.2 (iv)): analytic_pos_v_valid is 1 while (t/tau_v)^2/12 < 1 %, always on a flat Earth.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "estimate_cmd.h"
 
 #include <errno.h>
@@ -60,12 +61,6 @@ static const char *k_usage_estimate =
     "  summary.json   scene, timing, final analytic and covariance values\n"
     "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
 
@@ -178,27 +173,6 @@ static nav_callback_result keep_cov(void *user, const nav_cov_point *p) {
   return NAV_CONTINUE;
 }
 
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ++*(int *)user;
-}
-
-static void json_text(FILE *f, const char *s) {
-  fputc('"', f);
-  for (; *s; ++s) {
-    const unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\')
-      fprintf(f, "\\%c", c);
-    else if (c < 0x20)
-      fprintf(f, "\\u%04x", c);
-    else
-      fputc(c, f);
-  }
-  fputc('"', f);
-}
-
 /*
  * estimate.json: the final values of the analytic estimate (totals and every term), the
  * covariance analysis when available, the conventions, and one verdict per requirement of the
@@ -212,9 +186,9 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
   FILE *f = path ? fopen(path, "w") : NULL;
   if (!f) return -1;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
-  json_text(f, sc->name);
+  navsim_json_string(f, sc->name);
   fputs(", \"file\": ", f);
-  json_text(f, scene_path);
+  navsim_json_string(f, scene_path);
   fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"t_s\": %.17g,\n", nav_nav_scheme_name(sc->navigation.scheme), tab->t_s);
   fputs("  \"conventions\": {\"per_axis\": \"one level channel (north or east) of a free-inertial INS, numerics.md "
         "1.2; inputs are the worst axis of the IMU model\", \"horizontal\": \"sqrt(2) x per axis (independent "
@@ -262,7 +236,7 @@ int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool quiet = false;
   for (int i = 0; i < argc; ++i) {
-    if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+    if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
       return 0;
     } else if (strcmp(argv[i], "--quiet") == 0) {
@@ -284,12 +258,8 @@ int navsim_estimate(int argc, char **argv) {
     return 2;
   }
   nav_scene sc;
-  int ndiag = 0;
-  const nav_status rst = nav_scene_read_file(scene_path, &sc, print_diag, &ndiag);
-  if (rst != NAV_OK) {
-    if (ndiag == 0) fprintf(stderr, "%s: error: %s\n", scene_path, nav_status_str(rst));
-    return rst == NAV_ERR_PARSE ? 2 : 1;
-  }
+  const int lrc = navsim_load_scene(scene_path, &sc);
+  if (lrc != 0) return lrc;
   char default_dir[600];
   if (!out_dir) {
     snprintf(default_dir, sizeof default_dir, "out/%s-estimate", sc.name[0] ? sc.name : "scene");
@@ -306,7 +276,7 @@ int navsim_estimate(int argc, char **argv) {
   double *pos_v = NULL;
   double *times = NULL;
   FILE *f = NULL;
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
 
   /* Output epochs of the scene. */
   const int64_t n_imu = (int64_t)floor(sc.trajectory.duration_s * sc.imu.rate_hz + 1e-9);
@@ -345,7 +315,7 @@ int navsim_estimate(int argc, char **argv) {
     fprintf(stderr, "navsim estimate: analytic table failed: %s\n", nav_status_str(st));
     goto cleanup;
   }
-  const double t_analytic = now_s() - t0;
+  const double t_analytic = navsim_now_s() - t0;
   /* Vertical validity: (t / tau_v)^2 / 12 < 1 %, tau_v = sqrt(a / (2 g)) (numerics.md 1.2 (iv)). */
   const double tau_v_s = sqrt(NAV_WGS84_A_M / (2.0 * acfg.imu.g_mps2));
   const double t_v_max_s = sc.earth.model == NAV_EARTH_FLAT ? INFINITY : tau_v_s * sqrt(0.12);
@@ -354,9 +324,9 @@ int navsim_estimate(int argc, char **argv) {
   if (sc.earth.model == NAV_EARTH_WGS84) {
     st = nav_sim_create(&sc, &sim);
     if (st == NAV_OK) {
-      const double tc = now_s();
+      const double tc = navsim_now_s();
       st = nav_sim_covariance(sim, keep_cov, &cov);
-      t_cov = now_s() - tc;
+      t_cov = navsim_now_s() - tc;
     }
     if (st != NAV_OK) {
       fprintf(stderr, "navsim estimate: covariance analysis failed: %s\n", sim ? nav_sim_last_error(sim) : nav_status_str(st));

@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
+#include "cli_util.h"
 #include "import_cmd.h"
 
 #include <errno.h>
@@ -20,29 +21,6 @@
 #include "navcore/nav_track_import.h"
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
-
-static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
-
-typedef struct diag_sink {
-  int count;
-} diag_sink;
-
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ((diag_sink *)user)->count++;
-}
-
-static bool parse_pos(const char *s, double *out, bool allow_zero) {
-  if (!s || !*s) return false;
-  char *end = NULL;
-  errno = 0;
-  const double v = strtod(s, &end);
-  if (errno || !end || *end || !isfinite(v) || v < 0 || (!allow_zero && v == 0)) return false;
-  *out = v;
-  return true;
-}
 
 static const char *k_usage_import =
     "usage: navsim import FILE --out SCENE.yaml [--speed M/S] [--name NAME] [--tolerance M] [--no-time]\n"
@@ -90,7 +68,7 @@ int navsim_import(int argc, char **argv) {
   bool speed_given = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
-    if (is_help(a)) {
+    if (navsim_is_help(a)) {
       fputs(k_usage_import, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--no-merge") == 0) {
@@ -102,10 +80,7 @@ int navsim_import(int argc, char **argv) {
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--speed") == 0 || strcmp(a, "--name") == 0 ||
                strcmp(a, "--tolerance") == 0 || strcmp(a, "--track") == 0 || strcmp(a, "--format") == 0 ||
                strcmp(a, "--template") == 0) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim import: %s needs a value\n", a);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("import", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (strcmp(a, "--out") == 0) out = v;
       else if (strcmp(a, "--name") == 0) name = v;
@@ -113,18 +88,17 @@ int navsim_import(int argc, char **argv) {
       else if (strcmp(a, "--format") == 0) fmt_s = v;
       else if (strcmp(a, "--template") == 0) templ = v;
       else if (strcmp(a, "--speed") == 0) {
-        if (!parse_pos(v, &opt.speed_mps, false) || opt.speed_mps > 1000.0) {
+        if (!navsim_parse_positive(v, &opt.speed_mps, false) || opt.speed_mps > 1000.0) {
           fprintf(stderr, "navsim import: --speed: expected a speed in (0, 1000] m/s, got \"%s\"\n", v);
           return EXIT_INVALID;
         }
         speed_given = true;
-      } else if (!parse_pos(v, &opt.tolerance_m, true) || opt.tolerance_m > 1e5) {
+      } else if (!navsim_parse_positive(v, &opt.tolerance_m, true) || opt.tolerance_m > 1e5) {
         fprintf(stderr, "navsim import: --tolerance: expected a distance in [0, 1e5] m, got \"%s\"\n", v);
         return EXIT_INVALID;
       }
     } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "navsim import: unknown option \"%s\" (see navsim import --help)\n", a);
-      return EXIT_INVALID;
+      return navsim_unknown_option("import", a);
     } else if (!in) {
       in = a;
     } else {
@@ -171,13 +145,12 @@ int navsim_import(int argc, char **argv) {
   nav_scene *sc = malloc(sizeof *sc);
   if (!sc) return EXIT_FAIL;
   int rc = EXIT_OK;
-  diag_sink sink = {0};
+  navsim_diag_sink sink = {0};
   if (templ) {
-    const nav_status st = nav_scene_read_file(templ, sc, print_diag, &sink);
-    if (st != NAV_OK) {
-      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", templ, nav_status_str(st));
+    const int lrc = navsim_load_scene(templ, sc);
+    if (lrc != EXIT_OK) {
       free(sc);
-      return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
+      return lrc;
     }
   } else {
     *sc = nav_scene_default();
@@ -190,7 +163,7 @@ int navsim_import(int argc, char **argv) {
   base_name(default_name, sizeof default_name, in);
 
   if (fmt == NAV_TRACK_FORMAT_MOTION_DEF) {
-    const nav_status st = nav_motiondef_read_file(in, sc, print_diag, &sink);
+    const nav_status st = nav_motiondef_read_file(in, sc, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
       rc = st == NAV_ERR_IO ? EXIT_FAIL : EXIT_INVALID;
@@ -201,7 +174,7 @@ int navsim_import(int argc, char **argv) {
            sc->trajectory.duration_s);
   } else {
     nav_geotrack tr = {0};
-    nav_status st = nav_geotrack_read_file(in, fmt, track_name, &tr, print_diag, &sink);
+    nav_status st = nav_geotrack_read_file(in, fmt, track_name, &tr, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
       rc = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
@@ -243,8 +216,8 @@ int navsim_import(int argc, char **argv) {
       goto done;
     }
     /* The written file must read back as a valid scene. */
-    diag_sink s2 = {0};
-    const nav_status st2 = nav_scene_read_file(out, sc, print_diag, &s2);
+    navsim_diag_sink s2 = {0};
+    const nav_status st2 = nav_scene_read_file(out, sc, navsim_print_diag, &s2);
     if (st2 != NAV_OK) {
       fprintf(stderr, "navsim import: the written scene \"%s\" does not read back: %s\n", out, nav_status_str(st2));
       rc = EXIT_FAIL;
@@ -451,7 +424,7 @@ int navsim_export(int argc, char **argv) {
   bool kml = false, csv = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
-    if (is_help(a)) {
+    if (navsim_is_help(a)) {
       fputs(k_usage_export, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--kml") == 0) {
@@ -459,8 +432,7 @@ int navsim_export(int argc, char **argv) {
     } else if (strcmp(a, "--csv") == 0) {
       csv = true;
     } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "navsim export: unknown option \"%s\" (see navsim export --help)\n", a);
-      return EXIT_INVALID;
+      return navsim_unknown_option("export", a);
     } else if (!dir) {
       dir = a;
     } else {

@@ -18,6 +18,7 @@
 #include "bench.h"
 #include "budget_cmd.h"
 #include "catalog_cmd.h"
+#include "cli_util.h"
 #include "mpi_run.h"
 #include "estimate_cmd.h"
 #include "gnss_out.h"
@@ -113,39 +114,9 @@ static const char *k_usage_run =
     "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
     "            2 invalid scene or options; 1 other failure\n";
 
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static long cores(void) {
   const long n = sysconf(_SC_NPROCESSORS_ONLN);
   return n > 0 ? n : 1;
-}
-
-static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
-
-/* Print each diagnostic on stderr and count them. */
-typedef struct diag_sink {
-  int count;
-} diag_sink;
-
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ((diag_sink *)user)->count++;
-}
-
-/* NAV_OK -> 0; invalid scene -> 2; unreadable -> 1. */
-static int load_scene(const char *path, nav_scene *scene) {
-  diag_sink sink = {0};
-  const nav_status st = nav_scene_read_file(path, scene, print_diag, &sink);
-  if (st == NAV_OK) return EXIT_OK;
-  if (st == NAV_ERR_PARSE) return EXIT_INVALID;
-  if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
-  return EXIT_FAIL;
 }
 
 static int cmd_check(int argc, char **argv) {
@@ -154,14 +125,14 @@ static int cmd_check(int argc, char **argv) {
     return EXIT_INVALID;
   }
   for (int i = 0; i < argc; ++i)
-    if (is_help(argv[i])) {
+    if (navsim_is_help(argv[i])) {
       fputs(k_usage_check, stdout);
       return EXIT_OK;
     }
   int worst = EXIT_OK;
   for (int i = 0; i < argc; ++i) {
     nav_scene scene;
-    const int rc = load_scene(argv[i], &scene);
+    const int rc = navsim_load_scene(argv[i], &scene);
     if (rc == EXIT_FAIL) worst = EXIT_FAIL;
     else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
   }
@@ -236,7 +207,7 @@ static nav_callback_result on_smoothed(void *user, const nav_sim_record *r) {
 static nav_callback_result on_progress(void *user, const nav_progress *p) {
   run_out *o = user;
   if (o->quiet_progress) return NAV_CONTINUE;
-  const double t = now_s();
+  const double t = navsim_now_s();
   if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
     /* Runs done and the time left, extrapolated from the fraction of the job done so far. */
     const long done = (long)floor(p->fraction * (double)o->runs + 1e-9);
@@ -255,38 +226,13 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
   return NAV_CONTINUE;
 }
 
-static bool parse_u64(const char *s, uint64_t *out) {
-  if (!s || !*s || *s == '-' || *s == '+') return false;
-  for (const char *p = s; *p; ++p)
-    if (*p < '0' || *p > '9') return false;
-  errno = 0;
-  char *end = NULL;
-  const unsigned long long v = strtoull(s, &end, 10);
-  if (errno != 0 || !end || *end) return false;
-  *out = (uint64_t)v;
-  return true;
-}
-
-/* Scene name -> a safe directory name. */
-static void safe_name(char *out, size_t cap, const char *name) {
-  size_t j = 0;
-  for (const char *p = name; *p && j + 1 < cap; ++p) {
-    const char c = *p;
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
-                    c == '_' || c == '.';
-    out[j++] = ok ? c : '_';
-  }
-  out[j] = '\0';
-  if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", "scene");
-}
-
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
-    if (is_help(a)) {
+    if (navsim_is_help(a)) {
       fputs(k_usage_run, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--kml") == 0) {
@@ -298,34 +244,27 @@ static int cmd_run(int argc, char **argv) {
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = true;
     } else if (strcmp(a, "--runs") == 0 || strcmp(a, "--threads") == 0) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim run: %s needs a value\n", a);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       uint64_t *dst = a[2] == 'r' ? &runs : &threads;
       const uint64_t max = a[2] == 'r' ? (uint64_t)NAV_SCENE_MAX_RUNS : 256u;
-      if (!parse_u64(v, dst) || *dst < 1 || *dst > max) {
+      if (!navsim_parse_u64(v, dst) || *dst < 1 || *dst > max) {
         fprintf(stderr, "navsim run: %s: expected an integer in [1, %llu], got \"%s\"\n", a, (unsigned long long)max, v);
         return EXIT_INVALID;
       }
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--seed") == 0) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim run: %s needs a value\n", a);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (a[2] == 'o') {
         out_dir = v;
-      } else if (!parse_u64(v, &seed)) {
+      } else if (!navsim_parse_u64(v, &seed)) {
         fprintf(stderr, "navsim run: --seed: expected an integer in [0, 2^64-1], got \"%s\"\n", v);
         return EXIT_INVALID;
       } else {
         have_seed = true;
       }
     } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "navsim run: unknown option \"%s\" (see navsim run --help)\n", a);
-      return EXIT_INVALID;
+      return navsim_unknown_option("run", a);
     } else if (!scene_path) {
       scene_path = a;
     } else {
@@ -339,7 +278,7 @@ static int cmd_run(int argc, char **argv) {
   }
 
   nav_scene scene;
-  int rc = load_scene(scene_path, &scene);
+  int rc = navsim_load_scene(scene_path, &scene);
   if (rc != EXIT_OK) return rc;
   if (have_seed) scene.simulation.seed = seed;
   if (runs > 0) scene.simulation.runs = (long)runs;
@@ -351,7 +290,7 @@ static int cmd_run(int argc, char **argv) {
   char default_dir[600];
   if (!out_dir) {
     char nm[NAV_SCENE_NAME_MAX];
-    safe_name(nm, sizeof nm, scene.name);
+    navsim_safe_name(nm, sizeof nm, scene.name, "scene");
     snprintf(default_dir, sizeof default_dir, "out/%s", nm);
     out_dir = default_dir;
   }
@@ -360,8 +299,8 @@ static int cmd_run(int argc, char **argv) {
   nav_resultdir *rd = NULL;
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
-  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, now_s(), scene.simulation.runs,
-               NULL, NULL, NULL};
+  run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, navsim_now_s(),
+               scene.simulation.runs, NULL, NULL, NULL};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -436,9 +375,9 @@ static int cmd_run(int argc, char **argv) {
     opts.observer = &req_obs;
   }
   nav_sim_summary sum;
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
   st = navsim_mpi_sim_run(sim, &opts, &sum); /* nav_sim_run, over every MPI rank when under mpirun */
-  const double wall = now_s() - t0;
+  const double wall = navsim_now_s() - t0;
   if (navsim_interrupted()) {
     rc = 128 + navsim_interrupted();
     goto cleanup;
@@ -614,7 +553,7 @@ int main(int argc, char **argv) {
     printf("navsim %s\n", nav_version_string());
     return EXIT_OK;
   }
-  if (is_help(cmd)) {
+  if (navsim_is_help(cmd)) {
     fputs(k_usage, stdout);
     return EXIT_OK;
   }

@@ -5,6 +5,7 @@
  * this file parses the command line, writes the result directory and prints the tables.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "replay_cmd.h"
 #include "req_out.h"
 
@@ -72,33 +73,6 @@ static const char *k_usage_replay =
     "  --quiet         print nothing but errors\n"
     "\n"
     "exit codes: 0 success; 2 invalid files or options; 1 other failure\n";
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static bool parse_double(const char *s, double *out) {
-  if (!s || !*s) return false;
-  errno = 0;
-  char *end = NULL;
-  const double v = strtod(s, &end);
-  if (errno != 0 || !end || *end || !isfinite(v)) return false;
-  *out = v;
-  return true;
-}
-
-static void print_diag(const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-}
-
-static void on_scene_diag(void *user, const nav_diag *d) {
-  (void)user;
-  print_diag(d);
-}
 
 /* ---------------------------------------------------------------- published peer figures */
 
@@ -233,7 +207,7 @@ static nav_callback_result on_record(void *user, const nav_replay_record *r) {
 static nav_callback_result on_progress(void *user, const nav_progress *p) {
   out_files *o = user;
   if (!o->show_progress) return NAV_CONTINUE;
-  const double t = now_s();
+  const double t = navsim_now_s();
   if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
     fprintf(stderr, "\r  replaying: %5.1f %%  (t = %.3f s)", 100.0 * p->fraction, p->sim_time_s);
     if (p->fraction >= 1.0) fputc('\n', stderr);
@@ -242,25 +216,7 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
   return NAV_CONTINUE;
 }
 
-static void json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(f, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(f, "\\u%04x", *p);
-    else
-      fputc(*p, f);
-  }
-  fputc('"', f);
-}
-
-static void json_number(FILE *f, double v) {
-  if (isfinite(v))
-    fprintf(f, "%.17g", v);
-  else
-    fputs("null", f);
-}
+static void json_number(FILE *f, double v) { navsim_json_number(f, v, 17); }
 
 static void json_vec3(FILE *f, nav_vec3 v, double scale) {
   fputc('[', f);
@@ -331,21 +287,21 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   const nav_filter_config *fc = &nc->filter;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"command\": \"replay\",\n  \"inputs\": {\"imu\": ",
           nav_version_string());
-  json_string(f, j->imu);
+  navsim_json_string(f, j->imu);
   fputs(", \"gnss\": ", f);
   if (j->gnss)
-    json_string(f, j->gnss);
+    navsim_json_string(f, j->gnss);
   else
     fputs("null", f);
   fputs(", \"truth\": ", f);
-  json_string(f, j->truth);
+  navsim_json_string(f, j->truth);
   fputs(", \"config\": ", f);
   if (j->config)
-    json_string(f, j->config);
+    navsim_json_string(f, j->config);
   else
     fputs("null", f);
   fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"case\": ", s->free_ins ? "free_ins" : "ins_gnss");
-  json_string(f, k_case_names[j->dcase]);
+  navsim_json_string(f, k_case_names[j->dcase]);
   fprintf(f, ",\n  \"dataset\": %s,\n", j->long_drive ? "\"gnss-ins-sim long_drive\"" : "null");
   fprintf(
       f,
@@ -453,7 +409,7 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs("  \"peers_published\": ", f);
   if (j->long_drive) {
     fputs("{\"source\": \"gnss-ins-sim-long-drive/README.md\", \"case\": ", f);
-    json_string(f, k_case_readme[j->dcase]);
+    navsim_json_string(f, k_case_readme[j->dcase]);
     for (int p = 0; p < 2; ++p) {
       fprintf(f, ", \"%s\": {", k_peers[p].name);
       for (int k = 0; k < N_FIG; ++k) {
@@ -469,9 +425,9 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs("  \"peers_scored\": [", f);
   for (int p = 0; p < j->n_peers; ++p) {
     fputs(p ? ",\n    {\"name\": " : "\n    {\"name\": ", f);
-    json_string(f, j->peers[p].name);
+    navsim_json_string(f, j->peers[p].name);
     fputs(", \"file\": ", f);
-    json_string(f, j->peers[p].path);
+    navsim_json_string(f, j->peers[p].path);
     fputs(",\n", f);
     json_stats(f, 3, "errors", &j->peers[p].stats, true);
     fputs("    }", f);
@@ -583,14 +539,6 @@ static void print_tables(const replay_job *j, bool show_published) {
 
 /* ---------------------------------------------------------------- command */
 
-static int need_value(int argc, int i, const char *opt) {
-  if (i + 1 >= argc) {
-    fprintf(stderr, "navsim replay: %s needs a value\n", opt);
-    return 0;
-  }
-  return 1;
-}
-
 int navsim_replay(int argc, char **argv) {
   const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay";
   bool quiet = false, peers_auto = true, smooth = false;
@@ -615,10 +563,10 @@ int navsim_replay(int argc, char **argv) {
     } else if (strcmp(a, "--smooth") == 0) {
       smooth = true;
     } else if (strcmp(a, "--smooth-group") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       double n = 0.0;
-      if (!parse_double(v, &n) || n != floor(n) || n < 1.0 || n > 1000.0) {
+      if (!navsim_parse_double(v, &n) || n != floor(n) || n < 1.0 || n > 1000.0) {
         fprintf(stderr, "navsim replay: --smooth-group: expected an integer in [1, 1000], got \"%s\"\n", v);
         return EXIT_INVALID;
       }
@@ -626,7 +574,7 @@ int navsim_replay(int argc, char **argv) {
       smooth = true;
     } else if (strcmp(a, "--imu") == 0 || strcmp(a, "--gnss") == 0 || strcmp(a, "--truth") == 0 ||
                strcmp(a, "--config") == 0 || strcmp(a, "--scene") == 0 || strcmp(a, "--out") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       const char **dst = a[2] == 'i'   ? &imu
                          : a[2] == 'g' ? &gnss
@@ -635,10 +583,10 @@ int navsim_replay(int argc, char **argv) {
                                        : &out_dir;
       *dst = v;
     } else if (strcmp(a, "--start") == 0 || strcmp(a, "--end") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       double t = 0.0;
-      if (!parse_double(v, &t)) {
+      if (!navsim_parse_double(v, &t)) {
         fprintf(stderr, "navsim replay: %s: expected a time in seconds (file time base), got \"%s\"\n", a, v);
         return EXIT_INVALID;
       }
@@ -650,14 +598,14 @@ int navsim_replay(int argc, char **argv) {
         rc.t_end_s = t;
       }
     } else if (strcmp(a, "--outage") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       char buf[128];
       snprintf(buf, sizeof buf, "%s", v);
       char *colon = strchr(buf, ':');
       double t0 = 0.0, t1 = 0.0;
       if (colon) *colon = '\0';
-      if (!colon || !parse_double(buf, &t0) || !parse_double(colon + 1, &t1) || !(t1 > t0)) {
+      if (!colon || !navsim_parse_double(buf, &t0) || !navsim_parse_double(colon + 1, &t1) || !(t1 > t0)) {
         fprintf(
             stderr,
             "navsim replay: --outage: expected T0:T1 with T0 < T1 (seconds, file time base), got \"%s\"\n",
@@ -672,7 +620,7 @@ int navsim_replay(int argc, char **argv) {
       rc.outages[rc.outage_count].t1_s = t1;
       rc.outage_count++;
     } else if (strcmp(a, "--peer") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       const char *eq = strchr(v, '=');
       if (!eq || eq == v || !eq[1] || (size_t)(eq - v) >= sizeof peers[0].name) {
@@ -689,16 +637,16 @@ int navsim_replay(int argc, char **argv) {
       peers[n_peers].path = eq + 1;
       n_peers++;
     } else if (strcmp(a, "--cov-decimation") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       double n = 0.0;
-      if (!parse_double(v, &n) || n != floor(n) || n < 1.0 || n > 1000.0) {
+      if (!navsim_parse_double(v, &n) || n != floor(n) || n < 1.0 || n > 1000.0) {
         fprintf(stderr, "navsim replay: --cov-decimation: expected an integer in [1, 1000], got \"%s\"\n", v);
         return EXIT_INVALID;
       }
       cov_decimation = (unsigned)n;
     } else if (strcmp(a, "--peers") == 0) {
-      if (!need_value(argc, i, a)) return EXIT_INVALID;
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (strcmp(v, "auto") == 0)
         peers_auto = true;
@@ -728,7 +676,7 @@ int navsim_replay(int argc, char **argv) {
     /* nav_scene is large (segment scripts): keep it off the stack. */
     nav_scene *scene = malloc(sizeof *scene);
     if (!scene) return EXIT_FAIL;
-    const nav_status st = nav_scene_read_file(config, scene, on_scene_diag, NULL);
+    const nav_status st = nav_scene_read_file(config, scene, navsim_print_diag, NULL);
     if (st != NAV_OK) {
       fprintf(stderr, "navsim replay: --scene %s: %s\n", config,
               st == NAV_ERR_PARSE ? "not a valid scene (errors above)" : nav_status_str(st));
@@ -794,18 +742,30 @@ int navsim_replay(int argc, char **argv) {
   nav_replay_summary sum;
   nav_diag d;
   memset(&d, 0, sizeof d);
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
   st = nav_replay_run(&rc, &sum, &d);
-  const double wall = now_s() - t0;
+  const double wall = navsim_now_s() - t0;
   if (st != NAV_OK) {
     if (o.st != NAV_OK)
       fprintf(stderr, "navsim replay: writing results failed: %s\n", nav_status_str(o.st));
     else if (d.message[0])
-      print_diag(&d);
+      navsim_print_diag(NULL, &d);
     else
       fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
     rc_exit = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
     goto cleanup;
+  }
+  {
+    /* A last line without a line end: the file may have been cut (a copy or a recording stopped
+     * mid-write), and then its last number may be short without looking malformed. */
+    const char *paths[3] = {imu, gnss, truth};
+    const long cut[3] = {sum.imu_cut_line, sum.gnss_cut_line, sum.ref_cut_line};
+    for (int i = 0; i < 3; ++i)
+      if (paths[i] && cut[i] > 0)
+        fprintf(stderr,
+                "%s:%ld: warning: the last line has no line end; if the file was cut short, its last number "
+                "may be incomplete\n",
+                paths[i], cut[i]);
   }
   for (int i = 0; i < 3; ++i) {
     const bool bad = ferror(o.f[i]) != 0;
@@ -829,7 +789,7 @@ int navsim_replay(int argc, char **argv) {
     st = nav_replay_score_pva(truth, peers[p].path, true, sum.t_first_s, true, sum.t_last_s,
                               rc.ref_sync_tol_s, &peers[p].stats, &d);
     if (st != NAV_OK) {
-      if (d.message[0]) print_diag(&d);
+      if (d.message[0]) navsim_print_diag(NULL, &d);
       fprintf(stderr, "navsim replay: --peer %s: cannot score %s\n", peers[p].name, peers[p].path);
       rc_exit = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
       goto cleanup;

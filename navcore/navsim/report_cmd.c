@@ -5,6 +5,7 @@
  * navview on PATH). Without DISPLAY every navview call runs under `xvfb-run -a`.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "report_cmd.h"
 
 #include <errno.h>
@@ -26,8 +27,6 @@ static const char *k_viewer = NAVVIEW_EXE;
 #else
 static const char *k_viewer = "navview";
 #endif
-
-static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
 
 static bool need_xvfb(void) {
   const char *d = getenv("DISPLAY");
@@ -131,7 +130,7 @@ static const char *k_usage_render =
     "exit codes: those of navview: 0 success, 2 bad options, 1 unreadable result directory or other failure\n";
 
 int navsim_render(int argc, char **argv) {
-  if (argc < 1 || is_help(argv[0])) {
+  if (argc < 1 || navsim_is_help(argv[0])) {
     fputs(k_usage_render, argc < 1 ? stderr : stdout);
     return argc < 1 ? RC_INVALID : RC_OK;
   }
@@ -144,7 +143,7 @@ int navsim_render(int argc, char **argv) {
   char dir[4096];
   snprintf(dir, sizeof dir, "%s", argv[0]);
   for (int i = 1; i < argc; ++i) {
-    if (is_help(argv[i])) {
+    if (navsim_is_help(argv[i])) {
       fputs(k_usage_render, stdout);
       return RC_OK;
     }
@@ -375,13 +374,13 @@ static int mkdir_p(const char *path) {
 }
 
 int navsim_report(int argc, char **argv) {
-  if (argc < 1 || is_help(argv[0])) {
+  if (argc < 1 || navsim_is_help(argv[0])) {
     fputs(k_usage_report, argc < 1 ? stderr : stdout);
     return argc < 1 ? RC_INVALID : RC_OK;
   }
   const char *dir = argv[0], *out = NULL, *size = "1200x800";
   for (int i = 1; i < argc; ++i) {
-    if (is_help(argv[i])) {
+    if (navsim_is_help(argv[i])) {
       fputs(k_usage_report, stdout);
       return RC_OK;
     } else if ((strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--size") == 0) && i + 1 < argc) {

@@ -20,6 +20,7 @@
  *    class k -> 3 x 10^k USD (order of magnitude only).
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "select_cmd.h"
 
 #include <errno.h>
@@ -76,25 +77,6 @@ static const char *k_usage_select =
     "                     the scene's rate when the reduced one is not a multiple of the output rate)\n"
     "\n"
     "exit codes: 0 a configuration passes; 3 none passes; 2 invalid scene or options; 1 other failure\n";
-
-static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-typedef struct diag_sink {
-  int count;
-} diag_sink;
-
-static void print_diag(void *user, const nav_diag *d) {
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s\n", line);
-  ((diag_sink *)user)->count++;
-}
 
 enum { DEC_PREDICTION = 0, DEC_MONTE_CARLO = 1 };
 
@@ -373,15 +355,6 @@ static int parse_names(const char *list, const nav_catalog *cat, bool imu, int *
   return EXIT_OK;
 }
 
-static bool parse_long(const char *s, long lo, long hi, long *out) {
-  char *end = NULL;
-  errno = 0;
-  const long v = strtol(s, &end, 10);
-  if (errno || !end || end == s || *end || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
-
 static void csv_text(FILE *f, const char *s) {
   fputc('"', f);
   for (; *s; ++s) {
@@ -450,7 +423,7 @@ int navsim_select(int argc, char **argv) {
   bool quiet = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
-    if (is_help(a)) {
+    if (navsim_is_help(a)) {
       fputs(k_usage_select, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -458,22 +431,19 @@ int navsim_select(int argc, char **argv) {
     } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") || !strcmp(a, "--schemes") ||
                !strcmp(a, "--runs") || !strcmp(a, "--threads") || !strcmp(a, "--band") ||
                !strcmp(a, "--predict-rate")) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim select: %s needs a value\n", a);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("select", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (!strcmp(a, "--out")) out_dir = v;
       else if (!strcmp(a, "--imus")) imus_s = v;
       else if (!strcmp(a, "--receivers")) rcv_s = v;
       else if (!strcmp(a, "--schemes")) schemes_s = v;
       else if (!strcmp(a, "--runs")) {
-        if (!parse_long(v, 1, 100000, &runs)) {
+        if (!navsim_parse_long(v, 1, 100000, &runs)) {
           fprintf(stderr, "navsim select: --runs: expected an integer in [1, 100000], got \"%s\"\n", v);
           return EXIT_INVALID;
         }
       } else if (!strcmp(a, "--threads")) {
-        if (!parse_long(v, 1, 256, &threads)) {
+        if (!navsim_parse_long(v, 1, 256, &threads)) {
           fprintf(stderr, "navsim select: --threads: expected an integer in [1, 256], got \"%s\"\n", v);
           return EXIT_INVALID;
         }
@@ -488,14 +458,9 @@ int navsim_select(int argc, char **argv) {
         if (is_band) band = d;
         else predict_rate = d;
       }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "navsim select: unknown option \"%s\" (see navsim select --help)\n", a);
-      return EXIT_INVALID;
-    } else if (!scene_path) {
-      scene_path = a;
     } else {
-      fprintf(stderr, "navsim select: only one SCENE may be given\n");
-      return EXIT_INVALID;
+      const int rc = navsim_scene_arg("select", a, &scene_path);
+      if (rc != EXIT_OK) return rc;
     }
   }
   if (!scene_path || !out_dir) {
@@ -517,15 +482,9 @@ int navsim_select(int argc, char **argv) {
   ctx x;
   memset(&x, 0, sizeof x);
   if (!base || !sc) goto done;
-  {
-    diag_sink sink = {0};
-    const nav_status st = nav_scene_read_file(scene_path, base, print_diag, &sink);
-    if (st != NAV_OK) {
-      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", scene_path, nav_status_str(st));
-      rc = st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
-      goto done;
-    }
-  }
+  rc = navsim_load_scene(scene_path, base);
+  if (rc != EXIT_OK) goto done;
+  rc = EXIT_FAIL;
   if (base->n_requirements == 0) {
     fprintf(stderr, "%s: error: requirements: the scene has no requirements to select against (add a requirements "
                     "list: id, metric, statistic, limit, unit)\n", scene_path);
@@ -568,12 +527,12 @@ int navsim_select(int argc, char **argv) {
       fprintf(stderr, "navsim select: cannot find the resources directory with the catalogs; set NAV_RESOURCES_DIR\n");
       goto done;
     }
-    diag_sink sink = {0};
+    navsim_diag_sink sink = {0};
     snprintf(path, sizeof path, "%s/imu_catalog.csv", res);
-    nav_status st = nav_catalog_load(path, NULL, &imus, print_diag, &sink);
+    nav_status st = nav_catalog_load(path, NULL, &imus, navsim_print_diag, &sink);
     if (st == NAV_OK) {
       snprintf(path, sizeof path, "%s/gnss_receivers.csv", res);
-      st = nav_catalog_load(path, NULL, &gnss, print_diag, &sink);
+      st = nav_catalog_load(path, NULL, &gnss, navsim_print_diag, &sink);
     }
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
@@ -621,7 +580,7 @@ int navsim_select(int argc, char **argv) {
     printf("select     %s: %d IMU%s x %d receiver%s x %d scheme%s = %zu configurations, %d requirement%s\n",
            base->name, n_imu, n_imu == 1 ? "" : "s", n_rcv, n_rcv == 1 ? "" : "s", n_sch, n_sch == 1 ? "" : "s", n,
            x.n_req, x.n_req == 1 ? "" : "s");
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
   {
     pthread_t th[256];
     int nt = 0;
@@ -630,7 +589,7 @@ int navsim_select(int argc, char **argv) {
     if (nt == 0) predict_worker(&x);
     for (int t = 0; t < nt; ++t) pthread_join(th[t], NULL);
   }
-  const double t_pred = now_s() - t0;
+  const double t_pred = navsim_now_s() - t0;
   int n_fail = 0, n_pass = 0, n_near = 0;
   for (size_t i = 0; i < n; ++i) {
     classify(&x, &c[i]);
@@ -645,7 +604,7 @@ int navsim_select(int argc, char **argv) {
            band);
 
   /* Monte Carlo of the survivors, cheapest first, while they can still be the recommendation. */
-  const double t1 = now_s();
+  const double t1 = navsim_now_s();
   int n_sim = 0;
   double best_pass_cost = INFINITY;
   for (size_t i = 0; i < n; ++i)
@@ -689,7 +648,7 @@ int navsim_select(int argc, char **argv) {
     nav_req_evaluator_destroy(ev);
     nav_sim_destroy(sim);
   }
-  const double t_sim = now_s() - t1;
+  const double t_sim = navsim_now_s() - t1;
   if (!quiet)
     printf("simulated  %d near the limit and not costlier than a passing one, %ld runs each, in %.1f s\n", n_sim, runs,
            t_sim);

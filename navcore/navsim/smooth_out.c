@@ -4,6 +4,7 @@
  * against the same reference rows as the forward one.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "smooth_out.h"
 
 #include <math.h>
@@ -44,12 +45,6 @@ struct smooth_out {
   gap_cmp gaps[NAV_REPLAY_MAX_GAPS];
   long n_gaps;
 };
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 nav_status smooth_out_create(const nav_filter_config *fc, unsigned group_steps, smooth_out **out,
                              nav_smoother **sm) {
@@ -111,9 +106,9 @@ static nav_ins_state to_ecef(const nav_filter_ins_state *s, double t_s) {
 }
 
 nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const char *csv_path) {
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
   nav_status st = nav_smoother_run(o->sm);
-  o->backward_wall_s = now_s() - t0;
+  o->backward_wall_s = navsim_now_s() - t0;
   if (st != NAV_OK) {
     fprintf(stderr, "navsim replay: smoother: %s\n", nav_smoother_last_error(o->sm));
     return st;
@@ -206,12 +201,7 @@ nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const
   return NAV_OK;
 }
 
-static void num(FILE *f, double v) {
-  if (isfinite(v))
-    fprintf(f, "%.17g", v);
-  else
-    fputs("null", f);
-}
+static void num(FILE *f, double v) { navsim_json_number(f, v, 17); }
 
 static void stat_json(FILE *f, const char *name, nav_replay_stat s, double scale, bool last) {
   fprintf(f, "    \"%s\": {\"rms\": ", name);

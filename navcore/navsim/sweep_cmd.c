@@ -15,6 +15,7 @@
  * is reported).
  */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
 #include "select_cmd.h"
 
 #include <errno.h>
@@ -59,27 +60,6 @@ static const char *k_usage_sweep =
     "                  (>= the largest value), none_pass (< the smallest) or non_monotonic\n"
     "\n"
     "exit codes: 0 success; 2 invalid scene, parameter or options; 1 other failure\n";
-
-static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
-
-static double now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-typedef struct diag_sink {
-  int count;
-  const char *context;
-} diag_sink;
-
-static void print_diag(void *user, const nav_diag *d) {
-  diag_sink *s = user;
-  char line[2048];
-  nav_diag_format(d, line, sizeof line);
-  fprintf(stderr, "%s%s%s\n", line, s->context ? " " : "", s->context ? s->context : "");
-  s->count++;
-}
 
 typedef struct sweep_param {
   char path[256];
@@ -162,7 +142,7 @@ int navsim_sweep(int argc, char **argv) {
   bool predict = false, quiet = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
-    if (is_help(a)) {
+    if (navsim_is_help(a)) {
       fputs(k_usage_sweep, stdout);
       return EXIT_OK;
     } else if (!strcmp(a, "--predict")) {
@@ -170,10 +150,7 @@ int navsim_sweep(int argc, char **argv) {
     } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
       quiet = true;
     } else if (!strcmp(a, "--param") || !strcmp(a, "--out") || !strcmp(a, "--runs") || !strcmp(a, "--threads")) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "navsim sweep: %s needs a value\n", a);
-        return EXIT_INVALID;
-      }
+      if (!navsim_need_value("sweep", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (!strcmp(a, "--out")) {
         out_dir = v;
@@ -191,25 +168,18 @@ int navsim_sweep(int argc, char **argv) {
         }
         ++np;
       } else {
-        char *end = NULL;
-        errno = 0;
-        const long x = strtol(v, &end, 10);
         const long hi = !strcmp(a, "--runs") ? 1000000 : 256;
-        if (errno || !end || end == v || *end || x < 1 || x > hi) {
+        long x = 0;
+        if (!navsim_parse_long(v, 1, hi, &x)) {
           fprintf(stderr, "navsim sweep: %s: expected an integer in [1, %ld], got \"%s\"\n", a, hi, v);
           return EXIT_INVALID;
         }
         if (!strcmp(a, "--runs")) runs = x;
         else threads = x;
       }
-    } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "navsim sweep: unknown option \"%s\" (see navsim sweep --help)\n", a);
-      return EXIT_INVALID;
-    } else if (!scene_path) {
-      scene_path = a;
     } else {
-      fprintf(stderr, "navsim sweep: only one SCENE may be given\n");
-      return EXIT_INVALID;
+      const int rc = navsim_scene_arg("sweep", a, &scene_path);
+      if (rc != EXIT_OK) return rc;
     }
   }
   if (!scene_path || !out_dir || np == 0) {
@@ -246,13 +216,9 @@ int navsim_sweep(int argc, char **argv) {
       goto done;
     }
     /* The scene as it is must be valid (its own diagnostics point into the file). */
-    diag_sink sink = {0, NULL};
-    const nav_status st2 = nav_scene_read_file(scene_path, sc, print_diag, &sink);
-    if (st2 != NAV_OK) {
-      if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", scene_path, nav_status_str(st2));
-      rc = st2 == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
-      goto done;
-    }
+    rc = navsim_load_scene(scene_path, sc);
+    if (rc != EXIT_OK) goto done;
+    rc = EXIT_FAIL;
     nreq = sc->n_requirements;
     if (nreq == 0) {
       fprintf(stderr, "%s: error: requirements: the scene has no requirements to sweep against\n", scene_path);
@@ -263,7 +229,7 @@ int navsim_sweep(int argc, char **argv) {
   v = calloc((size_t)total * (size_t)nreq, sizeof *v);
   x = calloc((size_t)total * (size_t)np, sizeof *x);
   if (!v || !x) goto done;
-  const double t0 = now_s();
+  const double t0 = navsim_now_s();
   for (long g = 0; g < total; ++g) {
     long rem = g;
     char context[1024] = "(with";
@@ -290,8 +256,8 @@ int navsim_sweep(int argc, char **argv) {
       }
     }
     strncat(context, ")", sizeof context - strlen(context) - 1);
-    diag_sink sink = {0, context};
-    const nav_status st = nav_scene_doc_read(doc, sc, print_diag, &sink);
+    navsim_diag_sink sink = {0, context};
+    const nav_status st = nav_scene_doc_read(doc, sc, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s %s\n", scene_path, nav_status_str(st), context);
       rc = st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
@@ -314,7 +280,7 @@ int navsim_sweep(int argc, char **argv) {
       fflush(stdout);
     }
   }
-  const double wall = now_s() - t0;
+  const double wall = navsim_now_s() - t0;
 
   if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
     fprintf(stderr, "navsim sweep: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));

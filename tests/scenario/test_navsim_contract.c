@@ -21,59 +21,12 @@
 #include <sys/wait.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define SCENE NAV_SOURCE_DIR "/scenes/paper-parametric.yaml"
 #define WORK NAV_TEST_WORK_DIR
-
-typedef struct result {
-  int code;
-  char out[16384];
-  char err[16384];
-} result;
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "r");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
-
-/* Run "navsim ARGS" (ARGS already shell-quoted where needed) in @p cwd; capture both streams. */
-static result *navsim(const char *cwd, const char *args) {
-  static result r;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", cwd ? cwd : WORK, NAVSIM_EXE,
-           args, WORK, WORK);
-  const int st = system(cmd);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  slurp(WORK "/stdout.txt", r.out, sizeof r.out);
-  slurp(WORK "/stderr.txt", r.err, sizeof r.err);
-  return &r;
-}
-
-static void write_file(const char *name, const char *text) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/%s", WORK, name);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
-
-static bool is_file(const char *path) {
-  struct stat s;
-  return stat(path, &s) == 0 && S_ISREG(s.st_mode);
-}
-
-static void assert_matches(const char *text, const char *pattern) {
-  regex_t re;
-  assert_int_equal(regcomp(&re, pattern, REG_EXTENDED | REG_NEWLINE), 0);
-  const int rc = regexec(&re, text, 0, NULL, 0);
-  regfree(&re);
-  if (rc != 0) fail_msg("\"%s\" does not match /%s/", text, pattern);
-}
+/* Run "navsim ARGS" (ARGS already shell-quoted where needed) in CWD (NULL: WORK). */
+#define navsim(cwd, args) nav_test_run_cli(NAVSIM_EXE, WORK, (cwd), (args))
 
 /* Value of "key": NUMBER inside the object that follows "parent": (or the whole text). */
 static double json_number(const char *json, const char *parent, const char *key) {
@@ -95,16 +48,14 @@ static double json_number(const char *json, const char *parent, const char *key)
 
 static int setup(void **state) {
   (void)state;
-  char cmd[1024];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", WORK, WORK);
-  return system(cmd) == 0 ? 0 : -1;
+  return nav_test_fresh_dir(WORK);
 }
 
 static void test_version_and_help(void **state) {
   (void)state;
-  result *r = navsim(NULL, "--version");
+  nav_cli_result *r = navsim(NULL, "--version");
   assert_int_equal(r->code, 0);
-  assert_matches(r->out, "^navsim [0-9]+\\.[0-9]+\\.[0-9]+\n$");
+  nav_test_assert_matches(r->out, "^navsim [0-9]+\\.[0-9]+\\.[0-9]+\n$");
   r = navsim(NULL, "--help");
   assert_int_equal(r->code, 0);
   assert_non_null(strstr(r->out, "check SCENE"));
@@ -131,7 +82,7 @@ static void test_usage_errors_exit_2(void **state) {
   assert_int_equal(navsim(NULL, "run")->code, 2);
   assert_int_equal(navsim(NULL, "check")->code, 2);
   assert_int_equal(navsim(NULL, "run " SCENE " --bogus")->code, 2);
-  result *r = navsim(NULL, "run " SCENE " --seed -1");
+  nav_cli_result *r = navsim(NULL, "run " SCENE " --seed -1");
   assert_int_equal(r->code, 2);
   assert_non_null(strstr(r->err, "--seed"));
   assert_int_equal(navsim(NULL, "run " SCENE " --seed 18446744073709551616")->code, 2);
@@ -156,21 +107,21 @@ static void test_check_scene_library(void **state) {
   }
   closedir(d);
   assert_true(n >= 1);
-  result *r = navsim(NULL, args);
+  nav_cli_result *r = navsim(NULL, args);
   if (r->code != 0) fail_msg("navsim check of the scene library failed (%d):\n%s", r->code, r->err);
   assert_string_equal(r->err, "");
 }
 
 static void test_check_invalid_scenes(void **state) {
   (void)state;
-  write_file("bad.yaml", "format_version: 1\nimu:\n  rat_hz: 100\n");
-  result *r = navsim(NULL, "check '" SCENE "' bad.yaml");
+  nav_test_write_file(WORK, "bad.yaml", "format_version: 1\nimu:\n  rat_hz: 100\n");
+  nav_cli_result *r = navsim(NULL, "check '" SCENE "' bad.yaml");
   assert_int_equal(r->code, 2);
-  assert_matches(r->err, "^bad\\.yaml:3:3: error: imu\\.rat_hz: .*\"rate_hz\"");
-  write_file("badval.yaml", "format_version: 1\nimu:\n  rate_hz: -5\n");
+  nav_test_assert_matches(r->err, "^bad\\.yaml:3:3: error: imu\\.rat_hz: .*\"rate_hz\"");
+  nav_test_write_file(WORK, "badval.yaml", "format_version: 1\nimu:\n  rate_hz: -5\n");
   r = navsim(NULL, "check badval.yaml");
   assert_int_equal(r->code, 2);
-  assert_matches(r->err, "^badval\\.yaml:3:12: error: imu\\.rate_hz: must be > 0");
+  nav_test_assert_matches(r->err, "^badval\\.yaml:3:12: error: imu\\.rate_hz: must be > 0");
   r = navsim(NULL, "check does-not-exist.yaml");
   assert_int_equal(r->code, 1);
   assert_non_null(strstr(r->err, "does-not-exist.yaml"));
@@ -178,32 +129,33 @@ static void test_check_invalid_scenes(void **state) {
 
 static void test_run_invalid_scene_leaves_nothing(void **state) {
   (void)state;
-  write_file("bad2.yaml", "format_version: 1\nimu: {rate_hz: abc}\n");
-  result *r = navsim(NULL, "run bad2.yaml --out bad2-out");
+  nav_test_write_file(WORK, "bad2.yaml", "format_version: 1\nimu: {rate_hz: abc}\n");
+  nav_cli_result *r = navsim(NULL, "run bad2.yaml --out bad2-out");
   assert_int_equal(r->code, 2);
-  assert_false(is_file(WORK "/bad2-out/summary.json"));
+  assert_false(nav_test_is_file(WORK "/bad2-out/summary.json"));
   struct stat s;
   assert_int_not_equal(stat(WORK "/bad2-out", &s), 0);
 }
 
 static void test_run_files_and_summary(void **state) {
   (void)state;
-  result *r = navsim(NULL, "run '" SCENE "' --out run1 --quiet --ideal --seed 42");
+  nav_cli_result *r = navsim(NULL, "run '" SCENE "' --out run1 --quiet --ideal --seed 42");
   if (r->code != 0) fail_msg("navsim run failed (%d): %s", r->code, r->err);
   assert_string_equal(r->out, "");
   const char *files[] = {"summary.json", "truth.csv", "nav.csv", "errors.csv"};
   for (int i = 0; i < 4; ++i) {
     char p[1024];
     snprintf(p, sizeof p, "%s/run1/%s", WORK, files[i]);
-    if (!is_file(p)) fail_msg("missing %s", p);
+    if (!nav_test_is_file(p)) fail_msg("missing %s", p);
   }
   static char js[65536];
-  slurp(WORK "/run1/summary.json", js, sizeof js);
-  assert_matches(js, "\"navsim_version\": \"[0-9]+\\.[0-9]+\\.[0-9]+\"");
-  assert_matches(js, "\"scene\": \\{\"name\": \"paper-parametric\", \"file\": \"[^\"]*paper-parametric\\.yaml\"\\}");
+  nav_test_slurp(WORK "/run1/summary.json", js, sizeof js);
+  nav_test_assert_matches(js, "\"navsim_version\": \"[0-9]+\\.[0-9]+\\.[0-9]+\"");
+  nav_test_assert_matches(
+      js, "\"scene\": \\{\"name\": \"paper-parametric\", \"file\": \"[^\"]*paper-parametric\\.yaml\"\\}");
   assert_near(json_number(js, NULL, "seed"), 42.0, 0.0);
   assert_near(json_number(js, NULL, "runs"), 1.0, 0.0);
-  assert_matches(js, "\"ideal\": true");
+  nav_test_assert_matches(js, "\"ideal\": true");
   assert_near(json_number(js, NULL, "duration_s"), 20.0, 1e-9);
   assert_near(json_number(js, NULL, "imu_rate_hz"), 100.0, 0.0);
   assert_true(json_number(js, "timing", "wall_s") > 0.0);
@@ -231,14 +183,14 @@ static void test_run_files_and_summary(void **state) {
 
 static void test_csv_tables(void **state) {
   (void)state;
-  result *r = navsim(NULL, "run '" SCENE "' --out run2 --quiet --ideal");
+  nav_cli_result *r = navsim(NULL, "run '" SCENE "' --out run2 --quiet --ideal");
   assert_int_equal(r->code, 0);
   static char buf[1 << 20];
   const char *state_cols = "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_mps,vel_d_mps,"
                            "roll_deg,pitch_deg,yaw_deg\n";
   const char *tables[2] = {WORK "/run2/truth.csv", WORK "/run2/nav.csv"};
   for (int t = 0; t < 2; ++t) {
-    slurp(tables[t], buf, sizeof buf);
+    nav_test_slurp(tables[t], buf, sizeof buf);
     assert_int_equal(strncmp(buf, state_cols, strlen(state_cols)), 0);
     int lines = 0;
     for (const char *p = buf; *p; ++p) lines += *p == '\n';
@@ -247,9 +199,10 @@ static void test_csv_tables(void **state) {
     while (last > buf && *last != '\n') --last;
     assert_near(strtod(last + 1, NULL), 20.0, 1e-12);
   }
-  slurp(WORK "/run2/errors.csv", buf, sizeof buf);
-  assert_matches(buf, "^t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,"
-                      "vel_err_e_mps,vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg$");
+  nav_test_slurp(WORK "/run2/errors.csv", buf, sizeof buf);
+  nav_test_assert_matches(
+      buf, "^t_s,pos_err_n_m,pos_err_e_m,pos_err_d_m,pos_err_h_m,pos_err_v_m,vel_err_n_mps,"
+           "vel_err_e_mps,vel_err_d_mps,vel_err_mps,att_err_rad,roll_err_deg,pitch_err_deg,yaw_err_deg$");
   /* Every cell of every data row is a number. */
   const char *p = strchr(buf, '\n') + 1;
   while (*p) {
@@ -264,10 +217,10 @@ static void test_csv_tables(void **state) {
 static void test_default_out_dir_and_summary_on_terminal(void **state) {
   (void)state;
   assert_int_equal(system("mkdir -p '" WORK "/cwd'"), 0);
-  result *r = navsim(WORK "/cwd", "run '" SCENE "' --ideal");
+  nav_cli_result *r = navsim(WORK "/cwd", "run '" SCENE "' --ideal");
   assert_int_equal(r->code, 0);
   assert_non_null(strstr(r->out, "out/paper-parametric"));
-  assert_true(is_file(WORK "/cwd/out/paper-parametric/summary.json"));
+  assert_true(nav_test_is_file(WORK "/cwd/out/paper-parametric/summary.json"));
 }
 
 static void test_deterministic_and_atomic_replace(void **state) {
@@ -278,18 +231,18 @@ static void test_deterministic_and_atomic_replace(void **state) {
   for (int i = 0; i < 3; ++i) {
     char p[1024];
     snprintf(p, sizeof p, "%s/det/%s", WORK, names[i]);
-    slurp(p, a[i], sizeof a[i]);
+    nav_test_slurp(p, a[i], sizeof a[i]);
   }
-  write_file("det/stale.txt", "from an earlier run");
+  nav_test_write_file(WORK, "det/stale.txt", "from an earlier run");
   assert_int_equal(navsim(NULL, "run '" SCENE "' --out det --quiet --seed 7")->code, 0);
   for (int i = 0; i < 3; ++i) {
     char p[1024];
     snprintf(p, sizeof p, "%s/det/%s", WORK, names[i]);
-    slurp(p, b[i], sizeof b[i]);
+    nav_test_slurp(p, b[i], sizeof b[i]);
     assert_string_equal(a[i], b[i]);
   }
   /* The earlier directory was replaced as a whole; no temporary directory is left behind. */
-  assert_false(is_file(WORK "/det/stale.txt"));
+  assert_false(nav_test_is_file(WORK "/det/stale.txt"));
   DIR *d = opendir(WORK);
   struct dirent *e;
   while ((e = readdir(d)) != NULL)
@@ -299,18 +252,19 @@ static void test_deterministic_and_atomic_replace(void **state) {
 
 static void test_monte_carlo_outputs(void **state) {
   (void)state;
-  result *r = navsim(NULL, "run '" SCENE "' --out mc --quiet --runs 3 --threads 2");
+  nav_cli_result *r = navsim(NULL, "run '" SCENE "' --out mc --quiet --runs 3 --threads 2");
   if (r->code != 0) fail_msg("navsim run --runs 3 failed (%d): %s", r->code, r->err);
   static char buf[1 << 18];
-  slurp(WORK "/mc/mc_stats.csv", buf, sizeof buf);
-  assert_matches(buf, "^t_s,pos_mean_n_m,pos_mean_e_m,pos_mean_d_m,pos_rms_n_m,pos_rms_e_m,pos_rms_d_m,pos_h_rms_m,"
-                      "pos_h_max_m,vel_rms_mps,att_rms_rad,pos_sd_reported_n_m,pos_sd_reported_e_m,"
-                      "pos_sd_reported_d_m,nees9_mean$");
-  slurp(WORK "/mc/mc_final.csv", buf, sizeof buf);
+  nav_test_slurp(WORK "/mc/mc_stats.csv", buf, sizeof buf);
+  nav_test_assert_matches(
+      buf, "^t_s,pos_mean_n_m,pos_mean_e_m,pos_mean_d_m,pos_rms_n_m,pos_rms_e_m,pos_rms_d_m,pos_h_rms_m,"
+           "pos_h_max_m,vel_rms_mps,att_rms_rad,pos_sd_reported_n_m,pos_sd_reported_e_m,"
+           "pos_sd_reported_d_m,nees9_mean$");
+  nav_test_slurp(WORK "/mc/mc_final.csv", buf, sizeof buf);
   int lines = 0;
   for (const char *p = buf; *p; ++p) lines += *p == '\n';
   assert_int_equal(lines, 1 + 3);
-  slurp(WORK "/mc/summary.json", buf, sizeof buf);
+  nav_test_slurp(WORK "/mc/summary.json", buf, sizeof buf);
   assert_near(json_number(buf, NULL, "runs"), 3.0, 0.0);
 }
 
@@ -354,19 +308,21 @@ static int csv_rows(const char *csv) {
  * must equal them exactly (signs and units: deg/s for gyros, m/s^2 for accelerometers). */
 static void test_run_imu_errors(void **state) {
   (void)state;
-  write_file("errs.yaml", "format_version: 1\nname: errs\n"
-                          "earth: {model: flat, origin: {lat_deg: 45, lon_deg: 0, h_m: 0}}\n"
-                          "trajectory: {type: test_motion, duration_s: 5, test_motion: {kind: stationary}}\n"
-                          "imu:\n  rate_hz: 100\n"
-                          "  gyro: {bias_turn_on_fixed_deg_per_h: [36, 0, -72]}\n"
-                          "  accel: {bias_turn_on_fixed_mg: [1, -2, 0]}\n"
-                          "output: {rate_hz: 10}\n");
-  result *r = navsim(NULL, "run errs.yaml --out errs-run --quiet");
+  nav_test_write_file(WORK, "errs.yaml",
+                      "format_version: 1\nname: errs\n"
+                      "earth: {model: flat, origin: {lat_deg: 45, lon_deg: 0, h_m: 0}}\n"
+                      "trajectory: {type: test_motion, duration_s: 5, test_motion: {kind: stationary}}\n"
+                      "imu:\n  rate_hz: 100\n"
+                      "  gyro: {bias_turn_on_fixed_deg_per_h: [36, 0, -72]}\n"
+                      "  accel: {bias_turn_on_fixed_mg: [1, -2, 0]}\n"
+                      "output: {rate_hz: 10}\n");
+  nav_cli_result *r = navsim(NULL, "run errs.yaml --out errs-run --quiet");
   if (r->code != 0) fail_msg("navsim run failed (%d): %s", r->code, r->err);
   static char buf[1 << 16];
-  slurp(WORK "/errs-run/imu_errors.csv", buf, sizeof buf);
-  assert_matches(buf, "^t_s,gyro_err_x_dps,gyro_err_y_dps,gyro_err_z_dps,accel_err_x_mps2,accel_err_y_mps2,"
-                      "accel_err_z_mps2$");
+  nav_test_slurp(WORK "/errs-run/imu_errors.csv", buf, sizeof buf);
+  nav_test_assert_matches(
+      buf, "^t_s,gyro_err_x_dps,gyro_err_y_dps,gyro_err_z_dps,accel_err_x_mps2,accel_err_y_mps2,"
+           "accel_err_z_mps2$");
   assert_int_equal(csv_rows(buf), 50); /* 10 Hz over 5 s; no row at t = 0 (no interval yet) */
   const double expect[6] = {0.01, 0.0, -0.02, 1e-3 * 9.80665, -2e-3 * 9.80665, 0.0};
   for (int row = 0; row < 50; row += 7) {
@@ -375,12 +331,12 @@ static void test_run_imu_errors(void **state) {
   }
   r = navsim(NULL, "run errs.yaml --out errs-ideal --quiet --ideal");
   assert_int_equal(r->code, 0);
-  assert_true(is_file(WORK "/errs-ideal/errors.csv"));
-  assert_false(is_file(WORK "/errs-ideal/imu_errors.csv"));
+  assert_true(nav_test_is_file(WORK "/errs-ideal/errors.csv"));
+  assert_false(nav_test_is_file(WORK "/errs-ideal/imu_errors.csv"));
   /* A scene without error terms writes none either (run1 of test_run_files_and_summary is --ideal). */
   r = navsim(NULL, "run '" SCENE "' --out noerr --quiet");
   assert_int_equal(r->code, 0);
-  assert_false(is_file(WORK "/noerr/imu_errors.csv"));
+  assert_false(nav_test_is_file(WORK "/noerr/imu_errors.csv"));
 }
 
 /* Issue 4 item 6: navsim estimate writes the closed form E1.21 (numerics.md 1.4) for the scene,
@@ -388,16 +344,18 @@ static void test_run_imu_errors(void **state) {
  * value is computed here from the formula with the scene's inputs converted to SI. */
 static void test_estimate_e121(void **state) {
   (void)state;
-  write_file("est.yaml", "format_version: 1\nname: est-e121\n"
-                         "earth: {model: flat, origin: {lat_deg: 45, lon_deg: 0, h_m: 0}, gravity_mps2: 9.80665}\n"
-                         "trajectory: {type: test_motion, duration_s: 60, test_motion: {kind: stationary}}\n"
-                         "imu:\n  rate_hz: 100\n"
-                         "  gyro: {arw_deg_per_sqrt_h: 0.1, bias_turn_on_deg_per_h: 10}\n"
-                         "  accel: {vrw_m_per_s_per_sqrt_h: 0.06, bias_turn_on_mg: 1}\n"
-                         "initial_errors: {position_m: [1, 1, 2], velocity_mps: [0.1, 0.1, 0.05], "
-                         "attitude_deg: [0.01, 0.01, 0.1]}\n"
-                         "output: {rate_hz: 1}\n");
-  result *r = navsim(NULL, "estimate est.yaml --out est --quiet");
+  nav_test_write_file(
+      WORK, "est.yaml",
+      "format_version: 1\nname: est-e121\n"
+      "earth: {model: flat, origin: {lat_deg: 45, lon_deg: 0, h_m: 0}, gravity_mps2: 9.80665}\n"
+      "trajectory: {type: test_motion, duration_s: 60, test_motion: {kind: stationary}}\n"
+      "imu:\n  rate_hz: 100\n"
+      "  gyro: {arw_deg_per_sqrt_h: 0.1, bias_turn_on_deg_per_h: 10}\n"
+      "  accel: {vrw_m_per_s_per_sqrt_h: 0.06, bias_turn_on_mg: 1}\n"
+      "initial_errors: {position_m: [1, 1, 2], velocity_mps: [0.1, 0.1, 0.05], "
+      "attitude_deg: [0.01, 0.01, 0.1]}\n"
+      "output: {rate_hz: 1}\n");
+  nav_cli_result *r = navsim(NULL, "estimate est.yaml --out est --quiet");
   if (r->code != 0) fail_msg("navsim estimate failed (%d): %s", r->code, r->err);
   const double pi = 3.14159265358979323846, g = 9.80665, t = 60.0;
   const double dr0 = 1.0, dv0 = 0.1, psi0 = 0.01 * pi / 180.0, b_a = 1e-3 * g, n_a = 0.06 / 60.0;
@@ -408,7 +366,7 @@ static void test_estimate_e121(void **state) {
                            b_a * b_a * pow(t, 4) / 4 + n_a * n_a * pow(t, 3) / 3 +
                            g * g * b_g * b_g * pow(t, 6) / 36 + g * g * n_g * n_g * pow(t, 5) / 20);
   static char csv[1 << 18];
-  slurp(WORK "/est/estimate.csv", csv, sizeof csv);
+  nav_test_slurp(WORK "/est/estimate.csv", csv, sizeof csv);
   const int last = csv_rows(csv) - 1;
   assert_int_equal(last, 60); /* 1 Hz over 60 s, both ends */
   assert_near(csv_cell(csv, last, 0), t, 0.0);
@@ -422,10 +380,10 @@ static void test_estimate_e121(void **state) {
     assert_rel_near(csv_cell(csv, last, c), expect[i], 1e-6);
   }
   static char js[1 << 16];
-  slurp(WORK "/est/estimate.json", js, sizeof js);
+  nav_test_slurp(WORK "/est/estimate.json", js, sizeof js);
   assert_rel_near(json_number(js, "analytic_final", "pos_sd_m"), e121, 1e-6);
   assert_rel_near(json_number(js, "analytic_final", "pos_h_sd_m"), sqrt(2.0) * e121, 1e-6);
-  assert_matches(js, "\"requirements\": \\[\\]");
+  nav_test_assert_matches(js, "\"requirements\": \\[\\]");
 }
 
 /* Issue 4 item 4 and its Done-when: navsim allan on a catalog part reproduces its ARW and VRW
@@ -433,15 +391,16 @@ static void test_estimate_e121(void **state) {
  * below 0.83 %, so 5 % is more than 6 sigma). */
 static void test_allan_catalog_part(void **state) {
   (void)state;
-  result *r = navsim(NULL, "allan --imu 'Safran Sensonor STIM300' --out allan1 --strict --quiet");
+  nav_cli_result *r = navsim(NULL, "allan --imu 'Safran Sensonor STIM300' --out allan1 --strict --quiet");
   if (r->code != 0) fail_msg("navsim allan failed (%d): %s", r->code, r->err);
   static char buf[1 << 16];
-  slurp(WORK "/allan1/allan.csv", buf, sizeof buf);
-  assert_matches(buf, "^tau_s,adev_gx_rad_per_s,adev_gy_rad_per_s,adev_gz_rad_per_s,adev_ax_mps2,adev_ay_mps2,"
-                      "adev_az_mps2,");
+  nav_test_slurp(WORK "/allan1/allan.csv", buf, sizeof buf);
+  nav_test_assert_matches(
+      buf, "^tau_s,adev_gx_rad_per_s,adev_gy_rad_per_s,adev_gz_rad_per_s,adev_ax_mps2,adev_ay_mps2,"
+           "adev_az_mps2,");
   assert_near(csv_cell(buf, 0, 0), 0.01, 1e-12);
-  slurp(WORK "/allan1/summary.json", buf, sizeof buf);
-  assert_matches(buf, "\"pass\": true\n}");
+  nav_test_slurp(WORK "/allan1/summary.json", buf, sizeof buf);
+  nav_test_assert_matches(buf, "\"pass\": true\n}");
   const char *chans[] = {"gx", "gy", "gz", "ax", "ay", "az"};
   for (int c = 0; c < 6; ++c) {
     char key[32];
@@ -454,18 +413,19 @@ static void test_allan_catalog_part(void **state) {
   assert_int_equal(navsim(NULL, "allan --imu 'no such part' --out allan2")->code, 2);
   /* A scene IMU whose angle quantum (1 mrad) hides its ARW at every tau up to 10 s: there is no
    * -1/2 slope to read, the gyro checks fail and --strict exits 3. */
-  write_file("quant.yaml", "format_version: 1\nname: quant\n"
-                           "trajectory: {type: test_motion, duration_s: 10, test_motion: {kind: stationary}}\n"
-                           "imu:\n  rate_hz: 100\n"
-                           "  gyro: {arw_deg_per_sqrt_h: 0.15, quantisation_rad: 1.0e-3}\n"
-                           "  accel: {vrw_m_per_s_per_sqrt_h: 0.05}\n");
+  nav_test_write_file(WORK, "quant.yaml",
+                      "format_version: 1\nname: quant\n"
+                      "trajectory: {type: test_motion, duration_s: 10, test_motion: {kind: stationary}}\n"
+                      "imu:\n  rate_hz: 100\n"
+                      "  gyro: {arw_deg_per_sqrt_h: 0.15, quantisation_rad: 1.0e-3}\n"
+                      "  accel: {vrw_m_per_s_per_sqrt_h: 0.05}\n");
   r = navsim(NULL, "allan quant.yaml --duration 1800 --out allan3 --quiet");
   assert_int_equal(r->code, 0);
   r = navsim(NULL, "allan quant.yaml --duration 1800 --out allan3 --quiet --strict");
   assert_int_equal(r->code, 3);
   assert_non_null(strstr(r->err, "3 of 6 ARW/VRW checks failed"));
-  slurp(WORK "/allan3/summary.json", buf, sizeof buf);
-  assert_matches(buf, "\"pass\": false\n}");
+  nav_test_slurp(WORK "/allan3/summary.json", buf, sizeof buf);
+  nav_test_assert_matches(buf, "\"pass\": false\n}");
 }
 
 /* navsim render (viewer built): both PNGs of a result directory appear and are real images. */
@@ -473,7 +433,7 @@ static void test_render(void **state) {
   (void)state;
 #ifdef NAV_HAVE_VIEWER
   assert_int_equal(navsim(NULL, "run '" SCENE "' --out rend --quiet --ideal")->code, 0);
-  result *r = navsim(NULL, "render rend --size 320x240");
+  nav_cli_result *r = navsim(NULL, "render rend --size 320x240");
   if (r->code != 0) fail_msg("navsim render failed (%d): %s", r->code, r->err);
   const char *pngs[2] = {WORK "/rend/view.png", WORK "/rend/errors.png"};
   for (int i = 0; i < 2; ++i) {

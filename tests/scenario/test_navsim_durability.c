@@ -32,6 +32,7 @@
 
 #include "navcore/nav_io.h"
 #include "navcore/nav_rng.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define SCENE WORK "/durability.yaml"
@@ -101,27 +102,12 @@ static int run_sync(char *const argv[]) {
 
 /* ---------------------------------------------------------------- files */
 
-static char *slurp(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  assert_non_null(b);
-  const size_t got = fread(b, 1, (size_t)n, f);
-  fclose(f);
-  b[got] = '\0';
-  *len = got;
-  return b;
-}
-
 /* FNV-1a 64 of a result file; for summary.json the wall-time line ("timing") is skipped. */
 static uint64_t file_hash(const char *dir, const char *name) {
   char path[2048];
   snprintf(path, sizeof path, "%s/%s", dir, name);
   size_t n = 0;
-  char *b = slurp(path, &n);
+  char *b = nav_test_slurp_len(path, &n);
   if (!b) fail_msg("%s: missing", path);
   uint64_t h = 1469598103934665603ull;
   const bool summary = strcmp(name, "summary.json") == 0;
@@ -236,7 +222,7 @@ static void assert_complete(const char *dir, const result_sig *ref, const char *
   char path[2048];
   snprintf(path, sizeof path, "%s/summary.json", dir);
   size_t n = 0;
-  char *js = slurp(path, &n);
+  char *js = nav_test_slurp_len(path, &n);
   if (!js) fail_msg("%s: %s has no summary.json (torn result)", what, dir);
   if (!json_valid(js)) fail_msg("%s: summary.json does not parse", what);
   free(js);
@@ -393,7 +379,7 @@ static void test_kill_during_scene_save(void **state) {
   assert_int_equal(nav_scene_write_file(a_path, &sa), NAV_OK);
   assert_int_equal(nav_scene_write_file(b_path, &sb), NAV_OK);
   size_t la = 0, lb = 0;
-  char *ta = slurp(a_path, &la), *tb = slurp(b_path, &lb);
+  char *ta = nav_test_slurp_len(a_path, &la), *tb = nav_test_slurp_len(b_path, &lb);
   assert_non_null(ta);
   assert_non_null(tb);
   assert_int_equal(nav_scene_write_file(path, &sa), NAV_OK);
@@ -411,7 +397,7 @@ static void test_kill_during_scene_save(void **state) {
     int sig = 0;
     (void)wait_code(pid, &sig);
     size_t l = 0;
-    char *t = slurp(path, &l);
+    char *t = nav_test_slurp_len(path, &l);
     if (!t) fail_msg("cycle %ld: %s is gone after SIGKILL at %.3f s", c, path, delay);
     if (l == la && memcmp(t, ta, la) == 0) ++saw_a;
     else if (l == lb && memcmp(t, tb, lb) == 0) ++saw_b;

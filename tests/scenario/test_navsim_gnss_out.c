@@ -20,24 +20,9 @@
 #include <sys/wait.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
-
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *buf = malloc((size_t)n + 1);
-  if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-    free(buf);
-    buf = NULL;
-  }
-  if (buf) buf[n] = '\0';
-  fclose(f);
-  return buf;
-}
 
 /* Replace the first occurrence of `from` in `s` (heap string) by `to`. */
 static char *replace(char *s, const char *from, const char *to) {
@@ -55,7 +40,7 @@ static char *replace(char *s, const char *from, const char *to) {
 
 static void every_fix_at_the_receiver_rate(void **state) {
   (void)state;
-  char *scene = slurp(NAV_SOURCE_DIR "/scenes/urban-drive.yaml");
+  char *scene = nav_test_slurp_alloc(NAV_SOURCE_DIR "/scenes/urban-drive.yaml");
   assert_non_null(scene);
   scene = replace(scene, "output:\n  rate_hz: 10", "output:\n  rate_hz: 1");
   scene = replace(scene, "gnss:\n  enabled: true\n", "gnss:\n  enabled: true\n  update_rate_hz: 5\n");
@@ -71,11 +56,11 @@ static void every_fix_at_the_receiver_rate(void **state) {
            NAVSIM_EXE);
   const int st = system(cmd);
   if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-    char *log = slurp(WORK "/gn.log");
+    char *log = nav_test_slurp_alloc(WORK "/gn.log");
     fail_msg("navsim run failed:\n%s", log ? log : "");
   }
   /* Outages. */
-  char *out = slurp(WORK "/gn/gnss_outages.csv");
+  char *out = nav_test_slurp_alloc(WORK "/gn/gnss_outages.csv");
   assert_non_null(out);
   double o0[8], o1[8];
   int no = 0;
@@ -84,7 +69,7 @@ static void every_fix_at_the_receiver_rate(void **state) {
   free(out);
   assert_int_equal(no, 2);
   /* Duration: the last truth row. */
-  char *truth = slurp(WORK "/gn/truth.csv");
+  char *truth = nav_test_slurp_alloc(WORK "/gn/truth.csv");
   assert_non_null(truth);
   char *last = truth + strlen(truth) - 2;
   while (last > truth && *last != '\n') --last;
@@ -92,7 +77,7 @@ static void every_fix_at_the_receiver_rate(void **state) {
   free(truth);
   assert_true(t_end > 400.0);
   /* The fixes. */
-  char *csv = slurp(WORK "/gn/gnss.csv");
+  char *csv = nav_test_slurp_alloc(WORK "/gn/gnss.csv");
   assert_non_null(csv);
   long rows = 0, regular = 0, across = 0;
   double prev = NAN;

@@ -31,6 +31,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "navsim_cli.h"
+
 #define HOSTILE NAV_TEST_DATA_DIR "/hostile"
 #define REPLAY NAV_TEST_DATA_DIR "/replay"
 #define WORK NAV_TEST_WORK_DIR
@@ -55,15 +57,6 @@ typedef struct outcome {
 
 static long g_worst_rss_kb;
 static char g_worst_rss_case[256];
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "rb");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
 
 /* Run navsim with @p argv (NULL-terminated, argv[0] ignored) in @p cwd. */
 static void run_navsim(const char *cwd, char *const argv[], outcome *o) {
@@ -107,7 +100,7 @@ static void run_navsim(const char *cwd, char *const argv[], outcome *o) {
   o->code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   o->signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
   o->maxrss_kb = ru.ru_maxrss;
-  slurp(WORK "/stderr.txt", o->err, sizeof o->err);
+  nav_test_slurp(WORK "/stderr.txt", o->err, sizeof o->err);
   if (o->maxrss_kb > g_worst_rss_kb) {
     g_worst_rss_kb = o->maxrss_kb;
     snprintf(g_worst_rss_case, sizeof g_worst_rss_case, "%s %s", argv[1], argv[2] ? argv[2] : "");
@@ -230,7 +223,7 @@ static void expect_import(const char *file, const char *loc, const char *fragmen
     assert_clean_exit(o, what, 0);
     char *text = malloc(1 << 20);
     assert_non_null(text);
-    slurp(WORK "/imported.yaml", text, 1 << 20);
+    nav_test_slurp(WORK "/imported.yaml", text, 1 << 20);
     if (strstr(text, fragment)) fail_msg("%s: the written scene contains \"%s\"", what, fragment);
     free(text);
     remove(WORK "/imported.yaml");

@@ -29,25 +29,10 @@
 #include <unistd.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define DATA NAV_SHARED_DIR "/data/gnss-ins-sim-long-drive/"
-
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *buf = malloc((size_t)n + 1);
-  if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-    free(buf);
-    buf = NULL;
-  }
-  if (buf) buf[n] = '\0';
-  fclose(f);
-  return buf;
-}
 
 /* Runs the replay of one GNSS file into WORK/<out>; returns summary.json (caller frees). */
 static char *replay(const char *gnss_file, const char *out) {
@@ -61,13 +46,13 @@ static char *replay(const char *gnss_file, const char *out) {
   if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
     char log[1024];
     snprintf(log, sizeof log, "%s/%s.log", WORK, out);
-    char *text = slurp(log);
+    char *text = nav_test_slurp_alloc(log);
     fail_msg("navsim replay --gnss %s exited %d:\n%s", gnss_file, WIFEXITED(st) ? WEXITSTATUS(st) : -1,
              text ? text : "(no log)");
   }
   char path[1024];
   snprintf(path, sizeof path, "%s/%s/summary.json", WORK, out);
-  char *json = slurp(path);
+  char *json = nav_test_slurp_alloc(path);
   assert_non_null(json);
   return json;
 }

@@ -21,52 +21,11 @@
 #include <sys/wait.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
-
-typedef struct result {
-  int code;
-  char out[16384];
-  char err[16384];
-} result;
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "r");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
-
-static result *navsim(const char *args) {
-  static result r;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", WORK, NAVSIM_EXE, args, WORK,
-           WORK);
-  const int st = system(cmd);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  slurp(WORK "/stdout.txt", r.out, sizeof r.out);
-  slurp(WORK "/stderr.txt", r.err, sizeof r.err);
-  return &r;
-}
-
-static void write_file(const char *name, const char *text) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/%s", WORK, name);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
-
-static void assert_matches(const char *text, const char *pattern) {
-  regex_t re;
-  assert_int_equal(regcomp(&re, pattern, REG_EXTENDED | REG_NEWLINE), 0);
-  const int rc = regexec(&re, text, 0, NULL, 0);
-  regfree(&re);
-  if (rc != 0) fail_msg("\"%s\" does not match /%s/", text, pattern);
-}
+/* Run "navsim ARGS" in WORK; both streams captured. */
+#define navsim(args) nav_test_run_cli(NAVSIM_EXE, WORK, NULL, (args))
 
 /* The "requirements" list of a summary.json (from its key to the end). */
 static const char *requirements_of(const char *json) {
@@ -91,21 +50,23 @@ static const char *requirements_of(const char *json) {
 
 static int setup(void **state) {
   (void)state;
-  char cmd[1024];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", WORK, WORK);
-  if (system(cmd) != 0) return -1;
-  write_file("pass.yaml", SCENE_HEAD "requirements:\n"
-                                     "  - {id: h-rms, metric: horizontal_position, statistic: rms, limit: 10, unit: km}\n"
-                                     "  - {id: yaw-max, metric: yaw, statistic: max, limit: 180, unit: deg}\n");
-  write_file("fail.yaml", SCENE_HEAD "requirements:\n"
-                                     "  - {id: h-rms, metric: horizontal_position, statistic: rms, limit: 10, unit: km}\n"
-                                     "  - {id: v-tiny, metric: velocity, statistic: p95, limit: 1e-9, unit: cm/s}\n");
+  if (nav_test_fresh_dir(WORK) != 0) return -1;
+  nav_test_write_file(WORK, "pass.yaml",
+                      SCENE_HEAD
+                      "requirements:\n"
+                      "  - {id: h-rms, metric: horizontal_position, statistic: rms, limit: 10, unit: km}\n"
+                      "  - {id: yaw-max, metric: yaw, statistic: max, limit: 180, unit: deg}\n");
+  nav_test_write_file(WORK, "fail.yaml",
+                      SCENE_HEAD
+                      "requirements:\n"
+                      "  - {id: h-rms, metric: horizontal_position, statistic: rms, limit: 10, unit: km}\n"
+                      "  - {id: v-tiny, metric: velocity, statistic: p95, limit: 1e-9, unit: cm/s}\n");
   return 0;
 }
 
 static void test_help_mentions_strict(void **state) {
   (void)state;
-  result *r = navsim("run --help");
+  nav_cli_result *r = navsim("run --help");
   assert_int_equal(r->code, 0);
   assert_non_null(strstr(r->out, "--strict"));
   assert_non_null(strstr(r->out, "3"));
@@ -113,34 +74,36 @@ static void test_help_mentions_strict(void **state) {
 
 static void test_passing_requirements(void **state) {
   (void)state;
-  result *r = navsim("run pass.yaml --out pass-out --strict --threads 1");
+  nav_cli_result *r = navsim("run pass.yaml --out pass-out --strict --threads 1");
   if (r->code != 0) fail_msg("navsim run --strict of a passing scene exited %d: %s", r->code, r->err);
-  assert_matches(r->out, "^requirements 2 of 2 pass$");
-  assert_matches(r->out, "^  PASS  h-rms +horizontal_position rms = [0-9.e+-]+ km <= 10 km$");
+  nav_test_assert_matches(r->out, "^requirements 2 of 2 pass$");
+  nav_test_assert_matches(r->out, "^  PASS  h-rms +horizontal_position rms = [0-9.e+-]+ km <= 10 km$");
   static char js[65536];
-  slurp(WORK "/pass-out/summary.json", js, sizeof js);
+  nav_test_slurp(WORK "/pass-out/summary.json", js, sizeof js);
   const char *q = requirements_of(js);
-  assert_matches(q, "\\{\"id\": \"h-rms\", \"metric\": \"horizontal_position\", \"statistic\": \"rms\", "
-                    "\"limit\": 10, \"unit\": \"km\", \"value\": [0-9.e+-]+, \"pass\": true");
-  assert_matches(q, "\\{\"id\": \"yaw-max\", \"metric\": \"yaw\", \"statistic\": \"max\", \"limit\": 180, "
-                    "\"unit\": \"deg\", \"value\": [0-9.e+-]+, \"pass\": true");
+  nav_test_assert_matches(
+      q, "\\{\"id\": \"h-rms\", \"metric\": \"horizontal_position\", \"statistic\": \"rms\", "
+         "\"limit\": 10, \"unit\": \"km\", \"value\": [0-9.e+-]+, \"pass\": true");
+  nav_test_assert_matches(
+      q, "\\{\"id\": \"yaw-max\", \"metric\": \"yaw\", \"statistic\": \"max\", \"limit\": 180, "
+         "\"unit\": \"deg\", \"value\": [0-9.e+-]+, \"pass\": true");
 }
 
 static void test_failing_requirement_exit_codes(void **state) {
   (void)state;
   /* Without --strict: exit 0, the failure in the summary and on the terminal. */
-  result *r = navsim("run fail.yaml --out fail-out");
+  nav_cli_result *r = navsim("run fail.yaml --out fail-out");
   if (r->code != 0) fail_msg("navsim run of a failing scene exited %d: %s", r->code, r->err);
-  assert_matches(r->out, "^requirements 1 of 2 pass$");
-  assert_matches(r->out, "^  FAIL  v-tiny +velocity p95 = [0-9.e+-]+ cm/s > 1e-09 cm/s$");
+  nav_test_assert_matches(r->out, "^requirements 1 of 2 pass$");
+  nav_test_assert_matches(r->out, "^  FAIL  v-tiny +velocity p95 = [0-9.e+-]+ cm/s > 1e-09 cm/s$");
   static char js[65536];
-  slurp(WORK "/fail-out/summary.json", js, sizeof js);
-  assert_matches(requirements_of(js), "\"id\": \"v-tiny\".*\"pass\": false");
+  nav_test_slurp(WORK "/fail-out/summary.json", js, sizeof js);
+  nav_test_assert_matches(requirements_of(js), "\"id\": \"v-tiny\".*\"pass\": false");
   /* --strict: exit 3, the results are still written. */
   r = navsim("run fail.yaml --out fail-strict --strict");
   assert_int_equal(r->code, 3);
-  slurp(WORK "/fail-strict/summary.json", js, sizeof js);
-  assert_matches(requirements_of(js), "\"id\": \"v-tiny\".*\"pass\": false");
+  nav_test_slurp(WORK "/fail-strict/summary.json", js, sizeof js);
+  nav_test_assert_matches(requirements_of(js), "\"id\": \"v-tiny\".*\"pass\": false");
   /* --strict --quiet: nothing on stdout, the failing verdict on stderr. */
   r = navsim("run fail.yaml --out fail-quiet --strict --quiet");
   assert_int_equal(r->code, 3);
@@ -150,25 +113,26 @@ static void test_failing_requirement_exit_codes(void **state) {
 
 static void test_verdicts_independent_of_threads(void **state) {
   (void)state;
-  result *r = navsim("run fail.yaml --out t1 --threads 1 --quiet");
+  nav_cli_result *r = navsim("run fail.yaml --out t1 --threads 1 --quiet");
   assert_int_equal(r->code, 0);
   r = navsim("run fail.yaml --out t2 --threads 2 --quiet");
   assert_int_equal(r->code, 0);
   static char a[65536], b[65536];
-  slurp(WORK "/t1/summary.json", a, sizeof a);
-  slurp(WORK "/t2/summary.json", b, sizeof b);
+  nav_test_slurp(WORK "/t1/summary.json", a, sizeof a);
+  nav_test_slurp(WORK "/t2/summary.json", b, sizeof b);
   assert_string_equal(requirements_of(a), requirements_of(b));
 }
 
 static void test_invalid_requirements_exit_2(void **state) {
   (void)state;
-  write_file("bad.yaml", SCENE_HEAD "requirements:\n"
-                                    "  - {id: x, metric: velocity, statistic: rms, limit: 1, unit: m/s}\n"
-                                    "  - {id: y, metric: velocity, statistic: rms, limit: 1, unit: m/s}\n"
-                                    "  - {id: z, metric: speed, statistic: rms, limit: 1, unit: m/s}\n");
-  result *r = navsim("run bad.yaml --out bad-out --strict");
+  nav_test_write_file(WORK, "bad.yaml",
+                      SCENE_HEAD "requirements:\n"
+                                 "  - {id: x, metric: velocity, statistic: rms, limit: 1, unit: m/s}\n"
+                                 "  - {id: y, metric: velocity, statistic: rms, limit: 1, unit: m/s}\n"
+                                 "  - {id: z, metric: speed, statistic: rms, limit: 1, unit: m/s}\n");
+  nav_cli_result *r = navsim("run bad.yaml --out bad-out --strict");
   assert_int_equal(r->code, 2);
-  assert_matches(r->err, "^bad\\.yaml:15:21: error: requirements\\[2\\]\\.metric: expected one of");
+  nav_test_assert_matches(r->err, "^bad\\.yaml:15:21: error: requirements\\[2\\]\\.metric: expected one of");
   struct stat s;
   assert_int_not_equal(stat(WORK "/bad-out", &s), 0);
   r = navsim("check bad.yaml");
@@ -188,22 +152,24 @@ static void test_replay_verdicts(void **state) {
            "  - {id: h-tiny, metric: horizontal_position, statistic: rms, limit: 1e-6, unit: m}\n",
            WORK);
   assert_int_equal(system(cmd), 0);
-  result *r = navsim("replay --imu '" NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt' --gnss '" NAV_TEST_DATA_DIR
-                     "/replay/GNSS-100195-100245.txt' --truth '" NAV_TEST_DATA_DIR
-                     "/replay/truth-100195-100245-20Hz.nav' --scene slice.yaml --outage 100220:100230 --peers none "
-                     "--out replay-out");
+  nav_cli_result *r =
+      navsim("replay --imu '" NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt' --gnss '" NAV_TEST_DATA_DIR
+             "/replay/GNSS-100195-100245.txt' --truth '" NAV_TEST_DATA_DIR
+             "/replay/truth-100195-100245-20Hz.nav' --scene slice.yaml --outage 100220:100230 --peers none "
+             "--out replay-out");
   if (r->code != 0) fail_msg("navsim replay exited %d: %s", r->code, r->err);
-  assert_matches(r->out, "^requirements 1 of 2 pass$");
-  assert_matches(r->out, "^  PASS  h-end +horizontal_position outage_end = [0-9.e+-]+ m <= 5 m$");
-  assert_matches(r->out, "^        outage \\[2[0-9.]+, 3[0-9.]+\\) s: ");
-  assert_matches(r->out, "^  FAIL  h-tiny ");
+  nav_test_assert_matches(r->out, "^requirements 1 of 2 pass$");
+  nav_test_assert_matches(r->out, "^  PASS  h-end +horizontal_position outage_end = [0-9.e+-]+ m <= 5 m$");
+  nav_test_assert_matches(r->out, "^        outage \\[2[0-9.]+, 3[0-9.]+\\) s: ");
+  nav_test_assert_matches(r->out, "^  FAIL  h-tiny ");
   static char js[262144];
-  slurp(WORK "/replay-out/summary.json", js, sizeof js);
+  nav_test_slurp(WORK "/replay-out/summary.json", js, sizeof js);
   const char *q = requirements_of(js);
-  assert_matches(q, "\"id\": \"h-end\", \"metric\": \"horizontal_position\", \"statistic\": \"outage_end\", "
-                    "\"limit\": 5, \"unit\": \"m\", \"value\": [0-9.e+-]+, \"pass\": true, \"samples\": 1, "
-                    "\"outages\": \\[\\{\"t0_s\": 2[0-9.]+, \"t1_s\": 3[0-9.]+, \"t_s\": ");
-  assert_matches(q, "\"id\": \"h-tiny\".*\"pass\": false");
+  nav_test_assert_matches(
+      q, "\"id\": \"h-end\", \"metric\": \"horizontal_position\", \"statistic\": \"outage_end\", "
+         "\"limit\": 5, \"unit\": \"m\", \"value\": [0-9.e+-]+, \"pass\": true, \"samples\": 1, "
+         "\"outages\": \\[\\{\"t0_s\": 2[0-9.]+, \"t1_s\": 3[0-9.]+, \"t_s\": ");
+  nav_test_assert_matches(q, "\"id\": \"h-tiny\".*\"pass\": false");
 }
 
 
@@ -212,39 +178,42 @@ static void test_replay_verdicts(void **state) {
  * predictable (max). */
 static void test_estimate_predictions(void **state) {
   (void)state;
-  write_file("est.yaml", "format_version: 1\n"
-                         "name: est\n"
-                         "earth: {model: wgs84, origin: {lat_deg: 45, lon_deg: 7, h_m: 200}}\n"
-                         "trajectory:\n"
-                         "  type: segments\n"
-                         "  segments:\n"
-                         "    v0_b_mps: [10, 0, 0]\n"
-                         "    items:\n"
-                         "      - {kind: hold, duration_s: 60}\n"
-                         "imu: {rate_hz: 100, catalog: \"Xsens MTi-300\"}\n"
-                         "gnss: {enabled: true, catalog: \"SBAS (WAAS/EGNOS class)\", outages: [[20, 40]]}\n"
-                         "initial_errors: {position_m: 2, velocity_mps: 0.1, attitude_deg: [0.5, 0.5, 2]}\n"
-                         "navigation: {scheme: ins_gnss}\n"
-                         "output: {rate_hz: 10}\n"
-                         "requirements:\n"
-                         "  - {id: h-end, metric: horizontal_position, statistic: outage_end, limit: 50, unit: m}\n"
-                         "  - {id: h-max, metric: horizontal_position, statistic: max, limit: 50, unit: m}\n");
-  result *r = navsim("estimate est.yaml --out est-out");
+  nav_test_write_file(
+      WORK, "est.yaml",
+      "format_version: 1\n"
+      "name: est\n"
+      "earth: {model: wgs84, origin: {lat_deg: 45, lon_deg: 7, h_m: 200}}\n"
+      "trajectory:\n"
+      "  type: segments\n"
+      "  segments:\n"
+      "    v0_b_mps: [10, 0, 0]\n"
+      "    items:\n"
+      "      - {kind: hold, duration_s: 60}\n"
+      "imu: {rate_hz: 100, catalog: \"Xsens MTi-300\"}\n"
+      "gnss: {enabled: true, catalog: \"SBAS (WAAS/EGNOS class)\", outages: [[20, 40]]}\n"
+      "initial_errors: {position_m: 2, velocity_mps: 0.1, attitude_deg: [0.5, 0.5, 2]}\n"
+      "navigation: {scheme: ins_gnss}\n"
+      "output: {rate_hz: 10}\n"
+      "requirements:\n"
+      "  - {id: h-end, metric: horizontal_position, statistic: outage_end, limit: 50, unit: m}\n"
+      "  - {id: h-max, metric: horizontal_position, statistic: max, limit: 50, unit: m}\n");
+  nav_cli_result *r = navsim("estimate est.yaml --out est-out");
   if (r->code != 0) fail_msg("navsim estimate exited %d: %s", r->code, r->err);
-  assert_matches(r->out, "^  PASS  h-end +horizontal_position outage_end = [0-9.e+-]+ m <= 50 m$");
-  assert_matches(r->out, "^  N/A   h-max ");
+  nav_test_assert_matches(r->out, "^  PASS  h-end +horizontal_position outage_end = [0-9.e+-]+ m <= 50 m$");
+  nav_test_assert_matches(r->out, "^  N/A   h-max ");
   static char js[1 << 20];
-  slurp(WORK "/est-out/estimate.json", js, sizeof js);
+  nav_test_slurp(WORK "/est-out/estimate.json", js, sizeof js);
   const char *q = requirements_of(js);
-  assert_matches(q, "\"id\": \"h-end\", \"metric\": \"horizontal_position\", \"statistic\": \"outage_end\", "
-                    "\"limit\": 50, \"unit\": \"m\", \"value\": [0-9.e+-]+, \"pass\": true, \"samples\": 1, "
-                    "\"outages\": \\[\\{\"t0_s\": 20, \"t1_s\": 40, \"t_s\": 39\\.[89]");
-  assert_matches(q, "\"id\": \"h-max\", .*\"value\": null, \"pass\": false");
+  nav_test_assert_matches(
+      q, "\"id\": \"h-end\", \"metric\": \"horizontal_position\", \"statistic\": \"outage_end\", "
+         "\"limit\": 50, \"unit\": \"m\", \"value\": [0-9.e+-]+, \"pass\": true, \"samples\": 1, "
+         "\"outages\": \\[\\{\"t0_s\": 20, \"t1_s\": 40, \"t_s\": 39\\.[89]");
+  nav_test_assert_matches(q, "\"id\": \"h-max\", .*\"value\": null, \"pass\": false");
   /* Flat Earth: no covariance analysis, nothing predicted. */
   r = navsim("estimate fail.yaml --out est-flat");
   assert_int_equal(r->code, 0);
-  slurp(WORK "/est-flat/estimate.json", js, sizeof js);
-  assert_matches(requirements_of(js), "\"id\": \"v-tiny\", .*\"value\": null, \"pass\": false");
+  nav_test_slurp(WORK "/est-flat/estimate.json", js, sizeof js);
+  nav_test_assert_matches(requirements_of(js), "\"id\": \"v-tiny\", .*\"value\": null, \"pass\": false");
 }
 
 
@@ -253,9 +222,11 @@ static void test_estimate_predictions(void **state) {
  * test_estimate_predictions (its est.yaml). */
 static void test_budget_cli(void **state) {
   (void)state;
-  result *r = navsim("budget est.yaml --out budget-out");
+  nav_cli_result *r = navsim("budget est.yaml --out budget-out");
   if (r->code != 0) fail_msg("navsim budget exited %d: %s", r->code, r->err);
-  assert_matches(r->out, "^h-end  horizontal_position outage_end: predicted [0-9.e+-]+ m \\(limit 50 m\\) at t = 39\\.9 s$");
+  nav_test_assert_matches(
+      r->out,
+      "^h-end  horizontal_position outage_end: predicted [0-9.e+-]+ m \\(limit 50 m\\) at t = 39\\.9 s$");
   FILE *f = fopen(WORK "/budget-out/budget.csv", "r");
   assert_non_null(f);
   char line[512];

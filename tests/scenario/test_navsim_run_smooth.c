@@ -20,10 +20,9 @@
 #include "navcore/nav_io.h"
 #include "navcore/nav_scene.h"
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
-
-static char g_out[1 << 16], g_err[1 << 14];
 
 static const char *k_scene_head =
     "format_version: 1\n"
@@ -79,45 +78,16 @@ static void write_scene(const char *name, const char *navigation) {
   assert_int_equal(fclose(f), 0);
 }
 
-static char *slurp_alloc(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  if (!b) {
-    fclose(f);
-    return NULL;
-  }
-  const size_t got = fread(b, 1, (size_t)n, f);
-  b[got] = '\0';
-  fclose(f);
-  return b;
-}
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "r");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
-
+/* Run "navsim ARGS" in WORK; both streams captured in g_r. @return the exit code. */
+static const nav_cli_result *g_r;
 static int navsim(const char *args) {
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", WORK, NAVSIM_EXE, args,
-           WORK, WORK);
-  const int st = system(cmd);
-  slurp(WORK "/stdout.txt", g_out, sizeof g_out);
-  slurp(WORK "/stderr.txt", g_err, sizeof g_err);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  g_r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, args);
+  return g_r->code;
 }
 
 static int setup(void **state) {
   (void)state;
-  if (system("rm -rf '" WORK "' && mkdir -p '" WORK "'") != 0) return -1;
+  if (nav_test_fresh_dir(WORK) != 0) return -1;
   return 0;
 }
 
@@ -148,15 +118,46 @@ static void test_run_writes_smoothed_results(void **state) {
   (void)state;
   write_scene("smooth.yaml", "navigation:\n  scheme: ins_gnss\n  smoother: true\n");
   assert_int_equal(navsim("run smooth.yaml --threads 1 --out t1 -q"), 0);
-  char *nav = slurp_alloc(WORK "/t1/nav.csv"), *err = slurp_alloc(WORK "/t1/errors.csv");
-  char *snav = slurp_alloc(WORK "/t1/nav_smoothed.csv"), *serr = slurp_alloc(WORK "/t1/smoothed_errors.csv");
+  char *nav = nav_test_slurp_alloc(WORK "/t1/nav.csv"), *err = nav_test_slurp_alloc(WORK "/t1/errors.csv");
+  char *snav = nav_test_slurp_alloc(WORK "/t1/nav_smoothed.csv");
+  char *serr = nav_test_slurp_alloc(WORK "/t1/smoothed_errors.csv");
   assert_non_null(nav);
   assert_non_null(err);
   assert_non_null(snav);
   assert_non_null(serr);
-  /* Same columns and the same epochs as the forward files. */
-  assert_int_equal(header_len(snav), header_len(nav));
+  /* The forward files' columns (nav_smoothed.csv adds the smoothed and forward sigmas) and the same
+   * epochs. */
+  static const char sigmas[] = ",sd_n_m,sd_e_m,sd_d_m,fwd_sd_n_m,fwd_sd_e_m,fwd_sd_d_m,sd_yaw_deg,fwd_sd_yaw_deg";
+  assert_int_equal(header_len(snav), header_len(nav) + strlen(sigmas));
   assert_memory_equal(snav, nav, header_len(nav));
+  assert_memory_equal(snav + header_len(nav), sigmas, strlen(sigmas));
+  /* Smoothed sigmas never exceed the forward ones (the backward pass only adds information). */
+  {
+    long rows = 0;
+    double fwd_max = 0.0, sm_at_max = 0.0;
+    for (const char *p = strchr(snav, '\n'); p && p[1]; p = strchr(p + 1, '\n')) {
+      const char *q = p + 1;
+      for (int c = 0; c < 13; ++c) q = strchr(q, ',') + 1;
+      double v[8];
+      for (int c = 0; c < 8; ++c) {
+        char *end = NULL;
+        v[c] = strtod(q, &end);
+        q = end + 1;
+      }
+      for (int c = 0; c < 3; ++c) assert_true(v[c] > 0.0 && v[c] <= v[3 + c] * (1.0 + 1e-9));
+      assert_true(v[6] > 0.0 && v[6] <= v[7] * (1.0 + 1e-9));
+      rows++;
+      if (v[3] > fwd_max) {
+        fwd_max = v[3];
+        sm_at_max = v[0];
+      }
+    }
+    /* Deep in the GNSS outage the forward sigma peaks; there the smoother, which also has the fixes
+     * after the outage, knows the position much better. */
+    print_message("nav_smoothed.csv: %ld rows; largest forward north sigma %.3g m, smoothed there %.3g m\n", rows,
+                  fwd_max, sm_at_max);
+    assert_true(sm_at_max < 0.5 * fwd_max);
+  }
   assert_int_equal(header_len(serr), header_len(err));
   assert_memory_equal(serr, err, header_len(err));
   assert_int_equal(lines(snav), lines(nav));
@@ -164,7 +165,7 @@ static void test_run_writes_smoothed_results(void **state) {
   assert_true(lines(snav) > 1000);
   /* The smoothed solution differs from the forward one (the smoother did something). */
   assert_true(strcmp(snav, nav) != 0);
-  char *js = slurp_alloc(WORK "/t1/summary.json");
+  char *js = nav_test_slurp_alloc(WORK "/t1/summary.json");
   assert_non_null(js);
   assert_non_null(strstr(js, "\"stats_smoothed\""));
   assert_non_null(strstr(js, "\"smoother_bytes_max\""));
@@ -188,14 +189,14 @@ static void test_run_writes_smoothed_results(void **state) {
     char a[512], b[512];
     snprintf(a, sizeof a, "%s/t1/%s", WORK, files[i]);
     snprintf(b, sizeof b, "%s/t2/%s", WORK, files[i]);
-    char *x = slurp_alloc(a), *y = slurp_alloc(b);
+    char *x = nav_test_slurp_alloc(a), *y = nav_test_slurp_alloc(b);
     assert_non_null(x);
     assert_non_null(y);
     if (strcmp(x, y) != 0) fail_msg("%s differs between --threads 1 and 2", files[i]);
     free(x);
     free(y);
   }
-  char *js2 = slurp_alloc(WORK "/t2/summary.json");
+  char *js2 = nav_test_slurp_alloc(WORK "/t2/summary.json");
   assert_non_null(js2);
   const char *b1 = strstr(js, "\"stats\""), *b2 = strstr(js2, "\"stats\"");
   const char *e1 = strstr(js, "\"requirements\""), *e2 = strstr(js2, "\"requirements\"");
@@ -232,14 +233,15 @@ static void test_mpi_same_as_threads(void **state) {
     char a[512], b[512];
     snprintf(a, sizeof a, "%s/m1/%s", WORK, files[i]);
     snprintf(b, sizeof b, "%s/mpi/%s", WORK, files[i]);
-    char *x = slurp_alloc(a), *y = slurp_alloc(b);
+    char *x = nav_test_slurp_alloc(a), *y = nav_test_slurp_alloc(b);
     assert_non_null(x);
     assert_non_null(y);
     if (strcmp(x, y) != 0) fail_msg("%s differs between threads and MPI", files[i]);
     free(x);
     free(y);
   }
-  char *j1 = slurp_alloc(WORK "/m1/summary.json"), *j2 = slurp_alloc(WORK "/mpi/summary.json");
+  char *j1 = nav_test_slurp_alloc(WORK "/m1/summary.json");
+  char *j2 = nav_test_slurp_alloc(WORK "/mpi/summary.json");
   assert_non_null(j1);
   assert_non_null(j2);
   const char *b1 = strstr(j1, "\"stats_smoothed\""), *b2 = strstr(j2, "\"stats_smoothed\"");
@@ -257,13 +259,13 @@ static void test_run_without_smoother(void **state) {
   (void)state;
   write_scene("plain.yaml", "navigation:\n  scheme: ins_gnss\n");
   assert_int_equal(navsim("run plain.yaml --runs 1 --out plain -q"), 0);
-  char *js = slurp_alloc(WORK "/plain/summary.json");
+  char *js = nav_test_slurp_alloc(WORK "/plain/summary.json");
   assert_non_null(js);
   assert_null(strstr(js, "stats_smoothed"));
   free(js);
-  char *x = slurp_alloc(WORK "/plain/nav_smoothed.csv");
+  char *x = nav_test_slurp_alloc(WORK "/plain/nav_smoothed.csv");
   assert_null(x);
-  x = slurp_alloc(WORK "/plain/smoothed_errors.csv");
+  x = nav_test_slurp_alloc(WORK "/plain/smoothed_errors.csv");
   assert_null(x);
 }
 
@@ -271,14 +273,14 @@ static void test_smoother_needs_ins_gnss(void **state) {
   (void)state;
   write_scene("free.yaml", "navigation:\n  scheme: free_ins\n  smoother: true\n");
   assert_int_equal(navsim("check free.yaml"), 2);
-  assert_non_null(strstr(g_err, "navigation.smoother"));
-  assert_non_null(strstr(g_err, "ins_gnss"));
+  assert_non_null(strstr(g_r->err, "navigation.smoother"));
+  assert_non_null(strstr(g_r->err, "ins_gnss"));
   assert_int_equal(navsim("run free.yaml --out free"), 2);
-  assert_non_null(strstr(g_err, "navigation.smoother"));
+  assert_non_null(strstr(g_r->err, "navigation.smoother"));
   /* Not a boolean: a reader error naming the field. */
   write_scene("bad.yaml", "navigation:\n  scheme: ins_gnss\n  smoother: maybe\n");
   assert_int_equal(navsim("check bad.yaml"), 2);
-  assert_non_null(strstr(g_err, "smoother"));
+  assert_non_null(strstr(g_r->err, "smoother"));
 }
 
 static void test_scene_round_trip(void **state) {
@@ -288,7 +290,7 @@ static void test_scene_round_trip(void **state) {
   assert_int_equal(nav_scene_read_file(WORK "/rt.yaml", &a, NULL, NULL), NAV_OK);
   assert_true(a.navigation.smoother);
   assert_int_equal(nav_scene_write_file(WORK "/rt-out.yaml", &a), NAV_OK);
-  char *text = slurp_alloc(WORK "/rt-out.yaml");
+  char *text = nav_test_slurp_alloc(WORK "/rt-out.yaml");
   assert_non_null(text);
   assert_non_null(strstr(text, "smoother: true"));
   free(text);

@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define DATA NAV_TEST_DATA_DIR "/replay/"
@@ -23,45 +24,31 @@
   "--imu '" DATA "IMU-100195-100245.txt' --gnss '" DATA "GNSS-100195-100245.txt' --truth '" DATA             \
   "truth-100195-100245-20Hz.nav' --scene '" DATA "long-drive.yaml' --outage 100215.5:100230.5"
 
-static char g_out[1 << 16], g_err[1 << 14];
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "r");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
-
+/* Run "navsim ARGS" in WORK; both streams captured in g_r. @return the exit code. */
+static const nav_cli_result *g_r;
 static int navsim(const char *args) {
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", WORK, NAVSIM_EXE, args,
-           WORK, WORK);
-  const int st = system(cmd);
-  slurp(WORK "/stdout.txt", g_out, sizeof g_out);
-  slurp(WORK "/stderr.txt", g_err, sizeof g_err);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  g_r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, args);
+  return g_r->code;
 }
 
 static int setup(void **state) {
   (void)state;
-  return system("rm -rf '" WORK "' && mkdir -p '" WORK "'") == 0 ? 0 : -1;
+  return nav_test_fresh_dir(WORK);
 }
 
 static void test_bad_options(void **state) {
   (void)state;
   assert_int_equal(navsim("replay " SLICE " --smooth-group 0 --out bad"), 2);
-  assert_non_null(strstr(g_err, "--smooth-group"));
+  assert_non_null(strstr(g_r->err, "--smooth-group"));
   assert_int_equal(navsim("replay " SLICE " --smooth-group"), 2);
 }
 
 static void test_smoothed_outputs(void **state) {
   (void)state;
   assert_int_equal(navsim("replay " SLICE " --smooth --out sm"), 0);
-  assert_non_null(strstr(g_out, "RTS smoother"));
+  assert_non_null(strstr(g_r->out, "RTS smoother"));
   static char csv[1 << 20];
-  slurp(WORK "/sm/nav_smoothed.csv", csv, sizeof csv);
+  nav_test_slurp(WORK "/sm/nav_smoothed.csv", csv, sizeof csv);
   assert_true(strncmp(csv, "t_s,lat_deg,lon_deg,h_m,", 24) == 0);
   long rows = 0;
   for (const char *p = csv; *p; ++p)
@@ -69,7 +56,7 @@ static void test_smoothed_outputs(void **state) {
   /* 10 Hz over 50 s plus the initial epoch, and the header. */
   assert_int_equal(rows, 502);
   static char js[1 << 16];
-  slurp(WORK "/sm/summary.json", js, sizeof js);
+  nav_test_slurp(WORK "/sm/summary.json", js, sizeof js);
   const char *s = strstr(js, "\"stats_smoothed\"");
   assert_non_null(s);
   assert_non_null(strstr(s, "\"pos_err_h_m\""));
@@ -78,9 +65,9 @@ static void test_smoothed_outputs(void **state) {
   assert_non_null(strstr(s, "\"backward_wall_s\""));
   /* Without --smooth: no smoothed outputs. */
   assert_int_equal(navsim("replay " SLICE " --out plain"), 0);
-  slurp(WORK "/plain/summary.json", js, sizeof js);
+  nav_test_slurp(WORK "/plain/summary.json", js, sizeof js);
   assert_null(strstr(js, "stats_smoothed"));
-  slurp(WORK "/plain/nav_smoothed.csv", csv, sizeof csv);
+  nav_test_slurp(WORK "/plain/nav_smoothed.csv", csv, sizeof csv);
   assert_int_equal(csv[0], '\0');
 }
 

@@ -23,49 +23,17 @@
 #include <sys/wait.h>
 
 #include "nav_test.h"
+#include "navsim_cli.h"
 #include "navcore/nav_frames.h"
 #include "navcore/nav_track_import.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define TRACKS NAV_TEST_DATA_DIR "/tracks"
 #define URBAN NAV_SOURCE_DIR "/scenes/urban-drive.yaml"
+/* Run "navsim ARGS" in WORK, ARGS formatted printf-style; both streams captured. */
+#define navsim(...) nav_test_run_clif(NAVSIM_EXE, WORK, NULL, __VA_ARGS__)
 
-typedef struct result {
-  int code;
-  char out[65536];
-  char err[65536];
-} result;
-
-static void slurp(const char *path, char *buf, size_t cap) {
-  buf[0] = '\0';
-  FILE *f = fopen(path, "r");
-  if (!f) return;
-  const size_t n = fread(buf, 1, cap - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-}
-
-static result *navsim(const char *fmt, ...) {
-  static result r;
-  char args[4096], cmd[8192];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(args, sizeof args, fmt, ap);
-  va_end(ap);
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s/stdout.txt' 2>'%s/stderr.txt'", WORK, NAVSIM_EXE, args, WORK, WORK);
-  const int st = system(cmd);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  slurp(WORK "/stdout.txt", r.out, sizeof r.out);
-  slurp(WORK "/stderr.txt", r.err, sizeof r.err);
-  return &r;
-}
-
-static bool is_file(const char *path) {
-  struct stat s;
-  return stat(path, &s) == 0 && S_ISREG(s.st_mode);
-}
-
-static void expect_code(const result *r, int code) {
+static void expect_code(const nav_cli_result *r, int code) {
   if (r->code != code) fail_msg("exit %d (expected %d)\nstdout: %s\nstderr: %s", r->code, code, r->out, r->err);
 }
 
@@ -78,9 +46,7 @@ static double number_after(const char *text, const char *key) {
 
 static int setup(void **state) {
   (void)state;
-  char cmd[1024];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", WORK, WORK);
-  return system(cmd) == 0 ? 0 : -1;
+  return nav_test_fresh_dir(WORK);
 }
 
 /* Largest distance of the points of @p a from the polyline @p b, in local NED about a's first
@@ -123,10 +89,10 @@ static void expect_valid_kml(const char *path) {
   snprintf(cmd, sizeof cmd, "xmllint --noout '%s' 2>'%s/xmllint.txt'", path, WORK);
   const int st = system(cmd);
   char log[4096];
-  slurp(WORK "/xmllint.txt", log, sizeof log);
+  nav_test_slurp(WORK "/xmllint.txt", log, sizeof log);
   if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) fail_msg("xmllint rejects %s:\n%s", path, log);
   char text[4096];
-  slurp(path, text, sizeof text);
+  nav_test_slurp(path, text, sizeof text);
   assert_non_null(strstr(text, "<kml xmlns=\"http://www.opengis.net/kml/2.2\">"));
 }
 
@@ -135,15 +101,15 @@ static void expect_valid_kml(const char *path) {
  * the result's coordinates to its 9 decimals. */
 static void test_round_trip(void **state) {
   (void)state;
-  result *r = navsim("import '%s/drive.gpx' --out drive.yaml", TRACKS);
+  nav_cli_result *r = navsim("import '%s/drive.gpx' --out drive.yaml", TRACKS);
   expect_code(r, 0);
   const double dev1 = number_after(r->out, "from the flown path ");
   assert_true(dev1 > 0 && dev1 < 20.0);
   expect_code(navsim("check drive.yaml"), 0);
   r = navsim("run drive.yaml --ideal --kml --out r1 --quiet");
   expect_code(r, 0);
-  assert_true(is_file(WORK "/r1/tracks.kml"));
-  assert_true(is_file(WORK "/r1/tracks.csv"));
+  assert_true(nav_test_is_file(WORK "/r1/tracks.kml"));
+  assert_true(nav_test_is_file(WORK "/r1/tracks.csv"));
   expect_valid_kml(WORK "/r1/tracks.kml");
 
   /* Every GPX point within the reported distance of the exported reference track (plus the
@@ -203,11 +169,11 @@ static void test_round_trip(void **state) {
 
   /* export on an existing result directory rewrites the same files. */
   char a[1 << 16], b[1 << 16];
-  slurp(WORK "/r1/tracks.kml", a, sizeof a);
+  nav_test_slurp(WORK "/r1/tracks.kml", a, sizeof a);
   assert_int_equal(remove(WORK "/r1/tracks.kml"), 0);
   r = navsim("export r1 --kml");
   expect_code(r, 0);
-  slurp(WORK "/r1/tracks.kml", b, sizeof b);
+  nav_test_slurp(WORK "/r1/tracks.kml", b, sizeof b);
   assert_string_equal(a, b);
   expect_code(navsim("export no-such-dir --kml"), 1);
   expect_code(navsim("export r1 --bogus"), 2);
@@ -216,18 +182,18 @@ static void test_round_trip(void **state) {
 /* An INS/GNSS run exports the receiver's fixes of run 0 as points. */
 static void test_kml_gnss_points(void **state) {
   (void)state;
-  result *r = navsim("run '%s' --runs 1 --kml --out urban --quiet", URBAN);
+  nav_cli_result *r = navsim("run '%s' --runs 1 --kml --out urban --quiet", URBAN);
   expect_code(r, 0);
   expect_valid_kml(WORK "/urban/tracks.kml");
   static char kml[1 << 22];
-  slurp(WORK "/urban/tracks.kml", kml, sizeof kml);
+  nav_test_slurp(WORK "/urban/tracks.kml", kml, sizeof kml);
   assert_non_null(strstr(kml, "<name>GNSS fixes (run 0)</name>"));
   assert_non_null(strstr(kml, "<name>estimate (run 0)</name>"));
   int points = 0;
   for (const char *p = kml; (p = strstr(p, "<Point>")) != NULL; ++p) ++points;
   /* One point per fix in gnss.csv (rows after the header). */
   static char csv[1 << 22];
-  slurp(WORK "/urban/gnss.csv", csv, sizeof csv);
+  nav_test_slurp(WORK "/urban/gnss.csv", csv, sizeof csv);
   int rows = -1;
   for (const char *p = csv; *p; ++p) rows += *p == '\n';
   assert_true(rows > 100);
@@ -237,11 +203,11 @@ static void test_kml_gnss_points(void **state) {
 /* Bad input: FILE:LINE:COL, exit 2, no output written. */
 static void test_import_errors(void **state) {
   (void)state;
-  result *r = navsim("import '%s/bad_lat.gpx' --out bad.yaml", TRACKS);
+  nav_cli_result *r = navsim("import '%s/bad_lat.gpx' --out bad.yaml", TRACKS);
   expect_code(r, 2);
   assert_non_null(strstr(r->err, "bad_lat.gpx:6:1: error: trkpt: attribute lat"));
   assert_non_null(strstr(r->err, "bad_lat.gpx:7:39: error: ele:"));
-  assert_false(is_file(WORK "/bad.yaml"));
+  assert_false(nav_test_is_file(WORK "/bad.yaml"));
   r = navsim("import '%s/broken.kml' --out bad.yaml", TRACKS);
   expect_code(r, 2);
   assert_non_null(strstr(r->err, "broken.kml:6:5: error:"));
@@ -249,7 +215,7 @@ static void test_import_errors(void **state) {
   expect_code(r, 2);
   assert_non_null(strstr(r->err, "sharp.kml:9:9: error: trajectory.waypoints:"));
   assert_non_null(strstr(r->err, "max_lateral_accel_mps2"));
-  assert_false(is_file(WORK "/bad.yaml"));
+  assert_false(nav_test_is_file(WORK "/bad.yaml"));
   /* Merging makes the same track feasible, and says what it did. */
   r = navsim("import '%s/sharp.kml' --speed 15 --out sharp.yaml", TRACKS);
   expect_code(r, 0);
@@ -263,7 +229,7 @@ static void test_import_errors(void **state) {
   expect_code(r, 0);
   expect_code(navsim("check md.yaml"), 0);
   char text[1 << 16];
-  slurp(WORK "/md.yaml", text, sizeof text);
+  nav_test_slurp(WORK "/md.yaml", text, sizeof text);
   assert_non_null(strstr(text, "type: segments"));
   assert_non_null(strstr(text, "name: \"turn\""));
   /* gx:Track with times: speeds from the times. */
@@ -314,11 +280,11 @@ static int column(char **cells, int n, const char *name) {
 
 static void test_select(void **state) {
   (void)state;
-  result *r = navsim("select '%s' %s --out sel", URBAN, SELECT_SET);
+  nav_cli_result *r = navsim("select '%s' %s --out sel", URBAN, SELECT_SET);
   expect_code(r, 0);
   assert_non_null(strstr(r->out, "recommend  "));
-  assert_true(is_file(WORK "/sel/ranking.csv"));
-  assert_true(is_file(WORK "/sel/recommended.yaml"));
+  assert_true(nav_test_is_file(WORK "/sel/ranking.csv"));
+  assert_true(nav_test_is_file(WORK "/sel/recommended.yaml"));
   FILE *f = fopen(WORK "/sel/ranking.csv", "r");
   assert_non_null(f);
   static char header[4096], line[4096];
@@ -360,7 +326,7 @@ static void test_select(void **state) {
   r = navsim("run sel/recommended.yaml --runs %d --out confirm --quiet", CONFIRM_RUNS);
   expect_code(r, 0);
   static char js[1 << 20];
-  slurp(WORK "/confirm/summary.json", js, sizeof js);
+  nav_test_slurp(WORK "/confirm/summary.json", js, sizeof js);
   const char *req = strstr(js, "\"requirements\"");
   assert_non_null(req);
   assert_non_null(strstr(req, "\"id\": \"h-outage-end\""));
@@ -381,7 +347,8 @@ static void test_select(void **state) {
  * threshold inside its bracket. */
 static void test_sweep(void **state) {
   (void)state;
-  result *r = navsim("sweep '%s' --param gnss.outages[0][1]=170:240:8 --predict --out sw --quiet", URBAN);
+  nav_cli_result *r =
+      navsim("sweep '%s' --param gnss.outages[0][1]=170:240:8 --predict --out sw --quiet", URBAN);
   /* gnss.outages is a list of [t0, t1] pairs: [0][1] is the end of the first outage. */
   expect_code(r, 0);
   FILE *f = fopen(WORK "/sw/sweep.csv", "r");
@@ -418,7 +385,7 @@ static void test_sweep(void **state) {
   assert_true(k > 0 && k < 8);
   const double expect = xs[k - 1] + (10.0 - cep[k - 1]) / (cep[k] - cep[k - 1]) * (xs[k] - xs[k - 1]);
   char th[4096];
-  slurp(WORK "/sw/thresholds.csv", th, sizeof th);
+  nav_test_slurp(WORK "/sw/thresholds.csv", th, sizeof th);
   assert_non_null(strstr(th, "requirement,limit,unit,parameter,largest_passing_value,status,bracket_low,bracket_high\n"));
   const char *row = strstr(th, "h-cep95,10,m,gnss.outages[0][1],");
   assert_non_null(row);
@@ -445,7 +412,7 @@ static void test_sweep(void **state) {
   assert_non_null(strstr(r->err, "--param imu.rate_hzz=100"));
   r = navsim("sweep '%s' --param imu.rate_hz=-5:-1:2 --out x --predict", URBAN);
   expect_code(r, 2);
-  assert_false(is_file(WORK "/x/sweep.csv"));
+  assert_false(nav_test_is_file(WORK "/x/sweep.csv"));
 }
 
 int main(void) {

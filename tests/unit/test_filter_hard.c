@@ -274,11 +274,12 @@ static void ignore_diag(void *user, const nav_diag *d) {
   (void)user;
 }
 
-/* An INS/GNSS Monte Carlo run of @p yaml: completes with finite statistics, or reports
- * NAV_ERR_NUMERIC with the time in its message. */
-static void run_scene(const char *name, const char *yaml) {
+/* An INS/GNSS Monte Carlo run of @p yaml (then @p tweak, if any, applied to the scene read):
+ * completes with finite statistics, or reports NAV_ERR_NUMERIC with the time in its message. */
+static void run_scene(const char *name, const char *yaml, void (*tweak)(nav_scene *)) {
   nav_scene sc;
   assert_int_equal(nav_scene_read_string(yaml, strlen(yaml), name, &sc, ignore_diag, NULL), NAV_OK);
+  if (tweak) tweak(&sc);
   nav_sim *sim = NULL;
   assert_int_equal(nav_sim_create(&sc, &sim), NAV_OK);
   nav_sim_options o = nav_sim_options_default();
@@ -325,17 +326,27 @@ static void test_scene_heading_180_rtk(void **state) {
             SCENE_HEAD "imu:\n  rate_hz: 100\n  catalog: \"Safran Sensonor STIM300\"\n"
                        "gnss:\n  enabled: true\n  update_rate_hz: 10\n  position_white_sigma_m: [0.01, 0.01, 0.02]\n"
                        "  reported_sigma: {position_m: [0.01, 0.01, 0.02], velocity_mps: [0.01, 0.01, 0.01]}\n"
-                       "initial_errors: {position_m: [1, 1, 1], velocity_mps: 0.1, attitude_deg: [1, 1, 180]}\n");
+                       "initial_errors: {position_m: [1, 1, 1], velocity_mps: 0.1, attitude_deg: [1, 1, 180]}\n",
+            NULL);
+}
+
+/* Noise above what a scene file may give (navcore/io/scene_bounds.h: ARW <= 100 deg/sqrt(h), VRW
+ * <= 10 m/s/sqrt(h)): ARW 500 deg/sqrt(h) and VRW 1 m/s/sqrt(s), set on the scene read as a
+ * program using the library may, with the reader's own unit factors. */
+static void huge_noise(nav_scene *sc) {
+  sc->imu.model.gyro.arw_rad_per_sqrt_s = v3(500.0 * (NAV_DEG2RAD / 60.0));
+  sc->imu.model.accel.vrw_mps_per_sqrt_s = v3(1.0);
 }
 
 static void test_scene_huge_noise(void **state) {
   (void)state;
   run_scene("scene: huge noise",
-            SCENE_HEAD "imu:\n  rate_hz: 100\n  gyro: {arw_deg_per_sqrt_h: 500, bias_turn_on_deg_per_h: 10000}\n"
-                       "  accel: {vrw_mps_per_sqrt_s: 1, bias_turn_on_mg: 500}\n"
+            SCENE_HEAD "imu:\n  rate_hz: 100\n  gyro: {arw_deg_per_sqrt_h: 100, bias_turn_on_deg_per_h: 10000}\n"
+                       "  accel: {vrw_mps_per_sqrt_s: 0.1, bias_turn_on_mg: 500}\n"
                        "gnss:\n  enabled: true\n  update_rate_hz: 1\n  position_white_sigma_m: [50, 50, 100]\n"
                        "  reported_sigma: {position_m: [50, 50, 100], velocity_mps: [1, 1, 1]}\n"
-                       "initial_errors: {position_m: [100, 100, 100], velocity_mps: 10, attitude_deg: [10, 10, 180]}\n");
+                       "initial_errors: {position_m: [100, 100, 100], velocity_mps: 10, attitude_deg: [10, 10, 180]}\n",
+            huge_noise);
 }
 
 int main(void) {

@@ -26,7 +26,9 @@
 #include "navcore/nav_frames.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_motiondef.h"
+#include "navcore/nav_requirements.h"
 #include "navcore/nav_sensors.h"
+#include "scene_bounds.h"
 
 #define SCENES_DIR NAV_TEST_DATA_DIR "/scenes/"
 
@@ -314,6 +316,19 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_int_equal(a->navigation.algorithm, b->navigation.algorithm);
   assert_int_equal(a->navigation.frame, b->navigation.frame);
   assert_int_equal(a->navigation.aid_vertical, b->navigation.aid_vertical);
+  assert_int_equal(a->navigation.cov_decimation, b->navigation.cov_decimation);
+  assert_int_equal(a->navigation.estimate_scale_factors, b->navigation.estimate_scale_factors);
+  assert_int_equal(a->navigation.smoother, b->navigation.smoother);
+  assert_int_equal(a->n_requirements, b->n_requirements);
+  for (int i = 0; i < a->n_requirements && i < NAV_SCENE_MAX_REQUIREMENTS; ++i) {
+    const nav_requirement *qa = &a->requirements[i], *qb = &b->requirements[i];
+    assert_string_equal(qa->id, qb->id);
+    assert_int_equal(qa->metric, qb->metric);
+    assert_int_equal(qa->statistic, qb->statistic);
+    assert_same_double(qa->limit, qb->limit);
+    assert_int_equal(qa->unit, qb->unit);
+    assert_same_double(qa->time_s, qb->time_s);
+  }
   assert_array_same(&a->array, &b->array);
   assert_same_double(a->output.rate_hz, b->output.rate_hz);
   assert_true(a->simulation.seed == b->simulation.seed);
@@ -1255,6 +1270,151 @@ static void test_gnss_catalog(void **state) {
   nav_catalog_destroy(cat);
 }
 
+/* ---------------------------------------------------------------- plausibility bounds (scene_bounds.h) */
+
+/* Each bounded quantity: its value at the bound is accepted in the primary unit, just above is
+   refused with the bound in the message, at FILE:LINE:COL of the value; the other spellings carry
+   the same bound converted; signed (fixed) values are bounded in magnitude. */
+static void test_sensor_bounds(void **state) {
+  (void)state;
+  static const struct {
+    const char *section, *key; /* imu.gyro / imu.accel / gnss / array.accel */
+    double bound;
+    const char *shown; /* the bound as the message prints it */
+    const char *tail;  /* keys the value needs, after it */
+  } k[] = {
+      {"imu:\n  gyro:\n", "arw_deg_per_sqrt_h", NAV_SCENE_MAX_GYRO_ARW_DEG_PER_SQRT_H, "100", NULL},
+      {"imu:\n  gyro:\n", "bias_turn_on_deg_per_h", NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H, "360000", NULL},
+      {"imu:\n  gyro:\n", "bias_gm_sigma_deg_per_h", NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H, "360000",
+       "    bias_gm_tau_s: 100\n"},
+      {"imu:\n  gyro:\n", "rrw_deg_per_h_per_sqrt_h", NAV_SCENE_MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H, "360000",
+       NULL},
+      {"imu:\n  gyro:\n", "scale_factor_ppm", NAV_SCENE_MAX_SCALE_FACTOR_PPM, "1000000", NULL},
+      {"imu:\n  gyro:\n", "misalignment_mrad", NAV_SCENE_MAX_MISALIGNMENT_MRAD, "100", NULL},
+      {"imu:\n  gyro:\n", "g_sensitivity_deg_per_h_per_g", NAV_SCENE_MAX_G_SENSITIVITY_DEG_PER_H_PER_G,
+       "36000", NULL},
+      {"imu:\n  accel:\n", "vrw_m_per_s_per_sqrt_h", NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H, "10", NULL},
+      {"imu:\n  accel:\n", "bias_turn_on_mg", NAV_SCENE_MAX_ACCEL_BIAS_MG, "1000", NULL},
+      {"imu:\n  accel:\n", "bias_rw_m_per_s2_per_sqrt_h", NAV_SCENE_MAX_ACCEL_BIAS_RW_M_PER_S2_PER_SQRT_H,
+       "10", NULL},
+      {"imu:\n  accel:\n", "scale_factor_ppm", NAV_SCENE_MAX_SCALE_FACTOR_PPM, "1000000", NULL},
+      {"imu:\n  accel:\n", "misalignment_mrad", NAV_SCENE_MAX_MISALIGNMENT_MRAD, "100", NULL},
+      {"gnss:\n  enabled: true\n", "position_sigma_m", NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, "1000", NULL},
+      {"gnss:\n  enabled: true\n", "position_white_sigma_m", NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, "1000",
+       NULL},
+      {"gnss:\n  enabled: true\n", "velocity_sigma_mps", NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, "100", NULL},
+      {"gnss:\n  enabled: true\n", "latency_s", NAV_SCENE_MAX_GNSS_LATENCY_S, "10", NULL},
+      {"array:\n  accel:\n", "vrw_m_per_s_per_sqrt_h", NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H, "10",
+       NULL},
+      {"array:\n  accel:\n", "bias_turn_on_mg", NAV_SCENE_MAX_ACCEL_BIAS_MG, "1000", NULL},
+  };
+  for (size_t i = 0; i < sizeof k / sizeof k[0]; ++i) {
+    const bool gnss = k[i].section[0] == 'g';
+    const char *indent = gnss ? "  " : "    ";
+    char text[512], path[128], got[96];
+    const char *where = gnss                     ? "gnss"
+                        : k[i].section[0] == 'a' ? "array.accel"
+                        : k[i].section[7] == 'g' ? "imu.gyro"
+                                                 : "imu.accel";
+    snprintf(path, sizeof path, "%s.%s", where, k[i].key);
+    const char *tail = k[i].tail ? k[i].tail : "";
+    snprintf(text, sizeof text, "format_version: 1\n%s%s%s: %.17g\n%s", k[i].section, indent, k[i].key,
+             k[i].bound, tail);
+    (void)read_ok(text);
+    const double above = k[i].bound * (1.0 + 1e-9);
+    snprintf(text, sizeof text, "format_version: 1\n%s%s%s: %.17g\n%s", k[i].section, indent, k[i].key, above,
+             tail);
+    snprintf(got, sizeof got, "must be <= %s (got %.17g)", k[i].shown, above);
+    expect_one(text, 4, (int)(strlen(indent) + strlen(k[i].key) + 3), path, got); /* after "KEY: " */
+  }
+  /* The other spellings: the same bound, converted to their unit. */
+  const double arw_max_rps = nav_unit_deg_per_sqrt_h_to_rad_per_sqrt_s(NAV_SCENE_MAX_GYRO_ARW_DEG_PER_SQRT_H);
+  char text[256];
+  snprintf(text, sizeof text, "format_version: 1\nimu:\n  gyro:\n    arw_rad_per_sqrt_s: %.17g\n",
+           arw_max_rps);
+  nav_scene s = read_ok(text);
+  assert_rel_near(s.imu.model.gyro.arw_rad_per_sqrt_s.x, arw_max_rps, 1e-15);
+  snprintf(text, sizeof text, "format_version: 1\nimu:\n  gyro:\n    arw_rad_per_sqrt_s: %.17g\n",
+           arw_max_rps * 1.000001);
+  expect_one(text, 4, 25, "imu.gyro.arw_rad_per_sqrt_s", "must be <= 0.0290888208665721");
+  (void)read_ok(
+      "format_version: 1\nimu:\n  gyro:\n    bias_turn_on_dps: 100\n    noise_density_deg_per_s_per_sqrt_hz: "
+      "1.6\n  accel:\n    noise_density_ug_per_sqrt_hz: 16995\n    bias_turn_on_mps2: 9.8\n");
+  expect_one("format_version: 1\nimu:\n  gyro:\n    bias_turn_on_dps: 100.001\n", 4, 23,
+             "imu.gyro.bias_turn_on_dps", "must be <= 100");
+  expect_one("format_version: 1\nimu:\n  accel:\n    noise_density_ug_per_sqrt_hz: 17000\n", 4, 35,
+             "imu.accel.noise_density_ug_per_sqrt_hz", "must be <= 16995.27");
+  expect_one("format_version: 1\nimu:\n  accel:\n    bias_turn_on_mps2: 9.81\n", 4, 24,
+             "imu.accel.bias_turn_on_mps2", "must be <= 9.80665");
+  /* Signed values within [-bound, bound]; the failing component is named. */
+  (void)read_ok("format_version: 1\nimu:\n  gyro:\n    bias_turn_on_fixed_dps: [-100, 0, 100]\n"
+                "    scale_factor_fixed_ppm: [-1e6, 0, 1e6]\n  accel:\n    bias_turn_on_fixed_mg: -1000\n");
+  expect_one("format_version: 1\nimu:\n  gyro:\n    bias_turn_on_fixed_dps: [0, -1e6, 0]\n", 4, 33,
+             "imu.gyro.bias_turn_on_fixed_dps[1]", "must be >= -100 (got -1e6)");
+  expect_one(
+      "format_version: 1\nimu:\n  accel:\n    misalignment_fixed_mrad: [[0, 1, 2], [3, 0, 4], [5, 101, 0]]\n",
+      4, 57, "imu.accel.misalignment_fixed_mrad[2][1]", "must be <= 100 (got 101)");
+  /* Bias instability: half the bias bound, so that its GM sigma (B / 0.6648) stays within it. */
+  expect_one("format_version: 1\nimu:\n  gyro:\n    bias_instability_deg_per_h: 2e5\n"
+             "    bias_instability_tau_min_s: 300\n",
+             4, 33, "imu.gyro.bias_instability_deg_per_h", "must be <= 180000 (got 2e5)");
+  s = read_ok("format_version: 1\nimu:\n  gyro:\n    bias_instability_deg_per_h: 180000\n"
+              "    bias_instability_tau_min_s: 300\n");
+  assert_true(s.imu.model.gyro.bias_gm_sd_rps.x <=
+              nav_unit_deg_per_h_to_rps(NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H));
+  /* The reported sigmas of a receiver. */
+  expect_one(
+      "format_version: 1\ngnss:\n  enabled: true\n  reported_sigma: {position_m: 1, velocity_mps: 1e10}\n", 4,
+      49, "gnss.reported_sigma.velocity_mps", "must be <= 100 (got 1e10)");
+}
+
+/* Every row of both catalogs, written out key by key (no catalog name), reads back within the
+   bounds and unchanged: the bounds never refuse a catalogued sensor. */
+static void test_catalog_rows_within_bounds(void **state) {
+  (void)state;
+  char dir[64], path[128], text[512];
+  diag_log log;
+  make_dir(dir, sizeof dir);
+  snprintf(path, sizeof path, "%s/row.yaml", dir);
+  nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
+  assert_non_null(a);
+  assert_non_null(b);
+  for (int kind = 0; kind < 2; ++kind) {
+    nav_catalog *cat = NULL;
+    assert_int_equal(nav_catalog_load(kind == 0 ? NAV_SOURCE_DIR "/resources/imu_catalog.csv"
+                                                : NAV_SOURCE_DIR "/resources/gnss_receivers.csv",
+                                      NULL, &cat, NULL, NULL),
+                     NAV_OK);
+    const size_t n = nav_catalog_count(cat);
+    assert_true(n >= (kind == 0 ? 10u : 5u));
+    for (size_t i = 0; i < n; ++i) {
+      const char *name = kind == 0 ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      if (kind == 0)
+        snprintf(text, sizeof text, "format_version: 1\nimu:\n  catalog: \"%s\"\n", name);
+      else
+        snprintf(text, sizeof text, "format_version: 1\ngnss:\n  enabled: true\n  catalog: \"%s\"\n", name);
+      nav_status st = read_text(text, a, &log);
+      if (st != NAV_OK) {
+        print_log(&log);
+        fail_msg("catalog row \"%s\" does not read", name);
+      }
+      a->imu.catalog[0] = '\0';
+      a->gnss.catalog[0] = '\0';
+      assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
+      st = read_path(path, b, &log);
+      if (st != NAV_OK) {
+        print_log(&log);
+        fail_msg("catalog row \"%s\" written key by key does not read back:\n%s", name, slurp(path));
+      }
+      assert_scene_same(a, b);
+    }
+    nav_catalog_destroy(cat);
+  }
+  rm_dir(dir);
+  free(a);
+  free(b);
+}
+
 /* ---------------------------------------------------------------- errors of the new sections */
 
 static void test_trajectory_errors(void **state) {
@@ -1664,6 +1824,29 @@ static nav_mat3 any_mat3(uint64_t *x, bool zero_diagonal, bool nonneg) {
   return m;
 }
 
+/* The plausibility bounds of the reader (scene_bounds.h), in SI, with a factor 2 of margin (the
+   writer may choose another unit). A drawn value above one is divided by 1000 until it fits:
+   the draws themselves, and so every other field, stay those of before the bounds. */
+static double fit(double v, double bound_si) {
+  while (fabs(v) > 0.5 * bound_si)
+    v /= 1000.0;
+  return v;
+}
+static nav_vec3 fit3(nav_vec3 v, double bound_si) {
+  return nav_vec3_make(fit(v.x, bound_si), fit(v.y, bound_si), fit(v.z, bound_si));
+}
+static nav_mat3 fit33(nav_mat3 m, double bound_si) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      m.m[i][j] = fit(m.m[i][j], bound_si);
+  return m;
+}
+#define B_GYRO_BIAS nav_unit_deg_per_h_to_rps(NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H)
+#define B_ACCEL_BIAS nav_unit_mg_to_mps2(NAV_SCENE_MAX_ACCEL_BIAS_MG)
+#define B_SF nav_unit_ppm_to_ratio(NAV_SCENE_MAX_SCALE_FACTOR_PPM)
+#define B_MIS nav_unit_mrad_to_rad(NAV_SCENE_MAX_MISALIGNMENT_MRAD)
+#define B_GSENS nav_unit_deg_per_h_per_g_to_rps_per_mps2(NAV_SCENE_MAX_G_SENSITIVITY_DEG_PER_H_PER_G)
+
 /* Random values for every field, each term on or off at random: a term that is off but holds
    values is written with an "off" entry. */
 static void random_imu(uint64_t *x, nav_imu_model_config *m) {
@@ -1671,30 +1854,36 @@ static void random_imu(uint64_t *x, nav_imu_model_config *m) {
   nav_accel_error_config *a = &m->accel;
   g->terms = (unsigned)splitmix64(x) & NAV_IMU_TERMS_GYRO_ALL;
   a->terms = (unsigned)splitmix64(x) & NAV_IMU_TERMS_ACCEL_ALL;
-  g->bias_turn_on_fixed_rps = any_vec3(x);
-  g->bias_turn_on_sd_rps = nonneg_vec3(x);
-  g->bias_gm_sd_rps = nonneg_vec3(x);
+  g->bias_turn_on_fixed_rps = fit3(any_vec3(x), B_GYRO_BIAS);
+  g->bias_turn_on_sd_rps = fit3(nonneg_vec3(x), B_GYRO_BIAS);
+  g->bias_gm_sd_rps = fit3(nonneg_vec3(x), B_GYRO_BIAS);
   g->bias_gm_tau_s = positive_vec3(x);
-  g->bias_rw_rps_per_sqrt_s = nonneg_vec3(x);
-  g->arw_rad_per_sqrt_s = nonneg_vec3(x);
-  g->scale_factor_fixed = any_vec3(x);
-  g->scale_factor_sd = nonneg_vec3(x);
-  g->misalignment_fixed_rad = any_mat3(x, true, false);
-  g->misalignment_sd_rad = any_mat3(x, true, true);
-  g->g_sensitivity_fixed_rps_per_mps2 = any_mat3(x, false, false);
-  g->g_sensitivity_sd_rps_per_mps2 = any_mat3(x, false, true);
+  g->bias_rw_rps_per_sqrt_s =
+      fit3(nonneg_vec3(x),
+           nav_unit_deg_per_h_per_sqrt_h_to_rps_per_sqrt_s(NAV_SCENE_MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H));
+  g->arw_rad_per_sqrt_s =
+      fit3(nonneg_vec3(x), nav_unit_deg_per_sqrt_h_to_rad_per_sqrt_s(NAV_SCENE_MAX_GYRO_ARW_DEG_PER_SQRT_H));
+  g->scale_factor_fixed = fit3(any_vec3(x), B_SF);
+  g->scale_factor_sd = fit3(nonneg_vec3(x), B_SF);
+  g->misalignment_fixed_rad = fit33(any_mat3(x, true, false), B_MIS);
+  g->misalignment_sd_rad = fit33(any_mat3(x, true, true), B_MIS);
+  g->g_sensitivity_fixed_rps_per_mps2 = fit33(any_mat3(x, false, false), B_GSENS);
+  g->g_sensitivity_sd_rps_per_mps2 = fit33(any_mat3(x, false, true), B_GSENS);
   g->quant_step_rad = positive_vec3(x);
   g->range_rps = positive_vec3(x);
-  a->bias_turn_on_fixed_mps2 = any_vec3(x);
-  a->bias_turn_on_sd_mps2 = nonneg_vec3(x);
-  a->bias_gm_sd_mps2 = nonneg_vec3(x);
+  a->bias_turn_on_fixed_mps2 = fit3(any_vec3(x), B_ACCEL_BIAS);
+  a->bias_turn_on_sd_mps2 = fit3(nonneg_vec3(x), B_ACCEL_BIAS);
+  a->bias_gm_sd_mps2 = fit3(nonneg_vec3(x), B_ACCEL_BIAS);
   a->bias_gm_tau_s = positive_vec3(x);
-  a->bias_rw_mps2_per_sqrt_s = nonneg_vec3(x);
-  a->vrw_mps_per_sqrt_s = nonneg_vec3(x);
-  a->scale_factor_fixed = any_vec3(x);
-  a->scale_factor_sd = nonneg_vec3(x);
-  a->misalignment_fixed_rad = any_mat3(x, true, false);
-  a->misalignment_sd_rad = any_mat3(x, true, true);
+  a->bias_rw_mps2_per_sqrt_s =
+      fit3(nonneg_vec3(x),
+           nav_unit_mps2_per_sqrt_h_to_mps2_per_sqrt_s(NAV_SCENE_MAX_ACCEL_BIAS_RW_M_PER_S2_PER_SQRT_H));
+  a->vrw_mps_per_sqrt_s = fit3(
+      nonneg_vec3(x), nav_unit_mps_per_sqrt_h_to_mps_per_sqrt_s(NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H));
+  a->scale_factor_fixed = fit3(any_vec3(x), B_SF);
+  a->scale_factor_sd = fit3(nonneg_vec3(x), B_SF);
+  a->misalignment_fixed_rad = fit33(any_mat3(x, true, false), B_MIS);
+  a->misalignment_sd_rad = fit33(any_mat3(x, true, true), B_MIS);
   a->quant_step_mps = positive_vec3(x);
   a->range_mps2 = positive_vec3(x);
 }
@@ -1705,15 +1894,15 @@ static void random_gnss(uint64_t *x, nav_scene_gnss *n) {
   m->terms = (unsigned)splitmix64(x) & NAV_GNSS_TERMS_ALL;
   m->update_rate_hz = 0.1 + 20.0 * uniform(x);
   m->latency_s = uniform(x);
-  m->pos_gm_sd_m = nonneg_vec3(x);
+  m->pos_gm_sd_m = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M);
   m->pos_gm_tau_s = nonneg_vec3(x);
-  m->pos_white_sd_m = nonneg_vec3(x);
-  m->vel_sd_mps = nonneg_vec3(x);
+  m->pos_white_sd_m = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M);
+  m->vel_sd_mps = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS);
   m->r_ba_b_m = any_vec3(x);
   m->report_model_sigmas = splitmix64(x) & 1;
   if (!m->report_model_sigmas) {
-    m->reported_pos_sd_m = nonneg_vec3(x);
-    m->reported_vel_sd_mps = nonneg_vec3(x);
+    m->reported_pos_sd_m = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M);
+    m->reported_vel_sd_mps = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS);
   }
   m->outage_count = (size_t)(splitmix64(x) % 4);
   for (size_t i = 0; i < m->outage_count; ++i) {
@@ -1842,6 +2031,36 @@ static void random_array(uint64_t *x, nav_scene_array *a) {
   a->initial_rate_sd_rps = nonneg_vec3(x);
 }
 
+/* Random navigation options of the ins_gnss filter (the smoother only with ins_gnss, as the
+   checks require) and 0 to NAV_SCENE_MAX_REQUIREMENTS random valid requirements: every metric,
+   statistic and unit, the unit of the metric's quantity, cep only on horizontal_position, time_s
+   only with at_time. */
+static void random_navigation_and_requirements(uint64_t *x, nav_scene *s, int k) {
+  s->navigation.cov_decimation = (int)(splitmix64(x) % 1001);
+  s->navigation.estimate_scale_factors = splitmix64(x) & 1;
+  s->navigation.smoother = s->navigation.scheme == NAV_SCHEME_INS_GNSS && (splitmix64(x) & 1);
+  s->n_requirements = k == 2 ? NAV_SCENE_MAX_REQUIREMENTS : (int)(splitmix64(x) % 6);
+  static const char id_chars[] = "abcXYZ019_.-";
+  for (int i = 0; i < s->n_requirements; ++i) {
+    nav_requirement *q = &s->requirements[i];
+    memset(q, 0, sizeof *q);
+    int n = snprintf(q->id, sizeof q->id, "r%d", i); /* unique; random characters after it */
+    const int extra = (int)(splitmix64(x) % 40);
+    for (int c = 0; c < extra && n + 1 < NAV_REQ_ID_MAX; ++c)
+      q->id[n++] = id_chars[splitmix64(x) % 12];
+    q->id[n] = '\0';
+    q->statistic = (nav_req_statistic)(splitmix64(x) % NAV_REQ_STATISTIC_COUNT);
+    q->metric = q->statistic == NAV_REQ_CEP50 || q->statistic == NAV_REQ_CEP95
+                    ? NAV_REQ_HORIZONTAL_POSITION
+                    : (nav_req_metric)(splitmix64(x) % NAV_REQ_METRIC_COUNT);
+    do {
+      q->unit = (nav_req_unit)(splitmix64(x) % NAV_REQ_UNIT_COUNT);
+    } while (nav_req_unit_quantity(q->unit) != nav_req_metric_quantity(q->metric));
+    q->limit = 1e-6 + fabs(any_double(x));
+    q->time_s = q->statistic == NAV_REQ_AT_TIME ? fabs(any_double(x)) : NAN;
+  }
+}
+
 static void test_round_trip_random_bit_exact(void **state) {
   (void)state;
   char dir[64], path[128];
@@ -1854,6 +2073,7 @@ static void test_round_trip_random_bit_exact(void **state) {
   nav_test_print_seed("test_round_trip_random_bit_exact", seed);
   make_dir(dir, sizeof dir);
   snprintf(path, sizeof path, "%s/rt.yaml", dir);
+  int smoothers = 0, sf_states = 0, decimated = 0, stats[NAV_REQ_STATISTIC_COUNT] = {0};
   for (int k = 0; k < 40; ++k) {
     nav_scene *a = ap, *b = bp;
     *a = nav_scene_default();
@@ -1903,6 +2123,16 @@ static void test_round_trip_random_bit_exact(void **state) {
         a->navigation.aid_vertical = false;
       }
     }
+    {
+      /* Navigation options and requirements from their own stream too. */
+      uint64_t xn = seed + 0x4E5Au * (uint64_t)(k + 1);
+      random_navigation_and_requirements(&xn, a, k);
+      smoothers += a->navigation.smoother;
+      sf_states += a->navigation.estimate_scale_factors;
+      decimated += a->navigation.cov_decimation > 1;
+      for (int i = 0; i < a->n_requirements; ++i)
+        ++stats[a->requirements[i].statistic];
+    }
     a->output.rate_hz = 1.0 + 40.0 * uniform(&x);
     a->simulation.seed = splitmix64(&x);
     a->simulation.runs = 1 + (long)(splitmix64(&x) % 1000);
@@ -1916,6 +2146,10 @@ static void test_round_trip_random_bit_exact(void **state) {
     }
     assert_scene_same(a, b);
   }
+  /* The new fields were exercised: each option on in some cases, every statistic drawn. */
+  assert_true(smoothers > 0 && sf_states > 0 && decimated > 0);
+  for (int s = 0; s < NAV_REQ_STATISTIC_COUNT; ++s)
+    if (stats[s] == 0) fail_msg("statistic %d never drawn", s);
   assert_int_equal(count_entries(dir), 1);
   rm_dir(dir);
   free(ap);
@@ -1990,6 +2224,8 @@ int main(void) {
       cmocka_unit_test(test_bias_instability_conventions),
       cmocka_unit_test(test_imu_catalog),
       cmocka_unit_test(test_gnss_catalog),
+      cmocka_unit_test(test_sensor_bounds),
+      cmocka_unit_test(test_catalog_rows_within_bounds),
       cmocka_unit_test(test_trajectory_errors),
       cmocka_unit_test(test_sensor_errors),
       cmocka_unit_test(test_motion_def_errors),

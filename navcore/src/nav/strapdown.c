@@ -28,8 +28,11 @@
  * so a refused or non-finite step leaves the state untouched. The NED step is the hot path of
  * the WGS-84 runs: it uses one sin/cos pair of lat/2 and one of lon/2 per step (the output in
  * e needs both anyway), series instead of trig for small rotations, and reciprocals shared or
- * refined from a nearby point instead of fresh divisions (about 5 M steps/s on the reference
- * machine, against 7 M for the flat mechanization).
+ * refined from a nearby point instead of fresh divisions. The step helpers are inlined into one
+ * function per configuration (algorithm x gravity step), and nav_ins_step is compiled for the
+ * baseline and for AVX2 (nav_clones.h, bit-identical): about 1010 instructions per NED step,
+ * 860 per ECEF step (its normal gravity without trigonometry, nav/ecef_gravity.h), 890 flat
+ * (high order, 200 Hz; 1360, 2290 and 970 before).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,6 +40,8 @@
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_ins.h"
+#include "nav/ecef_gravity.h"
+#include "nav_clones.h"
 
 /* 1 - e^2 = (b/a)^2. */
 #define E2M (1.0 - NAV_WGS84_E2)
@@ -59,6 +64,17 @@
  * used when the relative residual e is below this: the result's relative error, O(e^2) < 1e-18,
  * is below the rounding of the direct evaluation. */
 #define NEWTON_REL 1e-9
+
+/* The per-step helpers are inlined into each step function so that the whole step is one block of
+ * straight-line code with its values in registers (constant configuration tests fold away). */
+#if defined(__GNUC__)
+#define HOT_INLINE static inline __attribute__((always_inline))
+#else
+#define HOT_INLINE static inline
+#endif
+
+/* Entries of the cache of Earth-rotation steps per dt (ECEF). */
+#define ROT_CACHE 4
 
 /* Earth terms at one point of the NED mechanization. */
 typedef struct ned_terms {
@@ -88,9 +104,11 @@ struct nav_ins {
   double view_sh, view_ch;
   /* WGS-84 ECEF state: s holds r, v, q; the gravity at s.r_fb_f_m is cached. */
   nav_vec3 g_e_mps2;
-  /* Earth-rotation quaternion R_z(-omega_ie dt) for the dt it was last computed for. */
-  double rot_dt_s;
-  nav_quat q_rot;
+  /* cos, sin of omega_ie dt / 2 for the last ROT_CACHE distinct dt (R_z(-omega_ie dt)): the
+   * interval t_k - t_(k-1) of the time stamps k dt takes a few values differing in the last bits,
+   * which alternate early in a run (a single cached dt was recomputed every other step). */
+  double rot_dt_s[ROT_CACHE], rot_c[ROT_CACHE], rot_s[ROT_CACHE];
+  int rot_next;
   char msg[256];
 };
 
@@ -107,6 +125,17 @@ nav_ins_config nav_ins_config_default(void) {
 }
 
 /* ------------------------------------------------------------------ small helpers */
+
+/* C(q) of nav_quat_to_dcm() (math.c), the same operations inlined into the step. */
+HOT_INLINE nav_mat3 dcm_of_quat(nav_quat q) {
+  const double ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
+  const double xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+  const double wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+  nav_mat3 c = {{{ww + xx - yy - zz, 2.0 * (xy - wz), 2.0 * (xz + wy)},
+                 {2.0 * (xy + wz), ww - xx + yy - zz, 2.0 * (yz - wx)},
+                 {2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz}}};
+  return c;
+}
 
 /* Renormalise a quaternion whose norm is 1 to rounding (a product of unit quaternions): one
  * Newton step for 1/sqrt(n2), s = (3 - n2)/2, leaves an error of O((n2 - 1)^2) ~ 1e-32, i.e. the
@@ -140,8 +169,7 @@ static inline nav_quat quat_of_rotvec(nav_vec3 v) {
  * rotated into n; the J2 field and the centrifugal term are axially symmetric, so the point is
  * placed on the meridian lon = 0 and no trig of longitude is needed.
  */
-static void ned_terms_fill(const nav_ins *ins, double sl, double cl, double h, const ned_terms *near,
-                           ned_terms *t) {
+HOT_INLINE void ned_terms_fill(bool j2, double sl, double cl, double h, const ned_terms *near, ned_terms *t) {
   const double s2 = sl * sl;
   const double den2 = 1.0 - NAV_WGS84_E2 * s2;
   /* 1/sqrt(den2): one Newton step y (3 - den2 y^2)/2 from a nearby point's value leaves a
@@ -166,7 +194,7 @@ static void ned_terms_fill(const nav_ins *ins, double sl, double cl, double h, c
   t->iRMh = t->inv * B * cl;
   t->iRNh = t->inv * A * cl;
   t->icl = t->inv * P;
-  if (ins->cfg.gravity_model == NAV_GRAVITY_J2) {
+  if (j2) {
     /* Geodetic -> ECEF (Groves eq. 2.112) on lon = 0, then C_e_n g_e (rows of C_e_n: north,
      * east, down). */
     const nav_vec3 r_e = nav_vec3_make(B * cl, 0.0, (t->RN * E2M + h) * sl);
@@ -226,9 +254,9 @@ static inline void sincos_shift(double sl, double cl, double lat_new, double d, 
  *      At the first step there is no previous increment and the coning and sculling terms are
  *      dropped (one-off O(dt^3) error, numerics.md T5.1 note).
  */
-static void body_terms(const nav_ins *ins, nav_vec3 dth, nav_vec3 dv, nav_vec3 *phi_out, nav_quat *q_phi,
-                       nav_vec3 *dv_body) {
-  if (ins->cfg.algorithm == NAV_MECH_FIRST_ORDER) {
+HOT_INLINE void body_terms(bool high, const nav_ins *ins, nav_vec3 dth, nav_vec3 dv, nav_vec3 *phi_out,
+                           nav_quat *q_phi, nav_vec3 *dv_body) {
+  if (!high) {
     *phi_out = dth;
     *q_phi = quat_of_rotvec(dth);
     *dv_body = nav_vec3_add(dv, nav_vec3_scale(nav_vec3_cross(dth, dv), 0.5));
@@ -277,8 +305,8 @@ static void body_terms(const nav_ins *ins, nav_vec3 dth, nav_vec3 dv, nav_vec3 *
  * frame term alone leaves zeta x (zeta x C dv)/6 per step, a velocity drift of up to omega_ie^2 g dt / 6
  * (9e-10 m/s^2 at dt = 0.1 s, mostly vertical), which the closure test at rest detects.
  */
-static inline nav_vec3 frame_rotation_term(const nav_ins *ins, nav_vec3 zeta, nav_vec3 cdv, nav_vec3 cphi) {
-  if (ins->cfg.algorithm == NAV_MECH_FIRST_ORDER) return nav_vec3_scale(nav_vec3_cross(zeta, cdv), -0.5);
+HOT_INLINE nav_vec3 frame_rotation_term(bool high, nav_vec3 zeta, nav_vec3 cdv, nav_vec3 cphi) {
+  if (!high) return nav_vec3_scale(nav_vec3_cross(zeta, cdv), -0.5);
   const nav_vec3 k = nav_vec3_sub(nav_vec3_scale(zeta, 1.0 / 6.0), nav_vec3_scale(cphi, 1.0 / 3.0));
   return nav_vec3_cross(zeta, nav_vec3_add(nav_vec3_scale(cdv, -0.5), nav_vec3_cross(k, cdv)));
 }
@@ -327,7 +355,7 @@ static void ned_half_lat(double lat, double *sh, double *ch, double *sl, double 
 static void ned_refresh(nav_ins *ins) {
   double sl, cl;
   ned_half_lat(ins->lat_rad, &ins->view_sh, &ins->view_ch, &sl, &cl);
-  ned_terms_fill(ins, sl, cl, ins->h_m, NULL, &ins->et);
+  ned_terms_fill(ins->cfg.gravity_model == NAV_GRAVITY_J2, sl, cl, ins->h_m, NULL, &ins->et);
   ned_output(ins, ins->view_sh, ins->view_ch);
   ins->view_stale = false;
 }
@@ -518,10 +546,10 @@ nav_status nav_ins_aid_vertical(nav_ins *ins, double h_m, double v_d_mps) {
 
 /* ------------------------------------------------------------------ flat step */
 
-static nav_status step_flat(nav_ins *ins, const nav_imu_increment *imu) {
+HOT_INLINE nav_status step_flat(nav_ins *ins, const nav_imu_increment *imu) {
   const double dt = imu->dt_s;
   const nav_vec3 dth = imu->dtheta_b_rad, dv = imu->dv_b_mps;
-  const nav_mat3 C_b_l = nav_quat_to_dcm(ins->s.q_b_f);
+  const nav_mat3 C_b_l = dcm_of_quat(ins->s.q_b_f);
   nav_vec3 phi, dv_body;
 
   if (ins->cfg.algorithm == NAV_MECH_FIRST_ORDER) {
@@ -568,18 +596,19 @@ static nav_status refuse_pole(nav_ins *ins, const char *where, double lat_rad, d
   return NAV_ERR_OUT_OF_RANGE;
 }
 
-static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
+HOT_INLINE nav_status step_ned_impl(nav_ins *ins, const nav_imu_increment *imu, bool high, bool pc) {
+  const bool j2 = ins->cfg.gravity_model == NAV_GRAVITY_J2;
   const double dt = imu->dt_s, hdt = 0.5 * dt;
   const ned_terms *t0 = &ins->et;
   const double lat0 = ins->lat_rad, h0 = ins->h_m;
   const nav_vec3 v0 = ins->v_n_mps;
   nav_quat q_phi;
   nav_vec3 phi, dv_body;
-  body_terms(ins, imu->dtheta_b_rad, imu->dv_b_mps, &phi, &q_phi, &dv_body);
+  body_terms(high, ins, imu->dtheta_b_rad, imu->dv_b_mps, &phi, &q_phi, &dv_body);
 
   /* Specific-force part: C_b_n(k-1) dv_body, and C_b_n(k-1) dv, C_b_n(k-1) phi for the term of
    * the rotation of n during the interval (frame_rotation_term). */
-  const nav_mat3 C_b_n = nav_quat_to_dcm(ins->q_b_n);
+  const nav_mat3 C_b_n = dcm_of_quat(ins->q_b_n);
   const nav_vec3 dv_f = nav_mat3_mul_vec(C_b_n, dv_body);
   const nav_vec3 cdv = nav_mat3_mul_vec(C_b_n, imu->dv_b_mps);
   const nav_vec3 cphi = nav_mat3_mul_vec(C_b_n, phi);
@@ -596,9 +625,8 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
   nav_vec3 zeta = nav_vec3_scale(w_in0, dt);
   /* (The predicted v_k feeds only the Coriolis and transport terms, so the first-order frame term
    * is enough for it; the start-of-interval variant has no corrector and takes the full term.) */
-  const bool pc = ins->cfg.gravity_step == NAV_INS_GRAVITY_PREDICTOR_CORRECTOR;
   nav_vec3 v1 = nav_vec3_add(nav_vec3_add(base, pc ? nav_vec3_scale(nav_vec3_cross(zeta, cdv), -0.5)
-                                                   : frame_rotation_term(ins, zeta, cdv, cphi)),
+                                                   : frame_rotation_term(high, zeta, cdv, cphi)),
                              nav_vec3_scale(F0, dt));
   ned_terms tp;
   const ned_terms *pk = NULL; /* the predicted point, when there is one */
@@ -611,7 +639,7 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
     double sp, cp;
     sincos_shift(t0->sl, t0->cl, lat_p, lat_p - lat0, &sp, &cp);
     if (!(cp >= NAV_INS_NED_MIN_COS_LAT)) return refuse_pole(ins, "predicted", lat_p, cp, imu->t_s);
-    ned_terms_fill(ins, sp, cp, h_p, t0, &tp);
+    ned_terms_fill(j2, sp, cp, h_p, t0, &tp);
     pk = &tp;
     /* The velocity-dependent terms (Coriolis, transport rate) use the predicted v_k. */
     nav_vec3 w_inp, w_corp;
@@ -619,7 +647,7 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
     const nav_vec3 Fp = ned_force(&tp, w_corp, v1);
     /* Corrector: trapezoidal means of the k-1 and predicted-k terms. */
     zeta = nav_vec3_scale(nav_vec3_add(w_in0, w_inp), hdt);
-    v1 = nav_vec3_add(nav_vec3_add(base, frame_rotation_term(ins, zeta, cdv, cphi)),
+    v1 = nav_vec3_add(nav_vec3_add(base, frame_rotation_term(high, zeta, cdv, cphi)),
                       nav_vec3_scale(nav_vec3_add(F0, Fp), hdt));
   }
   const double h1 = h0 - hdt * (v0.z + v1.z);
@@ -631,8 +659,10 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
   double sh1, ch1, sl1, cl1;
   ned_half_lat(lat1, &sh1, &ch1, &sl1, &cl1);
   if (!(cl1 >= NAV_INS_NED_MIN_COS_LAT)) return refuse_pole(ins, "new", lat1, cl1, imu->t_s);
+  /* The Earth terms of the new point, seeded by the nearest point (the Newton steps): with the
+   * predictor they are not needed before the commit and are filled in place (ins->et) then. */
   ned_terms t1;
-  ned_terms_fill(ins, sl1, cl1, h1, pk ? pk : t0, &t1); /* the nearest point seeds the Newton steps */
+  if (!pk) ned_terms_fill(j2, sl1, cl1, h1, t0, &t1);
   const double lon_fac1 = pk ? pk->iRNh * pk->icl : t1.iRNh * t1.icl;
   double lon1 = ins->lon_rad + hdt * (lon_rate0 + v1.y * lon_fac1);
   /* Wrap to (-pi, pi]; values already inside are returned unchanged by nav_earth_wrap_lon. */
@@ -653,13 +683,16 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
   ins->h_m = h1;
   ins->v_n_mps = v1;
   ins->q_b_n = q1;
+  if (pk)
+    ned_terms_fill(j2, sl1, cl1, h1, pk, &ins->et);
+  else
+    ins->et = t1;
   if (ins->cfg.clamp_vertical) {
     ins->h_m = ins->hold_h_m;
     ins->v_n_mps.z = ins->hold_vd_mps;
-    const ned_terms seed = t1;
-    ned_terms_fill(ins, sl1, cl1, ins->h_m, &seed, &t1);
+    const ned_terms seed = ins->et;
+    ned_terms_fill(j2, sl1, cl1, ins->h_m, &seed, &ins->et);
   }
-  ins->et = t1;
   ins->view_sh = sh1;
   ins->view_ch = ch1;
   ins->view_stale = true;
@@ -667,32 +700,45 @@ static nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
   return NAV_OK;
 }
 
+/* The NED step specialised for the algorithm and the gravity step (the hot path of WGS-84 runs). */
+HOT_INLINE nav_status step_ned(nav_ins *ins, const nav_imu_increment *imu) {
+  const bool high = ins->cfg.algorithm == NAV_MECH_HIGH_ORDER;
+  if (ins->cfg.gravity_step == NAV_INS_GRAVITY_PREDICTOR_CORRECTOR)
+    return high ? step_ned_impl(ins, imu, true, true) : step_ned_impl(ins, imu, false, true);
+  return high ? step_ned_impl(ins, imu, true, false) : step_ned_impl(ins, imu, false, false);
+}
+
 /* ------------------------------------------------------------------ ECEF step */
 
-static nav_status step_ecef(nav_ins *ins, const nav_imu_increment *imu) {
+HOT_INLINE nav_status step_ecef(nav_ins *ins, const nav_imu_increment *imu) {
+  const bool high = ins->cfg.algorithm == NAV_MECH_HIGH_ORDER;
   const double dt = imu->dt_s, hdt = 0.5 * dt;
   const nav_vec3 w_ie_e = nav_earth_rate_e_rps();
   const nav_vec3 r0 = ins->s.r_fb_f_m, v0 = ins->s.v_fb_f_mps;
   nav_quat q_phi;
   nav_vec3 phi, dv_body;
-  body_terms(ins, imu->dtheta_b_rad, imu->dv_b_mps, &phi, &q_phi, &dv_body);
+  body_terms(high, ins, imu->dtheta_b_rad, imu->dv_b_mps, &phi, &q_phi, &dv_body);
 
   /* Exact Earth-rotation step R_z(-omega_ie dt) (numerics.md 4.1 ECEF row); cached per dt. */
-  if (dt != ins->rot_dt_s) {
+  int ir = 0;
+  while (ir < ROT_CACHE && ins->rot_dt_s[ir] != dt)
+    ++ir;
+  if (ir == ROT_CACHE) {
+    ir = ins->rot_next;
+    ins->rot_next = (ir + 1) % ROT_CACHE;
     const double half = 0.5 * NAV_WGS84_OMEGA_IE_RPS * dt;
-    ins->q_rot.w = cos(half);
-    ins->q_rot.x = 0.0;
-    ins->q_rot.y = 0.0;
-    ins->q_rot.z = -sin(half);
-    ins->rot_dt_s = dt;
+    ins->rot_c[ir] = cos(half);
+    ins->rot_s[ir] = sin(half);
+    ins->rot_dt_s[ir] = dt;
   }
+  const nav_quat q_rot = {ins->rot_c[ir], 0.0, 0.0, -ins->rot_s[ir]};
 
-  const nav_mat3 C_b_e = nav_quat_to_dcm(ins->s.q_b_f);
+  const nav_mat3 C_b_e = dcm_of_quat(ins->s.q_b_f);
   const nav_vec3 dv_f = nav_mat3_mul_vec(C_b_e, dv_body);
   /* The e frame turns by omega_ie dt while the increment accrues (-1/2 [omega_ie_e x] C_b_e dv dt
    * and, for (b), the second-order terms; frame_rotation_term). */
   const nav_vec3 rot = frame_rotation_term(
-      ins, nav_vec3_scale(w_ie_e, dt), nav_mat3_mul_vec(C_b_e, imu->dv_b_mps), nav_mat3_mul_vec(C_b_e, phi));
+      high, nav_vec3_scale(w_ie_e, dt), nav_mat3_mul_vec(C_b_e, imu->dv_b_mps), nav_mat3_mul_vec(C_b_e, phi));
   const nav_vec3 base = nav_vec3_add(nav_vec3_add(v0, dv_f), rot);
 
   /* Gravity (with centrifugal) minus Coriolis, at k-1 (cached gravity at r0). */
@@ -703,18 +749,18 @@ static nav_status step_ecef(nav_ins *ins, const nav_imu_increment *imu) {
   if (ins->cfg.gravity_step == NAV_INS_GRAVITY_PREDICTOR_CORRECTOR) {
     /* Predicted point, then the trapezoidal mean. The gravity at the predicted position is kept
      * as the gravity at r_k: the two points differ by dt/2 |v_k - v_pred| ~ 1e-8 m at dt = 0.04 s,
-     * i.e. ~3e-14 m/s^2 of gravity gradient, and the cache halves the gravity evaluations (an
-     * ECEF -> geodetic conversion each for the normal model). */
-    g1 = nav_gravity_e_mps2(ins->cfg.gravity_model, r1);
+     * i.e. ~3e-14 m/s^2 of gravity gradient, and the cache halves the gravity evaluations (a
+     * foot-point solution each for the normal model, nav/ecef_gravity.h). */
+    g1 = nav_ecef_gravity_fast(ins->cfg.gravity_model, r1);
     const nav_vec3 Fp = nav_vec3_sub(g1, nav_vec3_scale(nav_vec3_cross(w_ie_e, v1), 2.0));
     v1 = nav_vec3_axpy(base, hdt, nav_vec3_add(F0, Fp));
     r1 = nav_vec3_axpy(r0, hdt, nav_vec3_add(v0, v1));
   } else {
-    g1 = nav_gravity_e_mps2(ins->cfg.gravity_model, r1);
+    g1 = nav_ecef_gravity_fast(ins->cfg.gravity_model, r1);
   }
 
   /* Attitude: q_k = q_z(-omega_ie dt) (x) q_(k-1) (x) q(phi), renormalised. */
-  const nav_quat q1 = renormalize(nav_quat_mul(ins->q_rot, nav_quat_mul(ins->s.q_b_f, q_phi)));
+  const nav_quat q1 = renormalize(nav_quat_mul(q_rot, nav_quat_mul(ins->s.q_b_f, q_phi)));
 
   if (!nav_vec3_isfinite(v1) || !nav_vec3_isfinite(r1) || !nav_vec3_isfinite(g1) || !isfinite(q1.w) ||
       !isfinite(q1.x) || !isfinite(q1.y) || !isfinite(q1.z)) {
@@ -732,7 +778,9 @@ static nav_status step_ecef(nav_ins *ins, const nav_imu_increment *imu) {
 
 /* ------------------------------------------------------------------ step */
 
-nav_status nav_ins_step(nav_ins *ins, const nav_imu_increment *imu) {
+/* The whole step, with the frame steps inlined, is compiled for the baseline and for AVX2
+ * (nav_clones.h; bit-identical results). */
+NAV_HOT_CLONES nav_status nav_ins_step(nav_ins *ins, const nav_imu_increment *imu) {
   if (!ins || !imu || !(imu->dt_s > 0.0)) return NAV_ERR_INVALID_ARG;
   if (!nav_vec3_isfinite(imu->dtheta_b_rad) || !nav_vec3_isfinite(imu->dv_b_mps) || !isfinite(imu->dt_s)) {
     snprintf(ins->msg, sizeof ins->msg, "non-finite IMU increment at t = %.6f s", imu->t_s);

@@ -8,6 +8,7 @@
 
 #include "navcore/nav_truth.h"
 #include "traj/traj_kin_internal.h"
+#include "nav_clones.h"
 
 /* ================================================================ Euler rates */
 
@@ -134,7 +135,7 @@ static ptrdiff_t find_step(const nav_kin_channel *c, double t) {
 
 /* find_step through a cached index: sequential evaluation stays in the same step or moves to
  * the next one, so the binary search is rarely needed. The result is the same index. */
-static ptrdiff_t find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
+NAV_CLONE_INLINE ptrdiff_t find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
   const ptrdiff_t n = (ptrdiff_t)c->n;
   for (ptrdiff_t k = *hint; k <= *hint + 1 && k < n; ++k) {
     if (k < -1) break;
@@ -177,8 +178,8 @@ void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *
   rate_state(c, find_step_hint(c, t_s, hint), t_s, x, r, r1);
 }
 
-void nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
-                                 double *x, double *r, double *r1) {
+NAV_HOT_CLONES void nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n,
+                                                ptrdiff_t *hint, double *x, double *r, double *r1) {
   if (n < 1) return;
   /* A channel at rest over the whole span (after its ramps, at zero rate: the usual case for
    * most channels) is evaluated once; its value is constant there, up to the rounding of

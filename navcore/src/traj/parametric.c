@@ -23,6 +23,7 @@
 #include <stdio.h>
 
 #include "traj/traj_kin_internal.h"
+#include "nav_clones.h"
 
 /* One checkpoint of the integrated attitude every CHECKPOINT_STRIDE grid steps, so evaluation
  * at an earlier time re-integrates at most that many steps. */
@@ -210,8 +211,8 @@ static inline void quat_dcm(nav_quat q, nav_mat3 *c) {
  * walk starts at the block. The rotations add at most PHASE_BLOCK roundings (~1e-14), less than
  * the rounding of the argument f t_K + g itself once t_K is more than a few seconds.
  */
-static void phase_at(int64_t K, double dt, nav_vec3 f, nav_vec3 g, const double (*step)[2],
-                     const phase_slot *from, phase_slot *out) {
+NAV_CLONE_INLINE void phase_at(int64_t K, double dt, nav_vec3 f, nav_vec3 g, const double (*step)[2],
+                               const phase_slot *from, phase_slot *out) {
   phase_slot r;
   if (from && from->k >= 0 && from->k <= K && K / PHASE_BLOCK == from->k / PHASE_BLOCK) {
     r = *from;
@@ -289,7 +290,7 @@ NAV_PARAM_INLINE void cache_apply(param_model *tr, nav_quat e) {
   }
 }
 
-static inline void cache_step(param_model *tr, const phase_slot *ph) {
+NAV_CLONE_INLINE void cache_step(param_model *tr, const phase_slot *ph) {
   cache_apply(tr, grid_exp(tr, ph, tr->cache_m));
 }
 
@@ -528,7 +529,7 @@ static void node_table(param_model *tr, int n, const double *x) {
  * in attitude_at: the cached grid attitude (grid steps are shared with nav_traj_eval) and one
  * partial Magnus step from the grid point below each node. Off the sample grid, param_eval.
  */
-nav_status nav_traj_parametric_nodes(void *self, nav_kin_nodes *io) {
+NAV_HOT_CLONES nav_status nav_traj_parametric_nodes(void *self, nav_kin_nodes *io) {
   param_model *tr = self;
   const nav_traj_parametric *p = &tr->p;
   if (io->k < 1) {

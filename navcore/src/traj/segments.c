@@ -42,6 +42,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_truth.h"
 #include "traj/traj_kin_internal.h"
+#include "nav_clones.h"
 
 enum { CH_YAW, CH_PITCH, CH_ROLL, CH_U, CH_V, CH_W, CH_CYAW, CH_N };
 
@@ -728,7 +729,7 @@ static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
  * expressions are those of seg_state, nav_euler_to_dcm and nav_kin_euler_rates (value parts of
  * the jets), so the numbers agree with seg_eval to rounding.
  */
-nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io) {
+NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io) {
   seg_model *m = self;
   const int n = io->n;
   /* Channel values at all nodes; ang/rate: yaw, pitch, roll (channel order). */

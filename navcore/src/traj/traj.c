@@ -8,6 +8,7 @@
 
 #include "navcore/nav_truth.h"
 #include "traj/traj_kin_internal.h"
+#include "nav_clones.h"
 
 /* Positions of the ideal IMU's position chain are re-anchored to the model's own (exact)
  * position every CHAIN_BLOCK samples; see chain_positions. */
@@ -394,7 +395,7 @@ static nav_vec3 chain_step(const nav_traj *tr, nav_vec3 r0, const nav_kin_nodes 
  * A sequential run costs one model position per CHAIN_BLOCK samples; a jump re-integrates at most
  * CHAIN_BLOCK - 1 intervals. Off the grid the model's position at t0 anchors the nodes.
  */
-static nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
+NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
   nav_vec3 r0;
   nav_status st = NAV_OK;
   if (io->k < 1) {
@@ -456,9 +457,9 @@ static nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) 
  * the radii, the Earth rate and gravity) and inv_sq = 1/sqrt(1 - e^2 sin^2 lat), which the
  * radii and gravity share.
  */
-static void ned_inertial(const nav_frame *fr, double inv_m_lat, double inv_m_lon, nav_vec3 r, nav_vec3 v,
-                         nav_vec3 a, const nav_mat3 *C_b_n, nav_vec3 w_nb_b, double sl, double cl,
-                         double inv_sq, nav_vec3 *f_b, nav_vec3 *w_ib_b) {
+NAV_CLONE_INLINE void ned_inertial(const nav_frame *fr, double inv_m_lat, double inv_m_lon, nav_vec3 r,
+                                   nav_vec3 v, nav_vec3 a, const nav_mat3 *C_b_n, nav_vec3 w_nb_b, double sl,
+                                   double cl, double inv_sq, nav_vec3 *f_b, nav_vec3 *w_ib_b) {
   const double h = fr->origin.h_m - r.z;
   const double dlat = v.x * inv_m_lat, dlon = v.y * inv_m_lon, dh = -v.z;
   const double ddlat = a.x * inv_m_lat, ddlon = a.y * inv_m_lon, ddh = -a.z;
@@ -487,7 +488,7 @@ static void ned_inertial(const nav_frame *fr, double inv_m_lat, double inv_m_lon
   *w_ib_b = nav_vec3_add(w_nb_b, nav_mat3_tmul_vec(*C_b_n, nav_vec3_add(w_ie_n, w_en_n)));
 }
 
-nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
+NAV_HOT_CLONES nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
                                        const double *w, nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad) {
   if (!traj || !x || !w || !dv_b_mps || !dtheta_b_rad || n < 1 || n > NAV_KIN_MAX_NODES || !isfinite(t0_s) ||
       !isfinite(t1_s))

@@ -67,7 +67,20 @@ nav_status nav_gauss_legendre(int n, double *nodes, double *weights) {
 nav_vec3 nav_gravity_e_mps2(nav_gravity_model model, nav_vec3 r_eb_e_m) {
   if (model == NAV_GRAVITY_J2) return nav_earth_gravity_j2_e_mps2(r_eb_e_m);
   const nav_geodetic p = nav_earth_ecef_to_geodetic(r_eb_e_m);
-  return nav_mat3_mul_vec(nav_earth_dcm_n_e(p.lat_rad, p.lon_rad), nav_earth_gravity_n_mps2(p.lat_rad, p.h_m));
+  /* C_n_e (0, 0, gamma(lat, h)): nav_earth_dcm_n_e() applied to nav_earth_gravity_n_mps2(), the same
+   * operations written out so that sin(lat) is evaluated once for both (the ECEF mechanization calls this
+   * every step); test_mech checks the agreement with those functions bit for bit. */
+  const double s = sin(p.lat_rad), c = cos(p.lat_rad);
+  const double so = sin(p.lon_rad), co = cos(p.lon_rad);
+  const double s2 = s * s, h = p.h_m;
+  const double ea = NAV_WGS84_A_M;
+  const double lin = (2.0 / ea) * (1.0 + NAV_WGS84_F + NAV_WGS84_M - 2.0 * NAV_WGS84_F * s2);
+  const double quad = 3.0 / (ea * ea);
+  const double surface =
+      NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) / sqrt(1.0 - NAV_WGS84_E2 * s2);
+  const nav_vec3 g_n = nav_vec3_make(0.0, 0.0, surface * (1.0 - lin * h + quad * h * h));
+  const nav_mat3 C_n_e = {{{-s * co, -so, -c * co}, {-s * so, co, -c * so}, {c, 0.0, -s}}};
+  return nav_mat3_mul_vec(C_n_e, g_n);
 }
 
 nav_status nav_truth_create_msg(const nav_scene *scene, nav_truth **out, char *msg, size_t msg_size) {

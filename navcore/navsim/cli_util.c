@@ -1,0 +1,130 @@
+/* Helpers shared by the navsim commands (see cli_util.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_util.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+bool navsim_is_help(const char *arg) {
+  return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+double navsim_now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void navsim_print_diag(void *user, const nav_diag *d) {
+  navsim_diag_sink *s = user;
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  if (s && s->context)
+    fprintf(stderr, "%s %s\n", line, s->context);
+  else
+    fprintf(stderr, "%s\n", line);
+  if (s) s->count++;
+}
+
+int navsim_load_scene(const char *path, nav_scene *scene) {
+  navsim_diag_sink sink = {0};
+  const nav_status st = nav_scene_read_file(path, scene, navsim_print_diag, &sink);
+  if (st == NAV_OK) return 0;
+  if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
+  return st == NAV_ERR_PARSE ? 2 : 1;
+}
+
+bool navsim_parse_u64(const char *s, uint64_t *out) {
+  if (!s || !*s || *s == '-' || *s == '+') return false;
+  for (const char *p = s; *p; ++p)
+    if (*p < '0' || *p > '9') return false;
+  errno = 0;
+  char *end = NULL;
+  const unsigned long long v = strtoull(s, &end, 10);
+  if (errno != 0 || !end || *end) return false;
+  *out = (uint64_t)v;
+  return true;
+}
+
+bool navsim_parse_double(const char *s, double *out) {
+  if (!s || !*s) return false;
+  errno = 0;
+  char *end = NULL;
+  const double v = strtod(s, &end);
+  if (errno != 0 || !end || *end || !isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+bool navsim_parse_positive(const char *s, double *out, bool allow_zero) {
+  double v = 0.0;
+  if (!navsim_parse_double(s, &v) || v < 0.0 || (!allow_zero && v == 0.0)) return false;
+  *out = v;
+  return true;
+}
+
+bool navsim_parse_long(const char *s, long lo, long hi, long *out) {
+  if (!s) return false;
+  char *end = NULL;
+  errno = 0;
+  const long v = strtol(s, &end, 10);
+  if (errno != 0 || !end || end == s || *end || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+bool navsim_need_value(const char *cmd, int argc, int i, const char *opt) {
+  if (i + 1 < argc) return true;
+  fprintf(stderr, "navsim %s: %s needs a value\n", cmd, opt);
+  return false;
+}
+
+int navsim_unknown_option(const char *cmd, const char *opt) {
+  fprintf(stderr, "navsim %s: unknown option \"%s\" (see navsim %s --help)\n", cmd, opt, cmd);
+  return 2;
+}
+
+int navsim_scene_arg(const char *cmd, const char *arg, const char **scene) {
+  if (arg[0] == '-' && arg[1] != '\0') return navsim_unknown_option(cmd, arg);
+  if (*scene) {
+    fprintf(stderr, "navsim %s: only one SCENE may be given\n", cmd);
+    return 2;
+  }
+  *scene = arg;
+  return 0;
+}
+
+void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallback) {
+  size_t j = 0;
+  for (const char *p = name; *p && j + 1 < cap; ++p) {
+    const char c = *p;
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                    c == '_' || c == '.';
+    out[j++] = ok ? c : '_';
+  }
+  out[j] = '\0';
+  if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", fallback);
+}
+
+void navsim_json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(f, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(f, "\\u%04x", *p);
+    else
+      fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+void navsim_json_number(FILE *f, double v, int digits) {
+  if (isfinite(v))
+    fprintf(f, "%.*g", digits, v);
+  else
+    fputs("null", f);
+}

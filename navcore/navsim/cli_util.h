@@ -1,0 +1,70 @@
+/*
+ * Small helpers shared by the navsim commands: option words, number parsing, diagnostics on
+ * stderr, wall clock, JSON text. One copy here instead of one per command file; the messages
+ * they print are part of the navsim contract (tests/scenario/test_navsim_*.c).
+ */
+#ifndef NAVSIM_CLI_UTIL_H
+#define NAVSIM_CLI_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "navcore/nav_io.h"
+
+/* "-h" or "--help". */
+bool navsim_is_help(const char *arg);
+
+/* Monotonic wall clock [s] (for elapsed times only). */
+double navsim_now_s(void);
+
+/* Diagnostics sink for nav_diag_fn callbacks: navsim_print_diag prints each diagnostic on stderr
+ * as one line (nav_diag_format), followed by " CONTEXT" when context is set, and counts it. */
+typedef struct navsim_diag_sink {
+  int count;
+  const char *context; /* NULL: nothing appended */
+} navsim_diag_sink;
+
+/* nav_diag_fn: @p user is a navsim_diag_sink or NULL (print only). */
+void navsim_print_diag(void *user, const nav_diag *d);
+
+/* nav_scene_read_file with navsim_print_diag; "PATH: error: STATUS" on stderr when the reader
+ * reported nothing. @return the exit code: 0 read, 2 invalid scene (NAV_ERR_PARSE), 1 otherwise. */
+int navsim_load_scene(const char *path, nav_scene *scene);
+
+/* Decimal digits only (no sign, no blanks), within uint64_t. */
+bool navsim_parse_u64(const char *s, uint64_t *out);
+
+/* The whole text is one finite number (strtod syntax). */
+bool navsim_parse_double(const char *s, double *out);
+
+/* A finite number > 0, or >= 0 with @p allow_zero. */
+bool navsim_parse_positive(const char *s, double *out, bool allow_zero);
+
+/* The whole text is one integer (strtol syntax) in [lo, hi]. */
+bool navsim_parse_long(const char *s, long lo, long hi, long *out);
+
+/* argv[i] is an option taking a value: true when argv[i + 1] exists, else prints
+ * "navsim CMD: OPT needs a value" on stderr and returns false. */
+bool navsim_need_value(const char *cmd, int argc, int i, const char *opt);
+
+/* Prints "navsim CMD: unknown option "OPT" (see navsim CMD --help)" on stderr. @return 2. */
+int navsim_unknown_option(const char *cmd, const char *opt);
+
+/* A command-line word that no option of CMD took: "-X..." is an unknown option
+ * (navsim_unknown_option), anything else the SCENE, of which only one may be given ("navsim CMD:
+ * only one SCENE may be given"). @return 0 (stored in *scene) or the exit code 2. */
+int navsim_scene_arg(const char *cmd, const char *arg, const char **scene);
+
+/* @p name made safe as a file or directory name: characters other than [A-Za-z0-9._-] become
+ * '_'; empty, "." or ".." become @p fallback. */
+void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallback);
+
+/* A JSON string literal (quotes, backslash and control characters escaped); NULL prints "". */
+void navsim_json_string(FILE *f, const char *s);
+
+/* A JSON number with @p digits significant digits ("%.*g"); non-finite values print null. */
+void navsim_json_number(FILE *f, double v, int digits);
+
+#endif /* NAVSIM_CLI_UTIL_H */
