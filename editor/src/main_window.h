@@ -34,7 +34,11 @@ namespace studio {
 /** Live preview simplifications (MainWindow::StartPreview). */
 constexpr int kPreviewCovDecimation = 10;
 constexpr double kPreviewOutputHz = 10.0;
-constexpr double kPreviewImuHz = 50.0;
+constexpr double kPreviewImuHz = 20.0;
+/** The preview's IMU rate when kPreviewImuHz does not fit the scene. */
+constexpr double kPreviewImuHzFallback = 50.0;
+/** A running live preview that has done less than this fraction is dropped for a newer edit. */
+constexpr double kPreviewPreemptFraction = 0.5;
 /** During a live drag the path waits at most this long for its preview to be drawn with it. */
 constexpr int kLiveRenderDelayMs = 100;
 /** The lighter scene the live preview simulates (a copy of @p scene). */
@@ -59,6 +63,11 @@ public:
    *  in @p errors. */
   bool ImportTrack(const QString &path, QStringList *errors = nullptr);
   bool SaveAs(const QString &path);
+  /** File > Export report: one self-contained HTML file (report_export.h) with the last full
+   *  run's verdicts and statistics and pictures of the window and the error chart. */
+  bool ExportReport(const QString &path, QString *error);
+  /** Draw the error band of @p r about its estimate in both views (3 sigma or 3 RMS). */
+  void SetEnvelopes(const SimResult &r, bool preview);
   /** Start the Monte Carlo run of the scene. false when the scene has issues. */
   bool Run();
   void Cancel();
@@ -72,6 +81,8 @@ public:
 
   void SetAsk(AskFn fn) { ask_ = std::move(fn); }
   void SetLivePreview(bool on);
+  /** How long a live edit's frame may wait for its preview (default kLiveRenderDelayMs; tests). */
+  void SetLiveFrameHoldMs(int ms) { frame_hold_ms_ = ms; }
   SceneDocument *Doc() { return &doc_; }
   PathView *MapView() { return map_; }
   PathView *View3D() { return view3d_; }
@@ -81,8 +92,11 @@ public:
   SimWorker *PreviewWorker() { return &preview_; }
   std::shared_ptr<const SimResult> LastResult() const { return last_result_; }
   std::shared_ptr<const SimResult> LastPreview() const { return last_preview_; }
-  /** Edit-to-picture latencies of the live previews so far [ms]. */
+  /** Edit-to-picture latencies of the live previews so far [ms]: from the edit (the scene's
+   *  change) to the swap of the window's frame that shows the preview's estimate. */
   const std::vector<double> &PreviewLatenciesMs() const { return latencies_ms_; }
+  /** Frames of the window composed and swapped so far (benchmarks, tests). */
+  long FramesShown() const { return frames_shown_; }
   QString ResultsText() const;
   QStringList RecentFiles() const;
 
@@ -92,6 +106,8 @@ signals:
 
 protected:
   void closeEvent(QCloseEvent *e) override;
+  /** Holds the window's repaints (QEvent::UpdateRequest) while a live edit waits for its preview. */
+  bool event(QEvent *e) override;
 
 private:
   void BuildUi();
@@ -108,6 +124,12 @@ private:
   void RemoveAutosave();
   bool SceneSmallForPreview() const;
   void UpdateLiveRenderDelay();
+  /** The views' picture of the pending preview reached the screen: record its latency. */
+  void OnPictureShown();
+  /** During a live edit the window draws one frame per preview: the panels, the path and the
+   *  estimate that follows it together (at most kLiveRenderDelayMs after the edit). */
+  void HoldFrames();
+  void ReleaseFrames();
 
   SceneDocument doc_;
   Catalogs catalogs_;
@@ -130,6 +152,19 @@ private:
   QTimer autosave_timer_;
   int autosaved_index_ = -1;
   qint64 preview_started_ns_ = 0;
+  // The preview whose picture is drawn but not yet on screen (composed and swapped by Qt).
+  struct PendingPicture {
+    qint64 change_ns = 0, started_ns = 0, arrived_ns = 0, drawn_ns = 0;
+    double sim_ms = 0.0, final_err_m = 0.0;
+    long long samples = 0;
+  };
+  PendingPicture pending_picture_;
+  bool hold_frames_ = false, held_update_ = false;
+  long frames_shown_ = 0;
+  int frame_hold_ms_ = kLiveRenderDelayMs;
+  QTimer frame_hold_timer_;
+  QTimer latency_label_timer_; // the latency read-out waits for a pause (no extra frame per edit)
+  QString latency_text_;
   AskFn ask_;
   std::shared_ptr<const SimResult> last_result_, last_preview_;
   std::vector<double> latencies_ms_;

@@ -1,5 +1,6 @@
 #include "panels.h"
 #include "path_view.h"
+#include "segment_editor.h"
 
 #include <QCheckBox>
 #include <QComboBox>
@@ -169,7 +170,7 @@ ScenePanels::ScenePanels(SceneDocument *doc, Catalogs *catalogs, QWidget *parent
   addTab(Scrolled(BuildModel()), tr("Model"));
   addTab(Scrolled(BuildImu()), tr("IMU"));
   addTab(Scrolled(BuildGnss()), tr("GNSS"));
-  addTab(BuildTrajectory(), tr("Trajectory"));
+  addTab(new TrajectoryEditors(doc_, BuildTrajectory()), tr("Trajectory")); // waypoints, segments, parametric
   addTab(Scrolled(BuildSimulation()), tr("Simulation"));
   addTab(BuildRequirements(), tr("Requirements"));
   connect(doc_, &SceneDocument::Changed, this, &ScenePanels::Refresh);

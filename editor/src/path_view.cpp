@@ -1,6 +1,7 @@
 #include "path_view.h"
 
 #include <QResizeEvent>
+#include <QShowEvent>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -12,6 +13,13 @@
 #include <vtkBillboardTextActor3D.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
+#include <vtkCameraPass.h>
+#include <vtkLightsPass.h>
+#include <vtkOpaquePass.h>
+#include <vtkOverlayPass.h>
+#include <vtkRenderPassCollection.h>
+#include <vtkSequencePass.h>
+#include <vtkTranslucentPass.h>
 #include <vtkCellArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGlyph3D.h>
@@ -208,6 +216,26 @@ size_t SetXyPolylines(vtkPolyData *pd, const std::vector<std::vector<double>> &l
   return static_cast<size_t>(cells->GetNumberOfCells());
 }
 
+/** SamplePath for the views: both draw the same path, the second one of an edit reuses the
+ *  first one's samples (GUI thread only, as the views). */
+bool SharedSamplePath(const nav_scene &s, int max_points, PathSamples *out, QString *msg) {
+  static std::vector<unsigned char> key;
+  static int key_points = 0;
+  static PathSamples samples;
+  static QString message;
+  static bool ok = false;
+  if (key_points != max_points || key.size() != sizeof s || std::memcmp(key.data(), &s, sizeof s) != 0) {
+    message.clear();
+    ok = SamplePath(s, max_points, &samples, &message);
+    const auto *bytes = reinterpret_cast<const unsigned char *>(&s);
+    key.assign(bytes, bytes + sizeof s);
+    key_points = max_points;
+  }
+  *out = samples;
+  if (msg) *msg = message;
+  return ok;
+}
+
 double NiceStep(double x) {
   const double p = std::pow(10.0, std::floor(std::log10(std::max(x, 1e-6))));
   const double m = x / p;
@@ -235,6 +263,23 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   window_->SetMultiSamples(kMultiSamples);
   widget_->setRenderWindow(window_);
   renderer_ = vtkSmartPointer<vtkRenderer>::New();
+  {
+    // Lights, opaque props, translucent props with plain alpha blending, 2D overlay. The only
+    // translucent props (the 3D view's ground under everything, the label backgrounds over
+    // everything, in that actor order) blend alike in one pass; VTK's default for translucent
+    // props, order-independent transparency, adds full-window passes to every frame (about a
+    // quarter of a frame's main-thread time with Mesa's software renderer).
+    vtkNew<vtkRenderPassCollection> passes;
+    passes->AddItem(vtkNew<vtkLightsPass>());
+    passes->AddItem(vtkNew<vtkOpaquePass>());
+    passes->AddItem(vtkNew<vtkTranslucentPass>());
+    passes->AddItem(vtkNew<vtkOverlayPass>());
+    vtkNew<vtkSequencePass> sequence;
+    sequence->SetPasses(passes);
+    vtkNew<vtkCameraPass> camera;
+    camera->SetDelegatePass(sequence);
+    renderer_->SetPass(camera);
+  }
   window_->AddRenderer(renderer_);
   {
     vtkNew<vtkCallbackCommand> cb;
@@ -284,6 +329,9 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   selected_actor_->GetProperty()->LightingOn();
   bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
   bad_actor_->GetProperty()->LightingOn();
+  envelope_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 1.0);
+  envelope_->GetProperty()->SetOpacity(0.25);
+  renderer_->AddActor(envelope_); // first: under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
     renderer_->AddActor(a);
 
@@ -341,6 +389,11 @@ vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor()
 void PathView::Render() {
   render_timer_.stop();
   if (!window_) return;
+  if (!isVisible() || width() <= 0 || height() <= 0) {
+    render_pending_ = true;
+    return;
+  }
+  render_pending_ = false;
   // While a drag is live the views render without multisampling: with Mesa's software renderer
   // 8x MSAA about doubles the cost of a frame (measured: 20-30 ms -> 11-15 ms per view); the
   // committed edit is drawn smooth again.
@@ -449,7 +502,7 @@ void PathView::Rebuild() {
   rebuild_timer_.stop();
   const nav_scene &s = doc_->Scene();
   QString msg;
-  if (!SamplePath(s, 1200, &path_, &msg)) path_ = PathSamples();
+  if (!SharedSamplePath(s, 1200, &path_, &msg)) path_ = PathSamples();
   SetPolyline(InputOf(path_actor_), path_.ned_m, 0.3);
   // Parts of the path over a vehicle limit (a motion-definition script may exceed them): red.
   unsigned over_bits = 0;
@@ -634,6 +687,12 @@ void PathView::UpdateCaption() {
 void PathView::resizeEvent(QResizeEvent *e) {
   QWidget::resizeEvent(e);
   if (mode_ == Mode::Map) bg_timer_.start();
+  if (render_pending_) render_timer_.start(0);
+}
+
+void PathView::showEvent(QShowEvent *e) {
+  QWidget::showEvent(e);
+  if (render_pending_) render_timer_.start(0);
 }
 
 void PathView::SetMapExtent(double n, double e, double half_height_m) {
@@ -722,6 +781,45 @@ void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
   }
   Render();
 }
+
+void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview) {
+  vtkPolyData *pd = InputOf(envelope_);
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  auto strips = vtkSmartPointer<vtkCellArray>::New();
+  const size_t n = std::min(ned.size() / 3, half_width_m.size());
+  // Just under the estimate: in the map 4 m up (the estimate is drawn 5 m up), in 3D at its height.
+  const double lift = mode_ == Mode::Map ? 4.0 : 0.003 * std::max(grid_extent_, 100.0);
+  if (n >= 2) {
+    strips->InsertNextCell(static_cast<vtkIdType>(2 * n));
+    for (size_t i = 0; i < n; ++i) {
+      // Horizontal normal of the path at i (central difference; ends one-sided).
+      const size_t a = i > 0 ? i - 1 : i, b = i + 1 < n ? i + 1 : i;
+      double dn = ned[3 * b] - ned[3 * a], de = ned[3 * b + 1] - ned[3 * a + 1];
+      const double len = std::hypot(dn, de);
+      if (len > 1e-9) {
+        dn /= len;
+        de /= len;
+      } else {
+        dn = 1.0;
+        de = 0.0;
+      }
+      const double w = std::isfinite(half_width_m[i]) ? half_width_m[i] : 0.0;
+      const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift;
+      // Normal (east, north) = (dn, -de) rotated from the tangent (de, dn).
+      strips->InsertCellPoint(pts->InsertNextPoint(x + w * dn, y - w * de, z));
+      strips->InsertCellPoint(pts->InsertNextPoint(x - w * dn, y + w * de, z));
+    }
+  }
+  pd->SetPoints(pts);
+  pd->SetStrips(strips);
+  pd->Modified();
+  if (preview)
+    envelope_->GetProperty()->SetColor(0.95, 0.55, 0.05);
+  else
+    envelope_->GetProperty()->SetColor(0.85, 0.10, 0.45);
+}
+
+size_t PathView::EnvelopePointCount() { return static_cast<size_t>(InputOf(envelope_)->GetNumberOfPoints()); }
 
 bool PathView::DisplayOf(double n, double e, double d, int *x, int *y) {
   renderer_->SetWorldPoint(e, n, -d, 1.0);

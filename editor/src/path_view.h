@@ -48,9 +48,15 @@ public:
    *  colour, else the Monte Carlo result's (the one it replaces stays drawn in grey for A/B
    *  comparison). Empty clears it. */
   void SetEstimate(const std::vector<double> &ned, bool preview);
+  /** Error envelope around the estimate: a horizontal band of half-width @p half_width_m[i] about
+   *  the points @p ned (3 per point, local NED); translucent orange for a preview (k x the filter's
+   *  reported sigma), magenta for a Monte Carlo result (k x the RMS over runs). Empty clears it. */
+  void SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview);
+  /** Points of the drawn envelope band (2 per epoch; tests). */
+  size_t EnvelopePointCount();
   /** Fit the camera to the scene and rebuild the grid. */
   void ResetCamera();
-  /** Render now. */
+  /** Render now (a hidden view, or one collapsed to no area, renders when it is shown again). */
   void Render();
 
   /** VTK display coordinates (origin bottom-left) of a local N/E/D point; false if off-screen. */
@@ -102,6 +108,7 @@ private:
   void UpdateGrid(double cx, double cy, double extent);
   void UpdateCaption();
   void resizeEvent(QResizeEvent *e) override;
+  void showEvent(QShowEvent *e) override;
 
   SceneDocument *doc_;
   Mode mode_;
@@ -110,6 +117,7 @@ private:
   vtkSmartPointer<vtkRenderer> renderer_;
   vtkSmartPointer<PathViewStyle> style_;
   vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, over_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
+  vtkSmartPointer<vtkActor> envelope_; // band around the estimate (SetEnvelope)
   vtkSmartPointer<vtkTextActor> caption_, problem_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
   PathSamples path_;
@@ -134,6 +142,7 @@ private:
   unsigned long camera_observer_ = 0, render_observer_ = 0;
   int live_render_delay_ms_ = 0;
   QTimer render_timer_;
+  bool render_pending_ = false; // a render skipped while the view was hidden or had no area
   double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;
 };
 

@@ -10,7 +10,6 @@ namespace studio {
 
 namespace {
 constexpr int kProfilePoints = 500;
-constexpr int kLiveIntervalMs = 250;
 }
 
 ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
@@ -19,14 +18,11 @@ ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent
   // Coalesced like the views: a drag redraws the chart once per event-loop pass.
   timer_.setSingleShot(true);
   connect(&timer_, &QTimer::timeout, this, &ProfileChart::Recompute);
-  // During a live drag the chart follows at most every kLiveIntervalMs (a repaint of a widget
-  // recomposes the whole window, OpenGL views included, which software rendering pays for).
-  connect(doc_, &SceneDocument::Changed, this, [this] {
-    if (!doc_->IsLive())
-      timer_.start(0);
-    else if (!timer_.isActive())
-      timer_.start(kLiveIntervalMs);
-  });
+  // During a live drag too: a repaint of a widget recomposes the whole window, OpenGL views
+  // included, which software rendering pays for, so the chart joins the frame of the views
+  // (the window holds that frame until the live preview's estimate is drawn, MainWindow) instead
+  // of a frame of its own.
+  connect(doc_, &SceneDocument::Changed, this, [this] { timer_.start(0); });
   Recompute();
 }
 

@@ -2,6 +2,7 @@
 
 #include <QMetaObject>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -18,6 +19,7 @@ struct RunCtx {
   std::atomic<double> *fraction;
   std::atomic<bool> *cancel;
   SimResult *out;
+  double single_run_s; /* > 0: one run of this duration, whose progress the output epochs give */
 };
 
 nav_callback_result OnProgress(void *user, const nav_progress *p) {
@@ -29,6 +31,8 @@ nav_callback_result OnProgress(void *user, const nav_progress *p) {
 nav_callback_result OnRecord(void *user, const nav_sim_record *r) {
   auto *c = static_cast<RunCtx *>(user);
   if (r->run != 0) return NAV_CONTINUE;
+  // navcore reports progress every 65536 IMU samples: a preview's single run is done sooner.
+  if (c->single_run_s > 0.0) c->fraction->store(std::min(1.0, r->truth->t_s / c->single_run_s));
   const nav_local_view tv = nav_frame_view(r->frame, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
   const nav_local_view nv = nav_frame_view(r->frame, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f);
   SimResult *o = c->out;
@@ -131,10 +135,12 @@ void SimWorker::RunJob(SimWorker *self, Job *job, SimResult *out) {
   }
   if (self->cancel_.load()) nav_sim_request_cancel(sim);
 
+  // The live preview shows the estimate and the final error, not verdicts: no evaluator.
   nav_req_evaluator *ev = nullptr;
-  if (scene.n_requirements > 0 && nav_req_evaluator_create_for_scene(&scene, false, &ev) != NAV_OK) ev = nullptr;
+  if (!job->preview && scene.n_requirements > 0 && nav_req_evaluator_create_for_scene(&scene, false, &ev) != NAV_OK)
+    ev = nullptr;
 
-  RunCtx ctx{self, &self->fraction_, &self->cancel_, out};
+  RunCtx ctx{self, &self->fraction_, &self->cancel_, out, job->runs == 1 ? scene.trajectory.duration_s : 0.0};
   nav_sim_options o = nav_sim_options_default();
   const unsigned hc = std::thread::hardware_concurrency();
   o.threads = job->preview ? 1 : static_cast<int>(hc > 0 ? hc : 1);
@@ -160,6 +166,8 @@ void SimWorker::RunJob(SimWorker *self, Job *job, SimResult *out) {
     for (size_t i = 0; env && i < n; ++i) {
       out->env_t_s.push_back(env[i].t_s);
       out->env_h_rms_m.push_back(env[i].pos_h_rms_m);
+      if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS)
+        out->env_sd_h_m.push_back(std::hypot(env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y));
     }
     if (ev) {
       out->verdicts.resize(static_cast<size_t>(nav_req_evaluator_count(ev)));

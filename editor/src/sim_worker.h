@@ -40,7 +40,9 @@ struct SimResult {
   std::vector<double> err_h_m;    /**< horizontal error of run 0 [m] */
   std::vector<double> env_t_s;    /**< Monte Carlo envelope epochs */
   std::vector<double> env_h_rms_m; /**< RMS over runs of the horizontal error [m] */
-  std::vector<nav_requirement_verdict> verdicts; /**< one per scene requirement */
+  /** The filter's reported horizontal 1-sigma, mean over runs [m] (INS/GNSS; else empty) */
+  std::vector<double> env_sd_h_m;
+  std::vector<nav_requirement_verdict> verdicts; /**< one per scene requirement (none for a preview) */
   std::vector<nav_gnss_outage> outages;          /**< the scene's GNSS outages (for charts) */
 };
 

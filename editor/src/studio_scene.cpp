@@ -1,12 +1,18 @@
 #include "studio_scene.h"
+#include "scene_text.h"
 
 #include <QCoreApplication>
 #include <QDir>
 #include <QFile>
 #include <QFileInfo>
+#include <QRegularExpression>
 #include <QUndoCommand>
 
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <fcntl.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstring>
 
@@ -359,6 +365,7 @@ bool SceneDocument::Load(const QString &path, QStringList *errors) {
   const QByteArray p = QFile::encodeName(path);
   if (nav_scene_read_file(p.constData(), s.get(), CollectDiagList, &dl) != NAV_OK) return false;
   Normalize(s.get());
+  RememberUserText(path, *s);
   path_ = QFileInfo(path).absoluteFilePath();
   undo_.clear();
   live_ = false;
@@ -378,6 +385,17 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
                             CollectDiagList, &dl) != NAV_OK)
     return false;
   Normalize(s.get());
+  // The file the recovered document belongs to is the base of its comment-preserving save.
+  user_text_.clear();
+  user_scene_.reset();
+  if (!path_for_save.isEmpty() && QFileInfo::exists(path_for_save)) {
+    auto f = std::make_unique<nav_scene>();
+    const QByteArray fp = QFile::encodeName(path_for_save);
+    if (nav_scene_read_file(fp.constData(), f.get(), nullptr, nullptr) == NAV_OK) {
+      Normalize(f.get());
+      RememberUserText(path_for_save, *f);
+    }
+  }
   path_ = path_for_save;
   undo_.clear();
   // A recovered document differs from its file: push the recovery as an edit so it is "modified".
@@ -394,6 +412,8 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
 void SceneDocument::Reset(const nav_scene &s) {
   undo_.clear();
   path_.clear();
+  user_text_.clear();
+  user_scene_.reset();
   live_ = false;
   *scene_ = s;
   Normalize(scene_.get());
@@ -402,9 +422,132 @@ void SceneDocument::Reset(const nav_scene &s) {
   emit FileStateChanged();
 }
 
+void SceneDocument::RememberUserText(const QString &path, const nav_scene &read_as) {
+  QFile f(path);
+  if (f.open(QIODevice::ReadOnly)) {
+    user_text_ = f.readAll();
+    user_scene_ = std::make_unique<nav_scene>(read_as);
+  } else {
+    user_text_.clear();
+    user_scene_.reset();
+  }
+}
+
+namespace {
+QString ShmPath(const char *what) {
+  const QString dir = QDir("/dev/shm").exists() ? QStringLiteral("/dev/shm") : QDir::tempPath();
+  return QDir(dir).filePath(QStringLiteral("navstudio-%1-%2.yaml").arg(what).arg(QCoreApplication::applicationPid()));
+}
+
+/* navcore's writer's text of @p s (empty on failure). */
+QByteArray CanonicalText(const nav_scene &s) {
+  const QString p = ShmPath("canon");
+  const QByteArray pp = QFile::encodeName(p);
+  QByteArray out;
+  if (nav_scene_write_file(pp.constData(), &s) == NAV_OK) {
+    QFile f(p);
+    if (f.open(QIODevice::ReadOnly)) out = f.readAll();
+  }
+  QFile::remove(p);
+  return out;
+}
+
+/* Write @p text to @p path atomically: a temporary file in the same directory, fsync, rename. */
+bool WriteAtomically(const QString &path, const QByteArray &text, QString *error) {
+  const QByteArray final_path = QFile::encodeName(path);
+  const QByteArray tmp = final_path + ".tmp-" + QByteArray::number(QCoreApplication::applicationPid());
+  FILE *f = std::fopen(tmp.constData(), "wb");
+  bool ok = f != nullptr;
+  if (ok) ok = std::fwrite(text.constData(), 1, static_cast<size_t>(text.size()), f) == static_cast<size_t>(text.size());
+  if (ok) ok = std::fflush(f) == 0 && fsync(fileno(f)) == 0;
+  if (f && std::fclose(f) != 0) ok = false;
+  // The file keeps its permissions; the rename is made durable with the directory.
+  if (ok && QFileInfo::exists(path)) QFile::setPermissions(QFile::decodeName(tmp), QFile::permissions(path));
+  if (ok) ok = std::rename(tmp.constData(), final_path.constData()) == 0;
+  if (ok) {
+    const QByteArray dir = QFile::encodeName(QFileInfo(path).absolutePath());
+    const int fd = open(dir.constData(), O_RDONLY | O_DIRECTORY);
+    if (fd >= 0) {
+      (void)fsync(fd);
+      close(fd);
+    }
+  }
+  if (!ok) {
+    std::remove(tmp.constData());
+    if (error) *error = QStringLiteral("%1: error: cannot write the scene (%2)").arg(path, QString::fromLocal8Bit(std::strerror(errno)));
+    return false;
+  }
+  return true;
+}
+} // namespace
+
+QByteArray SceneDocument::SaveText(QString *note) const {
+  const QByteArray canon_new = CanonicalText(*scene_);
+  if (canon_new.isEmpty()) return QByteArray();
+  if (user_text_.isEmpty() || !user_scene_) {
+    if (note) *note = tr("written by navcore's writer (a new scene)");
+    return canon_new;
+  }
+  QByteArray canon_old = CanonicalText(*user_scene_);
+  // "duration_s: auto" (or none) of a script stays so while the duration is the planned one:
+  // both canonical texts say auto there, so the merge sees no change of that key.
+  QByteArray user_duration;
+  const bool has_duration = SceneScalar(user_text_, {QStringLiteral("trajectory"), QStringLiteral("duration_s")},
+                                        &user_duration);
+  QByteArray canon_new_auto = canon_new;
+  if (!has_duration || user_duration == "auto") {
+    auto autoify = [](QByteArray *canon, const nav_scene &sc) {
+      if (!IsScript(sc)) return;
+      auto planned = std::make_unique<nav_scene>(sc);
+      QString m;
+      if (!UpdateDuration(planned.get(), &m) || planned->trajectory.duration_s != sc.trajectory.duration_s) return;
+      static const QRegularExpression re(QStringLiteral("(^trajectory:\\n(?: .*\\n)*?  duration_s: )[^\\n]*"),
+                                         QRegularExpression::MultilineOption);
+      *canon = QString::fromUtf8(*canon).replace(re, QStringLiteral("\\1auto")).toUtf8();
+    };
+    autoify(&canon_old, *user_scene_);
+    autoify(&canon_new_auto, *scene_);
+  }
+  if (canon_old == canon_new_auto) {
+    if (note) *note = tr("unchanged: the file's text is kept as it is");
+    return user_text_;
+  }
+  const QByteArray display = QFile::encodeName(path_.isEmpty() ? QStringLiteral("scene.yaml") : path_);
+  for (MergeLevel level : {MergeLevel::Fine, MergeLevel::Sections}) {
+    QString replaced;
+    const QByteArray merged = MergeSceneText(user_text_, canon_old, canon_new_auto, level, &replaced);
+    if (merged.isEmpty()) continue;
+    // What the user wrote and what the program writes must load identically: the merged text
+    // must read back to exactly the scene the writer's text describes.
+    auto back = std::make_unique<nav_scene>();
+    if (nav_scene_read_string(merged.constData(), static_cast<size_t>(merged.size()), display.constData(), back.get(),
+                              nullptr, nullptr) != NAV_OK)
+      continue;
+    Normalize(back.get());
+    if (CanonicalText(*back) != canon_new) continue;
+    if (note)
+      *note = replaced.isEmpty() ? tr("comments and layout kept")
+                                 : tr("comments and layout kept except where rewritten: %1").arg(replaced);
+    return merged;
+  }
+  if (note) *note = tr("written by navcore's writer: the changes could not be placed into the file's text (comments lost)");
+  return canon_new;
+}
+
 bool SceneDocument::Save(const QString &path, QString *error) {
-  if (!WriteCopy(path, error)) return false;
-  path_ = QFileInfo(path).absoluteFilePath();
+  QString note;
+  const QString abs = QFileInfo(path).absoluteFilePath();
+  // A save to another file still starts from the text the document was loaded from.
+  const QByteArray text = SaveText(&note);
+  if (text.isEmpty()) {
+    if (error) *error = QStringLiteral("%1: error: cannot write the scene (the writer failed)").arg(path);
+    return false;
+  }
+  if (!WriteAtomically(abs, text, error)) return false;
+  save_note_ = note;
+  user_text_ = text;
+  user_scene_ = std::make_unique<nav_scene>(*scene_);
+  path_ = abs;
   undo_.setClean();
   emit FileStateChanged();
   return true;

@@ -130,8 +130,13 @@ public:
                 QStringList *errors);
   /** Start a new document from @p s (clean, no file). */
   void Reset(const nav_scene &s);
-  /** Save atomically (navcore's writer: temp + rename); marks the document clean. */
+  /** Save atomically (temp + fsync + rename); marks the document clean. When the document was
+   *  loaded from a file, the changes are spliced into the text the user wrote (scene_text.h), so
+   *  comments, blank lines and layout survive; the spliced text is used only if it reads back to
+   *  exactly this scene, else whole sections, else navcore's writer alone (SaveNote() says which). */
   bool Save(const QString &path, QString *error);
+  /** What the last Save() kept of the user's text ("" before any save). */
+  QString SaveNote() const { return save_note_; }
   /** Write a copy (autosave) without changing the document's file or clean state. */
   bool WriteCopy(const QString &path, QString *error) const;
 
@@ -153,10 +158,17 @@ signals:
 
 private:
   void Touch();
+  void RememberUserText(const QString &path, const nav_scene &read_as);
+  QByteArray SaveText(QString *note) const;
   std::unique_ptr<nav_scene> scene_;
   QUndoStack undo_;
   QString path_;
   QString plan_msg_;
+  // The text the document was loaded from (or last saved as) and the scene it reads as: the
+  // base of the comment-preserving save. Empty for a new document.
+  QByteArray user_text_;
+  std::unique_ptr<nav_scene> user_scene_;
+  QString save_note_;
   qint64 last_change_ns_ = 0;
   bool live_ = false;
 };

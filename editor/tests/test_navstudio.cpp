@@ -199,6 +199,10 @@ private slots:
     QVERIFY(w->ResultsText().contains(v.pass ? "verdict: PASS" : "verdict: FAIL"));
     qInfo("journey: 100 runs in %.1f s, %s = %.3f m (limit %.1f m): %s", r->wall_s, v.id, v.value, v.limit,
           v.pass ? "PASS" : "FAIL");
+    // The Monte Carlo band (3 x RMS over the 100 runs) about run 0's estimate in both views.
+    QVERIFY(r->env_t_s.size() > 10);
+    QCOMPARE(w->MapView()->EnvelopePointCount(), 2 * r->env_t_s.size());
+    QCOMPARE(w->View3D()->EnvelopePointCount(), 2 * r->env_t_s.size());
     w->Panels()->setCurrentIndex(5); // the Requirements panel: the verdict per requirement
     Shot(w.get(), "journey-04-verdict");
     w->findChild<QTabWidget *>("bottomTabs")->setCurrentIndex(1);
@@ -292,7 +296,8 @@ private slots:
     QVERIFY(WaitUntil([&] { return w->LastPreview() && w->LastPreview()->scene_change_ns == w->Doc()->LastChangeNs(); },
                       60000));
     QVERIFY(w->LastPreview()->nav_ned != est_before);
-    QVERIFY(!w->PreviewLatenciesMs().empty());
+    // The latency is taken when the frame showing the estimate has been swapped.
+    QVERIFY(WaitUntil([&] { return !w->PreviewLatenciesMs().empty(); }, 10000));
     qInfo("drag: preview latency %.1f ms (edit to picture)", w->PreviewLatenciesMs().back());
     Shot(w.get(), "drag-01-after-drag");
   }
@@ -318,6 +323,57 @@ private slots:
     QVERIFY(w->findChild<QLabel *>("statusText")->text().startsWith("Cancelled"));
     QVERIFY(w->findChild<QAction *>("actionRun")->isEnabled());
     Shot(w.get(), "cancel-02-cancelled");
+  }
+
+  // File > Export report: one self-contained HTML file with the verdict of each requirement, the
+  // statistics and the pictures embedded; before any run it says so; a path that cannot be
+  // written gives an error and leaves nothing.
+  void export_report() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+    const QString dir = QString(NAVSTUDIO_TEST_OUT_DIR);
+    QDir().mkpath(dir);
+    const QString before = dir + "/report-before-run.html";
+    QFile::remove(before);
+    QString err;
+    QVERIFY2(w->ExportReport(before, &err), qPrintable(err));
+    QFile fb(before);
+    QVERIFY(fb.open(QIODevice::ReadOnly));
+    const QString hb = QString::fromUtf8(fb.readAll());
+    QVERIFY(hb.contains("No simulation has been run for this scene yet."));
+    QVERIFY(hb.contains("data:image/png;base64,"));
+
+    QTest::mouseClick(w->findChild<QPushButton *>("addRequirement"), Qt::LeftButton);
+    TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "8");
+    QVERIFY(w->Run());
+    QVERIFY(WaitUntil([&] { return !w->Worker()->IsBusy(); }, 300000));
+    auto r = w->LastResult();
+    QVERIFY(r && r->status == NAV_OK && r->verdicts.size() == 1);
+    const QString path = dir + "/report.html";
+    QFile::remove(path);
+    QVERIFY2(w->ExportReport(path, &err), qPrintable(err));
+    QFile f(path);
+    QVERIFY(f.open(QIODevice::ReadOnly));
+    const QString h = QString::fromUtf8(f.readAll());
+    const nav_requirement_verdict &v = r->verdicts[0];
+    QVERIFY(h.startsWith("<!DOCTYPE html>"));
+    QVERIFY(h.contains("8 Monte Carlo runs"));
+    QVERIFY(h.contains(QString("Requirements: %1 of 1 pass").arg(v.pass ? 1 : 0)));
+    QVERIFY(h.contains(QString::fromUtf8(v.id)));
+    QVERIFY(h.contains(v.pass ? ">PASS<" : ">FAIL<"));
+    QVERIFY(h.contains(QString::number(v.value, 'g', 4)));
+    QVERIFY(h.contains("horizontal position"));
+    QCOMPARE(h.count("data:image/png;base64,"), 2);
+    QVERIFY(h.trimmed().endsWith("</html>"));
+    qInfo("report: %lld bytes, verdict %s = %.4g", static_cast<long long>(f.size()), v.id, v.value);
+    // An unwritable path: an error naming it, and no file.
+    const QString bad = dir + "/no-such-dir/report.html";
+    QVERIFY(!w->ExportReport(bad, &err));
+    QVERIFY(err.contains(bad));
+    QVERIFY(!QFile::exists(bad));
   }
 
   // Undo/redo of clicks, a catalog choice and a typed field; the modified marker follows.
@@ -596,9 +652,16 @@ private slots:
     // The preview of the lighter scene: estimates at 10 Hz over the whole drive.
     const auto pv = w->LastPreview();
     QVERIFY(std::fabs(double(pv->t_s.size()) - (s.trajectory.duration_s * 10.0 + 1.0)) <= 2.0);
+    // The preview's error band (3 x the filter's horizontal sigma) follows the estimate in both
+    // views: two band points per envelope epoch, a width that is the filter's, not zero.
+    QVERIFY(pv->env_sd_h_m.size() > 100 && pv->env_sd_h_m.size() == pv->env_t_s.size());
+    QCOMPARE(w->MapView()->EnvelopePointCount(), 2 * pv->env_t_s.size());
+    QCOMPARE(w->View3D()->EnvelopePointCount(), 2 * pv->env_t_s.size());
+    for (double sd : pv->env_sd_h_m) QVERIFY(std::isfinite(sd) && sd > 0.0 && sd < 1e3);
 
     PathView *views[2] = {w->MapView(), w->View3D()};
     for (PathView *v : views) v->SetLiveRenderDelay(60000); // the mechanism, not the machine's speed
+    w->SetLiveFrameHoldMs(60000);
     long r0[2] = {views[0]->RenderCount(), views[1]->RenderCount()};
     const size_t n0 = w->PreviewLatenciesMs().size();
     const nav_scene before = s;
@@ -606,9 +669,12 @@ private slots:
     for (int i = 0; i < edits; ++i) {
       nav_scene e = doc->Scene();
       e.trajectory.waypoints.points[1].r_ned_m.y += 5.0;
+      const long f0 = w->FramesShown();
       doc->Preview(e);
       QVERIFY(doc->IsLive());
       QVERIFY(WaitUntil([&] { return w->PreviewLatenciesMs().size() >= n0 + size_t(i) + 1; }, 30000));
+      // One window frame per edit: the panels, the path and its estimate together.
+      QCOMPARE(w->FramesShown() - f0, 1L);
       QVERIFY(WaitUntil(settled, 30000));
     }
     for (int k = 0; k < 2; ++k) QCOMPARE(views[k]->RenderCount() - r0[k], long(edits));
@@ -623,6 +689,45 @@ private slots:
     QVERIFY(views[0]->RenderCount() > r1);
     QVERIFY(WaitUntil(settled, 60000));
     Shot(w.get(), "live-02-released");
+  }
+
+  // Two drag steps in a row: the preview of the first, barely started, is dropped for the second
+  // (its estimate would be out of date); the second's estimate is drawn, in one frame.
+  void preview_preempt() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(true);
+    QVERIFY(w->OpenFile(studio::ScenesDir() + "/urban-drive.yaml")); // 513 s: a preview of some length
+    studio::SceneDocument *doc = w->Doc();
+    auto settled = [&] {
+      return !w->PreviewWorker()->IsBusy() && w->LastPreview() && w->LastPreview()->scene_change_ns == doc->LastChangeNs();
+    };
+    QVERIFY(WaitUntil(settled, 60000));
+    QVERIFY(WaitUntil([&] { return !w->PreviewLatenciesMs().empty(); }, 10000));
+    QTest::qWait(100); // the frame of the latency read-out
+    w->SetLiveFrameHoldMs(60000);
+    for (PathView *v : {w->MapView(), w->View3D()}) v->SetLiveRenderDelay(60000);
+    QSignalSpy finished(w->PreviewWorker(), &studio::SimWorker::Finished);
+    const size_t n0 = w->PreviewLatenciesMs().size();
+    const long f0 = w->FramesShown();
+    nav_scene e = doc->Scene();
+    e.trajectory.waypoints.points[6].r_ned_m.y += 5.0;
+    doc->Preview(e);
+    QVERIFY(w->PreviewWorker()->IsBusy());
+    e.trajectory.waypoints.points[6].r_ned_m.y += 5.0;
+    doc->Preview(e);
+    QVERIFY(WaitUntil(settled, 60000));
+    QVERIFY(WaitUntil([&] { return w->PreviewLatenciesMs().size() > n0; }, 10000));
+    QCOMPARE(finished.count(), 2);
+    const auto first = finished.at(0).at(0).value<std::shared_ptr<const studio::SimResult>>();
+    const auto second = finished.at(1).at(0).value<std::shared_ptr<const studio::SimResult>>();
+    QCOMPARE(first->status, int(NAV_ERR_CANCELLED));
+    QCOMPARE(second->status, int(NAV_OK));
+    QCOMPARE(second->scene_change_ns, doc->LastChangeNs());
+    QCOMPARE(w->PreviewLatenciesMs().size(), n0 + 1);
+    QCOMPARE(w->FramesShown() - f0, 1L);
+    QCOMPARE(w->LastPreview()->t_s.size(), second->t_s.size());
+    Shot(w.get(), "preempt-01");
   }
 
   // Map background: at street scale the metric grid; zoomed out, GSHHS coastlines (the Baltic

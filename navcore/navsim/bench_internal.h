@@ -60,6 +60,9 @@ bool bench_self_exe(char *buf, size_t cap);
 
 /* Cases added by bench_cases2.c after bench.c's own: appends to rows[*n] (capacity cap). */
 void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int cap, bool quiet);
+/* navstudio's live-preview latency (bench_studio.c): its row, and its line of the target table. */
+void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
+void bench_studio_target_md(FILE *md, const bench_row *rows, int n);
 
 /* Per-stage floating-point operation counts (bench_report.c). */
 typedef struct bench_flops {

@@ -3,20 +3,24 @@
  * @brief The error-state Kalman filter object: time update (second-order or Van Loan, optional
  *        covariance decimation), measurement updates (Cholesky of S, Joseph form), checks.
  *
- * Cost notes (n = 15, the hot path at IMU rate). The non-zero patterns of F T and of the
- * second-order Phi are structural (fixed by the layout: computed once at create), so products
- * with Phi run over them only: F has 66 non-zeros of 225, Phi about 140 (its bias rows are a
+ * Cost notes (the hot path at IMU rate). The non-zero patterns of F T and of the second-order
+ * Phi are structural (fixed by the layout: computed once at create), so products with Phi run
+ * over them only: at 15 states F has 66 non-zeros of 225, Phi about 140 (its bias rows are a
  * single diagonal entry). The second-order step is fused into one sandwich,
  * P+ = Phi (P + Q/2) Phi^T + Q/2, which is E6.2 rearranged: Phi P Phi^T + (Phi Q Phi^T + Q)/2
- * with Q = G Q_c G^T T. The sandwich runs row-wise on zero-padded rows of 16 (24 above 16
- * states) doubles, W = Phi S then the upper triangle of Phi W^T, each row an unrolled
- * multiply-add that the compiler vectorises (an AVX2 clone is picked at load time on x86-64;
- * same values). Positivity is checked by a right-looking Cholesky (vectorisable updates).
- * Measured with callgrind (n = 15, every IMU step): 25k instructions per predict, of which
- * sandwich 7.8k, Cholesky check 5.1k + finiteness 1.8k, Phi 1.7k, F and sums 2k (the previous
- * row-list version: 54k). With cov_decimation N the step runs every N-th call and the calls in
- * between only accumulate the sums of struct pending (~150 instructions). Measurement updates
- * (GNSS rate) use the Joseph form as (A P) A^T with A = I - K H never formed: O(n^2 m).
+ * with Q = G Q_c G^T T. The sandwich runs row-wise on zero-padded rows of 16, 20 or 24 doubles
+ * (n rounded up to a multiple of 4), W = Phi S, a 4 x 4-block transpose, then the upper
+ * triangle of Phi W^T, each row an unrolled multiply-add that the compiler vectorises (an AVX2
+ * clone is picked at load time on x86-64; same values). Positivity is checked on every step by
+ * a right-looking Cholesky on padded rows, whose success also proves P finite (chol_ok).
+ * Measured with callgrind on the Monte Carlo bench scene (18 states: the core plus three GNSS
+ * error states; cov_decimation 10): 19k instructions per covariance step (sandwich 8.3k,
+ * Cholesky check 6.2k, Phi 2.1k, the rest 2.5k) plus 4.8k for F and the interval sums
+ * (pending_integrals); the calls in between only accumulate the sums of struct pending (~350
+ * instructions with the input checks). Measurement updates (GNSS rate) use the Joseph form as
+ * (A P) A^T with A = I - K H never formed, O(n^2 m), instantiated with compile-time sizes for
+ * the GNSS cases: 32k instructions per 3-component update. Every one of these transformations
+ * keeps the values bit for bit.
  */
 #include <assert.h>
 #include <math.h>
@@ -172,54 +176,6 @@ nav_filter_layout nav_filter_get_layout(const nav_filter *f) {
 #define NAV_KERNEL_CLONES
 #endif
 
-/* Is the symmetric n x n matrix p positive definite? Right-looking Cholesky (as Gaussian
- * elimination, pivots a_kk = L_kk^2) on a copy of the upper triangle (outer-product updates of the trailing block are independent of each other, so
- * the check runs at multiply-add throughput instead of the latency of one long dot product per
- * entry): a strictly positive, finite pivot at every step is the criterion (numerics.md 6.5);
- * the factor itself is not kept. NaN fails (the comparisons are false). a is n x n scratch. */
-NAV_KERNEL_CLONES static bool chol_ok(const double *p, size_t n, double *a) {
-  memcpy(a, p, n * n * sizeof *a);
-  for (size_t k = 0; k < n; ++k) {
-    const double d = a[k * n + k];
-    if (!(d > 0.0) || !(d < INFINITY)) return false;
-    const double inv = 1.0 / d;
-    /* a_ij -= a_ki a_kj / a_kk for k < i <= j (the upper trailing block; rows are contiguous). */
-    const double *restrict ak = a + k * n;
-    for (size_t i = k + 1; i < n; ++i) {
-      const double f = ak[i] * inv;
-      double *restrict ai = a + i * n;
-      for (size_t j = i; j < n; ++j)
-        ai[j] -= f * ak[j];
-    }
-  }
-  return true;
-}
-
-/* Check a covariance candidate: every entry finite, Cholesky succeeds (which implies a
- * positive diagonal; numerics.md 6.5). On failure the message names the first leading block
- * that is not positive definite (found by factorising growing blocks: failure path only). */
-static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
-  const size_t n = f->n;
-  for (size_t i = 0; i < n * n; ++i)
-    if (!isfinite(p[i])) {
-      set_error(f, "%s: P(%zu,%zu) = %g is not finite", what, i / n, i % n, p[i]);
-      return NAV_ERR_NUMERIC;
-    }
-  if (chol_ok(p, n, f->L)) return NAV_OK;
-  size_t k = 1;
-  for (; k <= n; ++k) {
-    for (size_t i = 0; i < k; ++i)
-      for (size_t j = 0; j < k; ++j)
-        f->W[i * k + j] = p[i * n + j];
-    if (nav_matn_cholesky(f->L, f->W, k) != NAV_OK) break;
-  }
-  const size_t bad = k <= n ? k - 1 : n - 1;
-  set_error(f,
-            "%s: P is not positive definite: the Cholesky factorisation fails at state %zu (P(%zu,%zu) = %g)",
-            what, bad, bad, bad, p[bad * n + bad]);
-  return NAV_ERR_NUMERIC;
-}
-
 /* ---------------------------------------------------------------- time update */
 
 /* Row pattern of the non-zeros of an n x n matrix given as flags. */
@@ -265,7 +221,9 @@ static void init_patterns(nav_filter *f) {
     }
   pattern_of(&f->a_pat, a, n);
   pattern_of(&f->phi_pat, p, n);
-  f->ld = n <= 16 ? 16 : 24; /* the two instantiations of sandwich_ld */
+  /* The three instantiations of the padded kernels: 16 (the 15-state core), 20 (18 states: the
+   * core with GNSS error states) and 24 (the rest). */
+  f->ld = n <= 16 ? 16 : (n <= 20 ? 20 : 24);
 }
 
 /* Copy an n x n matrix into a zero-padded one of row stride ld. */
@@ -320,6 +278,125 @@ static NAV_ALWAYS_INLINE void scal_fixed(double *restrict y, double a, const dou
   }
 }
 
+/* y -= a x over LD elements (as axpy_fixed: elementwise, the values of a plain loop). */
+static NAV_ALWAYS_INLINE void axmy_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
+  NAV_UNROLL
+  for (size_t c = 0; c < len; c += 4) {
+    y[c] -= a * x[c];
+    y[c + 1] -= a * x[c + 1];
+    y[c + 2] -= a * x[c + 2];
+    y[c + 3] -= a * x[c + 3];
+  }
+}
+
+/* Is the symmetric n x n matrix p positive definite? Right-looking Cholesky (as Gaussian
+ * elimination, pivots a_kk = L_kk^2) on a zero-padded copy (row stride LD): the outer-product
+ * updates of the trailing rows are independent of each other, and each runs over a whole padded
+ * row at a compile-time width (unrolled, vectorised) instead of the variable tail j >= i. The
+ * entries j >= i get exactly the operations a_ij -= (a_ki / a_kk) a_kj of the textbook loop; the
+ * others (j < i and the padding) are computed but never read. A strictly positive, finite pivot
+ * at every step is the criterion (numerics.md 6.5); the factor itself is not kept. NaN fails (the
+ * comparisons are false).
+ *
+ * Success also proves that every entry of the upper triangle is finite, which is why check_cov
+ * scans for non-finite entries only on failure: an entry changes only by subtraction, so a
+ * non-finite one stays non-finite until its row k is the pivot row; there a non-finite diagonal
+ * fails at once, and a non-finite a_kj (j > k) makes the multiplier f_j = a_kj / a_kk non-finite
+ * and the later pivot a_jj - f_j a_kj infinite or NaN, which fails at step j. */
+static NAV_ALWAYS_INLINE bool chol_ok_ld(const double *p, size_t n, double *a, const size_t LD) {
+  pad_copy(a, p, n, LD);
+  for (size_t k = 0; k < n; ++k) {
+    const double *restrict ak = a + k * LD;
+    const double d = ak[k];
+    if (!(d > 0.0) || !(d < INFINITY)) return false;
+    const double inv = 1.0 / d;
+    for (size_t i = k + 1; i < n; ++i)
+      axmy_fixed(a + i * LD, ak[i] * inv, ak, LD);
+  }
+  return true;
+}
+
+/* The instantiations (as pattern_sandwich): LD 16, 20 or 24. */
+NAV_KERNEL_CLONES static bool chol_ok(const double *p, size_t n, size_t ld, double *a) {
+  if (ld == 16) return chol_ok_ld(p, n, a, 16);
+  if (ld == 20) return chol_ok_ld(p, n, a, 20);
+  return chol_ok_ld(p, n, a, 24);
+}
+
+/* Check a covariance candidate: every entry finite, Cholesky succeeds (which implies a
+ * positive diagonal; numerics.md 6.5), on every call. p must be exactly symmetric (every caller
+ * mirrors or symmetrises it): the Cholesky reads the upper triangle only, and its success proves
+ * that triangle finite (chol_ok), so the entry-by-entry finiteness scan runs on the failure path
+ * only, where it picks the message. On failure the message names the first non-finite entry, or
+ * else the first leading block that is not positive definite (found by factorising growing
+ * blocks). */
+static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
+  const size_t n = f->n;
+#ifndef NDEBUG
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < i; ++j)
+      assert(memcmp(&p[i * n + j], &p[j * n + i], sizeof *p) == 0);
+#endif
+  if (chol_ok(p, n, f->ld, f->L)) return NAV_OK;
+  for (size_t i = 0; i < n * n; ++i)
+    if (!isfinite(p[i])) {
+      set_error(f, "%s: P(%zu,%zu) = %g is not finite", what, i / n, i % n, p[i]);
+      return NAV_ERR_NUMERIC;
+    }
+  size_t k = 1;
+  for (; k <= n; ++k) {
+    for (size_t i = 0; i < k; ++i)
+      for (size_t j = 0; j < k; ++j)
+        f->W[i * k + j] = p[i * n + j];
+    if (nav_matn_cholesky(f->L, f->W, k) != NAV_OK) break;
+  }
+  const size_t bad = k <= n ? k - 1 : n - 1;
+  set_error(f,
+            "%s: P is not positive definite: the Cholesky factorisation fails at state %zu (P(%zu,%zu) = %g)",
+            what, bad, bad, bad, p[bad * n + bad]);
+  return NAV_ERR_NUMERIC;
+}
+
+/* Wt = W^T for the n x n part of padded matrices (stride LD). With GCC vector extensions: 4 x 4
+ * blocks, each loaded as four rows and stored as four columns with register shuffles. The scalar
+ * transpose (one load and one strided store per entry, the loads right behind the vector stores
+ * that wrote W) took a quarter of the sandwich. Blocks reach up to row and column
+ * round_up(n, 4) <= LD: the extra rows of W are scratch (stale values), which land in padding
+ * columns of Wt that are never read. Only values are moved, so the result is bit for bit the
+ * plain loop's. */
+#if defined(__GNUC__) && !defined(__clang__)
+typedef double nav_v4d __attribute__((vector_size(32)));
+typedef long long nav_v4i __attribute__((vector_size(32)));
+static NAV_ALWAYS_INLINE void transpose_ld(double *restrict Wt, const double *restrict W, size_t n, const size_t LD) {
+  for (size_t i0 = 0; i0 < n; i0 += 4)
+    for (size_t j0 = 0; j0 < n; j0 += 4) {
+      nav_v4d r0, r1, r2, r3;
+      memcpy(&r0, W + (i0 + 0) * LD + j0, sizeof r0);
+      memcpy(&r1, W + (i0 + 1) * LD + j0, sizeof r1);
+      memcpy(&r2, W + (i0 + 2) * LD + j0, sizeof r2);
+      memcpy(&r3, W + (i0 + 3) * LD + j0, sizeof r3);
+      const nav_v4d t0 = __builtin_shuffle(r0, r1, (nav_v4i){0, 4, 2, 6});
+      const nav_v4d t1 = __builtin_shuffle(r0, r1, (nav_v4i){1, 5, 3, 7});
+      const nav_v4d t2 = __builtin_shuffle(r2, r3, (nav_v4i){0, 4, 2, 6});
+      const nav_v4d t3 = __builtin_shuffle(r2, r3, (nav_v4i){1, 5, 3, 7});
+      const nav_v4d c0 = __builtin_shuffle(t0, t2, (nav_v4i){0, 1, 4, 5});
+      const nav_v4d c1 = __builtin_shuffle(t1, t3, (nav_v4i){0, 1, 4, 5});
+      const nav_v4d c2 = __builtin_shuffle(t0, t2, (nav_v4i){2, 3, 6, 7});
+      const nav_v4d c3 = __builtin_shuffle(t1, t3, (nav_v4i){2, 3, 6, 7});
+      memcpy(Wt + (j0 + 0) * LD + i0, &c0, sizeof c0);
+      memcpy(Wt + (j0 + 1) * LD + i0, &c1, sizeof c1);
+      memcpy(Wt + (j0 + 2) * LD + i0, &c2, sizeof c2);
+      memcpy(Wt + (j0 + 3) * LD + i0, &c3, sizeof c3);
+    }
+}
+#else
+static NAV_ALWAYS_INLINE void transpose_ld(double *restrict Wt, const double *restrict W, size_t n, const size_t LD) {
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      Wt[j * LD + i] = W[i * LD + j];
+}
+#endif
+
 static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
                                           const double *Qh, size_t n, double *W, double *Wt, const size_t LD) {
   for (size_t i = 0; i < n; ++i) {
@@ -332,9 +409,7 @@ static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const r
       axpy_fixed(wi, phi_i[k], S + k * LD, LD);
     }
   }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j)
-      Wt[j * LD + i] = W[i * LD + j];
+  transpose_ld(Wt, W, n, LD);
   double row[NMAX + 4];
   for (size_t i = 0; i < n; ++i) {
     /* Full rows (only j >= i is used): a fixed width unrolls completely, which costs less than
@@ -369,12 +444,16 @@ static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pa
   }
 }
 
-/* The instantiations: LD 16 (up to 16 states: the 15-state core) and 24 (the rest), each also
- * as an AVX2 clone (NAV_KERNEL_CLONES). */
+/* The instantiations: LD 16 (up to 16 states: the 15-state core), 20 (17 to 20: the core with
+ * the GNSS error states) and 24 (the rest), each also as an AVX2 clone (NAV_KERNEL_CLONES). The
+ * padding only adds products of zeros to entries that are never read, so the values do not
+ * depend on LD. */
 NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
                              const double *Qh, size_t n, size_t ld, double *W, double *Wt) {
   if (ld == 16)
     sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 16);
+  else if (ld == 20)
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 20);
   else
     sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 24);
 }
@@ -382,6 +461,8 @@ NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, co
 NAV_KERNEL_CLONES static void phi_second_order(double *Phi, const double *A, const row_pattern *ap, size_t n, size_t ld) {
   if (ld == 16)
     phi2_ld(Phi, A, ap, n, 16);
+  else if (ld == 20)
+    phi2_ld(Phi, A, ap, n, 20);
   else
     phi2_ld(Phi, A, ap, n, 24);
 }
@@ -409,6 +490,48 @@ static void pattern_of_values(row_pattern *pt, const double *a, size_t n, size_t
   }
 }
 
+/* The inputs of the second-order step: A = F T over the pattern of A (zeros elsewhere),
+ * and for the fused E6.2, P+ = Phi (P + Q/2) Phi^T + Q/2, Qd = Q/2 and S = P + Q/2 padded. Always
+ * inlined: cov_step instantiates it for 15 and 18 states with compile-time bounds (unrolled
+ * rows, no memset calls for the padding), and once generically; the same values either way. */
+static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *FT, const double *QT, const size_t n,
+                                                  const size_t ld) {
+  /* A is written only here and only over its pattern, which is fixed at create: every other
+   * entry (padding included) is still the zero of calloc, so the rows need no clearing (a
+   * rep stos per row cost a quarter of the step). */
+  double *A = f->A;
+  for (size_t i = 0; i < n; ++i) {
+    double *ai = A + i * ld;
+    for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
+      const size_t k = f->a_pat.col[i][p];
+      ai[k] = FT[i * n + k];
+    }
+  }
+  /* Qd = Q/2 only where QT can be non-zero (pending_integrals writes the diagonal, and the
+   * velocity and attitude blocks when the noise is not isotropic): elsewhere both keep the zeros
+   * of calloc (a filter with the second-order discretisation never writes Qd otherwise), so this
+   * is 0.5 QT everywhere without a pass over all n^2 entries. Then the padded rows of S
+   * (unrolled); S = P + Qd over every entry, as before, so that a -0.0 in P still becomes +0.0. */
+  for (size_t i = 0; i < n; ++i)
+    f->Qd[i * (n + 1)] = 0.5 * QT[i * (n + 1)];
+  if (!f->q_isotropic)
+    for (size_t b = NAV_FILTER_IDX_DV; b <= NAV_FILTER_IDX_PHI; b += NAV_FILTER_IDX_PHI - NAV_FILTER_IDX_DV)
+      for (size_t i = 0; i < 3; ++i)
+        for (size_t j = 0; j < 3; ++j)
+          f->Qd[(b + i) * n + b + j] = 0.5 * QT[(b + i) * n + b + j];
+#ifndef NDEBUG
+  for (size_t k = 0; k < n * n; ++k)
+    assert(memcmp(&f->Qd[k], &(double){0.5 * QT[k]}, sizeof(double)) == 0);
+#endif
+  for (size_t i = 0; i < n; ++i) {
+    NAV_UNROLL
+    for (size_t j = 0; j < n; ++j)
+      f->S[i * ld + j] = f->P[i * n + j] + f->Qd[i * n + j];
+    for (size_t c = n; c < ld; ++c)
+      f->S[i * ld + c] = 0.0;
+  }
+}
+
 /* One covariance step over the integrated FT = int F dt and QT = int G Q_c G^T dt. Commits x and
  * P only on success. */
 static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
@@ -429,32 +552,18 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
     pad_copy(f->S, f->P, n, ld);
   } else {
     /* E6.2: Phi = I + A + A^2/2, A = F T, the square over the structural non-zeros of A. */
-    double *A = f->A;
-    for (size_t i = 0; i < n; ++i) {
-      double *ai = A + i * ld;
-      for (size_t c = 0; c < ld; ++c)
-        ai[c] = 0.0;
-      for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
-        const size_t k = f->a_pat.col[i][p];
-        ai[k] = FT[i * n + k];
-      }
-    }
+    if (n == 15)
+      second_order_inputs(f, FT, QT, 15, 16);
+    else if (n == 18)
+      second_order_inputs(f, FT, QT, 18, 20);
+    else
+      second_order_inputs(f, FT, QT, n, ld);
 #ifndef NDEBUG
     for (size_t i = 0; i < n; ++i)
       for (size_t k = 0; k < n; ++k)
-        assert(FT[i * n + k] == A[i * ld + k]);
+        assert(FT[i * n + k] == f->A[i * ld + k]);
 #endif
-    phi_second_order(f->Phi, A, &f->a_pat, n, ld);
-    /* Fused E6.2: P+ = Phi (P + Q/2) Phi^T + Q/2. */
-    for (size_t i = 0; i < n; ++i) {
-      for (size_t j = 0; j < n; ++j) {
-        const double q = 0.5 * QT[i * n + j];
-        f->Qd[i * n + j] = q;
-        f->S[i * ld + j] = f->P[i * n + j] + q;
-      }
-      for (size_t c = n; c < ld; ++c)
-        f->S[i * ld + c] = 0.0;
-    }
+    phi_second_order(f->Phi, f->A, &f->a_pat, n, ld);
   }
   pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt);
   const nav_status st = check_cov(f, f->Pn, "predict");
@@ -564,8 +673,25 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
   }
   const nav_filter_earth_terms earth = nav_filter_earth_terms_wgs84(m.lat_rad, m.h_m);
   nav_filter_build_F(f->F, &f->lay, &m, &earth, f->proc_diag);
-  for (size_t i = 0; i < n * n; ++i)
-    f->FT[i] = f->F[i] * T;
+  /* F T over the structural pattern of F only (fixed at create, init_patterns). Outside it F is
+   * exactly zero, and FT and QT keep the zeros of calloc: both are written only here, always at
+   * the same positions (the pattern, the blocks below, the diagonal), so the values are those of
+   * a full pass after a clearing. The full passes cost more than the rest: their loads came right
+   * behind the rep stos of the clearing, which cannot forward to them. */
+  for (size_t i = 0; i < n; ++i)
+    for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
+      const size_t k = f->a_pat.col[i][p];
+      f->FT[i * n + k] = f->F[i * n + k] * T;
+    }
+#ifndef NDEBUG
+  for (size_t i = 0; i < n; ++i)
+    for (size_t k = 0; k < n; ++k) {
+      bool in = false;
+      for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p)
+        in = in || f->a_pat.col[i][p] == k;
+      assert(in || (f->F[i * n + k] == 0.0 && !signbit(f->F[i * n + k])));
+    }
+#endif
   /* The blocks linear in C_b_n: their exact integrals. */
   put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_PHI, nav_mat3_skew(pd->fn_T), 1.0);
   put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_BA, pd->C_T, 1.0);
@@ -574,7 +700,6 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
     put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_SA, pd->Cf_T, 1.0);
     put_block(f->FT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_SG, pd->Cw_T, -1.0);
   }
-  memset(f->QT, 0, n * n * sizeof *f->QT);
   if (f->q_isotropic) {
     for (size_t i = 0; i < 3; ++i) {
       f->QT[(NAV_FILTER_IDX_DV + i) * (n + 1)] = f->qc[NAV_FILTER_IDX_DV] * T;
@@ -601,13 +726,15 @@ nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double d
   }
   nav_status st = check_nav(f, nav, "predict");
   if (st != NAV_OK) return st;
-  /* Accumulate into a copy: a failing covariance step leaves the pending sums untouched. */
-  pending pd = f->pend;
-  pending_add(f, &pd, nav, dt_s);
-  if (pd.count < f->cfg.cov_decimation) {
-    f->pend = pd;
+  /* Between covariance steps, accumulate in place. */
+  if (f->pend.count + 1 < f->cfg.cov_decimation) {
+    pending_add(f, &f->pend, nav, dt_s);
     return NAV_OK;
   }
+  /* A covariance step: accumulate into a copy, so that a failing step leaves the pending sums
+   * untouched. */
+  pending pd = f->pend;
+  pending_add(f, &pd, nav, dt_s);
   pending_integrals(f, &pd);
   st = cov_step(f, f->FT, f->QT);
   if (st == NAV_OK) memset(&f->pend, 0, sizeof f->pend);
@@ -625,6 +752,124 @@ nav_status nav_filter_flush(nav_filter *f) {
 }
 
 /* ---------------------------------------------------------------- measurement update */
+
+/* The arithmetic of an update (do_update): y, S and its Cholesky factor Ls, K, x+ into xn and the
+ * Joseph-form P+ into Pn. Always inlined, so that do_update instantiates it for the GNSS cases
+ * (n = 15 or 18, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
+ * generically; the same operations in the same order either way, so the values are identical.
+ * Returns false when S is not positive definite. */
+static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const size_t m, const double *H,
+                                          const double *z, const double *R, double *y, double *S, double *Ls) {
+  /* Innovation y = z - H x_minus (x_minus = 0 in closed loop except the GNSS states). */
+  NAV_UNROLL
+  for (size_t r = 0; r < m; ++r) {
+    double hx = 0.0;
+    for (size_t j = 0; j < n; ++j)
+      hx += H[r * n + j] * f->x[j];
+    y[r] = z[r] - hx;
+  }
+  /* The columns of H with a non-zero entry (a position or velocity update touches 3 to 9 of
+   * the n): the products with H run over them only, without a test per entry (adding the exact
+   * zeros of the other rows changes no sum: every P entry is finite). */
+  size_t hc[NMAX], nhc = 0;
+  for (size_t j = 0; j < n; ++j) {
+    bool nz = false;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r)
+      nz = nz || H[r * n + j] != 0.0;
+    if (nz) hc[nhc++] = j;
+  }
+  /* P H^T (n x m). */
+  for (size_t i = 0; i < n; ++i)
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      double sum = 0.0;
+      for (size_t q = 0; q < nhc; ++q)
+        sum += f->P[i * n + hc[q]] * H[r * n + hc[q]];
+      f->PHt[i * m + r] = sum;
+    }
+  /* S = H P H^T + R, symmetrised. */
+  NAV_UNROLL
+  for (size_t r = 0; r < m; ++r)
+    NAV_UNROLL
+    for (size_t c = 0; c < m; ++c) {
+      double sum = 0.0;
+      for (size_t j = 0; j < n; ++j)
+        sum += H[r * n + j] * f->PHt[j * m + c];
+      S[r * m + c] = sum + R[r * m + c];
+    }
+  nav_matn_symmetrize(S, m);
+  if (nav_matn_cholesky(Ls, S, m) != NAV_OK) return false;
+  /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
+  NAV_UNROLL
+  for (size_t r = 0; r < m; ++r)
+    for (size_t j = 0; j < n; ++j)
+      f->Kt[r * n + j] = f->PHt[j * m + r];
+  nav_matn_chol_solve(f->Kt, Ls, f->Kt, m, n);
+  for (size_t j = 0; j < n; ++j)
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r)
+      f->K[j * m + r] = f->Kt[r * n + j];
+
+  /* x+ = x- + K y */
+  for (size_t j = 0; j < n; ++j) {
+    double sum = f->x[j];
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r)
+      sum += f->K[j * m + r] * y[r];
+    f->xn[j] = sum;
+  }
+  /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T, evaluated as (A P) A^T with
+   * A = I - K H without forming A: A P = P - K (H P) with H P = (P H^T)^T, then
+   * (A P) A^T = A P - ((A P) H^T) K^T over the non-zero columns of H. The same product in
+   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, (A P) H^T to PHt's
+   * companion Kt (both n x m or larger scratch). */
+  double *B = f->Phi, *BHt = f->S;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      double sum = 0.0;
+      NAV_UNROLL
+      for (size_t r = 0; r < m; ++r)
+        sum += f->K[i * m + r] * f->PHt[j * m + r];
+      B[i * n + j] = f->P[i * n + j] - sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      double sum = 0.0;
+      for (size_t q = 0; q < nhc; ++q)
+        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
+      BHt[i * m + r] = sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      double sum = 0.0;
+      NAV_UNROLL
+      for (size_t r = 0; r < m; ++r)
+        sum += BHt[i * m + r] * f->K[j * m + r];
+      f->Pn[i * n + j] = B[i * n + j] - sum;
+    }
+  /* K R K^T: W = K R (n x m), then the upper triangle of W K^T mirrored. */
+  for (size_t i = 0; i < n; ++i)
+    NAV_UNROLL
+    for (size_t c = 0; c < m; ++c) {
+      double sum = 0.0;
+      NAV_UNROLL
+      for (size_t r = 0; r < m; ++r)
+        sum += f->K[i * m + r] * R[r * m + c];
+      f->W[i * m + c] = sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i; j < n; ++j) {
+      double sum = 0.0;
+      NAV_UNROLL
+      for (size_t c = 0; c < m; ++c)
+        sum += f->W[i * m + c] * f->K[j * m + c];
+      f->Pn[i * n + j] += sum;
+      if (j != i) f->Pn[j * n + i] += sum;
+    }
+  return true;
+}
 
 /* Update with an m x n H, m measurements z and the m x m noise R (already checked finite and
  * positive definite). numerics.md 6.5. */
@@ -645,104 +890,18 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
   nav_status st = nav_filter_flush(f);
   if (st != NAV_OK) return st;
 
-  /* Innovation y = z - H x_minus (x_minus = 0 in closed loop except the GNSS states). */
   double y[MMAX], S[MMAX * MMAX], Ls[MMAX * MMAX], u[MMAX];
-  for (size_t r = 0; r < m; ++r) {
-    double hx = 0.0;
-    for (size_t j = 0; j < n; ++j)
-      hx += H[r * n + j] * f->x[j];
-    y[r] = z[r] - hx;
-  }
-  /* The columns of H with a non-zero entry (a position or velocity update touches 3 to 9 of
-   * the n): the products with H run over them only, without a test per entry (adding the exact
-   * zeros of the other rows changes no sum: every P entry is finite). */
-  size_t hc[NMAX], nhc = 0;
-  for (size_t j = 0; j < n; ++j) {
-    bool nz = false;
-    for (size_t r = 0; r < m; ++r)
-      nz = nz || H[r * n + j] != 0.0;
-    if (nz) hc[nhc++] = j;
-  }
-  /* P H^T (n x m). */
-  for (size_t i = 0; i < n; ++i)
-    for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += f->P[i * n + hc[q]] * H[r * n + hc[q]];
-      f->PHt[i * m + r] = sum;
-    }
-  /* S = H P H^T + R, symmetrised. */
-  for (size_t r = 0; r < m; ++r)
-    for (size_t c = 0; c < m; ++c) {
-      double sum = 0.0;
-      for (size_t j = 0; j < n; ++j)
-        sum += H[r * n + j] * f->PHt[j * m + c];
-      S[r * m + c] = sum + R[r * m + c];
-    }
-  nav_matn_symmetrize(S, m);
-  if (nav_matn_cholesky(Ls, S, m) != NAV_OK) {
+  bool s_ok = false;
+  if (n == 15 && m == 3)
+    s_ok = update_core(f, 15, 3, H, z, R, y, S, Ls);
+  else if (n == 18 && m == 3)
+    s_ok = update_core(f, 18, 3, H, z, R, y, S, Ls);
+  else
+    s_ok = update_core(f, n, m, H, z, R, y, S, Ls);
+  if (!s_ok) {
     set_error(f, "%s: innovation covariance S = H P H^T + R is not positive definite", what);
     return NAV_ERR_NUMERIC;
   }
-  /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
-  for (size_t r = 0; r < m; ++r)
-    for (size_t j = 0; j < n; ++j)
-      f->Kt[r * n + j] = f->PHt[j * m + r];
-  nav_matn_chol_solve(f->Kt, Ls, f->Kt, m, n);
-  for (size_t j = 0; j < n; ++j)
-    for (size_t r = 0; r < m; ++r)
-      f->K[j * m + r] = f->Kt[r * n + j];
-
-  /* x+ = x- + K y */
-  for (size_t j = 0; j < n; ++j) {
-    double sum = f->x[j];
-    for (size_t r = 0; r < m; ++r)
-      sum += f->K[j * m + r] * y[r];
-    f->xn[j] = sum;
-  }
-  /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T, evaluated as (A P) A^T with
-   * A = I - K H without forming A: A P = P - K (H P) with H P = (P H^T)^T, then
-   * (A P) A^T = A P - ((A P) H^T) K^T over the non-zero columns of H. The same product in
-   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, (A P) H^T to PHt's
-   * companion Kt (both n x m or larger scratch). */
-  double *B = f->Phi, *BHt = f->S;
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * f->PHt[j * m + r];
-      B[i * n + j] = f->P[i * n + j] - sum;
-    }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
-      BHt[i * m + r] = sum;
-    }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      for (size_t r = 0; r < m; ++r)
-        sum += BHt[i * m + r] * f->K[j * m + r];
-      f->Pn[i * n + j] = B[i * n + j] - sum;
-    }
-  /* K R K^T: W = K R (n x m), then the upper triangle of W K^T mirrored. */
-  for (size_t i = 0; i < n; ++i)
-    for (size_t c = 0; c < m; ++c) {
-      double sum = 0.0;
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * R[r * m + c];
-      f->W[i * m + c] = sum;
-    }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i; j < n; ++j) {
-      double sum = 0.0;
-      for (size_t c = 0; c < m; ++c)
-        sum += f->W[i * m + c] * f->K[j * m + c];
-      f->Pn[i * n + j] += sum;
-      if (j != i) f->Pn[j * n + i] += sum;
-    }
   nav_matn_symmetrize(f->Pn, n);
   for (size_t j = 0; j < n; ++j)
     if (!isfinite(f->xn[j])) {

@@ -3,11 +3,13 @@
  * The design and its reasons are in nav_rng.h; this file explains only the implementation.
  */
 #include "navcore/nav_rng.h"
+#include "rng/rng_internal.h"
 
 #include <assert.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 /* Weyl increment of splitmix64: 2^64 divided by the golden ratio, made odd (Steele, Lea and Flood,
  * "Fast splittable pseudorandom number generators", OOPSLA 2014; Vigna's splitmix64.c). */
@@ -263,21 +265,19 @@ static double gauss_tail(nav_rng *r) {
   }
 }
 
-double nav_rng_gauss(nav_rng *r) {
-  assert(r != NULL);
+/* The rest of the ziggurat after a first word that was not accepted at once: the wedge test of
+ * that word, the tail, and the retries with fresh words (the loop of Marsaglia and Tsang). Out of
+ * line: it runs for 1.2 % of the draws, and keeping it (with its calls to exp and log) out of
+ * the fast path below leaves that path without register saves or a stack frame. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static double
+gauss_slow(nav_rng *r, uint64_t bits) {
   for (;;) {
-    /* Disjoint bits for layer (0-7), sign (8) and abscissa (11-63): Doornik ("An improved
-     * ziggurat method to generate normal random samples", Nuffield College, 2005) showed that
-     * sharing bits between the layer index and the abscissa, as the original 32-bit code did,
-     * correlates them and fails tests. */
-    const uint64_t bits = next_u64(r);
     const unsigned layer = (unsigned)(bits & 0xffu);
-    /* +1 or -1 without a branch: the sign is a coin flip, which a branch predictor cannot
-     * learn (the branch cost half the sampler's time). Multiplying by +-1 is exact. */
     const double sign = 1.0 - 2.0 * (double)((bits >> 8) & 1u);
     const double x = (double)(bits >> 11) * TWO_POW_M53 * zig_x[layer];
-
-    /* Inside the part of the layer that lies wholly under the curve: accept at once. */
     if (x < zig_x[layer + 1]) return sign * x;
     /* Base layer beyond r: the tail. */
     if (layer == 0) {
@@ -288,7 +288,46 @@ double nav_rng_gauss(nav_rng *r) {
     const double y =
         zig_f[layer] + (double)(next_u64(r) >> 11) * TWO_POW_M53 * (zig_f[layer + 1] - zig_f[layer]);
     if (y < exp(-0.5 * x * x)) return sign * x;
+    bits = next_u64(r);
   }
+}
+
+/* One normal deviate: the accept-at-once test of the first word inline, everything else in
+ * gauss_slow (which repeats that test on the same word: the sequence of words consumed and the
+ * value returned are those of a single loop). */
+static inline double gauss_one(nav_rng *r) {
+  /* Disjoint bits for layer (0-7), sign (8) and abscissa (11-63): Doornik ("An improved
+   * ziggurat method to generate normal random samples", Nuffield College, 2005) showed that
+   * sharing bits between the layer index and the abscissa, as the original 32-bit code did,
+   * correlates them and fails tests. */
+  const uint64_t bits = next_u64(r);
+  const unsigned layer = (unsigned)(bits & 0xffu);
+  const double x = (double)(bits >> 11) * TWO_POW_M53 * zig_x[layer];
+  /* Inside the part of the layer that lies wholly under the curve: accept at once, with the
+   * sign bit 8 copied into the IEEE sign bit: without a branch (the sign is a coin flip, which a
+   * branch predictor cannot learn) and exactly the value (1 - 2 bit8) * x of gauss_slow, -0.0
+   * included (x >= 0 here). */
+  if (x < zig_x[layer + 1]) {
+    uint64_t xb;
+    memcpy(&xb, &x, sizeof xb);
+    xb |= (bits & UINT64_C(0x100)) << 55;
+    double v;
+    memcpy(&v, &xb, sizeof v);
+    return v;
+  }
+  return gauss_slow(r, bits);
+}
+
+double nav_rng_gauss(nav_rng *r) {
+  assert(r != NULL);
+  return gauss_one(r);
+}
+
+void nav_rng_gauss_streams(nav_rng *r, size_t n_streams, size_t per_stream, double *out) {
+  assert(r != NULL && out != NULL);
+  for (size_t s = 0; s < n_streams; ++s)
+    for (size_t d = 0; d < per_stream; ++d)
+      out[s * per_stream + d] = gauss_one(&r[s]);
 }
 
 nav_vec3 nav_rng_gauss_vec3(nav_rng *r) {

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "navcore/nav_rng.h"
+#include "rng/rng_internal.h"
 
 /* ------------------------------------------------------------------ bias instability -> GM */
 
@@ -509,23 +510,28 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
   if (terms & NAV_IMU_TERM_BIAS_TURN_ON)
     for (int i = 0; i < 3; ++i)
       ib[i] += t->b0[i] * dt;
-  if (terms & NAV_IMU_TERM_BIAS_GM)
+  /* Draws: one batch per term and triad (rng_internal.h), the same values as one
+   * nav_rng_gauss() per deviate. */
+  double u[6];
+  if (terms & NAV_IMU_TERM_BIAS_GM) {
+    /* Draw order per axis is fixed: u1 (bias step), then u2 (integral). */
+    nav_rng_gauss_streams(t->rng_gm, 3, 2, u);
     for (int i = 0; i < 3; ++i) {
-      /* Draw order per axis is fixed: u1 (bias step), then u2 (integral). */
       const pair_coef *c = &t->gm_c[i];
-      const double u1 = nav_rng_gauss(&t->rng_gm[i]);
-      const double u2 = nav_rng_gauss(&t->rng_gm[i]);
+      const double u1 = u[2 * i], u2 = u[2 * i + 1];
       ib[i] += c->c_int * t->gm_b[i] + c->l21 * u1 + c->l22 * u2;
       t->gm_b[i] = c->phi * t->gm_b[i] + c->l11 * u1;
     }
-  if (terms & NAV_IMU_TERM_BIAS_RW)
+  }
+  if (terms & NAV_IMU_TERM_BIAS_RW) {
+    nav_rng_gauss_streams(t->rng_rw, 3, 2, u);
     for (int i = 0; i < 3; ++i) {
       const pair_coef *c = &t->rw_c[i];
-      const double u1 = nav_rng_gauss(&t->rng_rw[i]);
-      const double u2 = nav_rng_gauss(&t->rng_rw[i]);
+      const double u1 = u[2 * i], u2 = u[2 * i + 1];
       ib[i] += c->c_int * t->rw_b[i] + c->l21 * u1 + c->l22 * u2;
       t->rw_b[i] += c->l11 * u1;
     }
+  }
   if (t->any_bias)
     for (int i = 0; i < 3; ++i) {
       y[i] += ib[i];
@@ -534,9 +540,11 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
   if (extra)
     for (int i = 0; i < 3; ++i)
       y[i] += extra[i];
-  if (terms & NAV_IMU_TERM_NOISE)
+  if (terms & NAV_IMU_TERM_NOISE) {
+    nav_rng_gauss_streams(t->rng_noise, 3, 1, u);
     for (int i = 0; i < 3; ++i)
-      y[i] += t->n_sd[i] * nav_rng_gauss(&t->rng_noise[i]);
+      y[i] += t->n_sd[i] * u[i];
+  }
   *sat = 0;
   if (terms & NAV_IMU_TERM_SATURATION)
     for (int i = 0; i < 3; ++i) {

@@ -533,6 +533,9 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
   }
   int64_t k = 1;
+  /* Steps left to the next statistics sample and output epoch: k % stride == 0 exactly when a
+   * countdown started at stride (k = 1) reaches 0, without two 64-bit divisions per step. */
+  int64_t stats_left = j->stats_stride, out_left = j->out_stride;
   for (; k <= j->n && !stop; ++k) {
     if (atomic_load_explicit(&sim->cancel, memory_order_relaxed)) {
       stop = true;
@@ -582,8 +585,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     /* The errors are needed only at the statistics samples, the output epochs and the end: the
      * reference state, the navigation state's e-frame view and the errors (together more than
      * the navigation step itself) are not computed in between. */
-    const bool stats_k = k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run;
-    const bool out_k = k % j->out_stride == 0 || k == j->n;
+    const bool stats_tick = --stats_left == 0, out_tick = --out_left == 0;
+    if (stats_tick) stats_left = j->stats_stride;
+    if (out_tick) out_left = j->out_stride;
+    const bool stats_k = stats_tick && k / j->stats_stride < j->stats_per_run;
+    const bool out_k = out_tick || k == j->n;
     if (!stats_k && !out_k && !(aid && !integrated)) {
       if (caller_thread && j->opts->progress && k % PROGRESS_EVERY == 0) {
         const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
