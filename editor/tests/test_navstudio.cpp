@@ -26,28 +26,13 @@
 #include <vtkRenderWindowInteractor.h>
 
 #include "main_window.h"
+#include "studio_test_support.h"
 
 using studio::MainWindow;
 using studio::PathView;
+using namespace studio_test;
 
 namespace {
-
-void Shot(MainWindow *w, const QString &name) {
-  QDir().mkpath(NAVSTUDIO_TEST_OUT_DIR);
-  QApplication::processEvents();
-  const QString p = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR) + "/" + name + ".png";
-  QVERIFY2(w->grab().save(p), qPrintable("cannot write " + p));
-}
-
-bool WaitUntil(const std::function<bool()> &done, int timeout_ms) {
-  QElapsedTimer t;
-  t.start();
-  while (!done()) {
-    if (t.elapsed() > timeout_ms) return false;
-    QTest::qWait(20);
-  }
-  return true;
-}
 
 // Injected VTK events (toolchain.md section 4a): hover, press, optional drag steps, release.
 void ClickAt(PathView *v, int x, int y, bool ctrl = false) {
@@ -88,33 +73,9 @@ double MapMetresPerPixel(PathView *v) {
   return std::hypot(n1 - n0, e1 - e0);
 }
 
-void Choose(QComboBox *c, const QString &text) {
-  const int i = c->findText(text, Qt::MatchContains);
-  QVERIFY2(i >= 0, qPrintable("no entry " + text));
-  c->setCurrentIndex(i);
-  emit c->activated(i);
-}
 
-void TypeInto(QLineEdit *e, const QString &text) {
-  e->setFocus();
-  e->selectAll();
-  QTest::keyClicks(e, text);
-  QTest::keyClick(e, Qt::Key_Return);
-}
 
-std::unique_ptr<MainWindow> MakeWindow() {
-  auto w = std::make_unique<MainWindow>();
-  w->SetAsk([](const QString &, const QString &, QMessageBox::StandardButtons b) {
-    return (b & QMessageBox::Yes) ? QMessageBox::Yes : QMessageBox::Discard;
-  });
-  w->show();
-  if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
-  QTest::qWait(50);
-  return w;
-}
 
-// Four waypoints of a small drive (north, east in metres).
-const double kDrive[4][2] = {{-200.0, -300.0}, {-200.0, 150.0}, {150.0, 150.0}, {150.0, 400.0}};
 
 } // namespace
 

@@ -26,6 +26,7 @@
 #include <vtkRenderWindowInteractor.h>
 
 #include "main_window.h"
+#include "studio_test_support.h"
 #include "parametric_editor.h"
 #include "segment_editor.h"
 
@@ -35,50 +36,9 @@ extern "C" {
 
 using studio::MainWindow;
 using studio::PathView;
+using namespace studio_test;
 
 namespace {
-
-void Shot(MainWindow *w, const QString &name) {
-  QDir().mkpath(NAVSTUDIO_TEST_OUT_DIR);
-  QApplication::processEvents();
-  const QString p = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR) + "/" + name + ".png";
-  QVERIFY2(w->grab().save(p), qPrintable("cannot write " + p));
-}
-
-bool WaitUntil(const std::function<bool()> &done, int timeout_ms) {
-  QElapsedTimer t;
-  t.start();
-  while (!done()) {
-    if (t.elapsed() > timeout_ms) return false;
-    QTest::qWait(20);
-  }
-  return true;
-}
-
-void Choose(QComboBox *c, const QString &text) {
-  const int i = c->findText(text, Qt::MatchFixedString);
-  QVERIFY2(i >= 0, qPrintable("no entry " + text));
-  c->setCurrentIndex(i);
-  emit c->activated(i);
-}
-
-void TypeInto(QLineEdit *e, const QString &text) {
-  e->setFocus();
-  e->selectAll();
-  QTest::keyClicks(e, text);
-  QTest::keyClick(e, Qt::Key_Return);
-}
-
-std::unique_ptr<MainWindow> MakeWindow() {
-  auto w = std::make_unique<MainWindow>();
-  w->SetAsk([](const QString &, const QString &, QMessageBox::StandardButtons b) {
-    return (b & QMessageBox::Yes) ? QMessageBox::Yes : QMessageBox::Discard;
-  });
-  w->show();
-  if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
-  QTest::qWait(50);
-  return w;
-}
 
 // Length of a drawn path [m] (3D polyline of the samples).
 double PathLength(const studio::PathSamples &p) {
@@ -94,9 +54,6 @@ QByteArray ReadAll(const QString &path) {
   QFile f(path);
   return f.open(QIODevice::ReadOnly) ? f.readAll() : QByteArray();
 }
-
-// Four waypoints of a small drive (north, east in metres).
-const double kDrive[4][2] = {{-200.0, -300.0}, {-200.0, 150.0}, {150.0, 150.0}, {150.0, 400.0}};
 
 } // namespace
 
@@ -120,7 +77,7 @@ private slots:
     w->Panels()->setCurrentIndex(3);
     auto *type = w->findChild<QComboBox *>("trajectoryType");
     QVERIFY(type);
-    Choose(type, "segments");
+    Choose(type, "segments", Qt::MatchFixedString);
     const nav_scene &s = w->Doc()->Scene();
     QCOMPARE(static_cast<int>(s.trajectory.type), static_cast<int>(NAV_TRAJ_SEGMENTS));
     QVERIFY2(w->Doc()->PlanMessage().isEmpty(), qPrintable(w->Doc()->PlanMessage()));
@@ -178,7 +135,7 @@ private slots:
     Shot(w.get(), "segments-02-edited");
 
     // Kind change from the combo: the turn becomes a circle (radius 100 m, one turn).
-    Choose(w->findChild<QComboBox *>("segKind"), "circle");
+    Choose(w->findChild<QComboBox *>("segKind"), "circle", Qt::MatchFixedString);
     QTest::qWait(10);
     QCOMPARE(static_cast<int>(s.trajectory.segments.items[turn].kind), static_cast<int>(NAV_SEG_CIRCLE));
     QVERIFY(w->findChild<QLineEdit *>("seg.radius_m")->isVisible());
@@ -227,11 +184,11 @@ private slots:
     w->SetLivePreview(false);
     QVERIFY(w->NewDrive());
     w->Panels()->setCurrentIndex(3);
-    Choose(w->findChild<QComboBox *>("trajectoryType"), "segments");
+    Choose(w->findChild<QComboBox *>("trajectoryType"), "segments", Qt::MatchFixedString);
     auto *table = w->findChild<QTableWidget *>("segmentTable");
     table->setCurrentCell(2, 0);
     QTest::qWait(10); // the rebuilt form's fields are shown by the event loop
-    Choose(w->findChild<QComboBox *>("segKind"), "circle");
+    Choose(w->findChild<QComboBox *>("segKind"), "circle", Qt::MatchFixedString);
     QTest::qWait(10);
     const nav_scene &s = w->Doc()->Scene();
     const int undo0 = w->Doc()->UndoStack()->index();
