@@ -114,6 +114,21 @@ static size_t header_len(const char *s) {
   return nl ? (size_t)(nl - s) : strlen(s);
 }
 
+/* The @p n files named @p files are identical in WORK/<a> and WORK/<b>; @p what says between what. */
+static void assert_same_files(const char *a, const char *b, const char *const *files, size_t n, const char *what) {
+  for (size_t i = 0; i < n; ++i) {
+    char pa[512], pb[512];
+    snprintf(pa, sizeof pa, "%s/%s/%s", WORK, a, files[i]);
+    snprintf(pb, sizeof pb, "%s/%s/%s", WORK, b, files[i]);
+    char *x = nav_test_slurp_alloc(pa), *y = nav_test_slurp_alloc(pb);
+    assert_non_null(x);
+    assert_non_null(y);
+    if (strcmp(x, y) != 0) fail_msg("%s differs %s", files[i], what);
+    free(x);
+    free(y);
+  }
+}
+
 static void test_run_writes_smoothed_results(void **state) {
   (void)state;
   write_scene("smooth.yaml", "navigation:\n  scheme: ins_gnss\n  smoother: true\n");
@@ -185,17 +200,7 @@ static void test_run_writes_smoothed_results(void **state) {
   assert_int_equal(navsim("run smooth.yaml --threads 2 --out t2 -q"), 0);
   static const char *files[] = {"nav.csv", "errors.csv", "nav_smoothed.csv", "smoothed_errors.csv", "mc_final.csv",
                                 "mc_stats.csv"};
-  for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
-    char a[512], b[512];
-    snprintf(a, sizeof a, "%s/t1/%s", WORK, files[i]);
-    snprintf(b, sizeof b, "%s/t2/%s", WORK, files[i]);
-    char *x = nav_test_slurp_alloc(a), *y = nav_test_slurp_alloc(b);
-    assert_non_null(x);
-    assert_non_null(y);
-    if (strcmp(x, y) != 0) fail_msg("%s differs between --threads 1 and 2", files[i]);
-    free(x);
-    free(y);
-  }
+  assert_same_files("t1", "t2", files, sizeof files / sizeof files[0], "between --threads 1 and 2");
   char *js2 = nav_test_slurp_alloc(WORK "/t2/summary.json");
   assert_non_null(js2);
   const char *b1 = strstr(js, "\"stats\""), *b2 = strstr(js2, "\"stats\"");
@@ -229,17 +234,7 @@ static void test_mpi_same_as_threads(void **state) {
   const int st = system(cmd);
   assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 0);
   static const char *files[] = {"nav_smoothed.csv", "smoothed_errors.csv", "mc_final.csv"};
-  for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
-    char a[512], b[512];
-    snprintf(a, sizeof a, "%s/m1/%s", WORK, files[i]);
-    snprintf(b, sizeof b, "%s/mpi/%s", WORK, files[i]);
-    char *x = nav_test_slurp_alloc(a), *y = nav_test_slurp_alloc(b);
-    assert_non_null(x);
-    assert_non_null(y);
-    if (strcmp(x, y) != 0) fail_msg("%s differs between threads and MPI", files[i]);
-    free(x);
-    free(y);
-  }
+  assert_same_files("m1", "mpi", files, sizeof files / sizeof files[0], "between threads and MPI");
   char *j1 = nav_test_slurp_alloc(WORK "/m1/summary.json");
   char *j2 = nav_test_slurp_alloc(WORK "/mpi/summary.json");
   assert_non_null(j1);
