@@ -93,18 +93,6 @@ nav_status smooth_out_on_record(smooth_out *o, const nav_replay_record *r) {
   return NAV_OK;
 }
 
-/* The smoothed state in the replay's frame (ECEF), as nav_ins_gnss writes its feedback. */
-static nav_ins_state to_ecef(const nav_filter_ins_state *s, double t_s) {
-  const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
-  nav_ins_state o;
-  o.t_s = t_s;
-  o.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
-  o.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, s->v_eb_n_mps);
-  o.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), s->q_b_n));
-  return o;
-}
-
 nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const char *csv_path) {
   const double t0 = navsim_now_s();
   nav_status st = nav_smoother_run(o->sm);
@@ -151,7 +139,7 @@ nav_status smooth_out_finish(smooth_out *o, const nav_replay_summary *sum, const
     nav_epoch_errors es;
     memset(&es, 0, sizeof es);
     if (has_ref) {
-      const nav_ins_state s = to_ecef(&e.smoothed, e.t_s);
+      const nav_ins_state s = nav_ins_gnss_state_ecef(&e.smoothed, e.t_s);
       es = nav_errors_compute(&o->frame, &o->k[j].ref, &s);
       nav_replay_stats_add(&a_sm, &es);
       nav_replay_stats_add(&a_fwd, &o->k[j].fwd);

@@ -428,17 +428,6 @@ static void test_linear_gaussian_gnss_states(void **state) {
 
 /* ---------------------------------------------------------------- (b) simulated drive */
 
-static nav_ins_state to_ecef(const nav_filter_ins_state *s, double t_s) {
-  const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
-  nav_ins_state o;
-  o.t_s = t_s;
-  o.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
-  o.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, s->v_eb_n_mps);
-  o.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), s->q_b_n));
-  return o;
-}
-
 static void test_simulated_outage(void **state) {
   (void)state;
   nav_scene *sc = malloc(sizeof *sc);
@@ -532,7 +521,8 @@ static void test_simulated_outage(void **state) {
       worst_ratio = fmax(worst_ratio, e.sd_smoothed[i] / e.sd_forward[i]);
       assert_true(e.sd_smoothed[i] <= e.sd_forward[i] * (1.0 + 1e-9));
     }
-    const nav_ins_state ss = to_ecef(&e.smoothed, e.t_s), sf = to_ecef(&e.forward, e.t_s);
+    const nav_ins_state ss = nav_ins_gnss_state_ecef(&e.smoothed, e.t_s);
+    const nav_ins_state sf = nav_ins_gnss_state_ecef(&e.forward, e.t_s);
     const nav_epoch_errors es = nav_errors_compute(&frame, &tr[k], &ss);
     const nav_epoch_errors ef = nav_errors_compute(&frame, &tr[k], &sf);
     total++;
@@ -643,7 +633,7 @@ static void replay_smoothed(nav_replay_config *c, nav_replay_summary *sum, doubl
     while (j < ctx.n && ctx.t[j] < e.t_s - 1e-6)
       ++j;
     if (j >= ctx.n || fabs(ctx.t[j] - e.t_s) > 1e-6) continue;
-    const nav_ins_state s = to_ecef(&e.smoothed, e.t_s);
+    const nav_ins_state s = nav_ins_gnss_state_ecef(&e.smoothed, e.t_s);
     const nav_epoch_errors es = nav_errors_compute(&ctx.frame, &ctx.ref[j], &s);
     ss += es.pos_err_h_m * es.pos_err_h_m;
     sf += ctx.fwd[j].pos_err_h_m * ctx.fwd[j].pos_err_h_m;

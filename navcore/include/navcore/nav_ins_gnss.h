@@ -89,6 +89,11 @@ NAV_API long nav_ins_gnss_updates(const nav_ins_gnss *x);
 /** Last failure message ("" if none). */
 NAV_API const char *nav_ins_gnss_last_error(const nav_ins_gnss *x);
 
+/** A filter-side INS state (geodetic position, NED velocity, q_b_n) as the WGS-84 strapdown
+ *  state in ECEF (the scene frame F = e), at time @p t_s: what the closed loop feeds back and
+ *  how the smoother's states are compared with a reference. Pure, thread-safe. */
+NAV_API nav_ins_state nav_ins_gnss_state_ecef(const nav_filter_ins_state *s, double t_s);
+
 NAV_END_DECLS
 
 #endif /* NAV_INS_GNSS_H */

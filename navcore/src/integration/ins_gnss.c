@@ -299,12 +299,7 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   fs.s_g = x->s_g;
   fs.s_a = x->s_a;
   nav_filter_apply_correction(&fs, &fs, &dx);
-  const nav_geodetic p = {fs.lat_rad, fs.lon_rad, fs.h_m};
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
-  nav_ins_state corrected = *s;
-  corrected.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
-  corrected.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, fs.v_eb_n_mps);
-  corrected.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), fs.q_b_n));
+  const nav_ins_state corrected = nav_ins_gnss_state_ecef(&fs, s->t_s);
   st = nav_ins_set_state(x->ins, &corrected);
   if (st == NAV_OK) st = nav_filter_reset_errors(x->kf);
   if (st != NAV_OK) {
@@ -331,4 +326,15 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
     }
   }
   return NAV_OK;
+}
+
+nav_ins_state nav_ins_gnss_state_ecef(const nav_filter_ins_state *s, double t_s) {
+  const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
+  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
+  nav_ins_state o;
+  o.t_s = t_s;
+  o.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
+  o.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, s->v_eb_n_mps);
+  o.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), s->q_b_n));
+  return o;
 }

@@ -344,18 +344,6 @@ static void store_sm(job *j, long run, int64_t slot, bool forward, const nav_epo
   for (int m = 0; m < N_METRICS; ++m) j->sm_metrics[(int64_t)(m + (forward ? N_METRICS : 0)) * plane + row] = v[m];
 }
 
-/* A smoother state (geodetic, NED) as a state in the WGS-84 scene frame F = e. */
-static nav_ins_state smoothed_in_frame(const nav_filter_ins_state *s, double t_s) {
-  const nav_geodetic p = {s->lat_rad, s->lon_rad, s->h_m};
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(p.lat_rad, p.lon_rad);
-  nav_ins_state o;
-  o.t_s = t_s;
-  o.r_fb_f_m = nav_earth_geodetic_to_ecef(p);
-  o.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, s->v_eb_n_mps);
-  o.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), s->q_b_n));
-  return o;
-}
-
 /*
  * End of a run with navigation.smoother: the backward pass over the run's records, then the
  * smoothed errors at every output slot (record sm_rec[slot]) against the reference (sm_ts, or the
@@ -381,7 +369,7 @@ static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t
                 sm_rec[e], ep.t_s, (double)k * dt);
       return NAV_ERR_STATE;
     }
-    const nav_ins_state s = smoothed_in_frame(&ep.smoothed, ts->t_s);
+    const nav_ins_state s = nav_ins_gnss_state_ecef(&ep.smoothed, ts->t_s);
     const nav_epoch_errors err = nav_errors_compute(frame, ts, &s);
     store_sm(j, run, e, false, &err);
     if (record) {
