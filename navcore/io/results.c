@@ -271,8 +271,7 @@ nav_status nav_csv_write_row(FILE *f, nav_csv_table table, const nav_sim_record 
   return n < 0 ? NAV_ERR_IO : NAV_OK;
 }
 
-/* JSON string with escapes for quotes, backslashes and control characters. */
-static void json_string(FILE *f, const char *s) {
+void nav_json_write_string(FILE *f, const char *s) {
   fputc('"', f);
   for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
     if (*p == '"' || *p == '\\')
@@ -311,9 +310,9 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   FILE *f = fopen(path, "w");
   if (!f) return NAV_ERR_IO;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
-  json_string(f, scene->name);
+  nav_json_write_string(f, scene->name);
   fputs(", \"file\": ", f);
-  json_string(f, info->scene_file);
+  nav_json_write_string(f, info->scene_file);
   fprintf(f, "},\n  \"seed\": %llu,\n  \"runs\": %ld,\n  \"ideal\": %s,\n", (unsigned long long)info->seed,
           sum->runs, info->ideal ? "true" : "false");
   fprintf(f,

@@ -355,10 +355,10 @@ static int write_json(const char *path, const allan_args *a, const allan_source 
   if (!f) return EXIT_FAIL;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"source\": {\"kind\": \"%s\", \"name\": ",
           nav_version_string(), src->kind);
-  navsim_json_string(f, src->name);
+  nav_json_write_string(f, src->name);
   if (a->scene_path) {
     fputs(", \"file\": ", f);
-    navsim_json_string(f, a->scene_path);
+    nav_json_write_string(f, a->scene_path);
   }
   if (src->bias_model)
     fprintf(f, ", \"bias_model\": \"%s\", \"verified\": \"%s\"", src->bias_model, src->verified);

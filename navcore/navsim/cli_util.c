@@ -109,19 +109,6 @@ void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallb
   if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", fallback);
 }
 
-void navsim_json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(f, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(f, "\\u%04x", *p);
-    else
-      fputc(*p, f);
-  }
-  fputc('"', f);
-}
-
 void navsim_json_number(FILE *f, double v, int digits) {
   if (isfinite(v))
     fprintf(f, "%.*g", digits, v);

@@ -61,9 +61,6 @@ int navsim_scene_arg(const char *cmd, const char *arg, const char **scene);
  * '_'; empty, "." or ".." become @p fallback. */
 void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallback);
 
-/* A JSON string literal (quotes, backslash and control characters escaped); NULL prints "". */
-void navsim_json_string(FILE *f, const char *s);
-
 /* A JSON number with @p digits significant digits ("%.*g"); non-finite values print null. */
 void navsim_json_number(FILE *f, double v, int digits);
 

@@ -186,9 +186,9 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
   FILE *f = path ? fopen(path, "w") : NULL;
   if (!f) return -1;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": ", nav_version_string());
-  navsim_json_string(f, sc->name);
+  nav_json_write_string(f, sc->name);
   fputs(", \"file\": ", f);
-  navsim_json_string(f, scene_path);
+  nav_json_write_string(f, scene_path);
   fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"t_s\": %.17g,\n", nav_nav_scheme_name(sc->navigation.scheme), tab->t_s);
   fputs("  \"conventions\": {\"per_axis\": \"one level channel (north or east) of a free-inertial INS, numerics.md "
         "1.2; inputs are the worst axis of the IMU model\", \"horizontal\": \"sqrt(2) x per axis (independent "

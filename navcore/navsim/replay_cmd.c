@@ -287,21 +287,21 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   const nav_filter_config *fc = &nc->filter;
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"command\": \"replay\",\n  \"inputs\": {\"imu\": ",
           nav_version_string());
-  navsim_json_string(f, j->imu);
+  nav_json_write_string(f, j->imu);
   fputs(", \"gnss\": ", f);
   if (j->gnss)
-    navsim_json_string(f, j->gnss);
+    nav_json_write_string(f, j->gnss);
   else
     fputs("null", f);
   fputs(", \"truth\": ", f);
-  navsim_json_string(f, j->truth);
+  nav_json_write_string(f, j->truth);
   fputs(", \"config\": ", f);
   if (j->config)
-    navsim_json_string(f, j->config);
+    nav_json_write_string(f, j->config);
   else
     fputs("null", f);
   fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"case\": ", s->free_ins ? "free_ins" : "ins_gnss");
-  navsim_json_string(f, k_case_names[j->dcase]);
+  nav_json_write_string(f, k_case_names[j->dcase]);
   fprintf(f, ",\n  \"dataset\": %s,\n", j->long_drive ? "\"gnss-ins-sim long_drive\"" : "null");
   fprintf(
       f,
@@ -409,7 +409,7 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs("  \"peers_published\": ", f);
   if (j->long_drive) {
     fputs("{\"source\": \"gnss-ins-sim-long-drive/README.md\", \"case\": ", f);
-    navsim_json_string(f, k_case_readme[j->dcase]);
+    nav_json_write_string(f, k_case_readme[j->dcase]);
     for (int p = 0; p < 2; ++p) {
       fprintf(f, ", \"%s\": {", k_peers[p].name);
       for (int k = 0; k < N_FIG; ++k) {
@@ -425,9 +425,9 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs("  \"peers_scored\": [", f);
   for (int p = 0; p < j->n_peers; ++p) {
     fputs(p ? ",\n    {\"name\": " : "\n    {\"name\": ", f);
-    navsim_json_string(f, j->peers[p].name);
+    nav_json_write_string(f, j->peers[p].name);
     fputs(", \"file\": ", f);
-    navsim_json_string(f, j->peers[p].path);
+    nav_json_write_string(f, j->peers[p].path);
     fputs(",\n", f);
     json_stats(f, 3, "errors", &j->peers[p].stats, true);
     fputs("    }", f);

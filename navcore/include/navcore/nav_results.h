@@ -62,6 +62,10 @@ typedef struct nav_run_info {
 NAV_API NAV_NODISCARD nav_status nav_summary_write_json(const char *path, const nav_scene *scene,
                                                         const nav_run_info *info, const nav_sim_summary *sum);
 
+/** @p s as a JSON string literal (quotes, backslashes and control characters escaped; other bytes
+ *  as they are); NULL is written as "". */
+NAV_API void nav_json_write_string(FILE *f, const char *s);
+
 /**
  * Write requirement verdicts as a JSON list (the "requirements" value of summary.json: objects
  * {id, metric, statistic, limit, unit, value, pass, samples} plus time_s for at_time and
