@@ -21,6 +21,7 @@
  * [NUM] docs/numerics.md (project), sections 0.2, 4.1, 4.4.
  */
 #include "navcore/nav_math.h"
+#include "math/quat_dcm_inline.h"
 
 #include <assert.h>
 #include <string.h>
@@ -141,17 +142,8 @@ nav_vec3 nav_quat_to_rotvec(nav_quat q) {
 
 /* ---------------------------------------------------------------- quaternion <-> DCM */
 
-nav_mat3 nav_quat_to_dcm(nav_quat q) {
-  /* [G] section 2.2.3 (quaternion to coordinate transformation matrix), Hamilton product:
-   * C(q) v = q (x) v (x) conj(q). */
-  const double ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
-  const double xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-  const double wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-  nav_mat3 c = {{{ww + xx - yy - zz, 2.0 * (xy - wz), 2.0 * (xz + wy)},
-                 {2.0 * (xy + wz), ww - xx + yy - zz, 2.0 * (yz - wx)},
-                 {2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz}}};
-  return c;
-}
+/* The formula is in quat_dcm_inline.h, shared with the hot kernels that inline it. */
+nav_mat3 nav_quat_to_dcm(nav_quat q) { return nav_quat_to_dcm_inline(q); }
 
 nav_quat nav_quat_from_dcm(nav_mat3 c) {
   /* [SH] Shepperd 1978: of 4w^2 = 1 + tr, 4x^2 = 1 + C_11 - C_22 - C_33, 4y^2 = ..., 4z^2 = ...

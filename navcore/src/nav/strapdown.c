@@ -42,6 +42,7 @@
 #include "navcore/nav_ins.h"
 #include "nav/ecef_gravity.h"
 #include "nav_clones.h"
+#include "math/quat_dcm_inline.h"
 
 /* 1 - e^2 = (b/a)^2. */
 #define E2M (1.0 - NAV_WGS84_E2)
@@ -125,17 +126,6 @@ nav_ins_config nav_ins_config_default(void) {
 }
 
 /* ------------------------------------------------------------------ small helpers */
-
-/* C(q) of nav_quat_to_dcm() (math.c), the same operations inlined into the step. */
-HOT_INLINE nav_mat3 dcm_of_quat(nav_quat q) {
-  const double ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
-  const double xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-  const double wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-  nav_mat3 c = {{{ww + xx - yy - zz, 2.0 * (xy - wz), 2.0 * (xz + wy)},
-                 {2.0 * (xy + wz), ww - xx + yy - zz, 2.0 * (yz - wx)},
-                 {2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz}}};
-  return c;
-}
 
 /* Renormalise a quaternion whose norm is 1 to rounding (a product of unit quaternions): one
  * Newton step for 1/sqrt(n2), s = (3 - n2)/2, leaves an error of O((n2 - 1)^2) ~ 1e-32, i.e. the
@@ -549,7 +539,7 @@ nav_status nav_ins_aid_vertical(nav_ins *ins, double h_m, double v_d_mps) {
 HOT_INLINE nav_status step_flat(nav_ins *ins, const nav_imu_increment *imu) {
   const double dt = imu->dt_s;
   const nav_vec3 dth = imu->dtheta_b_rad, dv = imu->dv_b_mps;
-  const nav_mat3 C_b_l = dcm_of_quat(ins->s.q_b_f);
+  const nav_mat3 C_b_l = nav_quat_to_dcm_inline(ins->s.q_b_f);
   nav_vec3 phi, dv_body;
 
   if (ins->cfg.algorithm == NAV_MECH_FIRST_ORDER) {
@@ -608,7 +598,7 @@ HOT_INLINE nav_status step_ned_impl(nav_ins *ins, const nav_imu_increment *imu, 
 
   /* Specific-force part: C_b_n(k-1) dv_body, and C_b_n(k-1) dv, C_b_n(k-1) phi for the term of
    * the rotation of n during the interval (frame_rotation_term). */
-  const nav_mat3 C_b_n = dcm_of_quat(ins->q_b_n);
+  const nav_mat3 C_b_n = nav_quat_to_dcm_inline(ins->q_b_n);
   const nav_vec3 dv_f = nav_mat3_mul_vec(C_b_n, dv_body);
   const nav_vec3 cdv = nav_mat3_mul_vec(C_b_n, imu->dv_b_mps);
   const nav_vec3 cphi = nav_mat3_mul_vec(C_b_n, phi);
@@ -733,7 +723,7 @@ HOT_INLINE nav_status step_ecef(nav_ins *ins, const nav_imu_increment *imu) {
   }
   const nav_quat q_rot = {ins->rot_c[ir], 0.0, 0.0, -ins->rot_s[ir]};
 
-  const nav_mat3 C_b_e = dcm_of_quat(ins->s.q_b_f);
+  const nav_mat3 C_b_e = nav_quat_to_dcm_inline(ins->s.q_b_f);
   const nav_vec3 dv_f = nav_mat3_mul_vec(C_b_e, dv_body);
   /* The e frame turns by omega_ie dt while the increment accrues (-1/2 [omega_ie_e x] C_b_e dv dt
    * and, for (b), the second-order terms; frame_rotation_term). */
