@@ -243,25 +243,21 @@ SegmentEditor::SegmentEditor(SceneDocument *doc, QWidget *parent) : QWidget(pare
   insert_->setToolTip(tr("Insert a 10 s hold before the selected segment"));
   for (auto *b : {add_, insert_, del_, up_, down_}) row->addWidget(b);
   vl->addLayout(row);
-  connect(add_, &QPushButton::clicked, this, [this] {
-    const int n = doc_->Scene().trajectory.segments.count;
-    const int at = n == 0 ? 0 : std::min(current_ + 1, n);
-    EditItems(tr("Add segment %1").arg(at), [at](nav_traj_segments &S) {
+  // Add (after the selection) and Insert (before it) put a 10 s hold at index `at`.
+  auto insert_hold = [this](const QString &label, int at) {
+    EditItems(label.arg(at), [at](nav_traj_segments &S) {
       if (S.count >= NAV_MAX_SEGMENTS) return;
       std::memmove(&S.items[at + 1], &S.items[at], sizeof(nav_segment) * static_cast<size_t>(S.count - at));
       S.items[at] = HoldItem(10.0);
       ++S.count;
     }, at);
+  };
+  connect(add_, &QPushButton::clicked, this, [this, insert_hold] {
+    const int n = doc_->Scene().trajectory.segments.count;
+    insert_hold(tr("Add segment %1"), n == 0 ? 0 : std::min(current_ + 1, n));
   });
-  connect(insert_, &QPushButton::clicked, this, [this] {
-    const int n = doc_->Scene().trajectory.segments.count;
-    const int at = std::clamp(current_, 0, n);
-    EditItems(tr("Insert segment %1").arg(at), [at](nav_traj_segments &S) {
-      if (S.count >= NAV_MAX_SEGMENTS) return;
-      std::memmove(&S.items[at + 1], &S.items[at], sizeof(nav_segment) * static_cast<size_t>(S.count - at));
-      S.items[at] = HoldItem(10.0);
-      ++S.count;
-    }, at);
+  connect(insert_, &QPushButton::clicked, this, [this, insert_hold] {
+    insert_hold(tr("Insert segment %1"), std::clamp(current_, 0, doc_->Scene().trajectory.segments.count));
   });
   connect(del_, &QPushButton::clicked, this, [this] {
     const int n = doc_->Scene().trajectory.segments.count;
