@@ -10,7 +10,6 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
-#include <QScrollArea>
 #include <QTableWidget>
 #include <QVBoxLayout>
 
@@ -35,15 +34,6 @@ bool SameNumber(const QString &text, double v) {
   bool ok = false;
   const double t = text.trimmed().toDouble(&ok);
   return ok && (t == v || Num(t) == Num(v));
-}
-
-QWidget *Scrolled(QWidget *inner) {
-  auto *sa = new QScrollArea;
-  sa->setWidget(inner);
-  sa->setWidgetResizable(true);
-  sa->setFrameShape(QFrame::NoFrame);
-  sa->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-  return sa;
 }
 
 QComboBox *Combo(const QString &name, const QStringList &items) {
@@ -167,11 +157,11 @@ void NumField::Refresh() {
 ScenePanels::ScenePanels(SceneDocument *doc, Catalogs *catalogs, QWidget *parent)
     : QTabWidget(parent), doc_(doc), cat_(catalogs) {
   setObjectName("panels");
-  addTab(Scrolled(BuildModel()), tr("Model"));
-  addTab(Scrolled(BuildImu()), tr("IMU"));
-  addTab(Scrolled(BuildGnss()), tr("GNSS"));
+  addTab(ScrolledPanel(BuildModel()), tr("Model"));
+  addTab(ScrolledPanel(BuildImu()), tr("IMU"));
+  addTab(ScrolledPanel(BuildGnss()), tr("GNSS"));
   addTab(new TrajectoryEditors(doc_, BuildTrajectory()), tr("Trajectory")); // waypoints, segments, parametric
-  addTab(Scrolled(BuildSimulation()), tr("Simulation"));
+  addTab(ScrolledPanel(BuildSimulation()), tr("Simulation"));
   addTab(BuildRequirements(), tr("Requirements"));
   connect(doc_, &SceneDocument::Changed, this, &ScenePanels::Refresh);
   Refresh();

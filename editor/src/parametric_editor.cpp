@@ -39,12 +39,6 @@ const RowSpec kRows[] = {
     {"rate.c_hz", "c", "Hz", nullptr, POFF(wc_hz), "frequency of the body-rate sine"},
     {"rate.d_rad", "d", "rad", "deg", POFF(wd_rad), "phase of the body-rate sine"},
 };
-
-bool SameText(const QString &text, double v) {
-  bool ok = false;
-  const double t = text.trimmed().toDouble(&ok);
-  return ok && (t == v || FieldNumber(t) == FieldNumber(v));
-}
 } // namespace
 
 ParametricEditor::ParametricEditor(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
@@ -235,7 +229,7 @@ void ParametricEditor::OnCommit() {
       std::memcpy(&v, reinterpret_cast<const char *>(before_.get()) + f.offset, sizeof v);
       v /= Scale(f);
     }
-    if (SameText(f.edit->text(), v))
+    if (SameFieldNumber(f.edit->text(), v))
       f.edit->setModified(false);
     else
       changed = true;

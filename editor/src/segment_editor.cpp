@@ -152,17 +152,27 @@ nav_segment HoldItem(double s) {
   return g;
 }
 
-bool SameText(const QString &text, double v) {
-  bool ok = false;
-  const double t = text.trimmed().toDouble(&ok);
-  return ok && (t == v || FieldNumber(t) == FieldNumber(v));
-}
 } // namespace
 
 QString FieldNumber(double v) {
   if (!std::isfinite(v)) return QString::number(v);
   if (v == 0.0) return QStringLiteral("0"); // also -0
   return QString::number(v, 'g', 10);
+}
+
+bool SameFieldNumber(const QString &text, double v) {
+  bool ok = false;
+  const double t = text.trimmed().toDouble(&ok);
+  return ok && (t == v || FieldNumber(t) == FieldNumber(v));
+}
+
+QWidget *ScrolledPanel(QWidget *inner) {
+  auto *sa = new QScrollArea;
+  sa->setWidget(inner);
+  sa->setWidgetResizable(true);
+  sa->setFrameShape(QFrame::NoFrame);
+  sa->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  return sa;
 }
 
 bool ApplyFieldSets(const nav_scene &base, const QVector<FieldSet> &sets, nav_scene *out, QVector<Issue> *issues) {
@@ -455,7 +465,7 @@ void SegmentEditor::OnCommit(int field) {
     ShowIssues({}, field);
     return;
   }
-  if (SameText(text, ValueOf(f, cur))) {
+  if (SameFieldNumber(text, ValueOf(f, cur))) {
     f.edit->setModified(false);
     return;
   }
@@ -623,22 +633,14 @@ TrajectoryEditors::TrajectoryEditors(SceneDocument *doc, QWidget *waypoints, QWi
   stack_ = new QStackedWidget;
   segments_ = new SegmentEditor(doc_);
   parametric_ = new ParametricEditor(doc_);
-  auto scrolled = [](QWidget *inner) {
-    auto *sa = new QScrollArea;
-    sa->setWidget(inner);
-    sa->setWidgetResizable(true);
-    sa->setFrameShape(QFrame::NoFrame);
-    sa->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-    return sa;
-  };
   other_ = new QLabel;
   other_->setObjectName("trajectoryOther");
   other_->setWordWrap(true);
   other_->setAlignment(Qt::AlignTop | Qt::AlignLeft);
   other_->setMargin(8);
   stack_->addWidget(waypoints_);            // 0
-  stack_->addWidget(scrolled(segments_));   // 1
-  stack_->addWidget(scrolled(parametric_)); // 2
+  stack_->addWidget(ScrolledPanel(segments_));   // 1
+  stack_->addWidget(ScrolledPanel(parametric_)); // 2
   stack_->addWidget(other_);                // 3
   vl->addWidget(stack_, 1);
   connect(type_, QOverload<int>::of(&QComboBox::activated), this, [this](int idx) {

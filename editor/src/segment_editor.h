@@ -46,6 +46,10 @@ bool ApplyFieldSets(const nav_scene &base, const QVector<FieldSet> &sets, nav_sc
 
 /** Text of a number as the editor shows it (10 significant digits, no trailing zeros). */
 QString FieldNumber(double v);
+/** Whether a field's @p text already holds @p v (equal, or the same as FieldNumber shows it). */
+bool SameFieldNumber(const QString &text, double v);
+/** @p inner in a frameless, vertically scrolling area (the panels' tabs and editor pages). */
+QWidget *ScrolledPanel(QWidget *inner);
 
 /** Editor of trajectory.segments. */
 class SegmentEditor : public QWidget {
