@@ -304,6 +304,15 @@ static void json_stat(FILE *f, const char *name, nav_stat s, bool last) {
   fprintf(f, "}%s\n", last ? "" : ",");
 }
 
+/* The five metrics of a nav_sim_stats block, in summary.json's order; @p last: no trailing comma. */
+static void json_sim_stats(FILE *f, const nav_sim_stats *st, bool last) {
+  json_stat(f, "pos_err_h_m", st->pos_err_h_m, false);
+  json_stat(f, "pos_err_v_m", st->pos_err_v_m, false);
+  json_stat(f, "vel_err_mps", st->vel_err_mps, false);
+  json_stat(f, "att_err_rad", st->att_err_rad, false);
+  json_stat(f, "yaw_err_rad", st->yaw_err_rad, last);
+}
+
 nav_status nav_summary_write_json(const char *path, const nav_scene *scene, const nav_run_info *info,
                                   const nav_sim_summary *sum) {
   if (!path || !scene || !info || !sum) return NAV_ERR_INVALID_ARG;
@@ -358,11 +367,7 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
   json_number(f, sum->final_rms.att_err_rad);
   fprintf(f, "},\n  \"stats\": {\n    \"epochs\": %lld,\n    \"stride\": %lld,\n",
           (long long)sum->stats_epochs, (long long)sum->stats_stride);
-  json_stat(f, "pos_err_h_m", sum->stats.pos_err_h_m, false);
-  json_stat(f, "pos_err_v_m", sum->stats.pos_err_v_m, false);
-  json_stat(f, "vel_err_mps", sum->stats.vel_err_mps, false);
-  json_stat(f, "att_err_rad", sum->stats.att_err_rad, false);
-  json_stat(f, "yaw_err_rad", sum->stats.yaw_err_rad, true);
+  json_sim_stats(f, &sum->stats, true);
   if (sum->has_smoothed) {
     /* navigation.smoother: RTS-smoothed errors at the output epochs of every run, and the forward
      * filter's at the same epochs. */
@@ -372,17 +377,9 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
             "%lld,\n"
             "    \"smoother_bytes_max\": %zu,\n",
             (long long)sum->smoothed_epochs, (long long)sum->smoothed_stride, sum->smoother_bytes_max);
-    json_stat(f, "pos_err_h_m", sum->stats_smoothed.pos_err_h_m, false);
-    json_stat(f, "pos_err_v_m", sum->stats_smoothed.pos_err_v_m, false);
-    json_stat(f, "vel_err_mps", sum->stats_smoothed.vel_err_mps, false);
-    json_stat(f, "att_err_rad", sum->stats_smoothed.att_err_rad, false);
-    json_stat(f, "yaw_err_rad", sum->stats_smoothed.yaw_err_rad, false);
+    json_sim_stats(f, &sum->stats_smoothed, false);
     fputs("    \"forward_same_epochs\": {\n", f);
-    json_stat(f, "pos_err_h_m", sum->stats_forward_out.pos_err_h_m, false);
-    json_stat(f, "pos_err_v_m", sum->stats_forward_out.pos_err_v_m, false);
-    json_stat(f, "vel_err_mps", sum->stats_forward_out.vel_err_mps, false);
-    json_stat(f, "att_err_rad", sum->stats_forward_out.att_err_rad, false);
-    json_stat(f, "yaw_err_rad", sum->stats_forward_out.yaw_err_rad, true);
+    json_sim_stats(f, &sum->stats_forward_out, true);
     fputs("    }\n", f);
   }
   fputs("  },\n  \"requirements\": ", f);
