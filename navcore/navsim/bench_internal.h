@@ -22,6 +22,7 @@ typedef struct bench_row {
   /* Replay cases: the peers' published figures on the same data (README of the data set). */
   const char *peer;
   double peer_wall_s, peer_error_m, error_m;
+  double parse_s, nav_s; /* replay cases: parsing alone and the in-process replay (best of 3) [s] */
   double peak_rss_mb; /* child-process cases: peak resident memory (0: not measured) */
   double fps;         /* viewer case: frames per second */
   char note[160];     /* shown in bench.md (e.g. why a case stopped early) */
