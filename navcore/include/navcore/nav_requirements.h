@@ -129,7 +129,10 @@ typedef struct nav_requirement_verdict {
   int outage_count; /**< outage_end: outages evaluated (each below) */
   double outage_t0_s[NAV_REQ_MAX_OUTAGES];  /**< outage start [s] */
   double outage_t1_s[NAV_REQ_MAX_OUTAGES];  /**< outage end [s] */
-  double outage_end_t_s[NAV_REQ_MAX_OUTAGES]; /**< last output epoch inside it [s] */
+  /** the epoch scored [s]: the last epoch fed to the evaluator inside the outage (simulations:
+   *  the last output epoch; navsim replay also feeds the errors just before the fix that ends a
+   *  GNSS gap, 1 ulp before that fix's epoch) */
+  double outage_end_t_s[NAV_REQ_MAX_OUTAGES];
   double outage_value[NAV_REQ_MAX_OUTAGES];   /**< RMS over runs there, user units (NaN: no epoch inside) */
 } nav_requirement_verdict;
 
