@@ -4,12 +4,12 @@
 //   navstudio --bench-preview [N] [SCENE]  move a waypoint N times (default 20) and report the
 //                                     live-preview edit-to-picture latency (median, p90, max) [ms]:
 //                                     from the edit to the swap of the window frame showing the
-//                                     re-simulated estimate; renders per view and frames per edit
+//                                     re-simulated estimate; renders and frames per view per edit
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QSurfaceFormat>
 #include <QTimer>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <sys/resource.h>
 
@@ -78,7 +78,7 @@ int BenchPreview(studio::MainWindow *w, int n) {
   }
   const double cpu0 = cpu_s();
   const long renders0 = w->MapView()->RenderCount() + w->View3D()->RenderCount();
-  const long frames0 = w->FramesShown();
+  const long frames0 = w->MapView()->FrameCount() + w->View3D()->FrameCount();
   const int k = doc->Scene().trajectory.waypoints.count / 2;
   for (int i = 0; i < n; ++i) {
     nav_scene s = doc->Scene();
@@ -102,7 +102,7 @@ int BenchPreview(studio::MainWindow *w, int n) {
     std::fclose(f);
   }
   const double renders = double(w->MapView()->RenderCount() + w->View3D()->RenderCount() - renders0) / n;
-  const double frames = double(w->FramesShown() - frames0) / n;
+  const double frames = double(w->MapView()->FrameCount() + w->View3D()->FrameCount() - frames0) / n;
   {
     // The frames of a drag (the document is still live: no multisampling).
     QElapsedTimer t;
@@ -115,17 +115,17 @@ int BenchPreview(studio::MainWindow *w, int n) {
     std::printf("preview_parts_ms: live render_map=%.1f render_3d=%.1f\n", rm_ms, r3_ms);
   }
   std::printf("preview_latency_ms: samples=%zu median=%.1f p90=%.1f max=%.1f cpu_per_edit_ms=%.1f "
-              "renders_per_edit=%.1f renders_per_view_per_edit=%.2f frames_per_edit=%.2f duration_s=%.1f imu_rate_hz=%g "
+              "renders_per_edit=%.1f renders_per_view_per_edit=%.2f frames_per_view_per_edit=%.2f duration_s=%.1f imu_rate_hz=%g "
               "loadavg=%.2f\n",
               l.size(), l[l.size() / 2], l[std::min(l.size() - 1, l.size() * 9 / 10)], l.back(), cpu_ms, renders,
-              renders / 2.0, frames,
+              renders / 2.0, frames / 2.0,
               doc->Scene().trajectory.duration_s, doc->Scene().imu.rate_hz, load);
   return 0;
 }
 } // namespace
 
 int main(int argc, char **argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
   QApplication::setOrganizationName("navsim");
   QApplication::setApplicationName("navstudio");
@@ -171,7 +171,7 @@ int main(int argc, char **argv) {
     WaitFor([&] { return !w.PreviewWorker()->IsBusy() && w.LastPreview() != nullptr && !w.PreviewLatenciesMs().empty(); },
             20000);
     QApplication::processEvents();
-    return w.grab().save(shot) ? 0 : 1;
+    return w.Screenshot().save(shot) ? 0 : 1;
   }
   return app.exec();
 }

@@ -23,7 +23,8 @@
 #include <QTextBrowser>
 #include <QToolBar>
 #include <QUndoStack>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QImage>
+#include <QPainter>
 
 #include <algorithm>
 #include <cmath>
@@ -141,10 +142,10 @@ void MainWindow::BuildUi() {
 
   connect(map_, &PathView::CursorText, status_, &QLabel::setText);
   connect(view3d_, &PathView::CursorText, status_, &QLabel::setText);
-  // A frame of the window (both views are composed into it) reached the screen.
-  connect(map_->VtkWidget(), &QOpenGLWidget::frameSwapped, this, [this] { ++frames_shown_; });
-  connect(map_->VtkWidget(), &QOpenGLWidget::frameSwapped, this, &MainWindow::OnPictureShown);
-  connect(view3d_->VtkWidget(), &QOpenGLWidget::frameSwapped, this, &MainWindow::OnPictureShown);
+  // Each view swaps its own frames (native windows): a preview's picture is on screen when
+  // every visible view has swapped the frame with its estimate.
+  connect(map_, &PathView::FrameSwapped, this, [this] { OnViewFrame(1u); });
+  connect(view3d_, &PathView::FrameSwapped, this, [this] { OnViewFrame(2u); });
   // Selection in sync: views and the table.
   connect(map_, &PathView::SelectionChanged, this, [this](int i) {
     view3d_->SetSelectedWaypoint(i);
@@ -202,7 +203,7 @@ void MainWindow::BuildActions() {
   });
   connect(shot, &QAction::triggered, this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, tr("Export screenshot"), "navstudio.png", tr("PNG (*.png)"));
-    if (!p.isEmpty()) grab().save(p);
+    if (!p.isEmpty()) Screenshot().save(p);
   });
   connect(report, &QAction::triggered, this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, tr("Export report"), "navstudio-report.html",
@@ -471,9 +472,26 @@ void MainWindow::UpdateLiveRenderDelay() {
   view3d_->SetLiveRenderDelay(ms);
 }
 
+namespace {
+// The highest of the scene's output rate (at most kPreviewOutputHz) and 5, 4, 2, 1 Hz that
+// divides the IMU rate and gives at most kPreviewMaxEpochs epochs (else the lowest that divides).
+double PreviewOutputHz(const nav_scene &s) {
+  const double own = std::min(s.output.rate_hz, kPreviewOutputHz);
+  double best = s.output.rate_hz;
+  for (const double hz : {own, 10.0, 5.0, 4.0, 2.0, 1.0}) {
+    if (hz > own || std::fmod(s.imu.rate_hz, hz) != 0.0) continue;
+    best = hz;
+    if (hz * s.trajectory.duration_s <= kPreviewMaxEpochs) break;
+  }
+  return best;
+}
+} // namespace
+
 std::unique_ptr<nav_scene> PreviewScene(const nav_scene &scene) {
   // The preview is one run of a lighter scene: the filter covariance propagated every 10th IMU
-  // step, the IMU at 20 Hz (else 50 Hz) instead of 100 Hz, output at 10 Hz at most. The sensor
+  // step, the IMU at 20 Hz (else 50 Hz) instead of 100 Hz, output at 10 Hz at most and at most
+  // kPreviewMaxEpochs epochs (urban-drive's 513 s: 4 Hz; its estimate is still drawn with a
+  // point every 3 m). The error statistics are taken at the output epochs only (SimWorker). The sensor
   // noise densities are per root hertz and the increments are exact integrals of the reference
   // motion, so the error growth stays alike (over 24 seeds of urban-drive: horizontal RMS 7.97 m
   // at 20 Hz, 7.78 m at 50 Hz, 7.22 m for the full 100 Hz run; final error 2.18 / 2.20 / 2.17 m).
@@ -483,8 +501,7 @@ std::unique_ptr<nav_scene> PreviewScene(const nav_scene &scene) {
     auto s = std::make_unique<nav_scene>(scene);
     if (s->navigation.cov_decimation < kPreviewCovDecimation) s->navigation.cov_decimation = kPreviewCovDecimation;
     if (s->imu.rate_hz > imu_hz && std::fmod(s->imu.rate_hz, imu_hz) == 0.0) s->imu.rate_hz = imu_hz;
-    if (s->output.rate_hz > kPreviewOutputHz && std::fmod(s->imu.rate_hz, kPreviewOutputHz) == 0.0)
-      s->output.rate_hz = kPreviewOutputHz;
+    s->output.rate_hz = PreviewOutputHz(*s);
     if (nav_scene_validate(s.get(), nullptr, nullptr) == NAV_OK) return s;
   }
   return std::make_unique<nav_scene>(scene);
@@ -536,8 +553,8 @@ void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
   map_->SetEstimate(r->nav_ned, true);
   view3d_->SetEstimate(r->nav_ned, true);
   if (r->scene_change_ns == doc_.LastChangeNs()) {
-    // The views have drawn the current scene's estimate; the latency ends when Qt has composed
-    // that frame into the window and swapped it (OnPictureShown), or now for a hidden window.
+    // The views have drawn the current scene's estimate; the latency ends when every visible
+    // view has swapped the frame that shows it (OnViewFrame), or now for a hidden window.
     pending_picture_.change_ns = r->scene_change_ns;
     pending_picture_.started_ns = preview_started_ns_;
     pending_picture_.arrived_ns = arrived_ns;
@@ -545,10 +562,26 @@ void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
     pending_picture_.sim_ms = r->wall_s * 1e3;
     pending_picture_.samples = static_cast<long long>(r->summary.imu_samples);
     pending_picture_.final_err_m = r->summary.final.pos_err_h_m;
+    pending_picture_.views_owing = (map_->isVisible() ? 1u : 0u) | (view3d_->isVisible() ? 2u : 0u);
     ReleaseFrames();
-    if (!isVisible() || isMinimized() || (!map_->isVisible() && !view3d_->isVisible())) OnPictureShown();
+    if (!isVisible() || isMinimized() || pending_picture_.views_owing == 0) OnPictureShown();
   }
   emit ResultShown(true);
+}
+
+void MainWindow::OnViewFrame(unsigned bit) {
+  if (pending_picture_.change_ns == 0 || !(pending_picture_.views_owing & bit)) return;
+  pending_picture_.views_owing &= ~bit;
+  if (pending_picture_.views_owing == 0) OnPictureShown();
+}
+
+QImage MainWindow::Screenshot() {
+  QImage img = grab().toImage();
+  QPainter p(&img);
+  for (PathView *v : {map_, view3d_})
+    if (v->isVisible() && v->width() > 0 && v->height() > 0)
+      p.drawImage(QRect(v->mapTo(this, QPoint(0, 0)), v->size()), v->Grab());
+  return img;
 }
 
 void MainWindow::OnPictureShown() {
@@ -565,7 +598,7 @@ void MainWindow::OnPictureShown() {
     latency_label_->setText(latency_text_);
   std::fprintf(stderr,
                "navstudio: preview latency %.1f ms (edit to picture: %.1f ms to the start of the preview, simulation "
-               "%.1f ms for %lld samples, %.1f ms to draw, %.1f ms to compose and swap)\n",
+               "%.1f ms for %lld samples, %.1f ms to draw, %.1f ms to the views' swaps)\n",
                ms, (p.started_ns - p.change_ns) * 1e-6, p.sim_ms, p.samples, (p.drawn_ns - p.arrived_ns) * 1e-6,
                (now - p.drawn_ns) * 1e-6);
 }
@@ -695,7 +728,7 @@ bool MainWindow::ExportReport(const QString &path, QString *error) {
   r.receiver = QString::fromUtf8(sc.gnss.catalog);
   const std::shared_ptr<const SimResult> res = last_result_;
   r.result = res && !res->preview ? res.get() : nullptr;
-  r.images.push_back({tr("navstudio: map, 3D view and panels"), grab().toImage()});
+  r.images.push_back({tr("navstudio: map, 3D view and panels"), Screenshot()});
   if (chart_) r.images.push_back({tr("horizontal error against time"), chart_->grab().toImage()});
   return WriteStudioReport(path, r, error);
 }

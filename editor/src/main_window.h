@@ -34,6 +34,9 @@ namespace studio {
 /** Live preview simplifications (MainWindow::StartPreview). */
 constexpr int kPreviewCovDecimation = 10;
 constexpr double kPreviewOutputHz = 10.0;
+/** The preview's output rate is lowered (10, 5, 4, 2, 1 Hz) until the drive has at most this
+ *  many output epochs: about 2 per 3 m of drawn estimate at 13 m/s over 10 min. */
+constexpr double kPreviewMaxEpochs = 2500.0;
 constexpr double kPreviewImuHz = 20.0;
 /** The preview's IMU rate when kPreviewImuHz does not fit the scene. */
 constexpr double kPreviewImuHzFallback = 50.0;
@@ -93,10 +96,12 @@ public:
   std::shared_ptr<const SimResult> LastResult() const { return last_result_; }
   std::shared_ptr<const SimResult> LastPreview() const { return last_preview_; }
   /** Edit-to-picture latencies of the live previews so far [ms]: from the edit (the scene's
-   *  change) to the swap of the window's frame that shows the preview's estimate. */
+   *  change) to the last swap, among the visible views, of a frame that shows the preview's
+   *  estimate. */
   const std::vector<double> &PreviewLatenciesMs() const { return latencies_ms_; }
-  /** Frames of the window composed and swapped so far (benchmarks, tests). */
-  long FramesShown() const { return frames_shown_; }
+  /** The window as it is on screen, views included (QWidget::grab() leaves the views' native
+   *  windows out): screenshots, the report. */
+  QImage Screenshot();
   QString ResultsText() const;
   QStringList RecentFiles() const;
 
@@ -126,8 +131,11 @@ private:
   void UpdateLiveRenderDelay();
   /** The views' picture of the pending preview reached the screen: record its latency. */
   void OnPictureShown();
-  /** During a live edit the window draws one frame per preview: the panels, the path and the
-   *  estimate that follows it together (at most kLiveRenderDelayMs after the edit). */
+  /** View @p bit (1: map, 2: 3D) swapped a frame: the pending picture is shown once all have. */
+  void OnViewFrame(unsigned bit);
+  /** During a live edit the window's widgets (panels, table, profile chart) are repainted with
+   *  the preview, when the views show the path and its estimate (at most kLiveRenderDelayMs
+   *  after the edit), not before them. */
   void HoldFrames();
   void ReleaseFrames();
 
@@ -152,15 +160,15 @@ private:
   QTimer autosave_timer_;
   int autosaved_index_ = -1;
   qint64 preview_started_ns_ = 0;
-  // The preview whose picture is drawn but not yet on screen (composed and swapped by Qt).
+  // The preview whose picture is drawn but not yet on screen (each view swaps its own frame).
   struct PendingPicture {
     qint64 change_ns = 0, started_ns = 0, arrived_ns = 0, drawn_ns = 0;
     double sim_ms = 0.0, final_err_m = 0.0;
     long long samples = 0;
+    unsigned views_owing = 0; // bit 0: the map, bit 1: the 3D view, until each swaps its frame
   };
   PendingPicture pending_picture_;
   bool hold_frames_ = false, held_update_ = false;
-  long frames_shown_ = 0;
   int frame_hold_ms_ = kLiveRenderDelayMs;
   QTimer frame_hold_timer_;
   QTimer latency_label_timer_; // the latency read-out waits for a pause (no extra frame per edit)

@@ -3,7 +3,9 @@
 #include <QResizeEvent>
 #include <QShowEvent>
 #include <QVBoxLayout>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QImage>
+#include <QVTKOpenGLStereoWidget.h>
+#include <QVTKOpenGLWindow.h>
 
 #include <algorithm>
 #include <cmath>
@@ -257,8 +259,13 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   setObjectName(mode == Mode::Map ? "mapView" : "view3d");
   auto *lay = new QVBoxLayout(this);
   lay->setContentsMargins(0, 0, 0, 0);
-  widget_ = new QVTKOpenGLNativeWidget(this);
+  widget_ = new QVTKOpenGLStereoWidget(this);
   lay->addWidget(widget_);
+  connect(widget_->embeddedOpenGLWindow(), &QOpenGLWindow::frameSwapped, this, [this] {
+    ++frame_count_;
+    swapped_render_count_ = render_count_;
+    emit FrameSwapped();
+  });
   window_ = vtkSmartPointer<vtkGenericOpenGLRenderWindow>::New();
   window_->SetMultiSamples(kMultiSamples);
   widget_->setRenderWindow(window_);
@@ -386,6 +393,11 @@ PathView::~PathView() {
 
 vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor(); }
 
+QImage PathView::Grab() {
+  if (render_pending_ || render_timer_.isActive()) Render();
+  return widget_->grabFramebuffer();
+}
+
 void PathView::Render() {
   render_timer_.stop();
   if (!window_) return;
@@ -399,8 +411,7 @@ void PathView::Render() {
   // committed edit is drawn smooth again.
   const int samples = doc_->IsLive() ? 0 : kMultiSamples;
   if (window_->GetMultiSamples() != samples) window_->SetMultiSamples(samples);
-  window_->Render();
-  widget_->update();
+  window_->Render(); // VTK's adapter asks the view's window for the frame that shows it
 }
 
 void PathView::UpdateGrid(double cx, double cy, double extent) {

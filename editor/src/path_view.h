@@ -1,7 +1,11 @@
 /*
  * navstudio: the map view (top-down, parallel projection, local grid with geodetic read-out) and
- * the 3D view (perspective, ground plane) of the scene, both plain VTK in a
- * QVTKOpenGLNativeWidget. Click on the ground adds a waypoint (Ctrl+click inserts it into the
+ * the 3D view (perspective, ground plane) of the scene, both plain VTK in a native OpenGL window
+ * of their own (QVTKOpenGLStereoWidget: a QVTKOpenGLWindow in a window container). A view
+ * swaps its own frames: Qt does not compose it into the main window's frame, which with Mesa's
+ * software renderer cost about 20 ms per frame (live preview, urban-drive: edit-to-picture
+ * median 116-125 ms with QVTKOpenGLNativeWidget, 98-102 ms with native windows, all else equal).
+ * The price: QWidget::grab() of a parent shows no view; Grab() renders one for screenshots. Click on the ground adds a waypoint (Ctrl+click inserts it into the
  * nearest leg), dragging a waypoint's handle moves it (Shift+drag in 3D changes its height),
  * Delete removes the selected one. The smooth path comes from navcore's waypoint model.
  * World axes: x = East, y = North, z = Up, metres from the scene origin.
@@ -21,7 +25,8 @@
 
 #include "studio_scene.h"
 
-class QVTKOpenGLNativeWidget;
+class QImage;
+class QVTKOpenGLStereoWidget;
 class vtkActor;
 class vtkBillboardTextActor3D;
 class vtkGenericOpenGLRenderWindow;
@@ -64,7 +69,12 @@ public:
   /** Ground point (local N, E at height -d_plane) under a VTK display point. */
   bool GroundAt(int x, int y, double d_plane, double *n, double *e);
   vtkRenderWindowInteractor *Interactor();
-  QVTKOpenGLNativeWidget *VtkWidget() { return widget_; }
+  /** This view's picture as it is on screen (rendered anew; screenshots). */
+  QImage Grab();
+  /** Frames this view has swapped to the screen so far (benchmarks, tests). */
+  long FrameCount() const { return frame_count_; }
+  /** A render of this view has not reached the screen yet (tests wait for quiet views). */
+  bool FramePending() const { return render_count_ != swapped_render_count_; }
   int SelectedWaypoint() const { return selected_; }
   void SetSelectedWaypoint(int i);
   /** Number of points of the drawn reference path (tests). */
@@ -94,6 +104,8 @@ signals:
   void SelectionChanged(int waypoint);
   /** Cursor read-out text (status bar). */
   void CursorText(const QString &text);
+  /** A frame of this view reached the screen (swapped). */
+  void FrameSwapped();
 
 private:
   friend class PathViewStyle;
@@ -112,7 +124,7 @@ private:
 
   SceneDocument *doc_;
   Mode mode_;
-  QVTKOpenGLNativeWidget *widget_ = nullptr;
+  QVTKOpenGLStereoWidget *widget_ = nullptr;
   vtkSmartPointer<vtkGenericOpenGLRenderWindow> window_;
   vtkSmartPointer<vtkRenderer> renderer_;
   vtkSmartPointer<PathViewStyle> style_;
@@ -138,7 +150,7 @@ private:
   size_t coast_count_ = 0, graticule_count_ = 0;
   QString bg_note_;
   double graticule_step_deg_ = 0.0;
-  long render_count_ = 0;
+  long render_count_ = 0, frame_count_ = 0, swapped_render_count_ = 0;
   unsigned long camera_observer_ = 0, render_observer_ = 0;
   int live_render_delay_ms_ = 0;
   QTimer render_timer_;

@@ -18,10 +18,8 @@ ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent
   // Coalesced like the views: a drag redraws the chart once per event-loop pass.
   timer_.setSingleShot(true);
   connect(&timer_, &QTimer::timeout, this, &ProfileChart::Recompute);
-  // During a live drag too: a repaint of a widget recomposes the whole window, OpenGL views
-  // included, which software rendering pays for, so the chart joins the frame of the views
-  // (the window holds that frame until the live preview's estimate is drawn, MainWindow) instead
-  // of a frame of its own.
+  // During a live drag too: the window holds its repaints until the live preview's estimate is
+  // drawn (MainWindow), so the chart changes with the views' path and estimate, not before them.
   connect(doc_, &SceneDocument::Changed, this, [this] { timer_.start(0); });
   Recompute();
 }

@@ -22,7 +22,7 @@ inline void Shot(studio::MainWindow *w, const QString &name) {
   QDir().mkpath(NAVSTUDIO_TEST_OUT_DIR);
   QApplication::processEvents();
   const QString p = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR) + "/" + name + ".png";
-  QVERIFY2(w->grab().save(p), qPrintable("cannot write " + p));
+  QVERIFY2(w->Screenshot().save(p), qPrintable("cannot write " + p));
 }
 
 /** Process events until @p done or @p timeout_ms; false on timeout. */

@@ -16,7 +16,7 @@
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
 #include <cstring>
@@ -598,6 +598,7 @@ private slots:
       return !w->PreviewWorker()->IsBusy() && w->LastPreview() && w->LastPreview()->scene_change_ns == doc->LastChangeNs();
     };
     QVERIFY(WaitUntil(settled, 60000));
+    QVERIFY(WaitUntil([&] { return !w->PreviewLatenciesMs().empty(); }, 10000)); // its picture is shown
     const nav_scene &s = doc->Scene();
     QCOMPARE(s.imu.rate_hz, 100.0);
     auto light = studio::PreviewScene(s);
@@ -610,9 +611,16 @@ private slots:
     odd.imu.rate_hz = 64.0;
     odd.output.rate_hz = 8.0;
     QCOMPARE(studio::PreviewScene(odd)->imu.rate_hz, 64.0);
-    // The preview of the lighter scene: estimates at 10 Hz over the whole drive.
+    // The preview of the lighter scene: estimates over the whole drive at its output rate, at
+    // most kPreviewMaxEpochs of them (10 Hz for a short drive).
     const auto pv = w->LastPreview();
-    QVERIFY(std::fabs(double(pv->t_s.size()) - (s.trajectory.duration_s * 10.0 + 1.0)) <= 2.0);
+    QVERIFY(std::fabs(double(pv->t_s.size()) - (s.trajectory.duration_s * light->output.rate_hz + 1.0)) <= 2.0);
+    QVERIFY(pv->t_s.size() <= studio::kPreviewMaxEpochs + 2);
+    nav_scene long_drive = s;
+    long_drive.trajectory.duration_s = 513.0;
+    QCOMPARE(studio::PreviewScene(long_drive)->output.rate_hz, 4.0);
+    long_drive.output.rate_hz = 2.0; // a scene's lower rate stays
+    QCOMPARE(studio::PreviewScene(long_drive)->output.rate_hz, 2.0);
     // The preview's error band (3 x the filter's horizontal sigma) follows the estimate in both
     // views: two band points per envelope epoch, a width that is the filter's, not zero.
     QVERIFY(pv->env_sd_h_m.size() > 100 && pv->env_sd_h_m.size() == pv->env_t_s.size());
@@ -627,15 +635,17 @@ private slots:
     const size_t n0 = w->PreviewLatenciesMs().size();
     const nav_scene before = s;
     const int edits = 4;
+    auto quiet = [&] { return !views[0]->FramePending() && !views[1]->FramePending(); };
     for (int i = 0; i < edits; ++i) {
+      QVERIFY(WaitUntil(quiet, 10000)); // no earlier render's frame still to come
       nav_scene e = doc->Scene();
       e.trajectory.waypoints.points[1].r_ned_m.y += 5.0;
-      const long f0 = w->FramesShown();
+      const long f0[2] = {views[0]->FrameCount(), views[1]->FrameCount()};
       doc->Preview(e);
       QVERIFY(doc->IsLive());
       QVERIFY(WaitUntil([&] { return w->PreviewLatenciesMs().size() >= n0 + size_t(i) + 1; }, 30000));
-      // One window frame per edit: the panels, the path and its estimate together.
-      QCOMPARE(w->FramesShown() - f0, 1L);
+      // One frame per view and edit: the path and its estimate together.
+      for (int k = 0; k < 2; ++k) QCOMPARE(views[k]->FrameCount() - f0[k], 1L);
       QVERIFY(WaitUntil(settled, 30000));
     }
     for (int k = 0; k < 2; ++k) QCOMPARE(views[k]->RenderCount() - r0[k], long(edits));
@@ -665,12 +675,14 @@ private slots:
     };
     QVERIFY(WaitUntil(settled, 60000));
     QVERIFY(WaitUntil([&] { return !w->PreviewLatenciesMs().empty(); }, 10000));
-    QTest::qWait(100); // the frame of the latency read-out
+    // No earlier render's frame still to come.
+    QVERIFY(WaitUntil([&] { return !w->MapView()->FramePending() && !w->View3D()->FramePending(); }, 10000));
     w->SetLiveFrameHoldMs(60000);
     for (PathView *v : {w->MapView(), w->View3D()}) v->SetLiveRenderDelay(60000);
     QSignalSpy finished(w->PreviewWorker(), &studio::SimWorker::Finished);
     const size_t n0 = w->PreviewLatenciesMs().size();
-    const long f0 = w->FramesShown();
+    const long f0[2] = {w->MapView()->FrameCount(), w->View3D()->FrameCount()};
+    const long r0[2] = {w->MapView()->RenderCount(), w->View3D()->RenderCount()};
     nav_scene e = doc->Scene();
     e.trajectory.waypoints.points[6].r_ned_m.y += 5.0;
     doc->Preview(e);
@@ -686,7 +698,11 @@ private slots:
     QCOMPARE(second->status, int(NAV_OK));
     QCOMPARE(second->scene_change_ns, doc->LastChangeNs());
     QCOMPARE(w->PreviewLatenciesMs().size(), n0 + 1);
-    QCOMPARE(w->FramesShown() - f0, 1L);
+    // Each view rendered the second edit's path and estimate once and showed it in one frame.
+    QCOMPARE(w->MapView()->RenderCount() - r0[0], 1L);
+    QCOMPARE(w->View3D()->RenderCount() - r0[1], 1L);
+    QCOMPARE(w->MapView()->FrameCount() - f0[0], 1L);
+    QCOMPARE(w->View3D()->FrameCount() - f0[1], 1L);
     QCOMPARE(w->LastPreview()->t_s.size(), second->t_s.size());
     Shot(w.get(), "preempt-01");
   }
@@ -732,7 +748,7 @@ private:
 };
 
 int main(int argc, char **argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
   QApplication::setOrganizationName("navstudio-test");
   QApplication::setApplicationName("navstudio-test");

@@ -16,7 +16,7 @@
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
 #include <cstring>
@@ -520,7 +520,7 @@ private:
 };
 
 int main(int argc, char **argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
   QApplication::setOrganizationName("navstudio-test");
   QApplication::setApplicationName("navstudio-test");

@@ -72,7 +72,7 @@ void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, 
     median = field(line, " median=");
     p90 = field(line, " p90=");
     renders = field(line, " renders_per_view_per_edit=");
-    frames = field(line, " frames_per_edit=");
+    frames = field(line, " frames_per_view_per_edit=");
     load = field(line, " loadavg=");
     cpu = field(line, " cpu_per_edit_ms=");
   }
@@ -86,7 +86,7 @@ void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, 
   r->samples = (long long)samples;
   r->wall_s = median * 1e-3;
   snprintf(r->note, sizeof r->note,
-           "edit to picture: median %.0f ms, p90 %.0f ms; %.2g renders per view and %.2g frames per edit; "
+           "edit to picture: median %.0f ms, p90 %.0f ms; %.2g renders and %.2g frames per view per edit; "
            "%.0f ms CPU per edit; load %.1f",
            median, p90, renders, frames, cpu, load);
 }

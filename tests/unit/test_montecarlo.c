@@ -323,6 +323,70 @@ static void test_t65_nees_consistency(void **state) {
   assert_true((double)inside >= 0.9 * (double)ne);
 }
 
+/* Errors of run 0 at its output epochs (record callback). */
+typedef struct {
+  double h[256];
+  int n;
+} out_errors;
+
+static nav_callback_result keep_h(void *user, const nav_sim_record *r) {
+  out_errors *o = user;
+  if (r->run == 0 && o->n < 256) o->h[o->n++] = r->err->pos_err_h_m;
+  return NAV_CONTINUE;
+}
+
+/*
+ * nav_sim_options.stats_stride_min (navstudio's live preview passes its output stride): the
+ * statistics are taken at every N-th IMU epoch only, and are then exactly the statistics of the
+ * errors the record callback sees at the output epochs; the final errors and the envelope do
+ * not change. The run with statistics at every IMU epoch differs (it sees the epochs between).
+ */
+static void test_stats_stride_min(void **state) {
+  (void)state;
+  nav_scene sc = nav_scene_default();
+  sc.trajectory.duration_s = 30.0;
+  sc.imu.rate_hz = 100.0;
+  sc.output.rate_hz = 2.0;
+  sc.simulation.runs = 1;
+  sc.imu.model.accel.terms = NAV_IMU_TERM_NOISE;
+  sc.imu.model.accel.vrw_mps_per_sqrt_s = nav_vec3_make(2e-3, 2e-3, 2e-3);
+  sc.initial_errors.vel_sd_mps = nav_vec3_make(0.05, 0.05, 0.05);
+  nav_sim_summary sum[2];
+  out_errors rec[2];
+  const nav_sim_envelope_point *env[2];
+  size_t ne[2];
+  nav_sim *sim[2];
+  for (int i = 0; i < 2; ++i) {
+    memset(&rec[i], 0, sizeof rec[i]);
+    assert_int_equal(nav_sim_create(&sc, &sim[i]), NAV_OK);
+    nav_sim_options o = nav_sim_options_default();
+    o.record = keep_h;
+    o.user = &rec[i];
+    o.stats_stride_min = i == 0 ? 0 : 50;
+    if (nav_sim_run(sim[i], &o, &sum[i]) != NAV_OK) fail_msg("%s", nav_sim_last_error(sim[i]));
+    env[i] = nav_sim_envelope(sim[i], &ne[i]);
+  }
+  assert_int_equal(sum[0].stats_stride, 1);
+  assert_int_equal(sum[0].stats_epochs, 3001);
+  assert_int_equal(sum[1].stats_stride, 50);
+  assert_int_equal(sum[1].stats_epochs, 61);
+  assert_int_equal(rec[1].n, 61);
+  assert_memory_equal(rec[0].h, rec[1].h, sizeof rec[0].h);
+  assert_memory_equal(&sum[0].final, &sum[1].final, sizeof sum[0].final);
+  assert_int_equal(ne[0], ne[1]);
+  assert_memory_equal(env[0], env[1], ne[0] * sizeof *env[0]);
+  double ss = 0.0, mx = 0.0;
+  for (int e = 0; e < rec[1].n; ++e) {
+    ss += rec[1].h[e] * rec[1].h[e];
+    if (rec[1].h[e] > mx) mx = rec[1].h[e];
+  }
+  assert_true(mx > 1e-3);
+  assert_true(sum[1].stats.pos_err_h_m.max == mx);
+  assert_true(fabs(sum[1].stats.pos_err_h_m.rms - sqrt(ss / rec[1].n)) <= 1e-12 * mx);
+  assert_true(sum[0].stats.pos_err_h_m.rms != sum[1].stats.pos_err_h_m.rms);
+  for (int i = 0; i < 2; ++i) nav_sim_destroy(sim[i]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_deterministic_across_threads),
@@ -332,6 +396,7 @@ int main(void) {
       cmocka_unit_test(test_ideal_ignores_errors),
       cmocka_unit_test(test_t66_monte_carlo_vs_covariance),
       cmocka_unit_test(test_t65_nees_consistency),
+      cmocka_unit_test(test_stats_stride_min),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -79,12 +79,18 @@ typedef struct nav_sim_options {
    *  epoch in time order with the SMOOTHED navigation state (nav) and its errors (err); truth
    *  and frame as for @c record, the IMU increments NULL. NAV_STOP cancels the job. */
   nav_record_fn smoothed_record;
+  /** 0 or 1: the error statistics (summary stats) take every IMU epoch, as memory allows
+   *  (NAV_SIM_METRIC_MAX_VALUES); N > 1: at most every N-th one. A caller that reads only the
+   *  final errors and the output epochs (navstudio's live preview) passes the output stride and
+   *  skips the reference state and the errors at the other IMU epochs. */
+  int64_t stats_stride_min;
 } nav_sim_options;
 
 NAV_API nav_sim_options nav_sim_options_default(void);
 
 /** Statistics pooled over every run and epoch (epochs at the IMU rate, every stats_stride-th
- *  one when runs x epochs would exceed 4e6 values). */
+ *  one when runs x epochs would exceed NAV_SIM_METRIC_MAX_VALUES, or as
+ *  nav_sim_options.stats_stride_min asks). */
 typedef struct nav_sim_stats {
   nav_stat pos_err_h_m, pos_err_v_m, vel_err_mps, att_err_rad, yaw_err_rad;
 } nav_sim_stats;

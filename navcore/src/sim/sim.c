@@ -720,6 +720,7 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   const int64_t epochs = j.n + 1;
   j.stats_stride = ((int64_t)j.runs * epochs + METRIC_MAX_VALUES - 1) / METRIC_MAX_VALUES;
   if (j.stats_stride < 1) j.stats_stride = 1;
+  if (j.stats_stride < opts->stats_stride_min) j.stats_stride = opts->stats_stride_min;
   j.stats_per_run = j.n / j.stats_stride + 1;
   if (j.runs > 1 && j.run_end > r0 && j.n <= SHARED_TRUTH_MAX_SAMPLES) {
     /* Generate the truth once for all runs (the same numbers every run would compute): every
