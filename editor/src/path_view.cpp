@@ -393,6 +393,8 @@ PathView::~PathView() {
 
 vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor(); }
 
+QWindow *PathView::NativeWindow() { return widget_->embeddedOpenGLWindow(); }
+
 QImage PathView::Grab() {
   if (render_pending_ || render_timer_.isActive()) Render();
   return widget_->grabFramebuffer();

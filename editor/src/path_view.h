@@ -26,6 +26,7 @@
 #include "studio_scene.h"
 
 class QImage;
+class QWindow;
 class QVTKOpenGLStereoWidget;
 class vtkActor;
 class vtkBillboardTextActor3D;
@@ -69,6 +70,8 @@ public:
   /** Ground point (local N, E at height -d_plane) under a VTK display point. */
   bool GroundAt(int x, int y, double d_plane, double *n, double *e);
   vtkRenderWindowInteractor *Interactor();
+  /** The view's native window (receives the mouse and keys; tests send Qt events to it). */
+  QWindow *NativeWindow();
   /** This view's picture as it is on screen (rendered anew; screenshots). */
   QImage Grab();
   /** Frames this view has swapped to the screen so far (benchmarks, tests). */

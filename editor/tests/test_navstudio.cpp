@@ -9,6 +9,7 @@
 #include <QFile>
 #include <QLabel>
 #include <QLineEdit>
+#include <QMouseEvent>
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QSignalSpy>
@@ -16,6 +17,7 @@
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QWindow>
 #include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
@@ -660,6 +662,56 @@ private slots:
     QVERIFY(views[0]->RenderCount() > r1);
     QVERIFY(WaitUntil(settled, 60000));
     Shot(w.get(), "live-02-released");
+  }
+
+  // The views are native windows: real Qt mouse events (not injected VTK ones) reach the
+  // waypoint editor through VTK's Qt adapter. A click adds a waypoint under the cursor, a drag
+  // of its handle moves it, the Delete key removes the selected one.
+  void qt_events_on_views() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    PathView *map = w->MapView();
+    QWindow *win = map->NativeWindow();
+    QVERIFY(win && win->isExposed());
+    const double mpp = MapMetresPerPixel(map);
+    // VTK display coordinates have their origin at the bottom left, Qt's at the top left.
+    auto qt_point = [&](double n, double e) {
+      int x = 0, y = 0;
+      if (!map->DisplayOf(n, e, 0.0, &x, &y)) return QPoint(-1, -1);
+      return QPoint(x, win->height() - 1 - y);
+    };
+    for (int k = 0; k < 2; ++k) {
+      const QPoint p = qt_point(kDrive[k][0], kDrive[k][1]);
+      QVERIFY(p.x() >= 0);
+      QTest::mouseMove(win, p);
+      QTest::mouseClick(win, Qt::LeftButton, Qt::NoModifier, p);
+      QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, k + 1);
+      const nav_vec3 r = w->Doc()->Scene().trajectory.waypoints.points[k].r_ned_m;
+      QVERIFY2(std::fabs(r.x - kDrive[k][0]) <= 1.5 * mpp && std::fabs(r.y - kDrive[k][1]) <= 1.5 * mpp,
+               qPrintable(QString("waypoint %1 at %2, %3").arg(k).arg(r.x).arg(r.y)));
+    }
+    // Drag waypoint 1 by 40 px to the right (east) in steps.
+    const QPoint a = qt_point(kDrive[1][0], kDrive[1][1]);
+    QTest::mouseMove(win, a);
+    QTest::mousePress(win, Qt::LeftButton, Qt::NoModifier, a);
+    for (int s = 1; s <= 8; ++s) {
+      // QTest::mouseMove on a QWindow sends no button state: a QMouseEvent with the left button
+      // held, as the window system sends during a drag.
+      QMouseEvent mv(QEvent::MouseMove, a + QPoint(5 * s, 0), Qt::NoButton, Qt::LeftButton, Qt::NoModifier);
+      QGuiApplication::sendEvent(win, &mv);
+      QApplication::processEvents();
+    }
+    QTest::mouseRelease(win, Qt::LeftButton, Qt::NoModifier, a + QPoint(40, 0));
+    const nav_vec3 moved = w->Doc()->Scene().trajectory.waypoints.points[1].r_ned_m;
+    QVERIFY2(std::fabs(moved.y - (kDrive[1][1] + 40.0 * mpp)) <= 2.0 * mpp && std::fabs(moved.x - kDrive[1][0]) <= 2.0 * mpp,
+             qPrintable(QString("moved to %1, %2 (mpp %3)").arg(moved.x).arg(moved.y).arg(mpp)));
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 2);
+    QCOMPARE(map->SelectedWaypoint(), 1);
+    Shot(w.get(), "qt-events-01-dragged");
+    QTest::keyClick(win, Qt::Key_Delete);
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 1);
   }
 
   // Two drag steps in a row: the preview of the first, barely started, is dropped for the second
