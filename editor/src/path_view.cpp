@@ -44,6 +44,17 @@ namespace studio {
 
 /* ---------------------------------------------------------------- waypoint edits */
 
+QString TrajectoryKindName(nav_traj_type t) {
+  switch (t) {
+  case NAV_TRAJ_WAYPOINTS: return QObject::tr("waypoint");
+  case NAV_TRAJ_SEGMENTS: return QObject::tr("segment-script");
+  case NAV_TRAJ_PARAMETRIC: return QObject::tr("parametric");
+  case NAV_TRAJ_RECORDED: return QObject::tr("recorded");
+  case NAV_TRAJ_TEST_MOTION: return QObject::tr("test-motion");
+  }
+  return QString::fromUtf8(nav_traj_type_name(t));
+}
+
 void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at) {
   const nav_scene &cur = doc->Scene();
   if (cur.trajectory.type == NAV_TRAJ_WAYPOINTS && cur.trajectory.waypoints.count >= NAV_MAX_WAYPOINTS) return;
@@ -692,7 +703,9 @@ void PathView::UpdateCaption() {
   if (wp) cap += tr("  ·  %1 waypoints").arg(count);
   if (path_.Size() > 0) cap += tr("  ·  %1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
   if (mode_ == Mode::Map && !bg_note_.isEmpty()) cap += "  ·  " + bg_note_;
-  if (mode_ == Mode::Map && (!wp || count < 4))
+  if (mode_ == Mode::Map && !wp)
+    cap = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type)) + "\n" + cap;
+  else if (mode_ == Mode::Map && count < 4)
     cap = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)") + "\n" + cap;
   caption_->SetInput(cap.toUtf8().constData());
 }
@@ -943,6 +956,14 @@ void PathView::OnClick(int x, int y, bool ctrl) {
   double n = 0, e = 0;
   if (!GroundAt(x, y, 0.0, &n, &e)) return;
   const nav_scene &s = doc_->Scene();
+  if (s.trajectory.type != NAV_TRAJ_WAYPOINTS) {
+    // A click would replace a segment script, a parametric or a recorded trajectory by one
+    // waypoint: no edit, the status bar says where such a trajectory is edited.
+    emit CursorText(tr("A %1 trajectory has no waypoints to add: edit it in the Trajectory panel, or "
+                       "File > New drive to draw one")
+                        .arg(TrajectoryKindName(s.trajectory.type)));
+    return;
+  }
   int insert_at = -1;
   if (ctrl && s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count >= 2) {
     // Insert into the nearest leg (distance to the straight segment between waypoints).

@@ -161,6 +161,8 @@ private:
   double grid_cx_ = 0.0, grid_cy_ = 0.0, grid_extent_ = 0.0, grid_step_ = 100.0;
 };
 
+/** "waypoint", "segment-script", "parametric", ... (captions and messages). */
+QString TrajectoryKindName(nav_traj_type t);
 /** Waypoint edits shared by the views and the table (each is one undo step). */
 void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at = -1);
 void DeleteWaypoint(SceneDocument *doc, int index);

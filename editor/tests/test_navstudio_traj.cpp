@@ -15,6 +15,7 @@
 #include <QSurfaceFormat>
 #include <QTableWidget>
 #include <QTemporaryDir>
+#include <QSignalSpy>
 #include <QTest>
 #include <QVTKOpenGLStereoWidget.h>
 
@@ -263,6 +264,23 @@ private slots:
     const std::vector<double> path0 = map->Path().ned_m;
     QVERIFY(path0.size() > 300);
     const int undo0 = w->Doc()->UndoStack()->index();
+    {
+      // A click on the map does not replace the parametric trajectory by a waypoint; the status
+      // bar says where it is edited.
+      QSignalSpy said(map, &PathView::CursorText);
+      int x = 0, y = 0;
+      QVERIFY(map->DisplayOf(path0[0] + 30.0, path0[1] + 30.0, 0.0, &x, &y));
+      vtkRenderWindowInteractor *i = map->Interactor();
+      i->SetEventInformation(x, y, 0, 0);
+      i->InvokeEvent(vtkCommand::MouseMoveEvent);
+      i->InvokeEvent(vtkCommand::LeftButtonPressEvent);
+      i->InvokeEvent(vtkCommand::LeftButtonReleaseEvent);
+      QCOMPARE(static_cast<int>(s.trajectory.type), static_cast<int>(NAV_TRAJ_PARAMETRIC));
+      QCOMPARE(w->Doc()->UndoStack()->index(), undo0);
+      QVERIFY(!said.isEmpty());
+      QVERIFY2(said.last().at(0).toString().contains("parametric trajectory has no waypoints"),
+               qPrintable(said.last().at(0).toString()));
+    }
     b0->setFocus();
     b0->selectAll();
     QTest::keyClicks(b0, "50");
