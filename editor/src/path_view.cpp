@@ -858,18 +858,8 @@ bool PathView::DisplayOf(double n, double e, double d, int *x, int *y) {
 }
 
 bool PathView::GroundAt(int x, int y, double d_plane, double *n, double *e) {
-  double a[4], b[4];
-  renderer_->SetDisplayPoint(x, y, 0.0);
-  renderer_->DisplayToWorld();
-  renderer_->GetWorldPoint(a);
-  renderer_->SetDisplayPoint(x, y, 1.0);
-  renderer_->DisplayToWorld();
-  renderer_->GetWorldPoint(b);
-  if (a[3] == 0.0 || b[3] == 0.0) return false;
-  for (int k = 0; k < 3; ++k) {
-    a[k] /= a[3];
-    b[k] /= b[3];
-  }
+  double a[3], b[3];
+  if (!RayAt(x, y, a, b)) return false;
   const double z = -d_plane;
   const double dz = b[2] - a[2];
   if (std::fabs(dz) < 1e-12) return false;
@@ -878,6 +868,38 @@ bool PathView::GroundAt(int x, int y, double d_plane, double *n, double *e) {
   *e = a[0] + t * (b[0] - a[0]);
   *n = a[1] + t * (b[1] - a[1]);
   return std::isfinite(*n) && std::isfinite(*e);
+}
+
+bool PathView::RayAt(int x, int y, double a[3], double b[3]) {
+  double pa[4], pb[4];
+  renderer_->SetDisplayPoint(x, y, 0.0);
+  renderer_->DisplayToWorld();
+  renderer_->GetWorldPoint(pa);
+  renderer_->SetDisplayPoint(x, y, 1.0);
+  renderer_->DisplayToWorld();
+  renderer_->GetWorldPoint(pb);
+  if (pa[3] == 0.0 || pb[3] == 0.0) return false;
+  for (int k = 0; k < 3; ++k) {
+    a[k] = pa[k] / pa[3];
+    b[k] = pb[k] / pb[3];
+  }
+  return true;
+}
+
+bool PathView::HeightUnder(int x, int y, double n, double e, double *up) {
+  // Nearest points of the ray a + t (b - a) and the vertical line (e, n, 0) + s (0, 0, 1):
+  // with w = a - (e, n, 0) and d = b - a, s = w_z + d_z t and t minimises the horizontal
+  // distance |w_xy + d_xy t|, i.e. t = -(w_xy . d_xy) / |d_xy|^2.
+  double a[3], b[3];
+  if (!RayAt(x, y, a, b)) return false;
+  const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double w[3] = {a[0] - e, a[1] - n, a[2]};
+  const double dh2 = d[0] * d[0] + d[1] * d[1];
+  const double len2 = dh2 + d[2] * d[2];
+  if (!(len2 > 0.0) || dh2 < 1e-6 * len2) return false; // nearly vertical line of sight
+  const double t = -(w[0] * d[0] + w[1] * d[1]) / dh2;
+  *up = w[2] + d[2] * t;
+  return std::isfinite(*up);
 }
 
 int PathView::PickWaypoint(int x, int y) {
@@ -927,15 +949,24 @@ void PathView::OnDrag(int x, int y, bool shift) {
   nav_scene s = doc_->Scene();
   nav_waypoint &p = s.trajectory.waypoints.points[drag_index_];
   if (shift && mode_ == Mode::ThreeD) {
-    // Height: vertical mouse motion, scaled by the distance to the point.
-    vtkCamera *cam = renderer_->GetActiveCamera();
-    const double *cp = cam->GetPosition();
+    // Height: the point of the waypoint's vertical line nearest to the ray under the cursor, so
+    // that the handle stays under the cursor whatever the camera's tilt; measured from where
+    // the drag started (a press a few pixels off the handle's centre does not make it jump).
     const nav_vec3 r = drag_before_->trajectory.waypoints.points[drag_index_].r_ned_m;
-    const double dist = std::sqrt((cp[0] - r.y) * (cp[0] - r.y) + (cp[1] - r.x) * (cp[1] - r.x) +
-                                  (cp[2] + r.z) * (cp[2] + r.z));
-    const int h = window_->GetSize()[1] > 0 ? window_->GetSize()[1] : 1;
-    const double m_per_px = 2.0 * dist * std::tan(cam->GetViewAngle() * M_PI / 360.0) / h;
-    p.r_ned_m.z = drag_d_ - (y - press_y_) * m_per_px;
+    double up_now = 0.0, up_press = 0.0;
+    if (HeightUnder(x, y, r.x, r.y, &up_now) && HeightUnder(press_x_, press_y_, r.x, r.y, &up_press)) {
+      p.r_ned_m.z = drag_d_ - (up_now - up_press);
+    } else {
+      // The line of sight is vertical (looking straight down): vertical mouse motion, scaled by
+      // the distance to the point.
+      vtkCamera *cam = renderer_->GetActiveCamera();
+      const double *cp = cam->GetPosition();
+      const double dist = std::sqrt((cp[0] - r.y) * (cp[0] - r.y) + (cp[1] - r.x) * (cp[1] - r.x) +
+                                    (cp[2] + r.z) * (cp[2] + r.z));
+      const int h = window_->GetSize()[1] > 0 ? window_->GetSize()[1] : 1;
+      const double m_per_px = 2.0 * dist * std::tan(cam->GetViewAngle() * M_PI / 360.0) / h;
+      p.r_ned_m.z = drag_d_ - (y - press_y_) * m_per_px;
+    }
   } else {
     double n = 0, e = 0;
     if (!GroundAt(x, y, drag_d_, &n, &e)) return;

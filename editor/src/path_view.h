@@ -120,6 +120,11 @@ private:
   void OnHover(int x, int y);
   void OnDeleteKey();
   int PickWaypoint(int x, int y);
+  /** World points (x = E, y = N, z = Up) at the near and far planes under display point x, y. */
+  bool RayAt(int x, int y, double a[3], double b[3]);
+  /** Height (Up) of the point of the vertical line through local N/E @p n, @p e nearest to the
+   *  ray under display point x, y; false when the line of sight is (nearly) vertical. */
+  bool HeightUnder(int x, int y, double n, double e, double *up);
   void UpdateGrid(double cx, double cy, double extent);
   void UpdateCaption();
   void resizeEvent(QResizeEvent *e) override;
