@@ -352,6 +352,11 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   renderer_->AddActor(envelope_); // first: under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
     renderer_->AddActor(a);
+  if (mode == Mode::ThreeD) {
+    // Drop lines from waypoints off the ground plane (Shift+drag) to it: their height is read.
+    stems_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.95, 0.95, 1.5);
+    renderer_->AddActor(stems_);
+  }
 
   caption_ = vtkSmartPointer<vtkTextActor>::New();
   caption_->GetTextProperty()->SetFontSize(14);
@@ -403,6 +408,11 @@ PathView::~PathView() {
 }
 
 vtkRenderWindowInteractor *PathView::Interactor() { return widget_->interactor(); }
+
+size_t PathView::StemCount() {
+  Path(); // a pending redraw first
+  return stems_ ? static_cast<size_t>(InputOf(stems_)->GetNumberOfLines()) : 0u;
+}
 
 QWindow *PathView::NativeWindow() { return widget_->embeddedOpenGLWindow(); }
 
@@ -581,6 +591,22 @@ void PathView::Rebuild() {
     g->ScalingOff();
     g->Update();
     InputOf(handles_)->DeepCopy(g->GetOutput());
+  }
+  if (stems_) {
+    auto sp = vtkSmartPointer<vtkPoints>::New();
+    auto lines = vtkSmartPointer<vtkCellArray>::New();
+    for (int i = 0; i < count; ++i) {
+      const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+      if (std::fabs(r.z) < 0.5) continue;
+      const vtkIdType a = sp->InsertNextPoint(r.y, r.x, -r.z), b = sp->InsertNextPoint(r.y, r.x, 0.0);
+      lines->InsertNextCell(2);
+      lines->InsertCellPoint(a);
+      lines->InsertCellPoint(b);
+    }
+    vtkPolyData *pd = InputOf(stems_);
+    pd->SetPoints(sp);
+    pd->SetLines(lines);
+    pd->Modified();
   }
   {
     vtkNew<vtkPolyData> in;

@@ -80,6 +80,8 @@ public:
   bool FramePending() const { return render_count_ != swapped_render_count_; }
   int SelectedWaypoint() const { return selected_; }
   void SetSelectedWaypoint(int i);
+  /** 3D view: drop lines drawn from waypoints off the ground plane (tests). */
+  size_t StemCount();
   /** Number of points of the drawn reference path (tests). */
   size_t PathPointCount();
   /** Samples of the drawn path over a vehicle limit (coloured red; tests). */
@@ -138,6 +140,7 @@ private:
   vtkSmartPointer<PathViewStyle> style_;
   vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, over_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
   vtkSmartPointer<vtkActor> envelope_; // band around the estimate (SetEnvelope)
+  vtkSmartPointer<vtkActor> stems_;    // 3D view: drop lines of waypoints off the ground plane
   vtkSmartPointer<vtkTextActor> caption_, problem_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
   PathSamples path_;

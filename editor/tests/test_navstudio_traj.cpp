@@ -520,6 +520,7 @@ private slots:
     QCOMPARE(r1.y, r0.y);
     QVERIFY2(r1.z < r0.z - 1.0, qPrintable(QString::number(r1.z))); // up = negative down
     QCOMPARE(w->Doc()->UndoStack()->index(), undo0 + 1);
+    QCOMPARE(v3->StemCount(), size_t(1)); // the raised waypoint's drop line to the ground
     // The handle followed the height: it is drawn where the mouse was released.
     int x1 = 0, y1 = 0;
     QVERIFY(v3->DisplayOf(r1.x, r1.y, r1.z, &x1, &y1));
@@ -531,6 +532,7 @@ private slots:
     Shot(w.get(), "shift-drag-01-raised");
     w->findChild<QAction *>("actionUndo")->trigger();
     QCOMPARE(w->Doc()->Scene().trajectory.waypoints.points[2].r_ned_m.z, r0.z);
+    QCOMPARE(v3->StemCount(), size_t(0));
   }
 
 private:
