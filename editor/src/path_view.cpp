@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vtkUnsignedCharArray.h>
 
 #include <vtkActor.h>
 #include <vtkBillboardTextActor3D.h>
@@ -275,6 +276,9 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   connect(widget_->embeddedOpenGLWindow(), &QOpenGLWindow::frameSwapped, this, [this] {
     ++frame_count_;
     swapped_render_count_ = render_count_;
+    // The first frame after a resize can go to a drawable of the old size (Mesa learns a
+    // window's new size at a buffer swap): one more frame draws it at the new size.
+    if (resized_ && --resized_ == 0) render_timer_.start(0);
     emit FrameSwapped();
   });
   window_ = vtkSmartPointer<vtkGenericOpenGLRenderWindow>::New();
@@ -416,9 +420,32 @@ size_t PathView::StemCount() {
 
 QWindow *PathView::NativeWindow() { return widget_->embeddedOpenGLWindow(); }
 
+void PathView::SyncSize() {
+  // The native window takes its new size at once, VTK's window only when Qt next paints it: a
+  // render or a map background in between would use the old size (after a resize of the main
+  // window: a stale picture cropped or padded on screen).
+  QWindow *native = NativeWindow();
+  const qreal dpr = native->devicePixelRatio();
+  const int w = qRound(native->width() * dpr), h = qRound(native->height() * dpr);
+  const int *size = window_->GetSize();
+  if (w > 0 && h > 0 && (size[0] != w || size[1] != h)) Interactor()->UpdateSize(w, h);
+}
+
 QImage PathView::Grab() {
   if (render_pending_ || render_timer_.isActive()) Render();
-  return widget_->grabFramebuffer();
+  // VTK's own framebuffer holds the last frame; Qt's window buffer need not (after a resize it
+  // is blank until Qt paints it again).
+  const int *sz = window_->GetSize();
+  const int w = sz[0], h = sz[1];
+  if (w <= 0 || h <= 0) return QImage();
+  window_->MakeCurrent();
+  vtkNew<vtkUnsignedCharArray> px;
+  if (!window_->GetPixelData(0, 0, w - 1, h - 1, 1, px, 0)) return QImage();
+  QImage img(w, h, QImage::Format_RGB888);
+  const unsigned char *src = px->GetPointer(0);
+  for (int y = 0; y < h; ++y) std::memcpy(img.scanLine(h - 1 - y), src + 3 * static_cast<size_t>(w) * y, 3 * static_cast<size_t>(w));
+  img.setDevicePixelRatio(NativeWindow()->devicePixelRatio());
+  return img;
 }
 
 void PathView::Render() {
@@ -434,6 +461,7 @@ void PathView::Render() {
   // committed edit is drawn smooth again.
   const int samples = doc_->IsLive() ? 0 : kMultiSamples;
   if (window_->GetMultiSamples() != samples) window_->SetMultiSamples(samples);
+  SyncSize();
   window_->Render(); // VTK's adapter asks the view's window for the frame that shows it
 }
 
@@ -739,7 +767,8 @@ void PathView::UpdateCaption() {
 void PathView::resizeEvent(QResizeEvent *e) {
   QWidget::resizeEvent(e);
   if (mode_ == Mode::Map) bg_timer_.start();
-  if (render_pending_) render_timer_.start(0);
+  render_timer_.start(0); // at the new size (SyncSize), not waiting for Qt to paint the native window
+  resized_ = 1;
 }
 
 void PathView::showEvent(QShowEvent *e) {
@@ -770,6 +799,7 @@ bool PathView::MetricGridShown() const { return grid_->GetVisibility() != 0; }
 void PathView::UpdateBackground() {
   bg_timer_.stop();
   if (mode_ != Mode::Map) return;
+  SyncSize();
   vtkCamera *cam = renderer_->GetActiveCamera();
   const double *f = cam->GetFocalPoint();
   const int *sz = window_->GetSize();

@@ -5,7 +5,9 @@
  * swaps its own frames: Qt does not compose it into the main window's frame, which with Mesa's
  * software renderer cost about 20 ms per frame (live preview, urban-drive: edit-to-picture
  * median 116-125 ms with QVTKOpenGLNativeWidget, 98-102 ms with native windows, all else equal).
- * The price: QWidget::grab() of a parent shows no view; Grab() renders one for screenshots. Click on the ground adds a waypoint (Ctrl+click inserts it into the
+ * The price: QWidget::grab() of a parent shows no view (Grab() reads a view's frame from VTK's
+ * framebuffer for screenshots), and a resize needs care: a view renders at once at its new size
+ * and once more after that frame's swap (resize_redraws_views). Click on the ground adds a waypoint (Ctrl+click inserts it into the
  * nearest leg), dragging a waypoint's handle moves it (Shift+drag in 3D changes its height),
  * Delete removes the selected one. The smooth path comes from navcore's waypoint model.
  * World axes: x = East, y = North, z = Up, metres from the scene origin.
@@ -72,12 +74,12 @@ public:
   vtkRenderWindowInteractor *Interactor();
   /** The view's native window (receives the mouse and keys; tests send Qt events to it). */
   QWindow *NativeWindow();
-  /** This view's picture as it is on screen (rendered anew; screenshots). */
+  /** This view's last frame, read from VTK's framebuffer (a pending render first; screenshots). */
   QImage Grab();
   /** Frames this view has swapped to the screen so far (benchmarks, tests). */
   long FrameCount() const { return frame_count_; }
-  /** A render of this view has not reached the screen yet (tests wait for quiet views). */
-  bool FramePending() const { return render_count_ != swapped_render_count_; }
+  /** A render of this view is due or has not reached the screen yet (tests wait for quiet views). */
+  bool FramePending() const { return render_count_ != swapped_render_count_ || render_timer_.isActive(); }
   int SelectedWaypoint() const { return selected_; }
   void SetSelectedWaypoint(int i);
   /** 3D view: drop lines drawn from waypoints off the ground plane (tests). */
@@ -104,6 +106,8 @@ public:
   long RenderCount() const { return render_count_; }
   /** Bring the map background up to date with the camera now (normally deferred). */
   void UpdateBackground();
+  /** Give VTK's window the native window's current size (it learns it only when Qt paints). */
+  void SyncSize();
 
 signals:
   void SelectionChanged(int waypoint);
@@ -162,6 +166,7 @@ private:
   QString bg_note_;
   double graticule_step_deg_ = 0.0;
   long render_count_ = 0, frame_count_ = 0, swapped_render_count_ = 0;
+  int resized_ = 0; // frames to swap after a resize before the one more render (constructor)
   unsigned long camera_observer_ = 0, render_observer_ = 0;
   int live_render_delay_ms_ = 0;
   QTimer render_timer_;

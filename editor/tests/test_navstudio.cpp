@@ -7,11 +7,13 @@
 #include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QGuiApplication>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMouseEvent>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScreen>
 #include <QSignalSpy>
 #include <QSurfaceFormat>
 #include <QTableWidget>
@@ -712,6 +714,75 @@ private slots:
     Shot(w.get(), "qt-events-01-dragged");
     QTest::keyClick(win, Qt::Key_Delete);
     QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 1);
+  }
+
+  // A resize of the main window: each view draws at its new size at once, on screen and in its
+  // own framebuffer (a native window learns its size before VTK does; the first render after a
+  // resize used to draw at the old size: a stale, cropped map on screen and a blank Grab()).
+  void resize_redraws_views() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    PathView *map = w->MapView();
+    for (int k = 0; k < 4; ++k) ClickMap(map, kDrive[k][0], kDrive[k][1]);
+    QCOMPARE(w->Doc()->Scene().trajectory.waypoints.count, 4);
+    // The drawn path's blue (0.10, 0.35, 0.85).
+    auto blue_pixels = [](const QImage &img) {
+      int k = 0;
+      for (int y = 0; y < img.height(); ++y)
+        for (int x = 0; x < img.width(); ++x) {
+          const QColor c = img.pixelColor(x, y);
+          if (c.blue() > 180 && c.red() < 90 && c.green() < 140) ++k;
+        }
+      return k;
+    };
+    // Share of pixels where the screen and the view's own frame differ (any channel by > 40),
+    // over the part of the view that is on the screen.
+    auto screen_mismatch = [](PathView *v, const QImage &frame) {
+      const QRect on_screen = QRect(v->mapToGlobal(QPoint(0, 0)), v->size()) & QGuiApplication::primaryScreen()->geometry();
+      if (on_screen.width() * on_screen.height() < v->width() * v->height() / 4) return -1.0; // not enough to judge
+      const QImage screen = QGuiApplication::primaryScreen()
+                                ->grabWindow(0, on_screen.x(), on_screen.y(), on_screen.width(), on_screen.height())
+                                .toImage();
+      const QPoint off = v->mapFromGlobal(on_screen.topLeft());
+      long bad = 0;
+      for (int y = 0; y < screen.height(); ++y)
+        for (int x = 0; x < screen.width(); ++x) {
+          const QColor a = screen.pixelColor(x, y), b = frame.pixelColor(x + off.x(), y + off.y());
+          if (std::abs(a.red() - b.red()) > 40 || std::abs(a.green() - b.green()) > 40 || std::abs(a.blue() - b.blue()) > 40) ++bad;
+        }
+      return static_cast<double>(bad) / (static_cast<double>(screen.width()) * screen.height());
+    };
+    PathView *views[2] = {map, w->View3D()};
+    auto quiet = [&] { return !views[0]->FramePending() && !views[1]->FramePending(); };
+    QVERIFY(WaitUntil(quiet, 5000));
+    QTest::qWait(50);
+    const int blue_before = blue_pixels(map->Grab());
+    QVERIFY2(blue_before > 200, qPrintable(QString::number(blue_before)));
+    w->move(0, 0);
+    const QSize start = w->size();
+    for (const QSize size : {start - QSize(300, 150), start - QSize(100, 50)}) {
+      const QSize before = map->size();
+      w->resize(size);
+      QVERIFY(WaitUntil([&] { return map->size() != before; }, 5000));
+      QVERIFY(WaitUntil(quiet, 5000));
+      QTest::qWait(50);
+      int compared = 0; // a small screen (the 800x600 fallback) may show only the map
+      for (PathView *v : views) {
+        const QImage frame = v->Grab();
+        QCOMPARE(frame.size(), v->size()); // device pixel ratio 1 under Xvfb
+        const double mismatch = screen_mismatch(v, frame);
+        if (mismatch < 0.0) continue;
+        ++compared;
+        QVERIFY2(mismatch < 0.01, qPrintable(QString("%1: %2 of the pixels on screen differ from the view's frame")
+                                                 .arg(v->objectName()).arg(mismatch)));
+      }
+      QVERIFY(compared >= 1);
+      const int blue = blue_pixels(map->Grab());
+      QVERIFY2(blue > 100, qPrintable(QString("the path on the resized map: %1 blue pixels").arg(blue)));
+    }
+    Shot(w.get(), "resize-01");
   }
 
   // Two drag steps in a row: the preview of the first, barely started, is dropped for the second

@@ -36,4 +36,6 @@ void navsim_interrupt_disarm(void) {
   g_sim = NULL;
 }
 
+void navsim_interrupt_detach(void) { g_sim = NULL; }
+
 int navsim_interrupted(void) { return (int)g_signal; }

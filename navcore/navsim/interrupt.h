@@ -9,6 +9,9 @@
 void navsim_interrupt_arm(nav_sim *sim);
 /** Restore the default actions; forget the simulation. */
 void navsim_interrupt_disarm(void);
+/** Forget the simulation but keep catching the signals until the process ends: once the results
+ *  are in place a late SIGINT / SIGTERM changes nothing (exit status 0, not "killed"). */
+void navsim_interrupt_detach(void);
 /** The signal caught since navsim_interrupt_arm(), 0 if none. */
 int navsim_interrupted(void);
 

@@ -296,6 +296,7 @@ static int cmd_run(int argc, char **argv) {
   }
 
   nav_sim *sim = NULL;
+  bool committed = false; /* the result directory is in place */
   nav_resultdir *rd = NULL;
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
@@ -497,6 +498,7 @@ static int cmd_run(int argc, char **argv) {
     rc = EXIT_FAIL;
     goto cleanup;
   }
+  committed = true;
   if (!quiet) {
     printf("scene      %s (%s, %s Earth, %s mechanization%s)\n", scene.name, scene_path,
            nav_earth_model_name(scene.earth.model), nav_mech_algorithm_name(scene.navigation.algorithm),
@@ -534,7 +536,8 @@ cleanup:
   (void)navsim_gnss_out_end(o.gnss);
   navsim_run_smooth_abort(o.smooth);
   nav_resultdir_abort(rd);
-  navsim_interrupt_disarm();
+  if (committed) navsim_interrupt_detach(); /* the results are complete: a late signal is absorbed */
+  else navsim_interrupt_disarm();
   if (rc > 128) fprintf(stderr, "navsim run: interrupted by signal %d; no results written\n", rc - 128);
   navsim_mpi_abandon(); /* rank 0 failed before the runs: release the other ranks */
   nav_sim_destroy(sim);
