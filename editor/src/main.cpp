@@ -161,6 +161,7 @@ int main(int argc, char **argv) {
   }
   studio::MainWindow w;
   if (!shot.isEmpty() || bench > 0) qputenv("NAVSTUDIO_NO_DIALOGS", "1");
+  if (shot.isEmpty() && bench == 0) w.FitToScreen(); // screenshots and the bench keep the default size
   w.show();
   if (!scene.isEmpty() && !w.OpenFile(scene)) {
     if (!shot.isEmpty() || bench > 0) return 2;

@@ -16,6 +16,7 @@
 #include <QListWidget>
 #include <QMenuBar>
 #include <QProgressBar>
+#include <QScreen>
 #include <QSettings>
 #include <QSplitter>
 #include <QStandardPaths>
@@ -79,6 +80,7 @@ MainWindow::MainWindow(QWidget *parent) : QMainWindow(parent) {
   autosave_timer_.start();
   UpdateTitle();
   ShowIssues();
+  ShowResultsHint();
 }
 
 MainWindow::~MainWindow() {
@@ -104,8 +106,6 @@ void MainWindow::BuildUi() {
   bottom_tabs_->setObjectName("bottomTabs");
   results_ = new QTextBrowser;
   results_->setObjectName("resultsText");
-  results_->setHtml(tr("<p>Draw a drive on the map (click to add waypoints, drag to move them), choose the "
-                       "IMU and the GNSS receiver in the panels, then <b>Run</b> (F5).</p>"));
   chart_ = new ErrorChart;
   issues_ = new QListWidget;
   issues_->setObjectName("issuesList");
@@ -457,6 +457,7 @@ void MainWindow::ShowIssues() {
 void MainWindow::OnSceneChanged() {
   setWindowModified(doc_.IsModified());
   ShowIssues();
+  ShowResultsHint();
 }
 
 bool MainWindow::SceneSmallForPreview() const {
@@ -601,6 +602,29 @@ void MainWindow::OnPictureShown() {
                "%.1f ms for %lld samples, %.1f ms to draw, %.1f ms to the views' swaps)\n",
                ms, (p.started_ns - p.change_ns) * 1e-6, p.sim_ms, p.samples, (p.drawn_ns - p.arrived_ns) * 1e-6,
                (now - p.drawn_ns) * 1e-6);
+}
+
+void MainWindow::FitToScreen() {
+  QScreen *sc = screen();
+  if (!sc) return;
+  // Room for a window manager's frame and title bar; the layout's minimum size wins on a tiny screen.
+  const QRect avail = sc->availableGeometry().adjusted(0, 0, -16, -48);
+  const QSize fit = size().boundedTo(avail.size()).expandedTo(minimumSizeHint());
+  if (fit != size()) resize(fit);
+  move(avail.topLeft() + QPoint(std::max(0, (avail.width() - fit.width()) / 2), std::max(0, (avail.height() - fit.height()) / 2)));
+}
+
+void MainWindow::ShowResultsHint() {
+  if (last_result_ || worker_.IsBusy()) return; // a result stays until the next run replaces it
+  const nav_scene &s = doc_.Scene();
+  if (hint_type_ == static_cast<int>(s.trajectory.type)) return;
+  hint_type_ = static_cast<int>(s.trajectory.type);
+  const QString draw = s.trajectory.type == NAV_TRAJ_WAYPOINTS
+                           ? tr("Draw a drive on the map (click to add waypoints, drag to move them)")
+                           : tr("This scene has a %1 trajectory: edit it in the Trajectory panel (File &gt; New drive "
+                                "to draw one on the map instead)")
+                                 .arg(TrajectoryKindName(s.trajectory.type).toHtmlEscaped());
+  results_->setHtml(tr("<p>%1; choose the IMU and the GNSS receiver in the panels, then <b>Run</b> (F5).</p>").arg(draw));
 }
 
 bool MainWindow::Run() {

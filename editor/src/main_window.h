@@ -103,6 +103,9 @@ public:
    *  windows out): screenshots, the report. */
   QImage Screenshot();
   QString ResultsText() const;
+  /** Shrinks the window to the available area of its screen (the default size, 1500 x 950, is
+   *  larger than a 1280 x 1024 screen) and centres it; used when navstudio is opened by a user. */
+  void FitToScreen();
   QStringList RecentFiles() const;
 
 signals:
@@ -124,6 +127,8 @@ private:
   void OnFinished(std::shared_ptr<const SimResult> r);
   void OnPreviewFinished(std::shared_ptr<const SimResult> r);
   void ShowIssues();
+  /** The Results tab before the first result: how to draw or edit this kind of trajectory. */
+  void ShowResultsHint();
   void AddRecent(const QString &path);
   void RebuildRecentMenu();
   void RemoveAutosave();
@@ -175,6 +180,7 @@ private:
   QString latency_text_;
   AskFn ask_;
   std::shared_ptr<const SimResult> last_result_, last_preview_;
+  int hint_type_ = -1; /**< trajectory type the Results hint was written for */
   std::vector<double> latencies_ms_;
 };
 

@@ -452,6 +452,9 @@ QWidget *ScenePanels::BuildTrajectory() {
   AddField(form, tr("Hold at end"), "s", "trajectory.waypoints.hold_end",
            [](const nav_scene &s) { return s.trajectory.waypoints.hold_end_s; },
            [](nav_scene &s, double v) { s.trajectory.waypoints.hold_end_s = v; });
+  AddField(form, tr("Speed between stops"), "m/s", "trajectory.waypoints.cruise",
+           [](const nav_scene &s) { return s.trajectory.waypoints.cruise_mps; },
+           [](nav_scene &s, double v) { s.trajectory.waypoints.cruise_mps = v; });
   AddField(form, tr("Max acceleration"), "m/s²", "trajectory.waypoints.limits.max_accel",
            [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_accel_mps2; },
            [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_accel_mps2 = v; });

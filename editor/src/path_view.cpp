@@ -66,8 +66,9 @@ void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at
       w.count = 0;
       w.timing = NAV_WP_TIMING_SPEED;
       if (w.hold_start_s <= 0.0) w.hold_start_s = 30.0;
+      if (w.cruise_mps <= 0.0) w.cruise_mps = 10.0;
     }
-    const double cruise = 10.0;
+    const double cruise = w.cruise_mps > 0.0 ? w.cruise_mps : 10.0;
     nav_waypoint p;
     std::memset(&p, 0, sizeof p);
     p.r_ned_m = nav_vec3{n, e, d};

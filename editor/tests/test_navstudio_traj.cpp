@@ -15,6 +15,7 @@
 #include <QSurfaceFormat>
 #include <QTableWidget>
 #include <QTemporaryDir>
+#include <QScreen>
 #include <QSignalSpy>
 #include <QTest>
 #include <QVTKOpenGLStereoWidget.h>
@@ -257,6 +258,11 @@ private slots:
     QCOMPARE(static_cast<int>(s.trajectory.type), static_cast<int>(NAV_TRAJ_PARAMETRIC));
     auto *ed = w->findChild<studio::ParametricEditor *>("parametricEditor");
     QVERIFY(ed && ed->isVisible());
+    // Before any result, the Results tab says where this kind of trajectory is edited (not
+    // "draw a drive on the map").
+    QVERIFY2(w->ResultsText().contains("has a parametric trajectory") && w->ResultsText().contains("Trajectory panel") &&
+                 !w->ResultsText().contains("Draw a drive"),
+             qPrintable(w->ResultsText()));
     auto *b0 = w->findChild<QLineEdit *>("par.B_m[0]");
     QVERIFY(b0);
     QCOMPARE(b0->text(), QString("1"));
@@ -533,6 +539,26 @@ private slots:
     w->findChild<QAction *>("actionUndo")->trigger();
     QCOMPARE(w->Doc()->Scene().trajectory.waypoints.points[2].r_ned_m.z, r0.z);
     QCOMPARE(v3->StemCount(), size_t(0));
+  }
+
+  // Opened by a user, the window fits the screen's available area (the default 1500 x 950 is wider
+  // than a 1280 x 1024 screen) unless the layout's minimum is larger; the views stay usable.
+  void fit_to_screen() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    const QRect avail = w->screen()->availableGeometry();
+    QCOMPARE(w->size(), QSize(1500, 950)); // the default the screenshots and the bench use
+    w->FitToScreen();
+    QTRY_VERIFY_WITH_TIMEOUT(w->MapView()->isVisible(), 5000);
+    const QSize minimum = w->minimumSizeHint();
+    qInfo("screen %dx%d available, window %dx%d (layout minimum %dx%d)", avail.width(), avail.height(), w->width(),
+          w->height(), minimum.width(), minimum.height());
+    QVERIFY(w->width() <= std::max(avail.width(), minimum.width()));
+    QVERIFY(w->height() <= std::max(avail.height(), minimum.height()));
+    if (minimum.width() <= avail.width()) QVERIFY(avail.contains(w->geometry()));
+    QVERIFY(w->MapView()->width() >= 200 && w->MapView()->height() >= 150);
+    QVERIFY(w->Panels()->width() >= 400);
+    Shot(w.get(), "fit-to-screen");
   }
 
 private:

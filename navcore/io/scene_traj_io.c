@@ -9,7 +9,7 @@
  *     duration_s: 120            # or auto (the default for waypoints, segments and motion_def)
  *     initial_attitude: {roll_deg: 0, pitch_deg: 0, yaw_deg: 90}
  *     parametric: {...}          # the paper's formula (3)
- *     waypoints: {timing, attitude_mode, hold_start_s, hold_end_s, limits, points: [...]}
+ *     waypoints: {timing, attitude_mode, hold_start_s, hold_end_s, cruise_mps, limits, points: [...]}
  *     segments: {r0_ned_m, v0_b_mps, allow_unconverged, fit_rate_ramps, limits, items: [...]}
  *     test_motion: {kind: coning, ...the parameters of that kind}
  *     motion_def: {file: PATH, allow_unconverged, fit_rate_ramps}
@@ -371,6 +371,13 @@ static const nav_io_field k_waypoints[] = {
      .enums = k_wp_attitude_modes},
     D("hold_start_s", OFF(trajectory.waypoints.hold_start_s), 1.0, NONNEG),
     D("hold_end_s", OFF(trajectory.waypoints.hold_end_s), 1.0, NONNEG),
+    {.key = "cruise_mps",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NONNEG,
+     .offset = OFF(trajectory.waypoints.cruise_mps),
+     .scale = 1.0,
+     .write_if = if_changed,
+     .comment = "speed between two stops (timing speed)"},
     {.key = "limits", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_wp_limits_section},
     {.key = "points",
      .kind = NAV_IO_CUSTOM,

@@ -263,6 +263,7 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
   assert_int_equal(wa->attitude_mode, wb->attitude_mode);
   assert_same_double(wa->hold_start_s, wb->hold_start_s);
   assert_same_double(wa->hold_end_s, wb->hold_end_s);
+  assert_same_double(wa->cruise_mps, wb->cruise_mps);
   assert_limits_same(&wa->limits, &wb->limits);
   for (int i = 0; i < wa->count && i < NAV_MAX_WAYPOINTS; ++i) {
     assert_same_vec3(wa->points[i].r_ned_m, wb->points[i].r_ned_m);
@@ -583,6 +584,10 @@ static void test_out_of_range(void **state) {
              "expected an integer, got \"1.0\"");
   expect_one("format_version: 1\nimu:\n  quadrature_nodes: 99999999999\n", 3, 21, "imu.quadrature_nodes",
              "must be in [-2147483648, 2147483647] (got 99999999999)");
+  expect_one("format_version: 1\ntrajectory:\n  type: waypoints\n  waypoints:\n    cruise_mps: -1\n"
+             "    points: [{ned_m: [0, 0, 0]}, {ned_m: [10, 0, 0]}]\n",
+             5, 17,
+             "trajectory.waypoints.cruise_mps", "must be >= 0 (got -1)");
 }
 
 static void test_seed(void **state) {
@@ -888,6 +893,7 @@ static void test_waypoints(void **state) {
               "    attitude_mode: euler\n"
               "    hold_start_s: 2\n"
               "    hold_end_s: 3\n"
+              "    cruise_mps: 7.5\n"
               "    limits: {max_accel_mps2: 1.5, max_jerk_mps3: 2, max_lateral_accel_mps2: 2.5,\n"
               "             max_rate_dps: 20, max_ang_accel_dps2: 10, max_ang_jerk_rps3: 0.5}\n"
               "    points:\n"
@@ -901,6 +907,7 @@ static void test_waypoints(void **state) {
   assert_int_equal(w->attitude_mode, NAV_WP_ATT_EULER);
   assert_near(w->hold_start_s, 2.0, 0.0);
   assert_near(w->hold_end_s, 3.0, 0.0);
+  assert_near(w->cruise_mps, 7.5, 0.0);
   assert_near(w->limits.max_accel_mps2, 1.5, 0.0);
   assert_near(w->limits.max_jerk_mps3, 2.0, 0.0);
   assert_near(w->limits.max_lateral_accel_mps2, 2.5, 0.0);
@@ -1920,6 +1927,7 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
   w->attitude_mode = (nav_wp_attitude_mode)(splitmix64(x) % 4);
   w->hold_start_s = 10.0 * uniform(x);
   w->hold_end_s = 10.0 * uniform(x);
+  w->cruise_mps = splitmix64(x) % 2 ? 30.0 * uniform(x) : 0.0;
   w->limits.max_rate_rps = 0.01 + uniform(x);
   w->limits.max_ang_accel_rps2 = 0.01 + uniform(x);
   w->count = (int)(splitmix64(x) % 4);

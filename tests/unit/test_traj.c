@@ -503,6 +503,72 @@ static nav_scene *square(double side, double speed) {
   return s;
 }
 
+/* A leg between two stops (timing speed): rise to cruise_mps, cruise, stop at the next waypoint;
+ * a leg too short for the cruise speed peaks lower, with no cruise. Without cruise_mps such a leg
+ * is an error that names the field. */
+static void test_waypoints_between_stops(void **state) {
+  (void)state;
+  for (int c = 0; c < 2; ++c) {
+    const double leg = c == 0 ? 400.0 : 20.0, cruise = 10.0;
+    nav_scene *s = new_scene();
+    s->trajectory.type = NAV_TRAJ_WAYPOINTS;
+    nav_traj_waypoints *W = &s->trajectory.waypoints;
+    W->hold_start_s = 2.0;
+    W->hold_end_s = 1.0;
+    add_wp(s, 0, 0, 0, 0);
+    add_wp(s, 0.6 * leg, 0.8 * leg, 0, 0);
+    if (c == 0) expect_wp_error(s, 1, "the speed is 0 at both ends of leg 0-1", "trajectory.waypoints.cruise_mps");
+    W->cruise_mps = cruise;
+    const nav_traj_limits L = W->limits;
+    nav_traj_model m;
+    create_model(s, &m);
+    const double dt = 0.005, h = 1e-4;
+    double V_max = 0.0, t_peak = 0.0, a_max = 0.0, jerk = 0.0, V_min = 0.0;
+    for (double t = 0.0; t <= m.duration_s; t += dt) {
+      const nav_local_kin k = kin_at(&m, t);
+      const double V = nav_vec3_norm(k.v_ned_mps);
+      /* Along the leg, never backwards. */
+      const double along = (0.6 * k.v_ned_mps.x + 0.8 * k.v_ned_mps.y);
+      V_min = fmin(V_min, along);
+      if (V > V_max) {
+        V_max = V;
+        t_peak = t;
+      }
+      a_max = fmax(a_max, nav_vec3_norm(k.a_ned_mps2));
+      const nav_vec3 j =
+          nav_vec3_scale(nav_vec3_sub(kin_at(&m, t + h).a_ned_mps2, kin_at(&m, t - h).a_ned_mps2), 0.5 / h);
+      jerk = fmax(jerk, nav_vec3_norm(j));
+    }
+    const nav_local_kin end = kin_at(&m, m.duration_s);
+    const double t_mid = W->hold_start_s + 0.5 * (m.duration_s - W->hold_start_s - W->hold_end_s);
+    print_message("between stops, %.0f m leg: peak %.6f m/s (cruise_mps %g), |a| %.4f <= %g, |jerk| %.4f <= %g, "
+                  "motion %.3f s\n",
+                  leg, V_max, cruise, a_max, L.max_accel_mps2, jerk, L.max_jerk_mps3,
+                  m.duration_s - W->hold_start_s - W->hold_end_s);
+    assert_vec3_near(end.r_ned_m, W->points[1].r_ned_m, 1e-9);
+    assert_vec3_near(end.v_ned_mps, nav_vec3_zero(), 1e-12);
+    assert_true(V_min >= -1e-12);
+    assert_true(a_max <= L.max_accel_mps2 * (1 + 1e-9));
+    assert_true(jerk <= L.max_jerk_mps3 * (1 + 1e-6));
+    if (c == 0) {
+      /* The cruise speed is reached and held: 400 m at 10 m/s with two ramps. */
+      assert_near(V_max, cruise, 1e-9);
+      assert_near(nav_vec3_norm(kin_at(&m, t_mid).v_ned_mps), cruise, 1e-9);
+    } else {
+      /* 20 m is too short for 10 m/s (each ramp of 0 -> 10 m/s covers 30 m at 2 m/s^2, 2 m/s^3): the
+         peak is lower and reached at mid-leg with no cruise (still rising 0.5 s before). */
+      assert_true(V_max < 0.9 * cruise && V_max > 1.0);
+      assert_true(fabs(t_peak - t_mid) <= dt);
+      assert_near(nav_vec3_norm(kin_at(&m, t_mid).v_ned_mps), V_max, 1e-6 * V_max);
+      const double v_before = nav_vec3_norm(kin_at(&m, t_mid - 0.5).v_ned_mps);
+      print_message("  speed 0.5 s before mid-leg %.6f m/s\n", v_before);
+      assert_true(v_before < V_max * (1 - 1e-3));
+    }
+    m.destroy(m.self);
+    free(s);
+  }
+}
+
 static void test_waypoints_infeasible(void **state) {
   (void)state;
   nav_scene *s;
@@ -1239,6 +1305,7 @@ int main(void) {
       cmocka_unit_test(test_waypoints_limits),
       cmocka_unit_test(test_attitude_modes),
       cmocka_unit_test(test_waypoints_infeasible),
+      cmocka_unit_test(test_waypoints_between_stops),
       cmocka_unit_test(test_scene_validate),
       cmocka_unit_test(test_segments_derivatives),
       cmocka_unit_test(test_segments_semantics),

@@ -202,6 +202,8 @@ typedef struct nav_traj_waypoints {
   nav_wp_attitude_mode attitude_mode;
   double hold_start_s; /**< stationary time before the motion (needs speed 0 at the first waypoint) */
   double hold_end_s;   /**< stationary time after it (needs speed 0 at the last waypoint) */
+  double cruise_mps;   /**< timing speed: speed on a leg between two stops (speed 0 at both ends),
+                            less where the leg is too short; 0: such a leg is an error */
   nav_traj_limits limits;
   nav_waypoint points[NAV_MAX_WAYPOINTS];
 } nav_traj_waypoints;

@@ -220,6 +220,8 @@ static void check_waypoints(checker *c, const nav_traj_waypoints *w) {
     issue(c, "trajectory.waypoints.hold_start_s", "must be within [0, 1e7] s (got %g)", w->hold_start_s);
   if (!(w->hold_end_s >= 0.0 && w->hold_end_s <= NAV_SCENE_MAX_DURATION_S))
     issue(c, "trajectory.waypoints.hold_end_s", "must be within [0, 1e7] s (got %g)", w->hold_end_s);
+  if (!(w->cruise_mps >= 0.0 && w->cruise_mps <= 1.0e5))
+    issue(c, "trajectory.waypoints.cruise_mps", "must be within [0, 1e5] m/s (got %g)", w->cruise_mps);
   check_limits(c, "trajectory.waypoints", &w->limits);
   for (int i = 0; i < w->count; ++i) {
     const nav_waypoint *q = &w->points[i];

@@ -25,7 +25,9 @@
  * accelerations right after a turn, decelerations right before the next one. With timing
  * "time", interior waypoint speeds are the mean of the adjacent legs' average speeds and each
  * straight part gets a cruise speed solved so that the vehicle passes every waypoint (mid-turn)
- * at its time.
+ * at its time. With timing "speed", a straight part between two stops (speed 0 at both ends)
+ * rises to the section's cruise_mps, cruises and stops again; a part too short for that reaches
+ * the highest speed its length allows (the peak speed solved by bisection).
  *
  * Attitude: ground (heading and pitch of the tangent, roll 0), aircraft (the same plus the
  * coordinated bank atan(V psi_dot / g)), fixed, or per-waypoint Euler angles interpolated
@@ -135,6 +137,7 @@ typedef struct straight_plan {
   nav_kin_move m1, m2;
   double cruise_s, dist_m, time_s;
   bool feasible;
+  bool two_moves; /* m1, cruise, m2 (else timing speed: m1 only, before or after the cruise) */
 } straight_plan;
 
 static straight_plan straight_with_cruise(double va, double c, double vb, double s_len,
@@ -149,6 +152,7 @@ static straight_plan straight_with_cruise(double va, double c, double vb, double
   sp.feasible = rest >= -1e-9 * (1.0 + s_len) && c > 0.0;
   sp.cruise_s = rest > 0.0 && c > 0.0 ? rest / c : 0.0;
   sp.time_s = t1 + t2 + sp.cruise_s;
+  sp.two_moves = true;
   return sp;
 }
 
@@ -330,17 +334,40 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
     straight_plan *q = &sp[i];
     if (W->timing == NAV_WP_TIMING_SPEED) {
       const double va = v[i], vb = v[i + 1];
+      if (va == 0.0 && vb == 0.0 && s_use > 0.0) {
+        /* Between two stops: up to cruise_mps; a shorter part peaks at the speed whose rise and
+           fall just fill it (the distance of the two moves grows with the peak speed). */
+        if (!(W->cruise_mps > 0.0)) {
+          st = fail(&pl, i + 1,
+                    "waypoint %d: the speed is 0 at both ends of leg %d-%d; set trajectory.waypoints.cruise_mps "
+                    "(the speed between stops), give one end a speed > 0 or use timing time",
+                    i + 1, i, i + 1);
+          goto cleanup;
+        }
+        *q = straight_with_cruise(0.0, W->cruise_mps, 0.0, s_use, &lin);
+        if (!q->feasible) {
+          double lo = 0.0, hi = W->cruise_mps;
+          for (int it = 0; it < 200 && hi - lo > 1e-13 * hi; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            if (straight_with_cruise(0.0, mid, 0.0, s_use, &lin).dist_m <= s_use) /* no overshoot */
+              lo = mid;
+            else
+              hi = mid;
+          }
+          *q = straight_with_cruise(0.0, lo, 0.0, s_use, &lin);
+        }
+        if (!q->feasible) {
+          st = fail(&pl, i + 1, "waypoint %d: leg %d-%d between two stops is too short to move (%.4g m)", i + 1,
+                    i, i + 1, s_use);
+          goto cleanup;
+        }
+        continue;
+      }
       q->m1 = nav_kin_plan_move(vb - va, &lin);
       q->m2 = nav_kin_plan_move(0.0, &lin);
+      q->two_moves = false;
       const double t1 = nav_kin_move_duration(&q->m1);
       q->dist_m = 0.5 * (va + vb) * t1;
-      if (va == 0.0 && vb == 0.0 && s_use > 0.0) {
-        st = fail(&pl, i + 1,
-                  "waypoint %d: the speed is 0 at both ends of leg %d-%d; give one end a speed > 0 or use "
-                  "timing time",
-                  i + 1, i, i + 1);
-        goto cleanup;
-      }
       if (q->dist_m > s_use + 1e-9 * (1.0 + len[i])) {
         st = fail(&pl, i + 1,
                   "waypoint %d: the speed change from %g to %g m/s needs %.4g m (max_accel_mps2 %g, "
@@ -428,7 +455,7 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
     const straight_plan *q = &sp[i];
     st = add_piece(m, P_STRAIGHT, t, u[i], z, 0.0);
     if (st != NAV_OK) break;
-    if (W->timing == NAV_WP_TIMING_SPEED) {
+    if (!q->two_moves) {
       if (v[i + 1] >= v[i]) {
         st = nav_kin_channel_add_move(&m->speed, t, &q->m1);
       } else {
