@@ -462,7 +462,8 @@ void MainWindow::OnSceneChanged() {
 
 bool MainWindow::SceneSmallForPreview() const {
   const nav_scene &s = doc_.Scene();
-  return s.trajectory.duration_s <= 600.0 + 1e-9 && s.imu.rate_hz <= 100.0 + 1e-9;
+  // At most the IMU steps of 10 min at 100 Hz (a 20 s scene at 200 Hz is previewed too).
+  return s.trajectory.duration_s * s.imu.rate_hz <= kPreviewMaxImuSteps + 0.5;
 }
 
 void MainWindow::SetLivePreview(bool on) { preview_act_->setChecked(on); }
@@ -511,7 +512,10 @@ std::unique_ptr<nav_scene> PreviewScene(const nav_scene &scene) {
 void MainWindow::StartPreview() {
   if (!preview_act_->isChecked() || worker_.IsBusy()) return;
   if (!SceneSmallForPreview()) {
-    latency_label_->setText(tr("preview off: scene longer than 10 min at 100 Hz"));
+    const nav_scene &s = doc_.Scene();
+    latency_label_->setText(tr("preview off: %1 s at %2 Hz, more than 10 min at 100 Hz (Run simulates it)")
+                                .arg(s.trajectory.duration_s, 0, 'f', 0)
+                                .arg(s.imu.rate_hz, 0, 'g', 6));
     return;
   }
   if (!Validate(doc_.Scene()).isEmpty()) return;
@@ -653,6 +657,8 @@ void MainWindow::Cancel() {
 }
 
 QString MainWindow::ResultsText() const { return results_->toPlainText(); }
+
+QString MainWindow::PreviewStatusText() const { return latency_label_->text(); }
 
 void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
   run_act_->setEnabled(true);

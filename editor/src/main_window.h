@@ -37,6 +37,8 @@ constexpr double kPreviewOutputHz = 10.0;
 /** The preview's output rate is lowered (10, 5, 4, 2, 1 Hz) until the drive has at most this
  *  many output epochs: about 2 per 3 m of drawn estimate at 13 m/s over 10 min. */
 constexpr double kPreviewMaxEpochs = 2500.0;
+/** Live preview runs for scenes of at most this many IMU steps (10 min at 100 Hz). */
+constexpr double kPreviewMaxImuSteps = 600.0 * 100.0;
 constexpr double kPreviewImuHz = 20.0;
 /** The preview's IMU rate when kPreviewImuHz does not fit the scene. */
 constexpr double kPreviewImuHzFallback = 50.0;
@@ -103,6 +105,8 @@ public:
    *  windows out): screenshots, the report. */
   QImage Screenshot();
   QString ResultsText() const;
+  /** The status bar's preview read-out (latency, or why there is no preview). */
+  QString PreviewStatusText() const;
   /** Shrinks the window to the available area of its screen (the default size, 1500 x 950, is
    *  larger than a 1280 x 1024 screen) and centres it; used when navstudio is opened by a user. */
   void FitToScreen();

@@ -468,7 +468,8 @@ void PathView::Render() {
 
 void PathView::UpdateGrid(double cx, double cy, double extent) {
   const double step = NiceStep(extent / 12.0);
-  const double half = std::ceil(extent / step) * step;
+  // The oblique 3D view sees farther than the map: its ground reaches twice as far.
+  const double half = std::ceil((mode_ == Mode::ThreeD ? 2.0 : 1.0) * extent / step) * step;
   const double x0 = std::floor((cx - half) / step) * step, x1 = std::ceil((cx + half) / step) * step;
   const double y0 = std::floor((cy - half) / step) * step, y1 = std::ceil((cy + half) / step) * step;
   auto pts = vtkSmartPointer<vtkPoints>::New();
@@ -510,20 +511,21 @@ void PathView::UpdateGrid(double cx, double cy, double extent) {
 void PathView::ResetCamera() {
   Path(); // a pending redraw first: the camera fits the current path
   const nav_scene &s = doc_->Scene();
-  double xmin = -100, xmax = 100, ymin = -100, ymax = 100, zmax = 0;
-  auto grow = [&](double x, double y, double z) {
+  // The box of the path and the waypoints (east x, north y); around the origin when there are none.
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  auto grow = [&](double x, double y) {
     xmin = std::min(xmin, x);
     xmax = std::max(xmax, x);
     ymin = std::min(ymin, y);
     ymax = std::max(ymax, y);
-    zmax = std::max(zmax, std::fabs(z));
   };
-  for (size_t i = 0; i < path_.Size(); ++i) grow(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], path_.ned_m[3 * i + 2]);
+  for (size_t i = 0; i < path_.Size(); ++i) grow(path_.ned_m[3 * i + 1], path_.ned_m[3 * i]);
   if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
     for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
       const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
-      grow(r.y, r.x, r.z);
+      grow(r.y, r.x);
     }
+  if (!(xmin <= xmax)) xmin = xmax = ymin = ymax = 0.0;
   const double cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
   // An empty drive shows about a kilometre, a drawn one its extent.
   const bool empty = s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2;
@@ -534,16 +536,56 @@ void PathView::ResetCamera() {
     cam->SetFocalPoint(cx, cy, 0.0);
     cam->SetPosition(cx, cy, 10.0 * extent + 1000.0);
     cam->SetViewUp(0, 1, 0);
-    cam->SetParallelScale(extent);
+    // The larger of the box's half-height and half-width over the aspect, so that a tall path in
+    // a wide view and a wide path in a narrow view both fit, 25 % margin.
+    const int *sz = window_->GetSize();
+    const double aspect = sz[0] > 0 && sz[1] > 0 ? static_cast<double>(sz[0]) / sz[1] : 1.0;
+    const double minimum = empty ? 1000.0 : 200.0;
+    cam->SetParallelScale(0.5 * 1.25 * std::max({ymax - ymin, (xmax - xmin) / aspect, minimum}));
     renderer_->ResetCameraClippingRange();
   } else {
-    cam->SetFocalPoint(cx, cy, 0.0);
-    cam->SetPosition(cx - 0.8 * extent, cy - 2.0 * extent, 1.4 * extent + zmax);
+    // Seen from the south-south-west, 33 deg above the horizon, at the smallest distance at which
+    // every path sample, every waypoint and, for a small path, the minimum square (the kilometre
+    // of an empty drive) project inside the middle 84 % of the view. A point p (relative to the focal point) is at
+    // depth D - p.b in front of a camera at distance D along the unit vector b, so it is inside
+    // when D >= p.b + max(|p.r| / (tan(a/2) aspect m), |p.u| / (tan(a/2) m)) (r, u: the camera's
+    // right and up, a: the vertical view angle, m: the used fraction of the half-size).
+    const double view_angle_deg = 30.0, m = 0.84;
+    const double zc = 0.0;
+    const double bx = -0.8, by = -2.0, bz = 1.4, bn = std::sqrt(bx * bx + by * by + bz * bz);
+    const double b[3] = {bx / bn, by / bn, bz / bn};
+    // r = b x z (horizontal, to the right of a camera looking along -b); u = r x b.
+    double r[3] = {b[1], -b[0], 0.0};
+    const double rn = std::hypot(r[0], r[1]);
+    r[0] /= rn;
+    r[1] /= rn;
+    const double u[3] = {r[1] * b[2] - r[2] * b[1], r[2] * b[0] - r[0] * b[2], r[0] * b[1] - r[1] * b[0]};
+    const int *sz = window_->GetSize();
+    const double aspect = sz[0] > 0 && sz[1] > 0 ? static_cast<double>(sz[0]) / sz[1] : 1.0;
+    const double t = std::tan(0.5 * view_angle_deg * M_PI / 180.0);
+    double dist = 1.0;
+    auto fit = [&](double x, double y, double z) {
+      const double p[3] = {x - cx, y - cy, z - zc};
+      const double pb = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
+      const double pr = p[0] * r[0] + p[1] * r[1] + p[2] * r[2];
+      const double pu = p[0] * u[0] + p[1] * u[1] + p[2] * u[2];
+      dist = std::max(dist, pb + std::max(std::fabs(pr) / (t * aspect * m), std::fabs(pu) / (t * m)));
+    };
+    for (size_t i = 0; i < path_.Size(); ++i) fit(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], -path_.ned_m[3 * i + 2]);
+    if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
+      for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
+        const nav_vec3 w = s.trajectory.waypoints.points[i].r_ned_m;
+        fit(w.y, w.x, -w.z);
+      }
+    // The minimum square only for a path smaller than it (a longer path seen end-on fills the
+    // view's height rather than a square's width).
+    const double minimum = empty ? 1000.0 : 200.0, h = 0.5 * minimum;
+    if (std::max(xmax - xmin, ymax - ymin) < minimum)
+      for (int k = 0; k < 4; ++k) fit(cx + (k & 1 ? h : -h), cy + (k & 2 ? h : -h), 0.0);
+    cam->SetFocalPoint(cx, cy, zc);
+    cam->SetPosition(cx + dist * b[0], cy + dist * b[1], zc + dist * b[2]);
     cam->SetViewUp(0, 0, 1);
-    cam->SetViewAngle(30.0);
-    const double b[6] = {cx - extent, cx + extent, cy - extent, cy + extent, -zmax, zmax};
-    renderer_->ResetCamera(b);
-    cam->Zoom(2.2);
+    cam->SetViewAngle(view_angle_deg);
     renderer_->ResetCameraClippingRange();
   }
   Rebuild();

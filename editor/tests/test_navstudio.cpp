@@ -644,7 +644,19 @@ private slots:
     const int edits = 4;
     auto quiet = [&] { return !views[0]->FramePending() && !views[1]->FramePending(); };
     for (int i = 0; i < edits; ++i) {
-      QVERIFY(WaitUntil(quiet, 10000)); // no earlier render's frame still to come
+      // No earlier render's frame still to come (on failure: which view waits, and for what).
+      QVERIFY2(WaitUntil(quiet, 10000),
+               qPrintable(QString("edit %1: map renders %2 frames %3 pending %4 exposed %5; 3D renders %6 frames %7 "
+                                  "pending %8 exposed %9")
+                              .arg(i)
+                              .arg(views[0]->RenderCount())
+                              .arg(views[0]->FrameCount())
+                              .arg(views[0]->FramePending())
+                              .arg(views[0]->NativeWindow()->isExposed())
+                              .arg(views[1]->RenderCount())
+                              .arg(views[1]->FrameCount())
+                              .arg(views[1]->FramePending())
+                              .arg(views[1]->NativeWindow()->isExposed())));
       nav_scene e = doc->Scene();
       e.trajectory.waypoints.points[1].r_ned_m.y += 5.0;
       const long f0[2] = {views[0]->FrameCount(), views[1]->FrameCount()};

@@ -6,6 +6,7 @@
 #include <QAction>
 #include <QComboBox>
 #include <QDir>
+#include <QFileInfo>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QLabel>
@@ -25,6 +26,7 @@
 #include <memory>
 
 #include <vtkCommand.h>
+#include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 
 #include "main_window.h"
@@ -559,6 +561,97 @@ private slots:
     QVERIFY(w->MapView()->width() >= 200 && w->MapView()->height() >= 150);
     QVERIFY(w->Panels()->width() >= 400);
     Shot(w.get(), "fit-to-screen");
+  }
+
+  // Opening a scene frames it in both views: every waypoint and every drawn path sample projects
+  // inside the view with a margin, and the path is not a speck (it spans at least 40 % of the
+  // view's width or height). Before the fit was computed, the first waypoint of an opened
+  // elongated drive fell outside the 3D view. Every library scene, the journey's drive and a long
+  // thin climbing drive.
+  void views_frame_the_path() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QStringList files;
+    for (const QString &f : QDir(studio::ScenesDir()).entryList({"*.yaml"}, QDir::Files, QDir::Name))
+      files << studio::ScenesDir() + "/" + f;
+    files << QString(NAVSTUDIO_TEST_DATA_DIR) + "/four-waypoint-drive.yaml";
+    {
+      QByteArray text = ReadAll(QString(NAVSTUDIO_TEST_DATA_DIR) + "/four-waypoint-drive.yaml");
+      const int a = text.indexOf("    points:\n"), b = text.indexOf("imu:");
+      QVERIFY(a > 0 && b > a);
+      text.replace(a, b - a,
+                   "    cruise_mps: 10\n    points:\n      - {ned_m: [0, 0, 0], speed_mps: 0}\n"
+                   "      - {ned_m: [60, 900, -30], speed_mps: 0}\n");
+      QFile f(tmp_.filePath("thin-drive.yaml"));
+      QVERIFY(f.open(QIODevice::WriteOnly) && f.write(text) == text.size());
+      files << f.fileName();
+    }
+    for (const QString &file : files) {
+      QVERIFY2(w->OpenFile(file), qPrintable(file));
+      const nav_scene &s = w->Doc()->Scene();
+      for (PathView *v : {w->MapView(), w->View3D()}) {
+        v->Render();
+        const int *wsz = v->Interactor()->GetRenderWindow()->GetSize();
+        const struct {
+          int w, h;
+        } sz = {wsz[0], wsz[1]};
+        const studio::PathSamples &path = v->Path();
+        QVERIFY2(path.Size() >= 2, qPrintable(file));
+        const int margin = std::max(2, sz.w / 50);
+        int xmin = sz.w, xmax = -1, ymin = sz.h, ymax = -1, misses = 0;
+        auto inside = [&](double n, double e, double d, const char *what, int k) {
+          int x = 0, y = 0;
+          const bool on = v->DisplayOf(n, e, d, &x, &y) && x >= margin && y >= margin && x < sz.w - margin &&
+                          y < sz.h - margin;
+          xmin = std::min(xmin, x), xmax = std::max(xmax, x), ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+          if (!on && ++misses <= 3)
+            qWarning("%s, %s view: %s %d at %d,%d in %dx%d", qPrintable(QFileInfo(file).fileName()),
+                     v == w->MapView() ? "map" : "3D", what, k, x, y, sz.w, sz.h);
+          return on;
+        };
+        bool all = true;
+        for (size_t i = 0; i < path.Size(); ++i)
+          all = inside(path.ned_m[3 * i], path.ned_m[3 * i + 1], path.ned_m[3 * i + 2], "path sample", int(i)) && all;
+        if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
+          for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
+            const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+            all = inside(r.x, r.y, r.z, "waypoint", i) && all;
+          }
+        QVERIFY2(all, qPrintable(file));
+        const double span = std::max(double(xmax - xmin) / sz.w, double(ymax - ymin) / sz.h);
+        qInfo("%-28s %s view: path spans %.0f %% of the view", qPrintable(QFileInfo(file).fileName()),
+              v == w->MapView() ? "map" : "3D ", 100.0 * span);
+        // Paths shorter than the 200 m minimum square are allowed to be small.
+        double ext = 0.0;
+        for (size_t i = 0; i < path.Size(); ++i)
+          ext = std::max({ext, std::fabs(path.ned_m[3 * i] - path.ned_m[0]), std::fabs(path.ned_m[3 * i + 1] - path.ned_m[1])});
+        if (ext > 200.0) QVERIFY2(span >= 0.4, qPrintable(file));
+      }
+      if (file.endsWith("thin-drive.yaml")) Shot(w.get(), "frame-thin-drive");
+    }
+  }
+
+  // Live preview runs for scenes of up to 10 min at 100 Hz worth of IMU steps: a 20 s scene at
+  // 200 Hz (long-drive-replay's parametric path) is previewed, the long drive (811 s at 200 Hz) is
+  // not and the status bar says why.
+  void preview_size_limit() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(true);
+    QVERIFY(w->OpenFile(studio::ScenesDir() + "/long-drive-replay.yaml"));
+    const nav_scene &s = w->Doc()->Scene();
+    QCOMPARE(s.imu.rate_hz, 200.0);
+    QVERIFY(s.trajectory.duration_s * s.imu.rate_hz <= studio::kPreviewMaxImuSteps);
+    QVERIFY(WaitUntil([&] { return w->LastPreview() != nullptr && !w->PreviewWorker()->IsBusy(); }, 60000));
+    QVERIFY2(w->PreviewStatusText().startsWith("preview "), qPrintable(w->PreviewStatusText()));
+    QVERIFY2(!w->PreviewStatusText().contains("off"), qPrintable(w->PreviewStatusText()));
+    QVERIFY(w->OpenFile(studio::ScenesDir() + "/long-drive.yaml"));
+    QVERIFY(s.trajectory.duration_s * s.imu.rate_hz > studio::kPreviewMaxImuSteps);
+    const QString off = QString("preview off: %1 s at 200 Hz").arg(s.trajectory.duration_s, 0, 'f', 0);
+    QTRY_VERIFY2_WITH_TIMEOUT(w->PreviewStatusText().startsWith(off), qPrintable(w->PreviewStatusText()), 5000);
+    qInfo("%s", qPrintable(w->PreviewStatusText()));
+    Shot(w.get(), "preview-off-long-drive");
   }
 
 private:
