@@ -19,6 +19,7 @@
 #include <QScreen>
 #include <QSettings>
 #include <QSplitter>
+#include <QTabBar>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QTextBrowser>
@@ -94,7 +95,10 @@ MainWindow::~MainWindow() {
 void MainWindow::BuildUi() {
   resize(1500, 950);
   panels_ = new ScenePanels(&doc_, &catalogs_);
-  panels_->setMinimumWidth(470);
+  // Every panel's tab stays in sight (no scroll arrows): the panels are at least as wide as
+  // their tab bar.
+  panels_->setUsesScrollButtons(false);
+  panels_->setMinimumWidth(std::max(470, panels_->tabBar()->sizeHint().width() + 8));
   map_ = new PathView(&doc_, PathView::Mode::Map);
   view3d_ = new PathView(&doc_, PathView::Mode::ThreeD);
   auto *views = new QSplitter(Qt::Horizontal);

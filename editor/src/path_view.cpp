@@ -38,6 +38,7 @@
 #include <vtkSphereSource.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
 
 #include "map_background.h"
 
@@ -785,31 +786,58 @@ void PathView::Rebuild() {
 }
 
 void PathView::UpdateCaption() {
+  if (!caption_) return;
   const nav_scene &s = doc_->Scene();
   const bool wp = s.trajectory.type == NAV_TRAJ_WAYPOINTS;
   const int count = wp ? s.trajectory.waypoints.count : 0;
   double lat = 0, lon = 0, h = 0;
   const double zero[3] = {0, 0, 0};
   LocalToGeodetic(s, zero, &lat, &lon, &h);
-  QString cap = mode_ == Mode::Map ? tr("Map") : tr("3D");
-  cap += tr("  ·  origin %1").arg(FormatLatLon(lat, lon));
+  // The facts, in groups kept whole; the hint above them, in words. Both wrap to the view's width.
+  QStringList facts;
+  facts << (mode_ == Mode::Map ? tr("Map") : tr("3D")) << tr("origin %1").arg(FormatLatLon(lat, lon));
   if (mode_ == Mode::ThreeD || street_)
-    cap += tr("  ·  grid %1 m").arg(grid_step_, 0, 'g', 6);
+    facts << tr("grid %1 m").arg(grid_step_, 0, 'g', 6);
   else
-    cap += tr("  ·  graticule %1°").arg(bg_key_[2] > 0 ? QString::number(graticule_step_deg_, 'g', 6) : "-");
-  if (wp) cap += tr("  ·  %1 waypoints").arg(count);
-  if (path_.Size() > 0) cap += tr("  ·  %1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
-  if (mode_ == Mode::Map && !bg_note_.isEmpty()) cap += "  ·  " + bg_note_;
+    facts << tr("graticule %1°").arg(bg_key_[2] > 0 ? QString::number(graticule_step_deg_, 'g', 6) : "-");
+  if (wp) facts << tr("%1 waypoints").arg(count);
+  if (path_.Size() > 0) facts << tr("%1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
+  if (mode_ == Mode::Map && !bg_note_.isEmpty()) facts << bg_note_;
+  QString hint;
   if (mode_ == Mode::Map && !wp)
-    cap = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type)) + "\n" + cap;
+    hint = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type));
   else if (mode_ == Mode::Map && count < 4)
-    cap = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)") + "\n" + cap;
-  caption_->SetInput(cap.toUtf8().constData());
+    hint = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)");
+  const int avail = std::max(120, width() - 16); // the caption sits 8 px from the left edge
+  vtkTextRenderer *tr_ = vtkTextRenderer::GetInstance();
+  const int dpi = window_ ? window_->GetDPI() : 72;
+  auto fits = [&](const QString &line) {
+    int bb[4] = {0, 0, 0, 0};
+    if (!tr_ || !tr_->GetBoundingBox(caption_->GetTextProperty(), line.toUtf8().constData(), bb, dpi)) return true;
+    return bb[1] - bb[0] <= avail;
+  };
+  // Greedy packing of pieces joined by sep into lines that fit (a piece wider than the view gets
+  // a line of its own).
+  auto pack = [&](const QStringList &pieces, const QString &sep) {
+    QStringList lines;
+    for (const QString &p : pieces) {
+      if (!lines.isEmpty() && fits(lines.back() + sep + p))
+        lines.back() += sep + p;
+      else
+        lines << p;
+    }
+    return lines;
+  };
+  QStringList lines;
+  if (!hint.isEmpty()) lines << pack(hint.split(' ', Qt::SkipEmptyParts), " ");
+  lines << pack(facts, QStringLiteral("  ·  "));
+  caption_->SetInput(lines.join('\n').toUtf8().constData());
 }
 
 void PathView::resizeEvent(QResizeEvent *e) {
   QWidget::resizeEvent(e);
   if (mode_ == Mode::Map) bg_timer_.start();
+  UpdateCaption(); // wrapped to the new width
   render_timer_.start(0); // at the new size (SyncSize), not waiting for Qt to paint the native window
   resized_ = 1;
 }
@@ -945,6 +973,14 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
 }
 
 size_t PathView::EnvelopePointCount() { return static_cast<size_t>(InputOf(envelope_)->GetNumberOfPoints()); }
+
+QString PathView::CaptionText() const { return QString::fromUtf8(caption_->GetInput()); }
+
+int PathView::CaptionWidth() {
+  double bb[4] = {0, 0, 0, 0};
+  caption_->GetBoundingBox(renderer_, bb);
+  return static_cast<int>(std::ceil(bb[1] - bb[0]));
+}
 
 bool PathView::DisplayOf(double n, double e, double d, int *x, int *y) {
   renderer_->SetWorldPoint(e, n, -d, 1.0);

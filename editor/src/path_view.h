@@ -67,6 +67,10 @@ public:
   /** Render now (a hidden view, or one collapsed to no area, renders when it is shown again). */
   void Render();
 
+  /** The caption at the view's bottom-left (tests). */
+  QString CaptionText() const;
+  /** Width of the drawn caption [px] (tests: it fits the view). */
+  int CaptionWidth();
   /** VTK display coordinates (origin bottom-left) of a local N/E/D point; false if off-screen. */
   bool DisplayOf(double n, double e, double d, int *x, int *y);
   /** Ground point (local N, E at height -d_plane) under a VTK display point. */

@@ -63,10 +63,14 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   const double left = 150, right = width() - 12.0, top = 6, bottom = height() - 18.0;
   const PathSamples &pr = prof_;
   if (pr.Size() < 2) {
-    p.setPen(msg_.isEmpty() ? QColor(90, 90, 90) : QColor(200, 20, 20));
+    // A drive still being drawn (fewer than two waypoints) is not an error: grey, and what to do.
+    const nav_scene &s = doc_->Scene();
+    const bool drawing = msg_.isEmpty() || (s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2);
+    p.setPen(drawing ? QColor(90, 90, 90) : QColor(200, 20, 20));
     p.drawText(rect().adjusted(8, 4, -8, -4), Qt::AlignCenter | Qt::TextWordWrap,
-               msg_.isEmpty() ? tr("Profile: draw at least two waypoints")
-                              : tr("Profile: the plan is not feasible: %1").arg(msg_));
+               drawing ? tr("Profile: speed, acceleration and turn rate along the drive appear here once it has two "
+                            "waypoints (click on the map)")
+                       : tr("Profile: the plan is not feasible: %1").arg(msg_));
     return;
   }
   const double t0 = pr.t_s.front(), t1 = std::max(pr.t_s.back(), t0 + 1e-9);

@@ -14,6 +14,7 @@
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QSurfaceFormat>
+#include <QTabBar>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QScreen>
@@ -560,6 +561,18 @@ private slots:
     if (minimum.width() <= avail.width()) QVERIFY(avail.contains(w->geometry()));
     QVERIFY(w->MapView()->width() >= 200 && w->MapView()->height() >= 150);
     QVERIFY(w->Panels()->width() >= 400);
+    // Every panel tab is in sight, and each view's caption (hint and facts) wraps to its width.
+    QTabBar *tabs = w->Panels()->tabBar();
+    for (int i = 0; i < tabs->count(); ++i)
+      QVERIFY2(tabs->rect().contains(tabs->tabRect(i)), qPrintable(tabs->tabText(i)));
+    for (PathView *v : {w->MapView(), w->View3D()}) {
+      v->Render();
+      qInfo("%s view %d px wide, caption %d px:\n%s", v == w->MapView() ? "map" : "3D", v->width(), v->CaptionWidth(),
+            qPrintable(v->CaptionText()));
+      QVERIFY2(v->CaptionWidth() <= v->width() - 8, qPrintable(v->CaptionText()));
+    }
+    QVERIFY(w->MapView()->CaptionText().simplified().contains("drag one to move it (Ctrl+click inserts, Delete removes)"));
+    QVERIFY(w->MapView()->CaptionText().simplified().contains("0 waypoints"));
     Shot(w.get(), "fit-to-screen");
   }
 
