@@ -67,9 +67,9 @@ void AddWaypoint(SceneDocument *doc, double n, double e, double d, int insert_at
       w.count = 0;
       w.timing = NAV_WP_TIMING_SPEED;
       if (w.hold_start_s <= 0.0) w.hold_start_s = 30.0;
-      if (w.cruise_mps <= 0.0) w.cruise_mps = 10.0;
+      if (w.cruise_mps <= 0.0) w.cruise_mps = kDriveCruiseMps;
     }
-    const double cruise = w.cruise_mps > 0.0 ? w.cruise_mps : 10.0;
+    const double cruise = w.cruise_mps > 0.0 ? w.cruise_mps : kDriveCruiseMps;
     nav_waypoint p;
     std::memset(&p, 0, sizeof p);
     p.r_ned_m = nav_vec3{n, e, d};
@@ -512,25 +512,31 @@ void PathView::UpdateGrid(double cx, double cy, double extent) {
 void PathView::ResetCamera() {
   Path(); // a pending redraw first: the camera fits the current path
   const nav_scene &s = doc_->Scene();
-  // The box of the path and the waypoints (east x, north y); around the origin when there are none.
+  // The points framed: every path sample and every waypoint, in world axes (east, north, up).
+  auto each_point = [&](const auto &visit) {
+    for (size_t i = 0; i < path_.Size(); ++i) visit(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], -path_.ned_m[3 * i + 2]);
+    if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
+      for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
+        const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
+        visit(r.y, r.x, -r.z);
+      }
+  };
+  // Their horizontal box; around the origin when there are none.
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-  auto grow = [&](double x, double y) {
+  each_point([&](double x, double y, double) {
     xmin = std::min(xmin, x);
     xmax = std::max(xmax, x);
     ymin = std::min(ymin, y);
     ymax = std::max(ymax, y);
-  };
-  for (size_t i = 0; i < path_.Size(); ++i) grow(path_.ned_m[3 * i + 1], path_.ned_m[3 * i]);
-  if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
-    for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
-      const nav_vec3 r = s.trajectory.waypoints.points[i].r_ned_m;
-      grow(r.y, r.x);
-    }
+  });
   if (!(xmin <= xmax)) xmin = xmax = ymin = ymax = 0.0;
   const double cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
   // An empty drive shows about a kilometre, a drawn one its extent.
   const bool empty = s.trajectory.type == NAV_TRAJ_WAYPOINTS && s.trajectory.waypoints.count < 2;
-  const double extent = std::max({xmax - xmin, ymax - ymin, empty ? 1000.0 : 200.0}) * 0.5 * 1.25;
+  const double minimum = empty ? 1000.0 : 200.0;
+  const double extent = std::max({xmax - xmin, ymax - ymin, minimum}) * 0.5 * 1.25;
+  const int *sz = window_->GetSize();
+  const double aspect = sz[0] > 0 && sz[1] > 0 ? static_cast<double>(sz[0]) / sz[1] : 1.0;
   UpdateGrid(cx, cy, extent * 2.0);
   vtkCamera *cam = renderer_->GetActiveCamera();
   if (mode_ == Mode::Map) {
@@ -539,9 +545,6 @@ void PathView::ResetCamera() {
     cam->SetViewUp(0, 1, 0);
     // The larger of the box's half-height and half-width over the aspect, so that a tall path in
     // a wide view and a wide path in a narrow view both fit, 25 % margin.
-    const int *sz = window_->GetSize();
-    const double aspect = sz[0] > 0 && sz[1] > 0 ? static_cast<double>(sz[0]) / sz[1] : 1.0;
-    const double minimum = empty ? 1000.0 : 200.0;
     cam->SetParallelScale(0.5 * 1.25 * std::max({ymax - ymin, (xmax - xmin) / aspect, minimum}));
     renderer_->ResetCameraClippingRange();
   } else {
@@ -561,8 +564,6 @@ void PathView::ResetCamera() {
     r[0] /= rn;
     r[1] /= rn;
     const double u[3] = {r[1] * b[2] - r[2] * b[1], r[2] * b[0] - r[0] * b[2], r[0] * b[1] - r[1] * b[0]};
-    const int *sz = window_->GetSize();
-    const double aspect = sz[0] > 0 && sz[1] > 0 ? static_cast<double>(sz[0]) / sz[1] : 1.0;
     const double t = std::tan(0.5 * view_angle_deg * M_PI / 180.0);
     double dist = 1.0;
     auto fit = [&](double x, double y, double z) {
@@ -572,15 +573,10 @@ void PathView::ResetCamera() {
       const double pu = p[0] * u[0] + p[1] * u[1] + p[2] * u[2];
       dist = std::max(dist, pb + std::max(std::fabs(pr) / (t * aspect * m), std::fabs(pu) / (t * m)));
     };
-    for (size_t i = 0; i < path_.Size(); ++i) fit(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], -path_.ned_m[3 * i + 2]);
-    if (s.trajectory.type == NAV_TRAJ_WAYPOINTS)
-      for (int i = 0; i < s.trajectory.waypoints.count; ++i) {
-        const nav_vec3 w = s.trajectory.waypoints.points[i].r_ned_m;
-        fit(w.y, w.x, -w.z);
-      }
+    each_point(fit);
     // The minimum square only for a path smaller than it (a longer path seen end-on fills the
     // view's height rather than a square's width).
-    const double minimum = empty ? 1000.0 : 200.0, h = 0.5 * minimum;
+    const double h = 0.5 * minimum;
     if (std::max(xmax - xmin, ymax - ymin) < minimum)
       for (int k = 0; k < 4; ++k) fit(cx + (k & 1 ? h : -h), cy + (k & 2 ? h : -h), 0.0);
     cam->SetFocalPoint(cx, cy, zc);
@@ -809,11 +805,11 @@ void PathView::UpdateCaption() {
   else if (mode_ == Mode::Map && count < 4)
     hint = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)");
   const int avail = std::max(120, width() - 16); // the caption sits 8 px from the left edge
-  vtkTextRenderer *tr_ = vtkTextRenderer::GetInstance();
+  vtkTextRenderer *text_renderer = vtkTextRenderer::GetInstance();
   const int dpi = window_ ? window_->GetDPI() : 72;
   auto fits = [&](const QString &line) {
     int bb[4] = {0, 0, 0, 0};
-    if (!tr_ || !tr_->GetBoundingBox(caption_->GetTextProperty(), line.toUtf8().constData(), bb, dpi)) return true;
+    if (!text_renderer || !text_renderer->GetBoundingBox(caption_->GetTextProperty(), line.toUtf8().constData(), bb, dpi)) return true;
     return bb[1] - bb[0] <= avail;
   };
   // Greedy packing of pieces joined by sep into lines that fit (a piece wider than the view gets

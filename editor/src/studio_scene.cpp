@@ -56,7 +56,7 @@ std::unique_ptr<nav_scene> NewDriveScene() {
   w.attitude_mode = NAV_WP_ATT_GROUND;
   w.hold_start_s = 30.0;
   w.hold_end_s = 5.0;
-  w.cruise_mps = 10.0; // two clicks make a drive: the leg between the two stops is driven at up to 10 m/s
+  w.cruise_mps = kDriveCruiseMps; // two clicks make a drive: the leg between the two stops is driven
   s->trajectory.duration_s = 60.0;
   s->imu.rate_hz = 100.0;
   s->gnss.enabled = true;

@@ -59,6 +59,9 @@ QString ScenesDir();
 /** Equivalent spellings the editor keeps in one form (see the .cpp). */
 void Normalize(nav_scene *s);
 
+/** Speed of a drawn drive between its stops and at its interior waypoints [m/s]. */
+constexpr double kDriveCruiseMps = 10.0;
+
 /** A new drive: WGS-84 (Berlin), no waypoints yet, INS/GNSS, 100 Hz IMU, 10 Hz output, 10 runs. */
 std::unique_ptr<nav_scene> NewDriveScene();
 
