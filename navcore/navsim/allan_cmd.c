@@ -65,7 +65,7 @@ enum { N_CH = 6 };
 
 static const char *k_usage_allan =
     "usage: navsim allan (--imu NAME | SCENE) [--rate HZ] [--duration S] [--seed N] [--out DIR]\n"
-    "                    [--convention allan_peak|sigma_equals_b] [--strict] [--quiet]\n"
+    "                    [--force] [--convention allan_peak|sigma_equals_b] [--strict] [--quiet]\n"
     "\n"
     "Simulate a static IMU with the error model of a catalog part (--imu NAME, see `navsim catalog`)\n"
     "or of a scene's imu section, compute the overlapping Allan deviation of the three gyro and\n"
@@ -94,6 +94,7 @@ static const char *k_usage_allan =
     "  --strict          exit 3 when an ARW/VRW check fails\n"
     "  --quiet           print nothing but errors\n"
     "  -h, --help        print this help\n"
+    NAVSIM_OUT_HELP
     "\n"
     "exit codes: 0 success (failed checks are reported; with --strict they exit 3); 1 I/O or\n"
     "numerical failure, catalog not found; 2 invalid scene, part name or options; 3 see --strict\n";
@@ -210,7 +211,7 @@ static double b_disp(int ch) {
 typedef struct allan_args {
   const char *imu_name, *scene_path, *out_dir;
   double rate_hz, duration_s;
-  bool have_rate, have_duration, have_seed, strict, quiet;
+  bool have_rate, have_duration, have_seed, strict, quiet, force;
   uint64_t seed;
   nav_bi_convention convention;
 } allan_args;
@@ -224,6 +225,8 @@ static int parse_args(int argc, char **argv, allan_args *a) {
       return EXIT_OK;
     } else if (strcmp(s, "--strict") == 0) {
       a->strict = true;
+    } else if (strcmp(s, "--force") == 0) {
+      a->force = true;
     } else if (strcmp(s, "--quiet") == 0 || strcmp(s, "-q") == 0) {
       a->quiet = true;
     } else if (strcmp(s, "--imu") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--rate") == 0 ||
@@ -571,6 +574,10 @@ int navsim_allan(int argc, char **argv) {
     snprintf(default_dir, sizeof default_dir, "out/allan-%s", nm);
     a.out_dir = default_dir;
   }
+  {
+    const int orc = navsim_out_check("allan", a.out_dir, a.force);
+    if (orc != EXIT_OK) return orc;
+  }
 
   int rc = EXIT_FAIL;
   nav_imu_model *model = NULL;
@@ -734,10 +741,12 @@ int navsim_allan(int argc, char **argv) {
   clock_gettime(CLOCK_MONOTONIC, &t1);
   const double wall = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
 
-  st = nav_resultdir_begin(a.out_dir, &rd);
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim allan: cannot create result directory \"%s\": %s\n", a.out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_begin("allan", a.out_dir, a.force, &rd);
+    if (orc != EXIT_OK) {
+      rc = orc;
+      goto cleanup;
+    }
   }
   if (write_csv(nav_resultdir_file(rd, "allan.csv"), tau, n_m, adev, rel, ch) != EXIT_OK ||
       write_json(nav_resultdir_file(rd, "summary.json"), &a, &src, (int64_t)n, tau1_s, ch, res, n_checked,
@@ -745,11 +754,13 @@ int navsim_allan(int argc, char **argv) {
     fprintf(stderr, "navsim allan: writing the results in \"%s\" failed\n", a.out_dir);
     goto cleanup;
   }
-  st = nav_resultdir_commit(rd);
-  rd = NULL;
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim allan: cannot move the results into \"%s\": %s\n", a.out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_commit("allan", rd);
+    rd = NULL;
+    if (orc != EXIT_OK) {
+      rc = orc;
+      goto cleanup;
+    }
   }
   if (!a.quiet) print_table(&a, &src, (int64_t)n, tau[n_m - 1], ch, res, n_checked, n_pass, a.out_dir);
   if (n_pass < n_checked)

@@ -20,7 +20,7 @@
 #include "navcore/nav_version.h"
 
 static const char *k_usage_budget =
-    "usage: navsim budget SCENE [--out DIR] [--runs N] [--threads N] [--quiet]\n"
+    "usage: navsim budget SCENE [--out DIR] [--force] [--runs N] [--threads N] [--quiet]\n"
     "\n"
     "Error budget: how much each error source contributes to each requirement of the scene, so\n"
     "that the spec worth buying better shows at once. Covariance analysis with one source on at a\n"
@@ -47,6 +47,7 @@ static const char *k_usage_budget =
     "               variance in unit^2; share = variance / total variance\n"
     "               method: covariance or monte_carlo\n"
     "  budget.json  per requirement: the total, its epoch, the limit and the sources\n"
+    NAVSIM_OUT_HELP
     "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
@@ -246,7 +247,7 @@ static nav_status mc_budget_run(const nav_scene *sc, const nav_requirement *reqs
 
 int navsim_budget(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool quiet = false;
+  bool quiet = false, force = false;
   long runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
@@ -254,6 +255,8 @@ int navsim_budget(int argc, char **argv) {
       return 0;
     } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
       quiet = true;
+    } else if (strcmp(argv[i], "--force") == 0) {
+      force = true;
     } else if (strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--runs") == 0 || strcmp(argv[i], "--threads") == 0) {
       if (!navsim_need_value("budget", argc, i, argv[i])) return 2;
       const char *opt = argv[i], *v = argv[++i];
@@ -303,8 +306,17 @@ int navsim_budget(int argc, char **argv) {
   }
   char default_dir[600];
   if (!out_dir) {
-    snprintf(default_dir, sizeof default_dir, "out/%s-budget", sc->name[0] ? sc->name : "scene");
+    char nm[NAV_SCENE_NAME_MAX];
+    navsim_safe_name(nm, sizeof nm, sc->name, "scene");
+    snprintf(default_dir, sizeof default_dir, "out/%s-budget", nm);
     out_dir = default_dir;
+  }
+  {
+    const int orc = navsim_out_check("budget", out_dir, force);
+    if (orc != 0) {
+      free(sc);
+      return orc;
+    }
   }
   req_budget *rb = calloc((size_t)nreq, sizeof *rb);
   nav_budget_result *res = covariance ? calloc((size_t)nreq, sizeof *res) : NULL;
@@ -352,9 +364,12 @@ int navsim_budget(int argc, char **argv) {
   }
   const char *method = covariance ? "covariance" : "monte_carlo";
 
-  if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
-    fprintf(stderr, "navsim budget: cannot create \"%s\": %s\n", out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_begin("budget", out_dir, force, &rd);
+    if (orc != 0) {
+      rc = orc;
+      goto cleanup;
+    }
   }
   const char *csv = nav_resultdir_file(rd, "budget.csv");
   f = csv ? fopen(csv, "w") : NULL;
@@ -425,10 +440,13 @@ int navsim_budget(int argc, char **argv) {
     goto cleanup;
   }
   f = NULL;
-  if (nav_resultdir_commit(rd) != NAV_OK) {
-    rd = NULL;
-    fprintf(stderr, "navsim budget: cannot move the results into \"%s\": %s\n", out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_commit("budget", rd);
+    if (orc != 0) {
+      rd = NULL;
+      rc = orc;
+      goto cleanup;
+    }
   }
   rd = NULL;
   if (!quiet) {

@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -107,6 +108,37 @@ void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallb
   }
   out[j] = '\0';
   if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", fallback);
+}
+
+int navsim_out_check(const char *cmd, const char *dir, bool force) {
+  char msg[1200];
+  const nav_status st = nav_resultdir_check(dir, msg, sizeof msg);
+  if (st == NAV_OK) return 0;
+  if (force && st == NAV_ERR_INVALID_ARG && dir && *dir) {
+    struct stat sb;
+    if (lstat(dir, &sb) == 0) return 0; /* moved aside at commit */
+  }
+  fprintf(stderr, "navsim %s: --out: %s\n", cmd, msg);
+  return st == NAV_ERR_IO ? 1 : 2;
+}
+
+int navsim_out_begin(const char *cmd, const char *dir, bool force, nav_resultdir **rd) {
+  char msg[1200];
+  const nav_status st = nav_resultdir_open(dir, force ? NAV_RESULTDIR_FORCE : 0u, rd, msg, sizeof msg);
+  if (st == NAV_OK) return 0;
+  fprintf(stderr, "navsim %s: --out: %s\n", cmd, msg[0] ? msg : nav_status_str(st));
+  return st == NAV_ERR_INVALID_ARG ? 2 : 1;
+}
+
+int navsim_out_commit(const char *cmd, nav_resultdir *rd) {
+  char msg[1400];
+  const nav_status st = nav_resultdir_commit_msg(rd, msg, sizeof msg);
+  if (st == NAV_OK) {
+    if (msg[0]) fprintf(stderr, "navsim %s: note: %s\n", cmd, msg);
+    return 0;
+  }
+  fprintf(stderr, "navsim %s: --out: %s\n", cmd, msg[0] ? msg : nav_status_str(st));
+  return st == NAV_ERR_INVALID_ARG ? 2 : 1;
 }
 
 void navsim_json_number(FILE *f, double v, int digits) {

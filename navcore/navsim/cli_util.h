@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "navcore/nav_io.h"
+#include "navcore/nav_results.h"
 
 /* "-h" or "--help". */
 bool navsim_is_help(const char *arg);
@@ -60,6 +61,26 @@ int navsim_scene_arg(const char *cmd, const char *arg, const char **scene);
 /* @p name made safe as a file or directory name: characters other than [A-Za-z0-9._-] become
  * '_'; empty, "." or ".." become @p fallback. */
 void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallback);
+
+/* The help text of --out and --force, shared by every command that writes a result directory. */
+#define NAVSIM_OUT_HELP                                                                                    \
+  "An existing --out DIR is replaced only when it is a result directory navsim wrote holding nothing\n"   \
+  "else; a file, a symbolic link or any other directory is refused (exit 2) before any work.\n"           \
+  "--force moves whatever is at DIR aside to DIR.old-YYYYmmddTHHMMSS instead (nothing is deleted).\n"
+
+/* --out DIR of navsim CMD, checked before any work (nav_resultdir_check): 0 when DIR may receive
+ * the result (absent, empty, or a result directory navsim wrote) or @p force is set and DIR
+ * exists; else "navsim CMD: --out: WHAT IS THERE: HOW TO PROCEED" on stderr and the exit code
+ * (2 refused, 1 cannot be examined). Nothing is created. */
+int navsim_out_check(const char *cmd, const char *dir, bool force);
+
+/* nav_resultdir_open with the same messages as navsim_out_check. @return 0 or the exit code. */
+int navsim_out_begin(const char *cmd, const char *dir, bool force, nav_resultdir **rd);
+
+/* nav_resultdir_commit_msg; prints "navsim CMD: MSG" on stderr when the commit failed or moved a
+ * previous content aside. @return 0, or the exit code (2 when DIR stopped accepting the result
+ * meanwhile: the result is kept beside it; 1 on I/O failure). */
+int navsim_out_commit(const char *cmd, nav_resultdir *rd);
 
 /* A JSON number with @p digits significant digits ("%.*g"); non-finite values print null. */
 void navsim_json_number(FILE *f, double v, int digits);

@@ -37,7 +37,7 @@
 #include "navcore/nav_version.h"
 
 static const char *k_usage_estimate =
-    "usage: navsim estimate SCENE [--out DIR] [--quiet]\n"
+    "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet]\n"
     "\n"
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
@@ -59,6 +59,7 @@ static const char *k_usage_estimate =
     "                 analysis: rms, at_time, outage_end, p95/cep of horizontal, vertical and yaw;\n"
     "                 value null where sigmas do not determine the statistic, e.g. max)\n"
     "  summary.json   scene, timing, final analytic and covariance values\n"
+    NAVSIM_OUT_HELP
     "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
@@ -234,13 +235,15 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
 
 int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool quiet = false;
+  bool quiet = false, force = false;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
       return 0;
     } else if (strcmp(argv[i], "--quiet") == 0) {
       quiet = true;
+    } else if (strcmp(argv[i], "--force") == 0) {
+      force = true;
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
     } else if (argv[i][0] == '-') {
@@ -262,9 +265,13 @@ int navsim_estimate(int argc, char **argv) {
   if (lrc != 0) return lrc;
   char default_dir[600];
   if (!out_dir) {
-    snprintf(default_dir, sizeof default_dir, "out/%s-estimate", sc.name[0] ? sc.name : "scene");
+    char nm[NAV_SCENE_NAME_MAX];
+    navsim_safe_name(nm, sizeof nm, sc.name, "scene");
+    snprintf(default_dir, sizeof default_dir, "out/%s-estimate", nm);
     out_dir = default_dir;
   }
+  const int orc = navsim_out_check("estimate", out_dir, force);
+  if (orc != 0) return orc;
 
   int rc = 1;
   nav_sim *sim = NULL;
@@ -349,10 +356,9 @@ int navsim_estimate(int argc, char **argv) {
     }
   }
 
-  if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
-    fprintf(stderr, "navsim estimate: cannot create \"%s\": %s\n", out_dir, strerror(errno));
-    goto cleanup;
-  }
+  rc = navsim_out_begin("estimate", out_dir, force, &rd);
+  if (rc != 0) goto cleanup;
+  rc = 1;
   const char *csv = nav_resultdir_file(rd, "estimate.csv");
   f = csv ? fopen(csv, "w") : NULL;
   if (!f) goto cleanup;
@@ -439,9 +445,10 @@ int navsim_estimate(int argc, char **argv) {
     fprintf(stderr, "navsim estimate: writing estimate.json failed\n");
     goto cleanup;
   }
-  st = nav_resultdir_commit(rd);
+  rc = navsim_out_commit("estimate", rd);
   rd = NULL;
-  if (st != NAV_OK) goto cleanup;
+  if (rc != 0) goto cleanup;
+  rc = 1;
   if (!quiet) {
     printf("scene      %s (%s)\n", sc.name, scene_path);
     printf("%10s | %-38s | %s\n", "t [s]", "analytic free INS, per axis (1 sigma)",

@@ -72,8 +72,8 @@ static const char *k_usage_check =
     "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static const char *k_usage_run =
-    "usage: navsim run SCENE [--out DIR] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet] [--kml]\n"
-    "                  [--strict]\n"
+    "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
+    "                  [--kml] [--strict]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -95,7 +95,11 @@ static const char *k_usage_run =
     "The directory appears only when complete (it is built under a hidden name and renamed).\n"
     "\n"
     "options:\n"
-    "  --out DIR     result directory (default: out/<scene name>)\n"
+    "  --out DIR     result directory (default: out/<scene name>). An existing DIR is replaced only\n"
+    "                when it is a result directory navsim wrote and holds nothing else; a file, a\n"
+    "                symbolic link or any other directory is refused (exit 2) before any work\n"
+    "  --force       move whatever is at DIR aside to DIR.old-YYYYmmddTHHMMSS instead of refusing it\n"
+    "                (nothing is deleted)\n"
     "  --seed N      random seed, overriding simulation.seed of the scene (0 .. 2^64-1)\n"
     "  --runs N      Monte Carlo runs, overriding simulation.runs (1 .. 1000000)\n"
     "  --threads N   worker threads (default: simulation.threads, or one per core); results are\n"
@@ -228,7 +232,7 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
 
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false;
+  bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -237,6 +241,8 @@ static int cmd_run(int argc, char **argv) {
       return EXIT_OK;
     } else if (strcmp(a, "--kml") == 0) {
       kml = true;
+    } else if (strcmp(a, "--force") == 0) {
+      force = true;
     } else if (strcmp(a, "--strict") == 0) {
       strict = true;
     } else if (strcmp(a, "--ideal") == 0) {
@@ -283,10 +289,6 @@ static int cmd_run(int argc, char **argv) {
   if (have_seed) scene.simulation.seed = seed;
   if (runs > 0) scene.simulation.runs = (long)runs;
   if (threads == 0) threads = scene.simulation.threads > 0 ? (uint64_t)scene.simulation.threads : (uint64_t)cores();
-  /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */
-  int mpi_rc = EXIT_OK;
-  if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) return mpi_rc;
-
   char default_dir[600];
   if (!out_dir) {
     char nm[NAV_SCENE_NAME_MAX];
@@ -294,6 +296,13 @@ static int cmd_run(int argc, char **argv) {
     snprintf(default_dir, sizeof default_dir, "out/%s", nm);
     out_dir = default_dir;
   }
+  /* Refuse an --out that holds what navsim did not write before any work (every rank sees the
+     same file system, so under mpirun all ranks stop alike). */
+  rc = navsim_out_check("run", out_dir, force);
+  if (rc != EXIT_OK) return rc;
+  /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */
+  int mpi_rc = EXIT_OK;
+  if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) return mpi_rc;
 
   nav_sim *sim = NULL;
   bool committed = false; /* the result directory is in place */
@@ -310,12 +319,8 @@ static int cmd_run(int argc, char **argv) {
     goto cleanup;
   }
   navsim_interrupt_arm(sim); /* SIGINT / SIGTERM: cancel, remove the temporary directory */
-  st = nav_resultdir_begin(out_dir, &rd);
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim run: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
-    rc = EXIT_FAIL;
-    goto cleanup;
-  }
+  rc = navsim_out_begin("run", out_dir, force, &rd);
+  if (rc != EXIT_OK) goto cleanup;
   for (int i = 0; i < 3; ++i) {
     const char *file = nav_resultdir_file(rd, names[i]);
     o.f[i] = file ? fopen(file, "w") : NULL;
@@ -491,13 +496,9 @@ static int cmd_run(int argc, char **argv) {
     rc = 128 + navsim_interrupted();
     goto cleanup;
   }
-  st = nav_resultdir_commit(rd);
+  rc = navsim_out_commit("run", rd);
   rd = NULL;
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim run: cannot move the results into \"%s\": %s\n", out_dir, strerror(errno));
-    rc = EXIT_FAIL;
-    goto cleanup;
-  }
+  if (rc != EXIT_OK) goto cleanup;
   committed = true;
   if (!quiet) {
     printf("scene      %s (%s, %s Earth, %s mechanization%s)\n", scene.name, scene_path,

@@ -30,7 +30,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 static const char *k_usage_replay =
     "usage: navsim replay --imu FILE --truth FILE [--gnss FILE] [--scene SCENE] [--start T]\n"
     "                     [--end T] [--outage T0:T1]... [--peer NAME=FILE]... [--out DIR]\n"
-    "                     [--peers auto|none] [--cov-decimation N] [--smooth] [--quiet]\n"
+    "                     [--force] [--peers auto|none] [--cov-decimation N] [--smooth] [--quiet]\n"
     "\n"
     "Run our navigation on recorded data and score it against a reference:\n"
     "  --imu FILE      IMU increments, KF-GINS text: t [s], dtheta x/y/z [rad], dvel x/y/z [m/s],\n"
@@ -71,6 +71,7 @@ static const char *k_usage_replay =
     "  --smooth-group N  (implies --smooth) discretise the smoother's transition over groups of N\n"
     "                  IMU steps (default 10; 1: step by step, as the filter; nav_smoother_config)\n"
     "  --quiet         print nothing but errors\n"
+    NAVSIM_OUT_HELP
     "\n"
     "exit codes: 0 success; 2 invalid files or options; 1 other failure\n";
 
@@ -541,7 +542,7 @@ static void print_tables(const replay_job *j, bool show_published) {
 
 int navsim_replay(int argc, char **argv) {
   const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay";
-  bool quiet = false, peers_auto = true, smooth = false;
+  bool quiet = false, peers_auto = true, smooth = false, force = false;
   /* 10 IMU steps (50 ms at 200 Hz): on the long drive the smoothed positions move by < 2e-5 m
    * and the sigmas by < 1e-4 relative against step-by-step, at a third of the forward cost. */
   unsigned smooth_group = 10u;
@@ -562,6 +563,8 @@ int navsim_replay(int argc, char **argv) {
       quiet = true;
     } else if (strcmp(a, "--smooth") == 0) {
       smooth = true;
+    } else if (strcmp(a, "--force") == 0) {
+      force = true;
     } else if (strcmp(a, "--smooth-group") == 0) {
       if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -671,6 +674,12 @@ int navsim_replay(int argc, char **argv) {
   }
   if (rc.outage_count > 0 && !gnss)
     fprintf(stderr, "navsim replay: warning: --outage has no effect without --gnss\n");
+  {
+    /* Before anything is read: an --out holding the recorded files (or anything else navsim did
+       not write) is refused, never replaced. */
+    const int orc = navsim_out_check("replay", out_dir, force);
+    if (orc != EXIT_OK) return orc;
+  }
 
   if (config) {
     /* nav_scene is large (segment scripts): keep it off the stack. */
@@ -721,10 +730,12 @@ int navsim_replay(int argc, char **argv) {
     fprintf(stderr, "navsim replay: warning: --smooth has no effect without --gnss\n");
   }
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
-  st = nav_resultdir_begin(out_dir, &rd);
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim replay: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_begin("replay", out_dir, force, &rd);
+    if (orc != EXIT_OK) {
+      rc_exit = orc;
+      goto cleanup;
+    }
   }
   for (int i = 0; i < 3; ++i) {
     const char *file = nav_resultdir_file(rd, names[i]);
@@ -825,11 +836,13 @@ int navsim_replay(int argc, char **argv) {
     fprintf(stderr, "navsim replay: writing summary.json failed\n");
     goto cleanup;
   }
-  st = nav_resultdir_commit(rd);
-  rd = NULL;
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim replay: cannot move the results into \"%s\": %s\n", out_dir, strerror(errno));
-    goto cleanup;
+  {
+    const int orc = navsim_out_commit("replay", rd);
+    rd = NULL;
+    if (orc != EXIT_OK) {
+      rc_exit = orc;
+      goto cleanup;
+    }
   }
   if (!quiet) {
     print_tables(&job, job.long_drive);

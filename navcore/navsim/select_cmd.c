@@ -44,7 +44,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_select =
     "usage: navsim select SCENE [--imus NAMES|all] [--receivers NAMES|all] [--schemes LIST] [--runs N]\n"
-    "                    [--threads N] [--band F] [--predict-rate HZ] --out DIR [--quiet]\n"
+    "                    [--threads N] [--band F] [--predict-rate HZ] --out DIR [--force] [--quiet]\n"
     "\n"
     "Find the least expensive catalog configuration that meets the scene's requirements. Each\n"
     "combination of IMU (resources/imu_catalog.csv), GNSS receiver (gnss_receivers.csv) and scheme\n"
@@ -65,6 +65,7 @@ static const char *k_usage_select =
     "               configurations first, cheapest first, then not_confirmed, then failing ones\n"
     "  recommended.yaml  the scene with the recommended configuration\n"
     "The terminal shows the recommendation and why each cheaper configuration fails.\n"
+    NAVSIM_OUT_HELP
     "\n"
     "options:\n"
     "  --imus NAMES       IMU names separated by commas, or all (default)\n"
@@ -420,7 +421,7 @@ int navsim_select(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL, *imus_s = "all", *rcv_s = "all", *schemes_s = NULL;
   long runs = 20, threads = 0;
   double band = 1.5, predict_rate = 10.0;
-  bool quiet = false;
+  bool quiet = false, force = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (navsim_is_help(a)) {
@@ -428,6 +429,8 @@ int navsim_select(int argc, char **argv) {
       return EXIT_OK;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = true;
+    } else if (strcmp(a, "--force") == 0) {
+      force = true;
     } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") || !strcmp(a, "--schemes") ||
                !strcmp(a, "--runs") || !strcmp(a, "--threads") || !strcmp(a, "--band") ||
                !strcmp(a, "--predict-rate")) {
@@ -466,6 +469,10 @@ int navsim_select(int argc, char **argv) {
   if (!scene_path || !out_dir) {
     fprintf(stderr, "navsim select: %s\n%s", !scene_path ? "missing SCENE" : "missing --out DIR", k_usage_select);
     return EXIT_INVALID;
+  }
+  {
+    const int orc = navsim_out_check("select", out_dir, force);
+    if (orc != EXIT_OK) return orc;
   }
   if (threads == 0) {
     const long nc = sysconf(_SC_NPROCESSORS_ONLN);
@@ -655,9 +662,12 @@ int navsim_select(int argc, char **argv) {
   for (size_t i = 0; i < n; ++i) judge(&x, &c[i]);
   qsort(c, n, sizeof *c, by_rank);
 
-  if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
-    fprintf(stderr, "navsim select: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
-    goto done;
+  {
+    const int orc = navsim_out_begin("select", out_dir, force, &rd);
+    if (orc != EXIT_OK) {
+      rc = orc;
+      goto done;
+    }
   }
   {
     const char *p = nav_resultdir_file(rd, "ranking.csv");
@@ -672,9 +682,10 @@ int navsim_select(int argc, char **argv) {
         goto done;
       }
     }
-    if (nav_resultdir_commit(rd) != NAV_OK) {
+    const int orc = navsim_out_commit("select", rd);
+    if (orc != EXIT_OK) {
       rd = NULL;
-      fprintf(stderr, "navsim select: cannot move the results into \"%s\"\n", out_dir);
+      rc = orc;
       goto done;
     }
     rd = NULL;

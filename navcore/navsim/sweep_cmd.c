@@ -38,7 +38,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_sweep =
     "usage: navsim sweep SCENE --param PATH=START:STOP:COUNT[:log] [--param ...] [--runs N] [--threads N]\n"
-    "                   [--predict] --out DIR [--quiet]\n"
+    "                   [--predict] --out DIR [--force] [--quiet]\n"
     "\n"
     "Evaluate the scene's requirements over a grid of parameter values. PATH is the field's YAML\n"
     "path in the scene file (keys joined by dots, list items by [i]), e.g.\n"
@@ -58,6 +58,7 @@ static const char *k_usage_sweep =
     "                  meets it, interpolated between the last passing and the first failing grid\n"
     "                  point (linear; in log(value) for :log), with status interpolated, all_pass\n"
     "                  (>= the largest value), none_pass (< the smallest) or non_monotonic\n"
+    NAVSIM_OUT_HELP
     "\n"
     "exit codes: 0 success; 2 invalid scene, parameter or options; 1 other failure\n";
 
@@ -139,7 +140,7 @@ int navsim_sweep(int argc, char **argv) {
   sweep_param prm[SWEEP_MAX_PARAMS];
   int np = 0;
   long runs = 0, threads = 0;
-  bool predict = false, quiet = false;
+  bool predict = false, quiet = false, force = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (navsim_is_help(a)) {
@@ -149,6 +150,8 @@ int navsim_sweep(int argc, char **argv) {
       predict = true;
     } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
       quiet = true;
+    } else if (!strcmp(a, "--force")) {
+      force = true;
     } else if (!strcmp(a, "--param") || !strcmp(a, "--out") || !strcmp(a, "--runs") || !strcmp(a, "--threads")) {
       if (!navsim_need_value("sweep", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -186,6 +189,10 @@ int navsim_sweep(int argc, char **argv) {
     fprintf(stderr, "navsim sweep: %s\n%s",
             !scene_path ? "missing SCENE" : !out_dir ? "missing --out DIR" : "missing --param", k_usage_sweep);
     return EXIT_INVALID;
+  }
+  {
+    const int orc = navsim_out_check("sweep", out_dir, force);
+    if (orc != EXIT_OK) return orc;
   }
   long total = 1;
   for (int k = 0; k < np; ++k) total *= prm[k].count;
@@ -229,6 +236,11 @@ int navsim_sweep(int argc, char **argv) {
   v = calloc((size_t)total * (size_t)nreq, sizeof *v);
   x = calloc((size_t)total * (size_t)np, sizeof *x);
   if (!v || !x) goto done;
+  /* The result directory is started before any grid point is computed, so that an --out that
+     cannot be written is reported before the work, not after it. */
+  rc = navsim_out_begin("sweep", out_dir, force, &rd);
+  if (rc != EXIT_OK) goto done;
+  rc = EXIT_FAIL;
   const double t0 = navsim_now_s();
   for (long g = 0; g < total; ++g) {
     long rem = g;
@@ -282,10 +294,6 @@ int navsim_sweep(int argc, char **argv) {
   }
   const double wall = navsim_now_s() - t0;
 
-  if (nav_resultdir_begin(out_dir, &rd) != NAV_OK) {
-    fprintf(stderr, "navsim sweep: cannot create result directory \"%s\": %s\n", out_dir, strerror(errno));
-    goto done;
-  }
   {
     const char *p = nav_resultdir_file(rd, "sweep.csv");
     f = p ? fopen(p, "w") : NULL;
@@ -381,9 +389,9 @@ int navsim_sweep(int argc, char **argv) {
     f = NULL;
     if (bad || cl != 0) goto io_fail;
   }
-  if (nav_resultdir_commit(rd) != NAV_OK) {
+  rc = navsim_out_commit("sweep", rd);
+  if (rc != EXIT_OK) {
     rd = NULL;
-    fprintf(stderr, "navsim sweep: cannot move the results into \"%s\"\n", out_dir);
     goto done;
   }
   rd = NULL;

@@ -233,7 +233,9 @@ static void test_deterministic_and_atomic_replace(void **state) {
     snprintf(p, sizeof p, "%s/det/%s", WORK, names[i]);
     nav_test_slurp(p, a[i], sizeof a[i]);
   }
-  nav_test_write_file(WORK, "det/stale.txt", "from an earlier run");
+  /* A file an earlier navsim run wrote (tracks.kml of --kml) goes with the directory it was in. */
+  assert_int_equal(navsim(NULL, "run '" SCENE "' --out det --quiet --seed 7 --kml")->code, 0);
+  assert_true(nav_test_is_file(WORK "/det/tracks.kml"));
   assert_int_equal(navsim(NULL, "run '" SCENE "' --out det --quiet --seed 7")->code, 0);
   for (int i = 0; i < 3; ++i) {
     char p[1024];
@@ -242,7 +244,7 @@ static void test_deterministic_and_atomic_replace(void **state) {
     assert_string_equal(a[i], b[i]);
   }
   /* The earlier directory was replaced as a whole; no temporary directory is left behind. */
-  assert_false(nav_test_is_file(WORK "/det/stale.txt"));
+  assert_false(nav_test_is_file(WORK "/det/tracks.kml"));
   DIR *d = opendir(WORK);
   struct dirent *e;
   while ((e = readdir(d)) != NULL)

@@ -5,12 +5,20 @@
  *
  * A result directory is built under a hidden temporary name next to its final place and
  * renamed into place by nav_resultdir_commit(); an interrupted run leaves at most a hidden
- * ".NAME.tmp-XXXXXX" directory, never a half-written DIR. An existing DIR is replaced only at
- * commit time.
+ * ".NAME.tmp-PID-XXXXXX" directory, never a half-written DIR.
+ *
+ * Nothing that navsim did not write is ever deleted. Each committed directory holds a manifest,
+ * ".navsim-result", listing every file navsim wrote in it (tools that add files to a result
+ * later append them with nav_resultdir_record()). An existing DIR is replaced only when it is
+ * absent, an empty directory, or a directory whose manifest lists every file in it; a symbolic
+ * link, a file, or a directory holding anything else is refused before any work, or with
+ * NAV_RESULTDIR_FORCE renamed aside to "DIR.old-YYYYmmddTHHMMSS" at commit (moved, not deleted).
+ * A previous result is removed file by file from its manifest, never through a link.
  */
 #ifndef NAV_RESULTS_H
 #define NAV_RESULTS_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 #include "nav_export.h"
@@ -22,15 +30,39 @@ NAV_BEGIN_DECLS
 
 typedef struct nav_resultdir nav_resultdir;
 
-/** Start a result directory whose final path is @p final_dir (parents are created). */
+/** Flag of nav_resultdir_open: move whatever is at the final path aside at commit instead of
+ *  refusing it. */
+#define NAV_RESULTDIR_FORCE 1u
+
+/** May @p final_dir receive a result? NAV_OK: it is absent, an empty directory, or a navsim
+ *  result directory holding only files navsim wrote. NAV_ERR_INVALID_ARG: an empty or unusable
+ *  name, a symbolic link, a file, or a directory holding anything else; NAV_ERR_IO: it cannot be
+ *  examined. On failure @p msg (may be NULL) says what is there and how to proceed. */
+NAV_API NAV_NODISCARD nav_status nav_resultdir_check(const char *final_dir, char *msg, size_t msg_cap);
+/** Start a result directory whose final path is @p final_dir (parents are created), after
+ *  nav_resultdir_check() (skipped for an existing path with NAV_RESULTDIR_FORCE in @p flags).
+ *  On failure @p msg says why: NAV_ERR_INVALID_ARG refused, NAV_ERR_IO cannot create. */
+NAV_API NAV_NODISCARD nav_status nav_resultdir_open(const char *final_dir, unsigned flags, nav_resultdir **out,
+                                                    char *msg, size_t msg_cap);
+/** nav_resultdir_open(final_dir, 0, out, NULL, 0). */
 NAV_API NAV_NODISCARD nav_status nav_resultdir_begin(const char *final_dir, nav_resultdir **out);
 /** Full path of @p file_name inside the temporary directory (borrowed until the next call);
  *  NULL if the path would be too long. */
 NAV_API const char *nav_resultdir_file(nav_resultdir *rd, const char *file_name);
-/** Flush to disk and rename into place; frees @p rd whatever the outcome. */
+/** Write the manifest, flush to disk and rename into place; frees @p rd whatever the outcome.
+ *  The final path is checked again: when it no longer accepts a result (and FORCE was not
+ *  given), it is left untouched, the result is kept at "DIR.new-PID" and NAV_ERR_INVALID_ARG is
+ *  returned. @p msg (may be NULL) says why on failure, and on success says where a previous
+ *  content was moved aside ("" when nothing was). */
+NAV_API NAV_NODISCARD nav_status nav_resultdir_commit_msg(nav_resultdir *rd, char *msg, size_t msg_cap);
+/** nav_resultdir_commit_msg(rd, NULL, 0). */
 NAV_API NAV_NODISCARD nav_status nav_resultdir_commit(nav_resultdir *rd);
 /** Remove the temporary directory; frees @p rd. Accepts NULL. */
 NAV_API void nav_resultdir_abort(nav_resultdir *rd);
+/** Add @p rel_path (relative, no "." or "..") to the manifest of the committed result directory
+ *  @p result_dir, for a file a later tool wrote into it (a rendered image, a report, exported
+ *  tracks). NAV_ERR_INVALID_ARG when @p result_dir is not a navsim result directory. */
+NAV_API nav_status nav_resultdir_record(const char *result_dir, const char *rel_path);
 
 /** Which of the per-epoch CSV tables. Headers carry units in the column names. */
 /** NAV_CSV_NAV_SMOOTHED: the NAV_CSV_NAV columns of an RTS-smoothed solution plus the smoothed and
