@@ -448,6 +448,9 @@ int navsim_export(int argc, char **argv) {
   dir_ctx ctx = {dir, ""};
   const int rc = write_tracks(dir_file, &ctx, dir_label(dir), kml, csv);
   if (rc == 0) {
+    /* Listed in the result directory's manifest, so that a later run may still replace it. */
+    if (kml) (void)nav_resultdir_record(dir, "tracks.kml");
+    if (csv) (void)nav_resultdir_record(dir, "tracks.csv");
     if (kml) printf("written    %s/tracks.kml\n", dir);
     if (csv) printf("written    %s/tracks.csv\n", dir);
   }

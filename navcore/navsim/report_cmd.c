@@ -18,7 +18,17 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
+
+/* A file written at @p path inside the result directory @p dir is added to its manifest, so that
+ * a later navsim run may replace the directory with it (nav_resultdir_record; a directory navsim
+ * did not write is left as it is). */
+static void record_output(const char *dir, const char *path) {
+  size_t n = strlen(dir);
+  while (n > 1 && dir[n - 1] == '/') --n;
+  if (strncmp(path, dir, n) == 0 && path[n] == '/') (void)nav_resultdir_record(dir, path + n + 1);
+}
 
 enum { RC_OK = 0, RC_FAIL = 1, RC_INVALID = 2 };
 
@@ -194,7 +204,12 @@ int navsim_render(int argc, char **argv) {
     av_add(&v, out_buf);
     av_add(&v, "--chart");
     av_add(&v, png2);
-    return run_child(v.a, false);
+    const int rc = run_child(v.a, false);
+    if (rc == 0) {
+      record_output(dir, out_buf);
+      record_output(dir, png2);
+    }
+    return rc;
   }
   if (!view) view = "3d";
   if (!out) {
@@ -219,7 +234,9 @@ int navsim_render(int argc, char **argv) {
   }
   av_add(&v, "--png");
   av_add(&v, out);
-  return run_child(v.a, false);
+  const int rc = run_child(v.a, false);
+  if (rc == 0) record_output(dir, out);
+  return rc;
 }
 
 /* ------------------------------------------------------------------------------------ report */
@@ -407,6 +424,16 @@ int navsim_report(int argc, char **argv) {
     snprintf(out_dir, sizeof out_dir, "%s", out ? out : dir);
     if (!out) strncat(out_dir, "/report", sizeof out_dir - strlen(out_dir) - 1);
     snprintf(page, sizeof page, "%s/report.html", out_dir);
+  }
+  {
+    struct stat sb;
+    if (stat(out_dir, &sb) == 0 && !S_ISDIR(sb.st_mode)) {
+      fprintf(stderr,
+              "navsim report: --out \"%s\" is a file, not a directory: give a directory (the page is DIR/report.html) "
+              "or a FILE.html\n",
+              out_dir);
+      return RC_INVALID;
+    }
   }
   if (mkdir_p(out_dir) != 0) {
     fprintf(stderr, "navsim report: cannot create \"%s\": %s\n", out_dir, strerror(errno));
@@ -684,8 +711,14 @@ int navsim_report(int argc, char **argv) {
   }
   free(summary);
   int nok = 0;
-  for (int k = 0; k < nfig; ++k)
+  for (int k = 0; k < nfig; ++k) {
     nok += figs[k].ok ? 1 : 0;
+    if (figs[k].ok) {
+      snprintf(path, sizeof path, "%s/%s.png", out_dir, figs[k].key);
+      record_output(dir, path);
+    }
+  }
+  record_output(dir, page);
   printf("report     %s (%d figure%s%s)\n", page, nok, nok == 1 ? "" : "s", failures ? ", some failed" : "");
   return failures ? RC_FAIL : RC_OK;
 }
