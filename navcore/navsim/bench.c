@@ -9,11 +9,13 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench.h"
 #include "bench_internal.h"
+#include "bench_verdict.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/stat.h>
 #include <time.h>
 
@@ -188,8 +190,45 @@ static double replay_parse_s(const char *imu, const char *gnss, const char *ref)
   return st == NAV_OK ? bench_now_s() - t0 : NAN;
 }
 
+/* A KF-GINS configuration for the long drive with the values of the data set's README (the run
+ * that produced its published figures), output into @p out. @return 0 or -1. */
+static int write_kfgins_config(const char *path, const char *imu, const char *gnss, const char *out) {
+  FILE *f = fopen(path, "w");
+  if (!f) return -1;
+  fprintf(f,
+          "# KF-GINS configuration written by navsim bench --peer-kfgins: the long drive with the values of\n"
+          "# its data set's README (the run behind the published figures).\n"
+          "imupath: \"%s\"\ngnsspath: \"%s\"\noutputpath: \"%s\"\n"
+          "imudatalen: 7\nimudatarate: 200\nstarttime: 100000.005\nendtime: -1\n"
+          "initpos: [31.508183, 120.401989, 0.0]\ninitvel: [0, 0, 0]\ninitatt: [0, 0, -177]\n"
+          "initgyrbias: [0, 0, 0]\ninitaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\ninitaccscale: [0, 0, 0]\n"
+          "initposstd: [0.02, 0.02, 0.05]\ninitvelstd: [0.01, 0.01, 0.01]\ninitattstd: [0.05, 0.05, 0.2]\n"
+          "initbgstd: [10, 10, 10]\ninitbastd: [150, 150, 150]\ninitsgstd: [100, 100, 100]\n"
+          "initsastd: [100, 100, 100]\n"
+          "imunoise:\n  arw: [0.1, 0.1, 0.1]\n  vrw: [0.1, 0.1, 0.1]\n  gbstd: [2.0, 2.0, 2.0]\n"
+          "  abstd: [20.0, 20.0, 20.0]\n  gsstd: [100.0, 100.0, 100.0]\n  asstd: [100.0, 100.0, 100.0]\n"
+          "  corrtime: 1.0\n"
+          "antlever: [0, 0, 0]\n",
+          imu, gnss, out);
+  return fclose(f) == 0 ? 0 : -1;
+}
+
+/* "pos_err_h_m": {"rms": X} of the first peer scored in a navsim replay summary.json, or NAN. */
+static double peer_rms_from_summary(const char *path) {
+  FILE *f = fopen(path, "r");
+  if (!f) return NAN;
+  static char buf[1 << 16];
+  const size_t len = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[len] = '\0';
+  const char *p = strstr(buf, "\"peers_scored\"");
+  if (p) p = strstr(p, "\"pos_err_h_m\"");
+  if (p) p = strstr(p, "\"rms\": ");
+  return p ? strtod(p + 7, NULL) : NAN;
+}
+
 void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, const char *out_dir,
-                  bench_row *row) {
+                  const char *peer_exe, bench_row *row, bench_row *peer_row) {
   char imu[4400], gnss[4400], ref[4400];
   snprintf(imu, sizeof imu, "%s/IMU.txt", data_dir);
   snprintf(gnss, sizeof gnss, "%s/%s", data_dir, gnss_file);
@@ -223,8 +262,9 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
     return;
   }
   /* The whole program, as a user runs it (process start, scene, parsing, navigation, scoring,
-   * nav/truth/errors CSV and summary.json written atomically): best of 3. */
-  double whole = NAN;
+   * nav/truth/errors CSV and summary.json written atomically): median of 3. With a peer program
+   * (--peer-kfgins), its runs alternate with ours, so both see the same load. */
+  double whole = NAN, peer_wall = NAN;
   char exe[4096], res[4096], scene[4400], outp[4400], log[4400];
   snprintf(log, sizeof log, "%s/logs", out_dir);
   if (bench_make_dir(log) == 0 && bench_self_exe(exe, sizeof exe) && navsim_find_resources_dir(res, sizeof res)) {
@@ -232,10 +272,60 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
     snprintf(outp, sizeof outp, "%s/logs/replay-%s", out_dir, gnss_file);
     snprintf(log, sizeof log, "%s/logs/replay-%s.log", out_dir, gnss_file);
     char *argv[] = {exe,     "replay", "--imu", imu, "--gnss", gnss,    "--truth", ref,
-                    "--scene", scene,  "--out", outp, "--quiet", NULL};
+                    "--scene", scene,  "--out", outp, "--force", "--quiet", NULL};
+    char cfg[4500], pout[4500], plog[4500];
+    snprintf(cfg, sizeof cfg, "%s/logs/kf-gins-%s.yaml", out_dir, gnss_file);
+    snprintf(pout, sizeof pout, "%s/logs/kf-gins-%s", out_dir, gnss_file);
+    snprintf(plog, sizeof plog, "%s/logs/kf-gins-%s.log", out_dir, gnss_file);
+    const bool peer = peer_exe && bench_make_dir(pout) == 0 && write_kfgins_config(cfg, imu, gnss, pout) == 0;
+    char *pargv[] = {(char *)peer_exe, cfg, NULL};
+    double ours[3], theirs[3];
+    int n_ours = 0, n_theirs = 0;
     for (int rep = 0; rep < 3; ++rep) {
       const child_result c = bench_run_child(argv, log, 120.0);
-      if (c.started && c.exited_ok && !(c.wall_s >= whole)) whole = c.wall_s;
+      if (c.started && c.exited_ok) ours[n_ours++] = c.wall_s;
+      if (peer) {
+        const child_result pc = bench_run_child(pargv, plog, 600.0);
+        if (pc.started && pc.exited_ok) theirs[n_theirs++] = pc.wall_s;
+      }
+    }
+    if (n_ours == 3) whole = bench_median(ours, n_ours);
+    if (peer && n_theirs == 3) peer_wall = bench_median(theirs, n_theirs);
+    if (peer_row) {
+      snprintf(peer_row->case_name, sizeof peer_row->case_name, "long-drive-replay-peer");
+      snprintf(peer_row->variant, sizeof peer_row->variant, "%s", gnss_file);
+      peer_row->algorithm = nav_mech_algorithm_name(cfg_scene->navigation.algorithm);
+      peer_row->earth_model = "wgs84";
+      peer_row->frame = nav_mech_frame_name(cfg_scene->navigation.frame);
+      peer_row->rate_hz = 200.0;
+      peer_row->load1 = bench_load1();
+      if (!peer) {
+        snprintf(peer_row->error, sizeof peer_row->error, "cannot write the KF-GINS configuration %.200s", cfg);
+      } else if (!isfinite(peer_wall) || !isfinite(whole)) {
+        snprintf(peer_row->error, sizeof peer_row->error, "%s failed (see %.200s)", isfinite(whole) ? "KF-GINS" : "navsim replay",
+                 isfinite(whole) ? plog : log);
+      } else {
+        /* The peer's solution scored by navsim replay --peer against the same reference. */
+        char nav[4600], sout[4600], slog[4700], sjs[4700], pname[4700];
+        snprintf(nav, sizeof nav, "%s/KF_GINS_Navresult.nav", pout);
+        snprintf(sout, sizeof sout, "%s/logs/kf-gins-score-%s", out_dir, gnss_file);
+        snprintf(slog, sizeof slog, "%s.log", sout);
+        snprintf(pname, sizeof pname, "KF-GINS=%s", nav);
+        char *sargv[] = {exe,     "replay", "--imu", imu,   "--gnss", gnss,      "--truth", ref,      "--scene",
+                         scene,   "--peer", pname,   "--out", sout,    "--force", "--quiet", NULL};
+        const child_result sc = bench_run_child(sargv, slog, 120.0);
+        snprintf(sjs, sizeof sjs, "%s/summary.json", sout);
+        peer_row->ok = true;
+        peer_row->samples = row->samples;
+        peer_row->wall_s = whole;
+        peer_row->peer = "KF-GINS (measured here)";
+        peer_row->peer_wall_s = peer_wall;
+        peer_row->peer_error_m = sc.exited_ok ? peer_rms_from_summary(sjs) : NAN;
+        snprintf(peer_row->note, sizeof peer_row->note,
+                 "medians of 3 alternating whole-process runs: navsim %.3g s, %s %.3g s (ratio %.3g); horizontal RMS "
+                 "of KF-GINS by navsim's scorer",
+                 whole, peer_exe, peer_wall, whole / peer_wall);
+      }
     }
   }
   row->samples = sum.imu_steps;
@@ -244,12 +334,14 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
   row->wall_s = isfinite(whole) ? whole : inproc;
   row->mech_sps = (double)sum.imu_steps / row->wall_s;
   /* The parts are timed separately (best of 3 each), so they need not add up to the whole. */
-  snprintf(row->note, sizeof row->note, "%s %.3g s; in-process without output files %.3g s, parsing alone %.3g s",
-           isfinite(whole) ? "whole navsim replay" : "the navsim child failed; in-process", row->wall_s, inproc,
-           row->parse_s);
+  snprintf(row->note, sizeof row->note,
+           "%s %.3g s; in-process without output files %.3g s, parsing alone %.3g s (best of 3)",
+           isfinite(whole) ? "whole navsim replay (median of 3)" : "the navsim child failed; in-process", row->wall_s,
+           inproc, row->parse_s);
+  row->load1 = bench_load1();
   row->pos_err_m = sum.stats.pos_h_m.rms;
   row->att_err_rad = sum.stats.yaw_rad.rms;
-  row->peer = "KF-GINS";
+  row->peer = "KF-GINS (published)";
   row->peer_wall_s = 3.3;
   row->ok = true;
   /* The figure compared: horizontal RMS (full GNSS), or the end error of the first outage. */
@@ -341,7 +433,7 @@ int bench_make_dir(const char *path) {
 }
 
 static const char *k_usage_bench =
-    "usage: navsim bench [--suite quick|full] [--out DIR] [--quiet]\n"
+    "usage: navsim bench [--suite quick|full] [--out DIR] [--peer-kfgins PATH] [--quiet]\n"
     "\n"
     "Speed against error: for each algorithm x Earth model x mechanization frame x rate,\n"
     "the throughput of truth generation and of the mechanization (IMU samples per second,\n"
@@ -351,12 +443,17 @@ static const char *k_usage_bench =
     "options:\n"
     "  --suite S   quick (default, under a minute) or full\n"
     "  --out DIR   output directory\n"
+    "  --peer-kfgins PATH  a KF-GINS executable you built: it runs on the long drive in this suite,\n"
+    "              alternating with navsim replay (medians of 3 each), and its solution is scored by\n"
+    "              the same code as ours; without it, KF-GINS's published figures are shown, labelled\n"
+    "              with the machine they were measured on\n"
+    "Each row records the 1-minute load average when its case was timed (column load1).\n"
     "  --quiet     do not print the table\n"
     "\n"
     "exit codes: 0 success (failed cases are reported in the table), 2 bad options, 1 I/O failure\n";
 
 int navsim_bench(int argc, char **argv) {
-  const char *out_dir = "out/bench";
+  const char *out_dir = "out/bench", *peer_kfgins = NULL;
   bool full = false, quiet = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -365,6 +462,12 @@ int navsim_bench(int argc, char **argv) {
       return 0;
     } else if (strcmp(a, "--quiet") == 0) {
       quiet = true;
+    } else if (strcmp(a, "--peer-kfgins") == 0 && i + 1 < argc) {
+      peer_kfgins = argv[++i];
+      if (access(peer_kfgins, X_OK) != 0) {
+        fprintf(stderr, "navsim bench: --peer-kfgins: \"%s\" is not an executable file\n", peer_kfgins);
+        return 2;
+      }
     } else if (strcmp(a, "--stage") == 0 && i + 3 < argc && strcmp(argv[i + 2], "--steps") == 0) {
       /* Hidden: one stage for the FLOP counts under valgrind (bench_report.c). */
       return bench_stage_main(argv[i + 1], atol(argv[i + 3]));
@@ -398,6 +501,7 @@ int navsim_bench(int argc, char **argv) {
   for (int i = 0; i < n; ++i) {
     snprintf(rows[i].case_name, sizeof rows[i].case_name, "%s", cases[i].name);
     snprintf(rows[i].variant, sizeof rows[i].variant, "%s", cases[i].variant);
+    rows[i].load1 = bench_load1();
     bench_scene(&cases[i].scene, reps, &rows[i]);
     if (!quiet) fprintf(stderr, "\r  bench: %d/%d", i + 1, n);
   }
@@ -465,11 +569,12 @@ int navsim_bench(int argc, char **argv) {
           for (int q = 0; q < 2; ++q) {
             snprintf(rows[n_all].case_name, sizeof rows[n_all].case_name, "long-drive-replay");
             snprintf(rows[n_all].variant, sizeof rows[n_all].variant, "%s", files[q]);
-            bench_replay(data, files[q], sc, out_dir, &rows[n_all++]);
+            bench_replay(data, files[q], sc, out_dir, peer_kfgins, &rows[n_all], peer_kfgins ? &rows[n_all + 1] : NULL);
+            n_all += peer_kfgins ? 2 : 1;
             /* The same figures against the second peer (pyins, README of the data set). */
-            if (rows[n_all - 1].ok) {
-              rows[n_all] = rows[n_all - 1];
-              rows[n_all].peer = "pyins";
+            if (rows[n_all - (peer_kfgins ? 2 : 1)].ok) {
+              rows[n_all] = rows[n_all - (peer_kfgins ? 2 : 1)];
+              rows[n_all].peer = "pyins (published)";
               rows[n_all].peer_wall_s = 85.0;
               rows[n_all].peer_error_m = q == 0 ? 0.0222 : 6.742;
               n_all++;
@@ -487,6 +592,9 @@ int navsim_bench(int argc, char **argv) {
     }
     free(sc);
   }
+  /* Rows of this block not stamped where they were timed: the load now. */
+  for (int i = n; i < n_all; ++i)
+    if (rows[i].load1 == 0.0) rows[i].load1 = bench_load1();
   if (!quiet) fputc('\n', stderr);
   /* Covariance rate, long-drive per algorithm and rate, MPI ranks, viewer fps, memory (bench_cases2.c). */
   bench_cases2(full, out_dir, rows, &n_all, CAP, quiet);
@@ -510,7 +618,7 @@ int navsim_bench(int argc, char **argv) {
   }
   fputs("case,variant,algorithm,earth_model,frame,rate_hz,samples,wall_s,samples_per_s,truth_samples_per_s,"
         "mech_samples_per_s,pos_err_m,vel_err_mps,att_err_rad,peer,peer_wall_s,peer_error,error,rms_h_m,peak_rss_mb,"
-        "fps,status\n",
+        "fps,load1,status\n",
         csv);
   for (int i = 0; i < n_all; ++i) {
     const bench_row *r = &rows[i];
@@ -523,11 +631,11 @@ int navsim_bench(int argc, char **argv) {
         fprintf(csv, "%s,%.6g,%.6g,%.6g,", r->peer, r->peer_wall_s, r->peer_error_m, r->error_m);
       else
         fputs(",,,,", csv);
-      fprintf(csv, "%.6g,%.6g,%.6g,ok\n", r->rms_h_m, r->peak_rss_mb, r->fps);
+      fprintf(csv, "%.6g,%.6g,%.6g,%.3g,ok\n", r->rms_h_m, r->peak_rss_mb, r->fps, r->load1);
     } else {
-      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,,,,,,,,,,,,,,,\"failed: %s\"\n", r->case_name, r->variant,
+      fprintf(csv, "%s,%s,%s,%s,%s,%g,%lld,,,,,,,,,,,,,,%.3g,\"failed: %s\"\n", r->case_name, r->variant,
               r->algorithm ? r->algorithm : "-", r->earth_model ? r->earth_model : "-", r->frame ? r->frame : "-",
-              r->rate_hz, r->samples, r->error);
+              r->rate_hz, r->samples, r->load1, r->error);
     }
   }
   {
@@ -554,8 +662,8 @@ int navsim_bench(int argc, char **argv) {
   }
   fprintf(md, "# navsim bench --suite %s\n\n", full ? "full" : "quick");
   fputs("| case | variant | algorithm | earth | frame | rate [Hz] | samples | wall [s] | truth [samples/s] | "
-        "nav [samples/s] | pos err [m] | vel err [m/s] | att err [rad] | peer |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "nav [samples/s] | pos err [m] | vel err [m/s] | att err [rad] | load | peer |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         md);
   for (int i = 0; i < n_all; ++i) {
     const bench_row *r = &rows[i];
@@ -568,12 +676,12 @@ int navsim_bench(int argc, char **argv) {
         snprintf(peer, sizeof peer, "peak RSS %.1f MB", r->peak_rss_mb);
       else if (r->fps > 0)
         snprintf(peer, sizeof peer, "%.1f fps", r->fps);
-      fprintf(md, "| %s | %s | %s | %s | %s | %g | %lld | %.3g | %.3g | %.3g | %.3e | %.3e | %.3e | %s%s%s |\n",
+      fprintf(md, "| %s | %s | %s | %s | %s | %g | %lld | %.3g | %.3g | %.3g | %.3e | %.3e | %.3e | %.2g | %s%s%s |\n",
               r->case_name, r->variant, r->algorithm, r->earth_model, r->frame, r->rate_hz, r->samples, r->wall_s,
-              r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps, r->att_err_rad, peer,
+              r->truth_sps, r->mech_sps, r->pos_err_m, r->vel_err_mps, r->att_err_rad, r->load1, peer,
               r->note[0] && peer[0] ? "; " : "", r->note);
     } else {
-      fprintf(md, "| %s | %s | %s | %s | %s | %g | | | | | | | | failed: %s |\n", r->case_name, r->variant,
+      fprintf(md, "| %s | %s | %s | %s | %s | %g | | | | | | | | | failed: %s |\n", r->case_name, r->variant,
               r->algorithm ? r->algorithm : "-", r->earth_model ? r->earth_model : "-", r->frame ? r->frame : "-",
               r->rate_hz, r->error);
     }

@@ -27,6 +27,7 @@
 #include <unistd.h>
 
 #include "bench_internal.h"
+#include "bench_verdict.h"
 #include "catalog_cmd.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_recorded.h"
@@ -106,6 +107,7 @@ static void row_init(bench_row *r, const char *case_name, const char *variant) {
   r->algorithm = r->earth_model = r->frame = "-";
   r->truth_sps = r->mech_sps = NAN;
   r->pos_err_m = r->vel_err_mps = r->att_err_rad = NAN;
+  r->load1 = bench_load1(); /* the load when the case starts */
 }
 
 /* ------------------------------------------------------------------ covariance rate */

@@ -25,12 +25,17 @@ typedef struct bench_row {
   double parse_s, nav_s; /* replay cases: parsing alone and the in-process replay (best of 3) [s] */
   double peak_rss_mb; /* child-process cases: peak resident memory (0: not measured) */
   double fps;         /* viewer case: frames per second */
+  double load1;       /* 1-minute load average when the case finished (bench_load1) */
   char note[160];     /* shown in bench.md (e.g. why a case stopped early) */
   bool ok;
   char error[256];
 } bench_row;
 
 double bench_now_s(void);
+
+/* Where the published KF-GINS figures on the long drive come from. */
+#define BENCH_KFGINS_PUBLISHED_SOURCE                                                                          \
+  "data set README: 2-core AMD EPYC, Debian 12, 2026-11-22; not this machine, not this load"
 
 /* Child processes (bench_cases2.c): stdout+stderr into log_path, killed after timeout_s (0: none). */
 typedef struct child_result {
@@ -54,8 +59,10 @@ void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row);
 /* Replay of the shared long drive with the navigation settings of cfg_scene (bench.c). */
 /* The long-drive replay: the whole `navsim replay` as a child process (the headline wall time),
  * plus an in-process breakdown (parsing alone, the replay without output files). */
+/* With @p peer_exe (a KF-GINS executable; NULL: none), the peer runs alternate with ours and
+ * @p peer_row receives the side-by-side figures measured in this run. */
 void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, const char *out_dir,
-                  bench_row *row);
+                  const char *peer_exe, bench_row *row, bench_row *peer_row);
 /* This executable (/proc/self/exe). */
 bool bench_self_exe(char *buf, size_t cap);
 

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "bench_internal.h"
+#include "bench_verdict.h"
 #include "catalog_cmd.h"
 
 #define STUDIO_CASE "navstudio-preview"
@@ -102,7 +103,5 @@ void bench_studio_target_md(FILE *md, const bench_row *rows, int n) {
   else
     snprintf(v, sizeof v, "%s", r->error);
   fprintf(md, "| navstudio live preview, edit to picture | <= %.0f ms | %s | %s |\n", STUDIO_TARGET_MS, v,
-          !r->ok                                 ? "not measured"
-          : r->wall_s * 1e3 <= STUDIO_TARGET_MS ? "**met**"
-                                                 : "**not met**");
+          bench_verdict_text(bench_verdict_at_most(r->ok ? r->wall_s * 1e3 : NAN, STUDIO_TARGET_MS, false)));
 }
