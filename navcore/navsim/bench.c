@@ -213,15 +213,16 @@ static int write_kfgins_config(const char *path, const char *imu, const char *gn
   return fclose(f) == 0 ? 0 : -1;
 }
 
-/* "pos_err_h_m": {"rms": X} of the first peer scored in a navsim replay summary.json, or NAN. */
-static double peer_rms_from_summary(const char *path) {
+/* "pos_err_h_m": {"rms": X} after the key @p section ("peers_scored": the first peer scored;
+ * "errors_at_output_epochs": ours at the same 10 Hz epochs) of a navsim replay summary.json, or NAN. */
+static double rms_from_summary(const char *path, const char *section) {
   FILE *f = fopen(path, "r");
   if (!f) return NAN;
   static char buf[1 << 16];
   const size_t len = fread(buf, 1, sizeof buf - 1, f);
   fclose(f);
   buf[len] = '\0';
-  const char *p = strstr(buf, "\"peers_scored\"");
+  const char *p = strstr(buf, section);
   if (p) p = strstr(p, "\"pos_err_h_m\"");
   if (p) p = strstr(p, "\"rms\": ");
   return p ? strtod(p + 7, NULL) : NAN;
@@ -316,19 +317,22 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
         const child_result sc = bench_run_child(sargv, slog, 120.0);
         snprintf(sjs, sizeof sjs, "%s/summary.json", sout);
         peer_row->ok = true;
-        peer_row->samples = row->samples;
         peer_row->wall_s = whole;
         peer_row->peer = "KF-GINS (measured here)";
         peer_row->peer_wall_s = peer_wall;
-        peer_row->peer_error_m = sc.exited_ok ? peer_rms_from_summary(sjs) : NAN;
+        /* Both horizontal RMS by the same scorer at the same (10 Hz output) epochs. */
+        peer_row->peer_error_m = sc.exited_ok ? rms_from_summary(sjs, "\"peers_scored\"") : NAN;
+        peer_row->error_m = sc.exited_ok ? rms_from_summary(sjs, "\"errors_at_output_epochs\"") : NAN;
+        peer_row->pos_err_m = peer_row->error_m;
         snprintf(peer_row->note, sizeof peer_row->note,
-                 "medians of 3 alternating whole-process runs: navsim %.3g s, %s %.3g s (ratio %.3g); horizontal RMS "
-                 "of KF-GINS by navsim's scorer",
-                 whole, peer_exe, peer_wall, whole / peer_wall);
+                 "medians of 3 alternating runs: navsim %.3g s, peer %.3g s (ratio %.3g); RMS of both at 10 Hz, "
+                 "same scorer",
+                 whole, peer_wall, whole / peer_wall);
       }
     }
   }
   row->samples = sum.imu_steps;
+  if (peer_row && peer_row->ok) peer_row->samples = sum.imu_steps;
   row->parse_s = parse;
   row->nav_s = inproc - parse;
   row->wall_s = isfinite(whole) ? whole : inproc;

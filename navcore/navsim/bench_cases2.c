@@ -246,7 +246,7 @@ static void case_mpi(bool full, const char *out_dir, bench_row *rows, int *n, in
     snprintf(outp, sizeof outp, "%s/logs/mpi-np%d", out_dir, k + 1);
     char *argv[] = {
         NAVSIM_MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-np", k ? "2" : "1", exe,     "run", scene,
-        "--runs",       (char *)runs,          "--threads",       "1",   "--quiet",     "--out", outp,  NULL};
+        "--runs",       (char *)runs,          "--threads",       "1",   "--quiet",     "--out", outp,  "--force", NULL};
     const child_result c = bench_run_child(argv, log, 900.0);
     if (!c.started || !c.exited_ok) {
       snprintf(r->error, sizeof r->error, "mpirun %s (see %.200s)", c.timed_out ? "timed out" : "failed",
@@ -389,7 +389,7 @@ static void case_campaign(const char *case_name, long runs, double rate_hz, doub
   if (env && atof(env) > 0) cap_s = atof(env);
   char nruns[32];
   snprintf(nruns, sizeof nruns, "%ld", runs);
-  char *argv[] = {exe, "run", scene, "--runs", nruns, "--threads", "2", "--quiet", "--out", outp, NULL};
+  char *argv[] = {exe, "run", scene, "--runs", nruns, "--threads", "2", "--quiet", "--out", outp, "--force", NULL};
   const child_result c = bench_run_child(argv, log, cap_s);
   r->peak_rss_mb = c.maxrss_mb;
   r->wall_s = c.wall_s;
