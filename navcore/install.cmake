@@ -69,3 +69,20 @@ foreach(_pc navcore navcore-io)
 endforeach()
 
 install(TARGETS navsim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+
+# Man pages navsim.1 and navsim-COMMAND.1, generated with help2man from `navsim [COMMAND] --help`
+# each time navsim is linked (the test install_man checks that they agree with --help).
+find_program(NAV_HELP2MAN help2man)
+if(NAV_HELP2MAN)
+  add_custom_command(OUTPUT ${CMAKE_CURRENT_BINARY_DIR}/man/navsim.1.gz
+    COMMAND sh ${PROJECT_SOURCE_DIR}/packaging/help2man-pages.sh $<TARGET_FILE:navsim>
+            ${CMAKE_CURRENT_BINARY_DIR}/man ${PROJECT_VERSION}
+            "simulate inertial and integrated navigation systems from scene files" navview navstudio
+    DEPENDS navsim ${PROJECT_SOURCE_DIR}/packaging/help2man-pages.sh
+    COMMENT "Generating the navsim man pages (help2man)" VERBATIM)
+  add_custom_target(navsim_man ALL DEPENDS ${CMAKE_CURRENT_BINARY_DIR}/man/navsim.1.gz)
+  install(DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/man/ DESTINATION ${CMAKE_INSTALL_MANDIR}/man1
+    COMPONENT tools FILES_MATCHING PATTERN "navsim*.1.gz" PATTERN wrap EXCLUDE)
+else()
+  message(WARNING "help2man not found (Debian: help2man): the navsim man pages are not built")
+endif()

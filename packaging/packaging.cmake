@@ -1,7 +1,7 @@
-# Installed share data (issue 24). Included from the top-level CMakeLists.txt; each folder
-# installs its own targets.
+# Installed share data and bash completion (issue 24). Included from the top-level
+# CMakeLists.txt; each folder installs its own targets.
 #
-#   cmake --install build --prefix P     P/bin, P/lib, P/include/navcore, P/share/navcore, ...
+#   cmake --install build --prefix P     P/bin, P/lib, P/include/navcore, P/share/navcore, man, ...
 include(GNUInstallDirs)
 if(NOT NAV_INSTALLABLE)
   return()
@@ -17,3 +17,5 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${NAV_SHARE_DEST}/sc
 install(FILES ${PROJECT_SOURCE_DIR}/tests/data/recorded/adis16465-truth-116454-116754.nav
               ${PROJECT_SOURCE_DIR}/tests/data/recorded/README.md
   DESTINATION ${NAV_SHARE_DEST}/tests/data/recorded COMPONENT tools)
+install(FILES ${PROJECT_SOURCE_DIR}/packaging/navsim.bash-completion
+  DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions RENAME navsim COMPONENT tools)

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Install tests (issue 24), run by ctest (tests/install/install_tests.cmake).
+# Install and man-page tests (issue 24), run by ctest (tests/install/install_tests.cmake).
 # usage: install_test.sh MODE SOURCE_DIR BUILD_DIR WORK_DIR VERSION
 #   setup      cmake --install BUILD_DIR --prefix WORK_DIR/prefix --strip (the fixture of the others)
 #   tree       the installed files; no build or source path in the installed binaries; the
@@ -7,6 +7,7 @@
 #              its scenes and catalogs (check + run + catalog)
 #   cmake      an external CMake project: find_package(navcore), navcore::io and io_static
 #   pkgconfig  the same program built with pkg-config --cflags --libs navcore-io
+#   man        every command of navsim --help has a man page; each page says what --help says
 set -eu
 mode=$1
 src=$(cd "$2" && pwd -P)
@@ -40,15 +41,17 @@ tree)
     "$libdir/libnavcore.so.$version" "$libdir/libnavcore_io.so.$version" \
     "$libdir/cmake/navcore/navcoreConfig.cmake" "$libdir/cmake/navcore/navcoreConfigVersion.cmake" \
     "$libdir/cmake/navcore/navcoreTargets.cmake" "$libdir/pkgconfig/navcore.pc" "$libdir/pkgconfig/navcore-io.pc" \
-    include/navcore/nav_version.h include/navcore/nav_paths.h share/navcore/resources/imu_catalog.csv \
+    include/navcore/nav_version.h include/navcore/nav_paths.h share/man/man1/navsim.1.gz \
+    share/bash-completion/completions/navsim share/navcore/resources/imu_catalog.csv \
     share/navcore/resources/gnss_receivers.csv share/navcore/scenes/$scene; do
     [ -e "$prefix/$f" ] || fail "not installed: $f"
   done
   if [ -x "$build/viewer/navview" ]; then
-    for f in bin/navview; do [ -e "$prefix/$f" ] || fail "not installed: $f"; done
+    for f in bin/navview share/man/man1/navview.1.gz; do [ -e "$prefix/$f" ] || fail "not installed: $f"; done
   fi
   if [ -x "$build/editor/navstudio" ]; then
-    for f in bin/navstudio; do
+    for f in bin/navstudio share/man/man1/navstudio.1.gz share/applications/navstudio.desktop \
+      share/icons/hicolor/scalable/apps/navstudio.svg; do
       [ -e "$prefix/$f" ] || fail "not installed: $f"
     done
   fi
@@ -131,6 +134,48 @@ pkgconfig)
   cc -std=c11 -o "$work/consumer-pc/consumer" "$src/tests/install/consumer/consumer.c" \
     $(pkg-config --cflags --libs navcore-io) -Wl,-rpath,"$libdir" || fail "cc with pkg-config navcore-io"
   check_consumer_line "$(cd "$work" && "$work/consumer-pc/consumer")"
+  ;;
+
+man)
+  [ -d "$prefix" ] || fail "no installed tree at $prefix (fixture install_setup)"
+  mandir=$prefix/share/man/man1
+  # One page for navsim and one per command, nothing stale.
+  cmds=$("$prefix/bin/navsim" --help | sed -n '/^commands:/,/^$/p' | sed -n 's/^  \([a-z][a-z0-9-]*\) .*/\1/p')
+  [ -n "$cmds" ] || fail "no command list in navsim --help"
+  expected="navsim.1.gz"
+  for c in $cmds; do expected="$expected
+navsim-$c.1.gz"; done
+  printf '%s\n' "$expected" | sort > "$work/man.expected"
+  (cd "$mandir" && ls navsim*.1.gz) | sort > "$work/man.installed"
+  diff "$work/man.expected" "$work/man.installed" || fail "man pages differ from the commands of navsim --help"
+  # Rendered text: synopsis and description, word by word, against --help.
+  same() { # PAGE COMMAND...: the page's text from SYNOPSIS to SEE ALSO is the words of COMMAND --help
+    page=$1
+    shift
+    "$@" --help 2>&1 | sed '1s/^usage://' | tr -s ' \t\n' '\n' | sed '/^$/d' > "$work/help.words"
+    MANWIDTH=4000 man -E ascii -l "$mandir/$page.1.gz" 2>/dev/null | col -b |
+      awk '/^SYNOPSIS/ { f = 1; next } /^SEE ALSO/ { f = 0 } /^[A-Z][A-Z ]*$/ { next } f' |
+      tr -s ' \t\n' '\n' | sed '/^$/d' > "$work/man.words"
+    [ -s "$work/man.words" ] || fail "$page.1.gz renders no text"
+    diff "$work/help.words" "$work/man.words" > "$work/man.diff" ||
+      fail "$page.1.gz disagrees with '$* --help': $(head -n 6 "$work/man.diff")"
+  }
+  same navsim "$prefix/bin/navsim"
+  for c in $cmds; do
+    same "navsim-$c" "$prefix/bin/navsim" "$c"
+    MANWIDTH=4000 man -E ascii -l "$mandir/navsim.1.gz" | grep -q "^ *$c\\b" || fail "man navsim does not list $c"
+  done
+  if [ -x "$prefix/bin/navview" ]; then same navview "$prefix/bin/navview"; fi
+  if [ -x "$prefix/bin/navstudio" ]; then
+    # navstudio.1 is written: its SYNOPSIS is the usage line of navstudio --help.
+    u=$(QT_QPA_PLATFORM=offscreen "$prefix/bin/navstudio" --help 2>/dev/null | sed -n '1s/^usage: //p' | tr -s ' ')
+    m=$(MANWIDTH=4000 man -E ascii -l "$mandir/navstudio.1.gz" | col -b | awk '/^SYNOPSIS/ { f = 1; next } /^[A-Z]/ { f = 0 } f' | tr -s ' \n' ' ' | sed 's/^ //; s/ $//')
+    [ -n "$u" ] && [ "$u" = "$m" ] || fail "navstudio.1 SYNOPSIS '$m' is not navstudio --help's usage '$u'"
+  fi
+  # bash completion offers every command.
+  got=$(PATH="$prefix/bin:$PATH" bash -c ". '$prefix/share/bash-completion/completions/navsim'; COMP_WORDS=(navsim ''); COMP_CWORD=1; _navsim; echo \${COMPREPLY[*]}")
+  for c in $cmds; do echo " $got " | grep -q " $c " || fail "bash completion does not offer $c (got: $got)"; done
+  echo "man pages and completion agree with --help for: navsim" $cmds
   ;;
 
 *)
