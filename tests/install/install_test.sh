@@ -1,5 +1,5 @@
 #!/bin/sh
-# Install and man-page tests (issue 24), run by ctest (tests/install/install_tests.cmake).
+# Install, package and man-page tests (issue 24), run by ctest (tests/install/install_tests.cmake).
 # usage: install_test.sh MODE SOURCE_DIR BUILD_DIR WORK_DIR VERSION
 #   setup      cmake --install BUILD_DIR --prefix WORK_DIR/prefix --strip (the fixture of the others)
 #   tree       the installed files; no build or source path in the installed binaries; the
@@ -8,6 +8,7 @@
 #   cmake      an external CMake project: find_package(navcore), navcore::io and io_static
 #   pkgconfig  the same program built with pkg-config --cflags --libs navcore-io
 #   man        every command of navsim --help has a man page; each page says what --help says
+#   deb        cpack -G DEB; dpkg -x in a scratch root; navsim check + run from there; lintian
 set -eu
 mode=$1
 src=$(cd "$2" && pwd -P)
@@ -178,6 +179,29 @@ navsim-$c.1.gz"; done
   echo "man pages and completion agree with --help for: navsim" $cmds
   ;;
 
+deb)
+  rm -rf "$work"
+  mkdir -p "$work/root"
+  (cd "$build" && cpack -G DEB -B "$work/deb" > "$work/cpack.log" 2>&1) || { cat "$work/cpack.log"; fail "cpack -G DEB"; }
+  ls "$work"/deb/*.deb > "$work/debs.txt" || fail "cpack made no .deb"
+  for d in $(cat "$work/debs.txt"); do
+    echo "$(basename "$d"): Depends: $(dpkg-deb -f "$d" Depends)"
+    dpkg -x "$d" "$work/root"
+  done
+  [ -n "$(dpkg-deb -f "$(grep '/navsim_' "$work/debs.txt")" Depends)" ] || fail "the navsim package has no Depends (dpkg-shlibdeps)"
+  root=$work/root
+  (cd "$work" && "$root/usr/bin/navsim" check "$root"/usr/share/navcore/scenes/*.yaml) || fail "navsim check of the packaged scenes"
+  (cd "$work" && "$root/usr/bin/navsim" run "$root/usr/share/navcore/scenes/$scene" --out "$work/result" --quiet) || fail "navsim run from the package"
+  [ -s "$work/result/summary.json" ] || fail "no summary.json from the packaged navsim"
+  command -v lintian >/dev/null 2>&1 || fail "lintian is not installed (Debian: lintian)"
+  # lintian exits non-zero on an error tag (its default --fail-on error) or when it cannot run.
+  lrc=0
+  # shellcheck disable=SC2046
+  lintian --tag-display-limit 0 $(cat "$work/debs.txt") > "$work/lintian.txt" 2>&1 || lrc=$?
+  cat "$work/lintian.txt"
+  if grep -q '^E: ' "$work/lintian.txt" || [ "$lrc" -ne 0 ]; then fail "lintian reports errors (exit $lrc)"; fi
+  echo "packages extracted, navsim check + run passed, lintian: no errors"
+  ;;
 *)
   fail "unknown mode $mode"
   ;;
