@@ -14,6 +14,8 @@ NAV_PACKAGES=(
   clang libfuzzer-14-dev            # libFuzzer targets (tests/fuzz)
   chromium                          # navsim report check (headless screenshot)
   python-cartopy-data gmt-gshhg-low # offline map background (coastlines, borders)
+  help2man man-db bsdextrautils     # man pages from --help; tests render them (man, col)
+  dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

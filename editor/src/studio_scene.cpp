@@ -20,18 +20,23 @@ extern "C" {
 #include "navcore/nav_frames.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_motiondef.h"
+#include "navcore/nav_paths.h"
 #include "navcore/nav_traj.h"
 }
 
 namespace studio {
 
+// $NAV_RESOURCES_DIR, else <share>/resources; the share directory is found relative to the
+// executable, installed or in the build tree (nav_paths.h).
 QString ResourcesDir() {
-  const QByteArray env = qgetenv("NAV_RESOURCES_DIR");
-  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
-  return QStringLiteral(NAVSTUDIO_RESOURCES_DIR);
+  char dir[4096];
+  return nav_paths_resources_dir(dir, sizeof dir) ? QString::fromLocal8Bit(dir) : QString();
 }
 
-QString ScenesDir() { return QStringLiteral(NAVSTUDIO_SCENES_DIR); }
+QString ScenesDir() {
+  char dir[4096];
+  return nav_paths_scenes_dir(dir, sizeof dir) ? QString::fromLocal8Bit(dir) : QString();
+}
 
 void Normalize(nav_scene *s) {
   // navigation.cov_decimation: 0 (nav_scene_default) and 1 both mean "every IMU step"

@@ -51,9 +51,10 @@ enum : unsigned char { kOverAccel = 1, kOverTurnRate = 2, kOverLateral = 4 };
 /** Text of the limits in @p bits ("acceleration", "turn rate", "lateral acceleration"). */
 QString OverLimitText(unsigned bits);
 
-/** Directory holding imu_catalog.csv and gnss_receivers.csv ($NAV_RESOURCES_DIR or the source tree's). */
+/** Directory holding imu_catalog.csv and gnss_receivers.csv ($NAV_RESOURCES_DIR, else the share
+    directory's resources/ found by nav_paths_resources_dir: installed or build tree); "" if none. */
 QString ResourcesDir();
-/** Directory of the scene library (scenes/). */
+/** Directory of the scene library (the share directory's scenes/, nav_paths_scenes_dir); "" if none. */
 QString ScenesDir();
 
 /** Equivalent spellings the editor keeps in one form (see the .cpp). */

@@ -58,6 +58,7 @@
 #include "navcore/nav_catalog.h"
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
+#include "navcore/nav_paths.h"
 #include "navcore/nav_sensors.h"
 #include "scene_bounds.h"
 #include "scene_io_internal.h"
@@ -2122,18 +2123,9 @@ static void read_root(nav_io_reader *r, const nav_io_node *root, nav_scene *scen
 
 /* ================================================================ custom fields of the sensor sections */
 
-/* The resources directory: $NAV_RESOURCES_DIR, else the source tree's resources/ compiled in
-   (the build-tree fallback; navsim also knows the installed layout). */
+/* The resources directory: $NAV_RESOURCES_DIR, else <share>/resources (nav_paths.h). */
 static bool resources_dir(char *buf, size_t size) {
-  const char *env = getenv("NAV_RESOURCES_DIR");
-  if (env != NULL && env[0] != '\0') return snprintf(buf, size, "%s", env) < (int)size;
-#ifdef NAV_IO_SOURCE_RESOURCES_DIR
-  return snprintf(buf, size, "%s", NAV_IO_SOURCE_RESOURCES_DIR) < (int)size;
-#else
-  (void)buf;
-  (void)size;
-  return false;
-#endif
+  return nav_paths_resources_dir(buf, size);
 }
 
 static void forward_diag(void *user, const nav_diag *d) {

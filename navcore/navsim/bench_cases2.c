@@ -30,6 +30,7 @@
 #include "bench_verdict.h"
 #include "catalog_cmd.h"
 #include "navcore/nav_ins_gnss.h"
+#include "navcore/nav_paths.h"
 #include "navcore/nav_recorded.h"
 
 /* ------------------------------------------------------------------ child processes */
@@ -89,10 +90,8 @@ bool bench_self_exe(char *buf, size_t cap) {
 }
 
 const char *bench_navview_exe(void) {
-#ifdef NAVVIEW_EXE
-  if (access(NAVVIEW_EXE, X_OK) == 0) return NAVVIEW_EXE;
-#endif
-  return NULL;
+  static char path[4096];
+  return nav_paths_program("navview", path, sizeof path) ? path : NULL;
 }
 
 bool bench_have_display(void) {

@@ -17,15 +17,14 @@
 #include "bench_internal.h"
 #include "bench_verdict.h"
 #include "catalog_cmd.h"
+#include "navcore/nav_paths.h"
 
 #define STUDIO_CASE "navstudio-preview"
 #define STUDIO_TARGET_MS 100.0
 
 static const char *navstudio_exe(void) {
-#ifdef NAVSTUDIO_EXE
-  if (access(NAVSTUDIO_EXE, X_OK) == 0) return NAVSTUDIO_EXE;
-#endif
-  return NULL;
+  static char path[4096];
+  return nav_paths_program("navstudio", path, sizeof path) ? path : NULL;
 }
 
 /* Value of "key=" in line (NAN when absent). */

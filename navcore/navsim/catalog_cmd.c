@@ -14,6 +14,7 @@
 
 #include "navcore/nav_catalog.h"
 #include "navcore/nav_io.h"
+#include "navcore/nav_paths.h"
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
@@ -35,35 +36,15 @@ static const char *k_usage_catalog =
     "                    allan_peak (default; sigma = B / 0.61736) or sigma_equals_b\n"
     "  -h, --help        print this help\n"
     "\n"
-    "The catalogs are looked up in $NAV_RESOURCES_DIR, else <bin>/../share/navcore/resources,\n"
-    "else the source tree's resources/.\n"
+    "The catalogs are looked up in $NAV_RESOURCES_DIR, else <bin>/../share/navcore/resources\n"
+    "(the build tree links <build>/share/navcore to the sources).\n"
     "\n"
     "exit codes: 0 success; 1 a catalog cannot be found or read; 2 invalid catalog or options\n";
 
 bool navsim_find_resources_dir(char *buf, size_t size) {
   if (buf == NULL || size == 0) return false;
   buf[0] = '\0';
-  const char *env = getenv("NAV_RESOURCES_DIR");
-  if (env && *env) return snprintf(buf, size, "%s", env) < (int)size;
-
-  char probe[PATH_CAP + 64];
-  char exe[PATH_CAP];
-  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n > 0) {
-    exe[n] = '\0';
-    char *slash = strrchr(exe, '/');
-    if (slash) {
-      *slash = '\0';
-      snprintf(probe, sizeof probe, "%s/../share/navcore/resources/imu_catalog.csv", exe);
-      if (access(probe, R_OK) == 0)
-        return snprintf(buf, size, "%s/../share/navcore/resources", exe) < (int)size;
-    }
-  }
-#ifdef NAVSIM_SOURCE_RESOURCES_DIR
-  snprintf(probe, sizeof probe, "%s/imu_catalog.csv", NAVSIM_SOURCE_RESOURCES_DIR);
-  if (access(probe, R_OK) == 0) return snprintf(buf, size, "%s", NAVSIM_SOURCE_RESOURCES_DIR) < (int)size;
-#endif
-  return false;
+  return nav_paths_resources_dir(buf, size);
 }
 
 /* One CSV cell: quoted when it holds a comma, quote or leading/trailing blank. */

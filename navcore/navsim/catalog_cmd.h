@@ -18,10 +18,10 @@ int navsim_catalog(int argc, char **argv, const char *resources_dir);
  * Locate the resources directory, first match wins:
  *  1. $NAV_RESOURCES_DIR if set and non-empty (used as given, even if it lacks the files, so a
  *     wrong setting is reported instead of silently ignored);
- *  2. <directory of the executable>/../share/navcore/resources (installed layout; Linux
- *     /proc/self/exe);
- *  3. NAVSIM_SOURCE_RESOURCES_DIR, the source tree's resources/ compiled in by CMake (build tree).
- * Candidates 2 and 3 count only if they contain a readable imu_catalog.csv.
+ *  2. <share dir>/resources, the share directory found relative to the executable (installed
+ *     tree: <bin>/../share/navcore; build tree: <build>/share/navcore, linked to the sources) by
+ *     nav_paths_resources_dir() (nav_paths.h), which counts it only if it contains a readable
+ *     imu_catalog.csv.
  * @return true and the directory in @p buf, or false (buf = "").
  */
 bool navsim_find_resources_dir(char *buf, size_t size);

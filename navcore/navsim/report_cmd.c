@@ -1,8 +1,9 @@
 /*
  * navsim render / navsim report (see report_cmd.h).
  *
- * Both drive the viewer program navview (built with -DNAV_BUILD_VIEWER=ON; NAVVIEW_EXE, else
- * navview on PATH). Without DISPLAY every navview call runs under `xvfb-run -a`.
+ * Both drive the viewer program navview (built with -DNAV_BUILD_VIEWER=ON; the one next to this
+ * navsim, installed or in the build tree (nav_paths_program), else navview on PATH). Without
+ * DISPLAY every navview call runs under `xvfb-run -a`.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_util.h"
@@ -18,6 +19,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "navcore/nav_paths.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 
@@ -32,11 +34,12 @@ static void record_output(const char *dir, const char *path) {
 
 enum { RC_OK = 0, RC_FAIL = 1, RC_INVALID = 2 };
 
-#ifdef NAVVIEW_EXE
-static const char *k_viewer = NAVVIEW_EXE;
-#else
-static const char *k_viewer = "navview";
-#endif
+/* navview of this installation or build tree, else the one on PATH. */
+static const char *viewer_exe(void) {
+  static char path[4096];
+  if (path[0] == '\0' && !nav_paths_program("navview", path, sizeof path)) snprintf(path, sizeof path, "navview");
+  return path;
+}
 
 static bool need_xvfb(void) {
   const char *d = getenv("DISPLAY");
@@ -72,7 +75,7 @@ static void av_init(argvec *v) {
     v->a[v->n++] = "-s";
     v->a[v->n++] = "-screen 0 1920x1200x24";
   }
-  v->a[v->n++] = (char *)k_viewer;
+  v->a[v->n++] = (char *)viewer_exe();
   v->a[v->n] = NULL;
 }
 

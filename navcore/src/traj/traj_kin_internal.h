@@ -237,12 +237,14 @@ typedef struct nav_traj_script_info {
 /**
  * Plan the segment script of @p scene without building positions. On failure @p bad_index is the
  * offending segment (-1 when not tied to one) and msg says what is wrong.
+ * Exported from libnavcore.so (NAV_API, though not in a public header): libnavcore_io.so calls
+ * it, and a hidden symbol would fail that library's link.
  */
-nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_info *info, int *bad_index,
-                                       char *msg, size_t msg_size);
-/** Same for waypoints (bad_index = offending waypoint). */
-nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info, int *bad_index,
-                                        char *msg, size_t msg_size);
+NAV_API nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_info *info,
+                                               int *bad_index, char *msg, size_t msg_size);
+/** Same for waypoints (bad_index = offending waypoint); exported like the one above. */
+NAV_API nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info,
+                                                int *bad_index, char *msg, size_t msg_size);
 /**
  * Times at which a model built by nav_traj_segments_create / nav_traj_waypoints_create changes
  * piece or starts/ends a ramp (transitions). Writes up to @p cap, returns the total count.
