@@ -31,7 +31,8 @@ void navsim_print_diag(void *user, const nav_diag *d) {
 
 int navsim_load_scene(const char *path, nav_scene *scene) {
   navsim_diag_sink sink = {0};
-  const nav_status st = nav_scene_read_file(path, scene, navsim_print_diag, &sink);
+  /* Requirements the run cannot evaluate are refused here too (issue 25). */
+  const nav_status st = nav_scene_read_file_to_run(path, scene, navsim_print_diag, &sink);
   if (st == NAV_OK) return 0;
   if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
   return st == NAV_ERR_PARSE ? 2 : 1;
