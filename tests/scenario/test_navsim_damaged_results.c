@@ -1,0 +1,113 @@
+/*
+ * Damaged result directories (issue 25, "nothing pretended"): `navsim report` and `navsim export`
+ * read a result directory that navsim wrote; when one of its files was cut or replaced, they say
+ * which file and where, with exit 2, instead of a page that says "The scene states no
+ * requirements" or a shortened track. Every case starts from a fresh copy of one good result.
+ *
+ * NAVSIM_EXE, NAV_SOURCE_DIR and NAV_TEST_WORK_DIR come from the build.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "navsim_cli.h"
+
+#define WORK NAV_TEST_WORK_DIR
+
+static int setup(void **state) {
+  (void)state;
+  if (nav_test_fresh_dir(WORK) != 0) return -1;
+  /* One run of the urban drive (WGS-84, INS/GNSS, requirements that fail): about a second. */
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL,
+                                       "run '" NAV_SOURCE_DIR "/scenes/urban-drive.yaml' --runs 1 --quiet --out good");
+  if (r->code != 0) {
+    fprintf(stderr, "setup: navsim run exited %d: %s\n", r->code, r->err);
+    return -1;
+  }
+  return 0;
+}
+
+/* A fresh copy of the good result as WORK/d, then the shell command @p damage run in WORK. */
+static void fresh_copy(const char *damage) {
+  char cmd[2048];
+  snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf d && cp -r good d && %s", WORK, damage);
+  assert_int_equal(system(cmd), 0);
+}
+
+static bool exists(const char *path) {
+  struct stat sb;
+  return stat(path, &sb) == 0;
+}
+
+/* report of a summary.json cut at 500 bytes: exit 2 naming the file, its line and column, and
+ * the byte where it ends; no page (which would say the scene states no requirements). */
+static void test_issue_25_report_truncated_summary(void **state) {
+  (void)state;
+  fresh_copy("head -c 500 good/summary.json > d/summary.json");
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "report d");
+  if (r->code != 2) fail_msg("report of a cut summary.json exited %d:\n%s\n%s", r->code, r->out, r->err);
+  nav_test_assert_matches(r->err, "^d/summary\\.json:[0-9]+:[0-9]+: error: truncated JSON: the file ends at byte 500 ");
+  if (strstr(r->out, "no requirements") || strstr(r->err, "no requirements")) fail_msg("pretended: %s", r->out);
+  if (exists(WORK "/d/report")) fail_msg("a refused report wrote d/report");
+  /* Invalid in the middle (a byte replaced): its place. */
+  fresh_copy("sed -i 's/\"seed\"/seed/' d/summary.json");
+  r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "report d");
+  if (r->code != 2) fail_msg("report of an invalid summary.json exited %d:\n%s", r->code, r->err);
+  nav_test_assert_matches(r->err, "^d/summary\\.json:4:3: error: invalid JSON at byte [0-9]+ of [0-9]+: expected a key");
+}
+
+static void test_issue_25_report_missing_summary(void **state) {
+  (void)state;
+  fresh_copy("rm d/summary.json");
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "report d");
+  if (r->code != 2) fail_msg("report without summary.json exited %d:\n%s", r->code, r->err);
+  nav_test_assert_matches(r->err, "^d/summary\\.json: error: missing: ");
+  if (exists(WORK "/d/report")) fail_msg("a refused report wrote d/report");
+}
+
+/* export of a truth.csv cut after row 521 (whole lines), cut mid-line, replaced by a directory,
+ * or only its header; and of a cut nav.csv: exit 2 with the file and the line, no tracks. */
+static void test_issue_25_export_truncated_tracks(void **state) {
+  (void)state;
+  static const struct {
+    const char *damage, *pattern;
+  } k_cases[] = {
+      {"head -521 good/truth.csv > d/truth.csv",
+       "^d/truth\\.csv:521: error: the track ends at t = 51\\.9 s but the run ends at 513 s \\(summary\\.json "
+       "final\\.t_s\\): the file was cut short$"},
+      {"head -c 40000 good/truth.csv > d/truth.csv",
+       "^d/truth\\.csv:[0-9]+:[0-9]+: error: the last line has no line end: the file was cut short"},
+      {"rm d/truth.csv && mkdir d/truth.csv", "^d/truth\\.csv: error: not a regular file \\(a directory\\)"},
+      {"head -1 good/truth.csv > d/truth.csv", "^d/truth\\.csv:1:1: error: no data row after the header"},
+      {"head -2000 good/nav.csv > d/nav.csv", "^d/nav\\.csv:2000: error: the track ends at t = "},
+  };
+  for (size_t k = 0; k < sizeof k_cases / sizeof k_cases[0]; ++k) {
+    fresh_copy(k_cases[k].damage);
+    nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "export d");
+    if (r->code != 2) fail_msg("export after \"%s\" exited %d:\n%s\n%s", k_cases[k].damage, r->code, r->out, r->err);
+    nav_test_assert_matches(r->err, k_cases[k].pattern);
+    if (exists(WORK "/d/tracks.kml") || exists(WORK "/d/tracks.csv"))
+      fail_msg("export after \"%s\" wrote tracks", k_cases[k].damage);
+  }
+  /* The good directory still exports. */
+  fresh_copy("true");
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "export d");
+  if (r->code != 0) fail_msg("export of the good result exited %d:\n%s", r->code, r->err);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_issue_25_report_truncated_summary),
+      cmocka_unit_test(test_issue_25_report_missing_summary),
+      cmocka_unit_test(test_issue_25_export_truncated_tracks),
+  };
+  return cmocka_run_group_tests(tests, setup, NULL);
+}
