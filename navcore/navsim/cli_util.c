@@ -38,6 +38,18 @@ int navsim_load_scene(const char *path, nav_scene *scene) {
   return st == NAV_ERR_PARSE ? 2 : 1;
 }
 
+void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scene) {
+  if (!f || !scene || scene->trajectory.type != NAV_TRAJ_RECORDED) return;
+  const nav_recorded_fit_stats *s = &scene->trajectory.recorded.fit;
+  fprintf(f,
+          "%srecorded %s: %ld samples fitted; residuals of the fit: position RMS %.3g m (horizontal %.3g, vertical "
+          "%.3g), max %.3g m at t = %.6g s; velocity RMS %.3g m/s, max %.3g m/s at t = %.6g s; attitude RMS %.3g "
+          "deg, max %.3g deg at t = %.6g s; longest gap between samples %.6g s at t = %.6g s\n",
+          label ? label : "", scene->trajectory.recorded.file, s->samples, s->pos_rms_m, s->pos_h_rms_m,
+          s->pos_v_rms_m, s->pos_max_m, s->pos_max_t_s, s->vel_rms_mps, s->vel_max_mps, s->vel_max_t_s,
+          s->att_rms_rad * NAV_RAD2DEG, s->att_max_rad * NAV_RAD2DEG, s->att_max_t_s, s->max_gap_s, s->max_gap_t_s);
+}
+
 bool navsim_parse_u64(const char *s, uint64_t *out) {
   if (!s || !*s || *s == '-' || *s == '+') return false;
   for (const char *p = s; *p; ++p)

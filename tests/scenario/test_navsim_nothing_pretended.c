@@ -1,8 +1,10 @@
 /*
- * Damaged result directories (issue 25, "nothing pretended"): `navsim report` and `navsim export`
+ * Nothing pretended (issue 25). Damaged result directories: `navsim report` and `navsim export`
  * read a result directory that navsim wrote; when one of its files was cut or replaced, they say
  * which file and where, with exit 2, instead of a page that says "The scene states no
  * requirements" or a shortened track. Every case starts from a fresh copy of one good result.
+ * Recorded references: `navsim check` and `navsim run` report the residuals of the spline fit
+ * (terminal and summary.json "recorded_fit").
  *
  * NAVSIM_EXE, NAV_SOURCE_DIR and NAV_TEST_WORK_DIR come from the build.
  */
@@ -103,11 +105,41 @@ static void test_issue_25_export_truncated_tracks(void **state) {
   if (r->code != 0) fail_msg("export of the good result exited %d:\n%s", r->code, r->err);
 }
 
+/* The fit residuals of a recorded reference, on the terminal of check and run and in summary.json:
+ * the KF-GINS dataset 2 reference is fitted to centimetres (the figures themselves are
+ * test_recorded's; here they must be reported, finite and of that size). */
+static void test_issue_25_recorded_fit_residuals(void **state) {
+  (void)state;
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "check '" NAV_SOURCE_DIR "/scenes/recorded-adis16465.yaml'");
+  if (r->code != 0) fail_msg("check exited %d: %s", r->code, r->err);
+  nav_test_assert_matches(r->out, "recorded-adis16465\\.yaml: recorded .*adis16465-truth-116454-116754\\.nav: 3300 "
+                                  "samples fitted; residuals of the fit: position RMS [0-9.e-]+ m \\(horizontal "
+                                  "[0-9.e-]+, vertical [0-9.e-]+\\), max [0-9.e-]+ m at t = [0-9.]+ s; velocity RMS");
+  r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL,
+                       "run '" NAV_SOURCE_DIR "/scenes/recorded-adis16465.yaml' --ideal --out rec");
+  if (r->code != 0) fail_msg("run exited %d: %s", r->code, r->err);
+  nav_test_assert_matches(r->out, "^reference  recorded .*: 3300 samples fitted; residuals of the fit: position RMS ");
+  char *js = nav_test_slurp_alloc(WORK "/rec/summary.json");
+  assert_non_null(js);
+  nav_test_assert_matches(js, "\"recorded_fit\": \\{\"file\": \"[^\"]*adis16465-truth-116454-116754\\.nav\", "
+                              "\"samples\": 3300, \"pos_rms_m\": ");
+  const char *p = strstr(js, "\"pos_rms_m\": ");
+  assert_non_null(p);
+  const double pos_rms = strtod(p + strlen("\"pos_rms_m\": "), NULL);
+  if (!(pos_rms > 0.0 && pos_rms < 0.01)) fail_msg("pos_rms_m = %g: expected a centimetre-level fit", pos_rms);
+  p = strstr(js, "\"att_max_deg\": ");
+  assert_non_null(p);
+  const double att_max = strtod(p + strlen("\"att_max_deg\": "), NULL);
+  if (!(att_max > 0.0 && att_max < 1.0)) fail_msg("att_max_deg = %g", att_max);
+  free(js);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_report_truncated_summary),
       cmocka_unit_test(test_issue_25_report_missing_summary),
       cmocka_unit_test(test_issue_25_export_truncated_tracks),
+      cmocka_unit_test(test_issue_25_recorded_fit_residuals),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
