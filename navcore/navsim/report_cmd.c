@@ -789,7 +789,7 @@ int navsim_report(int argc, char **argv) {
   /* Requirement verdicts. */
   fputs("<h2>Requirements</h2>\n", f);
   char *req = summary ? json_block(summary, "requirements") : NULL;
-  int nreq = 0, nfail = 0;
+  int nreq = 0, nfail = 0, nna = 0;
   if (req) {
     const char *p = req + 1;
     int depth = 0;
@@ -822,6 +822,11 @@ int navsim_report(int argc, char **argv) {
           const bool have_value = json_num(o, "value", &value);
           const char *ps = strstr(o, "\"pass\"");
           const bool pass = ps && strncmp(ps + 6 + strspn(ps + 6, ": "), "true", 4) == 0;
+          /* A verdict without data says so (issue 25): "evaluated": false and its reason. */
+          const char *pe = strstr(o, "\"evaluated\"");
+          const bool na = pe && strncmp(pe + 11 + strspn(pe + 11, ": "), "false", 5) == 0;
+          char reason[160] = "";
+          if (na) json_str(o, "reason", reason, sizeof reason);
           if (nreq == 0)
             fputs("<table>\n<tr><th class=\"l\">id</th><th class=\"l\">metric</th><th class=\"l\">statistic</th>"
                   "<th>value</th><th>limit</th><th class=\"l\">unit</th><th class=\"l\">verdict</th></tr>\n",
@@ -836,15 +841,28 @@ int navsim_report(int argc, char **argv) {
           else fputs("</td><td>&ndash;</td>", f);
           fprintf(f, "<td>%.4g</td><td class=\"l\">", limit);
           html_text(f, unit);
-          fprintf(f, "</td><td class=\"l %s\">%s</td></tr>\n", pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+          if (na) {
+            fputs("</td><td class=\"l\">not evaluated", f);
+            if (reason[0]) {
+              fputs(": ", f);
+              html_text(f, reason);
+            }
+            fputs("</td></tr>\n", f);
+          } else {
+            fprintf(f, "</td><td class=\"l %s\">%s</td></tr>\n", pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+          }
           ++nreq;
-          if (!pass) ++nfail;
+          if (na) ++nna;
+          else if (!pass) ++nfail;
           free(o);
           obj = NULL;
         }
       }
     }
-    if (nreq > 0) fprintf(f, "</table>\n<p>%d of %d requirements met.</p>\n", nreq - nfail, nreq);
+    if (nreq > 0 && nna > 0)
+      fprintf(f, "</table>\n<p>%d of %d requirements met, %d not evaluated.</p>\n", nreq - nfail - nna, nreq, nna);
+    else if (nreq > 0)
+      fprintf(f, "</table>\n<p>%d of %d requirements met.</p>\n", nreq - nfail, nreq);
     free(req);
   }
   if (nreq == 0) fputs("<p>The scene states no requirements.</p>\n", f);
