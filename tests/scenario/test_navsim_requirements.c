@@ -234,6 +234,34 @@ static void test_issue_25_replay_no_scored_epoch(void **state) {
   }
 }
 
+/* Issue 25: a requirement at_time 1e6 s on a 10 s scene, or outage_end without an outage, is
+ * refused before any work by check, run, estimate and budget, at its place in the file (exit 2);
+ * none of them writes a result. */
+static void test_issue_25_unevaluable_requirements_refused(void **state) {
+  (void)state;
+  nav_test_write_file(WORK, "late.yaml",
+                      SCENE_HEAD "requirements:\n"
+                                 "  - {id: h-late, metric: horizontal_position, statistic: at_time, time_s: 1e6, "
+                                 "limit: 1, unit: m}\n");
+  nav_test_write_file(WORK, "noout.yaml",
+                      SCENE_HEAD "requirements:\n"
+                                 "  - {id: h-out, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n");
+  static const char *const cmds[4] = {"check", "run", "estimate", "budget"};
+  for (int k = 0; k < 4; ++k) {
+    nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s late.yaml%s", cmds[k],
+                                          k == 0 ? "" : " --out late-out");
+    if (r->code != 2) fail_msg("navsim %s late.yaml exited %d:\n%s\n%s", cmds[k], r->code, r->out, r->err);
+    nav_test_assert_matches(r->err, "^late\\.yaml:13:75: error: requirements\\[0\\]\\.time_s: 1e\\+06 s is after the "
+                                    "end of the run \\(trajectory duration 10 s\\)");
+    r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s noout.yaml%s", cmds[k], k == 0 ? "" : " --out late-out");
+    if (r->code != 2) fail_msg("navsim %s noout.yaml exited %d:\n%s", cmds[k], r->code, r->err);
+    nav_test_assert_matches(r->err, "^noout\\.yaml:13:[0-9]+: error: requirements\\[0\\]\\.statistic: outage_end needs "
+                                    "a GNSS outage, and navigation\\.scheme free_ins has no GNSS");
+    struct stat sb;
+    if (stat(WORK "/late-out", &sb) == 0) fail_msg("navsim %s wrote a result for a refused scene", cmds[k]);
+  }
+}
+
 /* navsim estimate: the requirements of estimate.json predicted from the covariance analysis
  * (wgs84 scenes); null values where there is none (flat Earth) or the statistic is not
  * predictable (max). */
@@ -346,6 +374,7 @@ int main(void) {
       cmocka_unit_test(test_replay_verdicts),
       cmocka_unit_test(test_issue_25_replay_no_fix_applied),
       cmocka_unit_test(test_issue_25_replay_no_scored_epoch),
+      cmocka_unit_test(test_issue_25_unevaluable_requirements_refused),
       cmocka_unit_test(test_estimate_predictions),
       cmocka_unit_test(test_budget_cli),
   };
