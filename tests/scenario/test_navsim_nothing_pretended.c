@@ -87,7 +87,8 @@ static void test_issue_25_export_truncated_tracks(void **state) {
        "final\\.t_s\\): the file was cut short$"},
       {"head -c 40000 good/truth.csv > d/truth.csv",
        "^d/truth\\.csv:[0-9]+:[0-9]+: error: the last line has no line end: the file was cut short"},
-      {"rm d/truth.csv && mkdir d/truth.csv", "^d/truth\\.csv: error: not a regular file \\(a directory\\)"},
+      /* (the wording of the readers' general refusal of non-regular files may replace this one) */
+      {"rm d/truth.csv && mkdir d/truth.csv", "^d/truth\\.csv: error: .*a directory"},
       {"head -1 good/truth.csv > d/truth.csv", "^d/truth\\.csv:1:1: error: no data row after the header"},
       {"head -2000 good/nav.csv > d/nav.csv", "^d/nav\\.csv:2000: error: the track ends at t = "},
   };
