@@ -138,7 +138,21 @@ static const char *const k_fig_keys[N_FIG] = {
     "pitch_err_rms_deg",   "yaw_err_rms_deg",   "yaw_err_max_deg",   "gap1_end_pos_err_h_m",
     "gap2_end_pos_err_h_m"};
 
-static void figures_of(const nav_replay_stats *s, const nav_replay_summary *sum, double v[N_FIG]) {
+/* Statistics of no epoch are not figures (issue 25): every value NaN, printed "-" and null. */
+static nav_replay_stats stats_or_none(const nav_replay_stats *s) {
+  nav_replay_stats z = *s;
+  if (z.epochs > 0) return z;
+  nav_replay_stat *st[8] = {&z.pos_h_m, &z.pos_v_m, &z.vel_h_mps, &z.vel_v_mps,
+                            &z.roll_rad, &z.pitch_rad, &z.yaw_rad, &z.att_rad};
+  for (int i = 0; i < 8; ++i) st[i]->rms = st[i]->max = st[i]->t_max_s = NAN;
+  z.pos_mean_n_m = nav_vec3_make(NAN, NAN, NAN);
+  z.vel_mean_n_mps = nav_vec3_make(NAN, NAN, NAN);
+  return z;
+}
+
+static void figures_of(const nav_replay_stats *s_in, const nav_replay_summary *sum, double v[N_FIG]) {
+  const nav_replay_stats zs = stats_or_none(s_in);
+  const nav_replay_stats *s = &zs;
   v[F_POS_H_RMS] = s->pos_h_m.rms;
   v[F_POS_H_MAX] = s->pos_h_m.max;
   v[F_POS_V_RMS] = s->pos_v_m.rms;
@@ -243,7 +257,9 @@ static void json_stat(FILE *f, const char *indent, const char *name, nav_replay_
 }
 
 /* "name": {statistics} at @p indent (two spaces per level), followed by a comma unless last. */
-static void json_stats(FILE *f, int indent, const char *name, const nav_replay_stats *s, bool last) {
+static void json_stats(FILE *f, int indent, const char *name, const nav_replay_stats *s_in, bool last) {
+  const nav_replay_stats zs = stats_or_none(s_in);
+  const nav_replay_stats *s = &zs;
   char in[32];
   snprintf(in, sizeof in, "%*s", 2 * indent + 2, "");
   fprintf(f, "%*s\"%s\": {\n%s\"epochs\": %ld,\n", 2 * indent, "", name, in, s->epochs);

@@ -135,12 +135,32 @@ static void test_issue_25_recorded_fit_residuals(void **state) {
   free(js);
 }
 
+/* A replay window whose one scored epoch (t0 + 0.05 s) is not an output epoch (every 0.1 s): the
+ * statistics at the output epochs have no epoch, and are printed "-" and written null, not 0. */
+static void test_issue_25_replay_statistics_of_no_epoch(void **state) {
+  (void)state;
+  nav_cli_result *r = nav_test_run_cli(
+      NAVSIM_EXE, WORK, NULL,
+      "replay --imu '" NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt' --gnss '" NAV_TEST_DATA_DIR
+      "/replay/GNSS-100195-100245.txt' --truth '" NAV_TEST_DATA_DIR "/replay/truth-100195-100245-20Hz.nav' --end "
+      "100195.05 --peer self='" NAV_TEST_DATA_DIR "/replay/truth-100195-100245-20Hz.nav' --peers none --out few");
+  if (r->code != 0) fail_msg("replay exited %d: %s", r->code, r->err);
+  nav_test_assert_matches(r->out, "^scored epochs +1 +0 +2$");
+  nav_test_assert_matches(r->out, "^horiz\\. pos RMS \\[m\\] +[0-9.e+-]+ +- +0$");
+  char *js = nav_test_slurp_alloc(WORK "/few/summary.json");
+  assert_non_null(js);
+  nav_test_assert_matches(js, "\"errors_at_output_epochs\": \\{\n +\"epochs\": 0,\n +\"pos_err_h_m\": \\{\"rms\": null, "
+                              "\"max\": null, \"t_max_s\": null\\}");
+  free(js);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_report_truncated_summary),
       cmocka_unit_test(test_issue_25_report_missing_summary),
       cmocka_unit_test(test_issue_25_export_truncated_tracks),
       cmocka_unit_test(test_issue_25_recorded_fit_residuals),
+      cmocka_unit_test(test_issue_25_replay_statistics_of_no_epoch),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
