@@ -40,6 +40,11 @@ nav_status nav_requirements_write_json(FILE *f, const nav_requirement_verdict *v
     fprintf(f, ", \"unit\": \"%s\", \"value\": ", nav_req_unit_name(q->unit));
     json_num(f, q->value);
     fprintf(f, ", \"pass\": %s, \"samples\": %ld", q->pass ? "true" : "false", q->samples);
+    /* Only for a verdict without a value (added keys; evaluated verdicts keep their bytes). */
+    if (!q->evaluated) {
+      fputs(", \"evaluated\": false, \"reason\": ", f);
+      json_str(f, nav_req_na_reason_text(q->na_reason));
+    }
     if (q->statistic == NAV_REQ_AT_TIME) {
       fputs(", \"time_s\": ", f);
       json_num(f, q->at_time_s);
@@ -67,19 +72,26 @@ nav_status nav_requirements_write_json(FILE *f, const nav_requirement_verdict *v
 
 void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count) {
   if (!f || count <= 0 || !v) return;
-  int pass = 0;
-  for (int i = 0; i < count; ++i) pass += v[i].pass ? 1 : 0;
-  fprintf(f, "requirements %d of %d pass\n", pass, count);
+  int pass = 0, na = 0;
+  for (int i = 0; i < count; ++i) {
+    pass += v[i].pass ? 1 : 0;
+    na += v[i].evaluated ? 0 : 1;
+  }
+  if (na > 0) fprintf(f, "requirements %d of %d pass, %d not evaluated\n", pass, count, na);
+  else fprintf(f, "requirements %d of %d pass\n", pass, count);
   for (int i = 0; i < count; ++i) {
     const nav_requirement_verdict *q = &v[i];
     const char *u = nav_req_unit_name(q->unit);
-    fprintf(f, "  %s  %-20s %s %s", !q->evaluated && q->statistic != NAV_REQ_OUTAGE_END ? "N/A " : q->pass ? "PASS" : "FAIL",
+    fprintf(f, "  %s  %-20s %s %s", !q->evaluated ? "N/A " : q->pass ? "PASS" : "FAIL",
             q->id, nav_req_metric_name(q->metric), nav_req_statistic_name(q->statistic));
-    if (q->statistic == NAV_REQ_AT_TIME) fprintf(f, " (t = %g s)", q->at_time_s);
+    if (q->statistic == NAV_REQ_AT_TIME && q->evaluated) fprintf(f, " (t = %g s)", q->at_time_s);
     if (q->evaluated) fprintf(f, " = %.4g %s %s %.4g %s\n", q->value, u, q->pass ? "<=" : ">", q->limit, u);
-    else if (q->statistic == NAV_REQ_OUTAGE_END && q->outage_count == 0)
-      fprintf(f, ": no GNSS outage, nothing to evaluate (limit %.4g %s)\n", q->limit, u);
-    else fprintf(f, ": not evaluated (no data, or not predictable from sigmas), limit %.4g %s\n", q->limit, u);
+    else if (q->na_reason == NAV_REQ_NA_TIME_OUTSIDE)
+      fprintf(f, ": not evaluated: t = %g s lies outside the run's epochs [%g, %g] s (limit %.4g %s)\n", q->at_time_s,
+              q->span_t0_s, q->span_t1_s, q->limit, u);
+    else
+      fprintf(f, ": not evaluated: %s (limit %.4g %s)\n",
+              q->na_reason != NAV_REQ_NA_NONE ? nav_req_na_reason_text(q->na_reason) : "no data", q->limit, u);
     if (q->statistic == NAV_REQ_OUTAGE_END)
       for (int j = 0; j < q->outage_count && j < NAV_REQ_MAX_OUTAGES; ++j) {
         if (isnan(q->outage_value[j])) fprintf(f, "        outage [%g, %g) s: no output epoch inside\n",

@@ -226,7 +226,42 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
     json_sim_stats(f, &sum->stats_forward_out, true);
     fputs("    }\n", f);
   }
-  fputs("  },\n  \"requirements\": ", f);
+  fputs("  },\n", f);
+  if (scene->trajectory.type == NAV_TRAJ_RECORDED) {
+    /* Residuals of the recorded reference's spline fit against its samples (issue 25): how far the
+     * reference the run used is from the recorded data. Only for recorded trajectories. */
+    const nav_recorded_fit_stats *fs = &scene->trajectory.recorded.fit;
+    fputs("  \"recorded_fit\": {\"file\": ", f);
+    nav_json_write_string(f, scene->trajectory.recorded.file);
+    fprintf(f, ", \"samples\": %ld, \"pos_rms_m\": ", fs->samples);
+    json_number(f, fs->pos_rms_m);
+    fputs(", \"pos_h_rms_m\": ", f);
+    json_number(f, fs->pos_h_rms_m);
+    fputs(", \"pos_v_rms_m\": ", f);
+    json_number(f, fs->pos_v_rms_m);
+    fputs(", \"pos_max_m\": ", f);
+    json_number(f, fs->pos_max_m);
+    fputs(", \"pos_max_t_s\": ", f);
+    json_number(f, fs->pos_max_t_s);
+    fputs(",\n    \"vel_rms_mps\": ", f);
+    json_number(f, fs->vel_rms_mps);
+    fputs(", \"vel_max_mps\": ", f);
+    json_number(f, fs->vel_max_mps);
+    fputs(", \"vel_max_t_s\": ", f);
+    json_number(f, fs->vel_max_t_s);
+    fputs(", \"att_rms_deg\": ", f);
+    json_number(f, fs->att_rms_rad * NAV_RAD2DEG);
+    fputs(", \"att_max_deg\": ", f);
+    json_number(f, fs->att_max_rad * NAV_RAD2DEG);
+    fputs(", \"att_max_t_s\": ", f);
+    json_number(f, fs->att_max_t_s);
+    fputs(", \"max_gap_s\": ", f);
+    json_number(f, fs->max_gap_s);
+    fputs(", \"max_gap_t_s\": ", f);
+    json_number(f, fs->max_gap_t_s);
+    fputs("},\n", f);
+  }
+  fputs("  \"requirements\": ", f);
   if (nav_requirements_write_json(f, info->requirements, info->requirements ? info->n_requirements : 0, 2) !=
       NAV_OK)
     fputs("[]", f);

@@ -2717,7 +2717,7 @@ static void on_validate_issue(void *user, const char *path, const char *message)
 }
 
 static nav_status read_buffer(const char *text, size_t len, const char *name, bool name_is_path,
-                              nav_scene *out, nav_diag_fn report, void *user) {
+                              nav_scene *out, nav_diag_fn report, void *user, bool to_run) {
   nav_status st = NAV_OK;
   nav_io_reader *r = NULL;
   nav_io_node *root = NULL;
@@ -2767,6 +2767,13 @@ static nav_status read_buffer(const char *text, size_t len, const char *name, bo
   const nav_status vs = nav_scene_validate(scene, on_validate_issue, r);
   if (vs != NAV_OK && r->ndiag == before && r->nerr_paths == 0)
     emitf(r, 0, 0, "", "the scene is not valid (%s)", nav_status_str(vs));
+  /* Requirements the run could not evaluate (an at_time after its end, an outage_end without an
+   * outage), for a scene about to be simulated (nav_scene_read_file_to_run). Only with a
+   * trajectory: without one the file is the filter configuration of navsim replay, whose
+   * requirements apply to recorded data (its span and gaps). */
+  if (to_run && vs == NAV_OK && nav_io_map_get(root, "trajectory", NULL) != NULL &&
+      nav_requirements_check_scene(scene, on_validate_issue, r) != NAV_OK && r->ndiag == before)
+    emitf(r, 0, 0, "", "the scene's requirements cannot be evaluated on its run");
 
 cleanup:
   nav_io_c_locale_end(&loc);
@@ -2788,7 +2795,7 @@ nav_status nav_scene_read_string(const char *text, size_t len, const char *displ
                                  nav_diag_fn report, void *user) {
   if (out == NULL || (text == NULL && len > 0)) return NAV_ERR_INVALID_ARG;
   return read_buffer(text != NULL ? text : "", len, display_name != NULL ? display_name : "<string>", false,
-                     out, report, user);
+                     out, report, user, false);
 }
 
 static void report_file_problem(const char *path, nav_diag_fn report, void *user, const char *fmt, ...)
@@ -2807,7 +2814,7 @@ static void report_file_problem(const char *path, nav_diag_fn report, void *user
   if (report != NULL) report(user, &d);
 }
 
-nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn report, void *user) {
+static nav_status read_file(const char *path, nav_scene *out, nav_diag_fn report, void *user, bool to_run) {
   nav_status st = NAV_OK;
   FILE *fp = NULL;
   char *buf = NULL;
@@ -2876,12 +2883,20 @@ nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn rep
     st = NAV_ERR_IO;
     goto cleanup;
   }
-  st = read_buffer(buf, len, path, true, out, report, user);
+  st = read_buffer(buf, len, path, true, out, report, user, to_run);
 
 cleanup:
   free(buf);
   if (fp != NULL) fclose(fp);
   return st;
+}
+
+nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn report, void *user) {
+  return read_file(path, out, report, user, false);
+}
+
+nav_status nav_scene_read_file_to_run(const char *path, nav_scene *out, nav_diag_fn report, void *user) {
+  return read_file(path, out, report, user, true);
 }
 
 /* ---------------------------------------------------------------- requirements */

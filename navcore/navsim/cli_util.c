@@ -32,10 +32,23 @@ void navsim_print_diag(void *user, const nav_diag *d) {
 
 int navsim_load_scene(const char *path, nav_scene *scene) {
   navsim_diag_sink sink = {0};
-  const nav_status st = nav_scene_read_file(path, scene, navsim_print_diag, &sink);
+  /* Requirements the run cannot evaluate are refused here too (issue 25). */
+  const nav_status st = nav_scene_read_file_to_run(path, scene, navsim_print_diag, &sink);
   if (st == NAV_OK) return 0;
   if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
   return st == NAV_ERR_PARSE ? 2 : 1;
+}
+
+void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scene) {
+  if (!f || !scene || scene->trajectory.type != NAV_TRAJ_RECORDED) return;
+  const nav_recorded_fit_stats *s = &scene->trajectory.recorded.fit;
+  fprintf(f,
+          "%srecorded %s: %ld samples fitted; residuals of the fit: position RMS %.3g m (horizontal %.3g, vertical "
+          "%.3g), max %.3g m at t = %.6g s; velocity RMS %.3g m/s, max %.3g m/s at t = %.6g s; attitude RMS %.3g "
+          "deg, max %.3g deg at t = %.6g s; longest gap between samples %.6g s at t = %.6g s\n",
+          label ? label : "", scene->trajectory.recorded.file, s->samples, s->pos_rms_m, s->pos_h_rms_m,
+          s->pos_v_rms_m, s->pos_max_m, s->pos_max_t_s, s->vel_rms_mps, s->vel_max_mps, s->vel_max_t_s,
+          s->att_rms_rad * NAV_RAD2DEG, s->att_max_rad * NAV_RAD2DEG, s->att_max_t_s, s->max_gap_s, s->max_gap_t_s);
 }
 
 bool navsim_parse_u64(const char *s, uint64_t *out) {

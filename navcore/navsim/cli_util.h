@@ -34,6 +34,11 @@ void navsim_print_diag(void *user, const nav_diag *d);
  * reported nothing. @return the exit code: 0 read, 2 invalid scene (NAV_ERR_PARSE), 1 otherwise. */
 int navsim_load_scene(const char *path, nav_scene *scene);
 
+/* For a recorded-reference scene (trajectory.type recorded): one line on @p f with the residuals
+ * of its spline fit against the recorded samples (issue 25); nothing for other scenes. @p label
+ * starts the line ("reference  " or "PATH: "). */
+void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scene);
+
 /* Decimal digits only (no sign, no blanks), within uint64_t. */
 bool navsim_parse_u64(const char *s, uint64_t *out);
 

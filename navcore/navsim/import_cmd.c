@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "navcore/nav_frames.h"
 #include "navcore/nav_io.h"
@@ -236,6 +237,7 @@ typedef struct geo_series {
   double *t;
   nav_geodetic *p;
   size_t n, cap;
+  int last_line; /* line of the last data row */
 } geo_series;
 
 static void series_free(geo_series *s) {
@@ -263,18 +265,29 @@ static bool series_push(geo_series *s, double t, nav_geodetic p) {
 
 /* Read t_s, lat_deg, lon_deg, h_m from a CSV with a header (truth.csv, nav.csv, gnss.csv).
  * Returns 0, 1 (cannot read), 2 (malformed: FILE:LINE:COL printed). */
-static int read_geo_csv(const char *path, geo_series *s) {
+static int read_geo_csv(const char *path, geo_series *s, bool need_rows) {
   FILE *f = fopen(path, "r");
   if (!f) return 1;
+  struct stat sb;
+  if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
+    fprintf(stderr, "%s: error: not a regular file (%s); expected the CSV file navsim writes there\n", path,
+            S_ISDIR(sb.st_mode) ? "a directory" : "a device, FIFO or socket");
+    fclose(f);
+    return 2;
+  }
   char *line = NULL;
   size_t cap = 0;
   ssize_t len;
   int col_idx[4] = {-1, -1, -1, -1};
   static const char *names[4] = {"t_s", "lat_deg", "lon_deg", "h_m"};
   int ln = 0, rc = 0;
+  bool line_end = true; /* the last line read ended with '\n' */
+  int last_len = 0;      /* its length without the line end */
   while ((len = getline(&line, &cap, f)) >= 0) {
     ++ln;
+    line_end = len > 0 && line[len - 1] == '\n';
     while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) line[--len] = '\0';
+    last_len = (int)len;
     if (ln == 1) {
       int c = 0;
       for (char *tok = line, *next; tok; tok = next, ++c) {
@@ -321,10 +334,58 @@ static int read_geo_csv(const char *path, geo_series *s) {
       rc = 1;
       break;
     }
+    s->last_line = ln;
   }
+  const int read_err = ferror(f) ? errno : 0;
   free(line);
   fclose(f);
+  /* navsim writes whole lines: a last line without its end, or no row at all, is a cut file
+   * whose track would be drawn shortened (or not at all) without a word. */
+  if (rc == 0 && read_err) {
+    fprintf(stderr, "%s: error: cannot read: %s\n", path, strerror(read_err));
+    rc = 1;
+  } else if (rc == 0 && ln == 0) {
+    fprintf(stderr, "%s: error: the file is empty; expected a header line (t_s,lat_deg,lon_deg,h_m,...) and rows\n",
+            path);
+    rc = 2;
+  } else if (rc == 0 && !line_end) {
+    fprintf(stderr, "%s:%d:%d: error: the last line has no line end: the file was cut short (navsim writes whole lines)\n",
+            path, ln, last_len + 1);
+    rc = 2;
+  } else if (rc == 0 && need_rows && s->n == 0) {
+    fprintf(stderr, "%s:%d:1: error: no data row after the header: the file was cut short\n", path, ln);
+    rc = 2;
+  }
   return rc;
+}
+
+/* final.t_s of the directory's summary.json (the last epoch of the run), NaN when unknown. */
+static double summary_final_t(const char *path) {
+  if (!path) return NAN;
+  FILE *f = fopen(path, "r");
+  if (!f) return NAN;
+  char buf[8192];
+  const size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  const char *p = strstr(buf, "\"final\": {\"t_s\": ");
+  if (!p) return NAN;
+  char *end = NULL;
+  const double t = strtod(p + strlen("\"final\": {\"t_s\": "), &end);
+  return end && end != p && isfinite(t) ? t : NAN;
+}
+
+/* A track that ends before the run's last epoch by more than 1.5 of its own row spacing. */
+static int check_track_end(const char *path, const geo_series *s, double t_final) {
+  if (!path || s->n == 0 || !isfinite(t_final)) return 0;
+  const double t_last = s->t[s->n - 1];
+  const double dt = s->n > 1 ? s->t[s->n - 1] - s->t[s->n - 2] : 0.0;
+  if (t_last >= t_final - 1.5 * dt - 1e-9 * fmax(1.0, fabs(t_final))) return 0;
+  fprintf(stderr,
+          "%s:%d: error: the track ends at t = %.9g s but the run ends at %.9g s (summary.json final.t_s): the file "
+          "was cut short\n",
+          path, s->last_line, t_last, t_final);
+  return 2;
 }
 
 /* Write tracks.kml / tracks.csv of a directory (files named by @p file_of). */
@@ -333,20 +394,23 @@ typedef const char *(*file_fn)(void *ctx, const char *name);
 static int write_tracks(file_fn file_of, void *ctx, const char *label, bool kml, bool csv) {
   geo_series ref = {0}, est = {0}, gnss = {0};
   int rc = 0;
+  const double t_final = summary_final_t(file_of(ctx, "summary.json"));
   const char *path = file_of(ctx, "truth.csv");
-  int r = path ? read_geo_csv(path, &ref) : 1;
+  int r = path ? read_geo_csv(path, &ref, true) : 1;
   if (r == 1) fprintf(stderr, "navsim: cannot read %s\n", path ? path : "truth.csv");
+  if (r == 0) r = check_track_end(path, &ref, t_final);
   if (r) rc = r;
   path = file_of(ctx, "nav.csv");
-  r = (rc == 0 && path) ? read_geo_csv(path, &est) : rc ? rc : 1;
+  r = (rc == 0 && path) ? read_geo_csv(path, &est, true) : rc ? rc : 1;
   if (r == 1 && rc == 0) fprintf(stderr, "navsim: cannot read %s\n", path ? path : "nav.csv");
+  if (r == 0) r = check_track_end(path, &est, t_final);
   if (r && !rc) rc = r;
   if (!rc) {
     path = file_of(ctx, "gnss.csv");
     FILE *probe = path ? fopen(path, "r") : NULL;
     if (probe) {
       fclose(probe);
-      rc = read_geo_csv(path, &gnss);
+      rc = read_geo_csv(path, &gnss, false);
     }
   }
   if (!rc) {

@@ -137,6 +137,11 @@ static int cmd_check(int argc, char **argv) {
   for (int i = 0; i < argc; ++i) {
     nav_scene scene;
     const int rc = navsim_load_scene(argv[i], &scene);
+    if (rc == EXIT_OK) {
+      char label[4200];
+      snprintf(label, sizeof label, "%s: ", argv[i]);
+      navsim_print_recorded_fit(stdout, label, &scene);
+    }
     if (rc == EXIT_FAIL) worst = EXIT_FAIL;
     else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
   }
@@ -504,6 +509,7 @@ static int cmd_run(int argc, char **argv) {
     printf("scene      %s (%s, %s Earth, %s mechanization%s)\n", scene.name, scene_path,
            nav_earth_model_name(scene.earth.model), nav_mech_algorithm_name(scene.navigation.algorithm),
            ideal ? ", ideal sensors" : "");
+    navsim_print_recorded_fit(stdout, "reference  ", &scene);
     printf("simulated  %ld run%s of %.3f s, %" PRId64 " IMU samples each at %g Hz in %.3f s wall (%.3g samples/s, "
            "%d thread%s)\n",
            sum.runs, sum.runs == 1 ? "" : "s", sum.duration_s, sum.imu_samples, scene.imu.rate_hz, wall,

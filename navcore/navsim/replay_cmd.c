@@ -101,10 +101,13 @@ enum {
   N_FIG
 };
 
-typedef enum data_case { CASE_FULL_GNSS = 0, CASE_OUTAGES = 1, CASE_FREE_INS = 2 } data_case;
+/* CASE_NO_FIX: a GNSS file was given but no fix of it was applied (all before the start, outside
+ * the window or unmatched): a free-inertial run, and no published row is comparable. */
+typedef enum data_case { CASE_FULL_GNSS = 0, CASE_OUTAGES = 1, CASE_FREE_INS = 2, CASE_NO_FIX = 3 } data_case;
 
-/* What kind of run this is; the published rows of the README for each. */
-static const char *const k_case_names[3] = {"full GNSS", "GNSS with gaps", "free INS (no GNSS)"};
+/* What kind of run this is; the published rows of the README for the first three. */
+static const char *const k_case_names[4] = {"full GNSS", "GNSS with gaps", "free INS (no GNSS)",
+                                            "no GNSS fix applied"};
 static const char *const k_case_readme[3] = {"full GNSS", "two 60 s outages", "ideal IMU, no GNSS"};
 
 typedef struct peer_figures {
@@ -136,7 +139,21 @@ static const char *const k_fig_keys[N_FIG] = {
     "pitch_err_rms_deg",   "yaw_err_rms_deg",   "yaw_err_max_deg",   "gap1_end_pos_err_h_m",
     "gap2_end_pos_err_h_m"};
 
-static void figures_of(const nav_replay_stats *s, const nav_replay_summary *sum, double v[N_FIG]) {
+/* Statistics of no epoch are not figures (issue 25): every value NaN, printed "-" and null. */
+static nav_replay_stats stats_or_none(const nav_replay_stats *s) {
+  nav_replay_stats z = *s;
+  if (z.epochs > 0) return z;
+  nav_replay_stat *st[8] = {&z.pos_h_m, &z.pos_v_m, &z.vel_h_mps, &z.vel_v_mps,
+                            &z.roll_rad, &z.pitch_rad, &z.yaw_rad, &z.att_rad};
+  for (int i = 0; i < 8; ++i) st[i]->rms = st[i]->max = st[i]->t_max_s = NAN;
+  z.pos_mean_n_m = nav_vec3_make(NAN, NAN, NAN);
+  z.vel_mean_n_mps = nav_vec3_make(NAN, NAN, NAN);
+  return z;
+}
+
+static void figures_of(const nav_replay_stats *s_in, const nav_replay_summary *sum, double v[N_FIG]) {
+  const nav_replay_stats zs = stats_or_none(s_in);
+  const nav_replay_stats *s = &zs;
   v[F_POS_H_RMS] = s->pos_h_m.rms;
   v[F_POS_H_MAX] = s->pos_h_m.max;
   v[F_POS_V_RMS] = s->pos_v_m.rms;
@@ -241,7 +258,9 @@ static void json_stat(FILE *f, const char *indent, const char *name, nav_replay_
 }
 
 /* "name": {statistics} at @p indent (two spaces per level), followed by a comma unless last. */
-static void json_stats(FILE *f, int indent, const char *name, const nav_replay_stats *s, bool last) {
+static void json_stats(FILE *f, int indent, const char *name, const nav_replay_stats *s_in, bool last) {
+  const nav_replay_stats zs = stats_or_none(s_in);
+  const nav_replay_stats *s = &zs;
   char in[32];
   snprintf(in, sizeof in, "%*s", 2 * indent + 2, "");
   fprintf(f, "%*s\"%s\": {\n%s\"epochs\": %ld,\n", 2 * indent, "", name, in, s->epochs);
@@ -766,6 +785,16 @@ int navsim_replay(int argc, char **argv) {
     rc_exit = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
     goto cleanup;
   }
+  if (sum.stats.epochs == 0) {
+    /* Statistics of no epoch would print as zeros and every requirement would pass: refuse. */
+    fprintf(stderr,
+            "%s: error: no epoch to score: %ld IMU step(s) processed from %.3f to %.3f s (file time base) and "
+            "none after the initial epoch coincides with a row of the reference %s; the replay needs IMU data "
+            "beyond its initial epoch that the reference covers (check the files and --start/--end)\n",
+            imu, sum.imu_steps, sum.t_first_s, sum.t_last_s, truth);
+    rc_exit = EXIT_INVALID;
+    goto cleanup;
+  }
   {
     /* A last line without a line end: the file may have been cut (a copy or a recording stopped
      * mid-write), and then its last number may be short without looking malformed. */
@@ -815,9 +844,11 @@ int navsim_replay(int argc, char **argv) {
   job.config = config;
   job.rc = &rc;
   job.sum = &sum;
-  job.dcase = sum.free_ins ? CASE_FREE_INS
-                           : (sum.gap_count > 0 || sum.gnss_dropped > 0 ? CASE_OUTAGES : CASE_FULL_GNSS);
-  job.long_drive = peers_auto && is_long_drive(truth);
+  job.dcase = sum.free_ins            ? CASE_FREE_INS
+              : sum.gnss_applied == 0 ? CASE_NO_FIX
+                                      : (sum.gap_count > 0 || sum.gnss_dropped > 0 ? CASE_OUTAGES : CASE_FULL_GNSS);
+  /* The published figures are for the three cases of the README only. */
+  job.long_drive = job.dcase != CASE_NO_FIX && peers_auto && is_long_drive(truth);
   job.wall_s = wall;
   job.peers = peers;
   job.n_peers = n_peers;
@@ -828,6 +859,15 @@ int navsim_replay(int argc, char **argv) {
       fprintf(stderr, "navsim replay: evaluating the requirements failed: %s\n", nav_status_str(st));
       goto cleanup;
     }
+    /* Without a single fix the outages of outage_end do not exist: not evaluated, saying why. */
+    if (!sum.free_ins && sum.gnss_applied == 0)
+      for (int k = 0; k < n_reqs; ++k)
+        if (verdicts[k].statistic == NAV_REQ_OUTAGE_END) {
+          verdicts[k].evaluated = false;
+          verdicts[k].pass = false;
+          verdicts[k].value = NAN;
+          verdicts[k].na_reason = NAV_REQ_NA_NO_GNSS_FIX;
+        }
     job.verdicts = verdicts;
     job.n_verdicts = n_reqs;
   }

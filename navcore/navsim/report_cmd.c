@@ -268,6 +268,201 @@ static char *read_all(const char *path, size_t *len) {
   return b;
 }
 
+/* ---------------------------------------------------------------- summary.json syntax */
+
+/* A strict JSON syntax check (RFC 8259: one value, then only whitespace), so that a cut or
+ * damaged summary.json is reported instead of read as "no requirements" or "no statistics".
+ * On failure *at is the byte offset of the problem and *why says what was expected there. */
+typedef struct jcheck {
+  const char *s;
+  size_t n, i;
+  const char *why;
+} jcheck;
+
+static void jws(jcheck *c) {
+  while (c->i < c->n && (c->s[c->i] == ' ' || c->s[c->i] == '\t' || c->s[c->i] == '\n' || c->s[c->i] == '\r'))
+    ++c->i;
+}
+
+static bool jfail(jcheck *c, const char *why) {
+  if (!c->why) c->why = why;
+  return false;
+}
+
+static bool jvalue(jcheck *c, int depth);
+
+static bool jstring(jcheck *c) {
+  ++c->i; /* the opening quote */
+  while (c->i < c->n) {
+    const unsigned char ch = (unsigned char)c->s[c->i];
+    if (ch == '"') {
+      ++c->i;
+      return true;
+    }
+    if (ch < 0x20) return jfail(c, "a control character inside a string");
+    if (ch == '\\') {
+      ++c->i;
+      if (c->i >= c->n) break;
+      const char e = c->s[c->i];
+      if (e == 'u') {
+        for (int k = 1; k <= 4; ++k) {
+          const size_t j = c->i + (size_t)k;
+          const char h = j < c->n ? c->s[j] : '\0';
+          if (!((h >= '0' && h <= '9') || (h >= 'a' && h <= 'f') || (h >= 'A' && h <= 'F'))) {
+            c->i = j;
+            return jfail(c, "four hexadecimal digits after \\u");
+          }
+        }
+        c->i += 4;
+      } else if (!strchr("\"\\/bfnrt", e) || e == '\0') {
+        return jfail(c, "an escape (\\\" \\\\ \\/ \\b \\f \\n \\r \\t \\uXXXX)");
+      }
+    }
+    ++c->i;
+  }
+  return jfail(c, "the closing quote of a string");
+}
+
+static bool jdigits(jcheck *c) {
+  const size_t a = c->i;
+  while (c->i < c->n && c->s[c->i] >= '0' && c->s[c->i] <= '9') ++c->i;
+  return c->i > a;
+}
+
+static bool jnumber(jcheck *c) {
+  if (c->s[c->i] == '-') ++c->i;
+  if (c->i < c->n && c->s[c->i] == '0') ++c->i;
+  else if (!jdigits(c)) return jfail(c, "a digit");
+  if (c->i < c->n && c->s[c->i] == '.') {
+    ++c->i;
+    if (!jdigits(c)) return jfail(c, "a digit after the decimal point");
+  }
+  if (c->i < c->n && (c->s[c->i] == 'e' || c->s[c->i] == 'E')) {
+    ++c->i;
+    if (c->i < c->n && (c->s[c->i] == '+' || c->s[c->i] == '-')) ++c->i;
+    if (!jdigits(c)) return jfail(c, "a digit in the exponent");
+  }
+  /* A number cut at the end of the file looks complete: the caller sees the missing bracket. */
+  return true;
+}
+
+static bool jword(jcheck *c, const char *w) {
+  const size_t k = strlen(w);
+  for (size_t j = 0; j < k; ++j, ++c->i)
+    if (c->i >= c->n || c->s[c->i] != w[j]) return jfail(c, "true, false or null");
+  return true;
+}
+
+static bool jvalue(jcheck *c, int depth) {
+  jws(c);
+  if (c->i >= c->n) return jfail(c, "a value");
+  if (depth > 256) return jfail(c, "nesting of at most 256 levels");
+  const char ch = c->s[c->i];
+  if (ch == '{' || ch == '[') {
+    const char close = ch == '{' ? '}' : ']';
+    ++c->i;
+    jws(c);
+    if (c->i < c->n && c->s[c->i] == close) {
+      ++c->i;
+      return true;
+    }
+    for (;;) {
+      if (ch == '{') {
+        jws(c);
+        if (c->i >= c->n || c->s[c->i] != '"') return jfail(c, "a key (a string in double quotes)");
+        if (!jstring(c)) return false;
+        jws(c);
+        if (c->i >= c->n || c->s[c->i] != ':') return jfail(c, "':' after the key");
+        ++c->i;
+      }
+      if (!jvalue(c, depth + 1)) return false;
+      jws(c);
+      if (c->i < c->n && c->s[c->i] == ',') {
+        ++c->i;
+        continue;
+      }
+      if (c->i < c->n && c->s[c->i] == close) {
+        ++c->i;
+        return true;
+      }
+      return jfail(c, ch == '{' ? "',' or '}' in an object" : "',' or ']' in an array");
+    }
+  }
+  if (ch == '"') return jstring(c);
+  if (ch == '-' || (ch >= '0' && ch <= '9')) return jnumber(c);
+  if (ch == 't') return jword(c, "true");
+  if (ch == 'f') return jword(c, "false");
+  if (ch == 'n') return jword(c, "null");
+  return jfail(c, "a value (object, array, string, number, true, false or null)");
+}
+
+/* NULL when @p text is one JSON value; else what is wrong, at byte *at. */
+static const char *json_syntax_error(const char *text, size_t n, size_t *at) {
+  jcheck c = {text, n, 0, NULL};
+  if (jvalue(&c, 0)) {
+    jws(&c);
+    if (c.i < c.n) {
+      c.why = "the end of the file after the JSON value";
+    }
+  }
+  *at = c.i;
+  return c.why;
+}
+
+/* The result directory's summary.json must exist and be whole: it holds the verdicts and the
+ * statistics, and a page without them would say "no requirements" where they failed. 0, or the
+ * exit code after a message. */
+static int check_summary(const char *dir) {
+  char path[4300];
+  snprintf(path, sizeof path, "%s/summary.json", dir);
+  struct stat sb;
+  if (stat(path, &sb) != 0) {
+    fprintf(stderr,
+            "%s: error: missing: a result directory of navsim holds summary.json (run, estimate, replay, allan "
+            "and bench write it), with the statistics and the requirement verdicts; run the command again\n",
+            path);
+    return RC_INVALID;
+  }
+  if (!S_ISREG(sb.st_mode)) {
+    fprintf(stderr, "%s: error: not a regular file; a result directory's summary.json is a JSON file\n", path);
+    return RC_INVALID;
+  }
+  size_t n = 0;
+  char *text = read_all(path, &n);
+  if (!text) {
+    fprintf(stderr, "%s: error: cannot read: %s\n", path, strerror(errno));
+    return RC_FAIL;
+  }
+  size_t at = 0;
+  const char *why = memchr(text, '\0', n) ? "a NUL byte (binary data)" : json_syntax_error(text, n, &at);
+  if (why && memchr(text, '\0', n)) at = (size_t)((const char *)memchr(text, '\0', n) - text);
+  int rc = 0;
+  if (why) {
+    long line = 1, col = 1;
+    for (size_t k = 0; k < at && k < n; ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    if (at >= n)
+      fprintf(stderr,
+              "%s:%ld:%ld: error: truncated JSON: the file ends at byte %zu where %s was expected (cut short?); the "
+              "result directory is damaged (run the command that wrote it again)\n",
+              path, line, col, n, why);
+    else
+      fprintf(stderr,
+              "%s:%ld:%ld: error: invalid JSON at byte %zu of %zu: expected %s; the result directory is damaged "
+              "(run the command that wrote it again)\n",
+              path, line, col, at, n, why);
+    rc = RC_INVALID;
+  }
+  free(text);
+  return rc;
+}
+
 static void html_escape(FILE *f, const char *s, size_t n) {
   for (size_t i = 0; i < n && s[i]; ++i) {
     const char c = s[i];
@@ -414,6 +609,10 @@ int navsim_report(int argc, char **argv) {
   if (!is_dir(dir)) {
     fprintf(stderr, "%s: error: not a result directory (navsim run --out DIR writes one)\n", dir);
     return RC_FAIL;
+  }
+  {
+    const int src = check_summary(dir);
+    if (src != 0) return src;
   }
   char out_dir[4096], page[4300], tmp_page[4400];
   const size_t ol = out ? strlen(out) : 0;
@@ -620,7 +819,7 @@ int navsim_report(int argc, char **argv) {
   /* Requirement verdicts. */
   fputs("<h2>Requirements</h2>\n", f);
   char *req = summary ? json_block(summary, "requirements") : NULL;
-  int nreq = 0, nfail = 0;
+  int nreq = 0, nfail = 0, nna = 0;
   if (req) {
     const char *p = req + 1;
     int depth = 0;
@@ -653,6 +852,11 @@ int navsim_report(int argc, char **argv) {
           const bool have_value = json_num(o, "value", &value);
           const char *ps = strstr(o, "\"pass\"");
           const bool pass = ps && strncmp(ps + 6 + strspn(ps + 6, ": "), "true", 4) == 0;
+          /* A verdict without data says so (issue 25): "evaluated": false and its reason. */
+          const char *pe = strstr(o, "\"evaluated\"");
+          const bool na = pe && strncmp(pe + 11 + strspn(pe + 11, ": "), "false", 5) == 0;
+          char reason[160] = "";
+          if (na) json_str(o, "reason", reason, sizeof reason);
           if (nreq == 0)
             fputs("<table>\n<tr><th class=\"l\">id</th><th class=\"l\">metric</th><th class=\"l\">statistic</th>"
                   "<th>value</th><th>limit</th><th class=\"l\">unit</th><th class=\"l\">verdict</th></tr>\n",
@@ -667,15 +871,28 @@ int navsim_report(int argc, char **argv) {
           else fputs("</td><td>&ndash;</td>", f);
           fprintf(f, "<td>%.4g</td><td class=\"l\">", limit);
           html_text(f, unit);
-          fprintf(f, "</td><td class=\"l %s\">%s</td></tr>\n", pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+          if (na) {
+            fputs("</td><td class=\"l\">not evaluated", f);
+            if (reason[0]) {
+              fputs(": ", f);
+              html_text(f, reason);
+            }
+            fputs("</td></tr>\n", f);
+          } else {
+            fprintf(f, "</td><td class=\"l %s\">%s</td></tr>\n", pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+          }
           ++nreq;
-          if (!pass) ++nfail;
+          if (na) ++nna;
+          else if (!pass) ++nfail;
           free(o);
           obj = NULL;
         }
       }
     }
-    if (nreq > 0) fprintf(f, "</table>\n<p>%d of %d requirements met.</p>\n", nreq - nfail, nreq);
+    if (nreq > 0 && nna > 0)
+      fprintf(f, "</table>\n<p>%d of %d requirements met, %d not evaluated.</p>\n", nreq - nfail - nna, nreq, nna);
+    else if (nreq > 0)
+      fprintf(f, "</table>\n<p>%d of %d requirements met.</p>\n", nreq - nfail, nreq);
     free(req);
   }
   if (nreq == 0) fputs("<p>The scene states no requirements.</p>\n", f);

@@ -172,6 +172,95 @@ static void test_replay_verdicts(void **state) {
   nav_test_assert_matches(q, "\"id\": \"h-tiny\".*\"pass\": false");
 }
 
+/* Issue 25: a replay whose window holds no GNSS fix (the only one is at the initial epoch) is a
+ * free-inertial run: labelled so, and outage_end (whose outages need fixes) is not evaluated,
+ * nor is an at_time after the end; neither is a PASS. */
+static void test_issue_25_replay_no_fix_applied(void **state) {
+  (void)state;
+  char cmd[2048];
+  snprintf(cmd, sizeof cmd, "cp '%s/replay/long-drive.yaml' '%s/nofix.yaml' && printf '%s' >> '%s/nofix.yaml'",
+           NAV_TEST_DATA_DIR, WORK,
+           "\nrequirements:\n"
+           "  - {id: h-end, metric: horizontal_position, statistic: outage_end, limit: 5, unit: m}\n"
+           "  - {id: h-late, metric: horizontal_position, statistic: at_time, time_s: 1e6, limit: 1, unit: km}\n"
+           "  - {id: h-rms, metric: horizontal_position, statistic: rms, limit: 1, unit: km}\n",
+           WORK);
+  assert_int_equal(system(cmd), 0);
+  nav_cli_result *r =
+      navsim("replay --imu '" NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt' --gnss '" NAV_TEST_DATA_DIR
+             "/replay/GNSS-100195-100245.txt' --truth '" NAV_TEST_DATA_DIR
+             "/replay/truth-100195-100245-20Hz.nav' --scene nofix.yaml --end 100195.5 --peers none "
+             "--out nofix-out");
+  if (r->code != 0) fail_msg("navsim replay exited %d: %s", r->code, r->err);
+  nav_test_assert_matches(r->out, "^gnss +0 fixes applied");
+  nav_test_assert_matches(r->out, "^case +no GNSS fix applied$");
+  nav_test_assert_matches(r->out, "^requirements 1 of 3 pass, 2 not evaluated$");
+  nav_test_assert_matches(r->out, "^  N/A   h-end +horizontal_position outage_end: not evaluated: no GNSS fix was "
+                                  "applied \\(limit 5 m\\)$");
+  nav_test_assert_matches(r->out, "^  N/A   h-late +horizontal_position at_time: not evaluated: t = 1e\\+06 s lies "
+                                  "outside the run's epochs \\[0, 0.5\\] s");
+  nav_test_assert_matches(r->out, "^  PASS  h-rms ");
+  if (strstr(r->out, "full GNSS")) fail_msg("a run without a fix is labelled full GNSS:\n%s", r->out);
+  static char js[262144];
+  nav_test_slurp(WORK "/nofix-out/summary.json", js, sizeof js);
+  nav_test_assert_matches(js, "\"case\": \"no GNSS fix applied\"");
+  const char *q = requirements_of(js);
+  nav_test_assert_matches(q, "\"id\": \"h-end\".*\"value\": null, \"pass\": false, \"samples\": 0, "
+                             "\"evaluated\": false, \"reason\": \"no GNSS fix was applied\"");
+  nav_test_assert_matches(q, "\"id\": \"h-late\".*\"pass\": false.*\"evaluated\": false");
+}
+
+/* Issue 25: a replay with no epoch to score (one IMU line, or a window that ends before the
+ * second IMU epoch) is refused with exit 2, saying what was processed; no result directory. */
+static void test_issue_25_replay_no_scored_epoch(void **state) {
+  (void)state;
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "head -1 '%s/replay/IMU-100195-100245.txt' > '%s/imu-one.txt'", NAV_TEST_DATA_DIR, WORK);
+  assert_int_equal(system(cmd), 0);
+  static const char *const imus[2] = {"imu-one.txt", NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt"};
+  static const char *const extra[2] = {"", " --end 100195.004"};
+  for (int k = 0; k < 2; ++k) {
+    nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                                          "replay --imu '%s' --gnss '" NAV_TEST_DATA_DIR
+                                          "/replay/GNSS-100195-100245.txt' --truth '" NAV_TEST_DATA_DIR
+                                          "/replay/truth-100195-100245-20Hz.nav' --peers none --out empty-out%s",
+                                          imus[k], extra[k]);
+    if (r->code != 2) fail_msg("replay with nothing to score (%s%s) exited %d:\n%s", imus[k], extra[k], r->code, r->out);
+    nav_test_assert_matches(r->err, "error: no epoch to score: 0 IMU step\\(s\\) processed from 100195.000 to "
+                                    "100195.000 s");
+    if (strstr(r->out, "PASS") || strstr(r->out, "scored epochs")) fail_msg("statistics printed:\n%s", r->out);
+    struct stat sb;
+    if (stat(WORK "/empty-out", &sb) == 0) fail_msg("a refused replay wrote its result directory");
+  }
+}
+
+/* Issue 25: a requirement at_time 1e6 s on a 10 s scene, or outage_end without an outage, is
+ * refused before any work by check, run, estimate and budget, at its place in the file (exit 2);
+ * none of them writes a result. */
+static void test_issue_25_unevaluable_requirements_refused(void **state) {
+  (void)state;
+  nav_test_write_file(WORK, "late.yaml",
+                      SCENE_HEAD "requirements:\n"
+                                 "  - {id: h-late, metric: horizontal_position, statistic: at_time, time_s: 1e6, "
+                                 "limit: 1, unit: m}\n");
+  nav_test_write_file(WORK, "noout.yaml",
+                      SCENE_HEAD "requirements:\n"
+                                 "  - {id: h-out, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n");
+  static const char *const cmds[4] = {"check", "run", "estimate", "budget"};
+  for (int k = 0; k < 4; ++k) {
+    nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s late.yaml%s", cmds[k],
+                                          k == 0 ? "" : " --out late-out");
+    if (r->code != 2) fail_msg("navsim %s late.yaml exited %d:\n%s\n%s", cmds[k], r->code, r->out, r->err);
+    nav_test_assert_matches(r->err, "^late\\.yaml:13:75: error: requirements\\[0\\]\\.time_s: 1e\\+06 s is after the "
+                                    "end of the run \\(trajectory duration 10 s\\)");
+    r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s noout.yaml%s", cmds[k], k == 0 ? "" : " --out late-out");
+    if (r->code != 2) fail_msg("navsim %s noout.yaml exited %d:\n%s", cmds[k], r->code, r->err);
+    nav_test_assert_matches(r->err, "^noout\\.yaml:13:[0-9]+: error: requirements\\[0\\]\\.statistic: outage_end needs "
+                                    "a GNSS outage, and navigation\\.scheme free_ins has no GNSS");
+    struct stat sb;
+    if (stat(WORK "/late-out", &sb) == 0) fail_msg("navsim %s wrote a result for a refused scene", cmds[k]);
+  }
+}
 
 /* navsim estimate: the requirements of estimate.json predicted from the covariance analysis
  * (wgs84 scenes); null values where there is none (flat Earth) or the statistic is not
@@ -283,6 +372,9 @@ int main(void) {
       cmocka_unit_test(test_verdicts_independent_of_threads),
       cmocka_unit_test(test_invalid_requirements_exit_2),
       cmocka_unit_test(test_replay_verdicts),
+      cmocka_unit_test(test_issue_25_replay_no_fix_applied),
+      cmocka_unit_test(test_issue_25_replay_no_scored_epoch),
+      cmocka_unit_test(test_issue_25_unevaluable_requirements_refused),
       cmocka_unit_test(test_estimate_predictions),
       cmocka_unit_test(test_budget_cli),
   };

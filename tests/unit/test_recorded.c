@@ -593,6 +593,33 @@ static void test_malformed_files(void **state) {
   assert_int_equal(log.n, 1);
 }
 
+/* Issue 25: a position that jumps beyond what the recorded velocities allow (1 deg of latitude,
+ * 111 km, in 0.1 s at 0.2 m/s) is refused at the later sample's latitude, not smoothed over by
+ * the fit; a small offset within 1 m + 100 m/s^2 x dt^2 / 4 is accepted. */
+static void test_issue_25_position_jump(void **state) {
+  (void)state;
+  read_bad(ROW1 "0 100.1 30.5 114.3 21.0 0.1 0.2 0.0 0.5 -0.2 179.5\n"
+                "0 100.2 31.5 114.3 21.0 0.1 0.2 0.0 0.5 -0.2 179.5\n",
+           3, 9, "the position jumps 110");
+  /* A height step of 2 m in 0.1 s (bound 1.25 m) is a jump; 1 m is not. */
+  read_bad(ROW1 "0 100.1 30.5 114.3 23.0 0.1 0.2 0.0 0.5 -0.2 179.5\n", 2, 9, "exceeds 1.25 m");
+  const char *ok = ROW1 "0 100.1 30.5 114.3 22.0 0.1 0.2 0.0 0.5 -0.2 179.5\n";
+  nav_track_sample *out = NULL;
+  size_t n = 0;
+  diag_log log = {0};
+  assert_int_equal(nav_track_read_string(ok, strlen(ok), "ok.nav", NAV_RECORDED_KF_GINS_NAV, 0, 0, 0, "x", &out, &n,
+                                         collect, &log),
+                   NAV_OK);
+  assert_int_equal(n, 2);
+  free(out);
+  /* The recorded reference of the test data (real vehicle, 10 Hz) passes: tests/data/recorded. */
+  assert_int_equal(nav_track_read_file(NAV_TEST_DATA_DIR "/recorded/adis16465-truth-116454-116754.nav",
+                                       NAV_RECORDED_KF_GINS_NAV, 0, 0, 0, "x", &out, &n, collect, &log),
+                   NAV_OK);
+  assert_true(n > 2000);
+  free(out);
+}
+
 /* What the fit refuses, with the sample or limit named. */
 static void test_fit_refusals(void **state) {
   (void)state;
@@ -807,6 +834,7 @@ int main(void) {
       cmocka_unit_test(test_derivatives),  cmocka_unit_test(test_continuity),
       cmocka_unit_test(test_exactness),    cmocka_unit_test(test_fit_residuals),
       cmocka_unit_test(test_closure),      cmocka_unit_test(test_malformed_files),
+      cmocka_unit_test(test_issue_25_position_jump),
       cmocka_unit_test(test_fit_refusals), cmocka_unit_test(test_scene_files),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -142,7 +142,7 @@ static void test_at_time_known(void **state) {
                           req("t99", NAV_REQ_YAW, NAV_REQ_AT_TIME, 1.0, NAV_REQ_UNIT_DEG)};
   q[0].time_s = 6.2;
   q[1].time_s = 2.5;
-  q[2].time_s = 99.0; /* beyond the end: the last epoch */
+  q[2].time_s = 10.4; /* past the last epoch (10 s) by less than half the spacing: that epoch */
   nav_req_evaluator *ev = NULL;
   assert_int_equal(nav_req_evaluator_create(q, 3, 2, NULL, 0, &ev), NAV_OK);
   for (long run = 0; run < 2; ++run) {
@@ -167,6 +167,50 @@ static void test_at_time_known(void **state) {
   assert_near(v[2].at_time_s, 10.0, 0.0);
   assert_rel_near(v[2].value, sqrt((0.01 * 0.01 + 0.02 * 0.02) / 2.0) * 180.0 / NAV_PI, 1e-14);
   assert_true(v[2].pass);
+  assert_int_equal(v[2].na_reason, NAV_REQ_NA_NONE);
+}
+
+/* Issue 25: an at_time requirement after the end (or before the start) of the run is not
+ * evaluated at the nearest epoch: it is "not evaluated", never a pass, with the run's span. */
+static void test_issue_25_at_time_outside_run(void **state) {
+  (void)state;
+  nav_requirement q[3] = {req("late", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_AT_TIME, 1000.0, NAV_REQ_UNIT_KM),
+                          req("edge", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_AT_TIME, 1000.0, NAV_REQ_UNIT_KM),
+                          req("early", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_AT_TIME, 1000.0, NAV_REQ_UNIT_KM)};
+  q[0].time_s = 1e6;  /* the issue's case: 1e6 s on a 10 s run */
+  q[1].time_s = 10.6; /* more than half a spacing (0.5 s) after the last epoch */
+  q[2].time_s = 0.4;  /* the run starts at 1 s: more than half a spacing before it */
+  nav_req_evaluator *ev = NULL;
+  assert_int_equal(nav_req_evaluator_create(q, 3, 1, NULL, 0, &ev), NAV_OK);
+  nav_epoch_errors e[10];
+  for (int i = 0; i < 10; ++i) e[i] = epoch_h((double)(i + 1), 0.001, 0.0);
+  feed_run(ev, 0, e, 10);
+  nav_requirement_verdict v[3];
+  assert_int_equal(nav_req_evaluator_finish(ev, v), NAV_OK);
+  nav_req_evaluator_destroy(ev);
+  for (int i = 0; i < 3; ++i) {
+    assert_false(v[i].evaluated);
+    assert_false(v[i].pass);
+    assert_true(isnan(v[i].value));
+    assert_int_equal(v[i].na_reason, NAV_REQ_NA_TIME_OUTSIDE);
+    assert_near(v[i].span_t0_s, 1.0, 0.0);
+    assert_near(v[i].span_t1_s, 10.0, 0.0);
+    assert_near(v[i].at_time_s, q[i].time_s, 0.0);
+    assert_false(nav_req_all_pass(&v[i], 1));
+  }
+  /* The prediction from covariance points applies the same rule. */
+  nav_cov_point pts[10];
+  memset(pts, 0, sizeof pts);
+  for (int i = 0; i < 10; ++i) {
+    pts[i].t_s = (double)(i + 1);
+    pts[i].pos_sd_n_m = nav_vec3_make(1.0, 1.0, 1.0);
+  }
+  assert_int_equal(nav_req_predict(q, 3, pts, 10, NULL, 0, v), NAV_OK);
+  for (int i = 0; i < 3; ++i) {
+    assert_false(v[i].evaluated);
+    assert_false(v[i].pass);
+    assert_int_equal(v[i].na_reason, NAV_REQ_NA_TIME_OUTSIDE);
+  }
 }
 
 /* outage_end: outages [2, 5) and [7, 9.5) on epochs t = 0..10 s: last epochs 4 s and 9 s; an
@@ -195,14 +239,15 @@ static void test_outage_end_known(void **state) {
   assert_false(v.pass); /* 14.2 > 12 */
   assert_true(v.evaluated);
 
-  /* No outage at all: not evaluated, and nothing violates it (passes). */
+  /* No outage at all: not evaluated, and not a pass either (issue 25: nothing pretended). */
   assert_int_equal(nav_req_evaluator_create(&q, 1, 1, NULL, 0, &ev), NAV_OK);
   nav_epoch_errors e = epoch_h(0.0, 1.0, 0.0);
   feed_run(ev, 0, &e, 1);
   assert_int_equal(nav_req_evaluator_finish(ev, &v), NAV_OK);
   nav_req_evaluator_destroy(ev);
   assert_false(v.evaluated);
-  assert_true(v.pass);
+  assert_false(v.pass);
+  assert_int_equal(v.na_reason, NAV_REQ_NA_NO_OUTAGE);
   assert_true(isnan(v.value));
   /* Outages without an epoch inside: not evaluated, fails. */
   const nav_req_interval late = {20.0, 30.0};
@@ -352,6 +397,74 @@ static const char *find_diag(const diags *ds, const char *needle) {
   for (int i = 0; i < ds->n && i < 16; ++i)
     if (strstr(ds->text[i], needle)) return ds->text[i];
   return NULL;
+}
+
+/* Issue 25: navsim check refuses requirements the scene's run cannot evaluate, at their place in
+ * the file: an at_time after the end, an outage_end without an outage (none given, none within
+ * the run, or no GNSS at all). A scene without a trajectory (the filter configuration of navsim
+ * replay) is not checked: its requirements apply to recorded data. */
+/* Read @p text as the file DIR/@p name through nav_scene_read_file_to_run (as navsim check,
+ * run and estimate do); the diagnostics name the file by its path. */
+static nav_status read_to_run(const char *dir, const char *name, const char *text, nav_scene *s, diags *ds) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fputs(text, f);
+  assert_int_equal(fclose(f), 0);
+  ds->n = 0;
+  const nav_status st = nav_scene_read_file_to_run(path, s, on_diag, ds);
+  remove(path);
+  return st;
+}
+
+static void test_issue_25_scene_requirements_evaluable(void **state) {
+  (void)state;
+  static const char bad[] = "format_version: 1\n"
+                            "earth: {model: wgs84}\n"
+                            "trajectory: {type: parametric, duration_s: 39.8}\n"
+                            "gnss: {enabled: true, outages: [[50, 60]]}\n"
+                            "navigation: {scheme: ins_gnss}\n"
+                            "requirements:\n"
+                            "  - {id: late, metric: horizontal_position, statistic: at_time, time_s: 1e6, limit: 1, unit: m}\n"
+                            "  - {id: end, metric: horizontal_position, statistic: at_time, time_s: 39.8, limit: 1, unit: m}\n"
+                            "  - {id: out, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n";
+  char dir[] = "/tmp/nav_req_run_XXXXXX";
+  assert_non_null(mkdtemp(dir));
+  nav_scene *s = malloc(sizeof *s);
+  assert_non_null(s);
+  diags ds = {0};
+  /* The library reader accepts it (a scene may be edited before it is run)... */
+  assert_int_equal(nav_scene_read_string(bad, strlen(bad), "req.yaml", s, on_diag, &ds), NAV_OK);
+  /* ...the reader of a scene to run does not. */
+  assert_int_equal(read_to_run(dir, "req.yaml", bad, s, &ds), NAV_ERR_PARSE);
+  assert_int_equal(ds.n, 2);
+  const char *m = find_diag(&ds, "requirements[0].time_s");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "req.yaml:7:73: error: requirements[0].time_s: 1e+06 s is after the end of the run"));
+  assert_null(find_diag(&ds, "requirements[1]"));
+  m = find_diag(&ds, "requirements[2].statistic");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "req.yaml:9:"));
+  assert_non_null(strstr(m, "every outage starts after its end"));
+
+  static const char none[] = "format_version: 1\n"
+                             "trajectory: {type: parametric, duration_s: 20}\n"
+                             "requirements:\n"
+                             "  - {id: out, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n";
+  assert_int_equal(read_to_run(dir, "none.yaml", none, s, &ds), NAV_ERR_PARSE);
+  m = find_diag(&ds, "requirements[0].statistic");
+  assert_non_null(m);
+  assert_non_null(strstr(m, "outage_end needs a GNSS outage"));
+
+  /* Without a trajectory: accepted (navsim replay --scene). */
+  static const char replay_cfg[] = "format_version: 1\n"
+                                   "requirements:\n"
+                                   "  - {id: out, metric: horizontal_position, statistic: outage_end, limit: 1, unit: m}\n"
+                                   "  - {id: late, metric: yaw, statistic: at_time, time_s: 500, limit: 1, unit: deg}\n";
+  assert_int_equal(read_to_run(dir, "cfg.yaml", replay_cfg, s, &ds), NAV_OK);
+  free(s);
+  assert_int_equal(rmdir(dir), 0);
 }
 
 static void test_scene_errors(void **state) {
@@ -570,6 +683,8 @@ int main(void) {
       cmocka_unit_test(test_names_and_units),
       cmocka_unit_test(test_rms_max_p95_known),
       cmocka_unit_test(test_at_time_known),
+      cmocka_unit_test(test_issue_25_at_time_outside_run),
+      cmocka_unit_test(test_issue_25_scene_requirements_evaluable),
       cmocka_unit_test(test_outage_end_known),
       cmocka_unit_test(test_cep_circular_gaussian),
       cmocka_unit_test(test_quantile_histogram_beyond_budget),

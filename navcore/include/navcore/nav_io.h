@@ -47,6 +47,16 @@ NAV_API void nav_diag_format(const nav_diag *d, char *buf, size_t size);
 NAV_API NAV_NODISCARD nav_status nav_scene_read_file(const char *path, nav_scene *out, nav_diag_fn report,
                                                      void *user);
 
+/**
+ * As nav_scene_read_file, for a scene that is about to be simulated (navsim check, run, estimate,
+ * budget, select, sweep): when the file states a trajectory, its requirements must also be
+ * evaluable on the run (nav_requirements_check_scene: no at_time after the end, no outage_end
+ * without an outage), each problem reported at the requirement's place. Without a trajectory
+ * the file is a filter configuration (navsim replay --scene) and this check does not apply.
+ */
+NAV_API NAV_NODISCARD nav_status nav_scene_read_file_to_run(const char *path, nav_scene *out, nav_diag_fn report,
+                                                            void *user);
+
 /** As nav_scene_read_file, from memory; @p display_name is used as FILE in diagnostics. */
 NAV_API NAV_NODISCARD nav_status nav_scene_read_string(const char *text, size_t len, const char *display_name,
                                                        nav_scene *out, nav_diag_fn report, void *user);

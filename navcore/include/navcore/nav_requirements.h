@@ -12,10 +12,13 @@
  *  - p95:        95th percentile, nearest rank (the smallest value with at least 95 % of the
  *                values at or below it);
  *  - at_time:    RMS over runs of the metric at the output epoch nearest time_s (the earlier one
- *                on a tie);
+ *                on a tie); not evaluated (NAV_REQ_NA_TIME_OUTSIDE) when time_s lies outside the
+ *                run's epochs [first, last] by more than half the spacing of the two epochs at that
+ *                end (the nearest epoch would then not be "at" time_s);
  *  - outage_end: for each GNSS outage [t0, t1), the RMS over runs of the metric at the last
  *                output epoch inside it; the value is the largest of those (each outage is
- *                reported in nav_requirement_verdict.outage_value);
+ *                reported in nav_requirement_verdict.outage_value); not evaluated
+ *                (NAV_REQ_NA_NO_OUTAGE) when there is no outage;
  *  - cep50/cep95 (horizontal_position only): radius containing 50 / 95 % of the horizontal
  *                errors (nearest rank of the horizontal error over runs and epochs).
  * Metrics: horizontal_position = hypot(dN, dE); vertical_position = |dD|; position_3d = |dr|;
@@ -103,6 +106,17 @@ typedef enum nav_req_quantity {
   NAV_REQ_ANGLE = 2
 } nav_req_quantity;
 
+/** Why a verdict was not evaluated (nav_requirement_verdict.na_reason). */
+typedef enum nav_req_na_reason {
+  NAV_REQ_NA_NONE = 0,          /**< evaluated */
+  NAV_REQ_NA_NO_DATA = 1,       /**< no epoch entered the statistic (no scored epoch; no epoch inside any outage) */
+  NAV_REQ_NA_NO_OUTAGE = 2,     /**< outage_end: the run has no GNSS outage */
+  NAV_REQ_NA_TIME_OUTSIDE = 3,  /**< at_time: time_s lies outside the run's epochs (span_t0_s .. span_t1_s) */
+  NAV_REQ_NA_NOT_PREDICTED = 4, /**< nav_req_predict: no covariance points, or the statistic is not
+                                     predictable from sigmas */
+  NAV_REQ_NA_NO_GNSS_FIX = 5    /**< set by callers (navsim replay): no GNSS fix was applied */
+} nav_req_na_reason;
+
 /** One requirement (scene file: requirements[i]). */
 typedef struct nav_requirement {
   char id[NAV_REQ_ID_MAX];     /**< [A-Za-z0-9_.-]{1,63}, unique within the scene */
@@ -121,11 +135,14 @@ typedef struct nav_requirement_verdict {
   double limit;  /**< user units */
   nav_req_unit unit;
   double value;  /**< user units; NaN when nothing was evaluated (no epoch, no outage) */
-  bool pass;     /**< value <= limit; without a value false, except outage_end when there is no
-                      outage at all (nothing can violate it: pass, evaluated false) */
-  bool evaluated; /**< false: no data for this statistic (e.g. outage_end without an outage) */
+  bool pass;     /**< value <= limit; false without a value (not evaluated is never a pass) */
+  bool evaluated; /**< false: no data for this statistic (e.g. outage_end without an outage); then
+                       pass is false and na_reason says why */
+  nav_req_na_reason na_reason; /**< NAV_REQ_NA_NONE when evaluated */
+  double span_t0_s; /**< at_time: the first epoch of the run(s) [s] (NaN: no epoch) */
+  double span_t1_s; /**< at_time: the last epoch of the run(s) [s] (NaN: no epoch) */
   long samples;  /**< values that entered the statistic */
-  double at_time_s; /**< at_time: the epoch used [s] */
+  double at_time_s; /**< at_time: the epoch used [s]; NAV_REQ_NA_TIME_OUTSIDE: the time asked [s] */
   int outage_count; /**< outage_end: outages evaluated (each below) */
   double outage_t0_s[NAV_REQ_MAX_OUTAGES];  /**< outage start [s] */
   double outage_t1_s[NAV_REQ_MAX_OUTAGES];  /**< outage end [s] */
@@ -155,6 +172,9 @@ NAV_API double nav_req_metric_value(nav_req_metric m, const struct nav_epoch_err
 /** Whether @p s is a quantile statistic (p95, cep50, cep95). */
 NAV_API bool nav_req_statistic_is_quantile(nav_req_statistic s);
 
+/** One line of text for a reason ("the run has no GNSS outage"); "" for NAV_REQ_NA_NONE. */
+NAV_API const char *nav_req_na_reason_text(nav_req_na_reason r);
+
 /** Problem callback: @p path like "requirements[2].unit" (same signature as nav_scene_issue_fn). */
 typedef void (*nav_req_issue_fn)(void *user, const char *path, const char *message);
 
@@ -165,6 +185,19 @@ typedef void (*nav_req_issue_fn)(void *user, const char *path, const char *messa
  */
 NAV_API NAV_NODISCARD nav_status nav_requirements_validate(const nav_requirement *reqs, int count,
                                                            nav_req_issue_fn report, void *user);
+
+struct nav_scene;
+/**
+ * Check the requirements of a simulation scene against what its run will hold, so that each can
+ * be evaluated: at_time needs time_s within [0, trajectory.duration_s]; outage_end needs a GNSS
+ * outage that starts within the run (scheme ins_gnss; gnss.outages or segments with
+ * gnss_visible: false, as nav_req_scene_outages). Not part of nav_scene_validate: a scene used as
+ * the filter configuration of navsim replay states requirements on recorded data, whose span and
+ * gaps only the data knows (navcore_io applies this check to scene files with a trajectory).
+ * @return NAV_OK, or NAV_ERR_INVALID_ARG when a problem was reported.
+ */
+NAV_API NAV_NODISCARD nav_status nav_requirements_check_scene(const struct nav_scene *scene, nav_req_issue_fn report,
+                                                              void *user);
 
 /* ---------------------------------------------------------------- streaming evaluator */
 
@@ -252,7 +285,8 @@ struct nav_cov_point;
  *    |N(0, s_att_D^2)| (yaw) or of the horizontal radius of N(0, diag(sN^2, sE^2)) (horizontal;
  *    its CDF by quadrature), solved by bisection to 1e-9 relative;
  *  - max, and p95 of position_3d, velocity and roll_pitch: not predicted (evaluated = false,
- *    value NaN, pass false).
+ *    value NaN, pass false, NAV_REQ_NA_NOT_PREDICTED); at_time outside the points' span and
+ *    outage_end without an outage are not evaluated as in the evaluator.
  * @p outages as for nav_req_evaluator_create. @p out: @p count verdicts (samples = epochs used).
  */
 NAV_API NAV_NODISCARD nav_status nav_req_predict(const nav_requirement *reqs, int count, const struct nav_cov_point *pts,

@@ -37,6 +37,10 @@ NAV_BEGIN_DECLS
  * must be a finite number, |lat| <= 90 deg, lon in [-360, 360] deg, |roll| <= 180 deg, |pitch|
  * <= 90 deg, yaw in [-360, 360] deg, times strictly increasing. Angles become radians here.
  * Only samples with start_s <= t <= end_s are kept when @p window has the corresponding bit.
+ * Consecutive kept samples must agree with their velocities: the displacement dr (local NED)
+ * and the trapezoid of the recorded velocities v_avg dt may differ by at most
+ * 1 m + 100 m/s^2 x dt^2 / 4 (the trapezoid rule's bound for accelerations up to 10 g, plus the
+ * position noise of a reference); a larger jump is reported at the later sample's latitude.
  *
  * Every problem is one nav_diag FILE:LINE:COL (COL the 1-based byte column of the offending
  * field, or of the end of the line for a missing field), with @p field_path as its path

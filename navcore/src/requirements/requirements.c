@@ -218,6 +218,58 @@ nav_status nav_requirements_validate(const nav_requirement *reqs, int count, nav
   return n ? NAV_ERR_INVALID_ARG : NAV_OK;
 }
 
+const char *nav_req_na_reason_text(nav_req_na_reason r) {
+  switch (r) {
+  case NAV_REQ_NA_NONE: return "";
+  case NAV_REQ_NA_NO_DATA: return "no epoch entered the statistic";
+  case NAV_REQ_NA_NO_OUTAGE: return "the run has no GNSS outage";
+  case NAV_REQ_NA_TIME_OUTSIDE: return "time_s lies outside the run's epochs";
+  case NAV_REQ_NA_NOT_PREDICTED: return "not predicted (no covariance analysis, or not predictable from sigmas)";
+  case NAV_REQ_NA_NO_GNSS_FIX: return "no GNSS fix was applied";
+  }
+  return "not evaluated";
+}
+
+nav_status nav_requirements_check_scene(const nav_scene *scene, nav_req_issue_fn report, void *user) {
+  if (!scene) return NAV_ERR_INVALID_ARG;
+  int n = 0;
+  const double dur = scene->trajectory.duration_s;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  bool outages_known = true;
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS)
+    outages_known = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni) == NAV_OK;
+  int n_in_run = 0;
+  for (int j = 0; j < ni; ++j)
+    if (!(iv[j].t0_s >= dur)) ++n_in_run;
+  for (int i = 0; i < scene->n_requirements && i < NAV_SCENE_MAX_REQUIREMENTS; ++i) {
+    const nav_requirement *q = &scene->requirements[i];
+    /* The last output epoch is at the end of the run (duration_s); 1e-9 relative covers its
+     * rounding to the output grid. */
+    if (q->statistic == NAV_REQ_AT_TIME && isfinite(dur) && q->time_s > dur * (1.0 + 1e-9) + 1e-9)
+      req_issue(report, user, &n, i, "time_s",
+                "%g s is after the end of the run (trajectory duration %g s): an at_time requirement needs a "
+                "time within [0, %g] s",
+                q->time_s, dur, dur);
+    if (q->statistic == NAV_REQ_OUTAGE_END && outages_known && n_in_run == 0) {
+      if (scene->navigation.scheme != NAV_SCHEME_INS_GNSS)
+        req_issue(report, user, &n, i, "statistic",
+                  "outage_end needs a GNSS outage, and navigation.scheme %s has no GNSS: use scheme ins_gnss "
+                  "with gnss.outages, or another statistic",
+                  nav_nav_scheme_name(scene->navigation.scheme));
+      else if (ni > 0)
+        req_issue(report, user, &n, i, "statistic",
+                  "outage_end needs a GNSS outage within the run, and every outage starts after its end (%g s)",
+                  dur);
+      else
+        req_issue(report, user, &n, i, "statistic",
+                  "outage_end needs a GNSS outage, and the scene has none: add gnss.outages (or a segment with "
+                  "gnss_visible: false), or use another statistic");
+    }
+  }
+  return n ? NAV_ERR_INVALID_ARG : NAV_OK;
+}
+
 bool nav_req_all_pass(const nav_requirement_verdict *v, int count) {
   for (int i = 0; i < count; ++i)
     if (!v[i].pass) return false;
@@ -321,7 +373,8 @@ static double qstore_quantile(qstore *q, int pct) {
 
 /* Row layout per requirement (offsets into a run's row of doubles):
  *   rms, max, quantiles: [sum of squares, count, max]
- *   at_time:             [value, epoch time, |epoch time - time_s|]  (value NaN: no epoch)
+ *   at_time:             [value, epoch time, |epoch time - time_s|, first epoch, last epoch, spacing
+ *                        of the last two epochs]  (value NaN: no epoch)
  *   outage_end:          [value, time] at the last epoch inside outage j, j = 0..n_outages-1 (NaN: none) */
 typedef struct req_layout {
   size_t off, width;
@@ -375,7 +428,9 @@ nav_status nav_req_evaluator_create(const nav_requirement *reqs, int count, long
     ev->reqs[i] = reqs[i];
     ev->lay[i].off = w;
     ev->lay[i].qindex = -1;
-    ev->lay[i].width = reqs[i].statistic == NAV_REQ_OUTAGE_END ? 2 * (size_t)n_outages : 3;
+    ev->lay[i].width = reqs[i].statistic == NAV_REQ_OUTAGE_END ? 2 * (size_t)n_outages
+                       : reqs[i].statistic == NAV_REQ_AT_TIME  ? 6
+                                                               : 3;
     if (nav_req_statistic_is_quantile(reqs[i].statistic)) {
       ev->lay[i].qindex = ev->nq;
       ev->q[ev->nq].budget = (size_t)(NAV_REQ_EXACT_BUDGET / nq);
@@ -458,6 +513,9 @@ nav_status nav_req_run_begin(nav_req_evaluator *ev, long run, nav_req_run **out)
       row[0] = NAN;
       row[1] = NAN;
       row[2] = INFINITY;
+      row[3] = NAN;
+      row[4] = NAN;
+      row[5] = 0.0;
     } else if (ev->reqs[i].statistic == NAV_REQ_OUTAGE_END) {
       for (size_t j = 0; j < ev->lay[i].width; ++j) row[j] = NAN;
     }
@@ -482,6 +540,9 @@ nav_status nav_req_run_add(nav_req_run *r, const nav_epoch_errors *e) {
         row[1] = e->t_s;
         row[2] = d;
       }
+      if (isnan(row[3])) row[3] = e->t_s;
+      else row[5] = e->t_s - row[4];
+      row[4] = e->t_s;
       break;
     }
     case NAV_REQ_OUTAGE_END:
@@ -555,6 +616,7 @@ nav_status nav_req_evaluator_finish(nav_req_evaluator *ev, nav_requirement_verdi
     v->limit = q->limit;
     v->unit = q->unit;
     v->at_time_s = NAN;
+    v->span_t0_s = v->span_t1_s = NAN;
     const double k = nav_req_unit_to_si(q->unit);
     const size_t off = ev->lay[i].off;
     double value = NAN;
@@ -585,16 +647,31 @@ nav_status nav_req_evaluator_finish(nav_req_evaluator *ev, nav_requirement_verdi
     case NAV_REQ_AT_TIME: {
       double s2 = 0.0;
       long n = 0;
+      bool outside = false;
+      v->span_t0_s = v->span_t1_s = NAN;
       for (long r = 0; r < ev->runs; ++r) {
         if (!ev->done[r]) continue;
         const double *row = ev->table + (size_t)r * ev->width + off;
         if (isnan(row[1])) continue;
-        if (n == 0) v->at_time_s = row[1];
+        if (n == 0) {
+          v->at_time_s = row[1];
+          v->span_t0_s = row[3];
+          v->span_t1_s = row[4];
+        }
+        /* Beyond half an epoch spacing past the first or last epoch, the nearest epoch is not at
+         * time_s: the run does not reach that time. 1e-9 relative covers rounding of the grid. */
+        const double tol = 0.5 * row[5] + 1e-9 * fmax(1.0, fabs(q->time_s));
+        if (q->time_s < row[3] - tol || q->time_s > row[4] + tol) outside = true;
         s2 += row[0] * row[0];
         ++n;
       }
       samples = n;
-      if (n > 0) value = sqrt(s2 / (double)n);
+      if (n > 0 && !outside) value = sqrt(s2 / (double)n);
+      if (outside) {
+        v->na_reason = NAV_REQ_NA_TIME_OUTSIDE;
+        v->at_time_s = q->time_s;
+        samples = 0;
+      }
       break;
     }
     case NAV_REQ_OUTAGE_END: {
@@ -624,8 +701,12 @@ nav_status nav_req_evaluator_finish(nav_req_evaluator *ev, nav_requirement_verdi
     v->samples = samples;
     v->evaluated = !isnan(value);
     v->value = v->evaluated ? value / k : NAN;
-    /* No data fails, except outage_end without any outage: nothing to violate it. */
-    v->pass = v->evaluated ? v->value <= v->limit : (q->statistic == NAV_REQ_OUTAGE_END && ev->n_outages == 0);
+    /* Not evaluated is never a pass, not even outage_end without an outage. */
+    v->pass = v->evaluated && v->value <= v->limit;
+    if (v->evaluated) v->na_reason = NAV_REQ_NA_NONE;
+    else if (v->na_reason == NAV_REQ_NA_NONE)
+      v->na_reason = q->statistic == NAV_REQ_OUTAGE_END && ev->n_outages == 0 ? NAV_REQ_NA_NO_OUTAGE
+                                                                            : NAV_REQ_NA_NO_DATA;
   }
   return NAV_OK;
 }
@@ -747,6 +828,7 @@ nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov
     v->limit = q->limit;
     v->unit = q->unit;
     v->at_time_s = NAN;
+    v->span_t0_s = v->span_t1_s = NAN;
     const double k = nav_req_unit_to_si(q->unit);
     double value = NAN;
     long samples = 0;
@@ -762,8 +844,18 @@ nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov
       for (size_t j = 1; j < npts; ++j)
         if (fabs(pts[j].t_s - q->time_s) < fabs(pts[best].t_s - q->time_s)) best = j;
       v->at_time_s = pts[best].t_s;
-      value = sqrt(mean_square(q->metric, &pts[best]));
-      samples = 1;
+      v->span_t0_s = pts[0].t_s;
+      v->span_t1_s = pts[npts - 1].t_s;
+      /* As the evaluator: half the spacing of the last two points beyond the span. */
+      const double tol = 0.5 * (npts > 1 ? pts[npts - 1].t_s - pts[npts - 2].t_s : 0.0) +
+                         1e-9 * fmax(1.0, fabs(q->time_s));
+      if (q->time_s < pts[0].t_s - tol || q->time_s > pts[npts - 1].t_s + tol) {
+        v->na_reason = NAV_REQ_NA_TIME_OUTSIDE;
+        v->at_time_s = q->time_s;
+      } else {
+        value = sqrt(mean_square(q->metric, &pts[best]));
+        samples = 1;
+      }
     } else if (q->statistic == NAV_REQ_OUTAGE_END) {
       v->outage_count = n_outages;
       for (int o = 0; o < n_outages; ++o) {
@@ -801,7 +893,13 @@ nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov
     v->samples = samples;
     v->evaluated = isfinite(value);
     v->value = v->evaluated ? value / k : NAN;
-    v->pass = v->evaluated ? v->value <= v->limit : (q->statistic == NAV_REQ_OUTAGE_END && n_outages == 0);
+    v->pass = v->evaluated && v->value <= v->limit;
+    if (v->evaluated) v->na_reason = NAV_REQ_NA_NONE;
+    else if (v->na_reason == NAV_REQ_NA_NONE)
+      v->na_reason = npts == 0                                               ? NAV_REQ_NA_NOT_PREDICTED
+                     : q->statistic == NAV_REQ_OUTAGE_END && n_outages == 0 ? NAV_REQ_NA_NO_OUTAGE
+                     : q->statistic == NAV_REQ_OUTAGE_END                   ? NAV_REQ_NA_NO_DATA
+                                                                            : NAV_REQ_NA_NOT_PREDICTED;
   }
   free(pp);
   return NAV_OK;
