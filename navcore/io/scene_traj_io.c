@@ -55,6 +55,7 @@
 #include "navcore/nav_frames.h"
 #include "navcore/nav_motiondef.h"
 #include "navcore/nav_track_io.h"
+#include "scene_bounds.h"
 #include "scene_io_internal.h"
 #include "traj/traj_kin_internal.h"
 
@@ -137,7 +138,14 @@ static const nav_io_enum_value k_attitude_modes[] = {{"magnus", NAV_ATT_RATE_MAG
 
 static const nav_io_field k_parametric[] = {
     PV("R0_m", r0_m, 1.0, 0),
-    PV("V0_mps", v0_mps, 1.0, 0),
+    /* Start velocity within the speed bound (scene_bounds.h), each component. */
+    {.key = "V0_mps",
+     .kind = NAV_IO_VEC3,
+     .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = OFF(trajectory.parametric.v0_mps),
+     .scale = 1.0,
+     .min = -NAV_SCENE_MAX_SPEED_MPS,
+     .max = NAV_SCENE_MAX_SPEED_MPS},
     PV("A_mps2", a_mps2, 1.0, 0),
     PV("B_m", b_m, 1.0, 0),
     PV("C_hz", c_hz, 1.0, 0),
@@ -620,9 +628,11 @@ static const nav_io_field k_segments[] = {
      .comment = "start position, local NED"},
     {.key = "v0_b_mps",
      .kind = NAV_IO_VEC3,
-     .flags = NAV_IO_FINITE,
+     .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(trajectory.segments.v0_b_mps),
      .scale = 1.0,
+     .min = -NAV_SCENE_MAX_SPEED_MPS,
+     .max = NAV_SCENE_MAX_SPEED_MPS,
      .comment = "start velocity, body axes"},
     {.key = "allow_unconverged", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.allow_unconverged)},
     {.key = "fit_rate_ramps", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.fit_rate_ramps)},
