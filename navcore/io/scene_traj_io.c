@@ -1104,11 +1104,21 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
   }
   if (ps != NAV_OK) {
     char path[96];
+    const char *text = ps == NAV_ERR_NO_MEMORY ? "out of memory" : msg;
     if (bad >= 0)
       snprintf(path, sizeof path, "trajectory.%s[%d]", wp ? "waypoints.points" : "segments.items", bad);
     else
       snprintf(path, sizeof path, "trajectory.%s", wp ? "waypoints" : "segments");
-    nav_io_reader_error_at_path(r, path, "%s", ps == NAV_ERR_NO_MEMORY ? "out of memory" : msg);
+    /* The planner's own messages may start with their field path ("trajectory.segments.limits: ...");
+       that path goes into the diagnostic's path, so it is not printed twice. */
+    const size_t pl = strlen(path);
+    const char *colon = strstr(text, ": ");
+    if (colon != NULL && strncmp(text, path, pl) == 0 && (text[pl] == ':' || text[pl] == '.' || text[pl] == '[') &&
+        memchr(text, ' ', (size_t)(colon - text)) == NULL && (size_t)(colon - text) < sizeof path) {
+      snprintf(path, sizeof path, "%.*s", (int)(colon - text), text);
+      text = colon + 2;
+    }
+    nav_io_reader_error_at_path(r, path, "%s", text);
     return;
   }
   if (st->duration_auto) T->duration_s = info.duration_s;
