@@ -102,11 +102,38 @@ static void test_issue_25_sweep_duplicate_param(void **state) {
   assert_false(exists("sw4"));
 }
 
+/* A track that gives an invalid scene: exit 2 at the track point, and the existing scene is
+   left byte-identical (it used to be replaced by a scene that fails check, exit 1); a valid
+   track still replaces it. */
+static void test_issue_25_import_never_replaces_a_valid_scene(void **state) {
+  (void)state;
+  static const char *bad[] = {"round-the-world.gpx", "ele-huge.gpx"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    nav_test_write_file(WORK, "mine.yaml", k_sweep_scene);
+    nav_cli_result *r = navsim("import '%s/hostile/tracks/%s' --out mine.yaml", NAV_TEST_DATA_DIR, bad[i]);
+    if (r->code != 2) fail_msg("import %s: exit %d, expected 2; stderr:\n%s", bad[i], r->code, r->err);
+    char pattern[256];
+    snprintf(pattern, sizeof pattern, "^[^ ]*/hostile/tracks/%s:[0-9]+:[0-9]+: error: ", bad[i]);
+    nav_test_assert_matches(r->err, pattern);
+    char *now = nav_test_slurp_alloc(WORK "/mine.yaml");
+    assert_non_null(now);
+    if (strcmp(now, k_sweep_scene) != 0) fail_msg("import %s replaced the existing scene:\n%s", bad[i], now);
+    free(now);
+  }
+  nav_cli_result *r = navsim("import '%s/tracks/drive.gpx' --out mine.yaml", NAV_TEST_DATA_DIR);
+  if (r->code != 0) fail_msg("import drive.gpx: exit %d; stderr:\n%s", r->code, r->err);
+  char *now = nav_test_slurp_alloc(WORK "/mine.yaml");
+  assert_non_null(now);
+  assert_non_null(strstr(now, "type: waypoints"));
+  free(now);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_sweep_grid_value_named_before_work),
       cmocka_unit_test(test_issue_25_sweep_file_location),
       cmocka_unit_test(test_issue_25_sweep_duplicate_param),
+      cmocka_unit_test(test_issue_25_import_never_replaces_a_valid_scene),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
