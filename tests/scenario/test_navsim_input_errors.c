@@ -128,12 +128,42 @@ static void test_issue_25_import_never_replaces_a_valid_scene(void **state) {
   free(now);
 }
 
+/* A GNSS fix whose sigma would make the filter's R infinite (it gave exit 1 "R[0] = inf is not
+   finite"), placed after the end of the IMU data: the whole file is checked before the run, so it
+   is reported at FILE:LINE:COL with exit 2 although the run would never reach it, and no result
+   directory appears. */
+static void test_issue_25_replay_values_checked_before_the_run(void **state) {
+  (void)state;
+  char *good = nav_test_slurp_alloc(NAV_TEST_DATA_DIR "/replay/GNSS-100195-100245.txt");
+  assert_non_null(good);
+  int lines = 0;
+  for (const char *p = good; *p; ++p) lines += *p == '\n';
+  const size_t n = strlen(good);
+  char *text = malloc(n + 256);
+  assert_non_null(text);
+  snprintf(text, n + 256, "%s100300.000 31.50818332870 120.40198876855 -0.0488 1e300 0.020 0.050\n", good);
+  nav_test_write_file(WORK, "gnss-late-huge.txt", text);
+  free(text);
+  free(good);
+  nav_cli_result *r = navsim("replay --imu '%s/replay/IMU-100195-100245.txt' --gnss gnss-late-huge.txt "
+                             "--truth '%s/replay/truth-100195-100245-20Hz.nav' --out rp --quiet",
+                             NAV_TEST_DATA_DIR, NAV_TEST_DATA_DIR);
+  if (r->code != 2) fail_msg("exit %d, expected 2; stderr:\n%s", r->code, r->err);
+  char pattern[256];
+  snprintf(pattern, sizeof pattern,
+           "^gnss-late-huge\\.txt:%d:51: error: column 5 \\(sd_n_m\\): standard deviation 1e\\+300 m exceeds 1000 m",
+           lines + 1);
+  nav_test_assert_matches(r->err, pattern);
+  assert_false(exists("rp"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_sweep_grid_value_named_before_work),
       cmocka_unit_test(test_issue_25_sweep_file_location),
       cmocka_unit_test(test_issue_25_sweep_duplicate_param),
       cmocka_unit_test(test_issue_25_import_never_replaces_a_valid_scene),
+      cmocka_unit_test(test_issue_25_replay_values_checked_before_the_run),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
