@@ -128,9 +128,11 @@
 
 /* ---- trajectory */
 
-/* Start velocity of segment scripts and the parametric trajectory, each component in magnitude
- * [m/s]: the bound of waypoint speeds (nav_scene_validate: [0, 1e5] m/s), about 9x the Earth's
- * escape speed; library scenes use <= 80 m/s. */
+/* Speeds of a trajectory, in magnitude [m/s]: the start velocity of segment scripts and of the
+ * parametric trajectory (each component), the target speed of accelerate segments and the speeds
+ * of the polar great-circle and vertical-loop test motions. The bound of waypoint speeds
+ * (nav_scene_validate: [0, 1e5] m/s), about 9x the Earth's escape speed; library scenes use
+ * <= 250 m/s. */
 #define NAV_SCENE_MAX_SPEED_MPS 1.0e5
 
 /* ---- catalogs (resources/imu_catalog.csv, resources/gnss_receivers.csv; catalog.c) */

@@ -107,6 +107,12 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
   RATE(name, off), D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT)
 #define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE)
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
+/* A speed within the plausibility bound of scene_bounds.h, in magnitude. */
+#define SPEED(k, off)                                                                                        \
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,               \
+    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS           \
+  }
 
 /* ================================================================ initial attitude, parametric */
 
@@ -478,7 +484,7 @@ static const nav_io_enum_value k_seg_kinds[] = {{"hold", NAV_SEG_HOLD},
   { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0 }
 
 static const nav_io_field k_seg_hold[] = {SEG_KIND, SEG_DURATION, SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_accelerate[] = {SEG_KIND, D("speed_mps", GOFF(speed_mps), 1.0, NAV_IO_FINITE),
+static const nav_io_field k_seg_accelerate[] = {SEG_KIND, SPEED("speed_mps", GOFF(speed_mps)),
                                                 SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
                                           RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_COORDINATED,
@@ -677,9 +683,9 @@ static const nav_io_field k_tm_spin[] = {
      .comment = "body axes; any non-zero length"}};
 static const nav_io_field k_tm_great_circle[] = {
     TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE),
-    D("gc_speed_mps", TM(gc_speed_mps), 1.0, NAV_IO_FINITE), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
+    SPEED("gc_speed_mps", TM(gc_speed_mps)), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
     ANGLE("gc_lon", TM(gc_lon_rad))};
-static const nav_io_field k_tm_loop[] = {TM_KIND, D("loop_speed_mps", TM(loop_speed_mps), 1.0, NAV_IO_FINITE),
+static const nav_io_field k_tm_loop[] = {TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps)),
                                          RATE("loop_pitch_rate", TM(loop_pitch_rate_rps))};
 SECTION_OF(k_tm_stationary_section, k_tm_stationary);
 SECTION_OF(k_tm_coning_section, k_tm_coning);

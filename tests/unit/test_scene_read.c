@@ -1403,6 +1403,13 @@ static void test_issue_25_initial_error_bounds(void **state) {
              5, 16, "trajectory.segments.v0_b_mps[0]", "must be <= 100000 (got 2e5)");
   expect_one("format_version: 1\narray:\n  initial_rate_sd_dps: 101\n", 3, 24, "array.initial_rate_sd_dps",
              "must be <= 100 (got 101)");
+  /* Every speed of a trajectory: segment targets and the test motions too. */
+  expect_one("format_version: 1\ntrajectory:\n  type: segments\n  segments:\n    items:\n"
+             "      - {kind: accelerate, speed_mps: 1e20}\n",
+             6, 39, "trajectory.segments.items[0].speed_mps", "must be <= 100000 (got 1e20)");
+  expect_one("format_version: 1\ntrajectory:\n  type: test_motion\n  duration_s: 10\n"
+             "  test_motion: {kind: vertical_loop, loop_speed_mps: -2e5}\n",
+             5, 54, "trajectory.test_motion.loop_speed_mps", "must be >= -100000 (got -2e5)");
 }
 
 /* Every row of both catalogs, written out key by key (no catalog name), reads back within the
@@ -1982,7 +1989,7 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
                      g->kind != NAV_SEG_COORD_TURN && g->kind != NAV_SEG_CLIMB && (splitmix64(x) & 1);
     switch (g->kind) {
     case NAV_SEG_HOLD: g->duration_s = 100.0 * uniform(x); break;
-    case NAV_SEG_ACCELERATE: g->speed_mps = any_double(x); break;
+    case NAV_SEG_ACCELERATE: g->speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS); break;
     case NAV_SEG_TURN:
     case NAV_SEG_COORD_TURN:
       g->yaw_rad = any_double(x);
@@ -2037,12 +2044,12 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
     break;
   case NAV_TEST_MOTION_POLAR_GREAT_CIRCLE:
     m->gc_height_m = any_double(x);
-    m->gc_speed_mps = any_double(x);
+    m->gc_speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS);
     m->gc_start_angle_rad = any_double(x);
     m->gc_lon_rad = any_double(x);
     break;
   case NAV_TEST_MOTION_VERTICAL_LOOP:
-    m->loop_speed_mps = any_double(x);
+    m->loop_speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS);
     m->loop_pitch_rate_rps = any_double(x);
     break;
   default: break;
