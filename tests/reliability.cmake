@@ -53,3 +53,11 @@ target_compile_definitions(test_navsim_durability PRIVATE
   NAVSIM_EXE="$<TARGET_FILE:navsim>" SCENE_SAVE_EXE="$<TARGET_FILE:scene_save_loop>"
   NAV_TEST_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/navsim_durability")
 add_dependencies(test_navsim_durability navsim scene_save_loop)
+
+# Issue 25, errors where the input is: sweep grid values named by their --param and checked
+# before any point is computed, import validated before it writes, replay values that would make
+# the filter non-finite at FILE:LINE:COL.
+nav_add_cmocka_test(test_navsim_input_errors SOURCES scenario/test_navsim_input_errors.c LABELS scenario)
+target_compile_definitions(test_navsim_input_errors PRIVATE
+  NAVSIM_EXE="$<TARGET_FILE:navsim>" NAV_TEST_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/navsim_input_errors")
+add_dependencies(test_navsim_input_errors navsim)

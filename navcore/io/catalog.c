@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene_bounds.h"
+
 #define MAX_COLS 64
 
 /* Relative disagreement allowed between a datasheet-unit column and its SI twin: the files carry
@@ -408,8 +410,9 @@ static field *cell(row *w, int k) {
 }
 
 /* Optional number: *has = false for an absent column or an empty cell. Range: >= 0, or > 0 when
- * positive. */
-static double number(row *w, int k, bool positive, bool *has) {
+ * positive, and <= max: the plausibility bound of the quantity (scene_bounds.h, in the column's
+ * unit), so that a catalog row gives nothing a scene file could not. */
+static double number(row *w, int k, bool positive, double max, bool *has) {
   *has = false;
   field *f = cell(w, k);
   if (!f || f->s[0] == '\0') return 0.0;
@@ -425,16 +428,21 @@ static double number(row *w, int k, bool positive, bool *has) {
     w->ok = false;
     return 0.0;
   }
+  if (v > max) {
+    diag(w->c, f->line, f->col, w->cols[k], "%s must be <= %.9g (the plausibility bound of the quantity)", f->s, max);
+    w->ok = false;
+    return 0.0;
+  }
   *has = true;
   return v;
 }
 
 /* One quantity stated in a datasheet unit (column k_ds, converted by factor) and/or in SI
  * (column k_si): the datasheet value wins, the SI twin must agree. */
-static double pair(row *w, int k_ds, int k_si, double factor, const char *si_unit, bool *has) {
+static double pair(row *w, int k_ds, int k_si, double factor, const char *si_unit, double max_ds, bool *has) {
   bool has_ds = false, has_si = false;
-  const double ds = number(w, k_ds, false, &has_ds);
-  const double si = number(w, k_si, false, &has_si);
+  const double ds = number(w, k_ds, false, max_ds, &has_ds);
+  const double si = number(w, k_si, false, max_ds * factor, &has_si);
   *has = has_ds || has_si;
   if (has_ds && has_si) {
     const double conv = ds * factor;
@@ -554,25 +562,28 @@ static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_
   bool has = false;
 
   const double arw =
-      pair(w, I_G_ARW_DPSH, I_G_ARW_SI, nav_unit_deg_per_sqrt_h_to_rad_per_sqrt_s(1.0), "rad/sqrt(s)", &has);
+      pair(w, I_G_ARW_DPSH, I_G_ARW_SI, nav_unit_deg_per_sqrt_h_to_rad_per_sqrt_s(1.0), "rad/sqrt(s)",
+           NAV_SCENE_MAX_GYRO_ARW_DEG_PER_SQRT_H, &has);
   if (has) {
     g->terms |= NAV_IMU_TERM_NOISE;
     g->arw_rad_per_sqrt_s = v3(arw);
   }
   const double vrw =
-      pair(w, I_A_VRW_MPSH, I_A_VRW_SI, nav_unit_mps_per_sqrt_h_to_mps_per_sqrt_s(1.0), "m/s/sqrt(s)", &has);
+      pair(w, I_A_VRW_MPSH, I_A_VRW_SI, nav_unit_mps_per_sqrt_h_to_mps_per_sqrt_s(1.0), "m/s/sqrt(s)",
+           NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H, &has);
   if (has) {
     a->terms |= NAV_IMU_TERM_NOISE;
     a->vrw_mps_per_sqrt_s = v3(vrw);
   }
 
   bool has_gb = false, has_ab = false, has_t = false;
-  const double gb = pair(w, I_G_BI_DPH, I_G_BI_RPS, nav_unit_deg_per_h_to_rps(1.0), "rad/s", &has_gb);
-  const double ab = pair(w, I_A_BI_UG, I_A_BI_SI, nav_unit_ug_to_mps2(1.0), "m/s^2", &has_ab);
-  const double corr = number(w, I_CORR_TIME_S, true, &has_t);
+  const double gb = pair(w, I_G_BI_DPH, I_G_BI_RPS, nav_unit_deg_per_h_to_rps(1.0), "rad/s",
+                         NAV_SCENE_MAX_GYRO_BI_DEG_PER_H, &has_gb);
+  const double ab = pair(w, I_A_BI_UG, I_A_BI_SI, nav_unit_ug_to_mps2(1.0), "m/s^2", NAV_SCENE_MAX_ACCEL_BI_UG, &has_ab);
+  const double corr = number(w, I_CORR_TIME_S, true, NAV_SCENE_MAX_CORRELATION_TIME_S, &has_t);
   bool has_gt = false, has_at = false;
-  const double gturn = nav_unit_deg_per_s_to_rps(number(w, I_G_TURN_ON_DPS, false, &has_gt));
-  const double aturn = nav_unit_mg_to_mps2(number(w, I_A_TURN_ON_MG, false, &has_at));
+  const double gturn = nav_unit_deg_per_s_to_rps(number(w, I_G_TURN_ON_DPS, false, NAV_SCENE_MAX_GYRO_BIAS_DEG_PER_H / 3600.0, &has_gt));
+  const double aturn = nav_unit_mg_to_mps2(number(w, I_A_TURN_ON_MG, false, NAV_SCENE_MAX_ACCEL_BIAS_MG, &has_at));
 
   double tau = 0.0, sigma_g = 0.0, sigma_a = 0.0;
   switch (e->bias_model) {
@@ -632,17 +643,17 @@ static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_
     a->terms |= NAV_IMU_TERM_BIAS_TURN_ON;
     a->bias_turn_on_sd_mps2 = v3(aturn);
   }
-  const double gsf = number(w, I_G_SF_PPM, false, &has);
+  const double gsf = number(w, I_G_SF_PPM, false, NAV_SCENE_MAX_SCALE_FACTOR_PPM, &has);
   if (has) {
     g->terms |= NAV_IMU_TERM_SCALE_FACTOR;
     g->scale_factor_sd = v3(nav_unit_ppm_to_ratio(gsf));
   }
-  const double asf = number(w, I_A_SF_PPM, false, &has);
+  const double asf = number(w, I_A_SF_PPM, false, NAV_SCENE_MAX_SCALE_FACTOR_PPM, &has);
   if (has) {
     a->terms |= NAV_IMU_TERM_SCALE_FACTOR;
     a->scale_factor_sd = v3(nav_unit_ppm_to_ratio(asf));
   }
-  const double mis = number(w, I_MISALIGN_MRAD, false, &has);
+  const double mis = number(w, I_MISALIGN_MRAD, false, NAV_SCENE_MAX_MISALIGNMENT_MRAD, &has);
   if (has) {
     g->terms |= NAV_IMU_TERM_MISALIGNMENT;
     a->terms |= NAV_IMU_TERM_MISALIGNMENT;
@@ -667,11 +678,11 @@ static void convert_gnss(row *w, nav_catalog_gnss_entry *e) {
   e->cost_class = cost_class(w, G_COST_CLASS);
   nav_gnss_model_config cfg = nav_gnss_model_config_default();
   bool has_h = false, has_v = false, has_t = false, has_vel = false, has_rate = false;
-  const double h = number(w, G_H_SD, false, &has_h);
-  const double v = number(w, G_V_SD, false, &has_v);
-  const double tau = number(w, G_CORR, false, &has_t);
-  const double vel = number(w, G_VEL_SD, false, &has_vel);
-  const double rate = number(w, G_RATE, true, &has_rate);
+  const double h = number(w, G_H_SD, false, NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, &has_h);
+  const double v = number(w, G_V_SD, false, NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, &has_v);
+  const double tau = number(w, G_CORR, false, NAV_SCENE_MAX_CORRELATION_TIME_S, &has_t);
+  const double vel = number(w, G_VEL_SD, false, NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, &has_vel);
+  const double rate = number(w, G_RATE, true, NAV_SCENE_MAX_GNSS_RATE_HZ, &has_rate);
   if (!has_h || !has_v || !has_rate) {
     const int k = !has_h ? G_H_SD : (!has_v ? G_V_SD : G_RATE);
     const field *f = cell(w, k);

@@ -15,6 +15,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_recorded.h"
 #include "fast_number.h"
+#include "scene_bounds.h"
 
 /* Buffer of a streaming reader. Larger than the longest line, so a full buffer always holds a
  * complete line; 256 KiB amortises fread and keeps memory flat for any file size. */
@@ -486,6 +487,15 @@ static double deg_to_rad_wrapped(double deg) {
   return nav_wrap_pi(deg * NAV_DEG2RAD);
 }
 
+/* Largest velocity increment of one IMU record [m/s]: 1000 g over a whole second. Accelerometer
+ * ranges end at tens of g (a few hundred for shock-rated parts) and recorded intervals are 1-10 ms,
+ * so a larger value is not an increment (wrong units, or another file); 1e300 made the filter's
+ * state non-finite. */
+#define REC_MAX_DVEL_MPS 1.0e4
+/* Recorded heights [m]: the range of a scene's earth.origin.h_m (nav_scene_validate). */
+#define REC_MIN_H_M (-1.0e5)
+#define REC_MAX_H_M 1.0e8
+
 nav_status nav_rec_read_imu(nav_rec_reader *r, nav_imu_increment *out, bool *got) {
   if (!r || !out || !got || r->fmt != NAV_REC_IMU) return NAV_ERR_INVALID_ARG;
   fields fl;
@@ -501,6 +511,14 @@ nav_status nav_rec_read_imu(nav_rec_reader *r, nav_imu_increment *out, bool *got
           "angle increment %.9g rad exceeds pi; expected the increment over one interval in rad "
           "(not a rate, not degrees)",
           fl.v[i]);
+    }
+  for (int i = 4; i <= 6; ++i)
+    if (!(fabs(fl.v[i]) <= REC_MAX_DVEL_MPS)) {
+      *got = false;
+      return range_error(r, &fl, i,
+                         "velocity increment %.9g m/s exceeds 1e4 m/s (1000 g over one second); expected the "
+                         "increment over one interval in m/s (not an acceleration in other units)",
+                         fl.v[i]);
     }
   nav_imu_increment m;
   m.k = r->k;
@@ -531,10 +549,26 @@ nav_status nav_rec_read_gnss(nav_rec_reader *r, nav_ins_gnss_fix *out, bool *got
   *got = false;
   st = check_position(r, &fl, 1);
   if (st != NAV_OK) return st;
+  if (!(fl.v[3] >= REC_MIN_H_M && fl.v[3] <= REC_MAX_H_M))
+    return range_error(r, &fl, 3, "height %.9g m outside [-1e5, 1e8] m (the heights a scene accepts)", fl.v[3]);
   for (int i = 4; i < fl.count; ++i) {
     if ((i >= 4 && i <= 6) || i >= 10) {
       if (!(fl.v[i] >= 0.0))
         return range_error(r, &fl, i, "standard deviation %.9g is negative; expected >= 0", fl.v[i]);
+      /* The receiver bounds of a scene (scene_bounds.h): a fix known worse than this is an outlier
+         to leave out, and 1e300 made the filter's measurement covariance infinite. */
+      if (i <= 6 && !(fl.v[i] <= NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M))
+        return range_error(r, &fl, i,
+                           "standard deviation %.9g m exceeds 1000 m (the bound of a scene's GNSS position "
+                           "sigmas); leave such a fix out of the file",
+                           fl.v[i]);
+      if (i >= 10 && !(fl.v[i] <= NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS))
+        return range_error(r, &fl, i,
+                           "standard deviation %.9g m/s exceeds 100 m/s (the bound of a scene's GNSS velocity "
+                           "sigmas); leave such a fix out of the file",
+                           fl.v[i]);
+    } else if (!(fabs(fl.v[i]) <= NAV_SCENE_MAX_SPEED_MPS)) {
+      return range_error(r, &fl, i, "velocity %.9g m/s exceeds 1e5 m/s (the speed bound of a scene)", fl.v[i]);
     }
   }
   nav_ins_gnss_fix f;
@@ -640,6 +674,33 @@ static nav_status load(const char *path, nav_rec_format fmt, read_fn read, void 
   }
   *count = n;
 cleanup:
+  nav_rec_reader_destroy(r);
+  return st;
+}
+
+nav_status nav_rec_check_file(const char *path, nav_rec_format fmt, size_t *count, nav_diag *diag) {
+  if (!path || (fmt != NAV_REC_IMU && fmt != NAV_REC_GNSS && fmt != NAV_REC_PVA)) return NAV_ERR_INVALID_ARG;
+  read_fn read = fmt == NAV_REC_IMU ? read_imu_v : fmt == NAV_REC_GNSS ? read_gnss_v : read_pva_v;
+  nav_rec_reader *r = NULL;
+  nav_status st = nav_rec_reader_open(path, fmt, &r, diag);
+  if (st != NAV_OK) return st;
+  size_t n = 0;
+  for (;;) {
+    union {
+      nav_imu_increment a;
+      nav_ins_gnss_fix b;
+      nav_rec_pva c;
+    } rec;
+    bool got = false;
+    st = read(r, &rec, &got);
+    if (st != NAV_OK) {
+      copy_diag(diag, r);
+      break;
+    }
+    if (!got) break;
+    ++n;
+  }
+  if (st == NAV_OK && count) *count = n;
   nav_rec_reader_destroy(r);
   return st;
 }

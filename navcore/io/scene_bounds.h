@@ -89,4 +89,57 @@
  * scenes use <= 0.1 s. */
 #define NAV_SCENE_MAX_GNSS_LATENCY_S 10.0
 
+/* Fix rate [Hz]. Receivers output 1-20 Hz, the fastest (high-end geodetic and RTK receivers) 100
+ * Hz; catalog worst (fastest) 10 Hz (RTK fixed), library scenes use <= 5 Hz. 1000 Hz is 10x the
+ * fastest receiver; beyond it a run only multiplies the filter's updates (1e5 Hz over the urban
+ * drive did not finish in 200 s, 1e9 Hz made the filter fail). */
+#define NAV_SCENE_MAX_GNSS_RATE_HZ 1000.0
+
+/* Antenna lever arm, each body-axis component in magnitude [m]. Library scenes use <= 1.2 m;
+ * the largest vehicles are about 400 m long (container ships), so no antenna sits 1 km from its
+ * IMU. A lever arm of 1e300 m made the innovation covariance non-finite in the first update. */
+#define NAV_SCENE_MAX_LEVER_ARM_M 1000.0
+
+/* ---- initial errors (1-sigma, per axis) */
+
+/* Position [m]: 100 km (0.9 deg of latitude). Library scenes use <= 5 m; a cold-start fix, a
+ * cell-tower position or a city name already give better than 10 km. Beyond, the errors are a
+ * sizeable part of the Earth radius (1e7 m moved the start by about 90 deg of latitude) and the
+ * linear error model of the filter no longer holds. */
+#define NAV_SCENE_MAX_INITIAL_POSITION_SD_M 1.0e5
+
+/* Velocity [m/s]. Library scenes use <= 0.2 m/s; an in-motion start without any velocity aid is
+ * known to the vehicle's speed, of order 10-100 m/s. 1e20 m/s moved the start off the Earth in
+ * the first step. */
+#define NAV_SCENE_MAX_INITIAL_VELOCITY_SD_MPS 1000.0
+
+/* Tilt, about north and east [deg]: levelling from the accelerometers gives roll and pitch to
+ * asin(b / g) of a bias b, and the accelerometer bias bound (1 g) gives 90 deg; library scenes use
+ * <= 1 deg. */
+#define NAV_SCENE_MAX_INITIAL_TILT_SD_DEG 90.0
+
+/* Heading, about down [deg]: 180 deg is a heading not known at all (a uniform heading has a sigma
+ * of 104 deg, and errors wrap at +-180 deg); the filter's hard cases start from it
+ * (test_filter_hard); library scenes use <= 10 deg. */
+#define NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG 180.0
+
+/* Initial angular-rate error of the gyro-free array [deg/s]: the gyro bias bound (100 deg/s). */
+#define NAV_SCENE_MAX_INITIAL_RATE_SD_DPS 100.0
+
+/* ---- trajectory */
+
+/* Speeds of a trajectory, in magnitude [m/s]: the start velocity of segment scripts and of the
+ * parametric trajectory (each component), the target speed of accelerate segments and the speeds
+ * of the polar great-circle and vertical-loop test motions. The bound of waypoint speeds
+ * (nav_scene_validate: [0, 1e5] m/s), about 9x the Earth's escape speed; library scenes use
+ * <= 250 m/s. */
+#define NAV_SCENE_MAX_SPEED_MPS 1.0e5
+
+/* ---- catalogs (resources/imu_catalog.csv, resources/gnss_receivers.csv; catalog.c) */
+
+/* Correlation time of a Gauss-Markov bias or of GNSS position errors [s]: 1e7 s (116 days).
+ * Catalog worst 7200 s / 0.6648 (navigation-grade Allan minimum); a process correlated over more
+ * than a quarter year is a constant, stated as a turn-on bias. */
+#define NAV_SCENE_MAX_CORRELATION_TIME_S 1.0e7
+
 #endif /* NAV_IO_SCENE_BOUNDS_H */

@@ -17,7 +17,40 @@
 struct nav_scene_doc {
   struct fy_document *fyd;
   char *path;
+  /* Nodes that nav_scene_doc_set created: they are not in the file, so a diagnostic about them
+     has no place in it (see nav_scene_doc_read). */
+  struct fy_node **created;
+  size_t ncreated, capcreated;
 };
+
+/* Remember @p n as created by an override; false when out of memory. */
+static bool remember(nav_scene_doc *doc, struct fy_node *n) {
+  if (!n) return true;
+  if (doc->ncreated == doc->capcreated) {
+    const size_t cap = doc->capcreated ? 2 * doc->capcreated : 16;
+    struct fy_node **c = realloc(doc->created, cap * sizeof *c);
+    if (!c) return false;
+    doc->created = c;
+    doc->capcreated = cap;
+  }
+  doc->created[doc->ncreated++] = n;
+  return true;
+}
+
+/* @p n is about to be freed: drop it (the list stays as long as the overrides, not the calls). */
+static void forget(nav_scene_doc *doc, const struct fy_node *n) {
+  for (size_t i = 0; i < doc->ncreated; ++i)
+    if (doc->created[i] == n) {
+      doc->created[i] = doc->created[--doc->ncreated];
+      return;
+    }
+}
+
+static bool was_created(const nav_scene_doc *doc, const struct fy_node *n) {
+  for (size_t i = 0; i < doc->ncreated; ++i)
+    if (doc->created[i] == n) return true;
+  return false;
+}
 
 static void say(char *msg, size_t size, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -74,6 +107,7 @@ void nav_scene_doc_destroy(nav_scene_doc *doc) {
   if (!doc) return;
   fy_document_destroy(doc->fyd);
   free(doc->path);
+  free(doc->created);
   free(doc);
 }
 
@@ -129,14 +163,17 @@ nav_status nav_scene_doc_set(nav_scene_doc *doc, const char *path, const char *v
       struct fy_node *key = fy_node_create_scalar_copy(fyd, k0, klen);
       struct fy_node *val = leaf ? fy_node_create_scalar_copy(fyd, value, strlen(value)) : fy_node_create_mapping(fyd);
       if (!key || !val || fy_node_mapping_append(cur, key, val) != 0) return NAV_ERR_NO_MEMORY;
+      if (!remember(doc, key) || !remember(doc, val)) return NAV_ERR_NO_MEMORY;
       if (leaf) return NAV_OK;
       cur = val;
       continue;
     }
     if (leaf) {
       struct fy_node *val = fy_node_create_scalar_copy(fyd, value, strlen(value));
+      struct fy_node *prev = fy_node_pair_value(pair);
       if (!val || fy_node_pair_set_value(pair, val) != 0) return NAV_ERR_NO_MEMORY;
-      return NAV_OK;
+      forget(doc, prev);
+      return remember(doc, val) ? NAV_OK : NAV_ERR_NO_MEMORY;
     }
     cur = fy_node_pair_value(pair);
     for (int i = 0; i < nidx; ++i) {
@@ -155,8 +192,9 @@ nav_status nav_scene_doc_set(nav_scene_doc *doc, const char *path, const char *v
         struct fy_node *old = fy_node_sequence_get_by_index(cur, idx[i]);
         if (!val) return NAV_ERR_NO_MEMORY;
         if (fy_node_sequence_insert_after(cur, old, val) != 0) return NAV_ERR_NO_MEMORY;
+        forget(doc, old);
         fy_node_free(fy_node_sequence_remove(cur, old));
-        return NAV_OK;
+        return remember(doc, val) ? NAV_OK : NAV_ERR_NO_MEMORY;
       }
       cur = fy_node_sequence_get_by_index(cur, idx[i]);
     }
@@ -165,11 +203,117 @@ nav_status nav_scene_doc_set(nav_scene_doc *doc, const char *path, const char *v
   return NAV_ERR_INVALID_ARG;
 }
 
+/*
+ * Places in the emitted document -> places in the scene file. The emitter writes every mapping and
+ * list in block style and drops comments, so its lines are not the file's: the emitted text is
+ * parsed again and walked together with the edited document (same shape), and each scalar (keys
+ * included) gives one entry: where it is in the emitted text, and where it was in the file, or
+ * that an override created it (not in the file at all).
+ */
+typedef struct place {
+  int emit_line, emit_col; /* 1-based */
+  int line, col;           /* 1-based; 0 for a node created by an override */
+} place;
+
+typedef struct place_map {
+  place *p;
+  size_t n, cap;
+  bool oom;
+} place_map;
+
+static void place_add(place_map *m, struct fy_node *emitted, struct fy_node *orig, bool created) {
+  struct fy_token *te = fy_node_get_scalar_token(emitted);
+  const struct fy_mark *me = te ? fy_token_start_mark(te) : NULL;
+  if (!me) return;
+  int line = 0, col = 0;
+  if (!created) {
+    struct fy_token *to = fy_node_get_scalar_token(orig);
+    const struct fy_mark *mo = to ? fy_token_start_mark(to) : NULL;
+    if (!mo) return; /* no place known: the diagnostic keeps no place rather than a wrong one */
+    line = mo->line + 1;
+    col = mo->column + 1;
+  }
+  if (m->n == m->cap) {
+    const size_t cap = m->cap ? 2 * m->cap : 256;
+    place *q = realloc(m->p, cap * sizeof *q);
+    if (!q) {
+      m->oom = true;
+      return;
+    }
+    m->p = q;
+    m->cap = cap;
+  }
+  m->p[m->n++] = (place){me->line + 1, me->column + 1, line, col};
+}
+
+static void place_walk(const nav_scene_doc *doc, place_map *m, struct fy_node *emitted, struct fy_node *orig,
+                       bool created, int depth) {
+  if (!emitted || !orig || depth > 256 || m->oom) return;
+  created = created || was_created(doc, orig);
+  if (fy_node_is_scalar(emitted) && fy_node_is_scalar(orig)) {
+    place_add(m, emitted, orig, created);
+  } else if (fy_node_is_sequence(emitted) && fy_node_is_sequence(orig)) {
+    void *ie = NULL, *io = NULL;
+    struct fy_node *a, *b;
+    while ((a = fy_node_sequence_iterate(emitted, &ie)) != NULL && (b = fy_node_sequence_iterate(orig, &io)) != NULL)
+      place_walk(doc, m, a, b, created, depth + 1);
+  } else if (fy_node_is_mapping(emitted) && fy_node_is_mapping(orig)) {
+    void *ie = NULL, *io = NULL;
+    struct fy_node_pair *a, *b;
+    while ((a = fy_node_mapping_iterate(emitted, &ie)) != NULL && (b = fy_node_mapping_iterate(orig, &io)) != NULL) {
+      place_walk(doc, m, fy_node_pair_key(a), fy_node_pair_key(b), created, depth + 1);
+      place_walk(doc, m, fy_node_pair_value(a), fy_node_pair_value(b), created, depth + 1);
+    }
+  }
+}
+
+typedef struct place_relay {
+  const place_map *m;
+  nav_diag_fn report;
+  void *user;
+} place_relay;
+
+/* A diagnostic at an emitted place, moved to the file's place: the entry at that exact place, else
+   the last one on its line at or before its column, else the first one on its line. No entry: no
+   place (line 0), never a line of the emitted text. */
+static void relay_diag(void *user, const nav_diag *d) {
+  const place_relay *r = user;
+  nav_diag c = *d;
+  if (d->line > 0) {
+    const place *best = NULL;
+    for (size_t i = 0; i < r->m->n; ++i) {
+      const place *p = &r->m->p[i];
+      if (p->emit_line != d->line) continue;
+      if (p->emit_col == d->col) {
+        best = p;
+        break;
+      }
+      if (!best || (p->emit_col <= d->col && (best->emit_col > d->col || p->emit_col > best->emit_col)))
+        best = p;
+    }
+    c.line = best ? best->line : 0;
+    c.col = best ? best->col : 0;
+  }
+  if (r->report) r->report(r->user, &c);
+}
+
 nav_status nav_scene_doc_read(const nav_scene_doc *doc, nav_scene *out, nav_diag_fn report, void *user) {
   if (!doc || !out) return NAV_ERR_INVALID_ARG;
   char *text = fy_emit_document_to_string(doc->fyd, (enum fy_emitter_cfg_flags)(FYECF_MODE_BLOCK | FYECF_WIDTH_INF));
   if (!text) return NAV_ERR_NO_MEMORY;
-  const nav_status st = nav_scene_read_string(text, strlen(text), doc->path, out, report, user);
+  place_map m = {NULL, 0, 0, false};
+  struct fy_parse_cfg cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.flags = (enum fy_parse_cfg_flags)(FYPCF_QUIET | FYPCF_DEFAULT_VERSION_1_2 | FYPCF_JSON_NONE);
+  struct fy_document *emitted = fy_document_build_from_string(&cfg, text, strlen(text));
+  if (emitted) place_walk(doc, &m, fy_document_root(emitted), fy_document_root(doc->fyd), false, 0);
+  nav_status st = NAV_ERR_NO_MEMORY;
+  if (emitted && !m.oom) {
+    place_relay relay = {&m, report, user};
+    st = nav_scene_read_string(text, strlen(text), doc->path, out, relay_diag, &relay);
+  }
+  fy_document_destroy(emitted);
+  free(m.p);
   free(text);
   return st;
 }

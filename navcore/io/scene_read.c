@@ -431,7 +431,7 @@ static const nav_io_field k_gnss[] = {
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
      .offset = OFF(NM(update_rate_hz)),
      .scale = 1.0,
-     .max = NAV_SCENE_MAX_RATE_HZ},
+     .max = NAV_SCENE_MAX_GNSS_RATE_HZ},
     Q("latency_s", NAV_IO_DOUBLE, NONNEG_LE, NM(latency_s), 1.0, .max = NAV_SCENE_MAX_GNSS_LATENCY_S,
       .bit = 0),
     Q("position_sigma_m", NAV_IO_VEC3S, NONNEG_LE, NM(pos_gm_sd_m), 1.0,
@@ -444,7 +444,7 @@ static const nav_io_field k_gnss[] = {
       .mark_as = "pos_white_sd_m"),
     Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG_LE, NM(vel_sd_mps), 1.0,
       .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, N_TERM(NAV_GNSS_TERM_VEL_WHITE), .mark_as = "vel_sd_mps"),
-    Q("lever_arm_b_m", NAV_IO_VEC3, NAV_IO_FINITE, NM(r_ba_b_m), 1.0, .mark_as = "r_ba_b_m",
+    Q("lever_arm_b_m", NAV_IO_VEC3, SIGNED_LE, NM(r_ba_b_m), 1.0, PM(NAV_SCENE_MAX_LEVER_ARM_M), .mark_as = "r_ba_b_m",
       .comment = "antenna relative to the IMU, body axes"),
     {.key = "outages",
      .kind = NAV_IO_CUSTOM,
@@ -554,22 +554,30 @@ static const nav_io_field k_array[] = {
      .same = same_array_sensors,
      .write_if = array_sensors_written},
     {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_array_accel_section},
-    Q("initial_rate_sd_dps", NAV_IO_VEC3S, NONNEG, array.initial_rate_sd_rps, NAV_DEG2RAD,
-      .mark_as = "initial_rate_sd_rps", .comment = "1-sigma error of the initial angular rate, body x, y, z"),
-    Q("initial_rate_sd_rps", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, array.initial_rate_sd_rps, 1.0, .bit = 0),
+    Q("initial_rate_sd_dps", NAV_IO_VEC3S, NONNEG_LE, array.initial_rate_sd_rps, NAV_DEG2RAD,
+      .max = NAV_SCENE_MAX_INITIAL_RATE_SD_DPS, .mark_as = "initial_rate_sd_rps",
+      .comment = "1-sigma error of the initial angular rate, body x, y, z"),
+    Q("initial_rate_sd_rps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, array.initial_rate_sd_rps, 1.0,
+      .max = NAV_SCENE_MAX_INITIAL_RATE_SD_DPS * NAV_DEG2RAD, .bit = 0),
 };
 DEFINE_SECTION(k_array_section, k_array);
 
 /* ---------------------------------------------------------------- the rest */
 
+/* Plausibility bounds (scene_bounds.h): the table bounds every component by the largest (the
+   heading's); finish_initial_errors bounds the tilt about north and east. */
+static void finish_initial_errors(nav_io_reader *r, const nav_io_node *map, void *base);
 static const nav_io_field k_initial_errors[] = {
-    Q("position_m", NAV_IO_VEC3S, NONNEG, initial_errors.pos_sd_m, 1.0, .comment = "1-sigma N, E, D"),
-    Q("velocity_mps", NAV_IO_VEC3S, NONNEG, initial_errors.vel_sd_mps, 1.0, .comment = "1-sigma N, E, D"),
-    Q("attitude_deg", NAV_IO_VEC3S, NONNEG, initial_errors.att_sd_rad, NAV_DEG2RAD,
-      .comment = "1-sigma about N, E, D"),
-    Q("attitude_rad", NAV_IO_VEC3S, NONNEG | NAV_IO_ALT, initial_errors.att_sd_rad, 1.0, .bit = 0),
+    Q("position_m", NAV_IO_VEC3S, NONNEG_LE, initial_errors.pos_sd_m, 1.0,
+      .max = NAV_SCENE_MAX_INITIAL_POSITION_SD_M, .comment = "1-sigma N, E, D"),
+    Q("velocity_mps", NAV_IO_VEC3S, NONNEG_LE, initial_errors.vel_sd_mps, 1.0,
+      .max = NAV_SCENE_MAX_INITIAL_VELOCITY_SD_MPS, .comment = "1-sigma N, E, D"),
+    Q("attitude_deg", NAV_IO_VEC3S, NONNEG_LE, initial_errors.att_sd_rad, NAV_DEG2RAD,
+      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG, .comment = "1-sigma about N, E, D"),
+    Q("attitude_rad", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, initial_errors.att_sd_rad, 1.0,
+      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG * NAV_DEG2RAD, .bit = 0),
 };
-DEFINE_SECTION(k_initial_errors_section, k_initial_errors);
+DEFINE_SECTION_FINISH(k_initial_errors_section, k_initial_errors, finish_initial_errors);
 
 static const nav_io_field k_navigation[] = {
     {.key = "scheme", .kind = NAV_IO_ENUM, .offset = OFF(navigation.scheme), .enums = k_schemes},
@@ -2685,6 +2693,49 @@ static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base) {
 
 static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base) {
   finish_triad(r, map, base, 1);
+}
+
+/*
+ * After initial_errors: the tilt (about north and east) within NAV_SCENE_MAX_INITIAL_TILT_SD_DEG,
+ * reported at the component (a list item) or at the single number given for all three axes.
+ */
+static void finish_initial_errors(nav_io_reader *r, const nav_io_node *map, void *base) {
+  const nav_scene *s = base;
+  const nav_io_node *k = NULL, *v = NULL;
+  bool deg = true;
+  if (map == NULL || map->kind != Y_MAP) return;
+  v = nav_io_map_get(map, "attitude_deg", &k);
+  if (v == NULL) {
+    v = nav_io_map_get(map, "attitude_rad", &k);
+    deg = false;
+  }
+  if (v == NULL) return;
+  const size_t saved = path_push_key(r, k->text, k->len);
+  if (had_error(r, r->path)) { /* rejected values keep their default: already reported */
+    path_pop(r, saved);
+    return;
+  }
+  const double bound_rad = NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD;
+  const nav_io_node *item = v->kind == Y_SEQ ? v->child : NULL;
+  for (int i = 0; i < 2; ++i) {
+    const double a = nav_vec3_get(s->initial_errors.att_sd_rad, i);
+    if (a > bound_rad) {
+      const size_t saved_i = item != NULL ? path_push_index(r, (size_t)i) : r->path_len;
+      const nav_io_node *at = item != NULL ? item : v;
+      char shown[SHOW_MAX + 4];
+      show(shown, sizeof shown, at->text != NULL ? at->text : "", at->text != NULL ? at->len : 0);
+      nav_io_reader_error(r, at, v,
+                          "the tilt about %s must be <= %.9g %s (got %s): levelling from the accelerometers "
+                          "gives roll and pitch to within 90 deg; only the heading (about D) may be unknown, up "
+                          "to 180 deg",
+                          i == 0 ? "north" : "east", deg ? NAV_SCENE_MAX_INITIAL_TILT_SD_DEG : bound_rad,
+                          deg ? "deg" : "rad", shown);
+      path_pop(r, saved_i);
+      if (item == NULL) break; /* one number for all three axes: one message */
+    }
+    if (item != NULL) item = item->next;
+  }
+  path_pop(r, saved);
 }
 
 /* ================================================================ validation and entry points */

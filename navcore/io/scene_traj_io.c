@@ -55,6 +55,7 @@
 #include "navcore/nav_frames.h"
 #include "navcore/nav_motiondef.h"
 #include "navcore/nav_track_io.h"
+#include "scene_bounds.h"
 #include "scene_io_internal.h"
 #include "traj/traj_kin_internal.h"
 
@@ -106,6 +107,12 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
   RATE(name, off), D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT)
 #define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE)
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
+/* A speed within the plausibility bound of scene_bounds.h, in magnitude. */
+#define SPEED(k, off)                                                                                        \
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,               \
+    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS           \
+  }
 
 /* ================================================================ initial attitude, parametric */
 
@@ -137,7 +144,14 @@ static const nav_io_enum_value k_attitude_modes[] = {{"magnus", NAV_ATT_RATE_MAG
 
 static const nav_io_field k_parametric[] = {
     PV("R0_m", r0_m, 1.0, 0),
-    PV("V0_mps", v0_mps, 1.0, 0),
+    /* Start velocity within the speed bound (scene_bounds.h), each component. */
+    {.key = "V0_mps",
+     .kind = NAV_IO_VEC3,
+     .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = OFF(trajectory.parametric.v0_mps),
+     .scale = 1.0,
+     .min = -NAV_SCENE_MAX_SPEED_MPS,
+     .max = NAV_SCENE_MAX_SPEED_MPS},
     PV("A_mps2", a_mps2, 1.0, 0),
     PV("B_m", b_m, 1.0, 0),
     PV("C_hz", c_hz, 1.0, 0),
@@ -470,7 +484,7 @@ static const nav_io_enum_value k_seg_kinds[] = {{"hold", NAV_SEG_HOLD},
   { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0 }
 
 static const nav_io_field k_seg_hold[] = {SEG_KIND, SEG_DURATION, SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_accelerate[] = {SEG_KIND, D("speed_mps", GOFF(speed_mps), 1.0, NAV_IO_FINITE),
+static const nav_io_field k_seg_accelerate[] = {SEG_KIND, SPEED("speed_mps", GOFF(speed_mps)),
                                                 SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
                                           RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_COORDINATED,
@@ -620,9 +634,11 @@ static const nav_io_field k_segments[] = {
      .comment = "start position, local NED"},
     {.key = "v0_b_mps",
      .kind = NAV_IO_VEC3,
-     .flags = NAV_IO_FINITE,
+     .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(trajectory.segments.v0_b_mps),
      .scale = 1.0,
+     .min = -NAV_SCENE_MAX_SPEED_MPS,
+     .max = NAV_SCENE_MAX_SPEED_MPS,
      .comment = "start velocity, body axes"},
     {.key = "allow_unconverged", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.allow_unconverged)},
     {.key = "fit_rate_ramps", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.fit_rate_ramps)},
@@ -667,9 +683,9 @@ static const nav_io_field k_tm_spin[] = {
      .comment = "body axes; any non-zero length"}};
 static const nav_io_field k_tm_great_circle[] = {
     TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE),
-    D("gc_speed_mps", TM(gc_speed_mps), 1.0, NAV_IO_FINITE), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
+    SPEED("gc_speed_mps", TM(gc_speed_mps)), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
     ANGLE("gc_lon", TM(gc_lon_rad))};
-static const nav_io_field k_tm_loop[] = {TM_KIND, D("loop_speed_mps", TM(loop_speed_mps), 1.0, NAV_IO_FINITE),
+static const nav_io_field k_tm_loop[] = {TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps)),
                                          RATE("loop_pitch_rate", TM(loop_pitch_rate_rps))};
 SECTION_OF(k_tm_stationary_section, k_tm_stationary);
 SECTION_OF(k_tm_coning_section, k_tm_coning);
@@ -1094,11 +1110,21 @@ void nav_io_traj_finish(nav_io_reader *r, const nav_io_node *root, nav_scene *sc
   }
   if (ps != NAV_OK) {
     char path[96];
+    const char *text = ps == NAV_ERR_NO_MEMORY ? "out of memory" : msg;
     if (bad >= 0)
       snprintf(path, sizeof path, "trajectory.%s[%d]", wp ? "waypoints.points" : "segments.items", bad);
     else
       snprintf(path, sizeof path, "trajectory.%s", wp ? "waypoints" : "segments");
-    nav_io_reader_error_at_path(r, path, "%s", ps == NAV_ERR_NO_MEMORY ? "out of memory" : msg);
+    /* The planner's own messages may start with their field path ("trajectory.segments.limits: ...");
+       that path goes into the diagnostic's path, so it is not printed twice. */
+    const size_t pl = strlen(path);
+    const char *colon = strstr(text, ": ");
+    if (colon != NULL && strncmp(text, path, pl) == 0 && (text[pl] == ':' || text[pl] == '.' || text[pl] == '[') &&
+        memchr(text, ' ', (size_t)(colon - text)) == NULL && (size_t)(colon - text) < sizeof path) {
+      snprintf(path, sizeof path, "%.*s", (int)(colon - text), text);
+      text = colon + 2;
+    }
+    nav_io_reader_error_at_path(r, path, "%s", text);
     return;
   }
   if (st->duration_auto) T->duration_s = info.duration_s;

@@ -438,6 +438,34 @@ static nav_status write_scene(FILE *fp, const nav_scene *scene, const nav_scene 
   return st != NAV_OK ? st : nav_io_write_block(&w, &nav_io_scene_schema, scene, def, 0);
 }
 
+nav_status nav_scene_write_string(const nav_scene *scene, char **text, size_t *len) {
+  if (scene == NULL || text == NULL) return NAV_ERR_INVALID_ARG;
+  *text = NULL;
+  if (len != NULL) *len = 0;
+  char *buf = NULL;
+  size_t n = 0;
+  nav_scene *def = malloc(sizeof *def); /* a scene is a few hundred kB: not on the stack */
+  FILE *fp = def != NULL ? open_memstream(&buf, &n) : NULL;
+  if (fp == NULL) {
+    free(def);
+    return NAV_ERR_NO_MEMORY;
+  }
+  *def = nav_scene_default();
+  nav_io_c_locale loc;
+  nav_io_c_locale_begin(&loc);
+  nav_status st = write_scene(fp, scene, def);
+  nav_io_c_locale_end(&loc);
+  if (fclose(fp) != 0 && st == NAV_OK) st = NAV_ERR_NO_MEMORY;
+  free(def);
+  if (st != NAV_OK) {
+    free(buf);
+    return st;
+  }
+  *text = buf;
+  if (len != NULL) *len = n;
+  return NAV_OK;
+}
+
 /* ================================================================ the file */
 
 /* fsync the directory holding @p path, so the rename itself survives a crash (best effort:

@@ -40,6 +40,13 @@ typedef struct ti_reader {
   int ndiag;
 } ti_reader;
 
+/* Heights of track points [m]: the range of a scene's earth.origin.h_m (nav_scene_validate), from
+ * below the deepest ocean floor to far beyond any aircraft, so a track gives no height a scene
+ * refuses (an <ele> of 1e9 used to be written into the scene). */
+#define TRACK_MIN_H_M (-1.0e5)
+#define TRACK_MAX_H_M 1.0e8
+static bool height_ok(double h) { return h >= TRACK_MIN_H_M && h <= TRACK_MAX_H_M; }
+
 static void ti_diag(ti_reader *r, int line, int col, const char *path, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 5, 6)))
@@ -403,6 +410,11 @@ static void kml_parse_coordinates(ti_xml *x) {
               "expected a tuple lon,lat[,alt] (degrees, degrees, metres; |lat| <= 90), got \"%.*s\"", (int)(i - b), t + b);
       continue;
     }
+    if (!height_ok(v[2])) {
+      ti_diag(x->r, line, col, "coordinates", "altitude %.9g m outside [-1e5, 1e8] m (the heights a scene accepts)",
+              v[2]);
+      continue;
+    }
     nav_geopoint p;
     memset(&p, 0, sizeof p);
     p.pos.lat_rad = v[1] * NAV_DEG2RAD;
@@ -438,9 +450,15 @@ static void kml_parse_gxcoord(ti_xml *x) {
     }
     ++k;
   }
-  if (!ok || k < 2 || fabs(v[1]) > 90.0 || fabs(v[0]) > 360.0) {
+  if (ok && k >= 2 && !height_ok(v[2])) {
+    ti_diag(x->r, line, col, "gx:coord", "altitude %.9g m outside [-1e5, 1e8] m (the heights a scene accepts)", v[2]);
+    ok = false;
+  } else if (!ok || k < 2 || fabs(v[1]) > 90.0 || fabs(v[0]) > 360.0) {
     ti_diag(x->r, line, col, "gx:coord", "expected \"lon lat [alt]\" (degrees, degrees, metres; |lat| <= 90), got \"%.*s\"",
             (int)(n - off > 60 ? 60 : n - off), t + off);
+    ok = false;
+  }
+  if (!ok) {
     nav_geopoint bad;
     memset(&bad, 0, sizeof bad);
     pt_push(x, &x->gxc, &bad); /* keep the pairing with <when> */
@@ -470,6 +488,8 @@ static void XMLCALL on_end(void *ud, const XML_Char *name) {
       trim(&s, &n);
       double h;
       if (!parse_double_n(s, n, &h)) ti_diag(x->r, line, col, "ele", "expected a height in metres, got \"%.*s\"", (int)n, s);
+      else if (!height_ok(h))
+        ti_diag(x->r, line, col, "ele", "height %.9g m outside [-1e5, 1e8] m (the heights a scene accepts)", h);
       else {
         x->cur.pos.h_m = h;
         x->cur.has_h = true;

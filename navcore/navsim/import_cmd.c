@@ -63,6 +63,62 @@ static void base_name(char *out, size_t cap, const char *path) {
   if (dot && dot != out) *dot = '\0';
 }
 
+/* Diagnostics of the scene an import would write, placed in the input file: a problem of
+ * waypoint i at the track point nearest to it (waypoints are track points, or corners between
+ * two of them), anything else at the file as a whole. */
+typedef struct import_check {
+  const char *in;
+  const nav_geotrack *track; /* NULL for a motion definition */
+  const nav_scene *scene;
+  int count;
+} import_check;
+
+static void import_diag(void *user, const nav_diag *d) {
+  import_check *c = user;
+  c->count++;
+  int wp = -1;
+  if (c->track && c->track->count > 0 && sscanf(d->path, "trajectory.waypoints.points[%d]", &wp) == 1 && wp >= 0 &&
+      wp < c->scene->trajectory.waypoints.count) {
+    const nav_frame fr = nav_frame_from_scene(c->scene);
+    const nav_vec3 w = c->scene->trajectory.waypoints.points[wp].r_ned_m;
+    size_t best = 0;
+    double best_d = INFINITY;
+    for (size_t i = 0; i < c->track->count; ++i) {
+      const double dist = nav_vec3_norm(nav_vec3_sub(nav_frame_geodetic_to_local(&fr, c->track->points[i].pos), w));
+      if (dist < best_d) {
+        best_d = dist;
+        best = i;
+      }
+    }
+    fprintf(stderr, "%s:%d:%d: error: %s: %s (in the scene this track gives: waypoint %d, at track point %zu)\n", c->in,
+            c->track->points[best].line, c->track->points[best].col, d->path, d->message, wp, best + 1);
+    return;
+  }
+  fprintf(stderr, "%s: error: %s%s%s (in the scene this %s gives)\n", c->in, d->path, d->path[0] ? ": " : "",
+          d->message, c->track ? "track" : "motion definition");
+}
+
+/* The scene as it would be written, read back from memory with every check of navsim check.
+ * @return 0, 2 (problems printed, placed in the input file) or 1. */
+static int validate_import(const char *in, const char *out, const nav_geotrack *track, const nav_scene *sc) {
+  char *text = NULL;
+  size_t len = 0;
+  nav_status st = nav_scene_write_string(sc, &text, &len);
+  nav_scene *back = st == NAV_OK ? malloc(sizeof *back) : NULL;
+  if (st == NAV_OK && back == NULL) st = NAV_ERR_NO_MEMORY;
+  import_check c = {in, track, sc, 0};
+  if (st == NAV_OK) st = nav_scene_read_string(text, len, out, back, import_diag, &c);
+  free(text);
+  free(back);
+  if (st == NAV_OK) return EXIT_OK;
+  if (st == NAV_ERR_PARSE) {
+    fprintf(stderr, "navsim import: %s gives no valid scene (problems above); \"%s\" was not written\n", in, out);
+    return EXIT_INVALID;
+  }
+  fprintf(stderr, "navsim import: cannot check the scene: %s; \"%s\" was not written\n", nav_status_str(st), out);
+  return EXIT_FAIL;
+}
+
 int navsim_import(int argc, char **argv) {
   const char *in = NULL, *out = NULL, *name = NULL, *track_name = NULL, *fmt_s = NULL, *templ = NULL;
   nav_track_import_options opt = nav_track_import_options_default();
@@ -146,6 +202,7 @@ int navsim_import(int argc, char **argv) {
   nav_scene *sc = malloc(sizeof *sc);
   if (!sc) return EXIT_FAIL;
   int rc = EXIT_OK;
+  nav_geotrack tr = {0};
   navsim_diag_sink sink = {0};
   if (templ) {
     const int lrc = navsim_load_scene(templ, sc);
@@ -174,7 +231,6 @@ int navsim_import(int argc, char **argv) {
     printf("imported   %s: motion definition, %d segments, %.3f s\n", in, sc->trajectory.segments.count,
            sc->trajectory.duration_s);
   } else {
-    nav_geotrack tr = {0};
     nav_status st = nav_geotrack_read_file(in, fmt, track_name, &tr, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
@@ -196,7 +252,6 @@ int navsim_import(int argc, char **argv) {
                 tr.points[rep.bad_point].col, msg, hint);
       else
         fprintf(stderr, "%s: error: trajectory.waypoints: %s%s\n", in, msg[0] ? msg : nav_status_str(st), hint);
-      nav_geotrack_free(&tr);
       rc = st == NAV_ERR_NO_MEMORY ? EXIT_FAIL : EXIT_INVALID;
       goto done;
     }
@@ -207,8 +262,10 @@ int navsim_import(int argc, char **argv) {
            "largest distance of a track point from the flown path %.2f m\n",
            in, rep.points_in, rep.waypoints, opt.tolerance_m, rep.merged, rep.merged == 1 ? "" : "s", rep.length_m,
            rep.timed ? "speeds from the track's times" : "constant speed", rep.duration_s, rep.max_dev_m);
-    nav_geotrack_free(&tr);
   }
+  /* Nothing is written, and no existing scene replaced, unless the scene is valid. */
+  rc = validate_import(in, out, fmt == NAV_TRACK_FORMAT_MOTION_DEF ? NULL : &tr, sc);
+  if (rc != EXIT_OK) goto done;
   {
     const nav_status st = nav_scene_write_file(out, sc);
     if (st != NAV_OK) {
@@ -227,6 +284,7 @@ int navsim_import(int argc, char **argv) {
     printf("scene      %s (%s)\n", out, sc->name);
   }
 done:
+  nav_geotrack_free(&tr);
   free(sc);
   return rc;
 }

@@ -732,6 +732,26 @@ int navsim_replay(int argc, char **argv) {
   rc.imu_path = imu;
   rc.gnss_path = gnss;
   rc.ref_path = truth;
+  {
+    /* Every IMU and GNSS record is checked before the run, wherever it is in the file: a value
+       that would make the filter non-finite is reported at FILE:LINE:COL (exit 2), not as a
+       failure of the run. */
+    const char *paths[2] = {imu, gnss};
+    const nav_rec_format fmts[2] = {NAV_REC_IMU, NAV_REC_GNSS};
+    for (int i = 0; i < 2; ++i) {
+      if (!paths[i]) continue;
+      nav_diag d;
+      memset(&d, 0, sizeof d);
+      const nav_status cs = nav_rec_check_file(paths[i], fmts[i], NULL, &d);
+      if (cs != NAV_OK) {
+        if (d.message[0]) navsim_print_diag(NULL, &d);
+        else fprintf(stderr, "%s: error: %s\n", paths[i], nav_status_str(cs));
+        free(reqs);
+        free(verdicts);
+        return cs == NAV_ERR_PARSE || cs == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+      }
+    }
+  }
 
   int rc_exit = EXIT_FAIL;
   nav_status st = NAV_OK;

@@ -103,6 +103,88 @@ static double param_value(const sweep_param *p, int i) {
   return p->start + u * (p->stop - p->start);
 }
 
+/* The values of grid point @p g (first parameter slowest). */
+static void grid_values(const sweep_param *prm, int np, long g, double *vals) {
+  long rem = g;
+  for (int k = np - 1; k >= 0; --k) {
+    vals[k] = param_value(&prm[k], (int)(rem % prm[k].count));
+    rem /= prm[k].count;
+  }
+}
+
+/* Field paths @p a and @p b are the same, or one holds the other ("x.y" and "x.y[1]", "x" and
+   "x.y"). */
+static bool paths_overlap(const char *a, const char *b) {
+  const size_t la = strlen(a), lb = strlen(b), n = la < lb ? la : lb;
+  if (strncmp(a, b, n) != 0) return false;
+  if (la == lb) return true;
+  const char next = la < lb ? b[n] : a[n];
+  return next == '.' || next == '[';
+}
+
+/* Diagnostics of one grid point before anything is computed. One about a value a --param set
+   has no place in the file (nav_scene_doc_read: line 0): it names the --param, the grid value
+   and the point; one about the file keeps its place, with the point's values as context. */
+typedef struct grid_sink {
+  const sweep_param *prm;
+  int np;
+  const double *vals;
+  long point;
+  bool print;
+  int count;
+} grid_sink;
+
+static void grid_diag(void *user, const nav_diag *d) {
+  grid_sink *s = user;
+  s->count++;
+  if (!s->print) return;
+  if (d->line == 0)
+    for (int k = 0; k < s->np; ++k)
+      if (paths_overlap(d->path, s->prm[k].path)) {
+        const bool same = strcmp(d->path, s->prm[k].path) == 0;
+        fprintf(stderr, "navsim sweep: --param %s: grid value %.17g at point %ld: %s%s%s\n", s->prm[k].path,
+                s->vals[k], s->point + 1, same ? "" : d->path, same ? "" : ": ", d->message);
+        return;
+      }
+  char line[2048];
+  nav_diag_format(d, line, sizeof line);
+  fprintf(stderr, "%s (grid point %ld:", line, s->point + 1);
+  for (int k = 0; k < s->np; ++k) fprintf(stderr, " --param %s=%.17g", s->prm[k].path, s->vals[k]);
+  fputs(")\n", stderr);
+}
+
+/* Every grid point read as a scene before any is computed, so a bad value is found before the
+   work, not after the points before it. @return 0, or the exit code (diagnostics printed). */
+static int validate_grid(nav_scene_doc *doc, const sweep_param *prm, int np, long total, nav_scene *sc) {
+  enum { SHOWN = 5 };
+  long bad = 0;
+  for (long g = 0; g < total; ++g) {
+    double vals[SWEEP_MAX_PARAMS];
+    grid_values(prm, np, g, vals);
+    for (int k = 0; k < np; ++k) {
+      char val[64], msg[512];
+      snprintf(val, sizeof val, "%.17g", vals[k]);
+      if (nav_scene_doc_set(doc, prm[k].path, val, msg, sizeof msg) != NAV_OK) {
+        fprintf(stderr, "navsim sweep: --param %s: %s\n", prm[k].path, msg);
+        return EXIT_INVALID;
+      }
+    }
+    grid_sink gs = {prm, np, vals, g, bad < SHOWN, 0};
+    const nav_status st = nav_scene_doc_read(doc, sc, grid_diag, &gs);
+    if (st == NAV_OK) continue;
+    if (st != NAV_ERR_PARSE) {
+      fprintf(stderr, "navsim sweep: grid point %ld: %s\n", g + 1, nav_status_str(st));
+      return EXIT_FAIL;
+    }
+    if (gs.count == 0 && bad < SHOWN) fprintf(stderr, "navsim sweep: grid point %ld is not a valid scene\n", g + 1);
+    ++bad;
+  }
+  if (bad == 0) return EXIT_OK;
+  fprintf(stderr, "navsim sweep: %ld of %ld grid point%s %s not a valid scene%s; nothing was computed\n", bad, total,
+          total == 1 ? "" : "s", bad == 1 ? "is" : "are", bad > SHOWN ? " (the first 5 are shown)" : "");
+  return EXIT_INVALID;
+}
+
 /* Evaluate one scene: verdicts of its requirements. */
 static nav_status evaluate(const nav_scene *sc, bool predict, long runs, int threads, nav_requirement_verdict *out,
                            char *err, size_t err_size) {
@@ -190,6 +272,15 @@ int navsim_sweep(int argc, char **argv) {
             !scene_path ? "missing SCENE" : !out_dir ? "missing --out DIR" : "missing --param", k_usage_sweep);
     return EXIT_INVALID;
   }
+  for (int k = 0; k < np; ++k)
+    for (int j = 0; j < k; ++j)
+      if (paths_overlap(prm[j].path, prm[k].path)) {
+        fprintf(stderr,
+                "navsim sweep: --param %s and --param %s set the same field: give each field once (several "
+                "--param make a grid of different fields)\n",
+                prm[j].path, prm[k].path);
+        return EXIT_INVALID;
+      }
   {
     const int orc = navsim_out_check("sweep", out_dir, force);
     if (orc != EXIT_OK) return orc;
@@ -229,6 +320,15 @@ int navsim_sweep(int argc, char **argv) {
     nreq = sc->n_requirements;
     if (nreq == 0) {
       fprintf(stderr, "%s: error: requirements: the scene has no requirements to sweep against\n", scene_path);
+      rc = EXIT_INVALID;
+      goto done;
+    }
+    rc = validate_grid(doc, prm, np, total, sc);
+    if (rc != EXIT_OK) goto done;
+    rc = EXIT_FAIL;
+    /* A --param may change the requirements (their count is the file's above). */
+    if (sc->n_requirements != nreq) {
+      fprintf(stderr, "navsim sweep: the --param values change the number of requirements\n");
       rc = EXIT_INVALID;
       goto done;
     }

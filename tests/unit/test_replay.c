@@ -242,15 +242,16 @@ static void test_streaming_across_refills(void **state) {
   assert_non_null(text);
   size_t len = 0;
   for (int k = 0; k < n; ++k)
-    len += (size_t)snprintf(text + len, cap - len, "%.3f 0 0.25 0 %d -%d.5 -0.049%s", 1000.0 + 0.005 * k, k,
-                            k, k + 1 == n ? "" : (k % 3 == 0 ? "\r\n" : "\n"));
+    /* dv x = k / 2 and y = -(k / 2 + 0.5): exact, and within the reader's 1e4 m/s bound */
+    len += (size_t)snprintf(text + len, cap - len, "%.3f 0 0.25 0 %.1f -%.1f -0.049%s", 1000.0 + 0.005 * k,
+                            0.5 * k, 0.5 * k + 0.5, k + 1 == n ? "" : (k % 3 == 0 ? "\r\n" : "\n"));
   assert_true(len > 2 * 256 * 1024);
   nav_rec_reader *r = open_text(text, len, NAV_REC_IMU);
   nav_imu_increment m;
   bool got = false;
   int count = 0;
   while (nav_rec_read_imu(r, &m, &got) == NAV_OK && got) {
-    if (m.k != count || m.dv_b_mps.x != (double)count || m.dv_b_mps.y != -(double)count - 0.5 ||
+    if (m.k != count || m.dv_b_mps.x != 0.5 * count || m.dv_b_mps.y != -0.5 * count - 0.5 ||
         m.dtheta_b_rad.y != 0.25 || fabs(m.t_s - (1000.0 + 0.005 * count)) > 1e-9)
       fail_msg("record %d: k %lld t %.6f dv (%g, %g)", count, (long long)m.k, m.t_s, m.dv_b_mps.x,
                m.dv_b_mps.y);

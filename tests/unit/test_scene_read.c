@@ -1375,6 +1375,43 @@ static void test_sensor_bounds(void **state) {
       49, "gnss.reported_sigma.velocity_mps", "must be <= 100 (got 1e10)");
 }
 
+/* Issue 25: the bounds of initial errors, start velocities, the lever arm and the fix rate
+   (scene_bounds.h): the bound itself is accepted, above it is refused at the value with the
+   bound in the message; the tilt bound applies about north and east only (a 180 deg heading
+   sigma, an unknown heading, stays valid), named by component. */
+static void test_issue_25_initial_error_bounds(void **state) {
+  (void)state;
+  nav_scene s = read_ok("format_version: 1\ninitial_errors:\n  position_m: 1e5\n  velocity_mps: 1000\n"
+                        "  attitude_deg: [90, 90, 180]\ngnss:\n  enabled: true\n  update_rate_hz: 1000\n"
+                        "  lever_arm_b_m: [-1000, 0, 1000]\n");
+  assert_near(s.initial_errors.att_sd_rad.z, NAV_PI, 1e-15);
+  (void)read_ok("format_version: 1\ninitial_errors: {attitude_rad: [1.5707963267948966, 0, 3.141592653589793]}\n");
+  (void)read_ok("format_version: 1\ntrajectory:\n  type: segments\n  segments:\n    v0_b_mps: [1e5, 0, -1e5]\n"
+                "    items: [{kind: hold, duration_s: 1}]\n");
+  expect_one("format_version: 1\ninitial_errors:\n  attitude_deg: [1, 91, 3]\n", 3, 21, "initial_errors.attitude_deg[1]",
+             "the tilt about east must be <= 90 deg (got 91)");
+  expect_one("format_version: 1\ninitial_errors:\n  attitude_rad: 1.6\n", 3, 17, "initial_errors.attitude_rad",
+             "the tilt about north must be <= 1.57079633 rad (got 1.6)");
+  expect_one("format_version: 1\ninitial_errors:\n  attitude_deg: [1, 1, 181]\n", 3, 24,
+             "initial_errors.attitude_deg[2]", "must be <= 180 (got 181)");
+  expect_one("format_version: 1\ninitial_errors:\n  velocity_mps: [0, 1001, 0]\n", 3, 21,
+             "initial_errors.velocity_mps[1]", "must be <= 1000 (got 1001)");
+  expect_one("format_version: 1\ngnss:\n  enabled: true\n  lever_arm_b_m: [0, -1001, 0]\n", 4, 22,
+             "gnss.lever_arm_b_m[1]", "must be >= -1000 (got -1001)");
+  expect_one("format_version: 1\ntrajectory:\n  type: segments\n  segments:\n    v0_b_mps: [2e5, 0, 0]\n"
+             "    items: [{kind: hold, duration_s: 1}]\n",
+             5, 16, "trajectory.segments.v0_b_mps[0]", "must be <= 100000 (got 2e5)");
+  expect_one("format_version: 1\narray:\n  initial_rate_sd_dps: 101\n", 3, 24, "array.initial_rate_sd_dps",
+             "must be <= 100 (got 101)");
+  /* Every speed of a trajectory: segment targets and the test motions too. */
+  expect_one("format_version: 1\ntrajectory:\n  type: segments\n  segments:\n    items:\n"
+             "      - {kind: accelerate, speed_mps: 1e20}\n",
+             6, 39, "trajectory.segments.items[0].speed_mps", "must be <= 100000 (got 1e20)");
+  expect_one("format_version: 1\ntrajectory:\n  type: test_motion\n  duration_s: 10\n"
+             "  test_motion: {kind: vertical_loop, loop_speed_mps: -2e5}\n",
+             5, 54, "trajectory.test_motion.loop_speed_mps", "must be >= -100000 (got -2e5)");
+}
+
 /* Every row of both catalogs, written out key by key (no catalog name), reads back within the
    bounds and unchanged: the bounds never refuse a catalogued sensor. */
 static void test_catalog_rows_within_bounds(void **state) {
@@ -1905,7 +1942,7 @@ static void random_gnss(uint64_t *x, nav_scene_gnss *n) {
   m->pos_gm_tau_s = nonneg_vec3(x);
   m->pos_white_sd_m = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M);
   m->vel_sd_mps = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS);
-  m->r_ba_b_m = any_vec3(x);
+  m->r_ba_b_m = fit3(any_vec3(x), NAV_SCENE_MAX_LEVER_ARM_M);
   m->report_model_sigmas = splitmix64(x) & 1;
   if (!m->report_model_sigmas) {
     m->reported_pos_sd_m = fit3(nonneg_vec3(x), NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M);
@@ -1941,7 +1978,7 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
   s->allow_unconverged = splitmix64(x) & 1;
   s->fit_rate_ramps = splitmix64(x) & 1;
   s->r0_ned_m = any_vec3(x);
-  s->v0_b_mps = any_vec3(x);
+  s->v0_b_mps = fit3(any_vec3(x), NAV_SCENE_MAX_SPEED_MPS);
   s->limits.max_ang_jerk_rps3 = 0.01 + uniform(x);
   s->count = (int)(splitmix64(x) % 6);
   for (int i = 0; i < s->count; ++i) {
@@ -1952,7 +1989,7 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
                      g->kind != NAV_SEG_COORD_TURN && g->kind != NAV_SEG_CLIMB && (splitmix64(x) & 1);
     switch (g->kind) {
     case NAV_SEG_HOLD: g->duration_s = 100.0 * uniform(x); break;
-    case NAV_SEG_ACCELERATE: g->speed_mps = any_double(x); break;
+    case NAV_SEG_ACCELERATE: g->speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS); break;
     case NAV_SEG_TURN:
     case NAV_SEG_COORD_TURN:
       g->yaw_rad = any_double(x);
@@ -2007,12 +2044,12 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
     break;
   case NAV_TEST_MOTION_POLAR_GREAT_CIRCLE:
     m->gc_height_m = any_double(x);
-    m->gc_speed_mps = any_double(x);
+    m->gc_speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS);
     m->gc_start_angle_rad = any_double(x);
     m->gc_lon_rad = any_double(x);
     break;
   case NAV_TEST_MOTION_VERTICAL_LOOP:
-    m->loop_speed_mps = any_double(x);
+    m->loop_speed_mps = fit(any_double(x), NAV_SCENE_MAX_SPEED_MPS);
     m->loop_pitch_rate_rps = any_double(x);
     break;
   default: break;
@@ -2036,7 +2073,7 @@ static void random_array(uint64_t *x, nav_scene_array *a) {
   a->accel.bias_gm_tau_s = 1.0 + 1000.0 * uniform(x);
   a->accel.vrw_mps_per_sqrt_s = uniform(x) * 1e-3;
   a->accel.scale_factor_sd = uniform(x) * 1e-3;
-  a->initial_rate_sd_rps = nonneg_vec3(x);
+  a->initial_rate_sd_rps = fit3(nonneg_vec3(x), NAV_SCENE_MAX_INITIAL_RATE_SD_DPS * NAV_DEG2RAD);
 }
 
 /* Random navigation options of the ins_gnss filter (the smoother only with ins_gnss, as the
@@ -2098,7 +2135,7 @@ static void test_round_trip_random_bit_exact(void **state) {
     a->trajectory.initial_attitude.yaw_rad = k == 1 ? 5e-324 : any_double(&x);
     nav_traj_parametric *p = &a->trajectory.parametric;
     p->r0_m = any_vec3(&x);
-    p->v0_mps = any_vec3(&x);
+    p->v0_mps = fit3(any_vec3(&x), NAV_SCENE_MAX_SPEED_MPS);
     p->a_mps2 = any_vec3(&x);
     p->b_m = any_vec3(&x);
     p->c_hz = any_vec3(&x);
@@ -2113,9 +2150,14 @@ static void test_round_trip_random_bit_exact(void **state) {
     a->imu.quadrature_nodes = 1 + (int)(splitmix64(&x) % 8);
     random_imu(&x, &a->imu.model);
     random_gnss(&x, &a->gnss);
-    a->initial_errors.pos_sd_m = nonneg_vec3(&x);
-    a->initial_errors.vel_sd_mps = nonneg_vec3(&x);
-    a->initial_errors.att_sd_rad = nonneg_vec3(&x);
+    a->initial_errors.pos_sd_m = fit3(nonneg_vec3(&x), NAV_SCENE_MAX_INITIAL_POSITION_SD_M);
+    a->initial_errors.vel_sd_mps = fit3(nonneg_vec3(&x), NAV_SCENE_MAX_INITIAL_VELOCITY_SD_MPS);
+    {
+      const nav_vec3 att = nonneg_vec3(&x); /* tilt about N and E, heading about D */
+      a->initial_errors.att_sd_rad = nav_vec3_make(fit(att.x, NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD),
+                                                   fit(att.y, NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD),
+                                                   fit(att.z, NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG * NAV_DEG2RAD));
+    }
     a->navigation.scheme = a->gnss.enabled && a->earth.model == NAV_EARTH_WGS84 && (splitmix64(&x) & 1)
                                ? NAV_SCHEME_INS_GNSS
                                : NAV_SCHEME_FREE_INS;
@@ -2233,6 +2275,7 @@ int main(void) {
       cmocka_unit_test(test_imu_catalog),
       cmocka_unit_test(test_gnss_catalog),
       cmocka_unit_test(test_sensor_bounds),
+      cmocka_unit_test(test_issue_25_initial_error_bounds),
       cmocka_unit_test(test_catalog_rows_within_bounds),
       cmocka_unit_test(test_trajectory_errors),
       cmocka_unit_test(test_sensor_errors),

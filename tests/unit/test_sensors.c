@@ -1327,6 +1327,77 @@ static void test_catalog_invalid_rows(void **state) {
   assert_null(cat);
 }
 
+/* Issue 25: every numeric column of both catalogs is bounded like the scene key it feeds
+ * (navcore/io/scene_bounds.h); a value above is reported at FILE:LINE:COL naming the column (a
+ * GNSS row with update_rate_hz 1e9 used to load, and the filter then failed), a value at the
+ * bound loads. */
+static void test_issue_25_catalog_plausibility(void **state) {
+  (void)state;
+  static const struct {
+    bool gnss;
+    const char *column, *at_bound, *above;
+  } k[] = {
+      {false, "gyro_bias_instability_deg_per_h", "180000", "2e5"},
+      {false, "gyro_bias_instability_rad_per_s", "0.87", "0.88"},
+      {false, "gyro_arw_deg_per_sqrt_h", "100", "101"},
+      {false, "gyro_arw_rad_per_sqrt_s", "0.029", "0.03"},
+      {false, "gyro_turn_on_bias_deg_per_s", "100", "1e300"},
+      {false, "gyro_scale_factor_ppm", "1e6", "1.1e6"},
+      {false, "accel_bias_instability_ug", "5e5", "6e5"},
+      {false, "accel_bias_instability_m_per_s2", "4.9", "5"},
+      {false, "accel_vrw_m_per_s_per_sqrt_h", "10", "11"},
+      {false, "accel_vrw_m_per_s_per_sqrt_s", "0.16", "0.17"},
+      {false, "accel_turn_on_bias_mg", "1000", "1001"},
+      {false, "accel_scale_factor_ppm", "1e6", "2e6"},
+      {false, "misalignment_mrad", "100", "101"},
+      {false, "bias_corr_time_s", "1e7", "1e8"},
+      {true, "horizontal_sigma_per_axis_m", "1000", "1001"},
+      {true, "vertical_sigma_m", "1000", "1e9"},
+      {true, "correlation_time_s", "1e7", "1e300"},
+      {true, "velocity_sigma_per_axis_m_per_s", "100", "101"},
+      {true, "update_rate_hz", "1000", "1e9"},
+  };
+  static diag_log log;
+  char text[1024];
+  for (size_t i = 0; i < sizeof k / sizeof k[0]; ++i) {
+    for (int above = 0; above < 2; ++above) {
+      const char *v = above ? k[i].above : k[i].at_bound;
+      if (k[i].gnss) {
+        const bool sigma = strstr(k[i].column, "sigma") && strcmp(k[i].column, "velocity_sigma_per_axis_m_per_s");
+        const bool rate = strcmp(k[i].column, "update_rate_hz") == 0;
+        snprintf(text, sizeof text, "mode,%s%s%s,source,verified_in_corpus\nR,%s%s%s,s,yes\n", k[i].column,
+                 sigma ? "" : ",horizontal_sigma_per_axis_m,vertical_sigma_m", rate ? "" : ",update_rate_hz", v,
+                 sigma ? "" : ",1,2", rate ? "" : ",1");
+        if (sigma) /* the other sigma column too */
+          snprintf(text, sizeof text, "mode,%s,%s,update_rate_hz,source,verified_in_corpus\nR,%s,1,1,s,yes\n",
+                   k[i].column,
+                   strcmp(k[i].column, "vertical_sigma_m") ? "vertical_sigma_m" : "horizontal_sigma_per_axis_m", v);
+      } else {
+        snprintf(text, sizeof text, "name,grade,%s,source,verified_in_corpus\nI,tactical MEMS,%s,s,yes\n",
+                 k[i].column, v);
+      }
+      memset(&log, 0, sizeof log);
+      nav_catalog *cat = NULL;
+      const nav_status st = nav_catalog_load_string(text, strlen(text), "c.csv", NULL, &cat, collect, &log);
+      if (!above) {
+        if (st != NAV_OK) {
+          print_log(&log);
+          fail_msg("%s = %s (at the bound) refused", k[i].column, v);
+        }
+        nav_catalog_destroy(cat);
+        continue;
+      }
+      assert_int_equal(st, NAV_ERR_PARSE);
+      assert_null(cat);
+      assert_int_equal(log.n, 1);
+      assert_int_equal(log.d[0].line, 2);
+      assert_int_equal(log.d[0].col, k[i].gnss ? 3 : 17); /* the cell after "R," / "I,tactical MEMS," */
+      assert_string_equal(log.d[0].path, k[i].column);
+      if (!strstr(log.d[0].message, "must be <=")) fail_msg("%s: %s", k[i].column, log.d[0].message);
+    }
+  }
+}
+
 /* Hostile input: 300 seeded mutations of the real catalog (random bytes overwritten, inserted
  * quotes, commas, NULs, truncations) must give NAV_OK or NAV_ERR_PARSE, never a crash (run under
  * ASan in CI), and a catalog only together with zero diagnostics. */
@@ -1395,6 +1466,7 @@ int main(void) {
       cmocka_unit_test(test_gnss_lever_arm_geometry),
       cmocka_unit_test(test_catalog_resources),
       cmocka_unit_test(test_catalog_invalid_rows),
+      cmocka_unit_test(test_issue_25_catalog_plausibility),
       cmocka_unit_test(test_catalog_hostile_input),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

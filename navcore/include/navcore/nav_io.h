@@ -68,6 +68,15 @@ NAV_API NAV_NODISCARD nav_status nav_scene_read_string(const char *text, size_t 
  */
 NAV_API NAV_NODISCARD nav_status nav_scene_write_file(const char *path, const nav_scene *scene);
 
+/**
+ * The text nav_scene_write_file would write for @p scene, in memory: to validate a scene exactly
+ * as a file reader will see it (nav_scene_read_string) before anything is written.
+ * @param[out] text NUL-terminated, malloc'd (the caller frees it); NULL on failure
+ * @param[out] len  its length in bytes (may be NULL)
+ * @return NAV_OK, NAV_ERR_NO_MEMORY, NAV_ERR_INVALID_ARG.
+ */
+NAV_API NAV_NODISCARD nav_status nav_scene_write_string(const nav_scene *scene, char **text, size_t *len);
+
 NAV_END_DECLS
 
 #endif /* NAV_IO_H */

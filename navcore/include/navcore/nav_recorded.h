@@ -152,6 +152,16 @@ NAV_API double nav_rec_reader_fraction(const nav_rec_reader *r);
 NAV_API NAV_NODISCARD nav_status nav_rec_load_gnss(const char *path, nav_ins_gnss_fix *out, size_t capacity,
                                                    size_t *count, nav_diag *diag);
 
+/**
+ * Read every record of a file of format @p fmt with the checks of the streaming readers and keep
+ * none: a replay finds a malformed or implausible record (FILE:LINE:COL in @p diag) before its
+ * run, wherever the record is in the file.
+ * @param[out] count records read (written on NAV_OK; may be NULL)
+ * @return NAV_OK; the statuses of nav_rec_reader_open() and the nav_rec_read_*() functions.
+ */
+NAV_API NAV_NODISCARD nav_status nav_rec_check_file(const char *path, nav_rec_format fmt, size_t *count,
+                                                    nav_diag *diag);
+
 /** As nav_rec_load_gnss(), for IMU files. */
 NAV_API NAV_NODISCARD nav_status nav_rec_load_imu(const char *path, nav_imu_increment *out, size_t capacity,
                                                   size_t *count, nav_diag *diag);

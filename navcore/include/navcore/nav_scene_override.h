@@ -46,7 +46,9 @@ NAV_API NAV_NODISCARD nav_status nav_scene_doc_set(nav_scene_doc *doc, const cha
 /**
  * Read the (overridden) document as a scene, exactly as nav_scene_read_string would read the
  * edited file (relative file references resolve against the original file's directory).
- * Diagnostics name the original file; their lines refer to the edited document.
+ * Diagnostics name the original file and its places (line and column in the file as given, not
+ * in the edited text); a diagnostic about a value that nav_scene_doc_set put there (or a key it
+ * added) has no place in the file: line and column 0, and its path names the overridden field.
  * @return the statuses of nav_scene_read_string.
  */
 NAV_API NAV_NODISCARD nav_status nav_scene_doc_read(const nav_scene_doc *doc, nav_scene *out, nav_diag_fn report,
