@@ -109,6 +109,24 @@ void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallb
   if (j == 0 || strcmp(out, ".") == 0 || strcmp(out, "..") == 0) snprintf(out, cap, "%s", fallback);
 }
 
+int navsim_refuse_special_result_files(const char *dir) {
+  static const char *const names[] = {"summary.json", "truth.csv", "nav.csv",          "errors.csv",
+                                      "mc_stats.csv", "gnss.csv",  "gnss_outages.csv", "imu_errors.csv",
+                                      "estimate.csv", "allan.csv", "bench.csv",        "requirements.csv"};
+  int rc = 0;
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+    char path[4352], why[320];
+    if (snprintf(path, sizeof path, "%s/%s", dir, names[i]) >= (int)sizeof path) continue;
+    FILE *f = NULL;
+    const nav_status st = nav_io_fopen_regular(path, &f, why, sizeof why);
+    if (st == NAV_OK) fclose(f);
+    if (st != NAV_ERR_PARSE) continue; /* a missing file is each reader's business */
+    fprintf(stderr, "%s: error: %s\n", path, why);
+    rc = 2;
+  }
+  return rc;
+}
+
 void navsim_json_number(FILE *f, double v, int digits) {
   if (isfinite(v))
     fprintf(f, "%.*g", digits, v);

@@ -61,6 +61,13 @@ int navsim_scene_arg(const char *cmd, const char *arg, const char **scene);
  * '_'; empty, "." or ".." become @p fallback. */
 void navsim_safe_name(char *out, size_t cap, const char *name, const char *fallback);
 
+/* The files of a result directory that navsim and navview read (summary.json, truth.csv, nav.csv,
+ * errors.csv, ...): each one that exists but is not a regular file (a FIFO, a device, a directory)
+ * is reported as "DIR/NAME: error: cannot read the file: it is a FIFO (named pipe), not a regular
+ * file", at once, before anything reads (a FIFO would block the reader).
+ * @return 0 when there is none, else 2 (the exit code of invalid input). */
+int navsim_refuse_special_result_files(const char *dir);
+
 /* A JSON number with @p digits significant digits ("%.*g"); non-finite values print null. */
 void navsim_json_number(FILE *f, double v, int digits);
 
