@@ -51,7 +51,7 @@ typedef struct outcome {
   int code;   /* exit code, -1 when killed by a signal */
   int signal; /* terminating signal, else 0 */
   double wall_s;
-  long maxrss_kb; /* peak resident size of the process group leader's children */
+  long maxrss_kb; /* peak resident size of the command (sh -c exec's it) */
   char err[65536];
 } outcome;
 
@@ -80,8 +80,10 @@ static void run_timed(const char *cmd, double deadline_s, long mem_limit_bytes, 
   }
   setpgid(pid, pid);
   int status = 0;
+  struct rusage ru;
+  memset(&ru, 0, sizeof ru);
   for (;;) {
-    const pid_t w = waitpid(pid, &status, WNOHANG);
+    const pid_t w = wait4(pid, &status, WNOHANG, &ru);
     if (w == pid) break;
     assert_true(w == 0);
     clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -98,8 +100,7 @@ static void run_timed(const char *cmd, double deadline_s, long mem_limit_bytes, 
   /* sh -c exec's the last command, so the status is the command's own. */
   o->code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   o->signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-  struct rusage ru;
-  if (getrusage(RUSAGE_CHILDREN, &ru) == 0) o->maxrss_kb = ru.ru_maxrss;
+  o->maxrss_kb = ru.ru_maxrss;
   nav_test_slurp(WORK "/stderr.txt", o->err, sizeof o->err);
 }
 
@@ -229,6 +230,47 @@ static void test_fifo_result_files(void **state) {
   expect_refusal(NAVSIM_EXE, "render lone.fifo", 2, "lone.fifo: error: cannot read the file: " FIFO_MSG);
 }
 
+/* paper-parametric (flat Earth: the closed forms alone) over @p duration_s with output at the IMU
+ * rate (100 Hz), as WORK/NAME. */
+static void write_long_scene(const char *name, int duration_s) {
+  char cmd[8192];
+  snprintf(
+      cmd, sizeof cmd,
+      "sed 's/^  duration_s: 20$/  duration_s: %d/; s/^  rate_hz: 10$/  rate_hz: 100/' '%s' > '%s/%s' && "
+      "grep -q '^  duration_s: %d$' '%s/%s'",
+      duration_s, SCENE, WORK, name, duration_s, WORK, name);
+  assert_int_equal(system(cmd), 0);
+}
+
+/* navsim estimate streams its rows like run: its peak memory does not grow with the output
+ * epochs (it held about 410 bytes per epoch: 2 001 and 100 001 epochs differed by 40 MB). */
+static void test_estimate_memory_does_not_grow(void **state) {
+  (void)state;
+  write_long_scene("short.yaml", 20);
+  write_long_scene("long.yaml", 1000);
+  outcome a, b;
+  run_timed("exec '" NAVSIM_EXE "' estimate short.yaml --out est-short --quiet", 120.0, 0, &a);
+  if (a.code != 0) fail_msg("estimate short.yaml: exit %d\n%s", a.code, a.err);
+  run_timed("exec '" NAVSIM_EXE "' estimate long.yaml --out est-long --quiet", 120.0, 0, &b);
+  if (b.code != 0) fail_msg("estimate long.yaml: exit %d\n%s", b.code, b.err);
+  size_t rows = 0;
+  {
+    FILE *f = fopen(WORK "/est-long/estimate.csv", "r");
+    assert_non_null(f);
+    int c;
+    while ((c = fgetc(f)) != EOF)
+      rows += c == '\n';
+    fclose(f);
+  }
+  assert_int_equal(rows, 100002); /* header and 100 001 output epochs */
+  printf("navsim estimate peak RSS: %ld KiB at 2 001 epochs, %ld KiB at 100 001 epochs\n", a.maxrss_kb,
+         b.maxrss_kb);
+  /* 98 000 more epochs at the former 410 bytes each would add 40 MB; the batches are constant. */
+  if (b.maxrss_kb - a.maxrss_kb > 16 * 1024)
+    fail_msg("estimate memory grows with the epochs: %ld KiB -> %ld KiB", a.maxrss_kb, b.maxrss_kb);
+  assert_int_equal(system("rm -rf '" WORK "/est-short' '" WORK "/est-long'"), 0);
+}
+
 #ifdef NAVVIEW_EXE
 static const char *const k_track_header = "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_"
                                           "mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n";
@@ -355,6 +397,7 @@ int main(void) {
       cmocka_unit_test(test_fifo_import),
       cmocka_unit_test(test_fifo_catalog),
       cmocka_unit_test(test_fifo_result_files),
+      cmocka_unit_test(test_estimate_memory_does_not_grow),
 #ifdef NAVVIEW_EXE
       cmocka_unit_test(test_navview_bad_and_huge_results),
       cmocka_unit_test(test_navview_large_result_renders),
