@@ -21,6 +21,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli_util.h"
 #include "estimate_cmd.h"
+#include "size_limits.h"
 
 #include <errno.h>
 #include <math.h>
@@ -39,7 +40,7 @@
 #include "navcore/nav_version.h"
 
 static const char *k_usage_estimate =
-    "usage: navsim estimate SCENE [--out DIR] [--quiet]\n"
+    "usage: navsim estimate SCENE [--out DIR] [--quiet] [--allow-large]\n"
     "\n"
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
@@ -62,6 +63,9 @@ static const char *k_usage_estimate =
     "                 value null where sigmas do not determine the statistic, e.g. max)\n"
     "  summary.json   scene, timing, final analytic and covariance values\n"
     "\n"
+    "options:\n"
+    "  --allow-large  go ahead above the limits below\n"
+    "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
 static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
@@ -214,6 +218,42 @@ static nav_status eval_epochs(const est_ctx *c, est_epoch *e, size_t n, double *
   return st;
 }
 
+/* The header line of estimate.csv. */
+static void write_header(FILE *f, const est_ctx *c) {
+  fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_"
+        "e_sd_m,"
+        "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
+        "cov_att_e_sd_rad,cov_att_d_sd_rad,analytic_pos_h_sd_m,analytic_vel_h_sd_mps,analytic_pos_v_sd_m,"
+        "analytic_pos_v_valid",
+        f);
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+    char lab[64];
+    term_label((nav_analytic_term_id)q, lab, sizeof lab);
+    fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
+  }
+  if (c->acfg.with_gyrofree)
+    fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_"
+          "pos_m",
+          f);
+  if (c->schuler) fputs(",analytic_schuler_pos_sd_m,analytic_schuler_vel_sd_mps", f);
+  fputc('\n', f);
+}
+
+/* Columns of estimate.csv: the commas of its header, plus one. */
+static int header_columns(const est_ctx *c) {
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *m = open_memstream(&buf, &len);
+  if (!m) return 0;
+  write_header(m, c);
+  fclose(m);
+  int n = buf ? 1 : 0;
+  for (const char *p = buf; p && *p; ++p)
+    n += *p == ',';
+  free(buf);
+  return n;
+}
+
 /* One row of estimate.csv (cov NULL: empty covariance columns). */
 static void write_row(FILE *f, const est_ctx *c, const est_epoch *e, const nav_cov_point *p) {
   const nav_analytic_estimate_point *a = &e->ana;
@@ -362,13 +402,15 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
 
 int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool quiet = false;
+  bool quiet = false, allow_large = false;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
       return 0;
     } else if (strcmp(argv[i], "--quiet") == 0) {
       quiet = true;
+    } else if (strcmp(argv[i], "--allow-large") == 0) {
+      allow_large = true;
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
     } else if (argv[i][0] == '-') {
@@ -430,6 +472,15 @@ int navsim_estimate(int argc, char **argv) {
     fprintf(stderr, "navsim estimate: out of memory\n");
     goto cleanup;
   }
+  {
+    /* estimate.csv predicted from the scene, refused beyond the limits before any work. */
+    navsim_size_prediction sp;
+    navsim_predict_estimate(&sc, header_columns(&ctx), &sp);
+    if (navsim_size_check("estimate", scene_path, &sp, allow_large, false) != 0) {
+      rc = 2;
+      goto cleanup;
+    }
+  }
   for (size_t q = 0; q < N_SHOW; ++q)
     es.show_i[q] = nt;
   /* The first epoch's analytic values: the closed forms' inputs are checked before any output. */
@@ -450,20 +501,7 @@ int navsim_estimate(int argc, char **argv) {
   const char *csv = nav_resultdir_file(rd, "estimate.csv");
   f = csv ? fopen(csv, "w") : NULL;
   if (!f) goto cleanup;
-  fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_e_sd_m,"
-        "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
-        "cov_att_e_sd_rad,cov_att_d_sd_rad,analytic_pos_h_sd_m,analytic_vel_h_sd_mps,analytic_pos_v_sd_m,"
-        "analytic_pos_v_valid",
-        f);
-  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
-    char lab[64];
-    term_label((nav_analytic_term_id)q, lab, sizeof lab);
-    fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
-  }
-  if (acfg.with_gyrofree)
-    fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_pos_m", f);
-  if (ctx.schuler) fputs(",analytic_schuler_pos_sd_m,analytic_schuler_vel_sd_mps", f);
-  fputc('\n', f);
+  write_header(f, &ctx);
   const long header_end = ftell(f);
   es.f = f;
 

@@ -271,6 +271,70 @@ static void test_estimate_memory_does_not_grow(void **state) {
   assert_int_equal(system("rm -rf '" WORK "/est-short' '" WORK "/est-long'"), 0);
 }
 
+/* Nothing named NAME or .NAME.tmp-* in WORK. */
+static void assert_no_result(const char *name) {
+  char cmd[8192];
+  snprintf(cmd, sizeof cmd, "cd '%s' && ! ls -a | grep -q -e '^%s$' -e '^\\.%s\\.tmp-'", WORK, name, name);
+  if (system(cmd) != 0) fail_msg("a refused command left %s (or its temporary) in %s", name, WORK);
+}
+
+/* A scene that passes check with 2e9 IMU samples at full output rate (1e7 s at 200 Hz): navsim
+ * run wrote 130 MB/s into it with no estimate or cap. Now check warns with the prediction, and
+ * run and estimate refuse at once (exit 2, the figures, the limit, what to change), unless
+ * --allow-large. */
+static void test_output_size_refused_before_work(void **state) {
+  (void)state;
+  char cmd[8192];
+  snprintf(cmd, sizeof cmd,
+           "sed 's/^  duration_s: 20$/  duration_s: 10000000/; s/^  rate_hz: 10$/  rate_hz: 200/; "
+           "s/^  rate_hz: 100$/  rate_hz: 200/' '%s' > '%s/huge.yaml'",
+           SCENE, WORK);
+  assert_int_equal(system(cmd), 0);
+  static const char *const figures = "2000000001 output epochs from 2000000000 IMU samples";
+  outcome o;
+  run_timed("exec '" NAVSIM_EXE "' check huge.yaml", k_refusal_deadline_s, 0, &o);
+  if (o.code != 0) fail_msg("check: exit %d\n%s", o.code, o.err);
+  nav_test_assert_matches(o.err,
+                          "^huge.yaml: warning: output.rate_hz: navsim run would write up to 2 TB of result "
+                          "files \\(2000000001 output epochs from 2000000000 IMU samples, in truth.csv, "
+                          "nav.csv, errors.csv\\), above the limit of 2.15 GB \\(2 GiB\\): lower "
+                          "output.rate_hz or trajectory.duration_s, or give --allow-large$");
+  expect_refusal(NAVSIM_EXE, "run huge.yaml --out big", 2, figures);
+  assert_no_result("big");
+  expect_refusal(
+      NAVSIM_EXE, "estimate huge.yaml --out bigest", 2,
+      "huge.yaml: error: output.rate_hz: navsim estimate would write up to 2.75 TB of result files "
+      "(2000000001 output epochs from 2000000000 IMU samples, in estimate.csv)");
+  assert_no_result("bigest");
+  /* --allow-large goes ahead: the run is under way when it is interrupted (exit 130, nothing left). */
+  run_timed("exec timeout -s INT --preserve-status 2 '" NAVSIM_EXE
+            "' run huge.yaml --out big --allow-large --quiet",
+            60.0, 0, &o);
+  if (o.code != 130)
+    fail_msg("run --allow-large: exit %d, expected 130 (interrupted while running)\n%s", o.code, o.err);
+  assert_null(strstr(o.err, "error:"));
+  assert_no_result("big");
+}
+
+/* The memory of navsim run is predicted too: the RTS smoother keeps one record per output and
+ * GNSS epoch of every run in flight (7.5 KiB measured at 18 states). */
+static void test_memory_refused_before_work(void **state) {
+  (void)state;
+  char cmd[8192];
+  snprintf(cmd, sizeof cmd,
+           "sed 's/^  duration_s: 1800$/  duration_s: 6000/; s/^  rate_hz: 5$/  rate_hz: 100/; "
+           "s/^  frame: ned$/  frame: ned\\n  smoother: true/' '%s/scenes/ship.yaml' > '%s/smooth.yaml' && "
+           "grep -q '^  smoother: true$' '%s/smooth.yaml'",
+           NAV_SOURCE_DIR, WORK, WORK);
+  assert_int_equal(system(cmd), 0);
+  expect_refusal(
+      NAVSIM_EXE, "run smooth.yaml --threads 1 --out sm", 2,
+      "smooth.yaml: error: navsim run would need about 5.28 GB of memory (statistics, shared reference, "
+      "RTS smoother records of 1 run(s) in flight, for 600001 output epochs), above the limit of 4.29 GB "
+      "(4 GiB)");
+  assert_no_result("sm");
+}
+
 #ifdef NAVVIEW_EXE
 static const char *const k_track_header = "t_s,lat_deg,lon_deg,h_m,pos_n_m,pos_e_m,pos_d_m,vel_n_mps,vel_e_"
                                           "mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n";
@@ -398,6 +462,8 @@ int main(void) {
       cmocka_unit_test(test_fifo_catalog),
       cmocka_unit_test(test_fifo_result_files),
       cmocka_unit_test(test_estimate_memory_does_not_grow),
+      cmocka_unit_test(test_output_size_refused_before_work),
+      cmocka_unit_test(test_memory_refused_before_work),
 #ifdef NAVVIEW_EXE
       cmocka_unit_test(test_navview_bad_and_huge_results),
       cmocka_unit_test(test_navview_large_result_renders),
