@@ -385,7 +385,7 @@ nav_status nav_motiondef_read_file(const char *path, nav_scene *scene, nav_diag_
   }
   struct stat sb;
   if (fstat(fileno(fp), &sb) != 0) {
-    diag(&r, 0, 0, "", "cannot read the file: not a regular file");
+    diag(&r, 0, 0, "", "cannot read the file: %s", strerror(errno));
     st = NAV_ERR_IO;
     goto cleanup;
   }

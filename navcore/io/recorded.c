@@ -168,7 +168,7 @@ nav_status nav_rec_reader_open(const char *path, nav_rec_format fmt, nav_rec_rea
   if (st != NAV_OK) {
     /* why is "cannot open the file: ..." or "cannot read the file: it is a FIFO ...": name the
      * format in it ("cannot read the IMU file: ..."). */
-    diag_set(diag, path, 0, 0, "", "%.11s the %s file%s", why, format_name(fmt), why + 20);
+    diag_set(diag, path, 0, 0, "", "%.11s the %s file%s", why, format_name(fmt), strlen(why) >= 20 ? why + 20 : "");
     nav_rec_reader_destroy(r);
     return st;
   }

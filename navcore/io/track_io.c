@@ -275,7 +275,7 @@ nav_status nav_track_read_file(const char *path, nav_recorded_format format, uns
     char why[320];
     const nav_status open_st = nav_io_fopen_regular(path, &fp, why, sizeof why);
     if (open_st != NAV_OK) {
-      diag(&r, 0, 0, "%.11s the recorded file%s", why, why + 20);
+      diag(&r, 0, 0, "%.11s the recorded file%s", why, strlen(why) >= 20 ? why + 20 : "");
       return open_st;
     }
   }
