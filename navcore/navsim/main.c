@@ -142,7 +142,7 @@ static int cmd_check(int argc, char **argv) {
     if (rc == EXIT_OK) {
       /* A valid scene whose run would exceed the limits: a warning with the prediction. */
       navsim_size_prediction pred;
-      navsim_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(),
+      navsim_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
                          &pred);
       (void)navsim_size_check("run", argv[i], &pred, false, true);
     }
@@ -300,7 +300,7 @@ static int cmd_run(int argc, char **argv) {
     /* Result files and memory predicted from the scene, refused beyond the limits before any
      * work (every MPI rank decides the same). */
     navsim_size_prediction pred;
-    navsim_predict_run(&scene, ideal, (long)threads, &pred);
+    navsim_predict_run(&scene, ideal, (long)threads, kml, &pred);
     rc = navsim_size_check("run", scene_path, &pred, allow_large, false);
     if (rc != EXIT_OK) return rc;
   }

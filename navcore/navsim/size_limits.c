@@ -17,6 +17,7 @@
 #define IMU_ERRORS_COLUMNS 7 /* imu_errors.csv */
 #define GNSS_COLUMNS 10      /* gnss.csv */
 #define MC_STATS_COLUMNS 15  /* mc_stats.csv */
+#define TRACKS_COLUMNS 5     /* tracks.csv of --kml (kml_export.c) */
 /* One RTS smoother record per output or GNSS epoch and run in flight: about 7 KiB at 18 states
  * (nav_scene.h, navigation.smoother); 8 KiB covers the 21-state filter's growth in part. */
 #define SMOOTHER_RECORD_BYTES 8192.0
@@ -57,7 +58,7 @@ static void add_file(navsim_size_prediction *p, const char *name, double rows, i
   snprintf(p->files + l, sizeof p->files - l, "%s%s", l ? ", " : "", name);
 }
 
-void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, navsim_size_prediction *out) {
+void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, navsim_size_prediction *out) {
   memset(out, 0, sizeof *out);
   int64_t n_imu = 0, n_out = 0;
   epochs(sc, &n_imu, &n_out);
@@ -82,6 +83,9 @@ void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, navsim_si
     add_file(out, "nav_smoothed.csv", rows, table_columns(NAV_CSV_NAV_SMOOTHED));
     add_file(out, "smoothed_errors.csv", rows, table_columns(NAV_CSV_ERRORS));
   }
+  /* --kml: tracks.csv holds every reference, estimate and GNSS epoch (the KML at most 20 000
+   * points a track, a few MB). */
+  if (kml) add_file(out, "tracks.csv", 2.0 * rows + n_gnss, TRACKS_COLUMNS);
 
   /* Memory that grows with the scene; everything else navcore caps (statistics at most
    * NAV_SIM_METRIC_MAX_VALUES per metric, the envelope at most NAV_SIM_ENV_MAX_VALUES values). */
@@ -105,6 +109,11 @@ void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, navsim_si
     const size_t l = strlen(out->memory);
     snprintf(out->memory + l, sizeof out->memory - l, ", RTS smoother records of %.0f run(s) in flight",
              in_flight);
+  }
+  if (kml) {
+    /* The tracks are read back whole for tracks.kml / tracks.csv: time and position per epoch. */
+    mem += (2.0 * rows + n_gnss) * 4.0 * 8.0;
+    strncat(out->memory, ", --kml tracks", sizeof out->memory - strlen(out->memory) - 1);
   }
   out->memory_bytes = mem;
 }

@@ -35,8 +35,8 @@ typedef struct navsim_size_prediction {
   char memory[256];      /**< what the memory is, e.g. "RTS smoother records of 2 runs in flight" */
 } navsim_size_prediction;
 
-/** navsim run of @p sc (after --runs / --ideal / --threads). */
-void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, navsim_size_prediction *out);
+/** navsim run of @p sc (after --runs / --ideal / --threads; @p kml: --kml, tracks.kml/.csv). */
+void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, navsim_size_prediction *out);
 
 /** navsim estimate of @p sc: estimate.csv with @p csv_columns columns, streamed. */
 void navsim_predict_estimate(const nav_scene *sc, int csv_columns, navsim_size_prediction *out);

@@ -300,6 +300,13 @@ static void test_output_size_refused_before_work(void **state) {
                           "nav.csv, errors.csv\\), above the limit of 2.15 GB \\(2 GiB\\): lower "
                           "output.rate_hz or trajectory.duration_s, or give --allow-large$");
   expect_refusal(NAVSIM_EXE, "run huge.yaml --out big", 2, figures);
+  /* --kml adds tracks.csv and reads the tracks back whole. */
+  expect_refusal(NAVSIM_EXE, "run huge.yaml --out big --kml", 2,
+                 "in truth.csv, nav.csv, errors.csv, tracks.csv)");
+  expect_refusal(
+      NAVSIM_EXE, "run huge.yaml --out big --kml", 2,
+      "huge.yaml: error: navsim run would need about 128 GB of memory (statistics, --kml tracks, for "
+      "2000000001 output epochs), above the limit of 4.29 GB (4 GiB)");
   assert_no_result("big");
   expect_refusal(
       NAVSIM_EXE, "estimate huge.yaml --out bigest", 2,
