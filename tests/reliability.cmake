@@ -35,6 +35,18 @@ target_compile_definitions(test_navsim_hostile PRIVATE
   NAVSIM_EXE="$<TARGET_FILE:navsim>" NAV_TEST_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/navsim_hostile")
 add_dependencies(test_navsim_hostile navsim)
 
+# Bounded work (issue 25): readers refuse FIFOs, devices and directories at once; navview never
+# aborts on a bad or huge result; output size and memory predicted and capped before a run.
+nav_add_cmocka_test(test_navsim_bounded SOURCES scenario/test_navsim_bounded.c LABELS scenario)
+target_compile_definitions(test_navsim_bounded PRIVATE
+  NAVSIM_EXE="$<TARGET_FILE:navsim>" NAV_TEST_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/navsim_bounded")
+add_dependencies(test_navsim_bounded navsim)
+if(TARGET navview_app AND NOT NAV_SANITIZE)
+  target_compile_definitions(test_navsim_bounded PRIVATE NAVVIEW_EXE="$<TARGET_FILE:navview_app>")
+  add_dependencies(test_navsim_bounded navview_app)
+  set_tests_properties(test_navsim_bounded PROPERTIES RESOURCE_LOCK xvfb)
+endif()
+
 # Numerical guards of the filter in hard cases (P symmetric positive definite, or NAV_ERR_NUMERIC).
 nav_add_cmocka_test(test_filter_hard SOURCES unit/test_filter_hard.c LIBS navcore_io LABELS unit scenario)
 

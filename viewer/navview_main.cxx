@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
+#include <stdexcept>
 #include <random>
 #include <string>
 
@@ -172,7 +174,7 @@ std::shared_ptr<NavResult> SyntheticResult(size_t epochs, int paths) {
 
 } // namespace
 
-int main(int argc, char **argv) {
+static int NavviewMain(int argc, char **argv) {
   std::string dir, png, chart, view_kind = "3d", allan_csv, bench_csv;
   NavViewOptions opt;
   NavChartOptions copt;
@@ -483,4 +485,20 @@ int main(int argc, char **argv) {
     }
   }
   return rc;
+}
+
+// No bad or huge result ends in an abort: the readers refuse what they cannot hold, and an
+// allocation that still fails (a large file on a small machine, VTK's own buffers) is one
+// message and exit 1, not std::terminate.
+int main(int argc, char **argv) {
+  try {
+    return NavviewMain(argc, argv);
+  } catch (const std::bad_alloc &) {
+    std::fprintf(stderr,
+                 "navview: error: out of memory (the result is too large for this machine: write it with a "
+                 "lower output.rate_hz or a shorter duration)\n");
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "navview: error: %s\n", e.what());
+  }
+  return 1;
 }

@@ -4,6 +4,7 @@
  * file explains only parsing choices.
  */
 #include "navcore/nav_catalog.h"
+#include "navcore/nav_io.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -826,10 +827,13 @@ nav_status nav_catalog_load(const char *path, const nav_catalog_options *opt, na
   ctx c = {.file = path, .report = report, .user = user};
   nav_status st = NAV_OK;
   char *buf = NULL;
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    diag(&c, 0, 0, "", "cannot open the file for reading");
-    return NAV_ERR_IO;
+  FILE *f = NULL;
+  char why[320];
+  st = nav_io_fopen_regular(path, &f, why, sizeof why);
+  if (st != NAV_OK) {
+    /* A FIFO, device or directory is refused at once (NAV_ERR_PARSE), not read until EOF. */
+    diag(&c, 0, 0, "", "%s", st == NAV_ERR_IO ? "cannot open the file for reading" : why);
+    return st;
   }
   buf = malloc((size_t)NAV_CATALOG_MAX_BYTES + 1);
   if (!buf) {

@@ -374,16 +374,18 @@ nav_status nav_motiondef_read_file(const char *path, nav_scene *scene, nav_diag_
   size_t len = 0;
   if (!path || !scene) return NAV_ERR_INVALID_ARG;
   md_reader r = {path, report, user, 0};
-  fp = fopen(path, "rb");
-  if (!fp) {
-    char why[128];
-    if (strerror_r(errno, why, sizeof why) != 0) snprintf(why, sizeof why, "error %d", errno);
-    diag(&r, 0, 0, "", "cannot open the file: %s", why);
-    return NAV_ERR_IO;
+  {
+    /* A FIFO, device or directory is refused at once, without a blocking open. */
+    char why[320];
+    st = nav_io_fopen_regular(path, &fp, why, sizeof why);
+    if (st != NAV_OK) {
+      diag(&r, 0, 0, "", "%s", why);
+      return st;
+    }
   }
   struct stat sb;
-  if (fstat(fileno(fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
-    diag(&r, 0, 0, "", "cannot read the file: not a regular file");
+  if (fstat(fileno(fp), &sb) != 0) {
+    diag(&r, 0, 0, "", "cannot read the file: %s", strerror(errno));
     st = NAV_ERR_IO;
     goto cleanup;
   }

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "navcore/nav_earth.h"
+#include "navcore/nav_io.h"
 #include "navcore/nav_recorded.h"
 #include "fast_number.h"
 #include "scene_bounds.h"
@@ -163,11 +164,14 @@ nav_status nav_rec_reader_open(const char *path, nav_rec_format fmt, nav_rec_rea
   nav_rec_reader *r = NULL;
   nav_status st = reader_new(fmt, path, &r);
   if (st != NAV_OK) return st;
-  r->f = fopen(path, "rb");
-  if (!r->f) {
-    diag_set(diag, path, 0, 0, "", "cannot open the %s file: %s", format_name(fmt), strerror(errno));
+  char why[320];
+  st = nav_io_fopen_regular(path, &r->f, why, sizeof why);
+  if (st != NAV_OK) {
+    /* why is "cannot open the file: ..." or "cannot read the file: it is a FIFO ...": name the
+     * format in it ("cannot read the IMU file: ..."). */
+    diag_set(diag, path, 0, 0, "", "%.11s the %s file%s", why, format_name(fmt), strlen(why) >= 20 ? why + 20 : "");
     nav_rec_reader_destroy(r);
-    return NAV_ERR_IO;
+    return st;
   }
   struct stat sb;
   if (fstat(fileno(r->f), &sb) == 0 && S_ISREG(sb.st_mode)) r->total = (double)sb.st_size;

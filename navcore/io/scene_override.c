@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "navcore/nav_io.h"
 #include "navcore/nav_scene_override.h"
 
 struct nav_scene_doc {
@@ -69,10 +70,15 @@ nav_status nav_scene_doc_load(const char *path, nav_scene_doc **out, char *msg, 
   if (msg && msg_size) msg[0] = '\0';
   if (!path || !out) return NAV_ERR_INVALID_ARG;
   *out = NULL;
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    say(msg, msg_size, "cannot open the scene file");
-    return NAV_ERR_IO;
+  FILE *f = NULL;
+  char why[320];
+  const nav_status open_st = nav_io_fopen_regular(path, &f, why, sizeof why);
+  if (open_st != NAV_OK) {
+    if (open_st == NAV_ERR_PARSE)
+      say(msg, msg_size, "%s", why); /* a FIFO, device or directory */
+    else
+      say(msg, msg_size, "cannot open the scene file");
+    return open_st;
   }
   fclose(f);
   struct fy_parse_cfg cfg;

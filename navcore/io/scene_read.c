@@ -2873,21 +2873,14 @@ static nav_status read_file(const char *path, nav_scene *out, nav_diag_fn report
   size_t len = 0, cap = 0;
 
   if (path == NULL || out == NULL) return NAV_ERR_INVALID_ARG;
-  fp = fopen(path, "rb");
-  if (fp == NULL) {
-    const int err = errno;
-    if (strerror_r(err, why, sizeof why) != 0) snprintf(why, sizeof why, "error %d", err);
-    report_file_problem(path, report, user, "cannot open the file: %s", why);
-    st = NAV_ERR_IO;
+  /* A FIFO, device or directory is refused at once (no blocking open, no endless read). */
+  st = nav_io_fopen_regular(path, &fp, why, sizeof why);
+  if (st != NAV_OK) {
+    report_file_problem(path, report, user, "%s", why);
     goto cleanup;
   }
   struct stat sb;
   if (fstat(fileno(fp), &sb) == 0) {
-    if (S_ISDIR(sb.st_mode)) {
-      report_file_problem(path, report, user, "cannot read the file: it is a directory");
-      st = NAV_ERR_IO;
-      goto cleanup;
-    }
     if (S_ISREG(sb.st_mode) && (uintmax_t)sb.st_size > NAV_IO_MAX_INPUT_BYTES) {
       report_file_problem(path, report, user,
                           "the file is too large (%jd bytes); scene files are limited to %zu bytes (16 MiB)",

@@ -673,8 +673,17 @@ nav_status nav_geotrack_read_string(const char *text, size_t len, const char *di
 nav_status nav_geotrack_read_file(const char *path, nav_track_format format, const char *select_name, nav_geotrack *out,
                                   nav_diag_fn report, void *user) {
   if (!path || !out) return NAV_ERR_INVALID_ARG;
-  FILE *fp = fopen(path, "rb");
-  if (!fp) return NAV_ERR_IO;
+  FILE *fp = NULL;
+  char why[320];
+  const nav_status open_st = nav_io_fopen_regular(path, &fp, why, sizeof why);
+  if (open_st != NAV_OK) {
+    /* A FIFO, device or directory is refused at once; a missing file stays an I/O error. */
+    if (open_st == NAV_ERR_PARSE) {
+      ti_reader r = {path, report, user, 0};
+      ti_diag(&r, 0, 0, "", "%s", why);
+    }
+    return open_st;
+  }
   char *buf = NULL;
   size_t n = 0, cap = 0;
   nav_status st = NAV_OK;

@@ -316,19 +316,16 @@ nav_status nav_track_read_file(const char *path, nav_recorded_format format, uns
   if (format != NAV_RECORDED_KF_GINS_NAV) return NAV_ERR_INVALID_ARG;
   tk_reader r;
   begin(&r, path, field_path, window, start_s, end_s, report, user);
-  FILE *fp = fopen(path, "rb");
-  if (!fp) {
-    char why[128];
-    const int err = errno;
-    if (strerror_r(err, why, sizeof why) != 0) snprintf(why, sizeof why, "error %d", err);
-    diag(&r, 0, 0, "cannot open the recorded file: %s", why);
-    return NAV_ERR_IO;
-  }
-  struct stat sb;
-  if (fstat(fileno(fp), &sb) == 0 && S_ISDIR(sb.st_mode)) {
-    diag(&r, 0, 0, "cannot read the recorded file: it is a directory");
-    fclose(fp);
-    return NAV_ERR_IO;
+  FILE *fp = NULL;
+  {
+    /* A FIFO, device or directory is refused at once, without a blocking open; why is
+     * "cannot open the file: ..." or "cannot read the file: it is ...". */
+    char why[320];
+    const nav_status open_st = nav_io_fopen_regular(path, &fp, why, sizeof why);
+    if (open_st != NAV_OK) {
+      diag(&r, 0, 0, "%.11s the recorded file%s", why, strlen(why) >= 20 ? why + 20 : "");
+      return open_st;
+    }
   }
   nav_io_c_locale loc;
   nav_io_c_locale_begin(&loc);

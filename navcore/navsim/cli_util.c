@@ -154,6 +154,24 @@ int navsim_out_commit(const char *cmd, nav_resultdir *rd) {
   return st == NAV_ERR_INVALID_ARG ? 2 : 1;
 }
 
+int navsim_refuse_special_result_files(const char *dir) {
+  static const char *const names[] = {"summary.json", "truth.csv", "nav.csv",          "errors.csv",
+                                      "mc_stats.csv", "gnss.csv",  "gnss_outages.csv", "imu_errors.csv",
+                                      "estimate.csv", "allan.csv", "bench.csv",        "requirements.csv"};
+  int rc = 0;
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+    char path[4352], why[320];
+    if (snprintf(path, sizeof path, "%s/%s", dir, names[i]) >= (int)sizeof path) continue;
+    FILE *f = NULL;
+    const nav_status st = nav_io_fopen_regular(path, &f, why, sizeof why);
+    if (st == NAV_OK) fclose(f);
+    if (st != NAV_ERR_PARSE) continue; /* a missing file is each reader's business */
+    fprintf(stderr, "%s: error: %s\n", path, why);
+    rc = 2;
+  }
+  return rc;
+}
+
 void navsim_json_number(FILE *f, double v, int digits) {
   if (isfinite(v))
     fprintf(f, "%.*g", digits, v);

@@ -87,6 +87,13 @@ int navsim_out_begin(const char *cmd, const char *dir, bool force, nav_resultdir
  * meanwhile: the result is kept beside it; 1 on I/O failure). */
 int navsim_out_commit(const char *cmd, nav_resultdir *rd);
 
+/* The files of a result directory that navsim and navview read (summary.json, truth.csv, nav.csv,
+ * errors.csv, ...): each one that exists but is not a regular file (a FIFO, a device, a directory)
+ * is reported as "DIR/NAME: error: cannot read the file: it is a FIFO (named pipe), not a regular
+ * file", at once, before anything reads (a FIFO would block the reader).
+ * @return 0 when there is none, else 2 (the exit code of invalid input). */
+int navsim_refuse_special_result_files(const char *dir);
+
 /* A JSON number with @p digits significant digits ("%.*g"); non-finite values print null. */
 void navsim_json_number(FILE *f, double v, int digits);
 

@@ -21,12 +21,15 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli_util.h"
 #include "estimate_cmd.h"
+#include "size_limits.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "navcore/nav_analytic.h"
 #include "navcore/nav_array.h"
@@ -37,7 +40,7 @@
 #include "navcore/nav_version.h"
 
 static const char *k_usage_estimate =
-    "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet]\n"
+    "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet] [--allow-large]\n"
     "\n"
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
@@ -61,6 +64,9 @@ static const char *k_usage_estimate =
     "  summary.json   scene, timing, final analytic and covariance values\n"
     NAVSIM_OUT_HELP
     "\n"
+    "options:\n"
+    "  --allow-large  go ahead above the limits below\n"
+    "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
 static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
@@ -162,16 +168,178 @@ static nav_analytic_schuler_error schuler_sd(const nav_analytic_imu_spec *sp, do
   return r;
 }
 
-typedef struct cov_rows {
-  nav_cov_point *p;
-  size_t n, cap;
-} cov_rows;
+/* Epochs computed and written per batch: the analytic closed forms are evaluated for a batch of
+ * output epochs at once and the rows written, so memory does not grow with the run (an estimate
+ * of 1e6 output epochs used to hold about 410 MB of rows; issue 25). */
+#define EST_BATCH 4096
 
-static nav_callback_result keep_cov(void *user, const nav_cov_point *p) {
-  cov_rows *r = user;
-  if (r->n >= r->cap) return NAV_STOP;
-  r->p[r->n++] = *p;
-  return NAV_CONTINUE;
+/* Terminal read-out times [s] (the first output epoch at or after each; 1e30: the last one). */
+static const double k_show_s[] = {1, 10, 30, 60, 120, 300, 600, 1800, 3600, 1e30};
+#define N_SHOW (sizeof k_show_s / sizeof k_show_s[0])
+
+/* What the rows of estimate.csv are made of, fixed for the scene. */
+typedef struct est_ctx {
+  const nav_scene *sc;
+  nav_analytic_estimate_config acfg;
+  nav_analytic_imu_spec vspec;
+  double t_v_max_s;
+  bool schuler;
+  double schuler_r;
+  int64_t n_imu, stride;
+  size_t nt; /* output epochs */
+} est_ctx;
+
+/* Time of output epoch @p i: every stride-th IMU sample, and the last one (as navsim run). */
+static double epoch_time(const est_ctx *c, size_t i) {
+  const int64_t k = (int64_t)i * c->stride;
+  return k <= c->n_imu ? (double)k / c->sc->imu.rate_hz : (double)c->n_imu / c->sc->imu.rate_hz;
+}
+
+/* The analytic values of one epoch. */
+typedef struct est_epoch {
+  double t_s;
+  nav_analytic_estimate_point ana;
+  nav_analytic_gyro_ins_table tab;
+  double pos_v_m;
+} est_epoch;
+
+/* Analytic estimate, term table and vertical channel at the times e[0..n).t_s. */
+static nav_status eval_epochs(const est_ctx *c, est_epoch *e, size_t n, double *tbuf,
+                              nav_analytic_estimate_point *abuf) {
+  for (size_t i = 0; i < n; ++i)
+    tbuf[i] = e[i].t_s;
+  nav_status st = nav_analytic_estimate(&c->acfg, tbuf, n, abuf);
+  for (size_t i = 0; i < n && st == NAV_OK; ++i) {
+    nav_analytic_gyro_ins_table vt;
+    e[i].ana = abuf[i];
+    st = nav_analytic_gyro_ins_table_eval(&c->acfg.imu, e[i].t_s, &e[i].tab);
+    if (st == NAV_OK) st = nav_analytic_gyro_ins_table_eval(&c->vspec, e[i].t_s, &vt);
+    if (st == NAV_OK) e[i].pos_v_m = vt.rss.pos_m;
+  }
+  return st;
+}
+
+/* The header line of estimate.csv. */
+static void write_header(FILE *f, const est_ctx *c) {
+  fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_"
+        "e_sd_m,"
+        "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
+        "cov_att_e_sd_rad,cov_att_d_sd_rad,analytic_pos_h_sd_m,analytic_vel_h_sd_mps,analytic_pos_v_sd_m,"
+        "analytic_pos_v_valid",
+        f);
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+    char lab[64];
+    term_label((nav_analytic_term_id)q, lab, sizeof lab);
+    fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
+  }
+  if (c->acfg.with_gyrofree)
+    fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_"
+          "pos_m",
+          f);
+  if (c->schuler) fputs(",analytic_schuler_pos_sd_m,analytic_schuler_vel_sd_mps", f);
+  fputc('\n', f);
+}
+
+/* Columns of estimate.csv: the commas of its header, plus one. */
+static int header_columns(const est_ctx *c) {
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *m = open_memstream(&buf, &len);
+  if (!m) return 0;
+  write_header(m, c);
+  fclose(m);
+  int n = buf ? 1 : 0;
+  for (const char *p = buf; p && *p; ++p)
+    n += *p == ',';
+  free(buf);
+  return n;
+}
+
+/* One row of estimate.csv (cov NULL: empty covariance columns). */
+static void write_row(FILE *f, const est_ctx *c, const est_epoch *e, const nav_cov_point *p) {
+  const nav_analytic_estimate_point *a = &e->ana;
+  fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", e->t_s, a->gyro_ins.pos_sd_m, a->gyro_ins.vel_sd_mps,
+          a->gyro_ins.att_sd_rad, a->gyro_ins_short_time_ok ? 1 : 0);
+  if (p) {
+    fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", p->pos_sd_n_m.x,
+            p->pos_sd_n_m.y, p->pos_sd_n_m.z, p->pos_h_sd_m, p->vel_sd_n_mps.x, p->vel_sd_n_mps.y,
+            p->vel_sd_n_mps.z, p->att_sd_rad.x, p->att_sd_rad.y, p->att_sd_rad.z);
+  } else {
+    fputs(",,,,,,,,,,", f);
+  }
+  fprintf(f, ",%.17g,%.17g,%.17g,%d", sqrt(2.0) * a->gyro_ins.pos_sd_m, sqrt(2.0) * a->gyro_ins.vel_sd_mps,
+          e->pos_v_m, e->t_s < c->t_v_max_s ? 1 : 0);
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q)
+    fprintf(f, ",%.17g,%.17g,%.17g", e->tab.term[q].pos_m, e->tab.term[q].vel_mps, e->tab.term[q].att_rad);
+  if (c->acfg.with_gyrofree)
+    fprintf(f, ",%.17g,%.17g,%.17g,%d,%.17g", a->gyrofree.pos_sd_m, a->gyrofree.vel_sd_mps,
+            a->gyrofree.att_sd_rad, a->gyrofree_small_angle_ok ? 1 : 0, a->gyrofree_paper_pos_m);
+  if (c->schuler) {
+    const nav_analytic_schuler_error se = schuler_sd(&c->acfg.imu, c->schuler_r, e->t_s);
+    fprintf(f, ",%.17g,%.17g", se.pos_m, se.vel_mps);
+  }
+  fputc('\n', f);
+}
+
+/* The rows of estimate.csv as they are computed: a batch of epochs (with their covariance points
+ * when the analysis runs), written when full. Only what the summaries need is kept: the last
+ * epoch, the covariance at the read-out times and the largest horizontal sigma. */
+typedef struct est_stream {
+  const est_ctx *c;
+  FILE *f;
+  bool with_cov;
+  nav_status st; /* first failure of the analytic part */
+  size_t n;      /* epochs received */
+  size_t nb;     /* epochs in the batch */
+  est_epoch *batch;
+  nav_cov_point *cov;
+  double *tbuf;
+  nav_analytic_estimate_point *abuf;
+  double analytic_wall_s;         /* time spent in the closed forms */
+  double hmax;                    /* largest cov pos_h_sd_m */
+  nav_cov_point cov_last;         /* covariance of the last epoch received */
+  size_t show_i[N_SHOW];          /* first epoch at or after each read-out time; nt: none yet */
+  nav_cov_point show_cov[N_SHOW]; /* its covariance */
+} est_stream;
+
+static bool flush_batch(est_stream *s) {
+  if (s->nb == 0 || s->st != NAV_OK) return s->st == NAV_OK;
+  const double t0 = navsim_now_s();
+  s->st = eval_epochs(s->c, s->batch, s->nb, s->tbuf, s->abuf);
+  s->analytic_wall_s += navsim_now_s() - t0;
+  if (s->st != NAV_OK) return false;
+  for (size_t i = 0; i < s->nb; ++i)
+    write_row(s->f, s->c, &s->batch[i], s->with_cov ? &s->cov[i] : NULL);
+  s->nb = 0;
+  return true;
+}
+
+/* Epoch s->n (its covariance point @p p, or NULL). */
+static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
+  const size_t i = s->n++;
+  const double t = epoch_time(s->c, i);
+  s->batch[s->nb].t_s = t;
+  if (p) {
+    s->cov[s->nb] = *p;
+    s->hmax = fmax(s->hmax, p->pos_h_sd_m);
+    s->cov_last = *p;
+  }
+  for (size_t q = 0; q < N_SHOW; ++q)
+    if (s->show_i[q] == s->c->nt && t >= k_show_s[q]) {
+      s->show_i[q] = i;
+      if (p) s->show_cov[q] = *p;
+    }
+  ++s->nb;
+  return s->nb < EST_BATCH || flush_batch(s);
+}
+
+static nav_callback_result stream_cov(void *user, const nav_cov_point *p) {
+  est_stream *s = user;
+  if (s->n >= s->c->nt) { /* more epochs than the scene's output epochs */
+    s->n = s->c->nt + 1;
+    return NAV_STOP;
+  }
+  return stream_epoch(s, p) ? NAV_CONTINUE : NAV_STOP;
 }
 
 /*
@@ -235,7 +403,7 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
 
 int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool quiet = false, force = false;
+  bool quiet = false, force = false, allow_large = false;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
@@ -244,6 +412,8 @@ int navsim_estimate(int argc, char **argv) {
       quiet = true;
     } else if (strcmp(argv[i], "--force") == 0) {
       force = true;
+    } else if (strcmp(argv[i], "--allow-large") == 0) {
+      allow_large = true;
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
     } else if (argv[i][0] == '-') {
@@ -276,82 +446,57 @@ int navsim_estimate(int argc, char **argv) {
   int rc = 1;
   nav_sim *sim = NULL;
   nav_resultdir *rd = NULL;
-  cov_rows cov = {NULL, 0, 0};
   nav_requirement_verdict *pred = NULL; /* predicted requirement verdicts */
-  nav_analytic_estimate_point *ana = NULL;
-  nav_analytic_gyro_ins_table *tab = NULL;
-  double *pos_v = NULL;
-  double *times = NULL;
+  est_stream es;
+  memset(&es, 0, sizeof es);
   FILE *f = NULL;
-  const double t0 = navsim_now_s();
 
-  /* Output epochs of the scene. */
-  const int64_t n_imu = (int64_t)floor(sc.trajectory.duration_s * sc.imu.rate_hz + 1e-9);
-  int64_t stride = (int64_t)llround(sc.imu.rate_hz / sc.output.rate_hz);
-  if (stride < 1) stride = 1;
-  const size_t n_out = (size_t)(n_imu / stride + 2);
-  times = calloc(n_out, sizeof *times);
-  ana = calloc(n_out, sizeof *ana);
-  cov.p = calloc(n_out, sizeof *cov.p);
-  cov.cap = n_out;
-  tab = calloc(n_out, sizeof *tab);
-  pos_v = calloc(n_out, sizeof *pos_v);
-  if (!times || !ana || !cov.p || !tab || !pos_v) {
+  /* Output epochs of the scene (as navsim run: every stride-th IMU sample and the last). */
+  est_ctx ctx;
+  memset(&ctx, 0, sizeof ctx);
+  ctx.sc = &sc;
+  ctx.n_imu = (int64_t)floor(sc.trajectory.duration_s * sc.imu.rate_hz + 1e-9);
+  ctx.stride = (int64_t)llround(sc.imu.rate_hz / sc.output.rate_hz);
+  if (ctx.stride < 1) ctx.stride = 1;
+  ctx.nt = (size_t)(ctx.n_imu / ctx.stride + 1 + (ctx.n_imu % ctx.stride != 0 ? 1 : 0));
+  const size_t nt = ctx.nt;
+  ctx.acfg = analytic_config(&sc);
+  /* Term by term (E1.6-E1.17) and the vertical channel. */
+  ctx.vspec = vertical_spec(&ctx.acfg.imu, &sc);
+  /* Vertical validity: (t / tau_v)^2 / 12 < 1 %, tau_v = sqrt(a / (2 g)) (numerics.md 1.2 (iv)). */
+  const double tau_v_s = sqrt(NAV_WGS84_A_M / (2.0 * ctx.acfg.imu.g_mps2));
+  ctx.t_v_max_s = sc.earth.model == NAV_EARTH_FLAT ? INFINITY : tau_v_s * sqrt(0.12);
+  ctx.schuler = sc.earth.model == NAV_EARTH_WGS84;
+  ctx.schuler_r = nav_analytic_schuler_radius_m(sc.earth.origin_lat_rad, sc.earth.origin_h_m);
+  const nav_analytic_estimate_config acfg = ctx.acfg;
+
+  es.c = &ctx;
+  es.batch = malloc(EST_BATCH * sizeof *es.batch);
+  es.cov = malloc(EST_BATCH * sizeof *es.cov);
+  es.tbuf = malloc(EST_BATCH * sizeof *es.tbuf);
+  es.abuf = malloc(EST_BATCH * sizeof *es.abuf);
+  if (!es.batch || !es.cov || !es.tbuf || !es.abuf) {
     fprintf(stderr, "navsim estimate: out of memory\n");
     goto cleanup;
   }
-  size_t nt = 0;
-  for (int64_t k = 0; k <= n_imu; k += stride) times[nt++] = (double)k / sc.imu.rate_hz;
-  if (times[nt - 1] < (double)n_imu / sc.imu.rate_hz) times[nt++] = (double)n_imu / sc.imu.rate_hz;
-
-  const nav_analytic_estimate_config acfg = analytic_config(&sc);
-  nav_status st = nav_analytic_estimate(&acfg, times, nt, ana);
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(st));
-    goto cleanup;
-  }
-  /* Term by term (E1.6-E1.17) and the vertical channel. */
-  const nav_analytic_imu_spec vspec = vertical_spec(&acfg.imu, &sc);
-  for (size_t i = 0; i < nt && st == NAV_OK; ++i) {
-    nav_analytic_gyro_ins_table vt;
-    st = nav_analytic_gyro_ins_table_eval(&acfg.imu, times[i], &tab[i]);
-    if (st == NAV_OK) st = nav_analytic_gyro_ins_table_eval(&vspec, times[i], &vt);
-    if (st == NAV_OK) pos_v[i] = vt.rss.pos_m;
-  }
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim estimate: analytic table failed: %s\n", nav_status_str(st));
-    goto cleanup;
-  }
-  const double t_analytic = navsim_now_s() - t0;
-  /* Vertical validity: (t / tau_v)^2 / 12 < 1 %, tau_v = sqrt(a / (2 g)) (numerics.md 1.2 (iv)). */
-  const double tau_v_s = sqrt(NAV_WGS84_A_M / (2.0 * acfg.imu.g_mps2));
-  const double t_v_max_s = sc.earth.model == NAV_EARTH_FLAT ? INFINITY : tau_v_s * sqrt(0.12);
-  bool have_cov = false;
-  double t_cov = 0.0;
-  if (sc.earth.model == NAV_EARTH_WGS84) {
-    st = nav_sim_create(&sc, &sim);
-    if (st == NAV_OK) {
-      const double tc = navsim_now_s();
-      st = nav_sim_covariance(sim, keep_cov, &cov);
-      t_cov = navsim_now_s() - tc;
-    }
-    if (st != NAV_OK) {
-      fprintf(stderr, "navsim estimate: covariance analysis failed: %s\n", sim ? nav_sim_last_error(sim) : nav_status_str(st));
+  {
+    /* estimate.csv predicted from the scene, refused beyond the limits before any work. */
+    navsim_size_prediction sp;
+    navsim_predict_estimate(&sc, header_columns(&ctx), &sp);
+    if (navsim_size_check("estimate", scene_path, &sp, allow_large, false) != 0) {
+      rc = 2;
       goto cleanup;
     }
-    have_cov = cov.n == nt;
   }
-
-  if (sc.n_requirements > 0) {
-    /* Requirements predicted from the covariance analysis; not evaluated without one. */
-    pred = calloc((size_t)sc.n_requirements, sizeof *pred);
-    if (!pred) goto cleanup;
-    /* The covariance analysis plus the truth's scale factors the filter does not estimate
-       (nav_req_predict_scene, as navsim select predicts); nothing without a covariance analysis. */
-    st = have_cov ? nav_req_predict_scene(&sc, pred) : nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0,
-                                                                       NULL, 0, pred);
-    if (st != NAV_OK) {
-      fprintf(stderr, "navsim estimate: predicting the requirements failed: %s\n", nav_status_str(st));
+  for (size_t q = 0; q < N_SHOW; ++q)
+    es.show_i[q] = nt;
+  /* The first epoch's analytic values: the closed forms' inputs are checked before any output. */
+  {
+    est_epoch e0;
+    e0.t_s = 0.0;
+    const nav_status st0 = eval_epochs(&ctx, &e0, 1, es.tbuf, es.abuf);
+    if (st0 != NAV_OK) {
+      fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(st0));
       goto cleanup;
     }
   }
@@ -362,60 +507,90 @@ int navsim_estimate(int argc, char **argv) {
   const char *csv = nav_resultdir_file(rd, "estimate.csv");
   f = csv ? fopen(csv, "w") : NULL;
   if (!f) goto cleanup;
-  fputs("t_s,analytic_pos_sd_m,analytic_vel_sd_mps,analytic_att_sd_rad,analytic_valid,cov_pos_n_sd_m,cov_pos_e_sd_m,"
-        "cov_pos_d_sd_m,cov_pos_h_sd_m,cov_vel_n_sd_mps,cov_vel_e_sd_mps,cov_vel_d_sd_mps,cov_att_n_sd_rad,"
-        "cov_att_e_sd_rad,cov_att_d_sd_rad,analytic_pos_h_sd_m,analytic_vel_h_sd_mps,analytic_pos_v_sd_m,"
-        "analytic_pos_v_valid",
-        f);
-  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
-    char lab[64];
-    term_label((nav_analytic_term_id)q, lab, sizeof lab);
-    fprintf(f, ",pos_sd_m_%s,vel_sd_mps_%s,att_sd_rad_%s", lab, lab, lab);
-  }
-  if (acfg.with_gyrofree)
-    fputs(",gyrofree_pos_sd_m,gyrofree_vel_sd_mps,gyrofree_att_sd_rad,gyrofree_small_angle_ok,gyrofree_paper_pos_m", f);
-  const bool schuler = sc.earth.model == NAV_EARTH_WGS84;
-  const double schuler_r = nav_analytic_schuler_radius_m(sc.earth.origin_lat_rad, sc.earth.origin_h_m);
-  if (schuler) fputs(",analytic_schuler_pos_sd_m,analytic_schuler_vel_sd_mps", f);
-  fputc('\n', f);
-  for (size_t i = 0; i < nt; ++i) {
-    fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
-            ana[i].gyro_ins.att_sd_rad, ana[i].gyro_ins_short_time_ok ? 1 : 0);
-    if (have_cov) {
-      const nav_cov_point *p = &cov.p[i];
-      fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", p->pos_sd_n_m.x, p->pos_sd_n_m.y,
-              p->pos_sd_n_m.z, p->pos_h_sd_m, p->vel_sd_n_mps.x, p->vel_sd_n_mps.y, p->vel_sd_n_mps.z, p->att_sd_rad.x,
-              p->att_sd_rad.y, p->att_sd_rad.z);
-    } else {
-      fputs(",,,,,,,,,,", f);
+  write_header(f, &ctx);
+  const long header_end = ftell(f);
+  es.f = f;
+
+  /* The covariance analysis streams its output epochs into the rows (WGS-84 scenes). */
+  bool have_cov = false;
+  double t_cov = 0.0;
+  nav_status st = NAV_OK;
+  if (sc.earth.model == NAV_EARTH_WGS84) {
+    st = nav_sim_create(&sc, &sim);
+    es.with_cov = true;
+    if (st == NAV_OK) {
+      const double tc = navsim_now_s();
+      st = nav_sim_covariance(sim, stream_cov, &es);
+      if (st == NAV_OK || st == NAV_ERR_CANCELLED) flush_batch(&es);
+      t_cov = navsim_now_s() - tc;
     }
-    fprintf(f, ",%.17g,%.17g,%.17g,%d", sqrt(2.0) * ana[i].gyro_ins.pos_sd_m, sqrt(2.0) * ana[i].gyro_ins.vel_sd_mps,
-            pos_v[i], times[i] < t_v_max_s ? 1 : 0);
-    for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q)
-      fprintf(f, ",%.17g,%.17g,%.17g", tab[i].term[q].pos_m, tab[i].term[q].vel_mps, tab[i].term[q].att_rad);
-    if (acfg.with_gyrofree)
-      fprintf(f, ",%.17g,%.17g,%.17g,%d,%.17g", ana[i].gyrofree.pos_sd_m, ana[i].gyrofree.vel_sd_mps,
-              ana[i].gyrofree.att_sd_rad, ana[i].gyrofree_small_angle_ok ? 1 : 0, ana[i].gyrofree_paper_pos_m);
-    if (schuler) {
-      const nav_analytic_schuler_error e = schuler_sd(&acfg.imu, schuler_r, times[i]);
-      fprintf(f, ",%.17g,%.17g", e.pos_m, e.vel_mps);
+    if (es.st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(es.st));
+      goto cleanup;
     }
-    fputc('\n', f);
+    if (st == NAV_ERR_CANCELLED && es.n > nt) st = NAV_OK; /* more epochs than expected: no covariance */
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: covariance analysis failed: %s\n",
+              sim ? nav_sim_last_error(sim) : nav_status_str(st));
+      goto cleanup;
+    }
+    have_cov = es.n == nt;
   }
+  if (!have_cov) {
+    /* No covariance analysis (flat Earth), or one whose epochs are not the output epochs: the
+     * analytic rows alone, from the first epoch. */
+    if (fflush(f) != 0 || fseek(f, header_end, SEEK_SET) != 0 || ftruncate(fileno(f), header_end) != 0)
+      goto cleanup;
+    es.with_cov = false;
+    es.n = es.nb = 0;
+    for (size_t q = 0; q < N_SHOW; ++q)
+      es.show_i[q] = nt;
+    for (size_t i = 0; i < nt; ++i)
+      if (!stream_epoch(&es, NULL)) break;
+    flush_batch(&es);
+    if (es.st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(es.st));
+      goto cleanup;
+    }
+  }
+  t_cov -= have_cov ? es.analytic_wall_s : 0.0;
+  const double t_analytic = es.analytic_wall_s;
   const bool bad = ferror(f) != 0;
   if (fclose(f) != 0 || bad) {
     f = NULL;
     goto cleanup;
   }
   f = NULL;
+
+  if (sc.n_requirements > 0) {
+    /* Requirements predicted from the covariance analysis; not evaluated without one. */
+    pred = calloc((size_t)sc.n_requirements, sizeof *pred);
+    if (!pred) goto cleanup;
+    /* The covariance analysis plus the truth's scale factors the filter does not estimate
+       (nav_req_predict_scene, as navsim select predicts); nothing without a covariance analysis. */
+    st = have_cov ? nav_req_predict_scene(&sc, pred)
+                  : nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim estimate: predicting the requirements failed: %s\n", nav_status_str(st));
+      goto cleanup;
+    }
+  }
+
+  /* The last epoch, for the summaries. */
+  est_epoch last;
+  last.t_s = epoch_time(&ctx, nt - 1);
+  st = eval_epochs(&ctx, &last, 1, es.tbuf, es.abuf);
+  if (st != NAV_OK) goto cleanup;
+  const nav_analytic_estimate_point *al = &last.ana;
   const char *js = nav_resultdir_file(rd, "summary.json");
   f = js ? fopen(js, "w") : NULL;
   if (!f) goto cleanup;
-  const nav_analytic_estimate_point *al = &ana[nt - 1];
   fprintf(f, "{\n  \"navsim_version\": \"%s\",\n  \"scene\": {\"name\": \"%s\", \"file\": \"%s\"},\n", nav_version_string(),
           sc.name, scene_path);
-  fprintf(f, "  \"duration_s\": %.17g,\n  \"timing\": {\"analytic_wall_s\": %.6g, \"covariance_wall_s\": %.6g},\n",
-          times[nt - 1], t_analytic, t_cov);
+  fprintf(
+      f,
+      "  \"duration_s\": %.17g,\n  \"timing\": {\"analytic_wall_s\": %.6g, \"covariance_wall_s\": %.6g},\n",
+      last.t_s, t_analytic, t_cov);
   fprintf(f, "  \"analytic_final\": {\"pos_sd_m\": %.17g, \"vel_sd_mps\": %.17g, \"att_sd_rad\": %.17g, \"valid\": %s}",
           al->gyro_ins.pos_sd_m, al->gyro_ins.vel_sd_mps, al->gyro_ins.att_sd_rad,
           al->gyro_ins_short_time_ok ? "true" : "false");
@@ -426,13 +601,12 @@ int navsim_estimate(int argc, char **argv) {
             al->gyrofree.pos_sd_m, al->gyrofree.vel_sd_mps, al->gyrofree.att_sd_rad,
             al->gyrofree_small_angle_ok ? "true" : "false", al->gyrofree_paper_pos_m);
   if (have_cov) {
-    const nav_cov_point *p = &cov.p[nt - 1];
-    double hmax = 0.0;
-    for (size_t i = 0; i < nt; ++i) hmax = fmax(hmax, cov.p[i].pos_h_sd_m);
-    fprintf(f,
-            ",\n  \"covariance_final\": {\"pos_h_sd_m\": %.17g, \"pos_d_sd_m\": %.17g, \"vel_n_sd_mps\": %.17g, "
-            "\"att_d_sd_rad\": %.17g},\n  \"covariance_max\": {\"pos_h_sd_m\": %.17g}",
-            p->pos_h_sd_m, p->pos_sd_n_m.z, p->vel_sd_n_mps.x, p->att_sd_rad.z, hmax);
+    const nav_cov_point *p = &es.cov_last;
+    fprintf(
+        f,
+        ",\n  \"covariance_final\": {\"pos_h_sd_m\": %.17g, \"pos_d_sd_m\": %.17g, \"vel_n_sd_mps\": %.17g, "
+        "\"att_d_sd_rad\": %.17g},\n  \"covariance_max\": {\"pos_h_sd_m\": %.17g}",
+        p->pos_h_sd_m, p->pos_sd_n_m.z, p->vel_sd_n_mps.x, p->att_sd_rad.z, es.hmax);
   }
   fputs("\n}\n", f);
   if (fclose(f) != 0) {
@@ -440,8 +614,9 @@ int navsim_estimate(int argc, char **argv) {
     goto cleanup;
   }
   f = NULL;
-  if (write_estimate_json(nav_resultdir_file(rd, "estimate.json"), &sc, scene_path, &tab[nt - 1], al, pos_v[nt - 1],
-                          times[nt - 1] < t_v_max_s, have_cov ? &cov.p[nt - 1] : NULL, pred, sc.n_requirements) != 0) {
+  if (write_estimate_json(nav_resultdir_file(rd, "estimate.json"), &sc, scene_path, &last.tab, al,
+                          last.pos_v_m, last.t_s < ctx.t_v_max_s, have_cov ? &es.cov_last : NULL, pred,
+                          sc.n_requirements) != 0) {
     fprintf(stderr, "navsim estimate: writing estimate.json failed\n");
     goto cleanup;
   }
@@ -455,33 +630,37 @@ int navsim_estimate(int argc, char **argv) {
            have_cov ? "covariance analysis of the scheme (1 sigma)" : "covariance analysis: wgs84 scenes only");
     printf("%10s | %11s %11s %11s  | %11s %11s %11s\n", "", "pos [m]", "vel [m/s]", "att [deg]", "pos h [m]",
            "pos d [m]", "yaw [deg]");
-    const double show[] = {1, 10, 30, 60, 120, 300, 600, 1800, 3600, 1e30};
-    for (size_t s = 0; s < sizeof show / sizeof *show; ++s) {
-      size_t i = nt - 1;
-      for (size_t q = 0; q < nt; ++q)
-        if (times[q] >= show[s]) {
-          i = q;
-          break;
-        }
-      if (s > 0 && times[i] < show[s - 1]) continue;
-      printf("%10.1f | %11.4g %11.4g %11.4g%s |", times[i], ana[i].gyro_ins.pos_sd_m, ana[i].gyro_ins.vel_sd_mps,
-             ana[i].gyro_ins.att_sd_rad * NAV_RAD2DEG, ana[i].gyro_ins_short_time_ok ? " " : "*");
-      if (have_cov)
-        printf(" %11.4g %11.4g %11.4g", cov.p[i].pos_h_sd_m, cov.p[i].pos_sd_n_m.z, cov.p[i].att_sd_rad.z * NAV_RAD2DEG);
+    for (size_t s = 0; s < N_SHOW; ++s) {
+      const size_t i = es.show_i[s] < nt ? es.show_i[s] : nt - 1;
+      est_epoch e;
+      e.t_s = epoch_time(&ctx, i);
+      if (s > 0 && e.t_s < k_show_s[s - 1]) continue;
+      if (eval_epochs(&ctx, &e, 1, es.tbuf, es.abuf) != NAV_OK) goto cleanup;
+      printf("%10.1f | %11.4g %11.4g %11.4g%s |", e.t_s, e.ana.gyro_ins.pos_sd_m, e.ana.gyro_ins.vel_sd_mps,
+             e.ana.gyro_ins.att_sd_rad * NAV_RAD2DEG, e.ana.gyro_ins_short_time_ok ? " " : "*");
+      if (have_cov) {
+        const nav_cov_point *p = es.show_i[s] < nt ? &es.show_cov[s] : &es.cov_last;
+        printf(" %11.4g %11.4g %11.4g", p->pos_h_sd_m, p->pos_sd_n_m.z, p->att_sd_rad.z * NAV_RAD2DEG);
+      }
       printf("\n");
       if (i == nt - 1) break;
     }
     printf("(* beyond the closed forms' validity: Schuler feedback or large angles)\n");
     if (acfg.with_gyrofree) {
       printf("gyro-free  %s array, per axis (E1.25-E1.28, corrected 1/252):\n", nav_array_layout_kind_name(sc.array.layout));
-      for (size_t i = 0; i < nt; i += (nt > 10 ? nt / 10 : 1))
-        printf("%10.1f | pos %11.4g m  vel %11.4g m/s  att %11.4g deg%s  (paper's formula: %.4g m)\n", times[i],
-               ana[i].gyrofree.pos_sd_m, ana[i].gyrofree.vel_sd_mps, ana[i].gyrofree.att_sd_rad * NAV_RAD2DEG,
-               ana[i].gyrofree_small_angle_ok ? " " : "*", ana[i].gyrofree_paper_pos_m);
+      for (size_t i = 0; i < nt; i += (nt > 10 ? nt / 10 : 1)) {
+        est_epoch e;
+        e.t_s = epoch_time(&ctx, i);
+        if (eval_epochs(&ctx, &e, 1, es.tbuf, es.abuf) != NAV_OK) goto cleanup;
+        printf("%10.1f | pos %11.4g m  vel %11.4g m/s  att %11.4g deg%s  (paper's formula: %.4g m)\n", e.t_s,
+               e.ana.gyrofree.pos_sd_m, e.ana.gyrofree.vel_sd_mps, e.ana.gyrofree.att_sd_rad * NAV_RAD2DEG,
+               e.ana.gyrofree_small_angle_ok ? " " : "*", e.ana.gyrofree_paper_pos_m);
+      }
     }
-    const nav_analytic_gyro_ins_table *tf = &tab[nt - 1];
-    printf("final      t = %g s: horizontal %.4g m (sqrt(2) x per axis), vertical %.4g m%s\n", times[nt - 1],
-           sqrt(2.0) * al->gyro_ins.pos_sd_m, pos_v[nt - 1], times[nt - 1] < t_v_max_s ? "" : " (beyond its validity)");
+    const nav_analytic_gyro_ins_table *tf = &last.tab;
+    printf("final      t = %g s: horizontal %.4g m (sqrt(2) x per axis), vertical %.4g m%s\n", last.t_s,
+           sqrt(2.0) * al->gyro_ins.pos_sd_m, last.pos_v_m,
+           last.t_s < ctx.t_v_max_s ? "" : " (beyond its validity)");
     /* The three largest rows of the final per-axis position (they add in squares). */
     int top[3] = {-1, -1, -1};
     for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
@@ -513,11 +692,10 @@ cleanup:
   if (f) fclose(f);
   nav_resultdir_abort(rd);
   nav_sim_destroy(sim);
-  free(cov.p);
   free(pred);
-  free(tab);
-  free(pos_v);
-  free(ana);
-  free(times);
+  free(es.batch);
+  free(es.cov);
+  free(es.tbuf);
+  free(es.abuf);
   return rc;
 }

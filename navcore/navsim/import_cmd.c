@@ -184,10 +184,15 @@ int navsim_import(int argc, char **argv) {
   if (fmt == NAV_TRACK_FORMAT_AUTO) {
     char head[4096];
     size_t n = 0;
-    FILE *f = fopen(in, "rb");
-    if (!f) {
-      fprintf(stderr, "%s: error: cannot open: %s\n", in, strerror(errno));
-      return EXIT_FAIL;
+    FILE *f = NULL;
+    char why[320];
+    const nav_status open_st = nav_io_fopen_regular(in, &f, why, sizeof why);
+    if (open_st != NAV_OK) { /* a FIFO, device or directory is refused at once (exit 2) */
+      if (open_st == NAV_ERR_PARSE)
+        fprintf(stderr, "%s: error: %s\n", in, why);
+      else
+        fprintf(stderr, "%s: error: cannot open: %s\n", in, strerror(errno));
+      return open_st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
     }
     n = fread(head, 1, sizeof head, f);
     fclose(f);
@@ -324,7 +329,13 @@ static bool series_push(geo_series *s, double t, nav_geodetic p) {
 /* Read t_s, lat_deg, lon_deg, h_m from a CSV with a header (truth.csv, nav.csv, gnss.csv).
  * Returns 0, 1 (cannot read), 2 (malformed: FILE:LINE:COL printed). */
 static int read_geo_csv(const char *path, geo_series *s, bool need_rows) {
-  FILE *f = fopen(path, "r");
+  FILE *f = NULL;
+  char why[320];
+  const nav_status open_st = nav_io_fopen_regular(path, &f, why, sizeof why);
+  if (open_st == NAV_ERR_PARSE) { /* a FIFO, device or directory: refused at once */
+    fprintf(stderr, "%s: error: %s\n", path, why);
+    return 2;
+  }
   if (!f) return 1;
   struct stat sb;
   if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
@@ -465,10 +476,10 @@ static int write_tracks(file_fn file_of, void *ctx, const char *label, bool kml,
   if (r && !rc) rc = r;
   if (!rc) {
     path = file_of(ctx, "gnss.csv");
-    FILE *probe = path ? fopen(path, "r") : NULL;
-    if (probe) {
-      fclose(probe);
-      rc = read_geo_csv(path, &gnss, false);
+    struct stat probe;
+    if (path && stat(path, &probe) == 0) {
+      rc = read_geo_csv(path, &gnss, false); /* 2 for a FIFO, device or directory, as for truth.csv */
+      if (rc == 1) rc = 0;            /* present but unreadable: no GNSS track, as before */
     }
   }
   if (!rc) {

@@ -28,6 +28,7 @@
 #include "replay_cmd.h"
 #include "report_cmd.h"
 #include "run_smooth_out.h"
+#include "size_limits.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -68,12 +69,14 @@ static const char *k_usage_check =
     "\n"
     "Read and validate each scene file. Every problem is printed on stderr as\n"
     "  FILE:LINE:COL: error: FIELD.PATH: what is wrong and what is expected\n"
-    "\n"
+    "A valid scene whose navsim run would exceed the limits below is reported as\n"
+    "  FILE: warning: ... with the predicted result files and memory (the scene stays valid).\n"
+    "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static const char *k_usage_run =
     "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
-    "                  [--kml] [--strict]\n"
+    "                  [--kml] [--strict] [--allow-large]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -113,8 +116,9 @@ static const char *k_usage_run =
     "                \"requirements\" and the terminal summary either way)\n"
     "  --kml         also write tracks.kml (reference, estimate of run 0, GNSS fixes; KML 2.2 for\n"
     "                Google Earth) and tracks.csv (see navsim export --help)\n"
+    "  --allow-large go ahead above the limits below\n"
     "  -h, --help    print this help\n"
-    "\n"
+    "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
     "            2 invalid scene or options; 1 other failure\n";
 
@@ -144,6 +148,13 @@ static int cmd_check(int argc, char **argv) {
     }
     if (rc == EXIT_FAIL) worst = EXIT_FAIL;
     else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
+    if (rc == EXIT_OK) {
+      /* A valid scene whose run would exceed the limits: a warning with the prediction. */
+      navsim_size_prediction pred;
+      navsim_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
+                         &pred);
+      (void)navsim_size_check("run", argv[i], &pred, false, true);
+    }
   }
   return worst;
 }
@@ -237,7 +248,8 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
 
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
-  bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false;
+  bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false,
+       allow_large = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -250,6 +262,8 @@ static int cmd_run(int argc, char **argv) {
       force = true;
     } else if (strcmp(a, "--strict") == 0) {
       strict = true;
+    } else if (strcmp(a, "--allow-large") == 0) {
+      allow_large = true;
     } else if (strcmp(a, "--ideal") == 0) {
       ideal = true;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
@@ -305,6 +319,14 @@ static int cmd_run(int argc, char **argv) {
      same file system, so under mpirun all ranks stop alike). */
   rc = navsim_out_check("run", out_dir, force);
   if (rc != EXIT_OK) return rc;
+  {
+    /* Result files and memory predicted from the scene, refused beyond the limits before any
+     * work (every MPI rank decides the same). */
+    navsim_size_prediction pred;
+    navsim_predict_run(&scene, ideal, (long)threads, kml, &pred);
+    rc = navsim_size_check("run", scene_path, &pred, allow_large, false);
+    if (rc != EXIT_OK) return rc;
+  }
   /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */
   int mpi_rc = EXIT_OK;
   if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) return mpi_rc;

@@ -190,9 +190,17 @@ int navsim_render(int argc, char **argv) {
     const int rc = run_child(run_args, false);
     if (rc != 0) return rc;
   } else if (!is_dir(argv[0])) {
+    FILE *f = NULL;
+    char why[320];
+    if (nav_io_fopen_regular(argv[0], &f, why, sizeof why) == NAV_ERR_PARSE) { /* a FIFO or device */
+      fprintf(stderr, "%s: error: %s; expected a result directory or a scene file\n", argv[0], why);
+      return RC_INVALID;
+    }
+    if (f) fclose(f);
     fprintf(stderr, "%s: error: not a result directory or scene file\n", argv[0]);
     return RC_FAIL;
   }
+  if (navsim_refuse_special_result_files(dir) != 0) return RC_INVALID;
 
   char out_buf[4200], in_buf[4200], png2[4200];
   const bool legacy = !view && !out;
@@ -245,8 +253,9 @@ int navsim_render(int argc, char **argv) {
 /* ------------------------------------------------------------------------------------ report */
 
 static char *read_all(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
+  FILE *f = NULL;
+  char why[320];
+  if (nav_io_fopen_regular(path, &f, why, sizeof why) != NAV_OK) return NULL; /* no FIFO blocks here */
   size_t cap = 1 << 16, n = 0;
   char *b = malloc(cap + 1);
   while (b) {
@@ -610,6 +619,7 @@ int navsim_report(int argc, char **argv) {
     fprintf(stderr, "%s: error: not a result directory (navsim run --out DIR writes one)\n", dir);
     return RC_FAIL;
   }
+  if (navsim_refuse_special_result_files(dir) != 0) return RC_INVALID;
   {
     const int src = check_summary(dir);
     if (src != 0) return src;

@@ -171,11 +171,9 @@ const unsigned char kAxisRGB[3][3] = {{214, 39, 40}, {44, 160, 44}, {31, 119, 18
 // Minimal CSV with text fields (bench.csv): header names, rows of strings; "..." quoting.
 bool ReadTextCsv(const std::string &path, std::vector<std::string> *header,
                  std::vector<std::vector<std::string>> *rows, std::string *error) {
-  std::ifstream in(path);
-  if (!in) {
-    *error = path + ": error: cannot open";
-    return false;
-  }
+  std::string text; // a FIFO, device or directory is refused at once (no blocking open)
+  if (!NavReadRegularFile(path, kNavCsvMaxFileBytes, &text, error)) return false;
+  std::istringstream in(text);
   auto split = [](const std::string &line) {
     std::vector<std::string> f;
     std::string cur;

@@ -8,7 +8,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <new>
+#include <sys/stat.h>
+
+#include "navcore/nav_io.h"
 
 namespace {
 
@@ -139,23 +142,57 @@ bool NavCsvParse(const std::string &text, const std::string &display_name, NavCs
   return true;
 }
 
-bool NavCsvReadFile(const std::string &path, NavCsvTable *out, std::string *error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *error = path + ": error: cannot open: " + std::strerror(errno);
+bool NavReadRegularFile(const std::string &path, size_t max_bytes, std::string *text, std::string *error) {
+  // A FIFO, device or directory is refused at once: a directory used to give a size of 2^63 and
+  // abort in std::string (std::length_error), a FIFO blocked the open.
+  FILE *f = nullptr;
+  char why[320];
+  if (nav_io_fopen_regular(path.c_str(), &f, why, sizeof why) != NAV_OK) {
+    *error = path + ": error: " + why;
     return false;
   }
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (size < 0) {
-    *error = path + ": error: cannot determine the file size";
+  struct stat st;
+  if (fstat(fileno(f), &st) != 0) {
+    *error = path + ": error: cannot determine the file size: " + std::strerror(errno);
+    std::fclose(f);
     return false;
   }
-  std::string text(static_cast<size_t>(size), '\0');
-  if (size > 0 && !in.read(&text[0], size)) {
+  const auto size = static_cast<unsigned long long>(st.st_size);
+  if (size > max_bytes) {
+    *error = path + ": error: the file is too large (" + std::to_string(size) +
+             " bytes); navview reads result files of up to " + std::to_string(max_bytes) + " bytes (" +
+             std::to_string(max_bytes >> 20) +
+             " MiB): write the run with a lower output.rate_hz or a shorter duration";
+    std::fclose(f);
+    return false;
+  }
+  std::string buf;
+  try {
+    buf.resize(static_cast<size_t>(size));
+  } catch (const std::exception &) {
+    *error = path + ": error: out of memory reading " + std::to_string(size) + " bytes";
+    std::fclose(f);
+    return false;
+  }
+  const size_t got = size > 0 ? std::fread(&buf[0], 1, buf.size(), f) : 0;
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) {
     *error = path + ": error: read failed";
     return false;
   }
-  return NavCsvParse(text, path, out, error);
+  buf.resize(got); // a file that shrank while read
+  *text = std::move(buf);
+  return true;
+}
+
+bool NavCsvReadFile(const std::string &path, NavCsvTable *out, std::string *error) {
+  std::string text;
+  if (!NavReadRegularFile(path, kNavCsvMaxFileBytes, &text, error)) return false;
+  try {
+    return NavCsvParse(text, path, out, error);
+  } catch (const std::bad_alloc &) {
+    *error = path + ": error: out of memory parsing " + std::to_string(text.size()) + " bytes";
+    return false;
+  }
 }

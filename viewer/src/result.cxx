@@ -13,9 +13,11 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
+// Something is there: a regular file is read, anything else (a FIFO, a directory) is refused by
+// the reader with a message instead of being skipped as absent.
 bool FileExists(const std::string &path) {
   struct stat st;
-  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  return stat(path.c_str(), &st) == 0;
 }
 
 std::string Join(const std::string &dir, const std::string &name) {
@@ -396,11 +398,9 @@ bool NavLoadResultDir(const std::string &dir, NavResult *out, std::string *error
   }
 
   const std::string sum_path = Join(dir, "summary.json");
-  std::ifstream sum(sum_path);
-  if (sum) {
-    std::stringstream ss;
-    ss << sum.rdbuf();
-    const std::string text = ss.str();
+  if (FileExists(sum_path)) {
+    std::string text;
+    if (!NavReadRegularFile(sum_path, size_t{16} << 20, &text, error)) return false;
     const size_t scene = text.find("\"scene\"");
     if (scene != std::string::npos) r.scene_name = JsonStringAfter(text.substr(scene), "name");
     r.runs = JsonIntAfter(text, "runs", 1);

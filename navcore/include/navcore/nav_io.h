@@ -11,6 +11,7 @@
 #define NAV_IO_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "nav_export.h"
 #include "nav_scene.h"
@@ -76,6 +77,26 @@ NAV_API NAV_NODISCARD nav_status nav_scene_write_file(const char *path, const na
  * @return NAV_OK, NAV_ERR_NO_MEMORY, NAV_ERR_INVALID_ARG.
  */
 NAV_API NAV_NODISCARD nav_status nav_scene_write_string(const nav_scene *scene, char **text, size_t *len);
+
+/**
+ * Open @p path for reading, refusing at once anything that is not a regular file.
+ *
+ * A FIFO, a character or block device, a directory or a socket is refused without reading from
+ * it and without blocking: the file is opened with O_NONBLOCK (a FIFO with no writer would
+ * otherwise block the open), checked with fstat, and only a regular file is handed back, in
+ * blocking mode. Every reader of navcore_io, navsim and navview opens its input files here.
+ * @param[in]  path      the file
+ * @param[out] out       the stream ("rb"); written only on NAV_OK; the caller fcloses it
+ * @param[out] why       on failure, what is wrong, e.g. "cannot open the file: No such file or
+ *                       directory" or "cannot read the file: it is a FIFO (named pipe), not a
+ *                       regular file" (may be NULL)
+ * @param[in]  why_size  capacity of @p why
+ * @return NAV_OK; NAV_ERR_IO when the file cannot be opened (missing, no permission);
+ *         NAV_ERR_PARSE when it exists but is not a regular file (the input is wrong);
+ *         NAV_ERR_INVALID_ARG for NULL arguments.
+ */
+NAV_API NAV_NODISCARD nav_status nav_io_fopen_regular(const char *path, FILE **out, char *why,
+                                                      size_t why_size);
 
 NAV_END_DECLS
 
