@@ -447,6 +447,12 @@ typedef struct nav_scene_navigation {
   /** ins_gnss: estimate gyro and accelerometer scale factors (21-state filter); their initial
    *  sigma is the scene's scale-factor sigma (with its fixed part), random constants. */
   bool estimate_scale_factors;
+  /** ins_gnss with estimate_scale_factors: 0 (default): the scale-factor states are random
+   *  constants; > 0: first-order Gauss-Markov processes with this correlation time [s] and the
+   *  scene's scale-factor sigma as their stationary sigma (KF-GINS's model: corrtime with
+   *  gsstd/asstd). With f_z near -g the z accelerometer scale factor acts as a second vertical
+   *  bias, so this choice decides how fast the filter follows a drifting vertical bias. */
+  double scale_factor_gm_tau_s;
   /** ins_gnss only: every Monte Carlo run also runs the RTS smoother (nav_smoother.h) over its
    *  output and GNSS epochs; smoothed errors at the output epochs (nav_sim.h). Default false.
    *  Memory per run in flight (one per thread): one record per output or GNSS epoch, about

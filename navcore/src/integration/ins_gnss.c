@@ -82,17 +82,25 @@ static nav_filter_config filter_config(const nav_scene *sc) {
     nav_vec3_set(&c.init.att_sd_rad, i, fmax(nav_vec3_get(sc->initial_errors.att_sd_rad, i), 1e-6));
   }
   if (sc->navigation.estimate_scale_factors) {
-    /* Scale factors as random constants with the scene's sigma (fixed part included), floored
-     * at 1 ppm so P0 stays positive definite for a perfect sensor. */
+    /* Scale factors with the scene's sigma (fixed part included), floored at 1 ppm so P0 stays
+     * positive definite for a perfect sensor: random constants, or Gauss-Markov processes of
+     * that stationary sigma when navigation.scale_factor_gm_tau_s > 0. */
     c.states |= NAV_FILTER_STATE_SCALE_FACTORS;
-    c.gyro_sf_terms = 0;
-    c.accel_sf_terms = 0;
+    const double sf_tau = sc->navigation.scale_factor_gm_tau_s;
+    c.gyro_sf_terms = sf_tau > 0.0 ? NAV_FILTER_PROC_GM : 0u;
+    c.accel_sf_terms = sf_tau > 0.0 ? NAV_FILTER_PROC_GM : 0u;
     const bool gs = (g->terms & NAV_IMU_TERM_SCALE_FACTOR) != 0, as = (a->terms & NAV_IMU_TERM_SCALE_FACTOR) != 0;
     for (int i = 0; i < 3; ++i) {
       const double sgs = gs ? hypot(nav_vec3_get(g->scale_factor_sd, i), nav_vec3_get(g->scale_factor_fixed, i)) : 0.0;
       const double sas = as ? hypot(nav_vec3_get(a->scale_factor_sd, i), nav_vec3_get(a->scale_factor_fixed, i)) : 0.0;
       nav_vec3_set(&c.init.gyro_sf_sd, i, fmax(sgs, 1e-6));
       nav_vec3_set(&c.init.accel_sf_sd, i, fmax(sas, 1e-6));
+      if (sf_tau > 0.0) {
+        nav_vec3_set(&c.gyro_sf_gm_sd, i, fmax(sgs, 1e-6));
+        nav_vec3_set(&c.accel_sf_gm_sd, i, fmax(sas, 1e-6));
+        nav_vec3_set(&c.gyro_sf_gm_tau_s, i, sf_tau);
+        nav_vec3_set(&c.accel_sf_gm_tau_s, i, sf_tau);
+      }
     }
   }
   /* A time-correlated GNSS error gets its own GM states when tau >> update interval
