@@ -14,6 +14,7 @@ NAV_PACKAGES=(
   clang libfuzzer-14-dev            # libFuzzer targets (tests/fuzz)
   chromium                          # navsim report check (headless screenshot)
   python-cartopy-data gmt-gshhg-low # offline map background (coastlines, borders)
+  rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions (issue 22)
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
