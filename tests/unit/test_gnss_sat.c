@@ -16,6 +16,7 @@
 #include "nav_test.h"
 #include "navcore/nav_gnss_almanac.h"
 #include "navcore/nav_gnss_sat.h"
+#include "navcore/nav_io.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -447,6 +448,162 @@ static void positions_against_rtklib(void **state) {
   assert_true(w2 <= 0.005);
 }
 
+
+/* ----------------------------------------------------------------- scene section gnss.constellation */
+
+typedef struct diag_list {
+  int n;
+  nav_diag d[8];
+} diag_list;
+static void collect(void *user, const nav_diag *d) {
+  diag_list *l = user;
+  if (l->n < 8) {
+    l->d[l->n] = *d;
+  }
+  l->n++;
+}
+
+static const char *k_scene_head = "format_version: 1\nname: c\n"
+                                  "earth: {model: wgs84, origin: {lat_deg: 45, lon_deg: 7, h_m: 0}}\n"
+                                  "trajectory: {type: parametric, duration_s: 10}\n";
+
+static nav_status read_scene_with(const char *gnss_yaml, nav_scene *s, diag_list *log) {
+  static char text[4096];
+  snprintf(text, sizeof text, "%s%s", k_scene_head, gnss_yaml);
+  memset(log, 0, sizeof *log);
+  return nav_scene_read_string(text, strlen(text), "c.yaml", s, collect, log);
+}
+
+static void assert_config_same(const nav_gnss_constellation_config *a, const nav_gnss_constellation_config *b) {
+  assert_int_equal(a->enabled, b->enabled);
+  assert_int_equal(a->gps, b->gps);
+  assert_int_equal(a->glonass, b->glonass);
+  assert_true(a->epoch_gps_s == b->epoch_gps_s);
+  assert_true(a->glonass_node1_lon_rad == b->glonass_node1_lon_rad);
+  assert_true(a->mask.elevation_mask_rad == b->mask.elevation_mask_rad);
+  assert_int_equal(a->mask.n_profile, b->mask.n_profile);
+  for (int i = 0; i < a->mask.n_profile; ++i) {
+    assert_true(a->mask.profile_az_rad[i] == b->mask.profile_az_rad[i]);
+    assert_true(a->mask.profile_el_rad[i] == b->mask.profile_el_rad[i]);
+  }
+  assert_int_equal(a->n_canyons, b->n_canyons);
+  assert_memory_equal(a->canyons, b->canyons, sizeof a->canyons[0] * (size_t)a->n_canyons);
+  assert_string_equal(a->almanac_file, b->almanac_file);
+  assert_int_equal(a->almanac.n, b->almanac.n);
+  assert_memory_equal(a->almanac.sats, b->almanac.sats, sizeof a->almanac.sats[0] * (size_t)a->almanac.n);
+}
+
+/* Every key read, written back and read again to the same values (bit for bit). */
+static void scene_section_round_trip(void **state) {
+  (void)state;
+  nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
+  assert_non_null(a);
+  assert_non_null(b);
+  diag_list log;
+  char yaml[2048];
+  snprintf(yaml, sizeof yaml,
+           "gnss:\n  constellation:\n    epoch: \"2007-12-01T06:30:15.5\"\n    gps: almanac\n"
+           "    almanac: %s/gnss/yuma431_prn01-08.alm\n    glonass: nominal\n    glonass_node_lon_deg: 12.5\n"
+           "    elevation_mask_deg: 7.5\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
+           "    canyons:\n      - {t0_s: 1, t1_s: 2, height_m: 20, left_m: 5, right_m: 6}\n"
+           "      - {t0_s: 3, t1_s: 4.5, height_m: 10, left_m: 3, right_m: 4}\n",
+           NAV_TEST_DATA_DIR);
+  nav_status st = read_scene_with(yaml, a, &log);
+  if (st != NAV_OK) {
+    fail_msg("%d problems, first %s:%d:%d %s: %s", log.n, log.d[0].file, log.d[0].line, log.d[0].col, log.d[0].path,
+             log.d[0].message);
+  }
+  const nav_gnss_constellation_config *c = &a->gnss.constellation;
+  assert_true(c->enabled);
+  assert_int_equal(c->gps, NAV_GNSS_SOURCE_ALMANAC);
+  assert_int_equal(c->glonass, NAV_GNSS_SOURCE_NOMINAL);
+  assert_near(c->epoch_gps_s, nav_gnss_gps_time_s(2007, 12, 1, 6, 30, 15.5), 0.0);
+  assert_int_equal(c->almanac.n, 8);
+  assert_int_equal(c->n_canyons, 2);
+  assert_near(c->mask.profile_el_rad[1], 20.25 * DEG, 1e-15);
+  nav_gnss_constellation all;
+  assert_int_equal(nav_gnss_constellation_build(c, &all), NAV_OK);
+  assert_int_equal(all.n, 8 + 24);
+  /* the canyon of t = 3.2 s */
+  const nav_gnss_sky_mask m = nav_gnss_constellation_mask_at(c, 3.2);
+  assert_near(m.canyon_height_m, 10.0, 0.0);
+  assert_near(nav_gnss_constellation_mask_at(c, 2.5).canyon_height_m, 0.0, 0.0);
+  mkdir(NAV_TEST_WORK_DIR, 0777);
+  const char *out = NAV_TEST_WORK_DIR "/rt.yaml";
+  assert_int_equal(nav_scene_write_file(out, a), NAV_OK);
+  memset(&log, 0, sizeof log);
+  st = nav_scene_read_file(out, b, collect, &log);
+  if (st != NAV_OK) {
+    fail_msg("written scene does not read: %s:%d:%d %s: %s", log.d[0].file, log.d[0].line, log.d[0].col,
+             log.d[0].path, log.d[0].message);
+  }
+  assert_config_same(&a->gnss.constellation, &b->gnss.constellation);
+  /* a scene without the section: disabled, nothing written */
+  assert_int_equal(read_scene_with("", a, &log), NAV_OK);
+  assert_false(a->gnss.constellation.enabled);
+  assert_int_equal(nav_scene_write_file(out, a), NAV_OK);
+  FILE *f = fopen(out, "r");
+  assert_non_null(f);
+  char buf[8192];
+  const size_t n = fread(buf, 1, sizeof buf - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  assert_null(strstr(buf, "constellation"));
+  free(a);
+  free(b);
+}
+
+/* Problems in the section, each at its FILE:LINE:COL and path. */
+static void scene_section_errors(void **state) {
+  (void)state;
+  nav_scene *s = malloc(sizeof *s);
+  assert_non_null(s);
+  diag_list log;
+  /* line 5 is "gnss:", so the section's keys start at line 7 */
+  assert_int_equal(read_scene_with("gnss:\n  constellation:\n    epoch: \"2026-02-30T00:00:00\"\n", s, &log),
+                   NAV_ERR_PARSE);
+  assert_int_equal(log.d[0].line, 7);
+  assert_int_equal(log.d[0].col, 12);
+  assert_string_equal(log.d[0].path, "gnss.constellation.epoch");
+  assert_int_equal(read_scene_with("gnss:\n  constellation:\n    sky_mask_deg: [[10, 5], [5, 5]]\n", s, &log),
+                   NAV_ERR_PARSE);
+  assert_int_equal(log.d[0].line, 7);
+  assert_int_equal(log.d[0].col, 30); /* the second azimuth */
+  assert_string_equal(log.d[0].path, "gnss.constellation.sky_mask_deg[1]");
+  assert_int_equal(read_scene_with("gnss:\n  constellation:\n    canyons:\n"
+                                   "      - {t0_s: 1, t1_s: 5, height_m: 20, left_m: 5, right_m: 6}\n"
+                                   "      - {t0_s: 3, t1_s: 8, height_m: 20, left_m: 5, right_m: 6}\n",
+                                   s, &log),
+                   NAV_ERR_PARSE);
+  assert_int_equal(log.d[0].line, 9);
+  assert_string_equal(log.d[0].path, "gnss.constellation.canyons[1]");
+  assert_int_equal(read_scene_with("gnss:\n  constellation:\n    canyons:\n"
+                                   "      - {t0_s: 1, t1_s: 5, height_m: 0, left_m: 5, right_m: 6}\n",
+                                   s, &log),
+                   NAV_ERR_PARSE);
+  assert_int_equal(log.d[0].line, 8);
+  assert_string_equal(log.d[0].path, "gnss.constellation.canyons[0].height_m");
+  assert_int_equal(read_scene_with("gnss:\n  constellation:\n    gps: almanac\n", s, &log), NAV_ERR_PARSE);
+  assert_string_equal(log.d[0].path, "gnss.constellation.gps");
+  /* an almanac file with a bad value: its own FILE:LINE:COL, then the scene's line */
+  mkdir(NAV_TEST_WORK_DIR, 0777);
+  FILE *f = fopen(NAV_TEST_WORK_DIR "/bad2.alm", "w");
+  assert_non_null(f);
+  fputs("******** Week 431 almanac for PRN-01 ********\nID: 01\nHealth: zero\n", f);
+  fclose(f);
+  char yaml[1024];
+  snprintf(yaml, sizeof yaml, "gnss:\n  constellation:\n    gps: almanac\n    almanac: %s/bad2.alm\n",
+           NAV_TEST_WORK_DIR);
+  assert_int_equal(read_scene_with(yaml, s, &log), NAV_ERR_PARSE);
+  assert_true(log.n >= 2);
+  assert_string_equal(log.d[0].file, NAV_TEST_WORK_DIR "/bad2.alm");
+  assert_int_equal(log.d[0].line, 3);
+  assert_int_equal(log.d[0].col, 9);
+  assert_string_equal(log.d[1].file, "c.yaml");
+  assert_int_equal(log.d[1].line, 8);
+  free(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(dop_hand_geometry),
@@ -457,6 +614,8 @@ int main(void) {
       cmocka_unit_test(static_receiver_repeat_period),
       cmocka_unit_test(yuma_errors),
       cmocka_unit_test(positions_against_rtklib),
+      cmocka_unit_test(scene_section_round_trip),
+      cmocka_unit_test(scene_section_errors),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -179,6 +179,68 @@ NAV_API NAV_NODISCARD nav_status nav_gnss_visibility(const nav_gnss_constellatio
                                                      double t_gps_s, nav_geodetic rx, double heading_rad,
                                                      nav_gnss_sat_view *views, nav_gnss_dop *dop);
 
+/* ======================================================================== scene configuration */
+
+/** Source of a system's orbits in a scene (gnss.constellation.gps / .glonass). */
+typedef enum nav_gnss_source {
+  NAV_GNSS_SOURCE_OFF = 0,
+  NAV_GNSS_SOURCE_NOMINAL = 1, /**< the published nominal 24-slot constellation at the epoch */
+  NAV_GNSS_SOURCE_ALMANAC = 2  /**< GPS only: the almanac file (YUMA) */
+} nav_gnss_source;
+
+/** Most street-canyon intervals of a scene. */
+#define NAV_GNSS_MAX_CANYONS 16
+/** Longest almanac path kept in a scene (bytes with the NUL). */
+#define NAV_GNSS_ALMANAC_PATH_MAX 1024
+
+/** A street canyon driven through from t0_s to t1_s (scene time): walls along the direction of
+ *  travel (nav_gnss_sky_mask canyon_*). */
+typedef struct nav_gnss_canyon {
+  double t0_s, t1_s;
+  double height_m; /**< wall height above the antenna [m], > 0 */
+  double left_m;   /**< horizontal distance to the left wall [m], > 0 */
+  double right_m;  /**< horizontal distance to the right wall [m], > 0 */
+} nav_gnss_canyon;
+
+/** The satellite constellation along a scene's trajectory (scene section gnss.constellation). */
+typedef struct nav_gnss_constellation_config {
+  bool enabled;                 /**< the section is present */
+  nav_gnss_source gps;          /**< OFF, NOMINAL (default) or ALMANAC */
+  nav_gnss_source glonass;      /**< OFF (default) or NOMINAL */
+  double epoch_gps_s;           /**< GPS time of scene time 0 (GPS seconds since 1980-01-06) */
+  double glonass_node1_lon_rad; /**< nav_gnss_add_glonass_nominal() node1_lon_rad */
+  /** Elevation mask and per-azimuth profile; its canyon fields are unused here (see canyons). */
+  nav_gnss_sky_mask mask;
+  int n_canyons;
+  nav_gnss_canyon canyons[NAV_GNSS_MAX_CANYONS]; /**< non-overlapping intervals */
+  /** ALMANAC: the YUMA file (navcore_io stores the resolved path) and its satellites (loaded by
+   *  navcore_io when the scene is read). */
+  char almanac_file[NAV_GNSS_ALMANAC_PATH_MAX];
+  nav_gnss_constellation almanac;
+} nav_gnss_constellation_config;
+
+/** Disabled; when enabled: GPS nominal, GLONASS off, epoch 2026-01-01 00:00 GPS, 10 deg mask. */
+NAV_API nav_gnss_constellation_config nav_gnss_constellation_config_default(void);
+
+/** Validation callback (the same signature as nav_scene_issue_fn). */
+typedef void (*nav_gnss_issue_fn)(void *user, const char *path, const char *message);
+
+/**
+ * Check a constellation configuration; @p report receives paths relative to the section
+ * ("elevation_mask_deg", "canyons[2]", ...). @return NAV_OK or NAV_ERR_INVALID_ARG.
+ */
+NAV_API NAV_NODISCARD nav_status nav_gnss_constellation_config_validate(const nav_gnss_constellation_config *cfg,
+                                                                        nav_gnss_issue_fn report, void *user);
+
+/** The satellites of a configuration (nominal constellations at its epoch, almanac satellites).
+ *  @return NAV_OK; NAV_ERR_INVALID_ARG; NAV_ERR_OUT_OF_RANGE (more than NAV_GNSS_MAX_SATS). */
+NAV_API NAV_NODISCARD nav_status nav_gnss_constellation_build(const nav_gnss_constellation_config *cfg,
+                                                              nav_gnss_constellation *out);
+
+/** The sky mask at scene time @p t_s: the configured mask plus the walls of the canyon whose
+ *  interval [t0_s, t1_s) contains t_s. Leaf. */
+NAV_API nav_gnss_sky_mask nav_gnss_constellation_mask_at(const nav_gnss_constellation_config *cfg, double t_s);
+
 NAV_END_DECLS
 
 #endif /* NAV_GNSS_SAT_H */

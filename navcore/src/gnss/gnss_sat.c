@@ -4,7 +4,10 @@
 #include "navcore/nav_gnss_sat.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <string.h>
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -374,4 +377,151 @@ nav_status nav_gnss_visibility(const nav_gnss_constellation *c, const nav_gnss_s
   }
   *dop = nav_gnss_dop_compute(nv, az, el, sy);
   return NAV_OK;
+}
+
+/* ---------------------------------------------------------------- scene configuration */
+
+nav_gnss_constellation_config nav_gnss_constellation_config_default(void) {
+  nav_gnss_constellation_config c;
+  memset(&c, 0, sizeof c);
+  c.enabled = false;
+  c.gps = NAV_GNSS_SOURCE_NOMINAL;
+  c.glonass = NAV_GNSS_SOURCE_OFF;
+  c.epoch_gps_s = nav_gnss_gps_time_s(2026, 1, 1, 0, 0, 0.0);
+  c.glonass_node1_lon_rad = 0.0;
+  c.mask.elevation_mask_rad = 10.0 * DEG;
+  return c;
+}
+
+static void report_issue(nav_gnss_issue_fn report, void *user, int *count, const char *path, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+static void report_issue(nav_gnss_issue_fn report, void *user, int *count, const char *path, const char *fmt, ...) {
+  char msg[256];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  ++*count;
+  if (report) {
+    report(user, path, msg);
+  }
+}
+
+nav_status nav_gnss_constellation_config_validate(const nav_gnss_constellation_config *cfg, nav_gnss_issue_fn report,
+                                                  void *user) {
+  if (!cfg) {
+    return NAV_ERR_INVALID_ARG;
+  }
+  int n = 0;
+  char path[64];
+  if (cfg->gps != NAV_GNSS_SOURCE_OFF && cfg->gps != NAV_GNSS_SOURCE_NOMINAL && cfg->gps != NAV_GNSS_SOURCE_ALMANAC) {
+    report_issue(report, user, &n, "gps", "must be off, nominal or almanac");
+  }
+  if (cfg->glonass != NAV_GNSS_SOURCE_OFF && cfg->glonass != NAV_GNSS_SOURCE_NOMINAL) {
+    report_issue(report, user, &n, "glonass", "must be off or nominal (GLONASS almanacs are not supported yet)");
+  }
+  if (cfg->gps == NAV_GNSS_SOURCE_OFF && cfg->glonass == NAV_GNSS_SOURCE_OFF) {
+    report_issue(report, user, &n, "gps", "no satellite system: set gps or glonass");
+  }
+  if (cfg->gps == NAV_GNSS_SOURCE_ALMANAC && (cfg->almanac.n <= 0 || cfg->almanac.n > NAV_GNSS_MAX_SATS)) {
+    report_issue(report, user, &n, "almanac", "gps: almanac needs an almanac file with at least one satellite");
+  }
+  if (cfg->gps != NAV_GNSS_SOURCE_ALMANAC && cfg->almanac_file[0] != '\0') {
+    report_issue(report, user, &n, "almanac", "an almanac file is given but gps is not 'almanac'");
+  }
+  const int total = (cfg->gps == NAV_GNSS_SOURCE_NOMINAL ? 24 : cfg->gps == NAV_GNSS_SOURCE_ALMANAC ? cfg->almanac.n : 0) +
+                    (cfg->glonass == NAV_GNSS_SOURCE_NOMINAL ? 24 : 0);
+  if (total > NAV_GNSS_MAX_SATS) {
+    report_issue(report, user, &n, "almanac", "more than %d satellites in total", NAV_GNSS_MAX_SATS);
+  }
+  if (!(cfg->epoch_gps_s >= nav_gnss_gps_time_s(1900, 1, 1, 0, 0, 0.0) &&
+        cfg->epoch_gps_s < nav_gnss_gps_time_s(2180, 1, 1, 0, 0, 0.0))) {
+    report_issue(report, user, &n, "epoch", "must be a date between 1900 and 2180");
+  }
+  if (!isfinite(cfg->glonass_node1_lon_rad)) {
+    report_issue(report, user, &n, "glonass_node_lon_deg", "must be finite");
+  }
+  if (!(cfg->mask.elevation_mask_rad >= 0.0 && cfg->mask.elevation_mask_rad < 0.5 * PI)) {
+    report_issue(report, user, &n, "elevation_mask_deg", "must be in [0, 90) deg");
+  }
+  if (cfg->mask.n_profile < 0 || cfg->mask.n_profile > NAV_GNSS_MASK_MAX_POINTS) {
+    report_issue(report, user, &n, "sky_mask_deg", "at most %d points", NAV_GNSS_MASK_MAX_POINTS);
+  } else {
+    for (int i = 0; i < cfg->mask.n_profile; ++i) {
+      snprintf(path, sizeof path, "sky_mask_deg[%d]", i);
+      const double az = cfg->mask.profile_az_rad[i], el = cfg->mask.profile_el_rad[i];
+      if (!(az >= 0.0 && az < 2.0 * PI)) {
+        report_issue(report, user, &n, path, "azimuth must be in [0, 360) deg");
+      } else if (i > 0 && !(az > cfg->mask.profile_az_rad[i - 1])) {
+        report_issue(report, user, &n, path, "azimuths must increase");
+      }
+      if (!(el >= 0.0 && el <= 0.5 * PI)) {
+        report_issue(report, user, &n, path, "elevation must be in [0, 90] deg");
+      }
+    }
+  }
+  if (cfg->n_canyons < 0 || cfg->n_canyons > NAV_GNSS_MAX_CANYONS) {
+    report_issue(report, user, &n, "canyons", "at most %d canyons", NAV_GNSS_MAX_CANYONS);
+  } else {
+    for (int i = 0; i < cfg->n_canyons; ++i) {
+      const nav_gnss_canyon *k = &cfg->canyons[i];
+      snprintf(path, sizeof path, "canyons[%d]", i);
+      if (!(isfinite(k->t0_s) && isfinite(k->t1_s) && k->t1_s > k->t0_s)) {
+        report_issue(report, user, &n, path, "needs finite times with t1_s > t0_s");
+      } else if (i > 0 && k->t0_s < cfg->canyons[i - 1].t1_s) {
+        report_issue(report, user, &n, path, "canyons must be in time order without overlap");
+      }
+      if (!(k->height_m > 0.0 && k->height_m <= 1000.0 && k->left_m > 0.0 && k->left_m <= 1000.0 &&
+            k->right_m > 0.0 && k->right_m <= 1000.0)) {
+        report_issue(report, user, &n, path, "height_m, left_m and right_m must be in (0, 1000] m");
+      }
+    }
+  }
+  return n == 0 ? NAV_OK : NAV_ERR_INVALID_ARG;
+}
+
+nav_status nav_gnss_constellation_build(const nav_gnss_constellation_config *cfg, nav_gnss_constellation *out) {
+  if (!cfg || !out || !isfinite(cfg->epoch_gps_s)) {
+    return NAV_ERR_INVALID_ARG;
+  }
+  nav_gnss_constellation c;
+  c.n = 0;
+  nav_status st = NAV_OK;
+  if (cfg->gps == NAV_GNSS_SOURCE_NOMINAL) {
+    st = nav_gnss_add_gps_nominal(&c, cfg->epoch_gps_s);
+  } else if (cfg->gps == NAV_GNSS_SOURCE_ALMANAC) {
+    if (cfg->almanac.n < 0 || cfg->almanac.n > NAV_GNSS_MAX_SATS) {
+      return NAV_ERR_INVALID_ARG;
+    }
+    for (int i = 0; i < cfg->almanac.n; ++i) {
+      c.sats[c.n++] = cfg->almanac.sats[i];
+    }
+  }
+  if (st == NAV_OK && cfg->glonass == NAV_GNSS_SOURCE_NOMINAL) {
+    st = nav_gnss_add_glonass_nominal(&c, cfg->epoch_gps_s, cfg->glonass_node1_lon_rad);
+  }
+  if (st == NAV_OK) {
+    *out = c;
+  }
+  return st;
+}
+
+nav_gnss_sky_mask nav_gnss_constellation_mask_at(const nav_gnss_constellation_config *cfg, double t_s) {
+  nav_gnss_sky_mask m = cfg->mask;
+  m.canyon_height_m = 0.0;
+  m.canyon_left_m = 0.0;
+  m.canyon_right_m = 0.0;
+  for (int i = 0; i < cfg->n_canyons && i < NAV_GNSS_MAX_CANYONS; ++i) {
+    const nav_gnss_canyon *k = &cfg->canyons[i];
+    if (t_s >= k->t0_s && t_s < k->t1_s) {
+      m.canyon_height_m = k->height_m;
+      m.canyon_left_m = k->left_m;
+      m.canyon_right_m = k->right_m;
+      break;
+    }
+  }
+  return m;
 }
