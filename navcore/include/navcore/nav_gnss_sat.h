@@ -241,6 +241,50 @@ NAV_API NAV_NODISCARD nav_status nav_gnss_constellation_build(const nav_gnss_con
  *  interval [t0_s, t1_s) contains t_s. Leaf. */
 NAV_API nav_gnss_sky_mask nav_gnss_constellation_mask_at(const nav_gnss_constellation_config *cfg, double t_s);
 
+/* ======================================================================== pseudoranges and PVT */
+
+/** Speed of light [m/s] (IS-GPS-200N 20.3.4.3). */
+#define NAV_GNSS_C_MPS 299792458.0
+
+/**
+ * Geometric range from satellite @p o to a receiver at @p r_rx_e_m at true receive time @p t_rx_s:
+ * the signal leaves at t_tx = t_rx - rho / c (fixed-point iteration to 1e-12 s) and the satellite
+ * position is rotated by the Earth's rotation during the flight (Sagnac; IS-GPS-200N 20.3.3.4.3.4,
+ * Kaplan and Hegarty 3rd ed. eq. 2.40 form: R3(omega_e tau) r_s). Leaf maths.
+ * @param[out] r_es_e_m the satellite position at t_tx in the ECEF frame of t_rx (may be NULL)
+ * @return rho [m]
+ */
+NAV_API double nav_gnss_geometric_range_m(const nav_gnss_orbit *o, double t_rx_s, nav_vec3 r_rx_e_m,
+                                          nav_vec3 *r_es_e_m);
+
+/** One pseudorange: the satellite and the measured code range P = rho + c dt_r + e [m]. */
+typedef struct nav_gnss_pseudorange {
+  const nav_gnss_orbit *sat;
+  double p_m;
+} nav_gnss_pseudorange;
+
+/** A least-squares position fix. */
+typedef struct nav_gnss_pvt {
+  nav_vec3 r_e_m;             /**< receiver position, ECEF [m] */
+  double clock_m[NAV_GNSS_SYS_COUNT]; /**< receiver clock bias c dt_r per system present [m] */
+  int n_used;
+  int iterations;
+  nav_gnss_dop dop;           /**< DOP at the solution */
+  double residual_rms_m;      /**< RMS of the post-fit residuals [m] */
+} nav_gnss_pvt;
+
+/**
+ * Single-point position from pseudoranges taken at receiver-clock time @p t_rx_s (Gauss-Newton,
+ * unweighted, one clock unknown per system; Kaplan and Hegarty 3rd ed. section 11.2): each
+ * satellite's position is evaluated at t_rx - P / c (which is the true transmit time whatever the
+ * receiver clock bias) and rotated by the Earth's rotation during rho / c. Starts from the Earth's
+ * centre; stops when the correction is below 1e-4 m (at most 20 iterations).
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, n < 3 + systems, non-finite input);
+ *         NAV_ERR_NOT_CONVERGED; NAV_ERR_NUMERIC (singular geometry).
+ */
+NAV_API NAV_NODISCARD nav_status nav_gnss_pvt_solve(int n, const nav_gnss_pseudorange *pr, double t_rx_s,
+                                                    nav_gnss_pvt *out);
+
 NAV_END_DECLS
 
 #endif /* NAV_GNSS_SAT_H */
