@@ -270,6 +270,9 @@ static const nav_io_field k_constellation[] = {
      .offset = OFF(C(mask.elevation_mask_rad)), .scale = DEG, .min = 0.0},
     {.key = "sky_mask_deg", .kind = NAV_IO_CUSTOM, .offset = OFF(C(mask)), .read = read_sky_mask,
      .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline"},
+    {.key = "min_satellites_for_fix", .kind = NAV_IO_INT, .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = OFF(C(min_satellites_for_fix)), .min = 0.0, .max = NAV_GNSS_MAX_SATS,
+     .comment = "receiver (gnss.enabled): no fix below this many visible satellites; 0: off"},
     {.key = "canyons", .kind = NAV_IO_CUSTOM, .offset = OFF(gnss.constellation), .read = read_canyons,
      .write = write_canyons, .same = same_canyons, .comment = "street walls along the direction of travel"},
 };

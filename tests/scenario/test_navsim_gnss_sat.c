@@ -2,7 +2,9 @@
  * navsim run with a gnss.constellation section (issue 22): scenes/urban-canyon.yaml writes
  * gnss_dop.csv and gnss_sats.csv; 2-3 satellites are visible for the whole 60 s canyon and at
  * least 4 (a valid DOP) outside it; every DOP row equals the DOP recomputed from the visible rows of
- * gnss_sats.csv; a satellite is visible exactly when its elevation is at or above the mask; a bad
+ * gnss_sats.csv; a satellite is visible exactly when its elevation is at or above the mask; the
+ * receiver gives no fix while fewer than 4 satellites are visible (gnss_outages.csv holds exactly
+ * the canyon, gnss.csv has no fix inside it) unless min_satellites_for_fix is 0; a bad
  * gnss.constellation value is FILE:LINE:COL with exit 2.
  *
  * NAVSIM_EXE, NAV_TEST_WORK_DIR and NAV_SOURCE_DIR come from the compile definitions.
@@ -117,6 +119,55 @@ static void canyon_visibility_and_dop(void **state) {
   assert_true(worst < 1e-4);
 }
 
+/* Fixes of run 0 (gnss.csv, first column t_s) inside [t0, t1) and in total. */
+static void count_fixes(const char *path, double t0, double t1, int *inside, int *total) {
+  char *g = nav_test_slurp_alloc(path);
+  assert_non_null(g);
+  *inside = *total = 0;
+  for (char *line = strchr(g, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+    const double t = strtod(line + 1, NULL);
+    *inside += t >= t0 && t < t1;
+    ++*total;
+  }
+  free(g);
+}
+
+static void receiver_follows_visibility(void **state) {
+  (void)state;
+  /* canyon_visibility_and_dop ran first: WORK/uc */
+  char *o = nav_test_slurp_alloc(WORK "/uc/gnss_outages.csv");
+  assert_non_null(o);
+  assert_string_equal(o, "t0_s,t1_s\n40,100\n");
+  free(o);
+  int inside = 0, total = 0;
+  count_fixes(WORK "/uc/gnss.csv", 40.0, 100.0, &inside, &total);
+  assert_int_equal(inside, 0);
+  const int with_canyon = total;
+  /* min_satellites_for_fix: 0: the receiver ignores the constellation */
+  char *scene = nav_test_slurp_alloc(NAV_SOURCE_DIR "/scenes/urban-canyon.yaml");
+  assert_non_null(scene);
+  char *p = strstr(scene, "    elevation_mask_deg: 10\n");
+  assert_non_null(p);
+  const size_t at = (size_t)(p - scene);
+  char *text = malloc(strlen(scene) + 64);
+  assert_non_null(text);
+  memcpy(text, scene, at);
+  strcpy(text + at, "    min_satellites_for_fix: 0\n");
+  strcat(text, scene + at);
+  nav_test_write_file(WORK, "nomin.yaml", text);
+  free(text);
+  free(scene);
+  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run nomin.yaml --runs 1 --out nomin --quiet");
+  if (r->code != 0) fail_msg("navsim run failed (%d):\n%s", r->code, r->err);
+  o = nav_test_slurp_alloc(WORK "/nomin/gnss_outages.csv");
+  assert_non_null(o);
+  assert_string_equal(o, "t0_s,t1_s\n");
+  free(o);
+  count_fixes(WORK "/nomin/gnss.csv", 40.0, 100.0, &inside, &total);
+  assert_int_equal(inside, 60); /* 1 Hz */
+  assert_int_equal(total, with_canyon + 60);
+}
+
 /* A bad value in gnss.constellation: FILE:LINE:COL, exit 2, nothing run. */
 static void bad_section_is_located(void **state) {
   (void)state;
@@ -144,6 +195,7 @@ static void bad_section_is_located(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(canyon_visibility_and_dop),
+      cmocka_unit_test(receiver_follows_visibility),
       cmocka_unit_test(bad_section_is_located),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

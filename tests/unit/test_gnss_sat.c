@@ -559,6 +559,7 @@ static void assert_config_same(const nav_gnss_constellation_config *a, const nav
     assert_true(a->mask.profile_az_rad[i] == b->mask.profile_az_rad[i]);
     assert_true(a->mask.profile_el_rad[i] == b->mask.profile_el_rad[i]);
   }
+  assert_int_equal(a->min_satellites_for_fix, b->min_satellites_for_fix);
   assert_int_equal(a->n_canyons, b->n_canyons);
   assert_memory_equal(a->canyons, b->canyons, sizeof a->canyons[0] * (size_t)a->n_canyons);
   assert_string_equal(a->almanac_file, b->almanac_file);
@@ -577,7 +578,7 @@ static void scene_section_round_trip(void **state) {
   snprintf(yaml, sizeof yaml,
            "gnss:\n  constellation:\n    epoch: \"2007-12-01T06:30:15.5\"\n    gps: almanac\n"
            "    almanac: %s/gnss/yuma431_prn01-08.alm\n    glonass: nominal\n    glonass_node_lon_deg: 12.5\n"
-           "    elevation_mask_deg: 7.5\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
+           "    elevation_mask_deg: 7.5\n    min_satellites_for_fix: 5\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
            "    canyons:\n      - {t0_s: 1, t1_s: 2, height_m: 20, left_m: 5, right_m: 6}\n"
            "      - {t0_s: 3, t1_s: 4.5, height_m: 10, left_m: 3, right_m: 4}\n",
            NAV_TEST_DATA_DIR);
@@ -593,6 +594,7 @@ static void scene_section_round_trip(void **state) {
   assert_near(c->epoch_gps_s, nav_gnss_gps_time_s(2007, 12, 1, 6, 30, 15.5), 0.0);
   assert_int_equal(c->almanac.n, 8);
   assert_int_equal(c->n_canyons, 2);
+  assert_int_equal(c->min_satellites_for_fix, 5);
   assert_near(c->mask.profile_el_rad[1], 20.25 * DEG, 1e-15);
   nav_gnss_constellation all;
   assert_int_equal(nav_gnss_constellation_build(c, &all), NAV_OK);

@@ -213,6 +213,10 @@ typedef struct nav_gnss_constellation_config {
   nav_gnss_sky_mask mask;
   int n_canyons;
   nav_gnss_canyon canyons[NAV_GNSS_MAX_CANYONS]; /**< non-overlapping intervals */
+  /** The receiver model of the integrated schemes (gnss.enabled) gives no fix at an epoch where
+   *  fewer satellites are visible (outages added by the simulation); 0: fixes do not depend on
+   *  the constellation. Default 4. */
+  int min_satellites_for_fix;
   /** ALMANAC: the YUMA file (navcore_io stores the resolved path) and its satellites (loaded by
    *  navcore_io when the scene is read). */
   char almanac_file[NAV_GNSS_ALMANAC_PATH_MAX];

@@ -390,6 +390,7 @@ nav_gnss_constellation_config nav_gnss_constellation_config_default(void) {
   c.epoch_gps_s = nav_gnss_gps_time_s(2026, 1, 1, 0, 0, 0.0);
   c.glonass_node1_lon_rad = 0.0;
   c.mask.elevation_mask_rad = 10.0 * DEG;
+  c.min_satellites_for_fix = 4;
   return c;
 }
 
@@ -440,6 +441,9 @@ nav_status nav_gnss_constellation_config_validate(const nav_gnss_constellation_c
   if (!(cfg->epoch_gps_s >= nav_gnss_gps_time_s(1900, 1, 1, 0, 0, 0.0) &&
         cfg->epoch_gps_s < nav_gnss_gps_time_s(2180, 1, 1, 0, 0, 0.0))) {
     report_issue(report, user, &n, "epoch", "must be a date between 1900 and 2180");
+  }
+  if (cfg->min_satellites_for_fix < 0 || cfg->min_satellites_for_fix > NAV_GNSS_MAX_SATS) {
+    report_issue(report, user, &n, "min_satellites_for_fix", "must be in [0, %d]", NAV_GNSS_MAX_SATS);
   }
   if (!isfinite(cfg->glonass_node1_lon_rad)) {
     report_issue(report, user, &n, "glonass_node_lon_deg", "must be finite");
