@@ -16,6 +16,7 @@ NAV_PACKAGES=(
   python-cartopy-data gmt-gshhg-low # offline map background (coastlines, borders)
   help2man man-db bsdextrautils     # man pages from --help; tests render them (man, col)
   dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
+  rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions (issue 22)
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

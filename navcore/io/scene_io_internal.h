@@ -142,6 +142,10 @@ struct nav_io_field {
 extern const nav_io_section nav_io_scene_schema;
 /** The trajectory section (scene_traj_io.c). */
 extern const nav_io_section nav_io_trajectory_section;
+/** gnss.constellation (scene_gnss_sat_io.c) and whether a scene writes it (when enabled). */
+extern const nav_io_section nav_io_gnss_constellation_section;
+bool nav_io_gnss_constellation_written(const nav_io_writer *w, const nav_io_field *f, const void *base,
+                                       const void *def);
 
 /* ================================================================ reader state */
 

@@ -469,6 +469,11 @@ static const nav_io_field k_gnss[] = {
      .same = same_terms,
      .write_if = off_needed,
      .comment = "terms switched off"},
+    {.key = "constellation",
+     .kind = NAV_IO_SECTION,
+     .section = &nav_io_gnss_constellation_section,
+     .write_if = nav_io_gnss_constellation_written,
+     .comment = "satellites along the trajectory: visibility and DOP (docs/gnss-constellations.md)"},
 };
 DEFINE_SECTION(k_gnss_section, k_gnss);
 
@@ -2548,7 +2553,7 @@ static bool same_reported(const nav_io_field *f, const void *a, const void *b) {
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
   (void)w;
   const nav_scene *s = base;
-  return s->gnss.enabled || !nav_io_section_same(f->section, base, def);
+  return s->gnss.enabled || s->gnss.constellation.enabled || !nav_io_section_same(f->section, base, def);
 }
 
 /* ---------------------------------------------------------------- accelerometer array */

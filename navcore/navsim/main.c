@@ -22,6 +22,7 @@
 #include "mpi_run.h"
 #include "estimate_cmd.h"
 #include "gnss_out.h"
+#include "gnss_sat_out.h"
 #include "import_cmd.h"
 #include "interrupt.h"
 #include "select_cmd.h"
@@ -170,6 +171,7 @@ typedef struct run_out {
   FILE *imu_err; /* imu_errors.csv, or NULL when not written */
   navsim_gnss_out *gnss; /* gnss.csv (INS/GNSS scenes), or NULL */
   navsim_run_smooth *smooth; /* navigation.smoother: nav_smoothed.csv, smoothed_errors.csv */
+  navsim_gnss_sat_out *gsat; /* gnss_dop.csv, gnss_sats.csv (gnss.constellation), or NULL */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -192,6 +194,13 @@ static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   run_out *o = user;
   for (int i = 0; i < 3; ++i) {
     const nav_status st = nav_csv_write_row(o->f[i], (nav_csv_table)i, r);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  if (o->gsat) {
+    const nav_status st = navsim_gnss_sat_out_record(o->gsat, r);
     if (st != NAV_OK) {
       o->st = st;
       return NAV_STOP;
@@ -337,7 +346,7 @@ static int cmd_run(int argc, char **argv) {
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
   run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, navsim_now_s(),
-               scene.simulation.runs, NULL, NULL, NULL};
+               scene.simulation.runs, NULL, NULL, NULL, NULL};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -376,6 +385,21 @@ static int cmd_run(int argc, char **argv) {
     const nav_status gst = (!gf || !ofile) ? NAV_ERR_IO : navsim_gnss_out_begin(&scene, ideal, of, ofile, &o.gnss);
     if (gst != NAV_OK) {
       fprintf(stderr, "navsim run: cannot write gnss.csv / gnss_outages.csv in \"%s\": %s\n", out_dir,
+              nav_status_str(gst));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+
+  if (scene.gnss.constellation.enabled) {
+    /* gnss_dop.csv and gnss_sats.csv: satellites in view along the trajectory (issue 22). */
+    const char *df = nav_resultdir_file(rd, "gnss_dop.csv");
+    char dp[4200];
+    snprintf(dp, sizeof dp, "%s", df ? df : "");
+    const char *sf = nav_resultdir_file(rd, "gnss_sats.csv");
+    const nav_status gst = (!df || !sf) ? NAV_ERR_IO : navsim_gnss_sat_out_begin(&scene, dp, sf, &o.gsat);
+    if (gst != NAV_OK) {
+      fprintf(stderr, "navsim run: cannot write gnss_dop.csv / gnss_sats.csv in \"%s\": %s\n", out_dir,
               nav_status_str(gst));
       rc = EXIT_FAIL;
       goto cleanup;
@@ -448,6 +472,13 @@ static int cmd_run(int argc, char **argv) {
     goto cleanup;
   }
   o.gnss = NULL;
+  if (!navsim_gnss_sat_out_end(o.gsat)) {
+    o.gsat = NULL;
+    fprintf(stderr, "navsim run: writing gnss_dop.csv / gnss_sats.csv failed\n");
+    rc = EXIT_FAIL;
+    goto cleanup;
+  }
+  o.gsat = NULL;
   st = navsim_run_smooth_end(o.smooth);
   o.smooth = NULL;
   if (st != NAV_OK) {
@@ -563,6 +594,7 @@ cleanup:
     if (o.f[i]) fclose(o.f[i]);
   if (o.imu_err) fclose(o.imu_err);
   (void)navsim_gnss_out_end(o.gnss);
+  (void)navsim_gnss_sat_out_end(o.gsat);
   navsim_run_smooth_abort(o.smooth);
   nav_resultdir_abort(rd);
   if (committed) navsim_interrupt_detach(); /* the results are complete: a late signal is absorbed */

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "nav_export.h"
+#include "nav_gnss_sat.h"
 #include "nav_math.h"
 #include "nav_requirements.h"
 #include "nav_sensor_config.h"
@@ -411,6 +412,9 @@ typedef struct nav_scene_gnss {
   bool enabled;
   char catalog[NAV_SCENE_CATALOG_NAME_MAX];
   nav_gnss_model_config model;
+  /** Satellites along the trajectory (issue 22): visibility and DOP outputs; independent of
+   *  @c enabled (the receiver model of the integrated schemes). */
+  nav_gnss_constellation_config constellation;
 } nav_scene_gnss;
 
 /** Initial navigation errors, drawn once per Monte Carlo run (1-sigma, zero mean). */

@@ -82,6 +82,7 @@ nav_scene nav_scene_default(void) {
   s.imu.model = nav_imu_model_config_default();
   s.gnss.enabled = false;
   s.gnss.model = nav_gnss_model_config_default();
+  s.gnss.constellation = nav_gnss_constellation_config_default();
   s.navigation.scheme = NAV_SCHEME_FREE_INS;
   s.navigation.aid_vertical = false;
   /* Gyro-free INS: the cube of numerics.md 1.6 (r = 0.1 m), ideal sensors, perfect initial rate. */
@@ -451,6 +452,13 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
       if (nav_gnss_model_config_validate(&s->gnss.model, report_prefixed, &pg) != NAV_OK && pg.count == 0)
         issue_text(&c, "gnss", "invalid GNSS receiver model");
       c.count += pg.count;
+    }
+    if (s->gnss.constellation.enabled) {
+      prefixed pc = {"gnss.constellation.", report, user, 0};
+      if (nav_gnss_constellation_config_validate(&s->gnss.constellation, report_prefixed, &pc) != NAV_OK &&
+          pc.count == 0)
+        issue_text(&c, "gnss.constellation", "invalid GNSS constellation");
+      c.count += pc.count;
     }
   }
   check_vec(&c, "initial_errors.position_m", s->initial_errors.pos_sd_m);

@@ -226,6 +226,8 @@ static nav_ins_state initial_state(const nav_scene *sc, const nav_frame *fr, con
 nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
                                size_t msg_size) {
   *out = sc->gnss.model;
+  const nav_status vst = nav_sim_gnss_visibility_outages(sc, dt_s, out, msg, msg_size);
+  if (vst != NAV_OK) return vst;
   if (sc->trajectory.type != NAV_TRAJ_SEGMENTS) return NAV_OK;
   bool any = false;
   for (int i = 0; i < sc->trajectory.segments.count; ++i)

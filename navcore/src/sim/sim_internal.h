@@ -56,6 +56,10 @@ const nav_ins_state *nav_sim_gyrofree_state(const nav_sim_gyrofree *g);
 const char *nav_sim_gyrofree_last_error(const nav_sim_gyrofree *g);
 
 /** The receiver configuration of a scene with segment-tied outages added (gnss_visible: false). */
+/** Append to @p out the receiver outages of gnss.constellation.min_satellites_for_fix: every
+ *  receiver epoch with fewer visible satellites (sim_gnss_sat.c). NAV_OK when not configured. */
+nav_status nav_sim_gnss_visibility_outages(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
+                                           size_t msg_size);
 nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
                                size_t msg_size);
 
