@@ -361,6 +361,7 @@ static int cmd_run(int argc, char **argv) {
      * work (every MPI rank decides the same). */
     navsim_size_prediction pred;
     navsim_predict_run(&scene, ideal, (long)threads, kml, &pred);
+    if (export_kfgins) navsim_predict_add_kfgins(&scene, &pred);
     rc = navsim_size_check("run", scene_path, &pred, allow_large, false);
     if (rc != EXIT_OK) return rc;
   }
