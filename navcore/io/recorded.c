@@ -1011,11 +1011,21 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   const nav_rec_pva row0 = p.ref_row;
   const nav_traj_state ts0 = nav_rec_pva_to_state(&row0);
   const nav_frame frame = frame_at(row0.pos);
+  if (cfg->has_initial && !(fabs(cfg->initial.t_s - inc.t_s) <= tol)) {
+    diag_set(diag, cfg->imu_path, 0, 0, "",
+             "the given initial state is at t = %.17g s, but the initial epoch (the first IMU epoch with a "
+             "reference row) is t = %.17g s; expected the same time within %.3g s",
+             cfg->initial.t_s, inc.t_s, tol);
+    st = NAV_ERR_INVALID_ARG;
+    goto cleanup;
+  }
+  /* The initial state: the reference row, or the given one (the frame stays the reference's). */
+  const nav_traj_state is0 = cfg->has_initial ? nav_rec_pva_to_state(&cfg->initial) : ts0;
   nav_ins_state s0;
   s0.t_s = inc.t_s;
-  s0.r_fb_f_m = ts0.r_fb_f_m;
-  s0.v_fb_f_mps = ts0.v_fb_f_mps;
-  s0.q_b_f = ts0.q_b_f;
+  s0.r_fb_f_m = is0.r_fb_f_m;
+  s0.v_fb_f_mps = is0.v_fb_f_mps;
+  s0.q_b_f = is0.q_b_f;
   if (p.gnss)
     st = nav_ins_gnss_create(&cfg->nav, &s0, &nav.x);
   else
@@ -1028,6 +1038,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->t_last_s = inc.t_s;
   nav_epoch_errors err = nav_errors_compute(&frame, &ts0, nav_state(&nav));
   sum->final = err;
+  if (cfg->scored) cfg->scored(cfg->user, &err);
   bool stop = false;
   long long last_out = llround(inc.t_s / cfg->output_interval_s);
   if (cfg->record) {
@@ -1132,6 +1143,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     if (has_ref) {
       err = errors_at(&frame, &p.ref_row, &nav);
       nav_replay_stats_add(&acc, &err);
+      if (cfg->scored) cfg->scored(cfg->user, &err);
       if (output) nav_replay_stats_add(&acc_out, &err);
       sum->final = err;
       gap_max_h = fmax(gap_max_h, err.pos_err_h_m);

@@ -25,6 +25,7 @@
 #include "gnss_sat_out.h"
 #include "import_cmd.h"
 #include "interrupt.h"
+#include "kfgins_out.h"
 #include "select_cmd.h"
 #include "replay_cmd.h"
 #include "report_cmd.h"
@@ -77,7 +78,7 @@ static const char *k_usage_check =
 
 static const char *k_usage_run =
     "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
-    "                  [--kml] [--strict] [--allow-large]\n"
+    "                  [--kml] [--strict] [--allow-large] [--export kfgins]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -117,7 +118,21 @@ static const char *k_usage_run =
     "                \"requirements\" and the terminal summary either way)\n"
     "  --kml         also write tracks.kml (reference, estimate of run 0, GNSS fixes; KML 2.2 for\n"
     "                Google Earth) and tracks.csv (see navsim export --help)\n"
-    "  --allow-large go ahead above the limits below\n"
+    "  --allow-large go ahead above the limits below\n";
+
+/* The rest of navsim run --help (one literal would exceed what C compilers must support). */
+static const char *k_usage_run_tail =
+    "  --export kfgins  also write run 0's inputs in the KF-GINS (i2Nav) text formats into DIR/kfgins/\n"
+    "                (ins_gnss scenes on WGS-84): IMU.txt (every measured increment the navigation\n"
+    "                used, and a zero one at t = 0), GNSS.txt (13 columns: every fix the filter\n"
+    "                applied, at the receiver rate, outages left out, with the sigmas it used),\n"
+    "                truth.nav (the reference at every IMU epoch), init.nav (run 0's initial state,\n"
+    "                drawn initial errors included) and kf-gins.yaml (KF-GINS configuration: initial\n"
+    "                state, P0, IMU noise model and lever arm of the scene's filter). Time base: scene\n"
+    "                time in s (0 at the start), GPS week 0; numbers with 17 digits. Then\n"
+    "                navsim replay --imu DIR/kfgins/IMU.txt --gnss DIR/kfgins/GNSS.txt\n"
+    "                --truth DIR/kfgins/truth.nav --init DIR/kfgins/init.nav --scene SCENE\n"
+    "                reproduces run 0's nav.csv (10 Hz output epochs)\n"
     "  -h, --help    print this help\n"
     "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
@@ -172,6 +187,8 @@ typedef struct run_out {
   navsim_gnss_out *gnss; /* gnss.csv (INS/GNSS scenes), or NULL */
   navsim_run_smooth *smooth; /* navigation.smoother: nav_smoothed.csv, smoothed_errors.csv */
   navsim_gnss_sat_out *gsat; /* gnss_dop.csv, gnss_sats.csv (gnss.constellation), or NULL */
+  navsim_kfgins *kfgins;     /* --export kfgins, or NULL */
+  char kfgins_msg[256];      /* what the kfgins export reported on failure */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -208,6 +225,13 @@ static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   }
   if (o->gnss) {
     const nav_status st = navsim_gnss_out_record(o->gnss, r);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  if (o->kfgins) {
+    const nav_status st = navsim_kfgins_record(o->kfgins, r, o->kfgins_msg, sizeof o->kfgins_msg);
     if (st != NAV_OK) {
       o->st = st;
       return NAV_STOP;
@@ -258,12 +282,13 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
 static int cmd_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false,
-       allow_large = false;
+       allow_large = false, export_kfgins = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (navsim_is_help(a)) {
       fputs(k_usage_run, stdout);
+      fputs(k_usage_run_tail, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--kml") == 0) {
       kml = true;
@@ -286,6 +311,14 @@ static int cmd_run(int argc, char **argv) {
         fprintf(stderr, "navsim run: %s: expected an integer in [1, %llu], got \"%s\"\n", a, (unsigned long long)max, v);
         return EXIT_INVALID;
       }
+    } else if (strcmp(a, "--export") == 0) {
+      if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      if (strcmp(v, "kfgins") != 0) {
+        fprintf(stderr, "navsim run: --export: expected kfgins (the only export format), got \"%s\"\n", v);
+        return EXIT_INVALID;
+      }
+      export_kfgins = true;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--seed") == 0) {
       if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -307,7 +340,7 @@ static int cmd_run(int argc, char **argv) {
     }
   }
   if (!scene_path) {
-    fprintf(stderr, "navsim run: missing SCENE\n%s", k_usage_run);
+    fprintf(stderr, "navsim run: missing SCENE\n%s%s", k_usage_run, k_usage_run_tail);
     return EXIT_INVALID;
   }
 
@@ -316,6 +349,10 @@ static int cmd_run(int argc, char **argv) {
   if (rc != EXIT_OK) return rc;
   if (have_seed) scene.simulation.seed = seed;
   if (runs > 0) scene.simulation.runs = (long)runs;
+  if (export_kfgins && navsim_kfgins_unsupported(&scene)) {
+    fprintf(stderr, "%s: error: --export kfgins: %s\n", scene_path, navsim_kfgins_unsupported(&scene));
+    return EXIT_INVALID;
+  }
   if (threads == 0) threads = scene.simulation.threads > 0 ? (uint64_t)scene.simulation.threads : (uint64_t)cores();
   char default_dir[600];
   if (!out_dir) {
@@ -333,6 +370,7 @@ static int cmd_run(int argc, char **argv) {
      * work (every MPI rank decides the same). */
     navsim_size_prediction pred;
     navsim_predict_run(&scene, ideal, (long)threads, kml, &pred);
+    if (export_kfgins) navsim_predict_add_kfgins(&scene, &pred);
     rc = navsim_size_check("run", scene_path, &pred, allow_large, false);
     if (rc != EXIT_OK) return rc;
   }
@@ -346,7 +384,7 @@ static int cmd_run(int argc, char **argv) {
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
   run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, navsim_now_s(),
-               scene.simulation.runs, NULL, NULL, NULL, NULL};
+               scene.simulation.runs, NULL, NULL, NULL, NULL, NULL, ""};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -405,6 +443,14 @@ static int cmd_run(int argc, char **argv) {
       goto cleanup;
     }
   }
+  if (export_kfgins) {
+    st = navsim_kfgins_begin(&scene, ideal, rd, &o.kfgins, o.kfgins_msg, sizeof o.kfgins_msg);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: --export kfgins: %s\n", o.kfgins_msg[0] ? o.kfgins_msg : nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
 
   if (scene.navigation.smoother && navsim_run_smooth_begin(rd, &o.smooth) != NAV_OK) {
     fprintf(stderr, "navsim run: cannot write nav_smoothed.csv / smoothed_errors.csv in \"%s\"\n", out_dir);
@@ -440,7 +486,8 @@ static int cmd_run(int argc, char **argv) {
     goto cleanup;
   }
   if (st != NAV_OK || o.st != NAV_OK) {
-    if (o.st != NAV_OK) fprintf(stderr, "navsim run: writing results failed: %s\n", nav_status_str(o.st));
+    if (o.st != NAV_OK && o.kfgins_msg[0]) fprintf(stderr, "navsim run: --export kfgins: %s\n", o.kfgins_msg);
+    else if (o.st != NAV_OK) fprintf(stderr, "navsim run: writing results failed: %s\n", nav_status_str(o.st));
     else fprintf(stderr, "navsim run: %s: %s\n", scene_path, nav_sim_last_error(sim));
     rc = EXIT_FAIL;
     goto cleanup;
@@ -479,6 +526,15 @@ static int cmd_run(int argc, char **argv) {
     goto cleanup;
   }
   o.gsat = NULL;
+  if (o.kfgins) {
+    st = navsim_kfgins_end(o.kfgins, o.kfgins_msg, sizeof o.kfgins_msg);
+    o.kfgins = NULL;
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: --export kfgins: %s\n", o.kfgins_msg[0] ? o.kfgins_msg : nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
   st = navsim_run_smooth_end(o.smooth);
   o.smooth = NULL;
   if (st != NAV_OK) {
@@ -595,6 +651,7 @@ cleanup:
   if (o.imu_err) fclose(o.imu_err);
   (void)navsim_gnss_out_end(o.gnss);
   (void)navsim_gnss_sat_out_end(o.gsat);
+  navsim_kfgins_destroy(o.kfgins);
   navsim_run_smooth_abort(o.smooth);
   nav_resultdir_abort(rd);
   if (committed) navsim_interrupt_detach(); /* the results are complete: a late signal is absorbed */

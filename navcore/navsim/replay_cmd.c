@@ -28,7 +28,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 #define MAX_PEERS 8
 
 static const char *k_usage_replay =
-    "usage: navsim replay --imu FILE --truth FILE [--gnss FILE] [--scene SCENE] [--start T]\n"
+    "usage: navsim replay --imu FILE --truth FILE [--gnss FILE] [--scene SCENE] [--init FILE] [--start T]\n"
     "                     [--end T] [--outage T0:T1]... [--peer NAME=FILE]... [--out DIR]\n"
     "                     [--force] [--peers auto|none] [--cov-decimation N] [--smooth] [--quiet]\n"
     "\n"
@@ -48,7 +48,14 @@ static const char *k_usage_replay =
     "                  normal gravity, a tactical-grade filter model (ARW 0.15 deg/sqrt(h), VRW\n"
     "                  0.07 m/s/sqrt(h), GM biases 0.5 deg/h and 0.05 mg over 1 h), P0 1 m,\n"
     "                  0.1 m/s, 0.1 deg level, 1 deg heading, no lever arm\n"
-    "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n"
+    "  --init FILE     initial state: the first row of a .nav file (same format as --truth) at the\n"
+    "                  initial epoch, instead of the reference row (the frame and the scoring still\n"
+    "                  come from --truth); navsim run --export kfgins writes run 0's initial state,\n"
+    "                  drawn initial errors included, to kfgins/init.nav\n"
+    "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n";
+
+/* The rest of navsim replay --help (one literal would exceed what C compilers must support). */
+static const char *k_usage_replay_tail =
     "  --outage T0:T1  drop the GNSS fixes with T0 <= t < T1 (repeatable, up to 32)\n"
     "  --peer NAME=FILE  also score another program's .nav output (e.g. KF-GINS) against the\n"
     "                  reference over the same window; compared with our figures at its epochs\n"
@@ -60,7 +67,10 @@ static const char *k_usage_replay =
     "                  relative, and N = 10 makes the filter about 8 times cheaper)\n"
     "  --out DIR       result directory (default out/replay), written atomically:\n"
     "                    summary.json  inputs, settings, counts, timing, error statistics,\n"
-    "                                  GNSS gaps with the errors at their end\n"
+    "                                  GNSS gaps with the errors at their end; \"stats\": the block\n"
+    "                                  of navsim run's summary.json (same keys and units: RMS, max,\n"
+    "                                  p95 of pos_err_h_m, pos_err_v_m, vel_err_mps, att_err_rad,\n"
+    "                                  yaw_err_rad) over the scored epochs, the initial one included\n"
     "                    nav.csv       our solution at 10 Hz (columns of navsim run's nav.csv)\n"
     "                    truth.csv, errors.csv  reference and errors at the 10 Hz epochs that\n"
     "                                  have a reference row\n"
@@ -189,6 +199,46 @@ static bool is_long_drive(const char *truth_path) {
   return yes;
 }
 
+/*
+ * The "stats" block of navsim run's summary.json (nav_summary_write_json: RMS, max and p95 of
+ * five metrics, angles in rad) over the scored epochs of the replay, the initial epoch included
+ * as run includes epoch 0: every stride-th scored epoch, the stride bounding the stored values
+ * to NAV_SIM_METRIC_MAX_VALUES per metric as run's statistics are.
+ */
+enum { RUN_STATS_METRICS = 5 };
+typedef struct run_stats {
+  nav_stat_acc *acc[RUN_STATS_METRICS];
+  long long stride, seen, kept;
+  nav_status st;
+} run_stats;
+
+static void run_stats_on_scored(void *user, const nav_epoch_errors *e);
+
+static nav_status run_stats_create(run_stats *rs, size_t epochs_max) {
+  memset(rs, 0, sizeof *rs);
+  const long long n = (long long)epochs_max + 1;
+  rs->stride = (n + NAV_SIM_METRIC_MAX_VALUES - 1) / NAV_SIM_METRIC_MAX_VALUES;
+  if (rs->stride < 1) rs->stride = 1;
+  const size_t cap = (size_t)(n / rs->stride + 1);
+  for (int m = 0; m < RUN_STATS_METRICS; ++m) {
+    const nav_status st = nav_stat_acc_create(cap, &rs->acc[m]);
+    if (st != NAV_OK) return st;
+  }
+  return NAV_OK;
+}
+
+static void run_stats_destroy(run_stats *rs) {
+  for (int m = 0; m < RUN_STATS_METRICS; ++m) nav_stat_acc_destroy(rs->acc[m]);
+}
+
+static void run_stats_add(run_stats *rs, const nav_epoch_errors *e) {
+  if (rs->st != NAV_OK || rs->seen++ % rs->stride != 0) return;
+  const double v[RUN_STATS_METRICS] = {e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad,
+                                       fabs(e->euler_err.yaw_rad)};
+  for (int m = 0; m < RUN_STATS_METRICS && rs->st == NAV_OK; ++m) rs->st = nav_stat_acc_add(rs->acc[m], v[m]);
+  rs->kept++;
+}
+
 /* ---------------------------------------------------------------- result files */
 
 typedef struct out_files {
@@ -198,6 +248,7 @@ typedef struct out_files {
   double t_last_print;
   smooth_out *so; /* --smooth: the smoother's recorder, else NULL */
   navsim_req_buffer *req; /* epochs for the scene's requirements (req_out.h), else NULL */
+  run_stats rstats;       /* the "stats" block of navsim run's summary.json */
 } out_files;
 
 static nav_callback_result on_record(void *user, const nav_replay_record *r) {
@@ -222,6 +273,11 @@ static nav_callback_result on_record(void *user, const nav_replay_record *r) {
   return NAV_CONTINUE;
 }
 
+static void run_stats_on_scored(void *user, const nav_epoch_errors *e) {
+  out_files *o = user;
+  run_stats_add(&o->rstats, e);
+}
+
 static nav_callback_result on_progress(void *user, const nav_progress *p) {
   out_files *o = user;
   if (!o->show_progress) return NAV_CONTINUE;
@@ -235,6 +291,26 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
 }
 
 static void json_number(FILE *f, double v) { navsim_json_number(f, v, 17); }
+
+/* "stats": {...} as navsim run writes it (two-space indent, followed by a comma). */
+static void json_run_stats(FILE *f, run_stats *rs) {
+  static const char *const names[RUN_STATS_METRICS] = {"pos_err_h_m", "pos_err_v_m", "vel_err_mps", "att_err_rad",
+                                                       "yaw_err_rad"};
+  fprintf(f, "  \"stats\": {\n    \"epochs\": %lld,\n    \"stride\": %lld,\n", rs->kept, rs->stride);
+  for (int m = 0; m < RUN_STATS_METRICS; ++m) {
+    nav_stat s = {NAN, NAN, NAN};
+    if (rs->kept > 0) s = nav_stat_acc_result(rs->acc[m]);
+    fprintf(f, "    \"%s\": {\"rms\": ", names[m]);
+    json_number(f, s.rms);
+    fputs(", \"max\": ", f);
+    json_number(f, s.max);
+    fputs(", \"p95\": ", f);
+    json_number(f, s.p95);
+    fprintf(f, "}%s\n", m + 1 < RUN_STATS_METRICS ? "," : "");
+  }
+  fputs("  },\n", f);
+}
+
 
 static void json_vec3(FILE *f, nav_vec3 v, double scale) {
   fputc('[', f);
@@ -297,6 +373,7 @@ typedef struct replay_job {
   const smooth_out *so;
   const nav_requirement_verdict *verdicts; /* the scene's requirements, or NULL */
   int n_verdicts;
+  run_stats *rstats; /* the "stats" block of navsim run */
 } replay_job;
 
 static nav_status write_summary(const char *path, const replay_job *j) {
@@ -392,6 +469,7 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs("},\n", f);
   json_stats(f, 1, "errors", &s->stats, false);
   json_stats(f, 1, "errors_at_output_epochs", &s->stats_output, false);
+  json_run_stats(f, j->rstats);
   fputs("  \"final\": {\"t_s\": ", f);
   json_number(f, s->final.t_s);
   fputs(", \"pos_err_h_m\": ", f);
@@ -402,6 +480,11 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   json_number(f, s->final.vel_err_mps);
   fputs(", \"att_err_deg\": ", f);
   json_number(f, s->final.att_err_rad * NAV_RAD2DEG);
+  /* navsim run's keys of the same figures (radians), beside the degrees. */
+  fputs(", \"att_err_rad\": ", f);
+  json_number(f, s->final.att_err_rad);
+  fputs(", \"yaw_err_rad\": ", f);
+  json_number(f, fabs(s->final.euler_err.yaw_rad));
   fputs("},\n  \"bias_estimates\": {\"gyro_deg_per_h\": ", f);
   json_vec3(f, s->b_g_rps, NAV_RAD2DEG * 3600.0);
   fputs(", \"accel_mps2\": ", f);
@@ -560,7 +643,7 @@ static void print_tables(const replay_job *j, bool show_published) {
 /* ---------------------------------------------------------------- command */
 
 int navsim_replay(int argc, char **argv) {
-  const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay";
+  const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay", *init = NULL;
   bool quiet = false, peers_auto = true, smooth = false, force = false;
   /* 10 IMU steps (50 ms at 200 Hz): on the long drive the smoothed positions move by < 2e-5 m
    * and the sigmas by < 1e-4 relative against step-by-step, at a third of the forward cost. */
@@ -577,6 +660,7 @@ int navsim_replay(int argc, char **argv) {
     const char *a = argv[i];
     if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
       fputs(k_usage_replay, stdout);
+      fputs(k_usage_replay_tail, stdout);
       return EXIT_OK;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = true;
@@ -604,6 +688,9 @@ int navsim_replay(int argc, char **argv) {
                          : (a[2] == 'c' || a[2] == 's') ? &config
                                        : &out_dir;
       *dst = v;
+    } else if (strcmp(a, "--init") == 0) {
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
+      init = argv[++i];
     } else if (strcmp(a, "--start") == 0 || strcmp(a, "--end") == 0) {
       if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -684,7 +771,7 @@ int navsim_replay(int argc, char **argv) {
     }
   }
   if (!imu || !truth) {
-    fprintf(stderr, "navsim replay: --imu and --truth are required\n%s", k_usage_replay);
+    fprintf(stderr, "navsim replay: --imu and --truth are required\n%s%s", k_usage_replay, k_usage_replay_tail);
     return EXIT_INVALID;
   }
   if (rc.has_start && rc.has_end && !(rc.t_end_s > rc.t_start_s)) {
@@ -729,6 +816,7 @@ int navsim_replay(int argc, char **argv) {
     free(scene);
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;
+  size_t imu_count = 0; /* IMU records (nav_rec_check_file): bounds the scored epochs */
   rc.imu_path = imu;
   rc.gnss_path = gnss;
   rc.ref_path = truth;
@@ -738,11 +826,12 @@ int navsim_replay(int argc, char **argv) {
        failure of the run. */
     const char *paths[2] = {imu, gnss};
     const nav_rec_format fmts[2] = {NAV_REC_IMU, NAV_REC_GNSS};
+    imu_count = 0;
     for (int i = 0; i < 2; ++i) {
       if (!paths[i]) continue;
       nav_diag d;
       memset(&d, 0, sizeof d);
-      const nav_status cs = nav_rec_check_file(paths[i], fmts[i], NULL, &d);
+      const nav_status cs = nav_rec_check_file(paths[i], fmts[i], i == 0 ? &imu_count : NULL, &d);
       if (cs != NAV_OK) {
         if (d.message[0]) navsim_print_diag(NULL, &d);
         else fprintf(stderr, "%s: error: %s\n", paths[i], nav_status_str(cs));
@@ -751,6 +840,35 @@ int navsim_replay(int argc, char **argv) {
         return cs == NAV_ERR_PARSE || cs == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
       }
     }
+  }
+
+  if (init) {
+    /* The initial state of --init: the first row of a .nav file, checked like the reference. */
+    nav_rec_reader *ir = NULL;
+    nav_diag d;
+    memset(&d, 0, sizeof d);
+    bool got = false;
+    nav_status is = nav_rec_reader_open(init, NAV_REC_PVA, &ir, &d);
+    if (is == NAV_OK) {
+      is = nav_rec_read_pva(ir, &rc.initial, &got);
+      if (is != NAV_OK) d = *nav_rec_reader_diag(ir);
+    }
+    nav_rec_reader_destroy(ir);
+    if (is == NAV_OK && !got) {
+      fprintf(stderr, "%s:1:1: error: --init: the file holds no row; expected one .nav row (week, t, lat, lon, h, "
+                      "vN vE vD, roll pitch yaw [deg]) at the initial epoch\n", init);
+      free(reqs);
+      free(verdicts);
+      return EXIT_INVALID;
+    }
+    if (is != NAV_OK) {
+      if (d.message[0]) navsim_print_diag(NULL, &d);
+      else fprintf(stderr, "%s: error: %s\n", init, nav_status_str(is));
+      free(reqs);
+      free(verdicts);
+      return is == NAV_ERR_PARSE || is == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+    }
+    rc.has_initial = true;
   }
 
   int rc_exit = EXIT_FAIL;
@@ -784,8 +902,14 @@ int navsim_replay(int argc, char **argv) {
       goto cleanup;
     }
   }
+  st = run_stats_create(&o.rstats, imu_count);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
+    goto cleanup;
+  }
   rc.record = on_record;
   rc.progress = on_progress;
+  rc.scored = run_stats_on_scored;
   rc.user = &o;
   if (n_reqs > 0) o.req = &req_buf;
 
@@ -873,6 +997,11 @@ int navsim_replay(int argc, char **argv) {
   job.peers = peers;
   job.n_peers = n_peers;
   job.so = o.so;
+  job.rstats = &o.rstats;
+  if (o.rstats.st != NAV_OK) {
+    fprintf(stderr, "navsim replay: statistics: %s\n", nav_status_str(o.rstats.st));
+    goto cleanup;
+  }
   if (n_reqs > 0) {
     st = navsim_req_replay_verdicts(reqs, n_reqs, &req_buf, &sum, verdicts);
     if (st != NAV_OK) {
@@ -920,6 +1049,7 @@ cleanup:
     if (o.f[i]) fclose(o.f[i]);
   nav_resultdir_abort(rd);
   smooth_out_destroy(o.so);
+  run_stats_destroy(&o.rstats);
   navsim_req_buffer_free(&req_buf);
   free(reqs);
   free(verdicts);

@@ -58,6 +58,18 @@ static void add_file(navsim_size_prediction *p, const char *name, double rows, i
   snprintf(p->files + l, sizeof p->files - l, "%s%s", l ? ", " : "", name);
 }
 
+void navsim_predict_add_kfgins(const nav_scene *sc, navsim_size_prediction *p) {
+  int64_t n_imu = 0, n_out = 0;
+  epochs(sc, &n_imu, &n_out);
+  const double n_gnss = sc->gnss.model.update_rate_hz > 0.0
+                            ? floor(sc->trajectory.duration_s * sc->gnss.model.update_rate_hz) + 1.0
+                            : 0.0;
+  /* kfgins_out.c: IMU.txt and truth.nav at every IMU epoch from t = 0, GNSS.txt per fix. */
+  add_file(p, "kfgins/IMU.txt", (double)n_imu + 1.0, 7);
+  add_file(p, "kfgins/truth.nav", (double)n_imu + 1.0, 11);
+  add_file(p, "kfgins/GNSS.txt", n_gnss, 13);
+}
+
 void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, navsim_size_prediction *out) {
   memset(out, 0, sizeof *out);
   int64_t n_imu = 0, n_out = 0;

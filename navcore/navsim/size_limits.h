@@ -38,6 +38,9 @@ typedef struct navsim_size_prediction {
 /** navsim run of @p sc (after --runs / --ideal / --threads; @p kml: --kml, tracks.kml/.csv). */
 void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, navsim_size_prediction *out);
 
+/** Add the files of navsim run --export kfgins (kfgins_out.h) to a navsim_predict_run() prediction. */
+void navsim_predict_add_kfgins(const nav_scene *sc, navsim_size_prediction *p);
+
 /** navsim estimate of @p sc: estimate.csv with @p csv_columns columns, streamed. */
 void navsim_predict_estimate(const nav_scene *sc, int csv_columns, navsim_size_prediction *out);
 

@@ -308,7 +308,18 @@ typedef struct nav_replay_config {
   double gap_factor;     /**< GNSS gap threshold relative to the smallest fix spacing; default 1.5 */
   nav_replay_record_fn record; /**< may be NULL; also called at the initial epoch */
   nav_progress_fn progress;    /**< may be NULL; stage "replay", fraction of the IMU file read */
-  void *user;                  /**< passed to both callbacks */
+  void *user;                  /**< passed to every callback */
+  /**
+   * Initial navigation state other than the reference row (has_initial): a .nav row whose t_s
+   * must be the initial epoch (within ref_sync_tol_s), e.g. the initial state with the drawn
+   * initial errors that `navsim run --export kfgins` writes to kfgins/init.nav. The frame and
+   * the scoring still come from the reference. Default: false (start from the reference row).
+   */
+  bool has_initial;
+  nav_rec_pva initial;
+  /** May be NULL; called with the errors of every scored epoch, the initial one included (the
+   *  epochs of nav_replay_summary.stats plus the initial epoch), in time order. */
+  void (*scored)(void *user, const nav_epoch_errors *e);
 } nav_replay_config;
 
 /**
