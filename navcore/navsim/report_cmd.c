@@ -134,6 +134,8 @@ static const char *k_usage_render =
     "  noise   simulated sensor errors (imu_errors.csv)\n"
     "  allan   Allan deviation of DIR/allan.csv (navsim allan --out DIR)\n"
     "  bench   speed against error of DIR/bench.csv (navsim bench --out DIR)\n"
+    "  tradeoff  CPU time against each requirement of DIR/tradeoff.csv, one panel per requirement\n"
+    "          (navsim tradeoff --out DIR)\n"
     "--out defaults to RESULT_DIR/VIEW.png. A SCENE file is run first (navsim run --out\n"
     "out/render-<file stem>). Without --view and --out (and with --png/--chart) the old form\n"
     "writes RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
@@ -171,8 +173,9 @@ int navsim_render(int argc, char **argv) {
   }
   if (view && strcmp(view, "3d") != 0 && strcmp(view, "top") != 0 && strcmp(view, "map") != 0 &&
       strcmp(view, "errors") != 0 && strcmp(view, "noise") != 0 && strcmp(view, "allan") != 0 &&
-      strcmp(view, "bench") != 0) {
-    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan or bench, got \"%s\"\n", view);
+      strcmp(view, "bench") != 0 && strcmp(view, "tradeoff") != 0) {
+    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan, bench or tradeoff, got \"%s\"\n",
+            view);
     return RC_INVALID;
   }
   /* A scene file: run it first. */
@@ -227,9 +230,9 @@ int navsim_render(int argc, char **argv) {
     snprintf(out_buf, sizeof out_buf, "%s/%s.png", dir, view);
     out = out_buf;
   }
-  if (strcmp(view, "allan") == 0 || strcmp(view, "bench") == 0) {
+  if (strcmp(view, "allan") == 0 || strcmp(view, "bench") == 0 || strcmp(view, "tradeoff") == 0) {
     snprintf(in_buf, sizeof in_buf, "%s/%s.csv", dir, view);
-    av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : "--speed-vs-error");
+    av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : strcmp(view, "bench") == 0 ? "--speed-vs-error" : "--tradeoff");
     av_add(&v, in_buf);
   } else {
     av_add(&v, dir);
