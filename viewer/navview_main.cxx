@@ -394,7 +394,7 @@ static int NavviewMain(int argc, char **argv) {
     }
     if (!size_given) {
       copt.width_px = 1000;
-      copt.height_px = 700;
+      copt.height_px = tradeoff_req.empty() ? 1100 : 700; // several panels without --requirement
     }
     std::string e2;
     if (!NavRenderTradeoffPng(tradeoff_csv, tradeoff_req, copt, png, &e2)) {

@@ -3,7 +3,8 @@
  * scene offers is changed one at a time (IMU rate, mechanization algorithm, Earth and gravity
  * model, frame, covariance decimation, filter states, each sensor error term switched off), each
  * variant is run by Monte Carlo with the scene's seed, and its CPU time per run is set against
- * the value of each requirement with a confidence interval. The recommendation is the cheapest
+ * the value of each requirement with a confidence interval. A combined variant applies the
+ * cheapest acceptable change of each cost group together. The recommendation is the cheapest
  * variant whose value of every requirement is within the tolerance of the full model's (the
  * scene as written), written as a scene.
  *
@@ -66,8 +67,12 @@ static const char *k_usage_tradeoff =
     "interval is too narrow (it cannot reach beyond the runs drawn): read it as a lower bound of\n"
     "the Monte Carlo uncertainty.\n"
     "A variant is within tolerance when for every requirement (or only --requirement ID)\n"
-    "|value - full| <= FRAC x full (--tolerance, default 0.1). The recommendation is the variant\n"
-    "within tolerance with the least CPU time per run (the full model when none is cheaper).\n"
+    "|value - full| <= FRAC x full (--tolerance, default 0.1). One more variant, 'combined', applies\n"
+    "together the cheapest variant within tolerance of each cost group (IMU rate, algorithm,\n"
+    "gravity, frame, covariance decimation, filter states; not the sensor terms, which change the\n"
+    "simulated hardware) and is run and judged like the others (skipped with the reason when fewer\n"
+    "than two groups have one). The recommendation is the variant within tolerance with the least\n"
+    "CPU time per run (the full model when none is cheaper).\n"
     "Writes into DIR (atomically):\n"
     "  tradeoff.csv         one row per variant and requirement: variant, group, change, status\n"
     "                       (ok or skipped), note, cpu_s_per_run, wall_s, runs, requirement,\n"
@@ -85,7 +90,7 @@ static const char *k_usage_tradeoff =
 typedef struct to_variant {
   char name[64];
   char group[32];
-  char change[160];
+  char change[400];
   bool skipped;
   char note[1200];
   nav_scene *scene; /* the scene read back (NULL when skipped) */
@@ -450,7 +455,6 @@ static int build_variants(const nav_scene *sc, to_variant *vs, nav_scene *tmp) {
   return n;
 }
 
-/* ---------------------------------------------------------------- command */
 
 static bool within(double v, double full, double tol) {
   return isfinite(v) && isfinite(full) && fabs(v - full) <= tol * fabs(full);
@@ -469,6 +473,61 @@ static bool pareto(const to_variant *vs, int n, int i, int q) {
       return false;
   }
   return true;
+}
+
+/* ---------------------------------------------------------------- command */
+
+/* The groups whose variants are cheaper computations of the same problem, combined into one
+   candidate; the sensor-term variants change the simulated hardware and are not combined. */
+#define TO_GROUPS 6
+static const char *const k_cost_groups[TO_GROUPS] = {"imu_rate", "algorithm", "gravity", "frame", "cov_decimation",
+                                                     "filter_states"};
+
+/* Copy the field of cost group @p group from @p from (a variant's scene) into @p to. */
+static void apply_group(nav_scene *to, const nav_scene *from, const char *group) {
+  if (!strcmp(group, "imu_rate")) to->imu.rate_hz = from->imu.rate_hz;
+  else if (!strcmp(group, "algorithm")) to->navigation.algorithm = from->navigation.algorithm;
+  else if (!strcmp(group, "gravity")) to->earth.gravity_model = from->earth.gravity_model;
+  else if (!strcmp(group, "frame")) to->navigation.frame = from->navigation.frame;
+  else if (!strcmp(group, "cov_decimation")) to->navigation.cov_decimation = from->navigation.cov_decimation;
+  else if (!strcmp(group, "filter_states"))
+    to->navigation.estimate_scale_factors = from->navigation.estimate_scale_factors;
+}
+
+/* Run variant @p va unless skipped; a failure marks it skipped with the simulation's message.
+   @return false when it failed. */
+static bool run_and_print(to_variant *va, long runs, int threads, int nreq, bool quiet) {
+  if (va->skipped) {
+    if (!quiet) printf("  %-28s skipped: %s\n", va->name, va->note);
+    return true;
+  }
+  char err[512] = "";
+  const nav_status st = run_variant(va, runs, threads, nreq, err, sizeof err);
+  if (st != NAV_OK) {
+    /* A variant the simulation refuses (e.g. a numerical failure) is reported, not faked. */
+    va->skipped = true;
+    snprintf(va->note, sizeof va->note, "the simulation failed: %s", err);
+    if (!quiet) printf("  %-28s failed: %s\n", va->name, err);
+    return false;
+  }
+  if (!quiet) {
+    printf("  %-28s %8.3f s CPU/run", va->name, va->cpu_s_per_run);
+    for (int q = 0; q < nreq; ++q)
+      printf("  %s %.4g [%.4g, %.4g] %s", va->v[q].id, va->v[q].value, va->ci_lo[q], va->ci_hi[q],
+             nav_req_unit_name(va->v[q].unit));
+    printf("\n");
+    fflush(stdout);
+  }
+  return true;
+}
+
+/* ok[i]: variant i was run and each considered requirement is within @p tol of the full model. */
+static void mark_within(const to_variant *vs, int nv, int nreq, int qsel, double tol, bool *ok) {
+  for (int i = 0; i < nv; ++i) {
+    ok[i] = !vs[i].skipped;
+    for (int q = 0; q < nreq && ok[i]; ++q)
+      if ((qsel < 0 || q == qsel) && !within(vs[i].v[q].value, vs[0].v[q].value, tol)) ok[i] = false;
+  }
 }
 
 static void csv_text(FILE *f, const char *s) {
@@ -592,46 +651,55 @@ int navsim_tradeoff(int argc, char **argv) {
   if (!quiet)
     printf("tradeoff   %s: %d variants (%d skipped), %ld run%s each, seed %llu\n", sc->name, nv, nv - nrun, runs,
            runs == 1 ? "" : "s", (unsigned long long)sc->simulation.seed);
-  for (int i = 0; i < nv; ++i) {
-    to_variant *va = &vs[i];
-    if (va->skipped) {
-      if (!quiet) printf("  %-28s skipped: %s\n", va->name, va->note);
-      continue;
+  for (int i = 0; i < nv; ++i)
+    if (!run_and_print(&vs[i], runs, (int)threads, nreq, quiet) && i == 0) {
+      fprintf(stderr, "navsim tradeoff: %s: the full model failed: %s\n", scene_path, vs[0].note);
+      goto done;
     }
-    char err[512] = "";
-    const nav_status st = run_variant(va, runs, (int)threads, nreq, err, sizeof err);
-    if (st != NAV_OK) {
-      if (i == 0) {
-        fprintf(stderr, "navsim tradeoff: %s: the full model failed: %s\n", scene_path, err);
-        goto done;
-      }
-      /* A variant the simulation refuses (e.g. a numerical failure) is reported, not faked. */
-      va->skipped = true;
-      snprintf(va->note, sizeof va->note, "the simulation failed: %s", err);
-      if (!quiet) printf("  %-28s failed: %s\n", va->name, err);
-      continue;
-    }
-    if (!quiet) {
-      printf("  %-28s %8.3f s CPU/run", va->name, va->cpu_s_per_run);
-      for (int q = 0; q < nreq; ++q)
-        printf("  %s %.4g [%.4g, %.4g] %s", va->v[q].id, va->v[q].value, va->ci_lo[q], va->ci_hi[q],
-               nav_req_unit_name(va->v[q].unit));
-      printf("\n");
-      fflush(stdout);
-    }
-  }
 
-  /* Within tolerance and the recommendation (index 0, the full model, unless a cheaper one is within). */
-  bool *ok = calloc((size_t)nv, sizeof *ok);
+  /* Within tolerance of the full model (index 0). */
+  bool *ok = calloc(TO_MAX_VARIANTS, sizeof *ok);
   if (!ok) goto done;
-  for (int i = 0; i < nv; ++i) {
-    if (vs[i].skipped) continue;
-    ok[i] = true;
-    for (int q = 0; q < nreq; ++q) {
-      if (qsel >= 0 && q != qsel) continue;
-      if (!within(vs[i].v[q].value, vs[0].v[q].value, tol)) ok[i] = false;
+  mark_within(vs, nv, nreq, qsel, tol, ok);
+  /* The combination: per cost group the cheapest variant within tolerance that is cheaper than the
+     full model, all applied together, run and judged like the others. */
+  {
+    int pick[TO_GROUPS];
+    char change[400] = "";
+    int npick = 0;
+    for (int g = 0; g < TO_GROUPS; ++g) {
+      pick[g] = -1;
+      for (int i = 1; i < nv; ++i)
+        if (ok[i] && !strcmp(vs[i].group, k_cost_groups[g]) && vs[i].cpu_s_per_run < vs[0].cpu_s_per_run &&
+            (pick[g] < 0 || vs[i].cpu_s_per_run < vs[pick[g]].cpu_s_per_run))
+          pick[g] = i;
+      if (pick[g] < 0) continue;
+      const size_t len = strlen(change);
+      snprintf(change + len, sizeof change - len, "%s%s", npick ? " + " : "", vs[pick[g]].name);
+      ++npick;
+    }
+    if (nv < TO_MAX_VARIANTS) {
+      if (npick >= 2) {
+        *tmp = *sc;
+        for (int g = 0; g < TO_GROUPS; ++g)
+          if (pick[g] >= 0) apply_group(tmp, vs[pick[g]].scene, k_cost_groups[g]);
+        to_variant *va = add_variant(vs, &nv, "combined", "combined", change);
+        realise(va, tmp);
+      } else {
+        add_skip(vs, &nv, "combined", "combined", npick ? change : "(none)",
+                 npick ? "only one cost group has a cheaper variant within tolerance (that variant is the combination)"
+                       : "no cost group has a variant within tolerance that is cheaper than the full model");
+      }
+      to_variant *va = &vs[nv - 1];
+      va->v = calloc((size_t)nreq, sizeof *va->v);
+      va->ci_lo = calloc((size_t)nreq, sizeof *va->ci_lo);
+      va->ci_hi = calloc((size_t)nreq, sizeof *va->ci_hi);
+      if (!va->v || !va->ci_lo || !va->ci_hi) goto io_fail_ok;
+      run_and_print(va, runs, (int)threads, nreq, quiet);
+      mark_within(vs, nv, nreq, qsel, tol, ok);
     }
   }
+  /* The recommendation: the cheapest within tolerance (the full model unless one is cheaper). */
   for (int i = 1; i < nv; ++i)
     if (ok[i] && vs[i].cpu_s_per_run < vs[rec].cpu_s_per_run) rec = i;
 

@@ -125,7 +125,7 @@ static void test_every_variant_row(void **state) {
       "cov_decimation_2", "cov_decimation_5", "cov_decimation_10", "states_plus_scale_factors",
       "gyro_bias_turn_on_off", "gyro_noise_off", "gyro_scale_factor_off", "accel_bias_turn_on_off",
       "gyro_bias_gm_off", "accel_noise_off", "accel_scale_factor_off", "accel_bias_gm_off", "gnss_pos_gm_off",
-      "gnss_vel_white_off"};
+      "gnss_vel_white_off", "combined"};
   for (size_t e = 0; e < sizeof expected / sizeof *expected; ++e)
     for (int q = 0; q < 2; ++q)
       if (!find(expected[e], k_reqs[q])) fail_msg("tradeoff.csv has no row %s x %s", expected[e], k_reqs[q]);
@@ -205,6 +205,29 @@ static void test_pareto_and_recommendation(void **state) {
     if (!strcmp(a->f[C_WITHIN], "true") && !strcmp(b->f[C_WITHIN], "true") && num(a->f[C_CPU]) < rec_cpu)
       fail_msg("%s is within tolerance and cheaper (%s s) than the recommended %s (%g s)", a->f[C_VARIANT],
                a->f[C_CPU], rec, rec_cpu);
+  }
+  /* The combination (when run) applies only variants within tolerance that are cheaper than the full
+     model, at most one per group. */
+  const row *comb = find("combined", k_reqs[0]);
+  assert_non_null(comb);
+  if (!strcmp(comb->f[C_STATUS], "ok")) {
+    char list[200];
+    snprintf(list, sizeof list, "%s", comb->f[C_CHANGE]);
+    char *save = NULL;
+    int parts = 0;
+    char groups[8][200];
+    for (char *v = strtok_r(list, " +", &save); v; v = strtok_r(NULL, " +", &save)) {
+      const row *a = find(v, k_reqs[0]), *b = find(v, k_reqs[1]);
+      if (!a || !b) fail_msg("combined names an unknown variant \"%s\"", v);
+      if (strcmp(a->f[C_WITHIN], "true") || strcmp(b->f[C_WITHIN], "true") ||
+          !(num(a->f[C_CPU]) < num(find("full", k_reqs[0])->f[C_CPU])))
+        fail_msg("combined includes %s, which is not within tolerance and cheaper than the full model", v);
+      for (int g = 0; g < parts && g < 8; ++g)
+        if (!strcmp(groups[g], a->f[C_GROUP])) fail_msg("combined has two variants of group %s", groups[g]);
+      if (parts < 8) snprintf(groups[parts], sizeof groups[parts], "%s", a->f[C_GROUP]);
+      ++parts;
+    }
+    assert_true(parts >= 2);
   }
   print_message("recommended: %s (%g s CPU per run, full model %s s)\n", rec, rec_cpu,
                 find("full", k_reqs[0])->f[C_CPU]);

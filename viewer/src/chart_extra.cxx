@@ -719,9 +719,8 @@ bool NavRenderTradeoffPng(const std::string &csv, const std::string &requirement
     }
     const TradeoffRow &t0 = pts.front();
     StyleChart(chart,
-               "speed against error: " + reqs[k] + " (" + t0.statistic + "), 95 % bootstrap interval, Pareto front",
-               k == 0 ? "CPU time per Monte Carlo run [s]" : "CPU time per Monte Carlo run [s]",
-               reqs[k] + " [" + t0.unit + "]", opt, cv.font);
+               reqs[k] + " (" + t0.statistic + ") against CPU time: 95 % intervals, Pareto front",
+               "CPU time per Monte Carlo run [s]", reqs[k] + " [" + t0.unit + "]", opt, cv.font);
     chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
     chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
     const double xs = xmax > xmin ? xmax - xmin : std::max(1e-3, 0.1 * xmax);
