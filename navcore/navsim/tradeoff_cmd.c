@@ -81,6 +81,8 @@ static const char *k_usage_tradeoff =
     "                       more accurate), recommended\n"
     "  recommended.yaml     the recommended variant as a scene (simulation.runs as the scene's)\n"
     "  tradeoff.md          the table and the recommendation\n"
+    "  summary.json         scene, seed, runs, tolerance, the recommendation and the requirement\n"
+    "                       verdicts of the recommended variant (what navsim report DIR shows)\n"
     "  tradeoff_<ID>.png    per requirement: CPU time against value with its interval, each point\n"
     "                       labelled, the Pareto front drawn (navview --tradeoff; when navview is\n"
     "                       built)\n" NAVSIM_OUT_HELP
@@ -539,6 +541,16 @@ static void csv_text(FILE *f, const char *s) {
   fputc('"', f);
 }
 
+static void json_text(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)s; *p; ++p) {
+    if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+    else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+    else fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
 static void csv_num(FILE *f, double v) {
   if (isfinite(v)) fprintf(f, ",%.9g", v);
   else fputs(",", f);
@@ -605,7 +617,7 @@ int navsim_tradeoff(int argc, char **argv) {
   to_variant *vs = calloc(TO_MAX_VARIANTS, sizeof *vs);
   nav_resultdir *rd = NULL;
   FILE *f = NULL;
-  char paths[8][4400];
+  char paths[8][4400]; /* tradeoff.csv, recommended.yaml, tradeoff.md, a chart, its log, summary.json */
   if (!sc || !tmp || !vs) goto done;
   rc = navsim_load_scene(scene_path, sc);
   if (rc != EXIT_OK) goto done;
@@ -787,6 +799,40 @@ int navsim_tradeoff(int argc, char **argv) {
           "\nP: on the Pareto front of that requirement. Recommended: **%s** (%s), %.3g s CPU per run against %.3g s "
           "for the full model; recommended.yaml.\n",
           vs[rec].name, vs[rec].change, vs[rec].cpu_s_per_run, vs[0].cpu_s_per_run);
+  {
+    const bool bad = ferror(f) != 0;
+    const int cl = fclose(f);
+    f = NULL;
+    if (bad || cl != 0) goto io_fail_ok;
+  }
+
+  /* summary.json: what navsim report reads (scene name, seed, runs, the recommendation and the
+     requirement verdicts of the recommended variant over the runs of this command). */
+  snprintf(paths[5], sizeof paths[5], "%s", nav_resultdir_file(rd, "summary.json"));
+  f = fopen(paths[5], "w");
+  if (!f) goto io_fail_ok;
+  fputs("{\n  \"command\": \"tradeoff\",\n  \"scene\": {\"name\": ", f);
+  json_text(f, sc->name);
+  fprintf(f, "},\n  \"seed\": %llu,\n  \"runs\": %ld,\n  \"tolerance\": ", (unsigned long long)sc->simulation.seed,
+          runs);
+  navsim_json_number(f, tol, 9);
+  fputs(",\n  \"recommended\": {\"variant\": ", f);
+  json_text(f, vs[rec].name);
+  fputs(", \"change\": ", f);
+  json_text(f, vs[rec].change);
+  fputs(", \"cpu_s_per_run\": ", f);
+  navsim_json_number(f, vs[rec].cpu_s_per_run, 6);
+  fputs(", \"full_cpu_s_per_run\": ", f);
+  navsim_json_number(f, vs[0].cpu_s_per_run, 6);
+  fputs("},\n  \"requirements_of\": ", f);
+  {
+    char what[600];
+    snprintf(what, sizeof what, "the recommended variant %s over %ld run%s", vs[rec].name, runs, runs == 1 ? "" : "s");
+    json_text(f, what);
+  }
+  fputs(",\n  \"requirements\": ", f);
+  if (nav_requirements_write_json(f, vs[rec].v, nreq, 2) != NAV_OK) goto io_fail_ok;
+  fputs("\n}\n", f);
   {
     const bool bad = ferror(f) != 0;
     const int cl = fclose(f);

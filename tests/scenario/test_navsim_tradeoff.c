@@ -296,6 +296,20 @@ static void test_charts(void **state) {
     assert_int_equal(w, 1000);
     assert_int_equal(h, 700);
   }
+  /* navsim report of the directory: the tradeoff figure and the table, the recommended row marked. */
+  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "report t --out rep");
+  if (r->code != 0) fail_msg("navsim report exited %d:\n%s", r->code, r->err);
+  char *page = nav_test_slurp_alloc(WORK "/rep/report.html");
+  assert_non_null(page);
+  const char *rec = NULL;
+  for (int i = 0; i < g_n && !rec; ++i)
+    if (!strcmp(g_rows[i].f[C_REC], "true")) rec = g_rows[i].f[C_VARIANT];
+  char want[256];
+  snprintf(want, sizeof want, "<b>%s (recommended)</b>", rec);
+  if (!strstr(page, "<h2>Speed against error (navsim tradeoff)</h2>") || !strstr(page, "id=\"fig-tradeoff\"") ||
+      !strstr(page, want))
+    fail_msg("report.html lacks the tradeoff section, its figure or the recommended row (%s)", want);
+  free(page);
 #else
   skip();
 #endif
