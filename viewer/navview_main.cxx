@@ -23,6 +23,7 @@ void Usage(FILE *f) {
                "       navview --bench [--bench-epochs N] [--bench-paths M] [--size WxH]\n"
                "       navview --speed-vs-error bench.csv --png out.png\n"
                "       navview --allan allan.csv --png out.png\n"
+               "       navview --tradeoff tradeoff.csv [--requirement ID] --png out.png\n"
                "\n"
                "Show the result directory written by `navsim run`: reference and estimated paths,\n"
                "attitude triads, the error-envelope tube, ground grid with scale, NED axes and legend.\n"
@@ -43,6 +44,9 @@ void Usage(FILE *f) {
                "                      (24), --movie-no-video (PNG frames only)\n"
                "  --allan ALLAN_CSV   Allan deviation chart of navsim allan's allan.csv (with --png; no DIR)\n"
                "  --speed-vs-error BENCH_CSV  speed-vs-error chart of navsim bench's bench.csv (with --png)\n"
+               "  --tradeoff TRADEOFF_CSV  CPU time against requirement error of navsim tradeoff's tradeoff.csv,\n"
+               "                      one panel per requirement (--requirement ID: that one only), labelled\n"
+               "                      points, intervals, tolerance band and Pareto front (with --png)\n"
                "  --chart FILE        write the error-vs-time charts as PNG\n"
                "  --size WxH          image/window size in pixels (default 1000x700; charts 900x800)\n"
                "  --time T            playback time of the vehicle glyph and read-out [s] (default: end)\n"
@@ -175,7 +179,7 @@ std::shared_ptr<NavResult> SyntheticResult(size_t epochs, int paths) {
 } // namespace
 
 static int NavviewMain(int argc, char **argv) {
-  std::string dir, png, chart, view_kind = "3d", allan_csv, bench_csv;
+  std::string dir, png, chart, view_kind = "3d", allan_csv, bench_csv, tradeoff_csv, tradeoff_req;
   NavViewOptions opt;
   NavChartOptions copt;
   NavMapOptions mopt;
@@ -328,6 +332,10 @@ static int NavviewMain(int argc, char **argv) {
       allan_csv = need("ALLAN_CSV");
     } else if (a == "--speed-vs-error") {
       bench_csv = need("BENCH_CSV");
+    } else if (a == "--tradeoff") {
+      tradeoff_csv = need("TRADEOFF_CSV");
+    } else if (a == "--requirement") {
+      tradeoff_req = need("ID");
     } else if (a == "--msaa") {
       const char *s = need("N");
       if (!ParseDouble(s, &v) || v < 0 || v > 16) bad(s);
@@ -375,6 +383,26 @@ static int NavviewMain(int argc, char **argv) {
   mopt.show_gnss = opt.show_gnss;
   mopt.multisamples = opt.multisamples;
   // Chart-only modes: no result directory.
+  if (!tradeoff_req.empty() && tradeoff_csv.empty()) {
+    std::fprintf(stderr, "navview: --requirement applies to --tradeoff only\n");
+    return 2;
+  }
+  if (!tradeoff_csv.empty()) {
+    if (png.empty()) {
+      std::fprintf(stderr, "navview: --tradeoff needs --png FILE\n");
+      return 2;
+    }
+    if (!size_given) {
+      copt.width_px = 1000;
+      copt.height_px = tradeoff_req.empty() ? 1100 : 700; // several panels without --requirement
+    }
+    std::string e2;
+    if (!NavRenderTradeoffPng(tradeoff_csv, tradeoff_req, copt, png, &e2)) {
+      std::fprintf(stderr, "navview: %s\n", e2.c_str());
+      return 1;
+    }
+    return 0;
+  }
   if (!allan_csv.empty() || !bench_csv.empty()) {
     if (png.empty()) {
       std::fprintf(stderr, "navview: --allan / --speed-vs-error need --png FILE\n");

@@ -257,6 +257,28 @@ void MainWindow::BuildActions() {
   });
   UpdateLiveRenderDelay();
   sim->addActions({run_act_, cancel_act_, preview_act_});
+  QAction *trade = act(tr("Speed against &error..."), "actionTradeoff", QKeySequence());
+  connect(trade, &QAction::triggered, this, [this] {
+    const QString base = doc_.FilePath().isEmpty() ? QString("tradeoff") : doc_.FilePath().section('.', 0, -2);
+    const QString p = QFileDialog::getSaveFileName(this, tr("navsim tradeoff into the new directory"),
+                                                   base + "-tradeoff");
+    if (p.isEmpty()) return;
+    QString err;
+    if (!StartTradeoff(p, 0, &err)) QMessageBox::warning(this, tr("Speed against error"), err);
+  });
+  connect(&tradeoff_, &TradeoffRun::Finished, this, [this](bool ok, const QString &msg) {
+    if (!ok) {
+      statusBar()->showMessage(tr("navsim tradeoff failed"), 5000);
+      QMessageBox::warning(this, tr("Speed against error"), msg);
+      return;
+    }
+    statusBar()->showMessage(tr("navsim tradeoff written to %1").arg(tradeoff_.OutDir()), 5000);
+    QDialog *d = MakeTradeoffDialog(this, tradeoff_.OutDir(), [this](const QString &scene) { OpenFile(scene); });
+    d->setAttribute(Qt::WA_DeleteOnClose);
+    d->show();
+  });
+  sim->addSeparator();
+  sim->addAction(trade);
 
   QAction *reset = act(tr("&Fit views"), "actionFit", QKeySequence(tr("Ctrl+0")));
   connect(reset, &QAction::triggered, this, [this] {
@@ -270,6 +292,16 @@ void MainWindow::BuildActions() {
   tb->addActions({undo, redo});
   tb->addSeparator();
   tb->addActions({run_act_, cancel_act_, preview_act_});
+}
+
+bool MainWindow::StartTradeoff(const QString &out_dir, int runs, QString *error) {
+  if (doc_.FilePath().isEmpty() || doc_.IsModified()) {
+    if (error) *error = tr("Save the scene first: navsim tradeoff reads the scene file.");
+    return false;
+  }
+  if (!tradeoff_.Start(doc_.FilePath(), out_dir, runs, error)) return false;
+  statusBar()->showMessage(tr("navsim tradeoff running (every modelling choice, Monte Carlo each)..."));
+  return true;
 }
 
 /* ---------------------------------------------------------------- files */

@@ -21,6 +21,7 @@
 #include "path_view.h"
 #include "sim_worker.h"
 #include "studio_scene.h"
+#include "tradeoff_run.h"
 
 class QAction;
 class QLabel;
@@ -73,6 +74,11 @@ public:
   bool ExportReport(const QString &path, QString *error);
   /** Draw the error band of @p r about its estimate in both views (3 sigma or 3 RMS). */
   void SetEnvelopes(const SimResult &r, bool preview);
+  /** Simulation > Speed against error...: navsim tradeoff of the saved scene into @p out_dir
+   *  (@p runs 0: navsim's default); its dialog opens when it ends. false with @p error when the
+   *  scene is unsaved or modified (navsim reads the file) or a tradeoff is running. */
+  bool StartTradeoff(const QString &out_dir, int runs, QString *error);
+  TradeoffRun *Tradeoff() { return &tradeoff_; }
   /** Start the Monte Carlo run of the scene. false when the scene has issues. */
   bool Run();
   void Cancel();
@@ -163,6 +169,7 @@ private:
   QProgressBar *progress_ = nullptr;
   QLabel *status_ = nullptr;
   QLabel *latency_label_ = nullptr;
+  TradeoffRun tradeoff_;
   QAction *run_act_ = nullptr, *cancel_act_ = nullptr, *preview_act_ = nullptr;
   QMenu *recent_menu_ = nullptr;
   QTimer preview_timer_;

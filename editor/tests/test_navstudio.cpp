@@ -4,6 +4,7 @@
 // NAVSTUDIO_TEST_OUT_DIR/<test>-<step>.png.
 #include <QAction>
 #include <QComboBox>
+#include <QDialog>
 #include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
@@ -342,6 +343,44 @@ private slots:
     QVERIFY(!w->ExportReport(bad, &err));
     QVERIFY(err.contains(bad));
     QVERIFY(!QFile::exists(bad));
+  }
+
+  // Simulation > Speed against error: navsim tradeoff of the saved scene (1 run per variant), its
+  // dialog with one chart per requirement and the recommendation, which opens as the scene.
+  void tradeoff() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->OpenFile(studio::ScenesDir() + "/urban-drive.yaml"));
+    w->Tradeoff()->SetProgram(NAVSIM_EXE);
+    const QString out = QString(NAVSTUDIO_TEST_OUT_DIR) + "/tradeoff-urban-drive";
+    QDir(out).removeRecursively();
+    QSignalSpy done(w->Tradeoff(), &studio::TradeoffRun::Finished);
+    QString err;
+    QVERIFY2(w->StartTradeoff(out, 1, &err), qPrintable(err));
+    QVERIFY(!w->StartTradeoff(out, 1, &err)); // one at a time
+    QVERIFY(done.wait(600000));
+    QVERIFY2(done.at(0).at(0).toBool(), qPrintable(done.at(0).at(1).toString()));
+    QDialog *d = w->findChild<QDialog *>("tradeoffDialog");
+    QVERIFY(d);
+    QVERIFY(QTest::qWaitForWindowExposed(d));
+    const auto charts = d->findChildren<QLabel *>("tradeoffChart");
+    QCOMPARE(charts.size(), 2); // h-outage-end, h-cep95
+    for (const QLabel *c : charts) QCOMPARE(c->pixmap(Qt::ReturnByValue).width(), 1000);
+    QFile sf(out + "/summary.json");
+    QVERIFY(sf.open(QIODevice::ReadOnly));
+    const QString summary = QString::fromUtf8(sf.readAll());
+    const QRegularExpression re("\"recommended\": \\{\"variant\": \"([^\"]+)\"");
+    const QRegularExpressionMatch m = re.match(summary);
+    QVERIFY(m.hasMatch());
+    QVERIFY(d->findChild<QLabel *>("tradeoffRecommendation")->text().contains("<b>" + m.captured(1) + "</b>"));
+    d->grab().save(QString(NAVSTUDIO_TEST_OUT_DIR) + "/tradeoff-dialog.png");
+    QTest::mouseClick(d->findChild<QPushButton *>("openRecommended"), Qt::LeftButton);
+    QTRY_COMPARE(w->Doc()->FilePath(), out + "/recommended.yaml");
+    // A modified scene is not what navsim would read: refused with the reason.
+    QTest::mouseClick(w->findChild<QPushButton *>("addRequirement"), Qt::LeftButton);
+    QVERIFY(!w->StartTradeoff(out + "-2", 1, &err));
+    QVERIFY(err.contains("Save the scene first"));
   }
 
   // Undo/redo of clicks, a catalog choice and a typed field; the modified marker follows.

@@ -31,6 +31,7 @@
 #include "report_cmd.h"
 #include "run_smooth_out.h"
 #include "size_limits.h"
+#include "tradeoff_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
@@ -49,8 +50,8 @@ static const char *k_usage =
     "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
     "  budget SCENE     error budget: each error source's share of each requirement\n"
     "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
-    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan or bench\n"
-    "                   view (navview)\n"
+    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan, bench\n"
+    "                   or tradeoff view (navview)\n"
     "  report DIR       HTML page with the figures, statistics and requirement verdicts of a result\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
@@ -59,6 +60,7 @@ static const char *k_usage =
     "  export DIR       KML (Google Earth) and CSV tracks of a result directory\n"
     "  select SCENE     cheapest catalog IMU / receiver / scheme meeting the scene's requirements\n"
     "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
+    "  tradeoff SCENE   CPU time against error of each modelling choice; the cheapest within tolerance\n"
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -691,6 +693,7 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "export") == 0) return navsim_export(argc - 2, argv + 2);
   if (strcmp(cmd, "select") == 0) return navsim_select(argc - 2, argv + 2);
   if (strcmp(cmd, "sweep") == 0) return navsim_sweep(argc - 2, argv + 2);
+  if (strcmp(cmd, "tradeoff") == 0) return navsim_tradeoff(argc - 2, argv + 2);
   if (strcmp(cmd, "catalog") == 0) {
     char res[4096];
     return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);

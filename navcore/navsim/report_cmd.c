@@ -134,6 +134,8 @@ static const char *k_usage_render =
     "  noise   simulated sensor errors (imu_errors.csv)\n"
     "  allan   Allan deviation of DIR/allan.csv (navsim allan --out DIR)\n"
     "  bench   speed against error of DIR/bench.csv (navsim bench --out DIR)\n"
+    "  tradeoff  CPU time against each requirement of DIR/tradeoff.csv, one panel per requirement\n"
+    "          (navsim tradeoff --out DIR)\n"
     "--out defaults to RESULT_DIR/VIEW.png. A SCENE file is run first (navsim run --out\n"
     "out/render-<file stem>). Without --view and --out (and with --png/--chart) the old form\n"
     "writes RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
@@ -171,8 +173,9 @@ int navsim_render(int argc, char **argv) {
   }
   if (view && strcmp(view, "3d") != 0 && strcmp(view, "top") != 0 && strcmp(view, "map") != 0 &&
       strcmp(view, "errors") != 0 && strcmp(view, "noise") != 0 && strcmp(view, "allan") != 0 &&
-      strcmp(view, "bench") != 0) {
-    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan or bench, got \"%s\"\n", view);
+      strcmp(view, "bench") != 0 && strcmp(view, "tradeoff") != 0) {
+    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan, bench or tradeoff, got \"%s\"\n",
+            view);
     return RC_INVALID;
   }
   /* A scene file: run it first. */
@@ -227,9 +230,9 @@ int navsim_render(int argc, char **argv) {
     snprintf(out_buf, sizeof out_buf, "%s/%s.png", dir, view);
     out = out_buf;
   }
-  if (strcmp(view, "allan") == 0 || strcmp(view, "bench") == 0) {
+  if (strcmp(view, "allan") == 0 || strcmp(view, "bench") == 0 || strcmp(view, "tradeoff") == 0) {
     snprintf(in_buf, sizeof in_buf, "%s/%s.csv", dir, view);
-    av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : "--speed-vs-error");
+    av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : strcmp(view, "bench") == 0 ? "--speed-vs-error" : "--tradeoff");
     av_add(&v, in_buf);
   } else {
     av_add(&v, dir);
@@ -571,13 +574,99 @@ typedef struct figure {
   bool ok;
 } figure;
 
+/* One CSV line (navsim's own files: "..." quoting, "" inside quotes) into at most @p cap fields,
+   written into @p line in place. @return the number of fields. */
+static int csv_fields(char *line, char **field, int cap) {
+  int n = 0;
+  char *w = line;
+  bool q = false;
+  if (cap > 0) field[n++] = w;
+  for (char *r = line; *r && *r != '\n' && *r != '\r'; ++r) {
+    if (*r == '"') {
+      if (q && r[1] == '"') *w++ = *r++;
+      else q = !q;
+    } else if (*r == ',' && !q) {
+      *w++ = '\0';
+      if (n < cap) field[n++] = w;
+    } else {
+      *w++ = *r;
+    }
+  }
+  *w = '\0';
+  return n;
+}
+
+/* The table of navsim tradeoff's tradeoff.csv: one row per variant, per requirement its value with
+   the interval (P: on the Pareto front), whether it is within the tolerance, the recommendation. */
+static void tradeoff_section(FILE *f, const char *csv, const char *summary) {
+  char *text = read_all(csv, NULL);
+  if (!text) return;
+  fputs("<h2>Speed against error (navsim tradeoff)</h2>\n", f);
+  char what[600];
+  if (summary && json_str(summary, "requirements_of", what, sizeof what)) {
+    fputs("<p>The requirement verdicts above are those of ", f);
+    html_text(f, what);
+    fputs(" (recommended.yaml); the full model's and every variant's are in the table.</p>\n", f);
+  }
+  enum { MAXF = 24 };
+  char *fld[MAXF];
+  char *save = NULL;
+  char *line = strtok_r(text, "\n", &save);
+  int c_var = -1, c_change = -1, c_status = -1, c_note = -1, c_cpu = -1, c_req = -1, c_unit = -1, c_val = -1,
+      c_lo = -1, c_hi = -1, c_within = -1, c_pareto = -1, c_rec = -1;
+  const int nh = line ? csv_fields(line, fld, MAXF) : 0;
+  for (int k = 0; k < nh; ++k) {
+    const char *h = fld[k];
+    int *slot = !strcmp(h, "variant") ? &c_var : !strcmp(h, "change") ? &c_change : !strcmp(h, "status") ? &c_status
+              : !strcmp(h, "note") ? &c_note : !strcmp(h, "cpu_s_per_run") ? &c_cpu : !strcmp(h, "requirement") ? &c_req
+              : !strcmp(h, "unit") ? &c_unit : !strcmp(h, "value") ? &c_val : !strcmp(h, "ci_low") ? &c_lo
+              : !strcmp(h, "ci_high") ? &c_hi : !strcmp(h, "within_tolerance") ? &c_within
+              : !strcmp(h, "pareto") ? &c_pareto : !strcmp(h, "recommended") ? &c_rec : NULL;
+    if (slot) *slot = k;
+  }
+  if (c_var < 0 || c_change < 0 || c_status < 0 || c_note < 0 || c_cpu < 0 || c_req < 0 || c_unit < 0 || c_val < 0 ||
+      c_lo < 0 || c_hi < 0 || c_within < 0 || c_pareto < 0 || c_rec < 0) {
+    fputs("<p>tradeoff.csv: unexpected columns (not written by this navsim).</p>\n", f);
+    free(text);
+    return;
+  }
+  fputs("<table>\n<tr><th class=\"l\">variant</th><th class=\"l\">change</th><th>CPU s/run</th>"
+        "<th class=\"l\">requirement</th><th>value [95 % interval]</th><th class=\"l\">within tolerance</th>"
+        "<th class=\"l\">Pareto</th></tr>\n",
+        f);
+  for (line = strtok_r(NULL, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+    if (csv_fields(line, fld, MAXF) != nh) continue;
+    const bool rec = !strcmp(fld[c_rec], "true"), skipped = strcmp(fld[c_status], "ok") != 0;
+    fputs(rec ? "<tr style=\"background:#e6f0fa\"><td class=\"l\"><b>" : "<tr><td class=\"l\">", f);
+    html_text(f, fld[c_var]);
+    fputs(rec ? " (recommended)</b></td><td class=\"l\">" : "</td><td class=\"l\">", f);
+    html_text(f, fld[c_change]);
+    if (skipped) {
+      fputs("</td><td class=\"l\" colspan=\"5\">skipped: ", f);
+      html_text(f, fld[c_note]);
+      fputs("</td></tr>\n", f);
+      continue;
+    }
+    fprintf(f, "</td><td>%.3g</td><td class=\"l\">", atof(fld[c_cpu]));
+    html_text(f, fld[c_req]);
+    fputs("</td><td>", f);
+    fprintf(f, "%.4g [%.4g, %.4g] ", atof(fld[c_val]), atof(fld[c_lo]), atof(fld[c_hi]));
+    html_text(f, fld[c_unit]);
+    fprintf(f, "</td><td class=\"l\">%s</td><td class=\"l\">%s</td></tr>\n",
+            !strcmp(fld[c_within], "true") ? "yes" : "no", !strcmp(fld[c_pareto], "true") ? "front" : "");
+  }
+  fputs("</table>\n", f);
+  free(text);
+}
+
 static const char *k_usage_report =
     "usage: navsim report RESULT_DIR [--out DIR|FILE.html] [--size WxH]\n"
     "\n"
     "Write an HTML page about a result directory of navsim run, for presentations: the scene\n"
     "summary, the statistics table, the requirement verdicts (summary.json \"requirements\") and\n"
     "every figure the directory supports (3D view, plan view coloured by error, map, error charts,\n"
-    "simulated sensor errors, and allan.csv / bench.csv when present), rendered by navview.\n"
+    "simulated sensor errors, and allan.csv / bench.csv / tradeoff.csv when present), rendered by\n"
+    "navview; for navsim tradeoff's directory also the table of its variants.\n"
     "The page is self-contained (figures embedded); the PNG files are kept next to it.\n"
     "--out: a directory (the page is DIR/report.html) or a FILE.html (figures in its directory);\n"
     "default RESULT_DIR/report/. Rendering needs an X server: without DISPLAY, xvfb-run.\n"
@@ -663,6 +752,8 @@ int navsim_report(int argc, char **argv) {
   const bool have_bench = is_file(path);
   snprintf(path, sizeof path, "%s/truth.csv", dir);
   const bool have_truth = is_file(path);
+  snprintf(path, sizeof path, "%s/tradeoff.csv", dir);
+  const bool have_tradeoff = is_file(path);
 
   figure figs[] = {
       {"3d", "3D view", "Reference (black) and estimated path (red), GNSS fixes (green) and outages (pink), "
@@ -679,6 +770,10 @@ int navsim_report(int argc, char **argv) {
        false},
       {"allan", "Allan deviation", "Log-log, with slope guides.", false},
       {"bench", "Speed against error", "navsim bench: one marker per variant.", false},
+      {"tradeoff", "Speed against error per modelling choice",
+       "navsim tradeoff: CPU time per Monte Carlo run against each requirement's value with its 95 % "
+       "bootstrap interval; green within the tolerance of the full model (dashed band), grey outside, the full "
+       "model as a cross, the recommended variant as a blue diamond, the Pareto front in red.", false},
   };
   const int nfig = (int)(sizeof figs / sizeof figs[0]);
   int failures = 0;
@@ -687,14 +782,15 @@ int navsim_report(int argc, char **argv) {
     const bool applicable = (strcmp(fg->key, "noise") == 0   ? have_imu
                              : strcmp(fg->key, "allan") == 0 ? have_allan
                              : strcmp(fg->key, "bench") == 0 ? have_bench
+                             : strcmp(fg->key, "tradeoff") == 0 ? have_tradeoff
                                                              : have_truth);
     if (!applicable) continue;
     snprintf(path, sizeof path, "%s/%s.png", out_dir, fg->key);
     argvec v;
     av_init(&v);
-    if (strcmp(fg->key, "allan") == 0 || strcmp(fg->key, "bench") == 0) {
+    if (strcmp(fg->key, "allan") == 0 || strcmp(fg->key, "bench") == 0 || strcmp(fg->key, "tradeoff") == 0) {
       snprintf(in_csv, sizeof in_csv, "%s/%s.csv", dir, fg->key);
-      av_add(&v, fg->key[0] == 'a' ? "--allan" : "--speed-vs-error");
+      av_add(&v, fg->key[0] == 'a' ? "--allan" : fg->key[0] == 'b' ? "--speed-vs-error" : "--tradeoff");
       av_add(&v, in_csv);
     } else {
       av_add(&v, dir);
@@ -906,6 +1002,10 @@ int navsim_report(int argc, char **argv) {
     free(req);
   }
   if (nreq == 0) fputs("<p>The scene states no requirements.</p>\n", f);
+  if (have_tradeoff) {
+    snprintf(path, sizeof path, "%s/tradeoff.csv", dir);
+    tradeoff_section(f, path, summary);
+  }
 
   /* Figures, embedded. */
   fputs("<h2>Figures</h2>\n", f);

@@ -1,6 +1,6 @@
 /*
  * --out never deletes what navsim did not write (issue 25): every command that writes a result
- * directory (run, estimate, budget, select, sweep, replay, allan) is given as --out an unrelated
+ * directory (run, estimate, budget, select, sweep, replay, allan, tradeoff) is given as --out an unrelated
  * folder with notes and a sub-folder, a file, a symbolic link to a folder, and the folder that
  * holds its own inputs. Each must exit 2 with a message that says what is there, and leave every
  * pre-existing file byte-identical and nothing new beside it (a canary tree is snapshotted before
@@ -172,7 +172,7 @@ static void command_line(char *buf, size_t cap, const char *cmd, const char *cs,
   }
 }
 
-static const char *const k_commands[] = {"run", "estimate", "budget", "select", "sweep", "replay", "allan"};
+static const char *const k_commands[] = {"run", "estimate", "budget", "select", "sweep", "replay", "allan", "tradeoff"};
 
 static int setup(void **state) {
   (void)state;

@@ -17,7 +17,10 @@
 #include <vtkChartMatrix.h>
 #include <vtkChartXY.h>
 #include <vtkContextScene.h>
+#include <vtkContext2D.h>
 #include <vtkContextView.h>
+#include <vtkObjectFactory.h>
+#include <vtkTransform2D.h>
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkPen.h>
@@ -446,4 +449,287 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
   chart->GetAxis(vtkAxis::LEFT)->SetRange(ymin / 3.0, ymax * 3.0);
   c.view->Render();
   return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
+}
+
+// ------------------------------------------------------------------ tradeoff (navsim tradeoff)
+
+namespace {
+
+// Markers of a tradeoff chart with their interval bars and a text label next to each point.
+// vtkPlotPoints draws the markers; the bars and labels are painted in data coordinates under the
+// chart's transform (the axes are linear here, so data and plot coordinates agree).
+class vtkNavLabelledPoints : public vtkPlotPoints {
+public:
+  static vtkNavLabelledPoints *New();
+  vtkTypeMacro(vtkNavLabelledPoints, vtkPlotPoints)
+  std::vector<double> x, lo, hi, y;
+  std::vector<std::string> labels; // non-empty: this plot is the label layer (no markers, no bars)
+  double y_lo = 0.0, y_hi = 1.0;   // the axis range, to keep labels inside the plot area
+  int font = 10;
+  bool Paint(vtkContext2D *painter) override {
+    if (!this->Visible) return false;
+    if (labels.empty()) {
+      painter->GetPen()->SetColor(this->Pen->GetColor());
+      painter->GetPen()->SetWidth(1.5f);
+      for (size_t i = 0; i < x.size(); ++i)
+        if (std::isfinite(lo[i]) && std::isfinite(hi[i])) painter->DrawLine(x[i], lo[i], x[i], hi[i]);
+      return this->Superclass::Paint(painter);
+    }
+    vtkTransform2D *t = painter->GetTransform();
+    if (!t) return true;
+    vtkTextProperty *tp = painter->GetTextProp();
+    NavApplyFont(tp);
+    tp->SetFontSize(font);
+    tp->SetColor(0.1, 0.1, 0.15);
+    tp->SetJustificationToLeft();
+    tp->SetVerticalJustificationToCentered();
+    tp->BoldOff();
+    // Label placement in pixels: to the right of each point, moved up or down in steps of one
+    // line to the nearest place that overlaps no label placed before (points by decreasing
+    // value), with a leader line when moved.
+    struct Box {
+      double x0, x1, y0, y1;
+    };
+    std::vector<Box> placed;
+    std::vector<size_t> order(x.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return y[a] > y[b]; });
+    double lim[4] = {0.0, y_lo, 0.0, y_hi};
+    t->TransformPoints(lim, lim, 2);
+    const double py_min = std::min(lim[1], lim[3]), py_max = std::max(lim[1], lim[3]);
+    std::vector<double> px(x.size()), py(x.size()), ly(x.size());
+    for (size_t i = 0; i < x.size(); ++i) {
+      double p[2] = {x[i], y[i]};
+      t->TransformPoints(p, p, 1);
+      px[i] = p[0];
+      py[i] = p[1];
+    }
+    // Measure and draw in pixels (scene coordinates): the chart's data transform set aside.
+    vtkNew<vtkTransform2D> identity;
+    painter->PushMatrix();
+    painter->SetTransform(identity);
+    for (size_t i : order) {
+      float b[4] = {0, 0, 0, 0};
+      painter->ComputeStringBounds(labels[i], b);
+      const double w = b[2], h = std::max<double>(b[3], font) + 2.0;
+      const double x0 = px[i] + 7.0;
+      double best = py[i];
+      for (int k = 0; k < 400; ++k) {
+        const double cand = py[i] + ((k % 2) ? 1.0 : -1.0) * h * ((k + 1) / 2);
+        if (cand - h / 2 < py_min || cand + h / 2 > py_max) continue;
+        bool clash = false;
+        for (const Box &o : placed)
+          if (x0 < o.x1 && x0 + w > o.x0 && cand - h / 2 < o.y1 && cand + h / 2 > o.y0) clash = true;
+        if (!clash) {
+          best = cand;
+          break;
+        }
+      }
+      placed.push_back({x0, x0 + w, best - h / 2, best + h / 2});
+      ly[i] = best;
+    }
+    painter->GetPen()->SetColor(150, 150, 150, 255);
+    painter->GetPen()->SetWidth(0.8f);
+    for (size_t i = 0; i < x.size(); ++i)
+      if (std::fabs(ly[i] - py[i]) > 1.0) painter->DrawLine(px[i] + 3.0, py[i], px[i] + 6.0, ly[i]);
+    for (size_t i = 0; i < x.size(); ++i)
+      painter->DrawString(static_cast<float>(px[i] + 7.0), static_cast<float>(ly[i]), labels[i]);
+    painter->PopMatrix();
+    return true;
+  }
+};
+vtkStandardNewMacro(vtkNavLabelledPoints);
+
+struct TradeoffRow {
+  std::string variant, requirement, unit, statistic;
+  double cpu = NAN, value = NAN, lo = NAN, hi = NAN, full = NAN, tol = NAN;
+  bool pareto = false, recommended = false, within = false;
+};
+
+} // namespace
+
+bool NavRenderTradeoffPng(const std::string &csv, const std::string &requirement, const NavChartOptions &opt,
+                          const std::string &path, std::string *error) {
+  std::vector<std::string> h;
+  std::vector<std::vector<std::string>> rows;
+  if (!ReadTextCsv(csv, &h, &rows, error)) return false;
+  auto col = [&](const char *n) {
+    for (size_t i = 0; i < h.size(); ++i)
+      if (h[i] == n) return static_cast<int>(i);
+    return -1;
+  };
+  const char *need[] = {"variant", "status", "cpu_s_per_run", "requirement", "unit", "statistic", "value",
+                        "ci_low", "ci_high", "full_value", "tolerance", "within_tolerance", "pareto", "recommended"};
+  int c[14];
+  for (int k = 0; k < 14; ++k) {
+    c[k] = col(need[k]);
+    if (c[k] < 0) {
+      *error = csv + ":1: error: missing column '" + need[k] + "' (expected navsim tradeoff's tradeoff.csv)";
+      return false;
+    }
+  }
+  std::vector<std::string> reqs;
+  std::map<std::string, std::vector<TradeoffRow>> by_req;
+  for (const auto &r : rows) {
+    if (r.size() < h.size() || r[static_cast<size_t>(c[1])] != "ok") continue;
+    TradeoffRow t;
+    t.variant = r[static_cast<size_t>(c[0])];
+    t.requirement = r[static_cast<size_t>(c[3])];
+    t.unit = r[static_cast<size_t>(c[4])];
+    t.statistic = r[static_cast<size_t>(c[5])];
+    if (!requirement.empty() && t.requirement != requirement) continue;
+    if (!ParseNum(r[static_cast<size_t>(c[2])], &t.cpu) || !ParseNum(r[static_cast<size_t>(c[6])], &t.value))
+      continue;
+    ParseNum(r[static_cast<size_t>(c[7])], &t.lo);
+    ParseNum(r[static_cast<size_t>(c[8])], &t.hi);
+    ParseNum(r[static_cast<size_t>(c[9])], &t.full);
+    ParseNum(r[static_cast<size_t>(c[10])], &t.tol);
+    t.within = r[static_cast<size_t>(c[11])] == "true";
+    t.pareto = r[static_cast<size_t>(c[12])] == "true";
+    t.recommended = r[static_cast<size_t>(c[13])] == "true";
+    if (!by_req.count(t.requirement)) reqs.push_back(t.requirement);
+    by_req[t.requirement].push_back(t);
+  }
+  if (reqs.empty()) {
+    *error = csv + ": error: no evaluated variant" +
+             (requirement.empty() ? std::string() : " for requirement '" + requirement + "'");
+    return false;
+  }
+  ChartCanvas cv;
+  if (!MakeCanvas(&cv, opt, static_cast<int>(reqs.size()), error)) return false;
+  for (size_t k = 0; k < reqs.size(); ++k) {
+    vtkChartXY *chart = Panel(&cv, static_cast<int>(reqs.size() - 1 - k));
+    if (!chart) {
+      *error = "vtkChartMatrix did not create an XY chart";
+      return false;
+    }
+    const std::vector<TradeoffRow> &pts = by_req[reqs[k]];
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, full = NAN, tol = NAN;
+    for (const TradeoffRow &t : pts) {
+      xmin = std::min(xmin, t.cpu);
+      xmax = std::max(xmax, t.cpu);
+      ymin = std::min(ymin, std::isfinite(t.lo) ? std::min(t.lo, t.value) : t.value);
+      ymax = std::max(ymax, std::isfinite(t.hi) ? std::max(t.hi, t.value) : t.value);
+      if (t.variant == "full") full = t.value;
+      tol = t.tol;
+    }
+    // Tolerance band around the full model's value.
+    std::vector<Line> lines;
+    if (std::isfinite(full) && std::isfinite(tol)) {
+      for (int s : {-1, 1}) {
+        Line b;
+        b.name = s < 0 ? "full model \u00b1 tolerance" : "";
+        b.x = {xmin, xmax};
+        b.y = {full * (1.0 + s * tol), full * (1.0 + s * tol)};
+        b.rgb[0] = b.rgb[1] = b.rgb[2] = 120;
+        b.pen = vtkPen::DASH_LINE;
+        b.width = 1.0f;
+        lines.push_back(b);
+        ymin = std::min(ymin, b.y[0]);
+        ymax = std::max(ymax, b.y[0]);
+      }
+    }
+    // Pareto front: its points by increasing CPU time, joined as a staircase.
+    std::vector<const TradeoffRow *> front;
+    for (const TradeoffRow &t : pts)
+      if (t.pareto) front.push_back(&t);
+    std::sort(front.begin(), front.end(), [](const TradeoffRow *a, const TradeoffRow *b) { return a->cpu < b->cpu; });
+    Line pf;
+    pf.name = "Pareto front";
+    pf.rgb[0] = 214;
+    pf.rgb[1] = 39;
+    pf.rgb[2] = 40;
+    pf.width = 2.0f;
+    for (size_t i = 0; i < front.size(); ++i) {
+      if (i > 0) {
+        pf.x.push_back(front[i]->cpu);
+        pf.y.push_back(front[i - 1]->value);
+      }
+      pf.x.push_back(front[i]->cpu);
+      pf.y.push_back(front[i]->value);
+    }
+    lines.push_back(pf);
+    AddLines(chart, lines);
+    // Markers in three groups: within tolerance, outside, and the recommended one.
+    const struct {
+      const char *name;
+      unsigned char rgb[3];
+      int marker;
+      float size;
+    } groups[4] = {{"within tolerance", {44, 160, 44}, vtkPlotPoints::CIRCLE, 9.f},
+                   {"outside tolerance", {127, 127, 127}, vtkPlotPoints::SQUARE, 8.f},
+                   {"full model", {20, 20, 20}, vtkPlotPoints::CROSS, 14.f},
+                   {"recommended", {31, 119, 180}, vtkPlotPoints::DIAMOND, 15.f}};
+    const int font = std::max(8, cv.font - 3);
+    for (int g = 0; g < 4; ++g) {
+      vtkNew<vtkNavLabelledPoints> p;
+      vtkNew<vtkTable> table;
+      vtkNew<vtkDoubleArray> xc, yc;
+      xc->SetName("cpu");
+      yc->SetName(groups[g].name);
+      table->AddColumn(xc);
+      table->AddColumn(yc);
+      for (const TradeoffRow &t : pts) {
+        const int tg = t.recommended ? 3 : t.variant == "full" ? 2 : (t.within ? 0 : 1);
+        if (tg != g) continue;
+        p->x.push_back(t.cpu);
+        p->y.push_back(t.value);
+        p->lo.push_back(t.lo);
+        p->hi.push_back(t.hi);
+      }
+      if (p->x.empty()) continue;
+      table->SetNumberOfRows(static_cast<vtkIdType>(p->x.size()));
+      for (size_t i = 0; i < p->x.size(); ++i) {
+        table->SetValue(static_cast<vtkIdType>(i), 0, p->x[i]);
+        table->SetValue(static_cast<vtkIdType>(i), 1, p->y[i]);
+      }
+      p->font = font;
+      p->SetInputData(table, 0, 1);
+      p->SetColor(groups[g].rgb[0], groups[g].rgb[1], groups[g].rgb[2], 255);
+      p->SetMarkerStyle(groups[g].marker);
+      p->SetMarkerSize(groups[g].size);
+      p->SetWidth(2.0f);
+      p->SetLabel(groups[g].name);
+      chart->AddPlot(p);
+    }
+    const double ys = ymax > ymin ? ymax - ymin : std::max(1e-9, 0.1 * std::fabs(ymax));
+    const double y_lo = std::max(0.0, ymin - 0.1 * ys), y_hi = ymax + 0.1 * ys;
+    if (opt.show_text) {
+      vtkNew<vtkNavLabelledPoints> lab;
+      vtkNew<vtkTable> table;
+      vtkNew<vtkDoubleArray> xc, yc;
+      xc->SetName("cpu");
+      yc->SetName("labels");
+      table->AddColumn(xc);
+      table->AddColumn(yc);
+      table->SetNumberOfRows(static_cast<vtkIdType>(pts.size()));
+      for (size_t i = 0; i < pts.size(); ++i) {
+        lab->x.push_back(pts[i].cpu);
+        lab->y.push_back(pts[i].value);
+        lab->labels.push_back(pts[i].variant);
+        table->SetValue(static_cast<vtkIdType>(i), 0, pts[i].cpu);
+        table->SetValue(static_cast<vtkIdType>(i), 1, pts[i].value);
+      }
+      lab->font = font;
+      lab->y_lo = y_lo;
+      lab->y_hi = y_hi;
+      lab->SetInputData(table, 0, 1);
+      lab->SetLegendVisibility(false);
+      chart->AddPlot(lab);
+    }
+    const TradeoffRow &t0 = pts.front();
+    StyleChart(chart,
+               reqs[k] + " (" + t0.statistic + ") against CPU time: 95 % intervals, Pareto front",
+               "CPU time per Monte Carlo run [s]", reqs[k] + " [" + t0.unit + "]", opt, cv.font);
+    chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+    chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+    const double xs = xmax > xmin ? xmax - xmin : std::max(1e-3, 0.1 * xmax);
+    chart->GetAxis(vtkAxis::BOTTOM)->SetBehavior(vtkAxis::FIXED);
+    // Room on the right for the labels of the slowest points.
+    chart->GetAxis(vtkAxis::BOTTOM)->SetRange(std::max(0.0, xmin - 0.08 * xs), xmax + 0.45 * xs);
+    chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+    chart->GetAxis(vtkAxis::LEFT)->SetRange(y_lo, y_hi);
+  }
+  cv.view->Render();
+  return NavWriteWindowPng(cv.view->GetRenderWindow(), path, error);
 }

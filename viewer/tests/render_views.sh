@@ -1,6 +1,6 @@
 #!/bin/sh
 # navsim render --view for every view on the vendored tiny-gnss result (plus allan.csv and
-# bench.csv), a bad --view (exit 2), a missing directory (exit 1), and a scene file as input
+# bench.csv, tradeoff.csv), a bad --view (exit 2), a missing directory (exit 1), and a scene file as input
 # (run first, then rendered). Usage: render_views.sh NAVSIM DATA_DIR SCENE WORK_DIR
 set -u
 NAVSIM=$1
@@ -10,8 +10,8 @@ WORK=$4
 fail() { echo "render_views: FAILED: $*" >&2; exit 1; }
 rm -rf "$WORK"
 mkdir -p "$WORK" || fail "cannot create $WORK"
-cp -r "$DATA/tiny-gnss" "$WORK/res" && cp "$DATA/allan.csv" "$DATA/bench.csv" "$WORK/res/" || fail "copy"
-for v in 3d top map errors noise allan bench; do
+cp -r "$DATA/tiny-gnss" "$WORK/res" && cp "$DATA/allan.csv" "$DATA/bench.csv" "$DATA/tradeoff.csv" "$WORK/res/" || fail "copy"
+for v in 3d top map errors noise allan bench tradeoff; do
   "$NAVSIM" render "$WORK/res" --view $v --out "$WORK/$v.png" --size 400x300 || fail "--view $v exited $?"
   size=$(wc -c < "$WORK/$v.png") || fail "no $WORK/$v.png"
   [ "$size" -gt 3000 ] || fail "$v.png has only $size bytes"

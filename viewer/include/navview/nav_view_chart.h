@@ -55,4 +55,14 @@ bool NavRenderAllanChartPng(const std::string &allan_csv, const NavChartOptions 
 bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &options, const std::string &path,
                               std::string *error);
 
+/**
+ * Speed against error from tradeoff.csv (`navsim tradeoff`): per requirement (one panel each, or
+ * only @p requirement when not empty) CPU time per run against the requirement's value, each
+ * variant a labelled marker with its confidence interval as a vertical bar, coloured by whether
+ * it is within the tolerance of the full model (dashed band), the recommended one as a diamond,
+ * and the Pareto front (column pareto) as a staircase. Rows with status other than ok are skipped.
+ */
+bool NavRenderTradeoffPng(const std::string &tradeoff_csv, const std::string &requirement,
+                          const NavChartOptions &options, const std::string &path, std::string *error);
+
 #endif /* NAV_VIEW_CHART_H */
