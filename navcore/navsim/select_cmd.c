@@ -523,8 +523,9 @@ int navsim_select(int argc, char **argv) {
     }
   }
   for (int k = 0; k < n_sch; ++k)
-    if (schemes[k] == NAV_SCHEME_GYRO_FREE) {
-      fprintf(stderr, "navsim select: the gyro_free scheme has no catalog sensors to select\n");
+    if (schemes[k] == NAV_SCHEME_GYRO_FREE || schemes[k] == NAV_SCHEME_GYRO_FREE_GNSS) {
+      fprintf(stderr, "navsim select: the %s scheme has no catalog sensors to select (no accelerometer-array "
+                      "catalog yet)\n", nav_nav_scheme_name(schemes[k]));
       rc = EXIT_INVALID;
       goto done;
     }

@@ -419,7 +419,7 @@ nav_status nav_req_evaluator_create_for_scene(const nav_scene *scene, bool ideal
   if (!scene || !out) return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int n = 0;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS) {
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
     const nav_status st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &n);
     if (st != NAV_OK) return st;
   }
@@ -839,7 +839,8 @@ static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
 
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
   if (!scene || (scene->n_requirements > 0 && !out)) return NAV_ERR_INVALID_ARG;
-  if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE)
+  if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE ||
+      scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)
     return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;

@@ -45,6 +45,11 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
                            "(navsim estimate) or Monte Carlo");
     return NAV_ERR_INVALID_ARG;
   }
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+    nav_sim_set_error(sim, "covariance analysis of gyro_free_gnss is not implemented yet; use Monte Carlo "
+                           "(navsim run --runs N: mc_stats.csv has the filter's sigma and NEES)");
+    return NAV_ERR_INVALID_ARG;
+  }
   nav_truth *truth = NULL;
   nav_filter *kf = NULL;
   char msg[200];
