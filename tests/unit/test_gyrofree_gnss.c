@@ -588,6 +588,65 @@ static void test_p_spd_tiny_huge(void **state) {
   }
 }
 
+/*
+ * Observability (docs/gyro-free-gnss.md section 5), by covariance analysis: at rest, GNSS makes
+ * the level components of the rate error and of the angular-acceleration bias observable (their
+ * sigma falls well below P0) but not the vertical one (beta_w,z stays at its prior, dw_z grows);
+ * the drive with its turns and speed changes calibrates the vertical component too.
+ */
+static void final_sigmas(const nav_scene *sc, double *sd0, double *sd1) {
+  nav_truth *truth = NULL;
+  assert_int_equal(nav_truth_create(sc, &truth), NAV_OK);
+  const nav_frame fr = nav_truth_frame(truth);
+  const nav_gyrofree_gnss_config xc = nav_gyrofree_gnss_config_from_scene(sc);
+  nav_gfg_filter *kf = NULL;
+  assert_int_equal(nav_gfg_filter_create(&xc.filter, &kf), NAV_OK);
+  const size_t ns = nav_gfg_filter_n_states(kf);
+  for (size_t i = 0; i < ns; ++i) sd0[i] = sqrt(nav_gfg_filter_cov(kf)[i * ns + i]);
+  const int64_t n = nav_truth_sample_count(truth);
+  const nav_vec3 rp = nav_vec3_make(1.0, 1.0, 4.0), rv = nav_vec3_make(0.0025, 0.0025, 0.01);
+  for (int64_t k = 1; k <= n; ++k) {
+    nav_traj_state ts;
+    nav_imu_increment imu;
+    assert_int_equal(nav_truth_imu(truth, k, &imu), NAV_OK);
+    assert_int_equal(nav_truth_state(truth, imu.t_s, &ts), NAV_OK);
+    nav_filter_nav nv = ref_nav(&fr, &ts, &imu);
+    assert_int_equal(nav_gfg_filter_predict(kf, &nv, imu.dt_s), NAV_OK);
+    if (k % 100 == 0) {
+      assert_int_equal(nav_gfg_filter_update_pos(kf, &nv, nav_vec3_zero(), rp, xc.r_ba_b_m), NAV_OK);
+      assert_int_equal(nav_gfg_filter_update_vel(kf, &nv, nav_vec3_zero(), rv, xc.r_ba_b_m), NAV_OK);
+    }
+  }
+  for (size_t i = 0; i < ns; ++i) sd1[i] = sqrt(nav_gfg_filter_cov(kf)[i * ns + i]);
+  nav_gfg_filter_destroy(kf);
+  nav_truth_destroy(truth);
+}
+
+static void test_observability(void **state) {
+  (void)state;
+  nav_scene drive = read_scene();
+  nav_scene rest = drive;
+  rest.trajectory.type = NAV_TRAJ_TEST_MOTION;
+  rest.trajectory.test_motion.kind = NAV_TEST_MOTION_STATIONARY;
+  rest.trajectory.duration_s = 62.0;
+  rest.trajectory.initial_attitude = (nav_euler){0.0, 0.0, 0.5 * NAV_PI};
+  assert_int_equal(nav_scene_validate(&rest, NULL, NULL), NAV_OK);
+  double r0[NAV_GFG_MAX_STATES], r1[NAV_GFG_MAX_STATES], d0[NAV_GFG_MAX_STATES], d1[NAV_GFG_MAX_STATES];
+  final_sigmas(&rest, r0, r1);
+  final_sigmas(&drive, d0, d1);
+  static const char *nm[9] = {"dw_x", "dw_y", "dw_z", "beta_f_x", "beta_f_y", "beta_f_z", "beta_w_x", "beta_w_y", "beta_w_z"};
+  for (int i = 0; i < 9; ++i)
+    print_message("%-9s P0 %.3g, after 62 s at rest %.3g (x%.3f), after the drive %.3g (x%.3f)\n", nm[i], r0[9 + i],
+                  r1[9 + i], r1[9 + i] / r0[9 + i], d1[9 + i], d1[9 + i] / d0[9 + i]);
+  const int bwx = NAV_GFG_IDX_BW, bwz = NAV_GFG_IDX_BW + 2, dwz = NAV_GFG_IDX_DW + 2;
+  /* At rest: level beta_w well determined, vertical beta_w at its prior, dw_z not held. */
+  assert_true(r1[bwx] < 0.5 * r0[bwx] && r1[bwx + 1] < 0.5 * r0[bwx + 1]);
+  assert_true(r1[bwz] > 0.99 * r0[bwz]);
+  assert_true(r1[dwz] > r0[dwz]);
+  /* The drive calibrates the vertical component. */
+  assert_true(d1[bwz] < 0.5 * d0[bwz]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_ideal_closure),
@@ -595,6 +654,7 @@ int main(void) {
       cmocka_unit_test(test_sim_nees_and_threads),
       cmocka_unit_test(test_fast_rotation_stable),
       cmocka_unit_test(test_p_spd_tiny_huge),
+      cmocka_unit_test(test_observability),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
