@@ -139,9 +139,62 @@ static void test_car_run_agrees_with_estimate(void **state) {
   free(mc.v);
 }
 
+/*
+ * navsim select --schemes ins_gnss,gyro_free_gnss over every catalog IMU (one receiver, to keep
+ * the test short): ranking.csv ranks both schemes, one row per IMU and scheme, with finite
+ * predicted values for every requirement.
+ */
+static void test_select_both_schemes(void **state) {
+  (void)state;
+  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                                        "select '%s' --schemes ins_gnss,gyro_free_gnss --receivers 'standalone SPS typical "
+                                        "(single-frequency code, open sky)' --runs 10 --out sel",
+                                        SCENE);
+  if (r->code != 0 && r->code != 3) fail_msg("select: %d\n%s", r->code, r->err);
+  char *csv = nav_test_slurp_alloc(WORK "/sel/ranking.csv");
+  assert_non_null(csv);
+  int n_ins = 0, n_gf = 0;
+  for (char *line = strtok(csv, "\n"); line; line = strtok(NULL, "\n")) {
+    if (strstr(line, ",gyro_free_gnss,")) ++n_gf;
+    else if (strstr(line, ",ins_gnss,")) ++n_ins;
+    if (strstr(line, "nan")) fail_msg("non-finite value in ranking.csv: %s", line);
+  }
+  free(csv);
+  char cat[65536];
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "catalog --imu --csv");
+  assert_int_equal(r->code, 0);
+  snprintf(cat, sizeof cat, "%s", r->out);
+  int n_imu = -1; /* header */
+  for (const char *p = cat; *p; ++p) n_imu += *p == '\n';
+  print_message("select: %d ins_gnss and %d gyro_free_gnss rows for %d catalog IMUs\n", n_ins, n_gf, n_imu);
+  assert_true(n_imu > 0);
+  assert_int_equal(n_ins, n_imu);
+  assert_int_equal(n_gf, n_imu);
+}
+
+/*
+ * navsim sweep --predict of the car's array noise density: the outage-end requirement has a
+ * threshold between two grid points, and every predicted value is finite.
+ */
+static void test_sweep_noise_threshold(void **state) {
+  (void)state;
+  nav_cli_result *r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL,
+      "sweep '%s' --param array.accel.noise_density_ug_per_sqrt_hz=10:1000:9:log --predict --quiet --out sw", SCENE);
+  if (r->code != 0) fail_msg("sweep: %d\n%s", r->code, r->err);
+  char buf[8192];
+  nav_test_slurp(WORK "/sw/sweep.csv", buf, sizeof buf);
+  assert_null(strstr(buf, "nan"));
+  nav_test_slurp(WORK "/sw/thresholds.csv", buf, sizeof buf);
+  print_message("%s", buf);
+  nav_test_assert_matches(buf, "h-outage-end,4,m,array.accel.noise_density_ug_per_sqrt_hz,[0-9.]+,interpolated,31.62[0-9]*,56.23");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_car_run_agrees_with_estimate),
+      cmocka_unit_test(test_select_both_schemes),
+      cmocka_unit_test(test_sweep_noise_threshold),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
