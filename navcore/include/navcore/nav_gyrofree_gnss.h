@@ -13,7 +13,13 @@
  * | dw     | NAV_GFG_IDX_DW     | 3    | angular-rate error omega_ib_b, computed - true, body     | rad/s   |
  * | beta_f | NAV_GFG_IDX_BF     | 3    | specific-force bias left in H^+ dA / dt, body            | m/s^2   |
  * | beta_w | NAV_GFG_IDX_BW     | 3    | angular-acceleration bias left in H^+ dA / dt, body      | rad/s^2 |
- * | e_gnss | NAV_GFG_IDX_GNSS   | 3    | GNSS position error, Gauss-Markov, N/E/D (optional)      | m       |
+ * | beta_c | 18 (optional)      | 6    | constant (turn-on) part of beta_f, beta_w when the sensors also have a Gauss-Markov bias | |
+ * | e_gnss | 18 or 24 (optional)| 3    | GNSS position error, Gauss-Markov, N/E/D                 | m       |
+ *
+ * With both a turn-on and a Gauss-Markov bias per sensor, beta_f and beta_w carry the
+ * Gauss-Markov part and beta_c the constant part (one Gauss-Markov state of the combined sigma
+ * would let the constant part decay: overconfident); nav_gfg_filter_idx_const_bias() and
+ * nav_gfg_filter_idx_gnss() give where the optional blocks are.
  *
  * The six bias states are the combinations beta = H^+ b of the N per-sensor biases b: exactly
  * the part of b that reaches the navigation (the rest, N - 6 dimensions, is annihilated by H^+
@@ -63,12 +69,11 @@ NAV_BEGIN_DECLS
 #define NAV_GFG_IDX_DW 9
 #define NAV_GFG_IDX_BF 12
 #define NAV_GFG_IDX_BW 15
-#define NAV_GFG_IDX_GNSS 18
 /** @} */
 /** States of the core model (dr, dv, phi, dw, beta_f, beta_w). */
 #define NAV_GFG_N_CORE 18
-/** Largest state count (core + GNSS position Gauss-Markov). */
-#define NAV_GFG_MAX_STATES 21
+/** Largest state count (core + constant-bias block + GNSS position Gauss-Markov). */
+#define NAV_GFG_MAX_STATES 27
 
 /** Filter configuration, SI. Start from nav_gfg_filter_config_default(). */
 typedef struct nav_gfg_filter_config {
@@ -97,15 +102,23 @@ typedef struct nav_gfg_filter nav_gfg_filter;
 
 /**
  * Create with x = 0 and P = P0 (diagonal blocks; the bias block (sigma_c^2 + sigma_gm^2)
- * (H^T H)^-1, floored).
+ * (H^T H)^-1, floored; split into sigma_gm^2 (H^T H)^-1 on beta and sigma_c^2 (H^T H)^-1 on beta_c
+ * when both parts are present).
  * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, bad value); NAV_ERR_NUMERIC (singular layout);
  *         NAV_ERR_NO_MEMORY.
  */
 NAV_API NAV_NODISCARD nav_status nav_gfg_filter_create(const nav_gfg_filter_config *cfg, nav_gfg_filter **out);
 /** Destroy; accepts NULL. */
 NAV_API void nav_gfg_filter_destroy(nav_gfg_filter *f);
-/** Number of states: 18 or 21. */
+/** Number of states: 18, 21, 24 or 27. */
 NAV_API size_t nav_gfg_filter_n_states(const nav_gfg_filter *f);
+/** First index of the GNSS Gauss-Markov block (18 or 24), 0 when there is none. */
+NAV_API size_t nav_gfg_filter_idx_gnss(const nav_gfg_filter *f);
+/** First index of the constant-bias block beta_c (18), 0 when there is none. */
+NAV_API size_t nav_gfg_filter_idx_const_bias(const nav_gfg_filter *f);
+/** The estimated bias combinations beta (6: f [m/s^2], omega_dot [rad/s^2]): beta_f, beta_w plus
+ *  beta_c when present. NULL-safe. */
+NAV_API void nav_gfg_filter_bias_estimate(const nav_gfg_filter *f, double beta[6]);
 
 /**
  * Time update over one array interval at the linearisation point @p nav (its f_ib_b_mps2 is the
@@ -131,7 +144,7 @@ NAV_API NAV_NODISCARD nav_status nav_gfg_filter_update_pos(nav_gfg_filter *f, co
 NAV_API NAV_NODISCARD nav_status nav_gfg_filter_update_vel(nav_gfg_filter *f, const nav_filter_nav *nav,
                                                            nav_vec3 z_vel_ned_mps, nav_vec3 r_diag_m2s2,
                                                            nav_vec3 l_ba_b_m);
-/** Zero the states the INS absorbs on feedback (0..17); P is kept (first-order reset). */
+/** Zero the states the INS absorbs on feedback (0..17, and beta_c); P is kept (first-order reset). */
 NAV_API void nav_gfg_filter_reset_errors(nav_gfg_filter *f);
 /** x (n doubles; borrowed, valid until the next non-const call or destroy). */
 NAV_API const double *nav_gfg_filter_state(const nav_gfg_filter *f);

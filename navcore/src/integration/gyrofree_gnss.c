@@ -21,6 +21,10 @@ struct nav_gfg_filter {
   nav_array_geometry geom;
   nav_accel_array array; /* axes renormalised */
   size_t n;
+  bool split;      /* turn-on and Gauss-Markov bias parts as separate states (idx_bc) */
+  size_t idx_bc;   /* first of the six constant-bias states (valid when split) */
+  size_t idx_gnss; /* first GNSS state (valid with cfg.gnss_gm) */
+  size_t n_fb;     /* states fed back and reset: 18, or 24 when split */
   double x[NMAX];
   double P[NMAX * NMAX];
   double q_bias; /* per-sensor GM bias spectral density 2 sigma^2 / T [m^2/s^5] (0: none) */
@@ -83,7 +87,14 @@ nav_status nav_gfg_filter_create(const nav_gfg_filter_config *cfg, nav_gfg_filte
   f->array = cfg->array;
   for (int i = 0; i < f->array.n_sensors; ++i)
     f->array.n_s_b[i] = nav_vec3_scale(f->array.n_s_b[i], 1.0 / nav_vec3_norm(f->array.n_s_b[i]));
-  f->n = cfg->gnss_gm ? NAV_GFG_MAX_STATES : NAV_GFG_N_CORE;
+  /* A bias with both a turn-on (constant) and a Gauss-Markov part needs two sets of states: one
+   * Gauss-Markov state of the combined sigma would let the constant part decay and make the
+   * filter overconfident (docs/gyro-free-gnss.md section 2). */
+  f->split = cfg->bias_gm && cfg->bias_const_sd_mps2 > 0.0;
+  f->idx_bc = NAV_GFG_N_CORE;
+  f->n_fb = f->split ? NAV_GFG_N_CORE + 6 : NAV_GFG_N_CORE;
+  f->idx_gnss = f->n_fb;
+  f->n = f->n_fb + (cfg->gnss_gm ? 3 : 0);
   f->q_bias = cfg->bias_gm ? 2.0 * cfg->bias_gm_sd_mps2 * cfg->bias_gm_sd_mps2 / cfg->bias_gm_tau_s : 0.0;
   const size_t n = f->n;
   const nav_vec3 *sd[4] = {&cfg->pos_sd_m, &cfg->vel_sd_mps, &cfg->att_sd_rad, &cfg->rate_sd_rps};
@@ -95,14 +106,18 @@ nav_status nav_gfg_filter_create(const nav_gfg_filter_config *cfg, nav_gfg_filte
   /* Bias block: beta = H^+ b with independent per-sensor biases of variance sigma^2 has the
    * covariance sigma^2 H^+ H^+T = sigma^2 (H^T H)^-1 (geom.cov). */
   const double gm2 = cfg->bias_gm ? cfg->bias_gm_sd_mps2 * cfg->bias_gm_sd_mps2 : 0.0;
-  const double s2 = fmax(cfg->bias_const_sd_mps2 * cfg->bias_const_sd_mps2 + gm2,
-                         cfg->bias_sd_floor_mps2 * cfg->bias_sd_floor_mps2);
+  const double c2 = cfg->bias_const_sd_mps2 * cfg->bias_const_sd_mps2, fl2 = cfg->bias_sd_floor_mps2 * cfg->bias_sd_floor_mps2;
+  /* Split: the GM part on beta, the constant part on its own block; else both on beta. */
+  const double s2 = f->split ? fmax(gm2, fl2) : fmax(c2 + gm2, fl2);
   for (size_t a = 0; a < 6; ++a)
-    for (size_t b = 0; b < 6; ++b) f->P[(NAV_GFG_IDX_BF + a) * n + NAV_GFG_IDX_BF + b] = s2 * f->geom.cov[a][b];
+    for (size_t b = 0; b < 6; ++b) {
+      f->P[(NAV_GFG_IDX_BF + a) * n + NAV_GFG_IDX_BF + b] = s2 * f->geom.cov[a][b];
+      if (f->split) f->P[(f->idx_bc + a) * n + f->idx_bc + b] = fmax(c2, fl2) * f->geom.cov[a][b];
+    }
   if (cfg->gnss_gm)
     for (int i = 0; i < 3; ++i) {
       const double s = nav_vec3_get(cfg->gnss_gm_sd_m, i);
-      f->P[(size_t)(NAV_GFG_IDX_GNSS + i) * (n + 1)] = s * s;
+      f->P[(f->idx_gnss + (size_t)i) * (n + 1)] = s * s;
     }
   if (!is_pd(f->P, n)) {
     free(f);
@@ -121,7 +136,15 @@ const nav_array_geometry *nav_gfg_filter_geometry(const nav_gfg_filter *f) { ret
 const char *nav_gfg_filter_last_error(const nav_gfg_filter *f) { return f ? f->msg : ""; }
 
 void nav_gfg_filter_reset_errors(nav_gfg_filter *f) {
-  if (f) memset(f->x, 0, NAV_GFG_N_CORE * sizeof f->x[0]);
+  if (f) memset(f->x, 0, f->n_fb * sizeof f->x[0]);
+}
+
+size_t nav_gfg_filter_idx_gnss(const nav_gfg_filter *f) { return f && f->cfg.gnss_gm ? f->idx_gnss : 0; }
+size_t nav_gfg_filter_idx_const_bias(const nav_gfg_filter *f) { return f && f->split ? f->idx_bc : 0; }
+
+void nav_gfg_filter_bias_estimate(const nav_gfg_filter *f, double beta[6]) {
+  if (!f || !beta) return;
+  for (size_t a = 0; a < 6; ++a) beta[a] = f->x[NAV_GFG_IDX_BF + a] + (f->split ? f->x[f->idx_bc + a] : 0.0);
 }
 
 /*
@@ -180,11 +203,16 @@ static void build_model(const nav_gfg_filter *f, const nav_filter_nav *nav, doub
       F[(NAV_GFG_IDX_DW + (size_t)i) * n + NAV_GFG_IDX_DW + (size_t)c] = -M[3 + i][c];
     }
   for (size_t i = 0; i < 3; ++i) F[(NAV_GFG_IDX_DW + i) * n + NAV_GFG_IDX_BW + i] = 1.0;
+  if (f->split) /* the constant part enters as the Gauss-Markov part does: C_b_n on dv, I on dw */
+    for (size_t i = 0; i < 3; ++i) {
+      for (size_t c = 0; c < 3; ++c) F[(NAV_GFG_IDX_DV + i) * n + f->idx_bc + c] = C.m[i][c];
+      F[(NAV_GFG_IDX_DW + i) * n + f->idx_bc + 3 + i] = 1.0;
+    }
   if (f->cfg.bias_gm)
     for (size_t i = 0; i < 6; ++i) F[(NAV_GFG_IDX_BF + i) * (n + 1)] = -1.0 / f->cfg.bias_gm_tau_s;
   if (f->cfg.gnss_gm)
     for (int i = 0; i < 3; ++i)
-      F[(NAV_GFG_IDX_GNSS + (size_t)i) * (n + 1)] = -1.0 / nav_vec3_get(f->cfg.gnss_gm_tau_s, i);
+      F[(f->idx_gnss + (size_t)i) * (n + 1)] = -1.0 / nav_vec3_get(f->cfg.gnss_gm_tau_s, i);
   /* Sensor white noise: [w_f; w_w] = D w with cov N^2 (H^T H)^-1; w_f enters dv through C_b_n. */
   const double q = f->cfg.vrw_mps_per_sqrt_s * f->cfg.vrw_mps_per_sqrt_s;
   double Cc[3][3], Cfw[3][3];
@@ -212,7 +240,7 @@ static void build_model(const nav_gfg_filter *f, const nav_filter_nav *nav, doub
   if (f->cfg.gnss_gm)
     for (int i = 0; i < 3; ++i) {
       const double s = nav_vec3_get(f->cfg.gnss_gm_sd_m, i);
-      Q[(NAV_GFG_IDX_GNSS + (size_t)i) * (n + 1)] = 2.0 * s * s / nav_vec3_get(f->cfg.gnss_gm_tau_s, i);
+      Q[(f->idx_gnss + (size_t)i) * (n + 1)] = 2.0 * s * s / nav_vec3_get(f->cfg.gnss_gm_tau_s, i);
     }
 }
 
@@ -365,7 +393,7 @@ nav_status nav_gfg_filter_update_pos(nav_gfg_filter *f, const nav_filter_nav *na
   nav_filter_build_H_pos(H15, &lay, nav, l);
   embed_h(f, H15, H);
   if (f->cfg.gnss_gm) /* z = dr - e_gnss */
-    for (size_t c = 0; c < 3; ++c) H[c * f->n + NAV_GFG_IDX_GNSS + c] = -1.0;
+    for (size_t c = 0; c < 3; ++c) H[c * f->n + f->idx_gnss + c] = -1.0;
   return update3(f, H, z, r, "GNSS position");
 }
 
@@ -555,8 +583,9 @@ nav_status nav_gyrofree_gnss_update(nav_gyrofree_gnss *x, const nav_ins_gnss_fix
   fs.q_b_n = v.q_b_n;
   nav_filter_apply_correction(&fs, &fs, &dx);
   const nav_ins_state corrected = nav_ins_gnss_state_ecef(&fs, nav_gyrofree_get_state(x->gf)->t_s);
-  double beta[6];
-  for (int a = 0; a < 6; ++a) beta[a] = x->beta[a] + xs[NAV_GFG_IDX_BF + a];
+  double beta[6], dbeta[6];
+  nav_gfg_filter_bias_estimate(x->kf, dbeta);
+  for (int a = 0; a < 6; ++a) beta[a] = x->beta[a] + dbeta[a];
   /* The compensation first: it is the call that can refuse (non-finite), before anything moved. */
   st = nav_gyrofree_set_compensation(x->gf, beta);
   if (st == NAV_OK) st = nav_gyrofree_correct(x->gf, &corrected, nav_vec3_make(xs[9], xs[10], xs[11]));
