@@ -178,6 +178,43 @@ private slots:
     Shot(w.get(), "journey-05-error-chart");
   }
 
+  // Issue 21: the gyro-free INS aided by GNSS from the Model panel. A scene of that scheme shows
+  // it in the scheme list; choosing it from another scheme turns the receiver on; a Monte Carlo
+  // run reports the filter's sigma band beside the Monte Carlo band, and the requirement verdicts.
+  void gyro_free_gnss_scheme() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->OpenFile(studio::ScenesDir() + "/gyro-free-gnss-car.yaml"));
+    auto *scheme = w->findChild<QComboBox *>("scheme");
+    QVERIFY(scheme);
+    QCOMPARE(scheme->currentText(), QString("gyro_free_gnss"));
+    QVERIFY(!scheme->itemData(scheme->currentIndex(), Qt::ToolTipRole).toString().isEmpty());
+    w->Panels()->setCurrentIndex(0);
+    Choose(scheme, "free_ins", Qt::MatchExactly);
+    QCOMPARE(static_cast<int>(w->Doc()->Scene().navigation.scheme), static_cast<int>(NAV_SCHEME_FREE_INS));
+    w->Doc()->Edit("receiver off", [](nav_scene &s) { s.gnss.enabled = false; });
+    Choose(scheme, "gyro_free_gnss", Qt::MatchExactly);
+    QCOMPARE(static_cast<int>(w->Doc()->Scene().navigation.scheme), static_cast<int>(NAV_SCHEME_GYRO_FREE_GNSS));
+    QVERIFY(w->Doc()->Scene().gnss.enabled);
+    TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "4");
+    QCOMPARE(w->Doc()->Scene().simulation.runs, 4L);
+    QVERIFY(w->Run());
+    QVERIFY2(WaitUntil([&] { return !w->Worker()->IsBusy(); }, 600000), "the Monte Carlo run did not finish");
+    auto r = w->LastResult();
+    QVERIFY(r);
+    QCOMPARE(r->status, static_cast<int>(NAV_OK));
+    QCOMPARE(r->summary.runs, 4L);
+    QVERIFY(r->env_t_s.size() > 10);
+    QCOMPARE(r->env_sd_h_m.size(), r->env_t_s.size());
+    for (double sd : r->env_sd_h_m) QVERIFY(std::isfinite(sd) && sd > 0.0);
+    QCOMPARE(static_cast<int>(r->verdicts.size()), 2);
+    QVERIFY(r->verdicts[0].evaluated && r->verdicts[0].outage_count == 1);
+    qInfo("gyro_free_gnss: 4 runs in %.1f s, %s = %.3f m (limit %.1f m)", r->wall_s, r->verdicts[0].id,
+          r->verdicts[0].value, r->verdicts[0].limit);
+    Shot(w.get(), "gyro-free-gnss-01-run");
+  }
+
   // Fields validate as the user types, with the messages of `navsim check`; nothing is
   // committed until Enter, and a valid value then clears the message.
   void validation() {

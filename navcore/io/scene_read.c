@@ -178,6 +178,7 @@ static const nav_io_enum_value k_mech_algorithms[] = {
 static const nav_io_enum_value k_schemes[] = {{"free_ins", NAV_SCHEME_FREE_INS},
                                               {"ins_gnss", NAV_SCHEME_INS_GNSS},
                                               {"gyro_free", NAV_SCHEME_GYRO_FREE},
+                                              {"gyro_free_gnss", NAV_SCHEME_GYRO_FREE_GNSS},
                                               {NULL, 0}};
 static const nav_io_enum_value k_array_layouts[] = {{"cube6", NAV_ARRAY_LAYOUT_CUBE6},
                                                     {"nine", NAV_ARRAY_LAYOUT_NINE},
@@ -2619,7 +2620,8 @@ static bool array_sensors_written(const nav_io_writer *w, const nav_io_field *f,
 static bool array_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
   (void)w;
   const nav_scene *s = base;
-  return s->navigation.scheme == NAV_SCHEME_GYRO_FREE || !nav_io_section_same(f->section, base, def);
+  return s->navigation.scheme == NAV_SCHEME_GYRO_FREE || s->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+         !nav_io_section_same(f->section, base, def);
 }
 
 /* ---------------------------------------------------------------- bias instability -> GM */

@@ -103,7 +103,7 @@ static double vmax3(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
 /* The sources present in @p sc; returns their count. */
 static int mc_sources(const nav_scene *sc, mc_source *out, int cap) {
   int n = 0;
-  const bool gf = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE;
+  const bool gf = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   const unsigned skip = NAV_IMU_TERM_SATURATION; /* a limit, not an error source */
   for (int t = 0; t < 9 && n < cap; ++t) {
     const unsigned bit = 1u << t;
@@ -143,7 +143,8 @@ static int mc_sources(const nav_scene *sc, mc_source *out, int cap) {
       out[n].kind = init[i].kind;
       out[n++].bit = 0;
     }
-  if (sc->gnss.enabled && sc->navigation.scheme == NAV_SCHEME_INS_GNSS) {
+  if (sc->gnss.enabled &&
+      (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)) {
     static const char *const gn[3] = {"gnss_position_correlated", "gnss_position_noise", "gnss_velocity_noise"};
     for (int t = 0; t < 3 && n < cap; ++t)
       if (sc->gnss.model.terms & (1u << t)) {
@@ -293,7 +294,8 @@ int navsim_budget(int argc, char **argv) {
     const long nc = sysconf(_SC_NPROCESSORS_ONLN);
     threads = sc->simulation.threads > 0 ? sc->simulation.threads : (nc > 0 ? nc : 1);
   }
-  const bool covariance = sc->earth.model == NAV_EARTH_WGS84 && sc->navigation.scheme != NAV_SCHEME_GYRO_FREE;
+  const bool covariance = sc->earth.model == NAV_EARTH_WGS84 && sc->navigation.scheme != NAV_SCHEME_GYRO_FREE &&
+                          sc->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS;
   nav_requirement reqs[NAV_SCENE_MAX_REQUIREMENTS];
   int nreq = sc->n_requirements;
   for (int i = 0; i < nreq; ++i) reqs[i] = sc->requirements[i];

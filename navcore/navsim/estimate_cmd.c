@@ -108,7 +108,9 @@ static nav_analytic_estimate_config analytic_config(const nav_scene *sc) {
   if (g->terms & NAV_IMU_TERM_BIAS_RW) s->gyro_rrw_rps_per_sqrt_s = vmax(g->bias_rw_rps_per_sqrt_s);
   /* Gyro-free scheme: the array's geometry (kappa from its H, E1.23-E1.25) and per-sensor errors
    * (biases as zero-mean random constants: turn-on and GM sigma combined). */
-  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && nav_array_layout_from_scene(&sc->array, &c.array) == NAV_OK) {
+  /* gyro_free_gnss: the same closed forms describe its array alone, i.e. how fast an outage grows. */
+  if ((sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) &&
+      nav_array_layout_from_scene(&sc->array, &c.array) == NAV_OK) {
     const nav_array_error_config *ae = &sc->array.accel;
     c.with_gyrofree = true;
     c.array_accel_bias_mps2 = hypot((ae->terms & NAV_IMU_TERM_BIAS_TURN_ON) ? ae->bias_turn_on_sd_mps2 : 0.0,

@@ -32,7 +32,8 @@ struct navsim_gnss_out {
 nav_status navsim_gnss_out_begin(const nav_scene *scene, bool ideal, const char *gnss_path, const char *outages_path,
                                  navsim_gnss_out **out) {
   *out = NULL;
-  if (scene->navigation.scheme != NAV_SCHEME_INS_GNSS) return NAV_OK;
+  if (scene->navigation.scheme != NAV_SCHEME_INS_GNSS && scene->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS)
+    return NAV_OK;
   nav_gnss_model_config cfg;
   char msg[256];
   nav_status st = nav_sim_gnss_config(scene, 1.0 / scene->imu.rate_hz, &cfg, msg, sizeof msg);

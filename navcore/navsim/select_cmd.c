@@ -34,6 +34,7 @@
 #include <unistd.h>
 
 #include "catalog_cmd.h"
+#include "navcore/nav_array.h"
 #include "navcore/nav_catalog.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_requirements.h"
@@ -70,7 +71,10 @@ static const char *k_usage_select =
     "options:\n"
     "  --imus NAMES       IMU names separated by commas, or all (default)\n"
     "  --receivers NAMES  receiver modes separated by commas, or all (default)\n"
-    "  --schemes LIST     free_ins and/or ins_gnss, comma-separated (default: the scene's scheme)\n"
+    "  --schemes LIST     free_ins, ins_gnss and/or gyro_free_gnss, comma-separated (default: the\n"
+    "                     scene's scheme); gyro_free_gnss puts the catalog IMU's accelerometers\n"
+    "                     (noise, turn-on and Gauss-Markov bias; not its scale factors or bias random\n"
+    "                     walk) into every sensor of the scene's array (layout and arm kept)\n"
     "  --runs N           Monte Carlo runs per confirmed configuration (default 20)\n"
     "  --threads N        worker threads (default one per core); results do not depend on it\n"
     "  --band F           pruning band factor > 1 (default 1.5)\n"
@@ -110,6 +114,35 @@ typedef struct ctx {
 
 static double class_usd(int k) { return k >= 1 ? 3.0 * pow(10.0, k) : 0.0; }
 
+static double vmax3(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
+
+/*
+ * gyro_free_gnss: every sensor of the scene's array (its layout and arm) gets the error model of
+ * the catalog IMU's accelerometers: white noise, turn-on bias (random and fixed parts as one
+ * sigma) and Gauss-Markov bias, the largest axis of each. The terms the array model does not
+ * have (scale factor: not estimated by the gyro-free filter, refused by the scheme; bias random
+ * walk, misalignment, quantisation, range) are left out, so the array is somewhat optimistic.
+ */
+static nav_array_error_config array_accel_of(const nav_accel_error_config *a) {
+  nav_array_error_config o = nav_array_error_config_default();
+  if (a->terms & NAV_IMU_TERM_NOISE) {
+    o.terms |= NAV_IMU_TERM_NOISE;
+    o.vrw_mps_per_sqrt_s = vmax3(a->vrw_mps_per_sqrt_s);
+  }
+  if (a->terms & NAV_IMU_TERM_BIAS_TURN_ON) {
+    o.terms |= NAV_IMU_TERM_BIAS_TURN_ON;
+    o.bias_turn_on_sd_mps2 = hypot(vmax3(a->bias_turn_on_sd_mps2),
+                                   fmax(fmax(fabs(a->bias_turn_on_fixed_mps2.x), fabs(a->bias_turn_on_fixed_mps2.y)),
+                                        fabs(a->bias_turn_on_fixed_mps2.z)));
+  }
+  if (a->terms & NAV_IMU_TERM_BIAS_GM) {
+    o.terms |= NAV_IMU_TERM_BIAS_GM;
+    o.bias_gm_sd_mps2 = vmax3(a->bias_gm_sd_mps2);
+    o.bias_gm_tau_s = vmax3(a->bias_gm_tau_s);
+  }
+  return o;
+}
+
 /* The scene of a combination (heap). */
 static nav_status make_scene(const ctx *x, const combo *c, nav_scene *sc) {
   *sc = *x->base;
@@ -117,6 +150,7 @@ static nav_status make_scene(const ctx *x, const combo *c, nav_scene *sc) {
   sc->imu.model = ie->config;
   snprintf(sc->imu.catalog, sizeof sc->imu.catalog, "%s", ie->name);
   sc->navigation.scheme = c->scheme;
+  if (c->scheme == NAV_SCHEME_GYRO_FREE_GNSS) sc->array.accel = array_accel_of(&ie->config.accel);
   if (c->gnss >= 0) {
     const nav_catalog_gnss_entry *ge = nav_catalog_gnss_at(x->gnss, (size_t)c->gnss);
     const nav_gnss_model_config old = x->base->gnss.model;
@@ -170,7 +204,8 @@ nav_status navsim_predict_requirements(const nav_scene *sc, nav_requirement_verd
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   nav_status st = NAV_OK;
-  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS) st = nav_req_scene_outages(sc, iv, NAV_REQ_MAX_OUTAGES, &ni);
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)
+    st = nav_req_scene_outages(sc, iv, NAV_REQ_MAX_OUTAGES, &ni);
   if (st != NAV_OK) return st;
   nav_sim *sim = NULL;
   st = nav_sim_create(sc, &sim);
@@ -503,7 +538,7 @@ int navsim_select(int argc, char **argv) {
     rc = EXIT_INVALID;
     goto done;
   }
-  nav_nav_scheme schemes[2];
+  nav_nav_scheme schemes[3];
   int n_sch = 0;
   if (!schemes_s) {
     schemes[n_sch++] = base->navigation.scheme;
@@ -514,12 +549,16 @@ int navsim_select(int argc, char **argv) {
       nav_nav_scheme s;
       if (!strcmp(tok, "free_ins")) s = NAV_SCHEME_FREE_INS;
       else if (!strcmp(tok, "ins_gnss")) s = NAV_SCHEME_INS_GNSS;
+      else if (!strcmp(tok, "gyro_free_gnss")) s = NAV_SCHEME_GYRO_FREE_GNSS;
       else {
-        fprintf(stderr, "navsim select: --schemes: expected free_ins and/or ins_gnss, got \"%s\"\n", tok);
+        fprintf(stderr, "navsim select: --schemes: expected free_ins, ins_gnss and/or gyro_free_gnss, got \"%s\"\n",
+                tok);
         rc = EXIT_INVALID;
         goto done;
       }
-      if (n_sch < 2 && (n_sch == 0 || schemes[0] != s)) schemes[n_sch++] = s;
+      bool dup = false;
+      for (int q = 0; q < n_sch; ++q) dup = dup || schemes[q] == s;
+      if (n_sch < 3 && !dup) schemes[n_sch++] = s;
     }
   }
   for (int k = 0; k < n_sch; ++k)
@@ -558,11 +597,12 @@ int navsim_select(int argc, char **argv) {
     if (!c) goto done;
     for (int s = 0; s < n_sch; ++s)
       for (int i = 0; i < n_imu; ++i) {
-        const int nr = schemes[s] == NAV_SCHEME_INS_GNSS ? n_rcv : 1;
+        const bool aided = schemes[s] == NAV_SCHEME_INS_GNSS || schemes[s] == NAV_SCHEME_GYRO_FREE_GNSS;
+        const int nr = aided ? n_rcv : 1;
         for (int g = 0; g < nr; ++g) {
           combo *k = &c[n++];
           k->imu = imu_idx[i];
-          k->gnss = schemes[s] == NAV_SCHEME_INS_GNSS ? rcv_idx[g] : -1;
+          k->gnss = aided ? rcv_idx[g] : -1;
           k->scheme = schemes[s];
           k->imu_cls = nav_catalog_imu_at(imus, (size_t)k->imu)->cost_class;
           k->gnss_cls = k->gnss >= 0 ? nav_catalog_gnss_at(gnss, (size_t)k->gnss)->cost_class : 0;

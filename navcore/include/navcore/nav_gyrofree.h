@@ -123,6 +123,28 @@ NAV_API const nav_imu_increment *nav_gyrofree_last_increment(const nav_gyrofree 
 /** The array geometry in use (borrowed; valid until destroy). */
 NAV_API const nav_array_geometry *nav_gyrofree_geometry(const nav_gyrofree *gf);
 
+/**
+ * Closed-loop compensation of the array's sensor errors (nav_gyrofree_gnss.h): from the next step
+ * on, @p beta * dt is subtracted from y = H^+ dA, i.e. beta[0..2] is the estimated specific-force
+ * bias [m/s^2] and beta[3..5] the estimated angular-acceleration bias [rad/s^2], both the
+ * combinations H^+ b of the per-sensor biases b. Replaces any previous compensation.
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL); NAV_ERR_NUMERIC (non-finite value, nothing changed).
+ */
+NAV_API NAV_NODISCARD nav_status nav_gyrofree_set_compensation(nav_gyrofree *gf, const double beta[6]);
+
+/**
+ * Closed-loop feedback: replace the navigation state (when @p state is not NULL) and subtract
+ * the estimated rate error @p dw_ib_b_rps (estimate - true, body axes [rad/s]) from the rate and
+ * its history (the quadratic interpolant moves as a whole).
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL gf); NAV_ERR_NUMERIC (non-finite rate); what
+ *         nav_ins_set_state() returns (the rate is then not changed).
+ */
+NAV_API NAV_NODISCARD nav_status nav_gyrofree_correct(nav_gyrofree *gf, const nav_ins_state *state,
+                                                      nav_vec3 dw_ib_b_rps);
+
+/** The strapdown INS inside (borrowed; e.g. for nav_ins_get_ned()). NULL for NULL. */
+NAV_API const nav_ins *nav_gyrofree_ins(const nav_gyrofree *gf);
+
 /** Detailed message of the last failure ("" if none). Borrowed; valid until the next non-const
  *  call or destroy. */
 NAV_API const char *nav_gyrofree_last_error(const nav_gyrofree *gf);

@@ -295,7 +295,8 @@ NAV_API NAV_NODISCARD nav_status nav_req_predict(const nav_requirement *reqs, in
 /**
  * nav_req_predict for a scene: runs its covariance analysis (that of nav_sim_covariance plus the
  * truth's scale factors the filter does not estimate, as consider states: nav_budget.h; WGS-84
- * scenes, free_ins or ins_gnss) with its GNSS outages. @p out: scene->n_requirements verdicts.
+ * scenes, free_ins or ins_gnss; for gyro_free_gnss nav_sim_covariance() of its filter) with its
+ * GNSS outages. @p out: scene->n_requirements verdicts.
  * @return NAV_OK; NAV_ERR_INVALID_ARG (flat Earth, gyro_free); the simulation's statuses.
  */
 NAV_API NAV_NODISCARD nav_status nav_req_predict_scene(const struct nav_scene *scene, nav_requirement_verdict *out);

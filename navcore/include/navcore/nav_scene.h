@@ -437,7 +437,10 @@ typedef enum nav_nav_scheme {
   /** Gyro-free INS from the accelerometer array of the scene's @c array section (nav_gyrofree.h,
    *  numerics.md 1.5); the imu section's triads are not used, only imu.rate_hz and
    *  imu.quadrature_nodes. */
-  NAV_SCHEME_GYRO_FREE = 2
+  NAV_SCHEME_GYRO_FREE = 2,
+  /** The gyro-free INS of the @c array section aided by the @c gnss receiver: loosely coupled
+   *  error-state filter in closed loop (nav_gyrofree_gnss.h, docs/gyro-free-gnss.md); WGS-84. */
+  NAV_SCHEME_GYRO_FREE_GNSS = 3
 } nav_nav_scheme;
 
 typedef struct nav_scene_navigation {

@@ -25,6 +25,8 @@ struct nav_gyrofree {
   int n_hist;           /* rate samples known before the current step (1 after create) */
   double prev_dt_s;     /* length of the previous interval (the quadratic needs equal steps) */
   nav_imu_increment last;
+  bool comp_on;   /* a compensation was set (nav_gyrofree_set_compensation) */
+  double comp[6]; /* subtracted from H^+ dA / dt: [f bias; omega_dot bias] */
   char msg[256];
 };
 
@@ -90,6 +92,33 @@ const nav_array_geometry *nav_gyrofree_geometry(const nav_gyrofree *gf) {
 }
 const char *nav_gyrofree_last_error(const nav_gyrofree *gf) {
   return gf ? gf->msg : "";
+}
+
+nav_status nav_gyrofree_set_compensation(nav_gyrofree *gf, const double beta[6]) {
+  if (!gf || !beta) return NAV_ERR_INVALID_ARG;
+  for (int a = 0; a < 6; ++a)
+    if (!isfinite(beta[a])) return NAV_ERR_NUMERIC;
+  memcpy(gf->comp, beta, sizeof gf->comp);
+  gf->comp_on = true;
+  return NAV_OK;
+}
+
+nav_status nav_gyrofree_correct(nav_gyrofree *gf, const nav_ins_state *state, nav_vec3 dw_ib_b_rps) {
+  if (!gf) return NAV_ERR_INVALID_ARG;
+  if (!nav_vec3_isfinite(dw_ib_b_rps)) return NAV_ERR_NUMERIC;
+  if (state) {
+    const nav_status st = nav_ins_set_state(gf->ins, state);
+    if (st != NAV_OK) return st;
+  }
+  /* The whole rate history moves by the same amount, so the interpolant of the next interval
+   * is shifted, not bent. */
+  gf->w_prev_rps = nav_vec3_sub(gf->w_prev_rps, dw_ib_b_rps);
+  gf->w_prev2_rps = nav_vec3_sub(gf->w_prev2_rps, dw_ib_b_rps);
+  return NAV_OK;
+}
+
+const nav_ins *nav_gyrofree_ins(const nav_gyrofree *gf) {
+  return gf ? gf->ins : NULL;
 }
 
 /* Rate interpolant on the interval, s = (t - t_k)/dt in [-1, 0]. Quadratic: Lagrange through
@@ -163,6 +192,9 @@ nav_status nav_gyrofree_step(nav_gyrofree *gf, const nav_array_increment *inc) {
       acc += gf->geom.h_pinv[a][i] * inc->dv_mps[i];
     y[a] = acc;
   }
+  if (gf->comp_on)
+    for (int a = 0; a < 6; ++a)
+      y[a] -= gf->comp[a] * dt;
   const nav_vec3 dw_meas = nav_vec3_make(y[3], y[4], y[5]);
 
   /* The quadratic interpolant needs w_(k-2) on an interval of the same length; otherwise (first

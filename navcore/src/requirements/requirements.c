@@ -474,7 +474,7 @@ nav_status nav_req_evaluator_create_for_scene(const nav_scene *scene, bool ideal
   if (!scene || !out) return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int n = 0;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS) {
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
     const nav_status st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &n);
     if (st != NAV_OK) return st;
   }
@@ -935,18 +935,45 @@ static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
   return NAV_CONTINUE;
 }
 
+/* A covariance-analysis epoch (nav_sim_covariance) into the buffer. */
+static nav_callback_result keep_cov_point(void *user, const nav_cov_point *p) {
+  cov_buf *b = user;
+  if (b->n == b->cap) {
+    const size_t nc = b->cap ? 2 * b->cap : 1024;
+    nav_cov_point *g = realloc(b->p, nc * sizeof *g);
+    if (!g) {
+      b->failed = true;
+      return NAV_STOP;
+    }
+    b->p = g;
+    b->cap = nc;
+  }
+  b->p[b->n++] = *p;
+  return NAV_CONTINUE;
+}
+
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
   if (!scene || (scene->n_requirements > 0 && !out)) return NAV_ERR_INVALID_ARG;
   if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE)
     return NAV_ERR_INVALID_ARG;
+  const bool gfg = scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   nav_status st = NAV_OK;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS) st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni);
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || gfg) st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni);
   if (st != NAV_OK) return st;
   if (nav_scene_validate(scene, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
   cov_buf b = {NULL, 0, 0, false};
-  st = nav_budget_run(scene, false, keep_point, &b, NULL, NULL, 0);
+  if (gfg) {
+    /* gyro_free_gnss: its filter's covariance analysis (no consider states: the scheme refuses
+     * the scale-factor terms the filter does not estimate). */
+    nav_sim *sim = NULL;
+    st = nav_sim_create(scene, &sim);
+    if (st == NAV_OK) st = nav_sim_covariance(sim, keep_cov_point, &b);
+    nav_sim_destroy(sim);
+  } else {
+    st = nav_budget_run(scene, false, keep_point, &b, NULL, NULL, 0);
+  }
   if (b.failed) st = NAV_ERR_NO_MEMORY;
   if (st == NAV_OK) st = nav_req_predict(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, out);
   free(b.p);

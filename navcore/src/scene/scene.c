@@ -465,11 +465,24 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   check_vec(&c, "initial_errors.velocity_mps", s->initial_errors.vel_sd_mps);
   check_vec(&c, "initial_errors.attitude_deg", s->initial_errors.att_sd_rad);
   if (s->navigation.scheme != NAV_SCHEME_FREE_INS && s->navigation.scheme != NAV_SCHEME_INS_GNSS &&
-      s->navigation.scheme != NAV_SCHEME_GYRO_FREE)
+      s->navigation.scheme != NAV_SCHEME_GYRO_FREE && s->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS)
     issue(&c, "navigation.scheme", "unknown navigation scheme %g", (double)s->navigation.scheme);
   if (s->navigation.scheme == NAV_SCHEME_GYRO_FREE && s->navigation.aid_vertical)
     issue_text(&c, "navigation.aid_vertical", "applies to the free INS only, not to gyro_free");
   check_array(&c, &s->array, report, user);
+  if (s->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+    if (!s->gnss.enabled)
+      issue_text(&c, "navigation.scheme", "gyro_free_gnss needs a GNSS receiver: set gnss.enabled: true");
+    if (s->earth.model != NAV_EARTH_WGS84)
+      issue_text(&c, "navigation.scheme", "gyro_free_gnss needs the wgs84 Earth model");
+    if (s->navigation.aid_vertical)
+      issue_text(&c, "navigation.aid_vertical", "applies to the free INS only; gyro_free_gnss is aided by GNSS");
+    /* The filter has no scale-factor states (docs/gyro-free-gnss.md section 6): an unmodelled
+     * error would make it overconfident, so refuse it rather than report inconsistent sigmas. */
+    if (s->array.accel.terms & NAV_IMU_TERM_SCALE_FACTOR)
+      issue_text(&c, "array.accel", "gyro_free_gnss does not estimate accelerometer scale factors: turn the "
+                                    "scale-factor term off");
+  }
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && !s->gnss.enabled)
     issue_text(&c, "navigation.scheme", "ins_gnss needs a GNSS receiver: set gnss.enabled: true");
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->earth.model != NAV_EARTH_WGS84)
@@ -522,6 +535,7 @@ const char *nav_nav_scheme_name(nav_nav_scheme s) {
   case NAV_SCHEME_FREE_INS: return "free_ins";
   case NAV_SCHEME_INS_GNSS: return "ins_gnss";
   case NAV_SCHEME_GYRO_FREE: return "gyro_free";
+  case NAV_SCHEME_GYRO_FREE_GNSS: return "gyro_free_gnss";
   }
   return "unknown";
 }

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "navcore/nav_gyrofree_gnss.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
@@ -18,9 +19,34 @@ static bool in_outage(const nav_gnss_model_config *g, double t) {
   return false;
 }
 
-static nav_cov_point make_point(double t, const nav_filter *kf) {
-  const double *P = nav_filter_get_cov(kf);
-  const size_t n = nav_filter_get_layout(kf).n_states;
+/* The filter of the scene's scheme: the gyro INS's (nav_filter) or the gyro-free INS's
+ * (nav_gfg_filter, gyro_free_gnss). Both lead with dr, dv, phi at the same indices. */
+typedef struct cov_filter {
+  nav_filter *kf;
+  nav_gfg_filter *gf;
+} cov_filter;
+
+static nav_status cf_predict(cov_filter *c, const nav_filter_nav *nv, double dt) {
+  return c->gf ? nav_gfg_filter_predict(c->gf, nv, dt) : nav_filter_predict(c->kf, nv, dt);
+}
+static nav_status cf_update(cov_filter *c, const nav_filter_nav *nv, nav_vec3 rp, nav_vec3 rv, nav_vec3 l) {
+  nav_status st;
+  if (c->gf) {
+    st = nav_gfg_filter_update_pos(c->gf, nv, nav_vec3_zero(), rp, l);
+    if (st == NAV_OK) st = nav_gfg_filter_update_vel(c->gf, nv, nav_vec3_zero(), rv, l);
+    return st;
+  }
+  st = nav_filter_update_gnss_pos(c->kf, nv, nav_vec3_zero(), &rp, l);
+  if (st == NAV_OK) st = nav_filter_update_gnss_vel(c->kf, nv, nav_vec3_zero(), &rv, l);
+  return st;
+}
+static const char *cf_error(const cov_filter *c) {
+  return c->gf ? nav_gfg_filter_last_error(c->gf) : nav_filter_last_error(c->kf);
+}
+
+static nav_cov_point make_point(double t, const cov_filter *c) {
+  const double *P = c->gf ? nav_gfg_filter_cov(c->gf) : nav_filter_get_cov(c->kf);
+  const size_t n = c->gf ? nav_gfg_filter_n_states(c->gf) : nav_filter_get_layout(c->kf).n_states;
   nav_cov_point p;
   memset(&p, 0, sizeof p);
   p.t_s = t;
@@ -45,8 +71,9 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
                            "(navsim estimate) or Monte Carlo");
     return NAV_ERR_INVALID_ARG;
   }
+  const bool gfg = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   nav_truth *truth = NULL;
-  nav_filter *kf = NULL;
+  cov_filter cf = {NULL, NULL};
   char msg[200];
   nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
   if (st != NAV_OK) {
@@ -54,7 +81,10 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
     return st;
   }
   const nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
-  st = nav_filter_create(&xc.filter, &kf);
+  /* gyro_free_gnss: its filter along the reference (the IMU truth gives the mean specific force
+   * and rate of each interval, which F needs; docs/gyro-free-gnss.md). */
+  const nav_gyrofree_gnss_config xg = gfg ? nav_gyrofree_gnss_config_from_scene(sc) : (nav_gyrofree_gnss_config){0};
+  st = gfg ? nav_gfg_filter_create(&xg.filter, &cf.gf) : nav_filter_create(&xc.filter, &cf.kf);
   if (st != NAV_OK) {
     nav_sim_set_error(sim, "filter set-up failed");
     goto cleanup;
@@ -64,7 +94,7 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   const double dt = nav_truth_dt(truth);
   int64_t out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
   if (out_stride < 1) out_stride = 1;
-  const bool gnss = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
+  const bool gnss = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || gfg;
   nav_gnss_model_config gcfg;
   st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &gcfg, msg, sizeof msg);
   if (st != NAV_OK) {
@@ -72,9 +102,11 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
     goto cleanup;
   }
   const nav_gnss_model_config *g = &gcfg;
-  const bool gm_states = (xc.filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
+  const bool gm_states = gfg ? xg.filter.gnss_gm : (xc.filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
+  const double pos_floor_m = gfg ? xg.pos_sd_floor_m : xc.pos_sd_floor_m;
+  const double vel_floor_mps = gfg ? xg.vel_sd_floor_mps : xc.vel_sd_floor_mps;
   int64_t next_epoch = 0;
-  nav_cov_point p0 = make_point(0.0, kf);
+  nav_cov_point p0 = make_point(0.0, &cf);
   if (fn(user, &p0) == NAV_STOP) goto cleanup;
   for (int64_t k = 1; k <= n; ++k) {
     nav_imu_increment imu;
@@ -89,9 +121,9 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
                                nav_quat_to_dcm(v.q_b_n),
                                nav_vec3_scale(imu.dv_b_mps, 1.0 / imu.dt_s),
                                nav_vec3_scale(imu.dtheta_b_rad, 1.0 / imu.dt_s)};
-    st = nav_filter_predict(kf, &nv, imu.dt_s);
+    st = cf_predict(&cf, &nv, imu.dt_s);
     if (st != NAV_OK) {
-      nav_sim_set_error(sim, nav_filter_last_error(kf));
+      nav_sim_set_error(sim, cf_error(&cf));
       goto cleanup;
     }
     while (gnss) {
@@ -108,22 +140,21 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
         const double vv = (g->terms & NAV_GNSS_TERM_VEL_WHITE) ? nav_vec3_get(g->vel_sd_mps, i) : 0.0;
         double sp = g->report_model_sigmas ? (gm_states ? wh : hypot(gm, wh)) : nav_vec3_get(g->reported_pos_sd_m, i);
         double sv = g->report_model_sigmas ? vv : nav_vec3_get(g->reported_vel_sd_mps, i);
-        sp = fmax(sp, xc.pos_sd_floor_m);
-        sv = fmax(sv, xc.vel_sd_floor_mps);
+        sp = fmax(sp, pos_floor_m);
+        sv = fmax(sv, vel_floor_mps);
         nav_vec3_set(&rp, i, sp * sp);
         nav_vec3_set(&rv, i, sv * sv);
       }
-      st = nav_filter_update_gnss_pos(kf, &nv, nav_vec3_zero(), &rp, g->r_ba_b_m);
-      if (st == NAV_OK) st = nav_filter_update_gnss_vel(kf, &nv, nav_vec3_zero(), &rv, g->r_ba_b_m);
+      st = cf_update(&cf, &nv, rp, rv, g->r_ba_b_m);
       if (st != NAV_OK) {
-        nav_sim_set_error(sim, nav_filter_last_error(kf));
+        nav_sim_set_error(sim, cf_error(&cf));
         goto cleanup;
       }
     }
     if (k % out_stride == 0 || k == n) {
-      st = nav_filter_flush(kf);
+      st = cf.kf ? nav_filter_flush(cf.kf) : NAV_OK;
       if (st != NAV_OK) goto cleanup;
-      nav_cov_point p = make_point(imu.t_s, kf);
+      nav_cov_point p = make_point(imu.t_s, &cf);
       if (fn(user, &p) == NAV_STOP) {
         st = NAV_ERR_CANCELLED;
         goto cleanup;
@@ -131,7 +162,8 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
     }
   }
 cleanup:
-  nav_filter_destroy(kf);
+  nav_filter_destroy(cf.kf);
+  nav_gfg_filter_destroy(cf.gf);
   nav_truth_destroy(truth);
   return st;
 }

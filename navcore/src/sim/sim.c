@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "navcore/nav_earth.h"
+#include "navcore/nav_gyrofree_gnss.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_rng.h"
 #include "navcore/nav_sensors.h"
@@ -267,6 +268,7 @@ nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_
 typedef struct aiding {
   nav_gnss_model *gnss;
   nav_ins_gnss *x;
+  nav_sim_gyrofree *gf; /* gyro_free_gnss: the fixes go to the array INS's filter (borrowed) */
   int64_t next_epoch;
 } aiding;
 
@@ -313,9 +315,9 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     f.vel_sd_mps = fix.vel_sd_mps;
     /* With GNSS GM error states in the filter, R holds only the white part of the error. */
     if (j->gm_states) f.pos_sd_m = sc->gnss.model.pos_white_sd_m;
-    st = nav_ins_gnss_update(a->x, &f);
+    st = a->gf ? nav_sim_gyrofree_update(a->gf, &f) : nav_ins_gnss_update(a->x, &f);
     if (st != NAV_OK) {
-      job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(a->x));
+      job_error(j, "run %ld: %s", run, a->gf ? nav_sim_gyrofree_last_error(a->gf) : nav_ins_gnss_last_error(a->x));
       return st;
     }
   }
@@ -387,10 +389,8 @@ static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t
  * e = (dr_n, dv_n, phi) with phi from C_true C_est^T = I + [phi x] (E0.1), resolved in n.
  * Returns NAN when the block is not positive definite.
  */
-static double nees9(const nav_filter *kf, const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s,
+static double nees9(const double *P, size_t n, const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s,
                     const nav_epoch_errors *e) {
-  const double *P = nav_filter_get_cov(kf);
-  const size_t n = nav_filter_get_layout(kf).n_states;
   double B[81], L[81], x[9];
   for (size_t i = 0; i < 9; ++i)
     for (size_t q = 0; q < 9; ++q) B[i * 9 + q] = P[i * n + q];
@@ -406,7 +406,18 @@ static double nees9(const nav_filter *kf, const nav_frame *fr, const nav_traj_st
   return q2;
 }
 
-static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, const nav_filter *kf,
+/* The filter covariance of a run (INS/GNSS or gyro-free/GNSS; both lead with dr, dv, phi), or
+ * NULL for the unaided schemes. */
+static const double *run_cov(const nav_ins_gnss *x, const nav_sim_gyrofree *gf, size_t *n) {
+  if (x) {
+    const nav_filter *kf = nav_ins_gnss_filter(x);
+    *n = nav_filter_get_layout(kf).n_states;
+    return nav_filter_get_cov(kf);
+  }
+  return gf ? nav_sim_gyrofree_cov(gf, n) : NULL;
+}
+
+static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, const double *P, size_t n,
                       const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s) {
   const int64_t slot = out_slot(j, k);
   if (!j->env || slot < 0 || slot >= j->n_out) return;
@@ -417,11 +428,9 @@ static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, co
   v[3] = e->vel_err_mps;
   v[4] = e->att_err_rad;
   v[5] = v[6] = v[7] = v[8] = 0.0;
-  if (kf) {
-    const double *P = nav_filter_get_cov(kf);
-    const size_t n = nav_filter_get_layout(kf).n_states;
+  if (P) {
     for (int i = 0; i < 3; ++i) v[5 + i] = sqrt(P[(size_t)i * n + (size_t)i]);
-    v[8] = nees9(kf, fr, ts, s, e);
+    v[8] = nees9(P, n, fr, ts, s, e);
   }
 }
 
@@ -447,7 +456,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   const nav_frame frame = nav_truth_frame(truth);
   const double dt = nav_truth_dt(truth);
-  const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE;
+  const bool gf_gnss = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || gf_gnss;
   if (!j->ideal && !gyro_free) {
     st = nav_imu_model_create(&sc->imu.model, sc->simulation.seed, (uint64_t)run, &imu_model);
     if (st != NAV_OK) {
@@ -468,7 +478,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   const bool aid = sc->navigation.aid_vertical;
   const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
-  if (integrated) {
+  if (integrated || gf_gnss) {
     /* --ideal: the receiver is perfect too (same epochs and outages, no error terms). */
     nav_gnss_model_config gcfg = j->gnss_cfg;
     if (j->ideal) gcfg.terms = 0;
@@ -477,6 +487,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       job_error(j, "run %ld: GNSS receiver model: %s", run, nav_status_str(st));
       goto cleanup;
     }
+  }
+  if (integrated) {
     nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
     if (j->smooth) {
       /* Records at the output and GNSS epochs only (nav_smoother.h: ~4.3 KiB each at 15 states). */
@@ -505,13 +517,16 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       job_error(j, "run %ld: gyro-free INS: %s", run, msg[0] ? msg : nav_status_str(st));
       goto cleanup;
     }
+    aid_kf.gf = gf_gnss ? gf : NULL;
   }
+  size_t cov_n = 0;
   const bool record = caller_thread && run == 0 && j->opts->record;
   bool stop = false;
 
   nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
-  store_env(j, run, 0, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_ins_get_state(ins));
+  const double *cov0 = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
+  store_env(j, run, 0, &err, cov0, cov_n, &frame, &ts, nav_ins_get_state(ins));
   if (obs_ctx) obs->epoch(obs_ctx, &err);
   if (sm) {
     sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
@@ -564,6 +579,9 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       }
       st = aiding_fixes(j, &aid_kf, truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
+    } else if (gf_gnss) {
+      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
+      if (st != NAV_OK) goto cleanup;
     } else if (!gf) {
       st = nav_ins_step(ins, &meas);
       if (st != NAV_OK) {
@@ -604,7 +622,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     }
     err = nav_errors_compute(&frame, &ts, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
-    store_env(j, run, k, &err, integrated ? nav_ins_gnss_filter(aid_kf.x) : NULL, &frame, &ts, nav_now);
+    const double *cov = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
+    store_env(j, run, k, &err, cov, cov_n, &frame, &ts, nav_now);
     if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
     if (sm && out_k) {
       /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
@@ -696,8 +715,10 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   /* Ideal runs are identical: one is enough. */
   j.runs = opts->ideal ? 1 : sc->simulation.runs;
   j.smooth = sc->navigation.smoother && sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
-  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS) {
-    j.gm_states = (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0;
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+    j.gm_states = sc->navigation.scheme == NAV_SCHEME_INS_GNSS
+                      ? (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0
+                      : nav_gyrofree_gnss_config_from_scene(sc).filter.gnss_gm;
     char gmsg[200];
     st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &j.gnss_cfg, gmsg, sizeof gmsg);
     if (st != NAV_OK) {
@@ -768,7 +789,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     }
   }
   nav_truth_destroy(probe);
-  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE && j.runs > 1 && j.run_end > r0) {
+  if ((sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) &&
+      j.runs > 1 && j.run_end > r0) {
     /* The ideal array increments are those of every run too: sampled once (sim_gyrofree.c). */
     st = nav_sim_gyrofree_truth_create(sc, &j.gf_truth, msg, sizeof msg);
     if (st != NAV_OK) {

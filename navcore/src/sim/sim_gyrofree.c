@@ -18,6 +18,7 @@
 
 #include "navcore/nav_array.h"
 #include "navcore/nav_gyrofree.h"
+#include "navcore/nav_gyrofree_gnss.h"
 #include "navcore/nav_rng.h"
 #include "sim/sim_internal.h"
 
@@ -36,7 +37,8 @@ struct nav_sim_gyrofree {
   const nav_sim_gyrofree_truth *shared; /* borrowed; NULL: own truth */
   nav_array_truth *truth;
   nav_array_model *model; /* NULL: ideal array */
-  nav_gyrofree *ins;
+  nav_gyrofree *ins;       /* gyro_free: the free array INS */
+  nav_gyrofree_gnss *gfg;  /* gyro_free_gnss: the array INS in closed loop with its filter */
   int n_sensors;
   char msg[256];
 };
@@ -141,6 +143,18 @@ nav_status nav_sim_gyrofree_create(const nav_scene *sc, const nav_sim_gyrofree_t
       }
     }
   }
+  if (sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+    nav_gyrofree_gnss_config xc = nav_gyrofree_gnss_config_from_scene(sc);
+    xc.gf.ins = *ins;
+    st = nav_gyrofree_gnss_create(&xc, s0, w0, &g->gfg);
+    if (st != NAV_OK) {
+      set_msg(msg, msg_size, "gyro-free INS/GNSS set-up", st);
+      goto cleanup;
+    }
+    *out = g;
+    g = NULL;
+    goto cleanup;
+  }
   nav_gyrofree_config cfg = nav_gyrofree_config_default();
   cfg.array = layout;
   cfg.ins = *ins;
@@ -158,6 +172,7 @@ cleanup:
 
 void nav_sim_gyrofree_destroy(nav_sim_gyrofree *g) {
   if (!g) return;
+  nav_gyrofree_gnss_destroy(g->gfg);
   nav_gyrofree_destroy(g->ins);
   nav_array_model_destroy(g->model);
   nav_array_truth_destroy(g->truth);
@@ -195,6 +210,16 @@ nav_status nav_sim_gyrofree_step(nav_sim_gyrofree *g, int64_t k, nav_imu_increme
       return st;
     }
   }
+  if (g->gfg) {
+    st = nav_gyrofree_gnss_step(g->gfg, &inc);
+    if (st != NAV_OK) {
+      snprintf(g->msg, sizeof g->msg, "gyro-free INS/GNSS stopped: %s", nav_gyrofree_gnss_last_error(g->gfg));
+      return st;
+    }
+    *equiv = *nav_gyrofree_gnss_last_increment(g->gfg);
+    g->msg[0] = '\0';
+    return NAV_OK;
+  }
   st = nav_gyrofree_step(g->ins, &inc);
   if (st != NAV_OK) {
     snprintf(g->msg, sizeof g->msg, "gyro-free navigation stopped: %s", nav_gyrofree_last_error(g->ins));
@@ -206,7 +231,22 @@ nav_status nav_sim_gyrofree_step(nav_sim_gyrofree *g, int64_t k, nav_imu_increme
 }
 
 const nav_ins_state *nav_sim_gyrofree_state(const nav_sim_gyrofree *g) {
-  return g ? nav_gyrofree_get_state(g->ins) : NULL;
+  if (!g) return NULL;
+  return g->gfg ? nav_gyrofree_gnss_state(g->gfg) : nav_gyrofree_get_state(g->ins);
+}
+
+nav_status nav_sim_gyrofree_update(nav_sim_gyrofree *g, const nav_ins_gnss_fix *fix) {
+  if (!g || !fix || !g->gfg) return NAV_ERR_INVALID_ARG;
+  const nav_status st = nav_gyrofree_gnss_update(g->gfg, fix);
+  if (st != NAV_OK) snprintf(g->msg, sizeof g->msg, "%s", nav_gyrofree_gnss_last_error(g->gfg));
+  return st;
+}
+
+const double *nav_sim_gyrofree_cov(const nav_sim_gyrofree *g, size_t *n) {
+  if (!g || !g->gfg) return NULL;
+  const nav_gfg_filter *kf = nav_gyrofree_gnss_filter(g->gfg);
+  if (n) *n = nav_gfg_filter_n_states(kf);
+  return nav_gfg_filter_cov(kf);
 }
 
 const char *nav_sim_gyrofree_last_error(const nav_sim_gyrofree *g) {

@@ -55,6 +55,13 @@ nav_status nav_sim_gyrofree_step(nav_sim_gyrofree *g, int64_t k, nav_imu_increme
 const nav_ins_state *nav_sim_gyrofree_state(const nav_sim_gyrofree *g);
 const char *nav_sim_gyrofree_last_error(const nav_sim_gyrofree *g);
 
+#include "navcore/nav_ins_gnss.h"
+
+/** gyro_free_gnss: apply one GNSS fix (update, feedback). NAV_ERR_INVALID_ARG for gyro_free. */
+nav_status nav_sim_gyrofree_update(nav_sim_gyrofree *g, const nav_ins_gnss_fix *fix);
+/** gyro_free_gnss: the filter covariance (n x n, borrowed) and *n; NULL for gyro_free. */
+const double *nav_sim_gyrofree_cov(const nav_sim_gyrofree *g, size_t *n);
+
 /** The receiver configuration of a scene with segment-tied outages added (gnss_visible: false). */
 /** Append to @p out the receiver outages of gnss.constellation.min_satellites_for_fix: every
  *  receiver epoch with fewer visible satellites (sim_gnss_sat.c). NAV_OK when not configured. */
