@@ -237,8 +237,9 @@ nav_status nav_requirements_check_scene(const nav_scene *scene, nav_req_issue_fn
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   bool outages_known = true;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS)
-    outages_known = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni) == NAV_OK;
+  const bool has_gnss =
+      scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  if (has_gnss) outages_known = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni) == NAV_OK;
   int n_in_run = 0;
   for (int j = 0; j < ni; ++j)
     if (!(iv[j].t0_s >= dur)) ++n_in_run;
@@ -252,10 +253,10 @@ nav_status nav_requirements_check_scene(const nav_scene *scene, nav_req_issue_fn
                 "time within [0, %g] s",
                 q->time_s, dur, dur);
     if (q->statistic == NAV_REQ_OUTAGE_END && outages_known && n_in_run == 0) {
-      if (scene->navigation.scheme != NAV_SCHEME_INS_GNSS)
+      if (!has_gnss)
         req_issue(report, user, &n, i, "statistic",
                   "outage_end needs a GNSS outage, and navigation.scheme %s has no GNSS: use scheme ins_gnss "
-                  "with gnss.outages, or another statistic",
+                  "(or gyro_free_gnss) with gnss.outages, or another statistic",
                   nav_nav_scheme_name(scene->navigation.scheme));
       else if (ni > 0)
         req_issue(report, user, &n, i, "statistic",
