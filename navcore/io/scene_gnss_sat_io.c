@@ -338,7 +338,14 @@ static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void 
                                 nav_status_str(rs));
     return;
   }
-  snprintf(c->almanac_file, sizeof c->almanac_file, "%s", path);
+  const size_t plen = strlen(path);
+  if (plen >= sizeof c->almanac_file) {
+    nav_io_reader_error_at_path(r, "gnss.constellation.almanac",
+                                "the almanac file's path is %zu bytes long; at most %zu are kept", plen,
+                                sizeof c->almanac_file - 1);
+    return;
+  }
+  memcpy(c->almanac_file, path, plen + 1);
   c->almanac = alm;
 }
 

@@ -273,6 +273,7 @@ static void test_recommended_scene(void **state) {
   }
 }
 
+#ifdef NAV_HAVE_VIEWER
 /* PNG width and height from the IHDR chunk. */
 static void png_size(const char *path, int *w, int *h) {
   size_t len = 0;
@@ -284,6 +285,7 @@ static void png_size(const char *path, int *w, int *h) {
   *h = (int)((u[20] << 24) | (u[21] << 16) | (u[22] << 8) | u[23]);
   free(b);
 }
+#endif
 
 static void test_charts(void **state) {
   (void)state;
