@@ -78,8 +78,13 @@ nav_status navsim_gnss_sat_out_record(navsim_gnss_sat_out *g, const nav_sim_reco
 bool navsim_gnss_sat_out_end(navsim_gnss_sat_out *g) {
   if (!g) return true;
   bool ok = true;
-  if (g->dop) ok = (ferror(g->dop) == 0) & (fclose(g->dop) == 0) & ok;
-  if (g->sats) ok = (ferror(g->sats) == 0) & (fclose(g->sats) == 0) & ok;
+  /* Both files are closed whatever the first one gave. */
+  FILE *files[2] = {g->dop, g->sats};
+  for (int i = 0; i < 2; ++i) {
+    if (!files[i]) continue;
+    const bool bad = ferror(files[i]) != 0;
+    if (fclose(files[i]) != 0 || bad) ok = false;
+  }
   free(g);
   return ok;
 }

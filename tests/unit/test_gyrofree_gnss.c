@@ -200,7 +200,7 @@ static void one_run(const nav_scene *sc, long run, mc_acc *acc) {
   nav_rng r;
   nav_rng_init(&r, sc->simulation.seed, (uint64_t)run, 0xfeedu);
   const nav_local_view v0 = nav_frame_view(&fr, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f);
-  nav_vec3 dr, dv, phi, dw;
+  nav_vec3 dr = {0.0, 0.0, 0.0}, dv = dr, phi = dr, dw = dr;
   for (int i = 0; i < 3; ++i) {
     nav_vec3_set(&dr, i, nav_vec3_get(sc->initial_errors.pos_sd_m, i) * nav_rng_gauss(&r));
     nav_vec3_set(&dv, i, nav_vec3_get(sc->initial_errors.vel_sd_mps, i) * nav_rng_gauss(&r));
