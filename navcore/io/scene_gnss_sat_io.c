@@ -279,26 +279,6 @@ static const nav_io_field k_constellation[] = {
 const nav_io_section nav_io_gnss_constellation_section = {k_constellation, COUNT(k_constellation),
                                                           finish_constellation};
 
-/* The almanac file relative to the scene file's directory (absolute when that directory exists). */
-static bool resolve(char *out, size_t size, const char *scene_file, bool is_path, const char *file) {
-  const char *slash = scene_file != NULL ? strrchr(scene_file, '/') : NULL;
-  if (file[0] == '/' || (slash == NULL && !is_path)) return snprintf(out, size, "%s", file) < (int)size;
-  char dir[NAV_IO_PATH_MAX];
-  const int n = slash == NULL ? snprintf(dir, sizeof dir, ".")
-                              : snprintf(dir, sizeof dir, "%.*s",
-                                         slash == scene_file ? 1 : (int)(slash - scene_file), scene_file);
-  if (n < 0 || n >= (int)sizeof dir) return false;
-  char *abs = realpath(dir, NULL);
-  const char *d = abs != NULL ? abs : dir;
-  const int m = snprintf(out, size, "%s%s%s", d, strcmp(d, "/") == 0 ? "" : "/", file);
-  free(abs);
-  return m >= 0 && m < (int)size;
-}
-
-static void forward(void *user, const nav_diag *d) {
-  nav_io_reader_forward(user, d);
-}
-
 /* After the section: it is present, so enabled; load the almanac. */
 static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void *base) {
   (void)map;
@@ -314,7 +294,7 @@ static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void 
   }
   const nav_io_read_state *st = nav_io_reader_state(r);
   char path[3 * NAV_IO_PATH_MAX];
-  if (!resolve(path, sizeof path, st->file, st->file_is_path, c->almanac_file) ||
+  if (!nav_io_resolve_path(path, sizeof path, st->file, st->file_is_path, c->almanac_file) ||
       strlen(path) >= sizeof c->almanac_file) {
     nav_io_reader_error_at_path(r, "gnss.constellation.almanac", "the path of the almanac file is too long");
     return;
@@ -331,7 +311,7 @@ static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void 
   free(canonical);
   nav_gnss_constellation alm;
   alm.n = 0;
-  const nav_status rs = nav_gnss_almanac_read_yuma(path, c->epoch_gps_s, &alm, forward, r);
+  const nav_status rs = nav_gnss_almanac_read_yuma(path, c->epoch_gps_s, &alm, nav_io_forward_diag, r);
   if (rs != NAV_OK) {
     nav_io_reader_error_at_path(r, "gnss.constellation.almanac",
                                 "the almanac file \"%s\" was not read (%s; see its messages)", path,

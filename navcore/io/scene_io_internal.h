@@ -193,6 +193,14 @@ void nav_io_reader_error_at_path(nav_io_reader *r, const char *path, const char 
     ;
 /** Pass on a diagnostic about another file (a motion definition, a catalog) as it is. */
 void nav_io_reader_forward(nav_io_reader *r, const nav_diag *d);
+/* nav_io_reader_forward as a nav_diag_fn (@p user is the nav_io_reader): for the readers of files
+   that a scene names (motion definition, recorded reference, GNSS almanac). */
+void nav_io_forward_diag(void *user, const nav_diag *d);
+/* A file named in a scene, relative to the scene file's directory (made absolute when that
+   directory exists, so messages name the file unambiguously), or as given when absolute or when
+   the scene was read from memory under a name without a directory part (then relative to the
+   working directory). @return false when it does not fit in @p size. */
+bool nav_io_resolve_path(char *out, size_t size, const char *scene_file, bool is_path, const char *file);
 /** Diagnostics reported so far. */
 int nav_io_reader_count(const nav_io_reader *r);
 /** The reader's state (inputs without a place in the scene). */

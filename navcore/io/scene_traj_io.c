@@ -870,11 +870,8 @@ const nav_io_section nav_io_trajectory_section = {k_trajectory, COUNT(k_trajecto
 
 /* ================================================================ after the whole file */
 
-/* The motion-definition file relative to the scene file's directory (made absolute when that
-   directory exists, so messages name the file unambiguously), or as given if absolute or if the
-   scene was read from memory under a name without a directory part (then relative to the working
-   directory). */
-static bool resolve_path(char *out, size_t size, const char *scene_file, bool is_path, const char *file) {
+/* Files a scene names (scene_io_internal.h): relative to the scene file's directory. */
+bool nav_io_resolve_path(char *out, size_t size, const char *scene_file, bool is_path, const char *file) {
   const char *slash = scene_file != NULL ? strrchr(scene_file, '/') : NULL;
   if (file[0] == '/' || (slash == NULL && !is_path)) return snprintf(out, size, "%s", file) < (int)size;
   char dir[NAV_IO_PATH_MAX];
@@ -889,7 +886,7 @@ static bool resolve_path(char *out, size_t size, const char *scene_file, bool is
   return m >= 0 && m < (int)size;
 }
 
-static void forward_diag(void *user, const nav_diag *d) {
+void nav_io_forward_diag(void *user, const nav_diag *d) {
   nav_io_reader_forward(user, d);
 }
 
@@ -928,7 +925,7 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
     ok = false;
   }
   char path[3 * NAV_IO_PATH_MAX];
-  if (!resolve_path(path, sizeof path, st->file, st->file_is_path, st->md_file)) {
+  if (!nav_io_resolve_path(path, sizeof path, st->file, st->file_is_path, st->md_file)) {
     nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
                                 "the path of the motion-definition file is too long");
     return false;
@@ -949,7 +946,7 @@ static bool import_motion_def(nav_io_reader *r, const nav_io_node *root, nav_sce
   if (!ok) return false;
   const bool explicit_duration = !st->duration_auto;
   const double duration_s = scene->trajectory.duration_s;
-  const nav_status s = nav_motiondef_read_file(path, scene, forward_diag, r);
+  const nav_status s = nav_motiondef_read_file(path, scene, nav_io_forward_diag, r);
   if (s != NAV_OK) {
     nav_io_reader_error_at_path(r, "trajectory.motion_def.file",
                                 "the motion-definition file \"%s\" was not imported (%s; see its messages)",
@@ -988,7 +985,8 @@ static bool load_recorded(nav_io_reader *r, const nav_io_node *root, nav_scene *
     ok = false;
   }
   char path[3 * NAV_IO_PATH_MAX];
-  if (!resolve_path(path, sizeof path, st->file, st->file_is_path, R->file) || strlen(path) >= sizeof R->file) {
+  if (!nav_io_resolve_path(path, sizeof path, st->file, st->file_is_path, R->file) ||
+      strlen(path) >= sizeof R->file) {
     nav_io_reader_error_at_path(r, "trajectory.recorded.file", "the path of the recorded file is too long");
     return false;
   }
@@ -1013,7 +1011,7 @@ static bool load_recorded(nav_io_reader *r, const nav_io_node *root, nav_scene *
   nav_track_sample *samples = NULL;
   size_t n = 0;
   const nav_status s = nav_track_read_file(path, R->format, R->window, R->start_s, R->end_s,
-                                           "trajectory.recorded.file", &samples, &n, forward_diag, r);
+                                           "trajectory.recorded.file", &samples, &n, nav_io_forward_diag, r);
   if (s != NAV_OK) {
     nav_io_reader_error_at_path(r, "trajectory.recorded.file",
                                 "the recorded file \"%s\" was not loaded (%s; see its messages)", path,

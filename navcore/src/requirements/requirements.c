@@ -912,30 +912,6 @@ typedef struct cov_buf {
   bool failed;
 } cov_buf;
 
-static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
-  cov_buf *b = user;
-  nav_cov_point q;
-  memset(&q, 0, sizeof q);
-  q.t_s = e->t_s;
-  q.pos_sd_n_m = nav_vec3_make(sqrt(e->total.v[0]), sqrt(e->total.v[1]), sqrt(e->total.v[2]));
-  q.pos_h_sd_m = hypot(q.pos_sd_n_m.x, q.pos_sd_n_m.y);
-  q.vel_sd_n_mps = nav_vec3_make(sqrt(e->total.v[3]), sqrt(e->total.v[4]), sqrt(e->total.v[5]));
-  q.att_sd_rad = nav_vec3_make(sqrt(e->total.v[6]), sqrt(e->total.v[7]), sqrt(e->total.v[8]));
-  const nav_cov_point *p = &q;
-  if (b->n == b->cap) {
-    const size_t nc = b->cap ? 2 * b->cap : 1024;
-    nav_cov_point *g = realloc(b->p, nc * sizeof *g);
-    if (!g) {
-      b->failed = true;
-      return NAV_STOP;
-    }
-    b->p = g;
-    b->cap = nc;
-  }
-  b->p[b->n++] = *p;
-  return NAV_CONTINUE;
-}
-
 /* A covariance-analysis epoch (nav_sim_covariance) into the buffer. */
 static nav_callback_result keep_cov_point(void *user, const nav_cov_point *p) {
   cov_buf *b = user;
@@ -951,6 +927,18 @@ static nav_callback_result keep_cov_point(void *user, const nav_cov_point *p) {
   }
   b->p[b->n++] = *p;
   return NAV_CONTINUE;
+}
+
+/* A budget epoch's total covariance as a covariance-analysis epoch, into the buffer. */
+static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
+  nav_cov_point q;
+  memset(&q, 0, sizeof q);
+  q.t_s = e->t_s;
+  q.pos_sd_n_m = nav_vec3_make(sqrt(e->total.v[0]), sqrt(e->total.v[1]), sqrt(e->total.v[2]));
+  q.pos_h_sd_m = hypot(q.pos_sd_n_m.x, q.pos_sd_n_m.y);
+  q.vel_sd_n_mps = nav_vec3_make(sqrt(e->total.v[3]), sqrt(e->total.v[4]), sqrt(e->total.v[5]));
+  q.att_sd_rad = nav_vec3_make(sqrt(e->total.v[6]), sqrt(e->total.v[7]), sqrt(e->total.v[8]));
+  return keep_cov_point(user, &q);
 }
 
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
