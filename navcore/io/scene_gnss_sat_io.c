@@ -247,6 +247,30 @@ static bool same_canyons(const nav_io_field *f, const void *a, const void *b) {
   return true;
 }
 
+/* ---------------------------------------------------------------- JSON Schema of the custom values */
+
+static void schema_epoch(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "string");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}T[0-9]{1,2}:[0-9]{1,2}:[0-9]+(\\.[0-9]*)?$");
+}
+
+/* [[azimuth_deg, elevation_deg], ...]: the bounds of read_sky_mask's az_f and el_f (azimuths below
+   360, increasing: not expressible here). */
+static void schema_sky_mask(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "array");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, "{\"type\": \"array\", \"prefixItems\": [{\"type\": \"number\", \"minimum\": 0, "
+                     "\"exclusiveMaximum\": 360}, {\"type\": \"number\", \"minimum\": 0, \"maximum\": 90}], "
+                     "\"minItems\": 2, \"maxItems\": 2}");
+  nav_io_json_key(j, "x-unit");
+  nav_io_json_string(j, "deg");
+}
+
 /* ---------------------------------------------------------------- the section */
 
 static bool almanac_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
@@ -258,7 +282,7 @@ static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void 
 
 static const nav_io_field k_constellation[] = {
     {.key = "epoch", .kind = NAV_IO_CUSTOM, .offset = OFF(C(epoch_gps_s)), .read = read_epoch, .write = write_epoch,
-     .same = same_epoch, .comment = "GPS time of scene time 0"},
+     .same = same_epoch, .comment = "GPS time of scene time 0", .schema = schema_epoch},
     {.key = "gps", .kind = NAV_IO_ENUM, .offset = OFF(C(gps)), .enums = k_gps_sources,
      .comment = "nominal: SPS PS 24 slots; almanac: the YUMA file below"},
     {.key = "almanac", .kind = NAV_IO_STRING, .offset = OFF(C(almanac_file)), .size = NAV_GNSS_ALMANAC_PATH_MAX,
@@ -269,12 +293,14 @@ static const nav_io_field k_constellation[] = {
     {.key = "elevation_mask_deg", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE,
      .offset = OFF(C(mask.elevation_mask_rad)), .scale = DEG, .min = 0.0},
     {.key = "sky_mask_deg", .kind = NAV_IO_CUSTOM, .offset = OFF(C(mask)), .read = read_sky_mask,
-     .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline"},
+     .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline",
+     .max_items = NAV_GNSS_MASK_MAX_POINTS, .schema = schema_sky_mask},
     {.key = "min_satellites_for_fix", .kind = NAV_IO_INT, .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(C(min_satellites_for_fix)), .min = 0.0, .max = NAV_GNSS_MAX_SATS,
      .comment = "receiver (gnss.enabled): no fix below this many visible satellites; 0: off"},
     {.key = "canyons", .kind = NAV_IO_CUSTOM, .offset = OFF(gnss.constellation), .read = read_canyons,
-     .write = write_canyons, .same = same_canyons, .comment = "street walls along the direction of travel"},
+     .write = write_canyons, .same = same_canyons, .comment = "street walls along the direction of travel",
+     .items = &k_canyon_section, .max_items = NAV_GNSS_MAX_CANYONS},
 };
 const nav_io_section nav_io_gnss_constellation_section = {k_constellation, COUNT(k_constellation),
                                                           finish_constellation};

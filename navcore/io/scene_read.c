@@ -157,6 +157,11 @@ static void read_reported(nav_io_reader *r, const nav_io_field *f, const nav_io_
                           const nav_io_node *value, void *base);
 static nav_status write_reported(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
 static bool same_reported(const nav_io_field *f, const void *a, const void *b);
+static void schema_format_version(nav_io_json *j, const nav_io_field *f);
+static void schema_catalog(nav_io_json *j, const nav_io_field *f);
+static void schema_off(nav_io_json *j, const nav_io_field *f);
+static void schema_outages(nav_io_json *j, const nav_io_field *f);
+static void schema_reported(nav_io_json *j, const nav_io_field *f);
 static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base);
 static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base);
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
@@ -387,7 +392,8 @@ static const nav_io_field k_imu[] = {
      .write = write_catalog,
      .same = same_string,
      .write_if = catalog_given,
-     .comment = "resources/imu_catalog.csv; the keys below override it"},
+     .comment = "resources/imu_catalog.csv; the keys below override it",
+     .schema = schema_catalog},
     {.key = "gyro", .kind = NAV_IO_SECTION, .section = &k_gyro_section},
     {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_accel_section},
     {.key = "off",
@@ -398,7 +404,8 @@ static const nav_io_field k_imu[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
 };
 DEFINE_SECTION(k_imu_section, k_imu);
 
@@ -426,7 +433,8 @@ static const nav_io_field k_gnss[] = {
      .write = write_catalog,
      .same = same_string,
      .write_if = catalog_given,
-     .comment = "resources/gnss_receivers.csv; the keys below override it"},
+     .comment = "resources/gnss_receivers.csv; the keys below override it",
+     .schema = schema_catalog},
     {.key = "update_rate_hz",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
@@ -453,14 +461,19 @@ static const nav_io_field k_gnss[] = {
      .read = read_outages,
      .write = write_outages,
      .same = same_outages,
-     .comment = "[t0_s, t1_s): no fix"},
+     .comment = "[t0_s, t1_s): no fix",
+     .unit = "s",
+     .max_items = NAV_GNSS_MAX_OUTAGES,
+     .schema = schema_outages},
     {.key = "reported_sigma",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(gnss.model),
      .section = &k_reported_section,
      .read = read_reported,
      .write = write_reported,
-     .same = same_reported},
+     .same = same_reported,
+     .doc = "sigmas the receiver reports with each fix: model (the error model's) or given values",
+     .schema = schema_reported},
     {.key = "off",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_LATE,
@@ -469,7 +482,8 @@ static const nav_io_field k_gnss[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
     {.key = "constellation",
      .kind = NAV_IO_SECTION,
      .section = &nav_io_gnss_constellation_section,
@@ -517,7 +531,8 @@ static const nav_io_field k_array_accel[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
 };
 DEFINE_SECTION(k_array_accel_section, k_array_accel);
 
@@ -558,7 +573,10 @@ static const nav_io_field k_array[] = {
      .read = read_array_sensors,
      .write = write_array_sensors,
      .same = same_array_sensors,
-     .write_if = array_sensors_written},
+     .write_if = array_sensors_written,
+     .doc = "accelerometers of a custom layout: position and sensitive axis of each",
+     .items = &k_array_sensor_section,
+     .max_items = NAV_SCENE_ARRAY_MAX_SENSORS},
     {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_array_accel_section},
     Q("initial_rate_sd_dps", NAV_IO_VEC3S, NONNEG_LE, array.initial_rate_sd_rps, NAV_DEG2RAD,
       .max = NAV_SCENE_MAX_INITIAL_RATE_SD_DPS, .mark_as = "initial_rate_sd_rps",
@@ -706,7 +724,9 @@ static const nav_io_field k_root[] = {
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_REQUIRED,
      .read = read_format_version,
-     .write = write_format_version},
+     .write = write_format_version,
+     .doc = "version of the scene format the file is written in",
+     .schema = schema_format_version},
     {.key = "name", .kind = NAV_IO_STRING, .offset = OFF(name), .size = NAV_SCENE_NAME_MAX},
     {.key = "earth", .kind = NAV_IO_SECTION, .section = &k_earth_section},
     {.key = "trajectory", .kind = NAV_IO_SECTION, .section = &nav_io_trajectory_section},
@@ -722,7 +742,10 @@ static const nav_io_field k_root[] = {
      .read = read_requirements,
      .write = write_requirements,
      .same = same_requirements,
-     .write_if = requirements_written},
+     .write_if = requirements_written,
+     .doc = "accuracy requirements the results are judged against",
+     .items = &k_requirement_section,
+     .max_items = NAV_SCENE_MAX_REQUIREMENTS},
 };
 _Static_assert(COUNT(k_root) <= MAX_SECTION_FIELDS, "k_root: too many fields");
 const nav_io_section nav_io_scene_schema = {k_root, COUNT(k_root), NULL};
@@ -2549,6 +2572,73 @@ static bool same_reported(const nav_io_field *f, const void *a, const void *b) {
   const nav_gnss_model_config *mb = (const nav_gnss_model_config *)((const char *)b + f->offset);
   return ma->report_model_sigmas == mb->report_model_sigmas &&
          (ma->report_model_sigmas || nav_io_section_same(f->section, a, b));
+}
+
+/* ---------------------------------------------------------------- JSON Schema of the custom values */
+
+static void schema_format_version(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "integer");
+  nav_io_json_key(j, "minimum");
+  nav_io_json_number(j, 1);
+  nav_io_json_key(j, "maximum");
+  nav_io_json_number(j, NAV_SCENE_FORMAT_VERSION);
+}
+
+static void schema_catalog(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "string");
+  nav_io_json_key(j, "maxLength");
+  nav_io_json_number(j, (double)(f->size - 1));
+}
+
+/* "off": one term name or a list of them (read_off); IMU names may carry "gyro." / "accel.". */
+static void schema_off(nav_io_json *j, const nav_io_field *f) {
+  const bool imu = f->offset == OFF(imu.model);
+  const bool arr = f->offset == OFF(array.accel);
+  const term_name *terms = imu ? k_imu_terms : arr ? k_array_terms : k_gnss_terms;
+  const size_t nterms = imu ? COUNT(k_imu_terms) : arr ? COUNT(k_array_terms) : COUNT(k_gnss_terms);
+  char names[1024], pattern[512];
+  size_t ln = 0, lp = 0;
+  const char *prefixes[3] = {"", "gyro.", "accel."};
+  for (size_t p = 0; p < (imu ? 3u : 1u); ++p)
+    for (size_t k = 0; k < nterms; ++k) {
+      const int m = snprintf(names + ln, sizeof names - ln, "%s\"%s%s\"", ln ? ", " : "", prefixes[p], terms[k].name);
+      if (m > 0 && (size_t)m < sizeof names - ln) ln += (size_t)m;
+    }
+  lp = (size_t)snprintf(pattern, sizeof pattern, "^%s(", imu ? "((gyro|accel)\\.)?" : "");
+  for (size_t k = 0; k < nterms && lp < sizeof pattern; ++k) {
+    const int m = snprintf(pattern + lp, sizeof pattern - lp, "%s%s", k ? "|" : "", terms[k].name);
+    if (m > 0 && (size_t)m < sizeof pattern - lp) lp += (size_t)m;
+  }
+  if (lp < sizeof pattern) snprintf(pattern + lp, sizeof pattern - lp, ")$");
+  char items[1200];
+  snprintf(items, sizeof items, "{\"type\": \"string\", \"enum\": [%s]}", names);
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"array\", \"string\", \"null\"]");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, items);
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, pattern);
+}
+
+static void schema_outages(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "array");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, "{\"type\": \"array\", \"items\": {\"type\": \"number\"}, \"minItems\": 2, \"maxItems\": 2}");
+}
+
+/* reported_sigma: "model", or the mapping of k_reported_section (the object keywords apply to the
+   mapping form only). */
+static void schema_reported(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"string\", \"object\"]");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^model$");
+  nav_io_json_section_members(j, f->section, NULL);
 }
 
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {

@@ -398,20 +398,17 @@ static const nav_io_field k_waypoints[] = {
      .offset = OFF(trajectory.waypoints),
      .read = read_points,
      .write = write_points,
-     .same = same_points},
+     .same = same_points,
+     .doc = "waypoints: a position (ned_m, or lat/lon/h), and speed_mps or time_s by the timing",
+     .items = &k_point_section,
+     .max_items = NAV_MAX_WAYPOINTS},
 };
 SECTION_OF(k_waypoints_section, k_waypoints);
 
 /* ================================================================ kind-dependent mappings */
 
-/* A mapping whose keys depend on its "kind": one section per kind value (each starting with the
-   kind descriptor itself), so unknown keys are matched against that kind's keys only. */
-typedef struct kinded {
-  const nav_io_enum_value *kinds;
-  const nav_io_section *const *sections; /* indexed by kind value */
-  size_t nsections;
-  size_t kind_offset; /* of the int kind in the base object */
-} kinded;
+/* Kind-dependent mappings: nav_io_kinded (scene_io_internal.h). */
+typedef nav_io_kinded kinded;
 
 static void read_kinded(nav_io_reader *r, const kinded *kd, const nav_io_node *key, const nav_io_node *v,
                         void *base) {
@@ -648,7 +645,11 @@ static const nav_io_field k_segments[] = {
      .offset = OFF(trajectory.segments),
      .read = read_items,
      .write = write_items,
-     .same = same_items},
+     .same = same_items,
+     .doc = "the segments, flown in order; each a kind and that kind's keys",
+     .kinded = &k_seg_kinded,
+     .items_kinded = true,
+     .max_items = NAV_MAX_SEGMENTS},
 };
 SECTION_OF(k_segments_section, k_segments);
 
@@ -810,6 +811,18 @@ static bool same_duration(const nav_io_field *f, const void *a, const void *b) {
                    *(const double *)((const char *)b + f->offset));
 }
 
+/* A number within the descriptor's bounds, or the word auto (the bounds apply to numbers only). */
+static void schema_duration(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"number\", \"string\"]");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^auto$");
+  nav_io_json_key(j, "exclusiveMinimum");
+  nav_io_json_number(j, f->min);
+  nav_io_json_key(j, "maximum");
+  nav_io_json_number(j, f->max);
+}
+
 /* Sections of trajectory types: the selected one always, the others when they hold non-defaults. */
 static bool type_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
   nav_traj_type t = NAV_TRAJ_PARAMETRIC;
@@ -848,7 +861,9 @@ static const nav_io_field k_trajectory[] = {
      .max = NAV_SCENE_MAX_DURATION_S,
      .read = read_duration,
      .write = write_duration,
-     .same = same_duration},
+     .same = same_duration,
+     .doc = "length of the trajectory, or auto: the length of a waypoint or segment script",
+     .schema = schema_duration},
     {.key = "initial_attitude",
      .kind = NAV_IO_SECTION,
      .flags = NAV_IO_FLOW,
@@ -862,7 +877,9 @@ static const nav_io_field k_trajectory[] = {
      .read = read_test_motion,
      .write = write_test_motion,
      .same = same_test_motion,
-     .write_if = type_written},
+     .write_if = type_written,
+     .doc = "a test motion (type test_motion): its kind and that kind's keys",
+     .kinded = &k_tm_kinded},
     {.key = "motion_def", .kind = NAV_IO_SECTION, .section = &k_motion_def_section, .write_if = never},
     {.key = "recorded", .kind = NAV_IO_SECTION, .section = &k_recorded_section, .write_if = type_written},
 };
