@@ -182,12 +182,17 @@ static bool same_sky_mask(const nav_io_field *f, const void *a, const void *b) {
 
 #define POS_LE_1000 (NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE | NAV_IO_REQUIRED)
 static const nav_io_field k_canyon[] = {
-    {.key = "t0_s", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t0_s), .scale = 1.0},
-    {.key = "t1_s", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t1_s), .scale = 1.0},
-    {.key = "height_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(height_m), .scale = 1.0,
+    {.key = "t0_s",
+     .doc = "time the vehicle enters the canyon", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t0_s), .scale = 1.0},
+    {.key = "t1_s",
+     .doc = "time the vehicle leaves the canyon", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t1_s), .scale = 1.0},
+    {.key = "height_m",
+     .doc = "height of the walls above the antenna", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(height_m), .scale = 1.0,
      .max = 1000.0},
-    {.key = "left_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(left_m), .scale = 1.0, .max = 1000.0},
-    {.key = "right_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(right_m), .scale = 1.0,
+    {.key = "left_m",
+     .doc = "distance to the left wall", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(left_m), .scale = 1.0, .max = 1000.0},
+    {.key = "right_m",
+     .doc = "distance to the right wall", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(right_m), .scale = 1.0,
      .max = 1000.0},
 };
 static const nav_io_section k_canyon_section = {k_canyon, COUNT(k_canyon), NULL};
@@ -287,10 +292,12 @@ static const nav_io_field k_constellation[] = {
      .comment = "nominal: SPS PS 24 slots; almanac: the YUMA file below"},
     {.key = "almanac", .kind = NAV_IO_STRING, .offset = OFF(C(almanac_file)), .size = NAV_GNSS_ALMANAC_PATH_MAX,
      .write_if = almanac_given, .comment = "YUMA almanac, relative to this file"},
-    {.key = "glonass", .kind = NAV_IO_ENUM, .offset = OFF(C(glonass)), .enums = k_glo_sources},
+    {.key = "glonass",
+     .doc = "GLONASS satellites: their source", .kind = NAV_IO_ENUM, .offset = OFF(C(glonass)), .enums = k_glo_sources},
     {.key = "glonass_node_lon_deg", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE,
      .offset = OFF(C(glonass_node1_lon_rad)), .scale = DEG, .comment = "plane 1 ascending node at the epoch"},
-    {.key = "elevation_mask_deg", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE,
+    {.key = "elevation_mask_deg",
+     .doc = "lowest elevation of a visible satellite", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE,
      .offset = OFF(C(mask.elevation_mask_rad)), .scale = DEG, .min = 0.0},
     {.key = "sky_mask_deg", .kind = NAV_IO_CUSTOM, .offset = OFF(C(mask)), .read = read_sky_mask,
      .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline",

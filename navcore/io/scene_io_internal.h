@@ -82,7 +82,12 @@ enum {
   NAV_IO_STATE = 1u << 7,     /**< offset into nav_io_read_state; read only, never written */
   NAV_IO_EARLY = 1u << 8,     /**< read before the other keys of its mapping, wherever it is */
   NAV_IO_LATE = 1u << 9,      /**< read after the other keys of its mapping, wherever it is */
-  NAV_IO_WRITE_ALT = 1u << 10 /**< an ALT spelling the writer may choose when it is shorter */
+  NAV_IO_WRITE_ALT = 1u << 10, /**< an ALT spelling the writer may choose when it is shorter */
+  /** The range (min/max, max_axis) is checked on the SI value after reading, by nav_scene_validate
+      or a section's finish function, with its own message; the reader's number check applies only
+      NAV_IO_FINITE. The table still states the range: the schema publishes it and
+      test_scene_schema checks that it is the range enforced. */
+  NAV_IO_RANGE_LATER = 1u << 11
 };
 
 typedef struct nav_io_enum_value {
@@ -161,6 +166,8 @@ struct nav_io_field {
                                           mappings) whose keys depend on its kind */
   bool items_kinded;                 /**< CUSTOM with .kinded: a sequence of such mappings */
   size_t max_items;                  /**< CUSTOM sequences: the most items the reader accepts (0: none) */
+  const double *max_axis;            /**< VEC3S: per-axis maxima x, y, z (file units), tighter than .max;
+                                          enforced by the section's finish function (NULL: none) */
   nav_io_schema_fn schema;           /**< CUSTOM: JSON Schema of the value (NULL: from the above) */
 };
 

@@ -268,6 +268,14 @@ static const nav_io_field *preferred_of(const nav_io_section *sec, size_t i) {
   return NULL;
 }
 
+/* The description of field i of sec: its own, else its comment, else (another spelling of a
+   quantity) that of the preferred spelling. */
+static const char *doc_in(const nav_io_section *sec, size_t i) {
+  const char *d = doc_of(&sec->fields[i]);
+  const nav_io_field *pref = d[0] == '\0' ? preferred_of(sec, i) : NULL;
+  return pref != NULL ? doc_of(pref) : d;
+}
+
 /* The default of a plain field in the file's unit, from the default object @p def (NULL: none). */
 typedef struct field_default {
   bool has;
@@ -384,7 +392,7 @@ static field_default default_of(const nav_io_field *f, const void *def) {
 
 /* ================================================================ JSON Schema */
 
-static void json_field(nav_io_json *j, const nav_io_field *f, const void *def);
+static void json_field(nav_io_json *j, const nav_io_field *f, const void *def, const char *doc);
 
 static void number_bounds(nav_io_json *j, const nav_io_field *f) {
   if (f->flags & NAV_IO_MIN_GT) member_exact(j, "exclusiveMinimum", f->min);
@@ -438,7 +446,7 @@ void nav_io_json_section_members(nav_io_json *j, const nav_io_section *sec, cons
   nav_io_json_begin(j);
   for (size_t i = 0; i < sec->count; ++i) {
     nav_io_json_key(j, sec->fields[i].key);
-    json_field(j, &sec->fields[i], def);
+    json_field(j, &sec->fields[i], def, doc_in(sec, i));
   }
   nav_io_json_end(j);
   member_raw(j, "additionalProperties", "false");
@@ -498,6 +506,10 @@ static void kinded_schema(nav_io_json *j, const nav_io_kinded *kd, const void *d
   member_string(j, "type", "string");
   nav_io_json_key(j, "enum");
   enum_list(j, kd->kinds);
+  /* each kind's section starts with the kind descriptor itself (scene_io_internal.h) */
+  const nav_io_section *first = kd->nsections > 0 ? kd->sections[0] : NULL;
+  if (first != NULL && first->count > 0 && doc_of(&first->fields[0])[0] != '\0')
+    member_string(j, "description", doc_of(&first->fields[0]));
   nav_io_json_end(j);
   nav_io_json_end(j);
   nav_io_json_key(j, "allOf");
@@ -522,13 +534,13 @@ static void kinded_schema(nav_io_json *j, const nav_io_kinded *kd, const void *d
   array_end(j);
 }
 
-static void json_field(nav_io_json *j, const nav_io_field *f, const void *def) {
+static void json_field(nav_io_json *j, const nav_io_field *f, const void *def, const char *doc) {
   nav_io_json_begin(j);
   const char *unit = unit_of(f);
   switch (f->kind) {
   case NAV_IO_SECTION:
     member_raw(j, "type", "[\"object\", \"null\"]");
-    if (doc_of(f)[0] != '\0') member_string(j, "description", doc_of(f));
+    if (doc[0] != '\0') member_string(j, "description", doc);
     nav_io_json_section_members(j, f->section, def);
     nav_io_json_end(j);
     return;
@@ -544,7 +556,22 @@ static void json_field(nav_io_json *j, const nav_io_field *f, const void *def) {
     break;
   case NAV_IO_VEC3S:
     member_raw(j, "type", "[\"number\", \"array\"]");
-    number_bounds(j, f);
+    if (f->max_axis != NULL) {
+      /* one number sets all three axes: the smallest axis maximum; a list: each axis its own */
+      nav_io_field one = *f;
+      for (int a = 0; a < 3; ++a)
+        if (f->max_axis[a] < one.max) one.max = f->max_axis[a];
+      number_bounds(j, &one);
+      nav_io_json_key(j, "prefixItems");
+      array_begin(j, false);
+      for (int a = 0; a < 3; ++a) {
+        one.max = f->max_axis[a];
+        number_schema(j, &one);
+      }
+      array_end(j);
+    } else {
+      number_bounds(j, f);
+    }
     nav_io_json_key(j, "items");
     number_schema(j, f);
     three(j);
@@ -608,7 +635,7 @@ static void json_field(nav_io_json *j, const nav_io_field *f, const void *def) {
     if (f->max_items > 0) member_number(j, "maxItems", (double)f->max_items);
     break;
   }
-  if (doc_of(f)[0] != '\0') member_string(j, "description", doc_of(f));
+  if (doc[0] != '\0') member_string(j, "description", doc);
   json_default(j, f, def);
   if (unit != NULL) {
     member_string(j, "x-unit", unit);
@@ -721,10 +748,15 @@ static void walk(key_list *L, const nav_io_section *sec, const void *def, const 
     if (f->flags & NAV_IO_MIN_GE) k->bounds |= NAV_SCHEMA_MIN;
     if (f->flags & NAV_IO_MAX_LE) k->bounds |= NAV_SCHEMA_MAX;
     if (f->flags & NAV_IO_FINITE) k->bounds |= NAV_SCHEMA_FINITE;
+    if (f->flags & NAV_IO_RANGE_LATER) k->bounds |= NAV_SCHEMA_CHECKED_IN_SI;
     k->min = f->min;
     k->max = f->max;
+    for (int a = 0; a < 3; ++a) {
+      k->max_axis[a] = f->max_axis != NULL ? f->max_axis[a] : f->max;
+      if (k->max_axis[a] < k->max) k->max = k->max_axis[a];
+    }
     k->required = (f->flags & NAV_IO_REQUIRED) != 0;
-    k->doc = doc_of(f);
+    k->doc = doc_in(sec, i);
     const nav_io_field *pref = preferred_of(sec, i);
     if (pref != NULL && (size_t)(pref - sec->fields) < 64) k->alt_of = (int)index[pref - sec->fields];
     const field_default d = default_of(f, def);

@@ -118,7 +118,10 @@ def main():
             if "x-unit" not in sub and path.split(".")[-1] != "limit":
                 failures.append(f"{path}: numeric key without x-unit")
         if "object" in types and "properties" in sub and sub.get("additionalProperties") is not False:
-            failures.append(f"{path}: mapping accepts unknown keys")
+            # a mapping chosen by its kind: each kind's branch rejects unknown keys
+            branches = [b.get("then", {}) for b in sub.get("allOf", [])]
+            if not branches or any(b.get("additionalProperties") is not False for b in branches):
+                failures.append(f"{path}: mapping accepts unknown keys")
     scheme = schema["properties"]["navigation"]["properties"]["scheme"]
     if "free_ins" not in scheme.get("enum", []):
         failures.append("navigation.scheme: no enum of schemes")

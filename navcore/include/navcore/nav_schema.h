@@ -63,7 +63,10 @@ enum {
   NAV_SCHEMA_MIN = 1u << 0,          /**< value >= min */
   NAV_SCHEMA_MIN_EXCLUSIVE = 1u << 1,/**< value > min */
   NAV_SCHEMA_MAX = 1u << 2,          /**< value <= max */
-  NAV_SCHEMA_FINITE = 1u << 3        /**< .inf and .nan are rejected */
+  NAV_SCHEMA_FINITE = 1u << 3,       /**< .inf and .nan are rejected */
+  /** The range is checked on the SI value (file value * scale): a value a few ulps past the bound
+      may convert to the bound itself. */
+  NAV_SCHEMA_CHECKED_IN_SI = 1u << 4
 };
 
 /** One key of the scene file. Plain data; every pointer is to static text. */
@@ -74,7 +77,10 @@ typedef struct nav_schema_key {
   const char *unit;               /**< unit as written in the file ("deg/h", "m", "1"), or NULL */
   double scale;                   /**< SI value = file value * scale (1 for non-numbers) */
   unsigned bounds;                /**< NAV_SCHEMA_MIN / _MIN_EXCLUSIVE / _MAX / _FINITE */
-  double min, max;                /**< in the file's unit; per @c bounds (per component for vectors) */
+  double min, max;                /**< in the file's unit; per @c bounds (per component for vectors; for
+                                       VEC3_SCALAR max is that of the one-number form, see max_axis) */
+  double max_axis[3];             /**< vectors: the maximum of each component x, y, z (= max unless the
+                                       axes differ, as the tilt and heading sigmas do) */
   bool required;                  /**< the key must be present in its mapping */
   int alt_of;                     /**< index of the preferred spelling of the same quantity, or -1 */
   bool has_default;               /**< the reader has a default (default_value / default_text) */
