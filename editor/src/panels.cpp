@@ -1,5 +1,6 @@
 #include "panels.h"
 #include "path_view.h"
+#include "schema_fields.h"
 #include "segment_editor.h"
 
 #include <QCheckBox>
@@ -78,6 +79,10 @@ NumField::NumField(SceneDocument *doc, const QString &label, const QString &unit
   v->addWidget(msg_);
   connect(edit_, &QLineEdit::textEdited, this, &NumField::OnEdited);
   connect(edit_, &QLineEdit::editingFinished, this, &NumField::OnCommit);
+}
+
+void NumField::SetHelp(const QString &key, const QString &help) {
+  edit_->setToolTip(tr("%1 [%2] (scene file: %3)%4").arg(label_, unit_, key, help.isEmpty() ? QString() : ": " + help));
 }
 
 void NumField::SetOptional(std::function<bool(const nav_scene &)> is_set, std::function<void(nav_scene &)> clear) {
@@ -175,6 +180,17 @@ NumField *ScenePanels::AddField(QFormLayout *form, const QString &label, const Q
   return f;
 }
 
+NumField *ScenePanels::AddKey(QFormLayout *form, const QString &label, const char *key, const QString &path,
+                              NumField::Getter get_si, NumField::Setter set_si) {
+  const nav_schema_key &k = SchemaKey(key);
+  const double scale = k.scale;
+  NumField *f = AddField(
+      form, label, DisplayUnit(k.unit), path, [get_si, scale](const nav_scene &s) { return get_si(s) / scale; },
+      [set_si, scale](nav_scene &s, double v) { set_si(s, v * scale); });
+  f->SetHelp(QString::fromUtf8(key), KeyHelp(k));
+  return f;
+}
+
 QWidget *ScenePanels::BuildModel() {
   auto *w = new QWidget;
   auto *form = new QFormLayout(w);
@@ -211,15 +227,14 @@ QWidget *ScenePanels::BuildModel() {
   connect(frame_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
     doc_->Edit(tr("Set frame"), [i](nav_scene &s) { s.navigation.frame = static_cast<nav_mech_frame>(i); });
   });
-  const double r2d = 180.0 / M_PI;
-  AddField(form, tr("Origin latitude"), "deg", "earth.origin.lat",
-           [r2d](const nav_scene &s) { return s.earth.origin_lat_rad * r2d; },
-           [r2d](nav_scene &s, double v) { s.earth.origin_lat_rad = v / r2d; });
-  AddField(form, tr("Origin longitude"), "deg", "earth.origin.lon",
-           [r2d](const nav_scene &s) { return s.earth.origin_lon_rad * r2d; },
-           [r2d](nav_scene &s, double v) { s.earth.origin_lon_rad = v / r2d; });
-  AddField(form, tr("Origin height"), "m", "earth.origin.h",
-           [](const nav_scene &s) { return s.earth.origin_h_m; }, [](nav_scene &s, double v) { s.earth.origin_h_m = v; });
+  AddKey(form, tr("Origin latitude"), "earth.origin.lat_deg", "earth.origin.lat",
+         [](const nav_scene &s) { return s.earth.origin_lat_rad; },
+         [](nav_scene &s, double v) { s.earth.origin_lat_rad = v; });
+  AddKey(form, tr("Origin longitude"), "earth.origin.lon_deg", "earth.origin.lon",
+         [](const nav_scene &s) { return s.earth.origin_lon_rad; },
+         [](nav_scene &s, double v) { s.earth.origin_lon_rad = v; });
+  AddKey(form, tr("Origin height"), "earth.origin.h_m", "earth.origin.h",
+         [](const nav_scene &s) { return s.earth.origin_h_m; }, [](nav_scene &s, double v) { s.earth.origin_h_m = v; });
   return w;
 }
 
@@ -251,44 +266,44 @@ QWidget *ScenePanels::BuildImu() {
       s.imu.model = entry.config;
     });
   });
-  AddField(form, tr("IMU rate"), "Hz", "imu.rate_hz", [](const nav_scene &s) { return s.imu.rate_hz; },
-           [](nav_scene &s, double v) { s.imu.rate_hz = v; });
+  AddKey(form, tr("IMU rate"), "imu.rate_hz", "imu.rate_hz", [](const nav_scene &s) { return s.imu.rate_hz; },
+         [](nav_scene &s, double v) { s.imu.rate_hz = v; });
 
-  // Error terms in datasheet units; one value for the three axes; empty = term off.
+  // Error terms in datasheet units (the unit and scale of each scene key, from navcore_io's table);
+  // one value for the three axes; empty = term off.
   struct Term {
-    QString label, unit, path;
+    QString label;
+    const char *key; // the scene key whose unit, scale and bounds the field has
+    QString path;    // the field's name (its issues are those under this path)
     bool gyro;
     unsigned bit;
-    double scale;              // datasheet unit -> SI
     nav_vec3 nav_gyro_error_config::*g;
     nav_vec3 nav_accel_error_config::*a;
   };
-  const double d2r = M_PI / 180.0;
   const std::vector<Term> terms = {
-      {tr("Gyro ARW"), "deg/√h", "imu.gyro.arw", true, NAV_IMU_TERM_NOISE,
-       nav_unit_deg_per_sqrt_h_to_rad_per_sqrt_s(1.0), &nav_gyro_error_config::arw_rad_per_sqrt_s, nullptr},
-      {tr("Gyro bias GM σ"), "deg/h", "imu.gyro.bias_gm_sigma", true, NAV_IMU_TERM_BIAS_GM,
-       nav_unit_deg_per_h_to_rps(1.0), &nav_gyro_error_config::bias_gm_sd_rps, nullptr},
-      {tr("Gyro bias GM τ"), "s", "imu.gyro.bias_gm_tau", true, NAV_IMU_TERM_BIAS_GM, 1.0,
+      {tr("Gyro ARW"), "imu.gyro.arw_deg_per_sqrt_h", "imu.gyro.arw", true, NAV_IMU_TERM_NOISE,
+       &nav_gyro_error_config::arw_rad_per_sqrt_s, nullptr},
+      {tr("Gyro bias GM σ"), "imu.gyro.bias_gm_sigma_deg_per_h", "imu.gyro.bias_gm_sigma", true, NAV_IMU_TERM_BIAS_GM,
+       &nav_gyro_error_config::bias_gm_sd_rps, nullptr},
+      {tr("Gyro bias GM τ"), "imu.gyro.bias_gm_tau_s", "imu.gyro.bias_gm_tau", true, NAV_IMU_TERM_BIAS_GM,
        &nav_gyro_error_config::bias_gm_tau_s, nullptr},
-      {tr("Gyro turn-on bias σ"), "deg/h", "imu.gyro.bias_turn_on", true, NAV_IMU_TERM_BIAS_TURN_ON,
-       nav_unit_deg_per_h_to_rps(1.0), &nav_gyro_error_config::bias_turn_on_sd_rps, nullptr},
-      {tr("Gyro rate random walk"), "deg/h/√h", "imu.gyro.bias_rw", true, NAV_IMU_TERM_BIAS_RW,
-       nav_unit_deg_per_h_per_sqrt_h_to_rps_per_sqrt_s(1.0), &nav_gyro_error_config::bias_rw_rps_per_sqrt_s, nullptr},
-      {tr("Gyro scale factor σ"), "ppm", "imu.gyro.scale_factor", true, NAV_IMU_TERM_SCALE_FACTOR, 1e-6,
-       &nav_gyro_error_config::scale_factor_sd, nullptr},
-      {tr("Accel VRW"), "m/s/√h", "imu.accel.vrw", false, NAV_IMU_TERM_NOISE,
-       nav_unit_mps_per_sqrt_h_to_mps_per_sqrt_s(1.0), nullptr, &nav_accel_error_config::vrw_mps_per_sqrt_s},
-      {tr("Accel bias GM σ"), "µg", "imu.accel.bias_gm_sigma", false, NAV_IMU_TERM_BIAS_GM,
-       nav_unit_ug_to_mps2(1.0), nullptr, &nav_accel_error_config::bias_gm_sd_mps2},
-      {tr("Accel bias GM τ"), "s", "imu.accel.bias_gm_tau", false, NAV_IMU_TERM_BIAS_GM, 1.0, nullptr,
+      {tr("Gyro turn-on bias σ"), "imu.gyro.bias_turn_on_deg_per_h", "imu.gyro.bias_turn_on", true,
+       NAV_IMU_TERM_BIAS_TURN_ON, &nav_gyro_error_config::bias_turn_on_sd_rps, nullptr},
+      {tr("Gyro rate random walk"), "imu.gyro.rrw_deg_per_h_per_sqrt_h", "imu.gyro.bias_rw", true,
+       NAV_IMU_TERM_BIAS_RW, &nav_gyro_error_config::bias_rw_rps_per_sqrt_s, nullptr},
+      {tr("Gyro scale factor σ"), "imu.gyro.scale_factor_ppm", "imu.gyro.scale_factor", true,
+       NAV_IMU_TERM_SCALE_FACTOR, &nav_gyro_error_config::scale_factor_sd, nullptr},
+      {tr("Accel VRW"), "imu.accel.vrw_m_per_s_per_sqrt_h", "imu.accel.vrw", false, NAV_IMU_TERM_NOISE, nullptr,
+       &nav_accel_error_config::vrw_mps_per_sqrt_s},
+      {tr("Accel bias GM σ"), "imu.accel.bias_gm_sigma_ug", "imu.accel.bias_gm_sigma", false, NAV_IMU_TERM_BIAS_GM,
+       nullptr, &nav_accel_error_config::bias_gm_sd_mps2},
+      {tr("Accel bias GM τ"), "imu.accel.bias_gm_tau_s", "imu.accel.bias_gm_tau", false, NAV_IMU_TERM_BIAS_GM, nullptr,
        &nav_accel_error_config::bias_gm_tau_s},
-      {tr("Accel turn-on bias σ"), "mg", "imu.accel.bias_turn_on", false, NAV_IMU_TERM_BIAS_TURN_ON,
-       nav_unit_mg_to_mps2(1.0), nullptr, &nav_accel_error_config::bias_turn_on_sd_mps2},
-      {tr("Accel scale factor σ"), "ppm", "imu.accel.scale_factor", false, NAV_IMU_TERM_SCALE_FACTOR, 1e-6,
-       nullptr, &nav_accel_error_config::scale_factor_sd},
+      {tr("Accel turn-on bias σ"), "imu.accel.bias_turn_on_mg", "imu.accel.bias_turn_on", false,
+       NAV_IMU_TERM_BIAS_TURN_ON, nullptr, &nav_accel_error_config::bias_turn_on_sd_mps2},
+      {tr("Accel scale factor σ"), "imu.accel.scale_factor_ppm", "imu.accel.scale_factor", false,
+       NAV_IMU_TERM_SCALE_FACTOR, nullptr, &nav_accel_error_config::scale_factor_sd},
   };
-  (void)d2r;
   for (const Term &t : terms) {
     auto vec = [t](nav_scene &s) -> nav_vec3 & { return t.gyro ? s.imu.model.gyro.*(t.g) : s.imu.model.accel.*(t.a); };
     auto cvec = [t](const nav_scene &s) -> const nav_vec3 & {
@@ -296,10 +311,10 @@ QWidget *ScenePanels::BuildImu() {
     };
     auto bits = [t](nav_scene &s) -> unsigned & { return t.gyro ? s.imu.model.gyro.terms : s.imu.model.accel.terms; };
     const bool is_tau = t.path.endsWith("_tau");
-    NumField *f = AddField(
-        form, t.label, t.unit, t.path, [cvec, t](const nav_scene &s) { return cvec(s).x / t.scale; },
+    NumField *f = AddKey(
+        form, t.label, t.key, t.path, [cvec](const nav_scene &s) { return cvec(s).x; },
         [vec, bits, t, is_tau](nav_scene &s, double v) {
-          SetVec(vec(s), v * t.scale);
+          SetVec(vec(s), v);
           bits(s) |= t.bit;
           if (!is_tau && t.bit == NAV_IMU_TERM_BIAS_GM) {
             nav_vec3 &tau = t.gyro ? s.imu.model.gyro.bias_gm_tau_s : s.imu.model.accel.bias_gm_tau_s;
@@ -342,13 +357,14 @@ QWidget *ScenePanels::BuildGnss() {
       std::snprintf(s.gnss.catalog, sizeof s.gnss.catalog, "%s", entry.name);
     });
   });
-  AddField(form, tr("Fix rate"), "Hz", "gnss.update_rate", [](const nav_scene &s) { return s.gnss.model.update_rate_hz; },
-           [](nav_scene &s, double v) { s.gnss.model.update_rate_hz = v; });
-  AddField(form, tr("Latency"), "s", "gnss.latency", [](const nav_scene &s) { return s.gnss.model.latency_s; },
-           [](nav_scene &s, double v) { s.gnss.model.latency_s = v; });
+  AddKey(form, tr("Fix rate"), "gnss.update_rate_hz", "gnss.update_rate",
+         [](const nav_scene &s) { return s.gnss.model.update_rate_hz; },
+         [](nav_scene &s, double v) { s.gnss.model.update_rate_hz = v; });
+  AddKey(form, tr("Latency"), "gnss.latency_s", "gnss.latency", [](const nav_scene &s) { return s.gnss.model.latency_s; },
+         [](nav_scene &s, double v) { s.gnss.model.latency_s = v; });
   const char *axes[3] = {"x (forward)", "y (right)", "z (down)"};
   for (int k = 0; k < 3; ++k) {
-    AddField(form, tr("Lever arm %1").arg(axes[k]), "m", "gnss.lever_arm",
+    AddKey(form, tr("Lever arm %1").arg(axes[k]), "gnss.lever_arm_b_m", "gnss.lever_arm",
              [k](const nav_scene &s) { const nav_vec3 &r = s.gnss.model.r_ba_b_m; return k == 0 ? r.x : k == 1 ? r.y : r.z; },
              [k](nav_scene &s, double v) { nav_vec3 &r = s.gnss.model.r_ba_b_m; (k == 0 ? r.x : k == 1 ? r.y : r.z) = v; });
   }
@@ -448,21 +464,23 @@ QWidget *ScenePanels::BuildTrajectory() {
   auto *formw = new QWidget;
   auto *form = new QFormLayout(formw);
   form->setContentsMargins(0, 0, 0, 0);
-  AddField(form, tr("Hold at start"), "s", "trajectory.waypoints.hold_start",
-           [](const nav_scene &s) { return s.trajectory.waypoints.hold_start_s; },
-           [](nav_scene &s, double v) { s.trajectory.waypoints.hold_start_s = v; });
-  AddField(form, tr("Hold at end"), "s", "trajectory.waypoints.hold_end",
-           [](const nav_scene &s) { return s.trajectory.waypoints.hold_end_s; },
-           [](nav_scene &s, double v) { s.trajectory.waypoints.hold_end_s = v; });
-  AddField(form, tr("Speed between stops"), "m/s", "trajectory.waypoints.cruise",
-           [](const nav_scene &s) { return s.trajectory.waypoints.cruise_mps; },
-           [](nav_scene &s, double v) { s.trajectory.waypoints.cruise_mps = v; });
-  AddField(form, tr("Max acceleration"), "m/s²", "trajectory.waypoints.limits.max_accel",
-           [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_accel_mps2; },
-           [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_accel_mps2 = v; });
-  AddField(form, tr("Max lateral accel."), "m/s²", "trajectory.waypoints.limits.max_lateral",
-           [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_lateral_accel_mps2; },
-           [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_lateral_accel_mps2 = v; });
+  AddKey(form, tr("Hold at start"), "trajectory.waypoints.hold_start_s", "trajectory.waypoints.hold_start",
+         [](const nav_scene &s) { return s.trajectory.waypoints.hold_start_s; },
+         [](nav_scene &s, double v) { s.trajectory.waypoints.hold_start_s = v; });
+  AddKey(form, tr("Hold at end"), "trajectory.waypoints.hold_end_s", "trajectory.waypoints.hold_end",
+         [](const nav_scene &s) { return s.trajectory.waypoints.hold_end_s; },
+         [](nav_scene &s, double v) { s.trajectory.waypoints.hold_end_s = v; });
+  AddKey(form, tr("Speed between stops"), "trajectory.waypoints.cruise_mps", "trajectory.waypoints.cruise",
+         [](const nav_scene &s) { return s.trajectory.waypoints.cruise_mps; },
+         [](nav_scene &s, double v) { s.trajectory.waypoints.cruise_mps = v; });
+  AddKey(form, tr("Max acceleration"), "trajectory.waypoints.limits.max_accel_mps2",
+         "trajectory.waypoints.limits.max_accel",
+         [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_accel_mps2; },
+         [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_accel_mps2 = v; });
+  AddKey(form, tr("Max lateral accel."), "trajectory.waypoints.limits.max_lateral_accel_mps2",
+         "trajectory.waypoints.limits.max_lateral",
+         [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_lateral_accel_mps2; },
+         [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_lateral_accel_mps2 = v; });
   vl->addWidget(formw);
   plan_label_ = new QLabel;
   plan_label_->setObjectName("planLabel");
@@ -474,13 +492,15 @@ QWidget *ScenePanels::BuildTrajectory() {
 QWidget *ScenePanels::BuildSimulation() {
   auto *w = new QWidget;
   auto *form = new QFormLayout(w);
-  AddField(form, tr("Monte Carlo runs"), "", "simulation.runs",
+  NumField *runs = AddField(form, tr("Monte Carlo runs"), "", "simulation.runs",
            [](const nav_scene &s) { return static_cast<double>(s.simulation.runs); },
            [](nav_scene &s, double v) { s.simulation.runs = std::isfinite(v) && std::fabs(v) < 1e12 ? static_cast<long>(v) : -1; });
-  AddField(form, tr("Seed"), "", "simulation.seed", [](const nav_scene &s) { return static_cast<double>(s.simulation.seed); },
+  NumField *seed = AddField(form, tr("Seed"), "", "simulation.seed", [](const nav_scene &s) { return static_cast<double>(s.simulation.seed); },
            [](nav_scene &s, double v) { s.simulation.seed = v >= 0 && v < 9e15 ? static_cast<uint64_t>(v) : 0; });
-  AddField(form, tr("Output rate"), "Hz", "output.rate_hz", [](const nav_scene &s) { return s.output.rate_hz; },
-           [](nav_scene &s, double v) { s.output.rate_hz = v; });
+  runs->SetHelp("simulation.runs", KeyHelp(SchemaKey("simulation.runs")));
+  seed->SetHelp("simulation.seed", KeyHelp(SchemaKey("simulation.seed")));
+  AddKey(form, tr("Output rate"), "output.rate_hz", "output.rate_hz", [](const nav_scene &s) { return s.output.rate_hz; },
+         [](nav_scene &s, double v) { s.output.rate_hz = v; });
   auto *row = new QHBoxLayout;
   auto *run = new QPushButton(tr("Run"));
   run->setObjectName("panelRun");

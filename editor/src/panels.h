@@ -38,6 +38,8 @@ public:
   NumField(SceneDocument *doc, const QString &label, const QString &unit, const QString &path, Getter get,
            Setter set, QWidget *parent = nullptr);
   void SetOptional(std::function<bool(const nav_scene &)> is_set, std::function<void(nav_scene &)> clear);
+  /** Add the scene table's description, range and default of @p key to the tooltip. */
+  void SetHelp(const QString &key, const QString &help);
   void Refresh();
   QLineEdit *Edit() { return edit_; }
   QString Label() const { return label_; }
@@ -85,6 +87,10 @@ private:
   QWidget *BuildRequirements();
   NumField *AddField(QFormLayout *form, const QString &label, const QString &unit, const QString &path,
                      NumField::Getter get, NumField::Setter set);
+  /** A field for the scene key @p key of navcore_io's table (nav_schema.h): its unit, scale to SI
+   *  and help come from the table; @p get / @p set work in SI, the field in the key's unit. */
+  NumField *AddKey(QFormLayout *form, const QString &label, const char *key, const QString &path,
+                   NumField::Getter get_si, NumField::Setter set_si);
   void RefreshWaypoints();
   void RefreshOutages();
   void RefreshRequirements();

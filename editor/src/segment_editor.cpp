@@ -1,4 +1,5 @@
 #include "segment_editor.h"
+#include "schema_fields.h"
 #include "parametric_editor.h"
 
 #include <QCheckBox>
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <climits>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 
@@ -41,11 +43,6 @@ void CollectDiag(void *user, const nav_diag *d) {
   static_cast<QVector<Issue> *>(user)->push_back(Issue{QString::fromUtf8(d->path), QString::fromUtf8(d->message)});
 }
 
-QString EditFilePath() {
-  const QString dir = QDir("/dev/shm").exists() ? QStringLiteral("/dev/shm") : QDir::tempPath();
-  return QDir(dir).filePath(QStringLiteral("navstudio-edit-%1.yaml").arg(QCoreApplication::applicationPid()));
-}
-
 /* The segment kinds as the scene file names them (index = nav_segment_kind). */
 const char *const kKindNames[] = {"hold",           "accelerate",     "turn",          "coordinated_turn",
                                   "climb",          "circle",         "figure_eight",  "helix",
@@ -54,11 +51,9 @@ const char *const kKindNames[] = {"hold",           "accelerate",     "turn",   
 constexpr int kKindCount = static_cast<int>(sizeof kKindNames / sizeof kKindNames[0]);
 
 struct Spec {
-  const char *key;
+  const char *key;   // the scene key (its unit and scale come from navcore_io's table: KeyOf)
   const char *label;
-  const char *unit;
   size_t offset;
-  double scale;
   bool is_int;
 };
 
@@ -67,43 +62,57 @@ struct Spec {
 
 /* The keys of each kind as navcore_io reads and writes them (scene_traj_io.c), in its units. */
 std::vector<Spec> SpecsOf(int kind) {
-  const Spec duration{"duration_s", "Duration", "s", SEG(duration_s), 1.0, false};
-  const Spec yaw{"yaw_deg", "Yaw", "deg", SEG(yaw_rad), kDeg, false};
-  const Spec pitch{"pitch_deg", "Pitch", "deg", SEG(pitch_rad), kDeg, false};
-  const Spec roll{"roll_deg", "Roll", "deg", SEG(roll_rad), kDeg, false};
-  const Spec yaw_rate{"yaw_rate_dps", "Yaw rate", "deg/s", SEG(yaw_rate_rps), kDeg, false};
-  const Spec radius{"radius_m", "Radius", "m", SEG(radius_m), 1.0, false};
-  const Spec turns{"turns", "Turns", "", SEG(turns), 1.0, false};
+  const Spec duration{"duration_s", "Duration", SEG(duration_s), false};
+  const Spec yaw{"yaw_deg", "Yaw", SEG(yaw_rad), false};
+  const Spec pitch{"pitch_deg", "Pitch", SEG(pitch_rad), false};
+  const Spec roll{"roll_deg", "Roll", SEG(roll_rad), false};
+  const Spec yaw_rate{"yaw_rate_dps", "Yaw rate", SEG(yaw_rate_rps), false};
+  const Spec radius{"radius_m", "Radius", SEG(radius_m), false};
+  const Spec turns{"turns", "Turns", SEG(turns), false};
   switch (kind) {
   case NAV_SEG_HOLD: return {duration};
-  case NAV_SEG_ACCELERATE: return {{"speed_mps", "Speed", "m/s", SEG(speed_mps), 1.0, false}};
+  case NAV_SEG_ACCELERATE: return {{"speed_mps", "Speed", SEG(speed_mps), false}};
   case NAV_SEG_TURN:
   case NAV_SEG_COORD_TURN: return {yaw, yaw_rate};
-  case NAV_SEG_CLIMB: return {{"height_m", "Height change", "m", SEG(height_m), 1.0, false}, pitch};
+  case NAV_SEG_CLIMB: return {{"height_m", "Height change", SEG(height_m), false}, pitch};
   case NAV_SEG_CIRCLE:
   case NAV_SEG_FIGURE_EIGHT: return {radius, turns};
   case NAV_SEG_HELIX: return {radius, turns, pitch};
   case NAV_SEG_LAWNMOWER:
-    return {{"legs", "Legs", "", SEG(legs), 1.0, true},
-            {"length_m", "Leg length", "m", SEG(length_m), 1.0, false},
-            {"spacing_m", "Spacing", "m", SEG(spacing_m), 1.0, false}};
+    return {{"legs", "Legs", SEG(legs), true},
+            {"length_m", "Leg length", SEG(length_m), false},
+            {"spacing_m", "Spacing", SEG(spacing_m), false}};
   case NAV_SEG_MOTION_RATES:
     return {yaw_rate,
-            {"pitch_rate_dps", "Pitch rate", "deg/s", SEG(pitch_rate_rps), kDeg, false},
-            {"roll_rate_dps", "Roll rate", "deg/s", SEG(roll_rate_rps), kDeg, false},
-            {"accel_b_mps2[0]", "Accel. x", "m/s²", SEGV(accel_b_mps2, 0), 1.0, false},
-            {"accel_b_mps2[1]", "Accel. y", "m/s²", SEGV(accel_b_mps2, 1), 1.0, false},
-            {"accel_b_mps2[2]", "Accel. z", "m/s²", SEGV(accel_b_mps2, 2), 1.0, false},
+            {"pitch_rate_dps", "Pitch rate", SEG(pitch_rate_rps), false},
+            {"roll_rate_dps", "Roll rate", SEG(roll_rate_rps), false},
+            {"accel_b_mps2[0]", "Accel. x", SEGV(accel_b_mps2, 0), false},
+            {"accel_b_mps2[1]", "Accel. y", SEGV(accel_b_mps2, 1), false},
+            {"accel_b_mps2[2]", "Accel. z", SEGV(accel_b_mps2, 2), false},
             duration};
   default: // MOTION_ABS_ABS .. REL_ABS
     return {yaw,
             pitch,
             roll,
-            {"v_b_mps[0]", "Velocity x", "m/s", SEGV(v_b_mps, 0), 1.0, false},
-            {"v_b_mps[1]", "Velocity y", "m/s", SEGV(v_b_mps, 1), 1.0, false},
-            {"v_b_mps[2]", "Velocity z", "m/s", SEGV(v_b_mps, 2), 1.0, false},
+            {"v_b_mps[0]", "Velocity x", SEGV(v_b_mps, 0), false},
+            {"v_b_mps[1]", "Velocity y", SEGV(v_b_mps, 1), false},
+            {"v_b_mps[2]", "Velocity z", SEGV(v_b_mps, 2), false},
             duration};
   }
+}
+
+/* The table's path of scene key @p key (its "[i]" component index dropped) under @p prefix. */
+QByteArray KeyOf(const char *prefix, const char *key) {
+  QByteArray k(key);
+  const int br = k.indexOf('[');
+  if (br >= 0) k.truncate(br);
+  return QByteArray(prefix) + k;
+}
+
+/* The same for a key of a segment of kind @p kind ("trajectory.segments.items[circle].radius_m"). */
+QByteArray ItemKeyOf(int kind, const char *key) {
+  const char *name = kind >= 0 && kind < kKindCount ? kKindNames[kind] : "hold";
+  return KeyOf((QByteArray("trajectory.segments.items[") + name + "].").constData(), key);
 }
 
 bool HasCoordinated(int kind) { return kind != NAV_SEG_HOLD && kind != NAV_SEG_ACCELERATE && kind != NAV_SEG_COORD_TURN && kind != NAV_SEG_CLIMB; }
@@ -176,16 +185,19 @@ QWidget *ScrolledPanel(QWidget *inner) {
 }
 
 bool ApplyFieldSets(const nav_scene &base, const QVector<FieldSet> &sets, nav_scene *out, QVector<Issue> *issues) {
-  static const QByteArray tmp = QFile::encodeName(EditFilePath());
+  // The edit goes through navcore's writer, the override document and the reader, in memory.
   QVector<Issue> found;
-  if (nav_scene_write_file(tmp.constData(), &base) != NAV_OK) {
+  char *text = nullptr;
+  size_t len = 0;
+  if (nav_scene_write_string(&base, &text, &len) != NAV_OK) {
     if (issues) issues->push_back(Issue{QString(), QStringLiteral("cannot write the scene to check the edit")});
     return false;
   }
   nav_scene_doc *doc = nullptr;
   char msg[512] = "";
-  if (nav_scene_doc_load(tmp.constData(), &doc, msg, sizeof msg) != NAV_OK) {
-    QFile::remove(QFile::decodeName(tmp));
+  const nav_status load = nav_scene_doc_load_string(text, len, "navstudio", &doc, msg, sizeof msg);
+  std::free(text);
+  if (load != NAV_OK) {
     if (issues) issues->push_back(Issue{QString(), QString::fromUtf8(msg)});
     return false;
   }
@@ -200,7 +212,6 @@ bool ApplyFieldSets(const nav_scene &base, const QVector<FieldSet> &sets, nav_sc
   auto s = std::make_unique<nav_scene>();
   if (ok && nav_scene_doc_read(doc, s.get(), CollectDiag, &found) != NAV_OK) ok = false;
   nav_scene_doc_destroy(doc);
-  QFile::remove(QFile::decodeName(tmp));
   if (!ok) {
     if (found.isEmpty()) found.push_back(Issue{QString(), QStringLiteral("the edited scene cannot be read")});
     if (issues) *issues = found;
@@ -340,39 +351,38 @@ SegmentEditor::SegmentEditor(SceneDocument *doc, QWidget *parent) : QWidget(pare
   struct StartSpec {
     const char *key;
     const char *label;
-    const char *unit;
     size_t offset;
-    double scale;
     bool optional;
   };
   const StartSpec starts[] = {
-      {"r0_ned_m[0]", "Start N", "m", offsetof(nav_traj_segments, r0_ned_m) + 0 * sizeof(double), 1.0, false},
-      {"r0_ned_m[1]", "Start E", "m", offsetof(nav_traj_segments, r0_ned_m) + 1 * sizeof(double), 1.0, false},
-      {"r0_ned_m[2]", "Start D", "m", offsetof(nav_traj_segments, r0_ned_m) + 2 * sizeof(double), 1.0, false},
-      {"v0_b_mps[0]", "Start vx", "m/s", offsetof(nav_traj_segments, v0_b_mps) + 0 * sizeof(double), 1.0, false},
-      {"v0_b_mps[1]", "Start vy", "m/s", offsetof(nav_traj_segments, v0_b_mps) + 1 * sizeof(double), 1.0, false},
-      {"v0_b_mps[2]", "Start vz", "m/s", offsetof(nav_traj_segments, v0_b_mps) + 2 * sizeof(double), 1.0, false},
-      {"limits.max_accel_mps2", "Max accel.", "m/s²",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_accel_mps2), 1.0, true},
-      {"limits.max_jerk_mps3", "Max jerk", "m/s³",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_jerk_mps3), 1.0, true},
-      {"limits.max_lateral_accel_mps2", "Max lateral", "m/s²",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_lateral_accel_mps2), 1.0, true},
-      {"limits.max_rate_dps", "Max rate", "deg/s",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_rate_rps), kDeg, true},
-      {"limits.max_ang_accel_dps2", "Max ang. acc.", "deg/s²",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_ang_accel_rps2), kDeg, true},
-      {"limits.max_ang_jerk_dps3", "Max ang. jerk", "deg/s³",
-       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_ang_jerk_rps3), kDeg, true},
+      {"r0_ned_m[0]", "Start N", offsetof(nav_traj_segments, r0_ned_m) + 0 * sizeof(double), false},
+      {"r0_ned_m[1]", "Start E", offsetof(nav_traj_segments, r0_ned_m) + 1 * sizeof(double), false},
+      {"r0_ned_m[2]", "Start D", offsetof(nav_traj_segments, r0_ned_m) + 2 * sizeof(double), false},
+      {"v0_b_mps[0]", "Start vx", offsetof(nav_traj_segments, v0_b_mps) + 0 * sizeof(double), false},
+      {"v0_b_mps[1]", "Start vy", offsetof(nav_traj_segments, v0_b_mps) + 1 * sizeof(double), false},
+      {"v0_b_mps[2]", "Start vz", offsetof(nav_traj_segments, v0_b_mps) + 2 * sizeof(double), false},
+      {"limits.max_accel_mps2", "Max accel.",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_accel_mps2), true},
+      {"limits.max_jerk_mps3", "Max jerk",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_jerk_mps3), true},
+      {"limits.max_lateral_accel_mps2", "Max lateral",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_lateral_accel_mps2), true},
+      {"limits.max_rate_dps", "Max rate",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_rate_rps), true},
+      {"limits.max_ang_accel_dps2", "Max ang. acc.",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_ang_accel_rps2), true},
+      {"limits.max_ang_jerk_dps3", "Max ang. jerk",
+       offsetof(nav_traj_segments, limits) + offsetof(nav_traj_limits, max_ang_jerk_rps3), true},
   };
   int k = 0;
   for (const StartSpec &ss : starts) {
     Field f;
     f.key = QString::fromLatin1(ss.key);
     f.label = tr(ss.label);
-    f.unit = QString::fromUtf8(ss.unit);
+    const nav_schema_key &sk = SchemaKey(KeyOf("trajectory.segments.", ss.key).constData());
+    f.unit = DisplayUnit(sk.unit);
     f.offset = ss.offset;
-    f.scale = ss.scale;
+    f.scale = sk.scale;
     f.item = false;
     f.optional = ss.optional;
     f.edit = new QLineEdit;
@@ -500,9 +510,10 @@ void SegmentEditor::RebuildForm() {
     Field f;
     f.key = QString::fromLatin1(sp.key);
     f.label = tr(sp.label);
-    f.unit = QString::fromUtf8(sp.unit);
+    const nav_schema_key &sk = SchemaKey(ItemKeyOf(form_kind_, sp.key).constData());
+    f.unit = DisplayUnit(sk.unit);
     f.offset = sp.offset;
-    f.scale = sp.scale;
+    f.scale = sk.scale;
     f.is_int = sp.is_int;
     f.item = true;
     auto *w = new QWidget;
@@ -550,7 +561,7 @@ void SegmentEditor::Refresh() {
           v = iv;
         } else {
           std::memcpy(&v, reinterpret_cast<const char *>(&g) + sp.offset, sizeof v);
-          v /= sp.scale;
+          v /= SchemaKey(ItemKeyOf(kind, sp.key).constData()).scale;
         }
         parts << QStringLiteral("%1: %2").arg(QString::fromLatin1(sp.key), FieldNumber(v));
       }

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fcntl.h>
 #include <unistd.h>
 #include <cmath>
@@ -96,24 +97,22 @@ bool IsScript(const nav_scene &s) {
 } // namespace
 
 QVector<Issue> Validate(const nav_scene &s) {
-  // The scene goes through navcore's writer and reader, so the panels report exactly what
-  // `navsim check` would report for the file the editor writes (field checks of the reader,
+  // The scene goes through navcore's writer and reader, in memory, so the panels report exactly
+  // what `navsim check` would report for the file the editor writes (field checks of the reader,
   // then nav_scene_validate); the trajectory planner's verdict follows. The last answer is
-  // cached (one scene is validated by several widgets after each edit), and the file goes to
-  // /dev/shm where there is one: the writer fsyncs, which costs a disk flush elsewhere.
+  // cached (one scene is validated by several widgets after each edit).
   static std::vector<unsigned char> cached_scene;
   static QVector<Issue> cached_issues;
   if (cached_scene.size() == sizeof s && std::memcmp(cached_scene.data(), &s, sizeof s) == 0) return cached_issues;
   QVector<Issue> out;
-  static const QByteArray tmp = QFile::encodeName(
-      QDir(QDir("/dev/shm").exists() ? QStringLiteral("/dev/shm") : QDir::tempPath())
-          .filePath(QStringLiteral("navstudio-check-%1.yaml").arg(QCoreApplication::applicationPid())));
-  if (nav_scene_write_file(tmp.constData(), &s) == NAV_OK) {
+  char *text = nullptr;
+  size_t len = 0;
+  if (nav_scene_write_string(&s, &text, &len) == NAV_OK) {
     auto back = std::make_unique<nav_scene>();
     IssueSink sink{&out};
-    const nav_status st = nav_scene_read_file(tmp.constData(), back.get(), CollectDiagIssue, &sink);
+    const nav_status st = nav_scene_read_string(text, len, "navstudio", back.get(), CollectDiagIssue, &sink);
     (void)st;
-    QFile::remove(QFile::decodeName(tmp));
+    std::free(text);
   } else {
     IssueSink sink{&out};
     const nav_status st = nav_scene_validate(&s, CollectIssue, &sink);
@@ -440,21 +439,13 @@ void SceneDocument::RememberUserText(const QString &path, const nav_scene &read_
 }
 
 namespace {
-QString ShmPath(const char *what) {
-  const QString dir = QDir("/dev/shm").exists() ? QStringLiteral("/dev/shm") : QDir::tempPath();
-  return QDir(dir).filePath(QStringLiteral("navstudio-%1-%2.yaml").arg(what).arg(QCoreApplication::applicationPid()));
-}
-
 /* navcore's writer's text of @p s (empty on failure). */
 QByteArray CanonicalText(const nav_scene &s) {
-  const QString p = ShmPath("canon");
-  const QByteArray pp = QFile::encodeName(p);
+  char *text = nullptr;
+  size_t len = 0;
   QByteArray out;
-  if (nav_scene_write_file(pp.constData(), &s) == NAV_OK) {
-    QFile f(p);
-    if (f.open(QIODevice::ReadOnly)) out = f.readAll();
-  }
-  QFile::remove(p);
+  if (nav_scene_write_string(&s, &text, &len) == NAV_OK) out = QByteArray(text, static_cast<int>(len));
+  std::free(text);
   return out;
 }
 

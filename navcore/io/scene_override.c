@@ -18,6 +18,7 @@
 struct nav_scene_doc {
   struct fy_document *fyd;
   char *path;
+  char *text; /* the source of a document loaded from memory (libfyaml points into it), or NULL */
   /* Nodes that nav_scene_doc_set created: they are not in the file, so a diagnostic about them
      has no place in it (see nav_scene_doc_read). */
   struct fy_node **created;
@@ -66,6 +67,56 @@ static void say(char *msg, size_t size, const char *fmt, ...) {
   va_end(ap);
 }
 
+/* A parsed document with a mapping at its root becomes a nav_scene_doc named @p name. */
+static nav_status doc_from(struct fy_document *fyd, const char *name, nav_scene_doc **out, char *msg,
+                           size_t msg_size) {
+  struct fy_node *root = fy_document_root(fyd);
+  if (!root || !fy_node_is_mapping(root)) {
+    fy_document_destroy(fyd);
+    say(msg, msg_size, "the scene file's root is not a mapping");
+    return NAV_ERR_PARSE;
+  }
+  nav_scene_doc *d = calloc(1, sizeof *d);
+  char *p = strdup(name);
+  if (!d || !p) {
+    free(d);
+    free(p);
+    fy_document_destroy(fyd);
+    return NAV_ERR_NO_MEMORY;
+  }
+  d->fyd = fyd;
+  d->path = p;
+  *out = d;
+  return NAV_OK;
+}
+
+nav_status nav_scene_doc_load_string(const char *text, size_t len, const char *display_name, nav_scene_doc **out,
+                                     char *msg, size_t msg_size) {
+  if (msg && msg_size) msg[0] = '\0';
+  if (!text || !display_name || !out) return NAV_ERR_INVALID_ARG;
+  *out = NULL;
+  /* libfyaml keeps pointers into its input: the document keeps its own copy */
+  char *copy = malloc(len + 1);
+  if (!copy) return NAV_ERR_NO_MEMORY;
+  memcpy(copy, text, len);
+  copy[len] = '\0';
+  struct fy_parse_cfg cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.flags = (enum fy_parse_cfg_flags)(FYPCF_QUIET | FYPCF_DEFAULT_VERSION_1_2 | FYPCF_JSON_NONE);
+  struct fy_document *fyd = fy_document_build_from_string(&cfg, copy, len);
+  if (!fyd) {
+    free(copy);
+    say(msg, msg_size, "not a YAML document");
+    return NAV_ERR_PARSE;
+  }
+  const nav_status st = doc_from(fyd, display_name, out, msg, msg_size);
+  if (st != NAV_OK)
+    free(copy);
+  else
+    (*out)->text = copy;
+  return st;
+}
+
 nav_status nav_scene_doc_load(const char *path, nav_scene_doc **out, char *msg, size_t msg_size) {
   if (msg && msg_size) msg[0] = '\0';
   if (!path || !out) return NAV_ERR_INVALID_ARG;
@@ -89,29 +140,13 @@ nav_status nav_scene_doc_load(const char *path, nav_scene_doc **out, char *msg, 
     say(msg, msg_size, "not a YAML document (navsim check %s says where)", path);
     return NAV_ERR_PARSE;
   }
-  struct fy_node *root = fy_document_root(fyd);
-  if (!root || !fy_node_is_mapping(root)) {
-    fy_document_destroy(fyd);
-    say(msg, msg_size, "the scene file's root is not a mapping");
-    return NAV_ERR_PARSE;
-  }
-  nav_scene_doc *d = calloc(1, sizeof *d);
-  char *p = strdup(path);
-  if (!d || !p) {
-    free(d);
-    free(p);
-    fy_document_destroy(fyd);
-    return NAV_ERR_NO_MEMORY;
-  }
-  d->fyd = fyd;
-  d->path = p;
-  *out = d;
-  return NAV_OK;
+  return doc_from(fyd, path, out, msg, msg_size);
 }
 
 void nav_scene_doc_destroy(nav_scene_doc *doc) {
   if (!doc) return;
   fy_document_destroy(doc->fyd);
+  free(doc->text); /* after the document that points into it */
   free(doc->path);
   free(doc->created);
   free(doc);
