@@ -293,7 +293,28 @@ static const char *enum_name(const nav_io_enum_value *e, int v) {
   return NULL;
 }
 
+/* Whether @p x is inside the range of @p f (file units). */
+static bool in_range(const nav_io_field *f, double x) {
+  if ((f->flags & NAV_IO_MIN_GT) && !(x > f->min)) return false;
+  if ((f->flags & NAV_IO_MIN_GE) && !(x >= f->min)) return false;
+  if ((f->flags & NAV_IO_MAX_LE) && !(x <= f->max)) return false;
+  return true;
+}
+
+static field_default default_of_raw(const nav_io_field *f, const void *def);
+
+/* The default, unless it lies outside the key's own range: then the value in nav_scene_default()
+   is not one a file could give (an error term's correlation time, quantisation step or range is 0
+   while the term is off: the key is absent), and there is no default to publish. */
 static field_default default_of(const nav_io_field *f, const void *def) {
+  field_default d = default_of_raw(f, def);
+  if (d.has && d.text == NULL && !d.string && !d.boolean)
+    for (int i = 0; i < d.n; ++i)
+      if (!in_range(f, d.v[i])) d.has = false;
+  return d;
+}
+
+static field_default default_of_raw(const nav_io_field *f, const void *def) {
   field_default d;
   memset(&d, 0, sizeof d);
   if (def == NULL || (f->flags & NAV_IO_STATE)) return d;

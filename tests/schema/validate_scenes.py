@@ -122,7 +122,12 @@ def main():
             branches = [b.get("then", {}) for b in sub.get("allOf", [])]
             if not branches or any(b.get("additionalProperties") is not False for b in branches):
                 failures.append(f"{path}: mapping accepts unknown keys")
+        if "default" in sub:
+            # the reader's default satisfies the key's own type and bounds
+            for e in Draft202012Validator(sub).iter_errors(sub["default"]):
+                failures.append(f"{path}: default {sub['default']!r}: {e.message}")
     scheme = schema["properties"]["navigation"]["properties"]["scheme"]
+
     if "free_ins" not in scheme.get("enum", []):
         failures.append("navigation.scheme: no enum of schemes")
     print(f"schema: {len(keys)} keys ({numeric} numeric)")

@@ -29,11 +29,10 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "navcore/nav_status.h"
+#include "nav_export.h"
+#include "nav_status.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+NAV_BEGIN_DECLS
 
 /** Longest key path [bytes, with the NUL]. */
 #define NAV_SCHEMA_PATH_MAX 128
@@ -110,8 +109,6 @@ NAV_API const nav_schema_key *nav_schema_find(const nav_schema_key *keys, size_t
  */
 NAV_API char *nav_schema_json(void);
 
-#ifdef __cplusplus
-}
-#endif
+NAV_END_DECLS
 
 #endif /* NAVCORE_NAV_SCHEMA_H */
