@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "navcore/nav_io.h"
+#include "navcore/nav_scene_override.h"
 #include "navcore/nav_schema.h"
 
 typedef struct diag_log {
@@ -308,11 +309,36 @@ static void test_json_is_generated(void **state) {
   free(json);
 }
 
+/* nav_scene_doc_load_string: an editor's field edit checked in memory (navstudio), with the
+   reader's diagnostics at the overridden key. */
+static void test_doc_from_memory(void **state) {
+  (void)state;
+  const char *text = "format_version: 1\nimu:\n  rate_hz: 100\n";
+  nav_scene_doc *doc = NULL;
+  char msg[256];
+  assert_int_equal(nav_scene_doc_load_string(text, strlen(text), "edit", &doc, msg, sizeof msg), NAV_OK);
+  assert_int_equal(nav_scene_doc_set(doc, "imu.rate_hz", "200", msg, sizeof msg), NAV_OK);
+  static nav_scene scene;
+  diag_log log = {0};
+  assert_int_equal(nav_scene_doc_read(doc, &scene, collect, &log), NAV_OK);
+  assert_true(scene.imu.rate_hz == 200.0);
+  assert_int_equal(nav_scene_doc_set(doc, "imu.gyro.arw_deg_per_sqrt_h", "-1", msg, sizeof msg), NAV_OK);
+  assert_int_equal(nav_scene_doc_read(doc, &scene, collect, &log), NAV_ERR_PARSE);
+  assert_string_equal(log.first_path, "imu.gyro.arw_deg_per_sqrt_h");
+  nav_scene_doc_destroy(doc);
+  doc = NULL;
+  const char *list = "- 1\n- 2\n";
+  assert_int_equal(nav_scene_doc_load_string(list, strlen(list), "edit", &doc, msg, sizeof msg), NAV_ERR_PARSE);
+  assert_null(doc);
+  assert_non_null(strstr(msg, "not a mapping"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_table_form),
       cmocka_unit_test(test_json_is_generated),
       cmocka_unit_test(test_bounds_match_reader),
+      cmocka_unit_test(test_doc_from_memory),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
