@@ -1,4 +1,5 @@
 #include "parametric_editor.h"
+#include "schema_fields.h"
 
 #include <QComboBox>
 #include <QGridLayout>
@@ -14,13 +15,11 @@ namespace studio {
 
 namespace {
 const char *kErrorStyle = "QLineEdit { border: 2px solid #d03030; background: #fff0f0; }";
-constexpr double kDeg = M_PI / 180.0;
 
 struct RowSpec {
   const char *key;   /* file key in SI spelling, relative to trajectory.parametric */
   const char *label; /* symbol of formula (3) */
-  const char *unit;  /* SI unit */
-  const char *alt;   /* second unit (deg), or null */
+  const char *alt;   /* the key in a second unit (deg), or null; units and scales: the scene table */
   size_t offset;     /* of the nav_vec3 in nav_scene */
   const char *tip;
 };
@@ -28,17 +27,21 @@ struct RowSpec {
 #define POFF(m) offsetof(nav_scene, trajectory.parametric.m)
 
 const RowSpec kRows[] = {
-    {"R0_m", "R0", "m", nullptr, POFF(r0_m), "start position (N, E, D)"},
-    {"V0_mps", "V0", "m/s", nullptr, POFF(v0_mps), "start velocity"},
-    {"A_mps2", "A", "m/s²", nullptr, POFF(a_mps2), "R contains A t², so the acceleration is 2A"},
-    {"B_m", "B", "m", nullptr, POFF(b_m), "amplitude of the sine term of R"},
-    {"C_hz", "C", "Hz", nullptr, POFF(c_hz), "frequency of the sine term of R"},
-    {"D_rad", "D", "rad", "deg", POFF(d_rad), "phase of the sine term of R"},
-    {"rate.a_rps", "a", "rad/s", "deg/s", POFF(wa_rps), "constant body rate (x, y, z)"},
-    {"rate.b_rps", "b", "rad/s", "deg/s", POFF(wb_rps), "amplitude of the body-rate sine"},
-    {"rate.c_hz", "c", "Hz", nullptr, POFF(wc_hz), "frequency of the body-rate sine"},
-    {"rate.d_rad", "d", "rad", "deg", POFF(wd_rad), "phase of the body-rate sine"},
+    {"R0_m", "R0", nullptr, POFF(r0_m), "start position (N, E, D)"},
+    {"V0_mps", "V0", nullptr, POFF(v0_mps), "start velocity"},
+    {"A_mps2", "A", nullptr, POFF(a_mps2), "R contains A t², so the acceleration is 2A"},
+    {"B_m", "B", nullptr, POFF(b_m), "amplitude of the sine term of R"},
+    {"C_hz", "C", nullptr, POFF(c_hz), "frequency of the sine term of R"},
+    {"D_rad", "D", "D_deg", POFF(d_rad), "phase of the sine term of R"},
+    {"rate.a_rps", "a", "rate.a_dps", POFF(wa_rps), "constant body rate (x, y, z)"},
+    {"rate.b_rps", "b", "rate.b_dps", POFF(wb_rps), "amplitude of the body-rate sine"},
+    {"rate.c_hz", "c", nullptr, POFF(wc_hz), "frequency of the body-rate sine"},
+    {"rate.d_rad", "d", "rate.d_deg", POFF(wd_rad), "phase of the body-rate sine"},
 };
+/* The scene table's key trajectory.parametric.@p key. */
+const nav_schema_key &ParKey(const char *key) {
+  return SchemaKey((QByteArray("trajectory.parametric.") + key).constData());
+}
 } // namespace
 
 ParametricEditor::ParametricEditor(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
@@ -62,9 +65,10 @@ ParametricEditor::ParametricEditor(SceneDocument *doc, QWidget *parent) : QWidge
     if (rs.alt) {
       row.unit = new QComboBox;
       row.unit->setObjectName(QStringLiteral("par.unit.%1").arg(QString::fromLatin1(rs.key)));
-      row.unit->addItem(QString::fromUtf8(rs.unit));
-      row.unit->addItem(QString::fromUtf8(rs.alt));
-      row.alt_scale = kDeg;
+      row.unit->addItem(DisplayUnit(ParKey(rs.key).unit));
+      row.unit->addItem(DisplayUnit(ParKey(rs.alt).unit));
+      row.scale = ParKey(rs.key).scale;
+      row.alt_scale = ParKey(rs.alt).scale;
       grid->addWidget(row.unit, r, 4);
       connect(row.unit, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this] {
         // Show the committed values in the chosen unit (a pending edit is dropped).
@@ -72,7 +76,8 @@ ParametricEditor::ParametricEditor(SceneDocument *doc, QWidget *parent) : QWidge
         Refresh();
       });
     } else {
-      grid->addWidget(new QLabel(QString::fromUtf8(rs.unit)), r, 4);
+      grid->addWidget(new QLabel(DisplayUnit(ParKey(rs.key).unit)), r, 4);
+      row.scale = ParKey(rs.key).scale;
     }
     const int row_index = static_cast<int>(rows_.size());
     rows_.push_back(row);
@@ -143,7 +148,7 @@ ParametricEditor::ParametricEditor(SceneDocument *doc, QWidget *parent) : QWidge
 
 double ParametricEditor::Scale(const Field &f) const {
   const Row &row = rows_[static_cast<size_t>(f.row)];
-  return row.unit && row.unit->currentIndex() == 1 ? row.alt_scale : 1.0;
+  return row.unit && row.unit->currentIndex() == 1 ? row.alt_scale : row.scale;
 }
 
 QVector<FieldSet> ParametricEditor::Sets() const {

@@ -50,6 +50,7 @@ private:
   };
   struct Row {
     QComboBox *unit = nullptr; /**< null: a single unit */
+    double scale = 1.0;        /**< the first unit -> SI (the scene table's scale of the key) */
     double alt_scale = 1.0;    /**< the second unit (deg) -> SI */
   };
   double Scale(const Field &f) const;
