@@ -28,7 +28,9 @@ const Table &TheTable() {
   return t;
 }
 
-QString Number(double v) { return QString::number(v, 'g', 10); }
+QString Number(double v) {
+  return QString::number(v, 'g', 10);
+}
 } // namespace
 
 const nav_schema_key &SchemaKey(const char *path) {
@@ -64,10 +66,15 @@ QString KeyHelp(const nav_schema_key &k) {
   if (k.doc && k.doc[0]) parts << QString::fromUtf8(k.doc);
   const QString unit = DisplayUnit(k.unit);
   QString range;
-  if (k.bounds & NAV_SCHEMA_MIN) range += ((k.bounds & NAV_SCHEMA_MIN_EXCLUSIVE) ? QStringLiteral("> ") : QStringLiteral("≥ ")) + Number(k.min);
-  if (k.bounds & NAV_SCHEMA_MAX) range += (range.isEmpty() ? QString() : QStringLiteral(", ")) + QStringLiteral("≤ ") + Number(k.max);
-  if (!range.isEmpty()) parts << QStringLiteral("range %1%2").arg(range, unit.isEmpty() ? QString() : QStringLiteral(" ") + unit);
-  if (k.has_default && (k.type == NAV_SCHEMA_NUMBER || k.type == NAV_SCHEMA_VEC3_SCALAR || k.type == NAV_SCHEMA_INTEGER))
+  if (k.bounds & NAV_SCHEMA_MIN)
+    range +=
+        ((k.bounds & NAV_SCHEMA_MIN_EXCLUSIVE) ? QStringLiteral("> ") : QStringLiteral("≥ ")) + Number(k.min);
+  if (k.bounds & NAV_SCHEMA_MAX)
+    range += (range.isEmpty() ? QString() : QStringLiteral(", ")) + QStringLiteral("≤ ") + Number(k.max);
+  if (!range.isEmpty())
+    parts << QStringLiteral("range %1%2").arg(range, unit.isEmpty() ? QString() : QStringLiteral(" ") + unit);
+  if (k.has_default &&
+      (k.type == NAV_SCHEMA_NUMBER || k.type == NAV_SCHEMA_VEC3_SCALAR || k.type == NAV_SCHEMA_INTEGER))
     parts << QStringLiteral("default %1").arg(Number(k.default_value[0]));
   return parts.join(QStringLiteral("; "));
 }

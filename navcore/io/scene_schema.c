@@ -29,7 +29,7 @@ struct nav_io_json {
   size_t len, cap;
   bool oom;
   int depth;
-  int count[JSON_MAX_DEPTH];   /* members / items written in each open container */
+  int count[JSON_MAX_DEPTH]; /* members / items written in each open container */
   bool is_array[JSON_MAX_DEPTH];
   bool inline_array[JSON_MAX_DEPTH];
   bool after_key; /* a key was written; its value comes next on the same line */
@@ -39,7 +39,8 @@ static void put(nav_io_json *j, const char *s, size_t n) {
   if (j->oom) return;
   if (j->len + n + 1 > j->cap) {
     size_t cap = j->cap ? j->cap : 4096;
-    while (j->len + n + 1 > cap) cap *= 2;
+    while (j->len + n + 1 > cap)
+      cap *= 2;
     char *b = realloc(j->buf, cap);
     if (b == NULL) {
       j->oom = true;
@@ -59,7 +60,8 @@ static void puts_(nav_io_json *j, const char *s) {
 
 static void newline(nav_io_json *j) {
   puts_(j, "\n");
-  for (int i = 0; i < j->depth; ++i) puts_(j, "  ");
+  for (int i = 0; i < j->depth; ++i)
+    puts_(j, "  ");
 }
 
 /* Before a value: a separator and a new line inside arrays; nothing after a key. */
@@ -262,7 +264,8 @@ static const nav_io_field *preferred_of(const nav_io_section *sec, size_t i) {
   if (!(f->flags & NAV_IO_ALT)) return NULL;
   for (size_t k = i; k-- > 0;) {
     const nav_io_field *g = &sec->fields[k];
-    if (!(g->flags & NAV_IO_ALT) && g->offset == f->offset && (g->flags & NAV_IO_STATE) == (f->flags & NAV_IO_STATE))
+    if (!(g->flags & NAV_IO_ALT) && g->offset == f->offset &&
+        (g->flags & NAV_IO_STATE) == (f->flags & NAV_IO_STATE))
       return g;
   }
   return NULL;
@@ -279,7 +282,7 @@ static const char *doc_in(const nav_io_section *sec, size_t i) {
 /* The default of a plain field in the file's unit, from the default object @p def (NULL: none). */
 typedef struct field_default {
   bool has;
-  int n;          /* numbers in v (1 or 3); 0 for text */
+  int n; /* numbers in v (1 or 3); 0 for text */
   double v[3];
   const char *text; /* enum name (static) */
   bool string;      /* the default is the text in buf */
@@ -405,8 +408,7 @@ static field_default default_of_raw(const nav_io_field *f, const void *def) {
     d.string = true;
     d.has = strnlen(p, f->size) < sizeof d.buf;
     break;
-  default:
-    break;
+  default: break;
   }
   return d;
 }
@@ -448,7 +450,8 @@ static void json_default(nav_io_json *j, const nav_io_field *f, const void *def)
     nav_io_json_raw(j, d.buf);
   } else if (d.n == 3) {
     array_begin(j, true);
-    for (int i = 0; i < 3; ++i) nav_io_json_number(j, d.v[i]);
+    for (int i = 0; i < 3; ++i)
+      nav_io_json_number(j, d.v[i]);
     array_end(j);
   } else {
     nav_io_json_number(j, d.v[0]);
@@ -457,7 +460,8 @@ static void json_default(nav_io_json *j, const nav_io_field *f, const void *def)
 
 static void enum_list(nav_io_json *j, const nav_io_enum_value *e) {
   array_begin(j, true);
-  for (; e != NULL && e->name != NULL; ++e) nav_io_json_string(j, e->name);
+  for (; e != NULL && e->name != NULL; ++e)
+    nav_io_json_string(j, e->name);
   array_end(j);
 }
 
@@ -625,9 +629,7 @@ static void json_field(nav_io_json *j, const nav_io_field *f, const void *def, c
     member_number(j, "minimum", 0);
     member_raw(j, "maximum", "18446744073709551615");
     break;
-  case NAV_IO_BOOL:
-    member_string(j, "type", "boolean");
-    break;
+  case NAV_IO_BOOL: member_string(j, "type", "boolean"); break;
   case NAV_IO_ENUM:
     member_string(j, "type", "string");
     nav_io_json_key(j, "enum");
@@ -783,13 +785,14 @@ static void walk(key_list *L, const nav_io_section *sec, const void *def, const 
     const field_default d = default_of(f, def);
     if (d.has) {
       k->has_default = true;
-      for (int c = 0; c < 3; ++c) k->default_value[c] = d.n == 1 ? d.v[0] : d.v[c];
+      for (int c = 0; c < 3; ++c)
+        k->default_value[c] = d.n == 1 ? d.v[0] : d.v[c];
       if (d.text != NULL || d.string)
         snprintf(k->default_text, sizeof k->default_text, "%s", d.text != NULL ? d.text : d.buf);
     }
     if (f->kind == NAV_IO_ENUM)
-      for (const nav_io_enum_value *e = f->enums; e != NULL && e->name != NULL && k->n_choices < NAV_SCHEMA_MAX_CHOICES;
-           ++e)
+      for (const nav_io_enum_value *e = f->enums;
+           e != NULL && e->name != NULL && k->n_choices < NAV_SCHEMA_MAX_CHOICES; ++e)
         k->choices[k->n_choices++] = e->name;
     char path[NAV_SCHEMA_PATH_MAX];
     snprintf(path, sizeof path, "%s", k->path); /* k moves when the list grows */

@@ -117,8 +117,8 @@ static bool scene_with(char *buf, size_t size, const char *path, const char *v) 
   }
   /* the outer braces go: a block mapping at the top, after format_version */
   const size_t l = strlen(inner);
-  return (size_t)snprintf(buf, size, "format_version: 1\n%s%.*s\n", root_context(path), (int)(l - 2), inner + 1) <
-         size;
+  return (size_t)snprintf(buf, size, "format_version: 1\n%s%.*s\n", root_context(path), (int)(l - 2),
+                          inner + 1) < size;
 }
 
 static void format_value(char *buf, size_t size, const nav_schema_key *k, double x) {
@@ -142,11 +142,13 @@ static bool same_mapping(const char *got, const char *path) {
   while (*path && *got) {
     if (*path == '[' || *got == '[') {
       if (*path == '[') {
-        while (*path && *path != ']') ++path;
+        while (*path && *path != ']')
+          ++path;
         if (*path) ++path;
       }
       if (*got == '[') {
-        while (*got && *got != ']') ++got;
+        while (*got && *got != ']')
+          ++got;
         if (*got) ++got;
       }
       continue;
@@ -168,7 +170,8 @@ static void expect(const nav_schema_key *k, double x, int axis, bool accept, con
   if (axis >= 0) {
     char num[64];
     snprintf(num, sizeof num, "%.17g", x);
-    snprintf(v, sizeof v, "[%s, %s, %s]", axis == 0 ? num : "0", axis == 1 ? num : "0", axis == 2 ? num : "0");
+    snprintf(v, sizeof v, "[%s, %s, %s]", axis == 0 ? num : "0", axis == 1 ? num : "0",
+             axis == 2 ? num : "0");
   }
   if (!scene_with(text, sizeof text, k->path, v)) return;
   static nav_scene scene;
@@ -183,8 +186,8 @@ static void expect(const nav_schema_key *k, double x, int axis, bool accept, con
     if (st == NAV_OK) ++g_accepted_whole;
   } else if (st == NAV_OK) {
     ++g_failures;
-    print_message("%s = %s (%s) accepted; the table says it is out of bounds\n--- scene:\n%s", k->path, v, what,
-                  text);
+    print_message("%s = %s (%s) accepted; the table says it is out of bounds\n--- scene:\n%s", k->path, v,
+                  what, text);
   } else if (!about_key) {
     ++g_failures;
     print_message("%s = %s (%s) rejected for another reason: %s\n", k->path, v, what, log.first_text);
@@ -193,7 +196,8 @@ static void expect(const nav_schema_key *k, double x, int axis, bool accept, con
 
 /* @p x moved @p n ulps towards @p to. */
 static double ulps(double x, double to, int n) {
-  for (int i = 0; i < n; ++i) x = nextafter(x, to);
+  for (int i = 0; i < n; ++i)
+    x = nextafter(x, to);
   return x;
 }
 
@@ -207,7 +211,8 @@ static void test_bounds_match_reader(void **state) {
     const nav_schema_key *k = &keys[i];
     if (!(k->bounds & (NAV_SCHEMA_MIN | NAV_SCHEMA_MAX))) continue;
     if (k->type != NAV_SCHEMA_NUMBER && k->type != NAV_SCHEMA_VEC3 && k->type != NAV_SCHEMA_VEC3_SCALAR &&
-        k->type != NAV_SCHEMA_MAT3_OFFDIAG && k->type != NAV_SCHEMA_MAT3_DIAG && k->type != NAV_SCHEMA_INTEGER &&
+        k->type != NAV_SCHEMA_MAT3_OFFDIAG && k->type != NAV_SCHEMA_MAT3_DIAG &&
+        k->type != NAV_SCHEMA_INTEGER &&
         k->type != NAV_SCHEMA_OTHER /* trajectory.duration_s: a number or auto */) {
       ++skipped;
       continue;
@@ -236,9 +241,9 @@ static void test_bounds_match_reader(void **state) {
       expect(k, k->min, -1, false, "the exclusive minimum");
       /* the nearest value inside; above 0 in a unit smaller than SI, one whose SI value does not
          underflow to 0 (the validators check the SI value: range_dps 5e-324 is 0 rad/s) */
-      double inside = integer                             ? k->min + 1
+      double inside = integer                           ? k->min + 1
                       : k->min == 0.0 && k->scale < 1.0 ? DBL_MIN / k->scale
-                                                         : nextafter(k->min, INFINITY);
+                                                        : nextafter(k->min, INFINITY);
       /* a rule across keys that is tighter than the table's bound: the trajectory lasts at least
          one IMU interval (0.01 s by default) */
       if (strcmp(k->path, "trajectory.duration_s") == 0) inside = 1.0;
@@ -248,9 +253,10 @@ static void test_bounds_match_reader(void **state) {
       expect(k, integer ? k->min - 1 : ulps(k->min, -INFINITY, past), -1, false, "just below the minimum");
     }
   }
-  print_message("%d bounded keys, %d cases (%d of the accepted scenes accepted whole), %d failures, %d bounded "
-                "keys skipped\n",
-                bounded, g_cases, g_accepted_whole, g_failures, skipped);
+  print_message(
+      "%d bounded keys, %d cases (%d of the accepted scenes accepted whole), %d failures, %d bounded "
+      "keys skipped\n",
+      bounded, g_cases, g_accepted_whole, g_failures, skipped);
   free(keys);
   assert_true(bounded > 80);
   assert_int_equal(skipped, 0);
@@ -328,7 +334,8 @@ static void test_doc_from_memory(void **state) {
   nav_scene_doc_destroy(doc);
   doc = NULL;
   const char *list = "- 1\n- 2\n";
-  assert_int_equal(nav_scene_doc_load_string(list, strlen(list), "edit", &doc, msg, sizeof msg), NAV_ERR_PARSE);
+  assert_int_equal(nav_scene_doc_load_string(list, strlen(list), "edit", &doc, msg, sizeof msg),
+                   NAV_ERR_PARSE);
   assert_null(doc);
   assert_non_null(strstr(msg, "not a mapping"));
 }

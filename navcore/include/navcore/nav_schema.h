@@ -43,26 +43,26 @@ NAV_BEGIN_DECLS
 
 /** What a key's value is. */
 typedef enum nav_schema_type {
-  NAV_SCHEMA_SECTION,     /**< a mapping of further keys (may be empty: all defaults) */
-  NAV_SCHEMA_NUMBER,      /**< one number */
-  NAV_SCHEMA_VEC3,        /**< exactly three numbers [x, y, z] */
-  NAV_SCHEMA_VEC3_SCALAR, /**< three numbers, or one number for all three */
-  NAV_SCHEMA_MAT3_OFFDIAG,/**< one number for every off-diagonal element, or 3 rows of 3 */
-  NAV_SCHEMA_MAT3_DIAG,   /**< one number or 3 numbers for the diagonal, or 3 rows of 3 */
-  NAV_SCHEMA_INTEGER,     /**< an integer */
-  NAV_SCHEMA_BOOLEAN,     /**< true or false */
-  NAV_SCHEMA_ENUM,        /**< one of the names in choices */
-  NAV_SCHEMA_STRING,      /**< text */
-  NAV_SCHEMA_LIST,        /**< a sequence (its items' keys follow with "[]" in the path) */
-  NAV_SCHEMA_OTHER        /**< a value with its own syntax (see the JSON Schema and doc) */
+  NAV_SCHEMA_SECTION,      /**< a mapping of further keys (may be empty: all defaults) */
+  NAV_SCHEMA_NUMBER,       /**< one number */
+  NAV_SCHEMA_VEC3,         /**< exactly three numbers [x, y, z] */
+  NAV_SCHEMA_VEC3_SCALAR,  /**< three numbers, or one number for all three */
+  NAV_SCHEMA_MAT3_OFFDIAG, /**< one number for every off-diagonal element, or 3 rows of 3 */
+  NAV_SCHEMA_MAT3_DIAG,    /**< one number or 3 numbers for the diagonal, or 3 rows of 3 */
+  NAV_SCHEMA_INTEGER,      /**< an integer */
+  NAV_SCHEMA_BOOLEAN,      /**< true or false */
+  NAV_SCHEMA_ENUM,         /**< one of the names in choices */
+  NAV_SCHEMA_STRING,       /**< text */
+  NAV_SCHEMA_LIST,         /**< a sequence (its items' keys follow with "[]" in the path) */
+  NAV_SCHEMA_OTHER         /**< a value with its own syntax (see the JSON Schema and doc) */
 } nav_schema_type;
 
 /** Bound flags of nav_schema_key.bounds. */
 enum {
-  NAV_SCHEMA_MIN = 1u << 0,          /**< value >= min */
-  NAV_SCHEMA_MIN_EXCLUSIVE = 1u << 1,/**< value > min */
-  NAV_SCHEMA_MAX = 1u << 2,          /**< value <= max */
-  NAV_SCHEMA_FINITE = 1u << 3,       /**< .inf and .nan are rejected */
+  NAV_SCHEMA_MIN = 1u << 0,           /**< value >= min */
+  NAV_SCHEMA_MIN_EXCLUSIVE = 1u << 1, /**< value > min */
+  NAV_SCHEMA_MAX = 1u << 2,           /**< value <= max */
+  NAV_SCHEMA_FINITE = 1u << 3,        /**< .inf and .nan are rejected */
   /** The range is checked on the SI value (file value * scale): a value a few ulps past the bound
       may convert to the bound itself. */
   NAV_SCHEMA_CHECKED_IN_SI = 1u << 4
@@ -73,20 +73,20 @@ typedef struct nav_schema_key {
   char path[NAV_SCHEMA_PATH_MAX]; /**< e.g. "imu.gyro.arw_deg_per_sqrt_h" */
   const char *key;                /**< the last component as written ("arw_deg_per_sqrt_h") */
   nav_schema_type type;
-  const char *unit;               /**< unit as written in the file ("deg/h", "m", "1"), or NULL */
-  double scale;                   /**< SI value = file value * scale (1 for non-numbers) */
-  unsigned bounds;                /**< NAV_SCHEMA_MIN / _MIN_EXCLUSIVE / _MAX / _FINITE */
-  double min, max;                /**< in the file's unit; per @c bounds (per component for vectors; for
-                                       VEC3_SCALAR max is that of the one-number form, see max_axis) */
-  double max_axis[3];             /**< vectors: the maximum of each component x, y, z (= max unless the
-                                       axes differ, as the tilt and heading sigmas do) */
-  bool required;                  /**< the key must be present in its mapping */
-  int alt_of;                     /**< index of the preferred spelling of the same quantity, or -1 */
-  bool has_default;               /**< the reader has a default (default_value / default_text) */
-  double default_value[3];        /**< numbers in the file's unit (VEC3: x, y, z; else [0]); booleans 0/1 */
-  char default_text[NAV_SCHEMA_TEXT_MAX]; /**< ENUM / STRING default */
-  const char *doc;                /**< one-line description, or "" */
-  size_t n_choices;               /**< ENUM: number of names */
+  const char *unit;        /**< unit as written in the file ("deg/h", "m", "1"), or NULL */
+  double scale;            /**< SI value = file value * scale (1 for non-numbers) */
+  unsigned bounds;         /**< NAV_SCHEMA_MIN / _MIN_EXCLUSIVE / _MAX / _FINITE */
+  double min, max;         /**< in the file's unit; per @c bounds (per component for vectors; for
+                                VEC3_SCALAR max is that of the one-number form, see max_axis) */
+  double max_axis[3];      /**< vectors: the maximum of each component x, y, z (= max unless the
+                                axes differ, as the tilt and heading sigmas do) */
+  bool required;           /**< the key must be present in its mapping */
+  int alt_of;              /**< index of the preferred spelling of the same quantity, or -1 */
+  bool has_default;        /**< the reader has a default (default_value / default_text) */
+  double default_value[3]; /**< numbers in the file's unit (VEC3: x, y, z; else [0]); booleans 0/1 */
+  char default_text[NAV_SCHEMA_TEXT_MAX];      /**< ENUM / STRING default */
+  const char *doc;                             /**< one-line description, or "" */
+  size_t n_choices;                            /**< ENUM: number of names */
   const char *choices[NAV_SCHEMA_MAX_CHOICES]; /**< ENUM: the names */
 } nav_schema_key;
 
