@@ -31,6 +31,7 @@
 #include <vtkRenderWindowInteractor.h>
 
 #include "main_window.h"
+#include "schema_fields.h"
 #include "studio_test_support.h"
 
 using studio::MainWindow;
@@ -226,6 +227,10 @@ private slots:
     QVERIFY(arw);
     auto *msg = w->findChild<QLabel *>("imu.gyro.arw.message");
     QVERIFY(msg);
+    // The field's unit, bounds and description come from navcore_io's scene table.
+    const nav_schema_key &k = studio::SchemaKey("imu.gyro.arw_deg_per_sqrt_h");
+    QVERIFY2(arw->toolTip().contains(QString::fromUtf8(k.doc)), qPrintable(arw->toolTip()));
+    QVERIFY2(arw->toolTip().contains(QStringLiteral("≤ %1 deg/√h").arg(k.max)), qPrintable(arw->toolTip()));
     w->Panels()->setCurrentIndex(1);
     arw->setFocus();
     QTest::keyClicks(arw, "-1");
