@@ -390,7 +390,12 @@ DEFINE_SECTION_FINISH(k_accel_section, k_accel, finish_accel);
 static const nav_io_field k_imu[] = {
     RATE_HZ(imu.rate_hz, "IMU sample rate"),
     {.key = "quadrature_nodes",
-     .doc = "Gauss-Legendre nodes of the ideal increments over one IMU interval (1..16)", .kind = NAV_IO_INT, .offset = OFF(imu.quadrature_nodes)},
+     .doc = "Gauss-Legendre nodes of the ideal increments over one IMU interval",
+     .kind = NAV_IO_INT,
+     .flags = NAV_IO_RANGE_LATER | NAV_IO_MIN_GE | NAV_IO_MAX_LE, /* nav_scene_validate's range */
+     .offset = OFF(imu.quadrature_nodes),
+     .min = 1.0,
+     .max = 16.0},
     {.key = "bias_convention",
      .doc = "how a bias instability B becomes a Gauss-Markov sigma: allan_peak (B / 0.6648) or sigma_equals_b",
      .kind = NAV_IO_ENUM,
@@ -1593,7 +1598,9 @@ static bool read_integer(nav_io_reader *r, const nav_io_field *f, const nav_io_n
   if (!parse_integer(r, key, v, &neg, &mag, &overflow)) return false;
   show(shown, sizeof shown, v->text, v->len);
   long long lo = type_min, hi = type_max;
-  const bool lo_given = (f->flags & NAV_IO_MIN_GE) != 0, hi_given = (f->flags & NAV_IO_MAX_LE) != 0;
+  /* a range checked later (NAV_IO_RANGE_LATER) leaves only the type's range here */
+  const bool later = (f->flags & NAV_IO_RANGE_LATER) != 0;
+  const bool lo_given = !later && (f->flags & NAV_IO_MIN_GE) != 0, hi_given = !later && (f->flags & NAV_IO_MAX_LE) != 0;
   if (lo_given && f->min > (double)lo) lo = (long long)f->min;
   if (hi_given && f->max < (double)hi) hi = (long long)f->max;
   /* Below or above the range; magnitudes beyond long long are beyond every range. */
