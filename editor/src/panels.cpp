@@ -82,7 +82,8 @@ NumField::NumField(SceneDocument *doc, const QString &label, const QString &unit
 }
 
 void NumField::SetHelp(const QString &key, const QString &help) {
-  edit_->setToolTip(tr("%1 [%2] (scene file: %3)%4").arg(label_, unit_, key, help.isEmpty() ? QString() : ": " + help));
+  edit_->setToolTip(
+      tr("%1 [%2] (scene file: %3)%4").arg(label_, unit_, key, help.isEmpty() ? QString() : ": " + help));
 }
 
 void NumField::SetOptional(std::function<bool(const nav_scene &)> is_set, std::function<void(nav_scene &)> clear) {
@@ -185,7 +186,8 @@ NumField *ScenePanels::AddKey(QFormLayout *form, const QString &label, const cha
   const nav_schema_key &k = SchemaKey(key);
   const double scale = k.scale;
   NumField *f = AddField(
-      form, label, DisplayUnit(k.unit), path, [get_si, scale](const nav_scene &s) { return get_si(s) / scale; },
+      form, label, DisplayUnit(k.unit), path,
+      [get_si, scale](const nav_scene &s) { return get_si(s) / scale; },
       [set_si, scale](nav_scene &s, double v) { set_si(s, v * scale); });
   f->SetHelp(QString::fromUtf8(key), KeyHelp(k));
   return f;
@@ -227,14 +229,18 @@ QWidget *ScenePanels::BuildModel() {
   connect(frame_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
     doc_->Edit(tr("Set frame"), [i](nav_scene &s) { s.navigation.frame = static_cast<nav_mech_frame>(i); });
   });
-  AddKey(form, tr("Origin latitude"), "earth.origin.lat_deg", "earth.origin.lat",
-         [](const nav_scene &s) { return s.earth.origin_lat_rad; },
-         [](nav_scene &s, double v) { s.earth.origin_lat_rad = v; });
-  AddKey(form, tr("Origin longitude"), "earth.origin.lon_deg", "earth.origin.lon",
-         [](const nav_scene &s) { return s.earth.origin_lon_rad; },
-         [](nav_scene &s, double v) { s.earth.origin_lon_rad = v; });
-  AddKey(form, tr("Origin height"), "earth.origin.h_m", "earth.origin.h",
-         [](const nav_scene &s) { return s.earth.origin_h_m; }, [](nav_scene &s, double v) { s.earth.origin_h_m = v; });
+  AddKey(
+      form, tr("Origin latitude"), "earth.origin.lat_deg", "earth.origin.lat",
+      [](const nav_scene &s) { return s.earth.origin_lat_rad; },
+      [](nav_scene &s, double v) { s.earth.origin_lat_rad = v; });
+  AddKey(
+      form, tr("Origin longitude"), "earth.origin.lon_deg", "earth.origin.lon",
+      [](const nav_scene &s) { return s.earth.origin_lon_rad; },
+      [](nav_scene &s, double v) { s.earth.origin_lon_rad = v; });
+  AddKey(
+      form, tr("Origin height"), "earth.origin.h_m", "earth.origin.h",
+      [](const nav_scene &s) { return s.earth.origin_h_m; },
+      [](nav_scene &s, double v) { s.earth.origin_h_m = v; });
   return w;
 }
 
@@ -266,8 +272,9 @@ QWidget *ScenePanels::BuildImu() {
       s.imu.model = entry.config;
     });
   });
-  AddKey(form, tr("IMU rate"), "imu.rate_hz", "imu.rate_hz", [](const nav_scene &s) { return s.imu.rate_hz; },
-         [](nav_scene &s, double v) { s.imu.rate_hz = v; });
+  AddKey(
+      form, tr("IMU rate"), "imu.rate_hz", "imu.rate_hz", [](const nav_scene &s) { return s.imu.rate_hz; },
+      [](nav_scene &s, double v) { s.imu.rate_hz = v; });
 
   // Error terms in datasheet units (the unit and scale of each scene key, from navcore_io's table);
   // one value for the three axes; empty = term off.
@@ -283,8 +290,8 @@ QWidget *ScenePanels::BuildImu() {
   const std::vector<Term> terms = {
       {tr("Gyro ARW"), "imu.gyro.arw_deg_per_sqrt_h", "imu.gyro.arw", true, NAV_IMU_TERM_NOISE,
        &nav_gyro_error_config::arw_rad_per_sqrt_s, nullptr},
-      {tr("Gyro bias GM σ"), "imu.gyro.bias_gm_sigma_deg_per_h", "imu.gyro.bias_gm_sigma", true, NAV_IMU_TERM_BIAS_GM,
-       &nav_gyro_error_config::bias_gm_sd_rps, nullptr},
+      {tr("Gyro bias GM σ"), "imu.gyro.bias_gm_sigma_deg_per_h", "imu.gyro.bias_gm_sigma", true,
+       NAV_IMU_TERM_BIAS_GM, &nav_gyro_error_config::bias_gm_sd_rps, nullptr},
       {tr("Gyro bias GM τ"), "imu.gyro.bias_gm_tau_s", "imu.gyro.bias_gm_tau", true, NAV_IMU_TERM_BIAS_GM,
        &nav_gyro_error_config::bias_gm_tau_s, nullptr},
       {tr("Gyro turn-on bias σ"), "imu.gyro.bias_turn_on_deg_per_h", "imu.gyro.bias_turn_on", true,
@@ -293,12 +300,12 @@ QWidget *ScenePanels::BuildImu() {
        NAV_IMU_TERM_BIAS_RW, &nav_gyro_error_config::bias_rw_rps_per_sqrt_s, nullptr},
       {tr("Gyro scale factor σ"), "imu.gyro.scale_factor_ppm", "imu.gyro.scale_factor", true,
        NAV_IMU_TERM_SCALE_FACTOR, &nav_gyro_error_config::scale_factor_sd, nullptr},
-      {tr("Accel VRW"), "imu.accel.vrw_m_per_s_per_sqrt_h", "imu.accel.vrw", false, NAV_IMU_TERM_NOISE, nullptr,
-       &nav_accel_error_config::vrw_mps_per_sqrt_s},
-      {tr("Accel bias GM σ"), "imu.accel.bias_gm_sigma_ug", "imu.accel.bias_gm_sigma", false, NAV_IMU_TERM_BIAS_GM,
-       nullptr, &nav_accel_error_config::bias_gm_sd_mps2},
-      {tr("Accel bias GM τ"), "imu.accel.bias_gm_tau_s", "imu.accel.bias_gm_tau", false, NAV_IMU_TERM_BIAS_GM, nullptr,
-       &nav_accel_error_config::bias_gm_tau_s},
+      {tr("Accel VRW"), "imu.accel.vrw_m_per_s_per_sqrt_h", "imu.accel.vrw", false, NAV_IMU_TERM_NOISE,
+       nullptr, &nav_accel_error_config::vrw_mps_per_sqrt_s},
+      {tr("Accel bias GM σ"), "imu.accel.bias_gm_sigma_ug", "imu.accel.bias_gm_sigma", false,
+       NAV_IMU_TERM_BIAS_GM, nullptr, &nav_accel_error_config::bias_gm_sd_mps2},
+      {tr("Accel bias GM τ"), "imu.accel.bias_gm_tau_s", "imu.accel.bias_gm_tau", false, NAV_IMU_TERM_BIAS_GM,
+       nullptr, &nav_accel_error_config::bias_gm_tau_s},
       {tr("Accel turn-on bias σ"), "imu.accel.bias_turn_on_mg", "imu.accel.bias_turn_on", false,
        NAV_IMU_TERM_BIAS_TURN_ON, nullptr, &nav_accel_error_config::bias_turn_on_sd_mps2},
       {tr("Accel scale factor σ"), "imu.accel.scale_factor_ppm", "imu.accel.scale_factor", false,
@@ -357,16 +364,26 @@ QWidget *ScenePanels::BuildGnss() {
       std::snprintf(s.gnss.catalog, sizeof s.gnss.catalog, "%s", entry.name);
     });
   });
-  AddKey(form, tr("Fix rate"), "gnss.update_rate_hz", "gnss.update_rate",
-         [](const nav_scene &s) { return s.gnss.model.update_rate_hz; },
-         [](nav_scene &s, double v) { s.gnss.model.update_rate_hz = v; });
-  AddKey(form, tr("Latency"), "gnss.latency_s", "gnss.latency", [](const nav_scene &s) { return s.gnss.model.latency_s; },
-         [](nav_scene &s, double v) { s.gnss.model.latency_s = v; });
+  AddKey(
+      form, tr("Fix rate"), "gnss.update_rate_hz", "gnss.update_rate",
+      [](const nav_scene &s) { return s.gnss.model.update_rate_hz; },
+      [](nav_scene &s, double v) { s.gnss.model.update_rate_hz = v; });
+  AddKey(
+      form, tr("Latency"), "gnss.latency_s", "gnss.latency",
+      [](const nav_scene &s) { return s.gnss.model.latency_s; },
+      [](nav_scene &s, double v) { s.gnss.model.latency_s = v; });
   const char *axes[3] = {"x (forward)", "y (right)", "z (down)"};
   for (int k = 0; k < 3; ++k) {
-    AddKey(form, tr("Lever arm %1").arg(axes[k]), "gnss.lever_arm_b_m", "gnss.lever_arm",
-             [k](const nav_scene &s) { const nav_vec3 &r = s.gnss.model.r_ba_b_m; return k == 0 ? r.x : k == 1 ? r.y : r.z; },
-             [k](nav_scene &s, double v) { nav_vec3 &r = s.gnss.model.r_ba_b_m; (k == 0 ? r.x : k == 1 ? r.y : r.z) = v; });
+    AddKey(
+        form, tr("Lever arm %1").arg(axes[k]), "gnss.lever_arm_b_m", "gnss.lever_arm",
+        [k](const nav_scene &s) {
+          const nav_vec3 &r = s.gnss.model.r_ba_b_m;
+          return k == 0 ? r.x : k == 1 ? r.y : r.z;
+        },
+        [k](nav_scene &s, double v) {
+          nav_vec3 &r = s.gnss.model.r_ba_b_m;
+          (k == 0 ? r.x : k == 1 ? r.y : r.z) = v;
+        });
   }
   outages_ = new QTableWidget(0, 2);
   outages_->setObjectName("outageTable");
@@ -464,23 +481,28 @@ QWidget *ScenePanels::BuildTrajectory() {
   auto *formw = new QWidget;
   auto *form = new QFormLayout(formw);
   form->setContentsMargins(0, 0, 0, 0);
-  AddKey(form, tr("Hold at start"), "trajectory.waypoints.hold_start_s", "trajectory.waypoints.hold_start",
-         [](const nav_scene &s) { return s.trajectory.waypoints.hold_start_s; },
-         [](nav_scene &s, double v) { s.trajectory.waypoints.hold_start_s = v; });
-  AddKey(form, tr("Hold at end"), "trajectory.waypoints.hold_end_s", "trajectory.waypoints.hold_end",
-         [](const nav_scene &s) { return s.trajectory.waypoints.hold_end_s; },
-         [](nav_scene &s, double v) { s.trajectory.waypoints.hold_end_s = v; });
-  AddKey(form, tr("Speed between stops"), "trajectory.waypoints.cruise_mps", "trajectory.waypoints.cruise",
-         [](const nav_scene &s) { return s.trajectory.waypoints.cruise_mps; },
-         [](nav_scene &s, double v) { s.trajectory.waypoints.cruise_mps = v; });
-  AddKey(form, tr("Max acceleration"), "trajectory.waypoints.limits.max_accel_mps2",
-         "trajectory.waypoints.limits.max_accel",
-         [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_accel_mps2; },
-         [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_accel_mps2 = v; });
-  AddKey(form, tr("Max lateral accel."), "trajectory.waypoints.limits.max_lateral_accel_mps2",
-         "trajectory.waypoints.limits.max_lateral",
-         [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_lateral_accel_mps2; },
-         [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_lateral_accel_mps2 = v; });
+  AddKey(
+      form, tr("Hold at start"), "trajectory.waypoints.hold_start_s", "trajectory.waypoints.hold_start",
+      [](const nav_scene &s) { return s.trajectory.waypoints.hold_start_s; },
+      [](nav_scene &s, double v) { s.trajectory.waypoints.hold_start_s = v; });
+  AddKey(
+      form, tr("Hold at end"), "trajectory.waypoints.hold_end_s", "trajectory.waypoints.hold_end",
+      [](const nav_scene &s) { return s.trajectory.waypoints.hold_end_s; },
+      [](nav_scene &s, double v) { s.trajectory.waypoints.hold_end_s = v; });
+  AddKey(
+      form, tr("Speed between stops"), "trajectory.waypoints.cruise_mps", "trajectory.waypoints.cruise",
+      [](const nav_scene &s) { return s.trajectory.waypoints.cruise_mps; },
+      [](nav_scene &s, double v) { s.trajectory.waypoints.cruise_mps = v; });
+  AddKey(
+      form, tr("Max acceleration"), "trajectory.waypoints.limits.max_accel_mps2",
+      "trajectory.waypoints.limits.max_accel",
+      [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_accel_mps2; },
+      [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_accel_mps2 = v; });
+  AddKey(
+      form, tr("Max lateral accel."), "trajectory.waypoints.limits.max_lateral_accel_mps2",
+      "trajectory.waypoints.limits.max_lateral",
+      [](const nav_scene &s) { return s.trajectory.waypoints.limits.max_lateral_accel_mps2; },
+      [](nav_scene &s, double v) { s.trajectory.waypoints.limits.max_lateral_accel_mps2 = v; });
   vl->addWidget(formw);
   plan_label_ = new QLabel;
   plan_label_->setObjectName("planLabel");
@@ -492,15 +514,22 @@ QWidget *ScenePanels::BuildTrajectory() {
 QWidget *ScenePanels::BuildSimulation() {
   auto *w = new QWidget;
   auto *form = new QFormLayout(w);
-  NumField *runs = AddField(form, tr("Monte Carlo runs"), "", "simulation.runs",
-           [](const nav_scene &s) { return static_cast<double>(s.simulation.runs); },
-           [](nav_scene &s, double v) { s.simulation.runs = std::isfinite(v) && std::fabs(v) < 1e12 ? static_cast<long>(v) : -1; });
-  NumField *seed = AddField(form, tr("Seed"), "", "simulation.seed", [](const nav_scene &s) { return static_cast<double>(s.simulation.seed); },
-           [](nav_scene &s, double v) { s.simulation.seed = v >= 0 && v < 9e15 ? static_cast<uint64_t>(v) : 0; });
+  NumField *runs = AddField(
+      form, tr("Monte Carlo runs"), "", "simulation.runs",
+      [](const nav_scene &s) { return static_cast<double>(s.simulation.runs); },
+      [](nav_scene &s, double v) {
+        s.simulation.runs = std::isfinite(v) && std::fabs(v) < 1e12 ? static_cast<long>(v) : -1;
+      });
+  NumField *seed = AddField(
+      form, tr("Seed"), "", "simulation.seed",
+      [](const nav_scene &s) { return static_cast<double>(s.simulation.seed); },
+      [](nav_scene &s, double v) { s.simulation.seed = v >= 0 && v < 9e15 ? static_cast<uint64_t>(v) : 0; });
   runs->SetHelp("simulation.runs", KeyHelp(SchemaKey("simulation.runs")));
   seed->SetHelp("simulation.seed", KeyHelp(SchemaKey("simulation.seed")));
-  AddKey(form, tr("Output rate"), "output.rate_hz", "output.rate_hz", [](const nav_scene &s) { return s.output.rate_hz; },
-         [](nav_scene &s, double v) { s.output.rate_hz = v; });
+  AddKey(
+      form, tr("Output rate"), "output.rate_hz", "output.rate_hz",
+      [](const nav_scene &s) { return s.output.rate_hz; },
+      [](nav_scene &s, double v) { s.output.rate_hz = v; });
   auto *row = new QHBoxLayout;
   auto *run = new QPushButton(tr("Run"));
   run->setObjectName("panelRun");

@@ -51,7 +51,7 @@ const char *const kKindNames[] = {"hold",           "accelerate",     "turn",   
 constexpr int kKindCount = static_cast<int>(sizeof kKindNames / sizeof kKindNames[0]);
 
 struct Spec {
-  const char *key;   // the scene key (its unit and scale come from navcore_io's table: KeyOf)
+  const char *key; // the scene key (its unit and scale come from navcore_io's table: KeyOf)
   const char *label;
   size_t offset;
   bool is_int;

@@ -72,16 +72,16 @@ typedef enum nav_io_kind {
 
 /** Descriptor flags. */
 enum {
-  NAV_IO_FINITE = 1u << 0,    /**< reject .inf / .nan */
-  NAV_IO_MIN_GT = 1u << 1,    /**< value > min (file units) */
-  NAV_IO_MIN_GE = 1u << 2,    /**< value >= min */
-  NAV_IO_MAX_LE = 1u << 3,    /**< value <= max */
-  NAV_IO_REQUIRED = 1u << 4,  /**< the key must be present */
-  NAV_IO_ALT = 1u << 5,       /**< alternative unit spelling of the preceding quantity */
-  NAV_IO_FLOW = 1u << 6,      /**< SECTION written on one line: {a: 1, b: 2} */
-  NAV_IO_STATE = 1u << 7,     /**< offset into nav_io_read_state; read only, never written */
-  NAV_IO_EARLY = 1u << 8,     /**< read before the other keys of its mapping, wherever it is */
-  NAV_IO_LATE = 1u << 9,      /**< read after the other keys of its mapping, wherever it is */
+  NAV_IO_FINITE = 1u << 0,     /**< reject .inf / .nan */
+  NAV_IO_MIN_GT = 1u << 1,     /**< value > min (file units) */
+  NAV_IO_MIN_GE = 1u << 2,     /**< value >= min */
+  NAV_IO_MAX_LE = 1u << 3,     /**< value <= max */
+  NAV_IO_REQUIRED = 1u << 4,   /**< the key must be present */
+  NAV_IO_ALT = 1u << 5,        /**< alternative unit spelling of the preceding quantity */
+  NAV_IO_FLOW = 1u << 6,       /**< SECTION written on one line: {a: 1, b: 2} */
+  NAV_IO_STATE = 1u << 7,      /**< offset into nav_io_read_state; read only, never written */
+  NAV_IO_EARLY = 1u << 8,      /**< read before the other keys of its mapping, wherever it is */
+  NAV_IO_LATE = 1u << 9,       /**< read after the other keys of its mapping, wherever it is */
   NAV_IO_WRITE_ALT = 1u << 10, /**< an ALT spelling the writer may choose when it is shorter */
   /** The range (min/max, max_axis) is checked on the SI value after reading, by nav_scene_validate
       or a section's finish function, with its own message; the reader's number check applies only
@@ -159,16 +159,16 @@ struct nav_io_field {
                                        by the validators), may be NULL */
   const char *comment;            /**< written after the value, may be NULL */
   /* Schema only (scene_schema.c: navsim schema, nav_schema_keys); the reader and writer ignore these. */
-  const char *doc;                   /**< one-line description (NULL: .comment, else none) */
-  const char *unit;                  /**< unit as written in the file (NULL: from the key's suffix) */
-  const nav_io_section *items;       /**< CUSTOM: a sequence of mappings of this section */
-  const nav_io_kinded *kinded;       /**< CUSTOM: a mapping (or, with .items_kinded, a sequence of
-                                          mappings) whose keys depend on its kind */
-  bool items_kinded;                 /**< CUSTOM with .kinded: a sequence of such mappings */
-  size_t max_items;                  /**< CUSTOM sequences: the most items the reader accepts (0: none) */
-  const double *max_axis;            /**< VEC3S: per-axis maxima x, y, z (file units), tighter than .max;
-                                          enforced by the section's finish function (NULL: none) */
-  nav_io_schema_fn schema;           /**< CUSTOM: JSON Schema of the value (NULL: from the above) */
+  const char *doc;             /**< one-line description (NULL: .comment, else none) */
+  const char *unit;            /**< unit as written in the file (NULL: from the key's suffix) */
+  const nav_io_section *items; /**< CUSTOM: a sequence of mappings of this section */
+  const nav_io_kinded *kinded; /**< CUSTOM: a mapping (or, with .items_kinded, a sequence of
+                                    mappings) whose keys depend on its kind */
+  bool items_kinded;           /**< CUSTOM with .kinded: a sequence of such mappings */
+  size_t max_items;            /**< CUSTOM sequences: the most items the reader accepts (0: none) */
+  const double *max_axis;      /**< VEC3S: per-axis maxima x, y, z (file units), tighter than .max;
+                                    enforced by the section's finish function (NULL: none) */
+  nav_io_schema_fn schema;     /**< CUSTOM: JSON Schema of the value (NULL: from the above) */
 };
 
 /** The root mapping of a scene file (format_version, name, earth, trajectory, ...). */

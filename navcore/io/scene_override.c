@@ -90,8 +90,8 @@ static nav_status doc_from(struct fy_document *fyd, const char *name, nav_scene_
   return NAV_OK;
 }
 
-nav_status nav_scene_doc_load_string(const char *text, size_t len, const char *display_name, nav_scene_doc **out,
-                                     char *msg, size_t msg_size) {
+nav_status nav_scene_doc_load_string(const char *text, size_t len, const char *display_name,
+                                     nav_scene_doc **out, char *msg, size_t msg_size) {
   if (msg && msg_size) msg[0] = '\0';
   if (!text || !display_name || !out) return NAV_ERR_INVALID_ARG;
   *out = NULL;

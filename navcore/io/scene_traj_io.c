@@ -98,22 +98,24 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
 /* One double (a base-relative offset) in a unit; the angle and rate spellings. */
 #define D(k, off, sc, fl, ...)                                                                               \
   { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = (off), .scale = (sc), __VA_ARGS__ }
-#define ANGLE(name, off, text)                                                                                \
-  D(name "_deg", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                             \
+#define ANGLE(name, off, text)                                                                               \
+  D(name "_deg", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                            \
       D(name "_rad", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT, .doc = (text))
-#define RATE(name, off, text)                                                                                 \
-  D(name "_dps", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                             \
+#define RATE(name, off, text)                                                                                \
+  D(name "_dps", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                            \
       D(name "_rps", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT, .doc = (text))
 /* A rate that may also be given in Hz (cycles per second); written so when that is shorter. */
-#define RATE_HZ_ALT(name, off, text)                                                                          \
-  RATE(name, off, text), D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT, .doc = (text))
+#define RATE_HZ_ALT(name, off, text)                                                                         \
+  RATE(name, off, text),                                                                                     \
+      D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT, .doc = (text))
 #define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE)
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
 /* A speed within the plausibility bound of scene_bounds.h, in magnitude. */
 #define SPEED(k, off, d)                                                                                     \
   {                                                                                                          \
     .key = (k), .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,               \
-    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS, .doc = (d) \
+    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS,          \
+    .doc = (d)                                                                                               \
   }
 
 /* ================================================================ initial attitude, parametric */
@@ -121,7 +123,8 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
 static const nav_io_field k_attitude[] = {
     ANGLE("roll", OFF(trajectory.initial_attitude.roll_rad), "initial roll of the reference (ZYX Euler)"),
     ANGLE("pitch", OFF(trajectory.initial_attitude.pitch_rad), "initial pitch of the reference (ZYX Euler)"),
-    ANGLE("yaw", OFF(trajectory.initial_attitude.yaw_rad), "initial heading of the reference (ZYX Euler, from north)"),
+    ANGLE("yaw", OFF(trajectory.initial_attitude.yaw_rad),
+          "initial heading of the reference (ZYX Euler, from north)"),
 };
 SECTION_OF(k_attitude_section, k_attitude);
 
@@ -160,7 +163,10 @@ static const nav_io_field k_parametric[] = {
     PV("C_hz", c_hz, 1.0, 0, "position law: oscillation frequency C per axis"),
     PV("D_rad", d_rad, 1.0, 0, "position law: oscillation phase D per axis"),
     PV("D_deg", d_rad, NAV_DEG2RAD, NAV_IO_ALT, NULL),
-    {.key = "rate", .kind = NAV_IO_SECTION, .section = &k_rate_section, .doc = "angular rate law of the body, per axis"},
+    {.key = "rate",
+     .kind = NAV_IO_SECTION,
+     .section = &k_rate_section,
+     .doc = "angular rate law of the body, per axis"},
     {.key = "attitude",
      .kind = NAV_IO_ENUM,
      .offset = OFF(trajectory.parametric.attitude_mode),
@@ -178,15 +184,21 @@ SECTION_OF(k_parametric_section, k_parametric);
 
 #define LIMITS(name, base)                                                                                   \
   static const nav_io_field name##_fields[] = {                                                              \
-      D("max_accel_mps2", OFF(base.max_accel_mps2), 1.0, POSITIVE, .doc = "largest acceleration the planner may use"),                                          \
-      D("max_jerk_mps3", OFF(base.max_jerk_mps3), 1.0, POSITIVE, .doc = "largest jerk the planner may use"),                                            \
-      D("max_lateral_accel_mps2", OFF(base.max_lateral_accel_mps2), 1.0, POSITIVE, .doc = "largest lateral (turn) acceleration"),                          \
-      D("max_rate_dps", OFF(base.max_rate_rps), NAV_DEG2RAD, POSITIVE, .doc = "largest turn rate"),                                      \
-      D("max_rate_rps", OFF(base.max_rate_rps), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest turn rate"),                                 \
-      D("max_ang_accel_dps2", OFF(base.max_ang_accel_rps2), NAV_DEG2RAD, POSITIVE, .doc = "largest angular acceleration"),                          \
-      D("max_ang_accel_rps2", OFF(base.max_ang_accel_rps2), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest angular acceleration"),                     \
-      D("max_ang_jerk_dps3", OFF(base.max_ang_jerk_rps3), NAV_DEG2RAD, POSITIVE, .doc = "largest angular jerk"),                            \
-      D("max_ang_jerk_rps3", OFF(base.max_ang_jerk_rps3), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest angular jerk"),                       \
+      D("max_accel_mps2", OFF(base.max_accel_mps2), 1.0, POSITIVE,                                           \
+        .doc = "largest acceleration the planner may use"),                                                  \
+      D("max_jerk_mps3", OFF(base.max_jerk_mps3), 1.0, POSITIVE, .doc = "largest jerk the planner may use"), \
+      D("max_lateral_accel_mps2", OFF(base.max_lateral_accel_mps2), 1.0, POSITIVE,                           \
+        .doc = "largest lateral (turn) acceleration"),                                                       \
+      D("max_rate_dps", OFF(base.max_rate_rps), NAV_DEG2RAD, POSITIVE, .doc = "largest turn rate"),          \
+      D("max_rate_rps", OFF(base.max_rate_rps), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest turn rate"),     \
+      D("max_ang_accel_dps2", OFF(base.max_ang_accel_rps2), NAV_DEG2RAD, POSITIVE,                           \
+        .doc = "largest angular acceleration"),                                                              \
+      D("max_ang_accel_rps2", OFF(base.max_ang_accel_rps2), 1.0, POSITIVE | NAV_IO_ALT,                      \
+        .doc = "largest angular acceleration"),                                                              \
+      D("max_ang_jerk_dps3", OFF(base.max_ang_jerk_rps3), NAV_DEG2RAD, POSITIVE,                             \
+        .doc = "largest angular jerk"),                                                                      \
+      D("max_ang_jerk_rps3", OFF(base.max_ang_jerk_rps3), 1.0, POSITIVE | NAV_IO_ALT,                        \
+        .doc = "largest angular jerk"),                                                                      \
   };                                                                                                         \
   SECTION_OF(name, name##_fields)
 
@@ -240,9 +252,11 @@ static const nav_io_field k_point[] = {
      .scale = 1.0,
      .min = -NAV_PI / 2,
      .max = NAV_PI / 2},
-    D("lon_deg", SOFF(llh[1]), NAV_DEG2RAD, NAV_IO_STATE | NAV_IO_FINITE, .doc = "waypoint longitude (with lat and h, instead of ned_m)"),
+    D("lon_deg", SOFF(llh[1]), NAV_DEG2RAD, NAV_IO_STATE | NAV_IO_FINITE,
+      .doc = "waypoint longitude (with lat and h, instead of ned_m)"),
     D("lon_rad", SOFF(llh[1]), 1.0, NAV_IO_STATE | NAV_IO_FINITE | NAV_IO_ALT, .doc = NULL),
-    D("h_m", SOFF(llh[2]), 1.0, NAV_IO_STATE | NAV_IO_FINITE, .doc = "waypoint ellipsoidal height (with lat and lon)"),
+    D("h_m", SOFF(llh[2]), 1.0, NAV_IO_STATE | NAV_IO_FINITE,
+      .doc = "waypoint ellipsoidal height (with lat and lon)"),
     {.key = "speed_mps",
      .doc = "speed at the waypoint (timing speed)",
      .kind = NAV_IO_DOUBLE,
@@ -397,8 +411,10 @@ static const nav_io_field k_waypoints[] = {
      .kind = NAV_IO_ENUM,
      .offset = OFF(trajectory.waypoints.attitude_mode),
      .enums = k_wp_attitude_modes},
-    D("hold_start_s", OFF(trajectory.waypoints.hold_start_s), 1.0, NONNEG, .doc = "stationary time before the motion"),
-    D("hold_end_s", OFF(trajectory.waypoints.hold_end_s), 1.0, NONNEG, .doc = "stationary time after the motion"),
+    D("hold_start_s", OFF(trajectory.waypoints.hold_start_s), 1.0, NONNEG,
+      .doc = "stationary time before the motion"),
+    D("hold_end_s", OFF(trajectory.waypoints.hold_end_s), 1.0, NONNEG,
+      .doc = "stationary time after the motion"),
     {.key = "cruise_mps",
      .doc = "speed between two stops (timing speed)",
      .kind = NAV_IO_DOUBLE,
@@ -408,7 +424,10 @@ static const nav_io_field k_waypoints[] = {
      .write_if = if_changed,
      .comment = "speed between two stops (timing speed)"},
     {.key = "limits",
-     .doc = "dynamic limits the planner respects", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_wp_limits_section},
+     .doc = "dynamic limits the planner respects",
+     .kind = NAV_IO_SECTION,
+     .flags = NAV_IO_FLOW,
+     .section = &k_wp_limits_section},
     {.key = "points",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(trajectory.waypoints),
@@ -483,72 +502,90 @@ static const nav_io_enum_value k_seg_kinds[] = {{"hold", NAV_SEG_HOLD},
 
 /* Keys shared by the segment kinds (base: nav_segment). */
 #define SEG_KIND                                                                                             \
-  { .key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds, .doc = "what the segment does" }
+  {                                                                                                          \
+    .key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds,                          \
+    .doc = "what the segment does"                                                                           \
+  }
 #define SEG_DURATION                                                                                         \
   {                                                                                                          \
     .key = "duration_s", .kind = NAV_IO_DOUBLE, .flags = NONNEG | NAV_IO_MAX_LE, .offset = GOFF(duration_s), \
-    .scale = 1.0, .max = NAV_SCENE_MAX_DURATION_S, .doc = "duration (motion_abs/rel kinds: the most it may take)" \
+    .scale = 1.0, .max = NAV_SCENE_MAX_DURATION_S,                                                           \
+    .doc = "duration (motion_abs/rel kinds: the most it may take)"                                           \
   }
 #define SEG_COORDINATED                                                                                      \
   {                                                                                                          \
-    .key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed,           \
+    .key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed,          \
     .doc = "bank into turns (roll = atan(V yaw rate / g))"                                                   \
   }
 #define SEG_GNSS_VISIBLE                                                                                     \
   {                                                                                                          \
-    .key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed,         \
+    .key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed,        \
     .doc = "GNSS visible during the segment (motion-definition column, for outages)"                         \
   }
-#define SEG_V3(k, member, d)                                                                                    \
-  { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0, .doc = (d) }
+#define SEG_V3(k, member, d)                                                                                 \
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0,           \
+    .doc = (d)                                                                                               \
+  }
 
 static const nav_io_field k_seg_hold[] = {SEG_KIND, SEG_DURATION, SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_accelerate[] = {SEG_KIND, SPEED("speed_mps", GOFF(speed_mps), "speed at the end of the segment"),
-                                                SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
-                                          RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_COORDINATED,
-                                          SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_coord_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
-                                                RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_climb[] = {SEG_KIND, D("height_m", GOFF(height_m), 1.0, NAV_IO_FINITE, .doc = "height gained (+ = up)"),
-                                           ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the climb"), SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_circle[] = {SEG_KIND, D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
-                                            D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1", .doc = "number of turns (+ = right; figure_eight: per lobe)"), SEG_COORDINATED,
-                                            SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_helix[] = {SEG_KIND,
-                                           D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
-                                           D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1", .doc = "number of turns (+ = right; figure_eight: per lobe)"),
-                                           ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the helix (+ = climbing)"),
-                                           SEG_COORDINATED,
-                                           SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_lawnmower[] = {SEG_KIND,
-                                               {.key = "legs",
-                                                .kind = NAV_IO_INT,
-                                                .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
-                                                .offset = GOFF(legs),
-                                                .min = 1.0,
-                                                .max = 100000.0,
-                                                .doc = "number of straight legs"},
-                                               D("length_m", GOFF(length_m), 1.0, NONNEG, .doc = "straight length of each leg"),
-                                               D("spacing_m", GOFF(spacing_m), 1.0, NAV_IO_FINITE, .doc = "distance between legs (+ = first turn right)"),
-                                               SEG_COORDINATED,
-                                               SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_rates[] = {SEG_KIND,
-                                           RATE("yaw_rate", GOFF(yaw_rate_rps), "yaw rate held over the segment"),
-                                           RATE("pitch_rate", GOFF(pitch_rate_rps), "pitch rate held over the segment"),
-                                           RATE("roll_rate", GOFF(roll_rate_rps), "roll rate held over the segment"),
-                                           SEG_V3("accel_b_mps2", accel_b_mps2, "body-axis acceleration held over the segment"),
-                                           SEG_DURATION,
-                                           SEG_COORDINATED,
-                                           SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_motion[] = {SEG_KIND,
-                                            ANGLE("yaw", GOFF(yaw_rad), "yaw command: absolute or change, by the kind (gnss-ins-sim types 2-5)"),
-                                            ANGLE("pitch", GOFF(pitch_rad), "pitch command: absolute or change, by the kind"),
-                                            ANGLE("roll", GOFF(roll_rad), "roll command: absolute or change, by the kind"),
-                                            SEG_V3("v_b_mps", v_b_mps, "body velocity command: absolute or change, by the kind"),
-                                            SEG_DURATION,
-                                            SEG_COORDINATED,
-                                            SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_accelerate[] = {
+    SEG_KIND, SPEED("speed_mps", GOFF(speed_mps), "speed at the end of the segment"), SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_turn[] = {
+    SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
+    RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_COORDINATED,
+    SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_coord_turn[] = {
+    SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
+    RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_climb[] = {
+    SEG_KIND, D("height_m", GOFF(height_m), 1.0, NAV_IO_FINITE, .doc = "height gained (+ = up)"),
+    ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the climb"), SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_circle[] = {
+    SEG_KIND, D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
+    D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1",
+      .doc = "number of turns (+ = right; figure_eight: per lobe)"),
+    SEG_COORDINATED, SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_helix[] = {
+    SEG_KIND,
+    D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
+    D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1",
+      .doc = "number of turns (+ = right; figure_eight: per lobe)"),
+    ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the helix (+ = climbing)"),
+    SEG_COORDINATED,
+    SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_lawnmower[] = {
+    SEG_KIND,
+    {.key = "legs",
+     .kind = NAV_IO_INT,
+     .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+     .offset = GOFF(legs),
+     .min = 1.0,
+     .max = 100000.0,
+     .doc = "number of straight legs"},
+    D("length_m", GOFF(length_m), 1.0, NONNEG, .doc = "straight length of each leg"),
+    D("spacing_m", GOFF(spacing_m), 1.0, NAV_IO_FINITE,
+      .doc = "distance between legs (+ = first turn right)"),
+    SEG_COORDINATED,
+    SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_rates[] = {
+    SEG_KIND,
+    RATE("yaw_rate", GOFF(yaw_rate_rps), "yaw rate held over the segment"),
+    RATE("pitch_rate", GOFF(pitch_rate_rps), "pitch rate held over the segment"),
+    RATE("roll_rate", GOFF(roll_rate_rps), "roll rate held over the segment"),
+    SEG_V3("accel_b_mps2", accel_b_mps2, "body-axis acceleration held over the segment"),
+    SEG_DURATION,
+    SEG_COORDINATED,
+    SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_motion[] = {
+    SEG_KIND,
+    ANGLE("yaw", GOFF(yaw_rad), "yaw command: absolute or change, by the kind (gnss-ins-sim types 2-5)"),
+    ANGLE("pitch", GOFF(pitch_rad), "pitch command: absolute or change, by the kind"),
+    ANGLE("roll", GOFF(roll_rad), "roll command: absolute or change, by the kind"),
+    SEG_V3("v_b_mps", v_b_mps, "body velocity command: absolute or change, by the kind"),
+    SEG_DURATION,
+    SEG_COORDINATED,
+    SEG_GNSS_VISIBLE};
 SECTION_OF(k_seg_hold_section, k_seg_hold);
 SECTION_OF(k_seg_accelerate_section, k_seg_accelerate);
 SECTION_OF(k_seg_turn_section, k_seg_turn);
@@ -663,11 +700,18 @@ static const nav_io_field k_segments[] = {
      .max = NAV_SCENE_MAX_SPEED_MPS,
      .comment = "start velocity, body axes"},
     {.key = "allow_unconverged",
-     .doc = "accept a segment whose planner did not converge (kept as planned)", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.allow_unconverged)},
+     .doc = "accept a segment whose planner did not converge (kept as planned)",
+     .kind = NAV_IO_BOOL,
+     .offset = OFF(trajectory.segments.allow_unconverged)},
     {.key = "fit_rate_ramps",
-     .doc = "fit the rate ramps of a motion definition instead of stepping them", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.fit_rate_ramps)},
+     .doc = "fit the rate ramps of a motion definition instead of stepping them",
+     .kind = NAV_IO_BOOL,
+     .offset = OFF(trajectory.segments.fit_rate_ramps)},
     {.key = "limits",
-     .doc = "dynamic limits the planner respects", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_seg_limits_section},
+     .doc = "dynamic limits the planner respects",
+     .kind = NAV_IO_SECTION,
+     .flags = NAV_IO_FLOW,
+     .section = &k_seg_limits_section},
     {.key = "items",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(trajectory.segments),
@@ -695,11 +739,14 @@ static const nav_io_enum_value k_tm_kinds[] = {{"stationary", NAV_TEST_MOTION_ST
   { .key = "kind", .kind = NAV_IO_ENUM, .offset = TM(kind), .enums = k_tm_kinds, .doc = "which test motion" }
 
 static const nav_io_field k_tm_stationary[] = {TM_KIND};
-static const nav_io_field k_tm_coning[] = {TM_KIND, ANGLE("cone_half_angle", TM(cone_half_angle_rad), "half angle of the coning cone"),
-                                           RATE_HZ_ALT("cone_rate", TM(cone_rate_rps), "coning frequency")};
-static const nav_io_field k_tm_sculling[] = {TM_KIND, ANGLE("scull_angle", TM(scull_angle_rad), "angular amplitude of the sculling motion"),
-                                             D("scull_accel_mps2", TM(scull_accel_mps2), 1.0, NAV_IO_FINITE, .doc = "acceleration amplitude of the sculling motion"),
-                                             RATE_HZ_ALT("scull_rate", TM(scull_rate_rps), "sculling frequency")};
+static const nav_io_field k_tm_coning[] = {
+    TM_KIND, ANGLE("cone_half_angle", TM(cone_half_angle_rad), "half angle of the coning cone"),
+    RATE_HZ_ALT("cone_rate", TM(cone_rate_rps), "coning frequency")};
+static const nav_io_field k_tm_sculling[] = {
+    TM_KIND, ANGLE("scull_angle", TM(scull_angle_rad), "angular amplitude of the sculling motion"),
+    D("scull_accel_mps2", TM(scull_accel_mps2), 1.0, NAV_IO_FINITE,
+      .doc = "acceleration amplitude of the sculling motion"),
+    RATE_HZ_ALT("scull_rate", TM(scull_rate_rps), "sculling frequency")};
 static const nav_io_field k_tm_spin[] = {
     TM_KIND,
     RATE_HZ_ALT("spin_rate", TM(spin_rate_rps), "spin rate about the spin axis"),
@@ -714,11 +761,15 @@ static const nav_io_field k_tm_spin[] = {
      .unit = "1",
      .doc = "spin axis in body axes (any non-zero length)"}};
 static const nav_io_field k_tm_great_circle[] = {
-    TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE, .doc = "height of the great circle above the ellipsoid"),
-    SPEED("gc_speed_mps", TM(gc_speed_mps), "speed along the great circle"), ANGLE("gc_start_angle", TM(gc_start_angle_rad), "geocentric angle from the equator at t = 0"),
+    TM_KIND,
+    D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE,
+      .doc = "height of the great circle above the ellipsoid"),
+    SPEED("gc_speed_mps", TM(gc_speed_mps), "speed along the great circle"),
+    ANGLE("gc_start_angle", TM(gc_start_angle_rad), "geocentric angle from the equator at t = 0"),
     ANGLE("gc_lon", TM(gc_lon_rad), "longitude of the meridian plane")};
-static const nav_io_field k_tm_loop[] = {TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps), "speed around the loop"),
-                                         RATE("loop_pitch_rate", TM(loop_pitch_rate_rps), "pitch rate around the loop")};
+static const nav_io_field k_tm_loop[] = {
+    TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps), "speed around the loop"),
+    RATE("loop_pitch_rate", TM(loop_pitch_rate_rps), "pitch rate around the loop")};
 SECTION_OF(k_tm_stationary_section, k_tm_stationary);
 SECTION_OF(k_tm_coning_section, k_tm_coning);
 SECTION_OF(k_tm_sculling_section, k_tm_sculling);
@@ -778,7 +829,10 @@ static const nav_io_field k_motion_def[] = {
      .flags = NAV_IO_STATE,
      .offset = SOFF(md_allow_unconverged)},
     {.key = "fit_rate_ramps",
-     .doc = "fit the rate ramps of a motion definition instead of stepping them", .kind = NAV_IO_BOOL, .flags = NAV_IO_STATE, .offset = SOFF(md_fit_rate_ramps)},
+     .doc = "fit the rate ramps of a motion definition instead of stepping them",
+     .kind = NAV_IO_BOOL,
+     .flags = NAV_IO_STATE,
+     .offset = SOFF(md_fit_rate_ramps)},
 };
 SECTION_OF(k_motion_def_section, k_motion_def);
 
@@ -793,7 +847,10 @@ static const nav_io_field k_recorded[] = {
      .offset = RO(file),
      .size = NAV_RECORDED_PATH_MAX},
     {.key = "format",
-     .doc = "format of the recorded file", .kind = NAV_IO_ENUM, .offset = RO(format), .enums = k_recorded_formats},
+     .doc = "format of the recorded file",
+     .kind = NAV_IO_ENUM,
+     .offset = RO(format),
+     .enums = k_recorded_formats},
     {.key = "start_s",
      .doc = "first recorded time used (file time base)",
      .kind = NAV_IO_DOUBLE,
@@ -819,8 +876,10 @@ static const nav_io_field k_recorded[] = {
      .scale = 1.0,
      .min = 0.0,
      .max = 1000.0},
-    D("pos_sd_m", RO(pos_sd_m), 1.0, POSITIVE, .doc = "fit weight of a recorded position (1 / sigma^2 per axis)"),
-    D("vel_sd_mps", RO(vel_sd_mps), 1.0, POSITIVE, .doc = "fit weight of a recorded velocity (1 / sigma^2 per axis)"),
+    D("pos_sd_m", RO(pos_sd_m), 1.0, POSITIVE,
+      .doc = "fit weight of a recorded position (1 / sigma^2 per axis)"),
+    D("vel_sd_mps", RO(vel_sd_mps), 1.0, POSITIVE,
+      .doc = "fit weight of a recorded velocity (1 / sigma^2 per axis)"),
 };
 SECTION_OF(k_recorded_section, k_recorded);
 
@@ -891,7 +950,10 @@ static bool attitude_written(const nav_io_writer *w, const nav_io_field *f, cons
 
 static const nav_io_field k_trajectory[] = {
     {.key = "type",
-     .doc = "which trajectory model the scene uses", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
+     .doc = "which trajectory model the scene uses",
+     .kind = NAV_IO_ENUM,
+     .offset = OFF(trajectory.type),
+     .enums = k_traj_types},
     {.key = "duration_s",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
@@ -911,11 +973,20 @@ static const nav_io_field k_trajectory[] = {
      .section = &k_attitude_section,
      .write_if = attitude_written},
     {.key = "parametric",
-     .doc = "the paper's parametric trajectory: position and rate laws (type parametric)", .kind = NAV_IO_SECTION, .section = &k_parametric_section, .write_if = type_written},
+     .doc = "the paper's parametric trajectory: position and rate laws (type parametric)",
+     .kind = NAV_IO_SECTION,
+     .section = &k_parametric_section,
+     .write_if = type_written},
     {.key = "waypoints",
-     .doc = "a path through waypoints with speeds or times (type waypoints)", .kind = NAV_IO_SECTION, .section = &k_waypoints_section, .write_if = type_written},
+     .doc = "a path through waypoints with speeds or times (type waypoints)",
+     .kind = NAV_IO_SECTION,
+     .section = &k_waypoints_section,
+     .write_if = type_written},
     {.key = "segments",
-     .doc = "a script of segments: hold, accelerate, turn, climb, ... (type segments)", .kind = NAV_IO_SECTION, .section = &k_segments_section, .write_if = type_written},
+     .doc = "a script of segments: hold, accelerate, turn, climb, ... (type segments)",
+     .kind = NAV_IO_SECTION,
+     .section = &k_segments_section,
+     .write_if = type_written},
     {.key = "test_motion",
      .kind = NAV_IO_CUSTOM,
      .read = read_test_motion,
@@ -925,9 +996,15 @@ static const nav_io_field k_trajectory[] = {
      .doc = "a test motion (type test_motion): its kind and that kind's keys",
      .kinded = &k_tm_kinded},
     {.key = "motion_def",
-     .doc = "a gnss-ins-sim motion definition file, imported as segments (type motion_def)", .kind = NAV_IO_SECTION, .section = &k_motion_def_section, .write_if = never},
+     .doc = "a gnss-ins-sim motion definition file, imported as segments (type motion_def)",
+     .kind = NAV_IO_SECTION,
+     .section = &k_motion_def_section,
+     .write_if = never},
     {.key = "recorded",
-     .doc = "a recorded reference trajectory fitted by a B-spline (type recorded)", .kind = NAV_IO_SECTION, .section = &k_recorded_section, .write_if = type_written},
+     .doc = "a recorded reference trajectory fitted by a B-spline (type recorded)",
+     .kind = NAV_IO_SECTION,
+     .section = &k_recorded_section,
+     .write_if = type_written},
 };
 const nav_io_section nav_io_trajectory_section = {k_trajectory, COUNT(k_trajectory), NULL};
 

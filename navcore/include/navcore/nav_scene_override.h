@@ -36,8 +36,9 @@ NAV_API NAV_NODISCARD nav_status nav_scene_doc_load(const char *path, nav_scene_
  * the file in diagnostics; relative file references then resolve as nav_scene_read_string's do.
  * For editors that check an edit without writing a file.
  */
-NAV_API NAV_NODISCARD nav_status nav_scene_doc_load_string(const char *text, size_t len, const char *display_name,
-                                                           nav_scene_doc **out, char *msg, size_t msg_size);
+NAV_API NAV_NODISCARD nav_status nav_scene_doc_load_string(const char *text, size_t len,
+                                                           const char *display_name, nav_scene_doc **out,
+                                                           char *msg, size_t msg_size);
 NAV_API void nav_scene_doc_destroy(nav_scene_doc *doc);
 
 /**
