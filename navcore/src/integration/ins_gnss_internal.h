@@ -40,4 +40,22 @@ nav_status nav_ins_gnss_feedback(nav_ins_gnss *x, const nav_local_view *view, do
  *  GNSS position GM states (ins_gnss_tight.c). */
 void nav_ins_gnss_tight_filter(const nav_scene *sc, nav_filter_config *c);
 
+/** What the tightly coupled measurement rows need at one epoch (ins_gnss_tight.c). */
+typedef struct nav_tight_geom {
+  nav_filter_layout lay;
+  nav_mat3 C_n_e;
+  nav_vec3 r_ea_e, v_ea_e; /* antenna position and velocity (relative to the Earth), ECEF */
+  double Hpos[3 * NAV_FILTER_MAX_STATES], Hvel[3 * NAV_FILTER_MAX_STATES];
+} nav_tight_geom;
+
+/** The antenna and the loose position/velocity Jacobians at the linearisation point @p nav with
+ *  the geodetic position @p pos (the INS's, or the reference in covariance analysis). */
+void nav_ins_gnss_tight_geometry(nav_tight_geom *g, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                                 nav_geodetic pos, nav_vec3 l_ba_b_m);
+
+/** One satellite's pseudorange and range-rate H rows (n = lay.n_states each), predicted range and
+ *  range rate (docs/ins-gnss-tight.md 3). */
+void nav_ins_gnss_tight_rows(const nav_tight_geom *g, const nav_gnss_orbit *sat, double t_gps_s, double *H_pr,
+                             double *H_rr, double *rho_m, double *rr_mps);
+
 #endif /* NAV_INS_GNSS_INTERNAL_H */

@@ -55,6 +55,50 @@ static void project_rows(double *row, const double *M, nav_vec3 u, size_t n) {
     row[j] = u.x * M[j] + u.y * M[n + j] + u.z * M[2 * n + j];
 }
 
+void nav_ins_gnss_tight_geometry(nav_tight_geom *g, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                                 nav_geodetic pos, nav_vec3 l_ba_b_m) {
+  g->lay = *lay;
+  /* The antenna as the INS sees it: position and velocity in ECEF (docs/ins-gnss-tight.md 3). */
+  g->C_n_e = nav_earth_dcm_n_e(pos.lat_rad, pos.lon_rad);
+  const nav_vec3 r_eb_e = nav_earth_geodetic_to_ecef(pos);
+  g->r_ea_e = nav_vec3_add(r_eb_e, nav_mat3_mul_vec(g->C_n_e, nav_mat3_mul_vec(nav->C_b_n, l_ba_b_m)));
+  /* v_a = v + C_b_n (w_ib_b x l) - w_ie_n x (C_b_n l): the loose filter's velocity residual
+   * against a zero measurement (E6.4). */
+  const nav_vec3 v_ea_n = nav_filter_gnss_vel_residual(nav, l_ba_b_m, nav_vec3_zero());
+  g->v_ea_e = nav_mat3_mul_vec(g->C_n_e, v_ea_n);
+  nav_filter_build_H_pos(g->Hpos, lay, nav, l_ba_b_m);
+  nav_filter_build_H_vel(g->Hvel, lay, nav, l_ba_b_m);
+}
+
+void nav_ins_gnss_tight_rows(const nav_tight_geom *g, const nav_gnss_orbit *sat, double t_gps_s, double *H_pr,
+                             double *H_rr, double *rho_m, double *rr_mps) {
+  const nav_filter_layout *lay = &g->lay;
+  const size_t n = lay->n_states;
+  /* Predicted range from the INS antenna (light time and Sagnac rotation, nav_gnss_sat.h). */
+  nav_vec3 r_es_e;
+  const double rho = nav_gnss_geometric_range_m(sat, t_gps_s, g->r_ea_e, &r_es_e);
+  const nav_vec3 u_e = nav_vec3_scale(nav_vec3_sub(r_es_e, g->r_ea_e), 1.0 / rho);
+  const nav_vec3 u_n = nav_mat3_tmul_vec(g->C_n_e, u_e);
+  /* Pseudorange: z = P - rho_hat = u_n^T dr_a + b (+ isb) + e with dr_a = H_pos x
+   * (docs/ins-gnss-tight.md 3.1). With one system only, its clock is the receiver clock. */
+  project_rows(H_pr, g->Hpos, u_n, n);
+  H_pr[lay->idx_clock] = 1.0;
+  if (lay->has_isb && sat->system == NAV_GNSS_SYS_GLONASS) H_pr[lay->idx_isb] = 1.0;
+  /* Range rate: the satellite velocity at the transmit time, rotated like its position (Sagnac),
+   * and the rate of the moving geometry (u.(v_s - v_a)) / (1 + u.v_s / c); z = rr - rr_hat =
+   * u_n^T dv_a + d + e with dv_a = H_vel x (docs/ins-gnss-tight.md 3.2). */
+  const double tau = rho / NAV_GNSS_C_MPS;
+  nav_vec3 r_tx, v_tx;
+  nav_gnss_orbit_state(sat, t_gps_s - tau, &r_tx, &v_tx);
+  const double a = NAV_GPS_OMEGA_E_RPS * tau, ca = cos(a), sa = sin(a);
+  const nav_vec3 v_s = nav_vec3_make(ca * v_tx.x + sa * v_tx.y, -sa * v_tx.x + ca * v_tx.y, v_tx.z);
+  const double us = nav_vec3_dot(u_e, v_s);
+  project_rows(H_rr, g->Hvel, u_n, n);
+  H_rr[lay->idx_clock + 1] = 1.0;
+  *rho_m = rho;
+  *rr_mps = (us - nav_vec3_dot(u_e, g->v_ea_e)) / (1.0 + us / NAV_GNSS_C_MPS);
+}
+
 /* Test one scalar measurement against the gate and apply it. */
 static nav_status scalar_update(nav_ins_gnss *x, const double *H, double z, double r, bool *applied) {
   *applied = false;
@@ -88,19 +132,9 @@ nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch
   nav_ins_gnss_raw_result r0 = {0, 0, 0};
   nav_local_view v;
   const nav_filter_nav nav = nav_ins_gnss_epoch_nav(x, &v);
-  const nav_vec3 l = x->cfg.r_ba_b_m;
-  /* The antenna as the INS sees it: position and velocity in ECEF (docs/ins-gnss-tight.md 3). */
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(v.pos.lat_rad, v.pos.lon_rad);
-  const nav_vec3 r_eb_e = nav_earth_geodetic_to_ecef(v.pos);
-  const nav_vec3 r_ea_e = nav_vec3_add(r_eb_e, nav_mat3_mul_vec(C_n_e, nav_mat3_mul_vec(nav.C_b_n, l)));
-  /* v_a = v + C_b_n (w_ib_b x l) - w_ie_n x (C_b_n l): the loose filter's velocity residual
-   * against a zero measurement (E6.4). */
-  const nav_vec3 v_ea_n = nav_filter_gnss_vel_residual(&nav, l, nav_vec3_zero());
-  const nav_vec3 v_ea_e = nav_mat3_mul_vec(C_n_e, v_ea_n);
-  const size_t n = lay.n_states;
-  double Hpos[3 * NAV_FILTER_MAX_STATES], Hvel[3 * NAV_FILTER_MAX_STATES], H[NAV_FILTER_MAX_STATES];
-  nav_filter_build_H_pos(Hpos, &lay, &nav, l);
-  nav_filter_build_H_vel(Hvel, &lay, &nav, l);
+  nav_tight_geom geom;
+  nav_ins_gnss_tight_geometry(&geom, &lay, &nav, v.pos, x->cfg.r_ba_b_m);
+  double Hp[NAV_FILTER_MAX_STATES], Hr[NAV_FILTER_MAX_STATES];
   const double rp = ep->pr_sd_m * ep->pr_sd_m, rr = ep->rr_sd_mps * ep->rr_sd_mps;
   nav_status st = NAV_OK;
   for (int i = 0; i < ep->n && st == NAV_OK; ++i) {
@@ -110,25 +144,16 @@ nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch
       st = NAV_ERR_INVALID_ARG;
       break;
     }
-    /* With one system only, its clock is the receiver clock (no inter-system bias state). */
-    const bool glo = m->sat->system == NAV_GNSS_SYS_GLONASS && lay.has_isb;
     if ((m->has_pr && !isfinite(m->pr_m)) || (m->has_rr && !isfinite(m->rr_mps))) {
       snprintf(x->err, sizeof x->err, "non-finite raw measurement of satellite %d at t = %.6f s", m->sat->prn, ep->t_s);
       st = NAV_ERR_NUMERIC;
       break;
     }
-    /* Predicted range from the INS antenna (light time and Sagnac rotation, nav_gnss_sat.h). */
-    nav_vec3 r_es_e;
-    const double rho = nav_gnss_geometric_range_m(m->sat, ep->t_gps_s, r_ea_e, &r_es_e);
-    const nav_vec3 u_e = nav_vec3_scale(nav_vec3_sub(r_es_e, r_ea_e), 1.0 / rho);
-    const nav_vec3 u_n = nav_mat3_tmul_vec(C_n_e, u_e);
+    double rho, rr_hat;
+    nav_ins_gnss_tight_rows(&geom, m->sat, ep->t_gps_s, Hp, Hr, &rho, &rr_hat);
     bool applied = false;
     if (m->has_pr) {
-      /* z = P - rho_hat = u_n^T dr_a + b (+ isb) + e, dr_a = H_pos x (docs/ins-gnss-tight.md 3.1). */
-      project_rows(H, Hpos, u_n, n);
-      H[lay.idx_clock] = 1.0;
-      if (glo) H[lay.idx_isb] = 1.0;
-      st = scalar_update(x, H, m->pr_m - rho, rp, &applied);
+      st = scalar_update(x, Hp, m->pr_m - rho, rp, &applied);
       if (st != NAV_OK) {
         snprintf(x->err, sizeof x->err, "pseudorange update (satellite %d) failed at t = %.6f s: %s", m->sat->prn,
                  ep->t_s, nav_filter_last_error(x->kf));
@@ -138,19 +163,7 @@ nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch
       else r0.rejected++;
     }
     if (m->has_rr) {
-      /* Satellite velocity at the transmit time, rotated like its position (Sagnac); the range
-       * rate of the moving geometry, (u.(v_s - v_a)) / (1 + u.v_s / c) (docs/ins-gnss-tight.md 3.2). */
-      const double tau = rho / NAV_GNSS_C_MPS;
-      nav_vec3 r_tx, v_tx;
-      nav_gnss_orbit_state(m->sat, ep->t_gps_s - tau, &r_tx, &v_tx);
-      const double a = NAV_GPS_OMEGA_E_RPS * tau, ca = cos(a), sa = sin(a);
-      const nav_vec3 v_s = nav_vec3_make(ca * v_tx.x + sa * v_tx.y, -sa * v_tx.x + ca * v_tx.y, v_tx.z);
-      const double us = nav_vec3_dot(u_e, v_s);
-      const double rr_hat = (us - nav_vec3_dot(u_e, v_ea_e)) / (1.0 + us / NAV_GNSS_C_MPS);
-      /* z = rr - rr_hat = u_n^T dv_a + d + e, dv_a = H_vel x. */
-      project_rows(H, Hvel, u_n, n);
-      H[lay.idx_clock + 1] = 1.0;
-      st = scalar_update(x, H, m->rr_mps - rr_hat, rr, &applied);
+      st = scalar_update(x, Hr, m->rr_mps - rr_hat, rr, &applied);
       if (st != NAV_OK) {
         snprintf(x->err, sizeof x->err, "range-rate update (satellite %d) failed at t = %.6f s: %s", m->sat->prn,
                  ep->t_s, nav_filter_last_error(x->kf));
