@@ -437,7 +437,10 @@ static int cmd_run(int argc, char **argv) {
     char dp[4200];
     snprintf(dp, sizeof dp, "%s", df ? df : "");
     const char *sf = nav_resultdir_file(rd, "gnss_sats.csv");
-    const nav_status gst = (!df || !sf) ? NAV_ERR_IO : navsim_gnss_sat_out_begin(&scene, dp, sf, &o.gsat);
+    char sp[4200];
+    snprintf(sp, sizeof sp, "%s", sf ? sf : "");
+    const char *mf = nav_resultdir_file(rd, "gnss_mask.csv");
+    const nav_status gst = (!df || !sf || !mf) ? NAV_ERR_IO : navsim_gnss_sat_out_begin(&scene, dp, sp, mf, &o.gsat);
     if (gst != NAV_OK) {
       fprintf(stderr, "navsim run: cannot write gnss_dop.csv / gnss_sats.csv in \"%s\": %s\n", out_dir,
               nav_status_str(gst));
