@@ -257,7 +257,8 @@ typedef struct nav_filter_config {
  * = 1.16667e-3 m/s/sqrt(s), GM biases 0.5 deg/h and 0.05 mg with T = 3600 s, no scale-factor
  * process; P0 1 m, 0.1 m/s, 0.1 deg (N, E) and 1 deg (D), biases at their GM sigma, scale
  * factors 100 ppm, GNSS GM 1 m; GNSS GM process sigma 1 m, T = 300 s; R sigmas 1.5, 1.5, 3 m
- * and 0.05 m/s.
+ * and 0.05 m/s; receiver clock (when its states are chosen) of a low-quality TCXO (h_0 = 2e-19 s,
+ * h_-2 = 2e-20 /s) with 100 m, 10 m/s and 10 m (inter-system bias) initial sigmas.
  */
 NAV_API nav_filter_config nav_filter_config_default(void);
 

@@ -61,6 +61,15 @@ nav_filter_config nav_filter_config_default(void) {
   c.init.gnss_pos_sd_m = v3(1.0);
   c.gnss_pos_sd_m = nav_vec3_make(1.5, 1.5, 3.0);
   c.gnss_vel_sd_mps = v3(0.05);
+  /* Receiver clock (only with NAV_FILTER_STATE_RX_CLOCK / RX_ISB): a low-quality TCXO (Brown and
+   * Hwang, 4th ed., Table 9.2: h_0 = 2e-19 s, h_-2 = 2e-20 /s), q_f = c^2 h_0 / 2,
+   * q_g = 2 pi^2 c^2 h_-2; 100 m, 10 m/s and 10 m initial sigmas (docs/ins-gnss-tight.md). */
+  const double c2 = 299792458.0 * 299792458.0;
+  c.clock_bias_q_m2ps = 0.5 * 2e-19 * c2;
+  c.clock_drift_q_m2ps3 = 2.0 * NAV_PI * NAV_PI * 2e-20 * c2;
+  c.init.clock_bias_sd_m = 100.0;
+  c.init.clock_drift_sd_mps = 10.0;
+  c.init.isb_sd_m = 10.0;
   return c;
 }
 

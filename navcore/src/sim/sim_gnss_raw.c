@@ -110,9 +110,12 @@ nav_status nav_sim_gnss_raw_measure(nav_sim_gnss_raw *g, const nav_frame *fr, co
     const nav_gnss_orbit *o = &g->c.sats[i];
     const double rho = nav_gnss_geometric_range_m(o, t_gps, r_ea_e, NULL);
     /* The range rate of the true geometry: a central difference of the exact range (light time
-     * and Sagnac included) with the antenna moved along its velocity; h = 10 ms keeps the
-     * truncation (rho''' h^2 / 6) and the rounding (1e-9 m / h) below 1e-6 m/s. */
-    const double h = 0.01;
+     * and Sagnac included) with the antenna moved along its velocity. h = 0.5 s: GPS time as a
+     * double has a spacing of 2.4e-7 s in 2026, which makes the range jitter by about 1e-4 m
+     * (the satellite moves up to 1 mm in that time), 2e-4 m/s after dividing by 2 h; the
+     * truncation rho''' h^2 / 6 of the satellite's motion stays near 1e-5 m/s (the antenna moves
+     * on a straight line here, so its acceleration does not enter). */
+    const double h = 0.5;
     const double rp = nav_gnss_geometric_range_m(o, t_gps + h, nav_vec3_axpy(r_ea_e, h, v_ea_e), NULL);
     const double rm = nav_gnss_geometric_range_m(o, t_gps - h, nav_vec3_axpy(r_ea_e, -h, v_ea_e), NULL);
     const double rdot = (rp - rm) / (2.0 * h);
