@@ -83,7 +83,9 @@ static int col(const table *t, const char *name) {
   return -1;
 }
 
-static double at(const table *t, int row, int c) { return t->v[(size_t)row * (size_t)t->ncol + (size_t)c]; }
+static double at(const table *t, int row, int c) {
+  return t->v[(size_t)row * (size_t)t->ncol + (size_t)c];
+}
 
 /* Row whose t_s is @p t (to 1e-6 s), or -1. */
 static int row_at(const table *t, double time_s) {
@@ -99,7 +101,8 @@ static int setup(void **state) {
 }
 
 /* Ratios RMS / sigma of N, E, D at the ten epochs, counted inside the 99 % band of chi2(M). */
-static int ratios_inside(const table *mc, const table *ref, const char *const sd[3], const char *what, double M) {
+static int ratios_inside(const table *mc, const table *ref, const char *const sd[3], const char *what,
+                         double M) {
   const double lo = sqrt(chi2_over_k(M, -2.5758)), hi = sqrt(chi2_over_k(M, 2.5758));
   const double times[10] = {10.0, 30.0, 45.0, 60.0, 80.0, 99.9, 110.0, 130.0, 150.0, 170.0};
   const char *rms[3] = {"pos_rms_n_m", "pos_rms_e_m", "pos_rms_d_m"};
@@ -112,7 +115,8 @@ static int ratios_inside(const table *mc, const table *ref, const char *const sd
       ratio[c] = at(mc, rm, col(mc, rms[c])) / at(ref, re, col(ref, sd[c]));
       inside += ratio[c] > lo && ratio[c] < hi;
     }
-    print_message("t = %6.1f s: RMS / %s N %.3f E %.3f D %.3f\n", times[i], what, ratio[0], ratio[1], ratio[2]);
+    print_message("t = %6.1f s: RMS / %s N %.3f E %.3f D %.3f\n", times[i], what, ratio[0], ratio[1],
+                  ratio[2]);
   }
   print_message("%d of 30 ratios in the 99 %% band [%.3f, %.3f]\n", inside, lo, hi);
   return inside;
@@ -171,10 +175,11 @@ static void test_tight_canyon(void **state) {
   const int rt = row_at(&mc, 99.9), rl = row_at(&lo, 99.9), rb = row_at(&lo, 39.9);
   assert_true(rt >= 0 && rl >= 0 && rb >= 0);
   const double h_t = at(&mc, rt, col(&mc, "pos_h_rms_m")), h_l = at(&lo, rl, col(&lo, "pos_h_rms_m"));
-  print_message("canyon end (t = 99.9 s), horizontal RMS over 100 runs: tight %.2f m (max %.2f m), loose %.2f m "
-                "(max %.2f m); before the canyon (39.9 s): tight %.2f m, loose %.2f m\n",
-                h_t, at(&mc, rt, col(&mc, "pos_h_max_m")), h_l, at(&lo, rl, col(&lo, "pos_h_max_m")),
-                at(&mc, row_at(&mc, 39.9), col(&mc, "pos_h_rms_m")), at(&lo, rb, col(&lo, "pos_h_rms_m")));
+  print_message(
+      "canyon end (t = 99.9 s), horizontal RMS over 100 runs: tight %.2f m (max %.2f m), loose %.2f m "
+      "(max %.2f m); before the canyon (39.9 s): tight %.2f m, loose %.2f m\n",
+      h_t, at(&mc, rt, col(&mc, "pos_h_max_m")), h_l, at(&lo, rl, col(&lo, "pos_h_max_m")),
+      at(&mc, row_at(&mc, 39.9), col(&mc, "pos_h_rms_m")), at(&lo, rb, col(&lo, "pos_h_rms_m")));
   assert_true(h_t < h_l);
   free(est.v);
   free(mc.v);

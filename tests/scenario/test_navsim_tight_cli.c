@@ -58,7 +58,8 @@ static void test_scene_checks(void **state) {
   nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "check noconst.yaml");
   assert_int_equal(r->code, 2);
   print_message("%s", r->err);
-  nav_test_assert_matches(r->err, "noconst.yaml:[0-9]+:[0-9]+: error: navigation.scheme: ins_gnss_tight needs satellites");
+  nav_test_assert_matches(
+      r->err, "noconst.yaml:[0-9]+:[0-9]+: error: navigation.scheme: ins_gnss_tight needs satellites");
   variant("nognss.yaml", "  enabled: true", "  enabled: false");
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "check nognss.yaml");
   assert_int_equal(r->code, 2);
@@ -67,7 +68,8 @@ static void test_scene_checks(void **state) {
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "check badcode.yaml");
   assert_int_equal(r->code, 2);
   print_message("%s", r->err);
-  nav_test_assert_matches(r->err, "badcode.yaml:[0-9]+:[0-9]+: error: gnss.constellation.code_sd_m: must be in");
+  nav_test_assert_matches(r->err,
+                          "badcode.yaml:[0-9]+:[0-9]+: error: gnss.constellation.code_sd_m: must be in");
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "check '%s'", TIGHT);
   assert_int_equal(r->code, 0);
 }
@@ -81,7 +83,8 @@ static void test_unsupported_commands_refuse(void **state) {
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "select '%s' --out s", TIGHT);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "navsim select does not support ins_gnss_tight yet");
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "select '%s' --schemes ins_gnss,ins_gnss_tight --out s2", TIGHT);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "select '%s' --schemes ins_gnss,ins_gnss_tight --out s2",
+                        TIGHT);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--schemes: ins_gnss_tight is not supported by select yet");
   assert_false(nav_test_is_file(WORK "/s/ranking.csv"));

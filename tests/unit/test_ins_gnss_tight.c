@@ -34,7 +34,9 @@
  * satellite by up to 1 mm and a range by about 1e-4 m between neighbouring representable times.
  * The derivative checks run two weeks after the GPS epoch (spacing 2e-10 s) so that this
  * rounding stays far below the quantities compared. */
-static double t_epoch(void) { return 2.0 * NAV_GNSS_WEEK_S + 8.0 * 3600.0; }
+static double t_epoch(void) {
+  return 2.0 * NAV_GNSS_WEEK_S + 8.0 * 3600.0;
+}
 
 static nav_gnss_constellation gps_glo(void) {
   nav_gnss_constellation c;
@@ -67,7 +69,8 @@ static void test_clock_propagation(void **state) {
   nv.lat_rad = 0.9;
   nv.C_b_n = nav_mat3_identity();
   nv.f_ib_b_mps2 = nav_vec3_make(0.0, 0.0, -9.81);
-  for (int k = 0; k < 1000; ++k) assert_int_equal(nav_filter_predict(f, &nv, 0.01), NAV_OK);
+  for (int k = 0; k < 1000; ++k)
+    assert_int_equal(nav_filter_predict(f, &nv, 0.01), NAV_OK);
   const double *P = nav_filter_get_cov(f);
   const double T = 10.0, qf = c.clock_bias_q_m2ps, qg = c.clock_drift_q_m2ps3;
   const double pbb = 1e4 + T * T * 100.0 + qf * T + qg * T * T * T / 3.0;
@@ -77,7 +80,8 @@ static void test_clock_propagation(void **state) {
   assert_rel_near(P[i * n + i + 1], pbd, 1e-9);
   assert_rel_near(P[(i + 1) * n + i + 1], pdd, 1e-9);
   /* The clock is independent of the INS errors. */
-  for (size_t j = 0; j < lay.n_ins; ++j) assert_true(P[j * n + i] == 0.0);
+  for (size_t j = 0; j < lay.n_ins; ++j)
+    assert_true(P[j * n + i] == 0.0);
   /* The feedback reset keeps the clock estimate. */
   nav_filter_internal_state(f)[i] = 5.0;
   nav_filter_internal_state(f)[0] = 1.0;
@@ -116,8 +120,8 @@ static nstate perturbed(nstate s, nav_vec3 dr, nav_vec3 dv, nav_vec3 phi, nav_ve
   return s;
 }
 
-static void predict(const nstate *s, const nav_filter_layout *lay, nav_vec3 l, const nav_gnss_orbit *o, double t,
-                    double *rho, double *rr, double *Hp, double *Hr) {
+static void predict(const nstate *s, const nav_filter_layout *lay, nav_vec3 l, const nav_gnss_orbit *o,
+                    double t, double *rho, double *rr, double *Hp, double *Hr) {
   nav_tight_geom g;
   nav_ins_gnss_tight_geometry(&g, lay, &s->nav, s->pos, l);
   double hp[NAV_FILTER_MAX_STATES], hr[NAV_FILTER_MAX_STATES];
@@ -136,15 +140,16 @@ static void test_rows_are_jacobians(void **state) {
   int cases = 0;
   for (int k = 0; k < 40; ++k) {
     nstate s;
-    s.pos = (nav_geodetic){(30.0 + 30.0 * nav_rng_uniform(&r)) * NAV_DEG2RAD, 20.0 * nav_rng_uniform(&r) * NAV_DEG2RAD,
-                           100.0 * nav_rng_uniform(&r)};
+    s.pos = (nav_geodetic){(30.0 + 30.0 * nav_rng_uniform(&r)) * NAV_DEG2RAD,
+                           20.0 * nav_rng_uniform(&r) * NAV_DEG2RAD, 100.0 * nav_rng_uniform(&r)};
     memset(&s.nav, 0, sizeof s.nav);
     s.nav.lat_rad = s.pos.lat_rad;
     s.nav.h_m = s.pos.h_m;
     s.nav.v_eb_n_mps = nav_vec3_make(20.0 * nav_rng_gauss(&r), 20.0 * nav_rng_gauss(&r), nav_rng_gauss(&r));
     const nav_euler e = {0.1 * nav_rng_gauss(&r), 0.1 * nav_rng_gauss(&r), 3.0 * nav_rng_gauss(&r)};
     s.nav.C_b_n = nav_euler_to_dcm(e);
-    s.nav.w_ib_b_rps = nav_vec3_make(0.3 * nav_rng_gauss(&r), 0.3 * nav_rng_gauss(&r), 0.5 * nav_rng_gauss(&r));
+    s.nav.w_ib_b_rps =
+        nav_vec3_make(0.3 * nav_rng_gauss(&r), 0.3 * nav_rng_gauss(&r), 0.5 * nav_rng_gauss(&r));
     const nav_vec3 l = nav_vec3_make(0.8, -0.4, -1.3);
     const double t = t_epoch() + 3600.0 * nav_rng_uniform(&r);
     /* a satellite above the horizon */
@@ -204,7 +209,8 @@ static void test_range_rate_model(void **state) {
   const double t = t_epoch() + 100.0;
   /* The true antenna in ECEF and its velocity relative to the Earth (w_eb = w_ib - C_n_b w_ie). */
   const nav_mat3 C_n_e = nav_earth_dcm_n_e(s.pos.lat_rad, s.pos.lon_rad);
-  const nav_vec3 r_a = nav_vec3_add(nav_earth_geodetic_to_ecef(s.pos), nav_mat3_mul_vec(C_n_e, nav_mat3_mul_vec(s.nav.C_b_n, l)));
+  const nav_vec3 r_a = nav_vec3_add(nav_earth_geodetic_to_ecef(s.pos),
+                                    nav_mat3_mul_vec(C_n_e, nav_mat3_mul_vec(s.nav.C_b_n, l)));
   const nav_vec3 v_a = nav_mat3_mul_vec(C_n_e, nav_filter_gnss_vel_residual(&s.nav, l, nav_vec3_zero()));
   double worst = 0.0;
   int used = 0;
@@ -222,8 +228,9 @@ static void test_range_rate_model(void **state) {
     worst = fmax(worst, fabs(rr - (rp - rm) / (2.0 * h)));
     ++used;
   }
-  print_message("range-rate model vs central difference of the exact range: %d satellites, largest %.3g m/s\n", used,
-                worst);
+  print_message(
+      "range-rate model vs central difference of the exact range: %d satellites, largest %.3g m/s\n", used,
+      worst);
   assert_true(used >= 8);
   assert_true(worst < 1e-3);
 }
@@ -312,8 +319,8 @@ static void test_one_satellite_and_gating(void **state) {
       vu1 += nav_vec3_get(u, a) * P1[a * n + b] * nav_vec3_get(u, b);
       vw1 += nav_vec3_get(w, a) * P1[a * n + b] * nav_vec3_get(w, b);
     }
-  print_message("one satellite: line-of-sight position variance %.3f -> %.3f m^2, across %.3f -> %.3f m^2\n", vu0,
-                vu1, vw0, vw1);
+  print_message("one satellite: line-of-sight position variance %.3f -> %.3f m^2, across %.3f -> %.3f m^2\n",
+                vu0, vu1, vw0, vw1);
   /* Kalman: 1 / (1 / vu0 + 1 / 9) with sigma 3 m, plus the 1 cm clock. */
   assert_rel_near(vu1, 1.0 / (1.0 / vu0 + 1.0 / 9.0), 0.02);
   assert_rel_near(vw1, vw0, 0.02);
@@ -327,8 +334,8 @@ static void test_one_satellite_and_gating(void **state) {
   double b = 0.0, d = 0.0;
   nav_ins_gnss_clock(x, &b, &d);
   const nav_vec3 moved = nav_vec3_sub(nav_ins_gnss_state(x)->r_fb_f_m, s0.r_fb_f_m);
-  print_message("clock unknown: clock estimate %.2f m after a pseudorange 40 m long; position moved %.3f m\n", b,
-                nav_vec3_norm(moved));
+  print_message("clock unknown: clock estimate %.2f m after a pseudorange 40 m long; position moved %.3f m\n",
+                b, nav_vec3_norm(moved));
   assert_true(b > 39.0 && b < 40.0);
   assert_true(nav_vec3_norm(moved) < 0.1);
   P1 = nav_filter_get_cov(kf);
@@ -375,8 +382,8 @@ static void test_ideal_canyon(void **state) {
   o.ideal = true;
   nav_sim_summary s;
   if (nav_sim_run(sim, &o, &s) != NAV_OK) fail_msg("%s", nav_sim_last_error(sim));
-  print_message("ideal tight canyon: horizontal RMS %.3e m, max %.3e m; vertical RMS %.3e m\n", s.stats.pos_err_h_m.rms,
-                s.stats.pos_err_h_m.max, s.stats.pos_err_v_m.rms);
+  print_message("ideal tight canyon: horizontal RMS %.3e m, max %.3e m; vertical RMS %.3e m\n",
+                s.stats.pos_err_h_m.rms, s.stats.pos_err_h_m.max, s.stats.pos_err_v_m.rms);
   assert_true(s.stats.pos_err_h_m.max < 0.1);
   nav_sim_destroy(sim);
   free(sc);
@@ -384,8 +391,8 @@ static void test_ideal_canyon(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_clock_propagation),       cmocka_unit_test(test_rows_are_jacobians),
-      cmocka_unit_test(test_range_rate_model),        cmocka_unit_test(test_one_satellite_and_gating),
+      cmocka_unit_test(test_clock_propagation), cmocka_unit_test(test_rows_are_jacobians),
+      cmocka_unit_test(test_range_rate_model),  cmocka_unit_test(test_one_satellite_and_gating),
       cmocka_unit_test(test_ideal_canyon),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

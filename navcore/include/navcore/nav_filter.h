@@ -111,7 +111,8 @@ NAV_BEGIN_DECLS
 
 /** Number of states of the core model (dr, dv, phi, b_g, b_a). */
 #define NAV_FILTER_N_CORE 15
-/** Largest state count: core + scale factors + GNSS position GM. Arrays are sized for it. */
+/** Largest state count: core + scale factors + GNSS position GM (or receiver clock and inter-system
+ *  bias). Arrays are sized for it. */
 #define NAV_FILTER_MAX_STATES 24
 /** Largest measurement dimension accepted by nav_filter_update_linear(). */
 #define NAV_FILTER_MAX_MEAS 6
@@ -129,7 +130,7 @@ typedef enum nav_filter_state_option {
 
 /** Where the blocks of a configured filter live. Plain value. */
 typedef struct nav_filter_layout {
-  size_t n_states;        /**< 15, 18, 21 or 24 */
+  size_t n_states;        /**< 15, 18, 21 or 24; with the receiver clock 17 or 18, 23 or 24 */
   bool has_scale_factors; /**< s_g at NAV_FILTER_IDX_SG, s_a at NAV_FILTER_IDX_SA */
   bool has_gnss_pos_gm;   /**< GNSS position-error block present at idx_gnss_pos */
   size_t idx_gnss_pos;    /**< first index of the GNSS block; meaningful only if has_gnss_pos_gm */

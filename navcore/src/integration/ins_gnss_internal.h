@@ -13,12 +13,12 @@ struct nav_ins_gnss {
   nav_frame frame;
   nav_ins *ins;
   nav_filter *kf;
-  nav_vec3 b_g_rps, b_a_mps2;  /* estimated biases, subtracted from the raw increments */
-  nav_vec3 s_g, s_a;           /* estimated scale factors: compensated = (raw - b dt) / (1 + s) */
-  nav_imu_increment last;      /* compensated increment of the last step */
-  nav_vec3 w_prev_rps;         /* mean rate of the step before it */
+  nav_vec3 b_g_rps, b_a_mps2; /* estimated biases, subtracted from the raw increments */
+  nav_vec3 s_g, s_a;          /* estimated scale factors: compensated = (raw - b dt) / (1 + s) */
+  nav_imu_increment last;     /* compensated increment of the last step */
+  nav_vec3 w_prev_rps;        /* mean rate of the step before it */
   bool have_step, have_prev;
-  bool sf_on;                  /* the filter estimates scale factors */
+  bool sf_on; /* the filter estimates scale factors */
   long updates;
   long raw_used, raw_rejected; /* tightly coupled: scalar measurements applied / gated out */
   char err[256];

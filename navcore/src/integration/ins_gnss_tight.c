@@ -19,7 +19,8 @@ void nav_ins_gnss_tight_filter(const nav_scene *sc, nav_filter_config *c) {
    * (its code noise is white in this model, docs/ins-gnss-tight.md 2.2). */
   c->states &= ~(unsigned)NAV_FILTER_STATE_GNSS_POS_GM;
   c->states |= NAV_FILTER_STATE_RX_CLOCK;
-  if (cc->gps != NAV_GNSS_SOURCE_OFF && cc->glonass != NAV_GNSS_SOURCE_OFF) c->states |= NAV_FILTER_STATE_RX_ISB;
+  if (cc->gps != NAV_GNSS_SOURCE_OFF && cc->glonass != NAV_GNSS_SOURCE_OFF)
+    c->states |= NAV_FILTER_STATE_RX_ISB;
   /* Brown and Hwang, 4th ed., section 9.3: S_f = h_0 / 2, S_g = 2 pi^2 h_-2 (fractional
    * frequency), times c^2 for metres. */
   const double c2 = NAV_GNSS_C_MPS * NAV_GNSS_C_MPS;
@@ -113,8 +114,10 @@ static nav_status scalar_update(nav_ins_gnss *x, const double *H, double z, doub
   return st;
 }
 
-nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch *ep, nav_ins_gnss_raw_result *res) {
-  if (!x || !ep || (ep->n > 0 && !ep->sats) || ep->n < 0 || ep->n > NAV_GNSS_MAX_SATS) return NAV_ERR_INVALID_ARG;
+nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch *ep,
+                                   nav_ins_gnss_raw_result *res) {
+  if (!x || !ep || (ep->n > 0 && !ep->sats) || ep->n < 0 || ep->n > NAV_GNSS_MAX_SATS)
+    return NAV_ERR_INVALID_ARG;
   if (!(ep->pr_sd_m > 0.0) || !(ep->rr_sd_mps > 0.0) || !isfinite(ep->pr_sd_m) || !isfinite(ep->rr_sd_mps) ||
       !isfinite(ep->t_gps_s)) {
     snprintf(x->err, sizeof x->err, "raw GNSS epoch at t = %.6f s: sigmas must be finite and > 0", ep->t_s);
@@ -140,12 +143,14 @@ nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch
   for (int i = 0; i < ep->n && st == NAV_OK; ++i) {
     const nav_ins_gnss_sat_meas *m = &ep->sats[i];
     if (!m->sat) {
-      snprintf(x->err, sizeof x->err, "raw GNSS epoch at t = %.6f s: measurement %d has no satellite", ep->t_s, i);
+      snprintf(x->err, sizeof x->err, "raw GNSS epoch at t = %.6f s: measurement %d has no satellite",
+               ep->t_s, i);
       st = NAV_ERR_INVALID_ARG;
       break;
     }
     if ((m->has_pr && !isfinite(m->pr_m)) || (m->has_rr && !isfinite(m->rr_mps))) {
-      snprintf(x->err, sizeof x->err, "non-finite raw measurement of satellite %d at t = %.6f s", m->sat->prn, ep->t_s);
+      snprintf(x->err, sizeof x->err, "non-finite raw measurement of satellite %d at t = %.6f s", m->sat->prn,
+               ep->t_s);
       st = NAV_ERR_NUMERIC;
       break;
     }
@@ -155,22 +160,26 @@ nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch
     if (m->has_pr) {
       st = scalar_update(x, Hp, m->pr_m - rho, rp, &applied);
       if (st != NAV_OK) {
-        snprintf(x->err, sizeof x->err, "pseudorange update (satellite %d) failed at t = %.6f s: %s", m->sat->prn,
-                 ep->t_s, nav_filter_last_error(x->kf));
+        snprintf(x->err, sizeof x->err, "pseudorange update (satellite %d) failed at t = %.6f s: %s",
+                 m->sat->prn, ep->t_s, nav_filter_last_error(x->kf));
         break;
       }
-      if (applied) r0.pr_used++;
-      else r0.rejected++;
+      if (applied)
+        r0.pr_used++;
+      else
+        r0.rejected++;
     }
     if (m->has_rr) {
       st = scalar_update(x, Hr, m->rr_mps - rr_hat, rr, &applied);
       if (st != NAV_OK) {
-        snprintf(x->err, sizeof x->err, "range-rate update (satellite %d) failed at t = %.6f s: %s", m->sat->prn,
-                 ep->t_s, nav_filter_last_error(x->kf));
+        snprintf(x->err, sizeof x->err, "range-rate update (satellite %d) failed at t = %.6f s: %s",
+                 m->sat->prn, ep->t_s, nav_filter_last_error(x->kf));
         break;
       }
-      if (applied) r0.rr_used++;
-      else r0.rejected++;
+      if (applied)
+        r0.rr_used++;
+      else
+        r0.rejected++;
     }
   }
   if (st != NAV_OK) return st;

@@ -13,12 +13,12 @@
 struct nav_sim_gnss_raw {
   nav_gnss_constellation_config cc;
   nav_gnss_constellation c;
-  nav_vec3 r_ba_b_m;         /* antenna lever arm */
-  bool noise;                /* false with --ideal: no clock, no noise */
-  double q_f, q_g;           /* clock spectral densities [m^2/s], [m^2/s^3] */
-  double bias_m, drift_mps;  /* receiver clock now */
-  double t_clock_s;          /* time of the clock state */
-  double isb_m;              /* GLONASS - GPS inter-system bias (both systems on) */
+  nav_vec3 r_ba_b_m;        /* antenna lever arm */
+  bool noise;               /* false with --ideal: no clock, no noise */
+  double q_f, q_g;          /* clock spectral densities [m^2/s], [m^2/s^3] */
+  double bias_m, drift_mps; /* receiver clock now */
+  double t_clock_s;         /* time of the clock state */
+  double isb_m;             /* GLONASS - GPS inter-system bias (both systems on) */
   nav_rng clock_rng;
   nav_rng code_rng[NAV_GNSS_MAX_SATS];
   nav_rng dopp_rng[NAV_GNSS_MAX_SATS];
@@ -64,7 +64,9 @@ nav_status nav_sim_gnss_raw_create(const nav_scene *sc, uint64_t run, bool ideal
   return NAV_OK;
 }
 
-void nav_sim_gnss_raw_destroy(nav_sim_gnss_raw *g) { free(g); }
+void nav_sim_gnss_raw_destroy(nav_sim_gnss_raw *g) {
+  free(g);
+}
 
 /* Advance the receiver clock to t_s: the exact discrete form of b' = d + w_f, d' = w_g over T
  * (Brown and Hwang, 4th ed., eq. 9.3.11): Q = [[S_f T + S_g T^3/3, S_g T^2/2], [S_g T^2/2, S_g T]],
