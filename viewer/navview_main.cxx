@@ -24,6 +24,7 @@ void Usage(FILE *f) {
                "       navview --speed-vs-error bench.csv --png out.png\n"
                "       navview --allan allan.csv --png out.png\n"
                "       navview --tradeoff tradeoff.csv [--requirement ID] --png out.png\n"
+               "       navview --sky RESULT_DIR --png out.png    (or --dop RESULT_DIR)\n"
                "\n"
                "Show the result directory written by `navsim run`: reference and estimated paths,\n"
                "attitude triads, the error-envelope tube, ground grid with scale, NED axes and legend.\n"
@@ -47,6 +48,10 @@ void Usage(FILE *f) {
                "  --tradeoff TRADEOFF_CSV  CPU time against requirement error of navsim tradeoff's tradeoff.csv,\n"
                "                      one panel per requirement (--requirement ID: that one only), labelled\n"
                "                      points, intervals, tolerance band and Pareto front (with --png)\n"
+               "  --sky RESULT_DIR    sky plot of the satellites of run 0 (gnss_sats.csv, gnss_mask.csv of a\n"
+               "                      scene with gnss.constellation): tracks, GPS / GLONASS, masks (with --png)\n"
+               "  --dop RESULT_DIR    GDOP/PDOP/HDOP/VDOP and satellites in view over time (gnss_dop.csv),\n"
+               "                      canyon spans and receiver outages (with --png)\n"
                "  --chart FILE        write the error-vs-time charts as PNG\n"
                "  --size WxH          image/window size in pixels (default 1000x700; charts 900x800)\n"
                "  --time T            playback time of the vehicle glyph and read-out [s] (default: end)\n"
@@ -180,6 +185,7 @@ std::shared_ptr<NavResult> SyntheticResult(size_t epochs, int paths) {
 
 static int NavviewMain(int argc, char **argv) {
   std::string dir, png, chart, view_kind = "3d", allan_csv, bench_csv, tradeoff_csv, tradeoff_req;
+  std::string sky_dir, dop_dir;
   NavViewOptions opt;
   NavChartOptions copt;
   NavMapOptions mopt;
@@ -332,6 +338,10 @@ static int NavviewMain(int argc, char **argv) {
       allan_csv = need("ALLAN_CSV");
     } else if (a == "--speed-vs-error") {
       bench_csv = need("BENCH_CSV");
+    } else if (a == "--sky") {
+      sky_dir = need("RESULT_DIR");
+    } else if (a == "--dop") {
+      dop_dir = need("RESULT_DIR");
     } else if (a == "--tradeoff") {
       tradeoff_csv = need("TRADEOFF_CSV");
     } else if (a == "--requirement") {
@@ -398,6 +408,24 @@ static int NavviewMain(int argc, char **argv) {
     }
     std::string e2;
     if (!NavRenderTradeoffPng(tradeoff_csv, tradeoff_req, copt, png, &e2)) {
+      std::fprintf(stderr, "navview: %s\n", e2.c_str());
+      return 1;
+    }
+    return 0;
+  }
+  if (!sky_dir.empty() || !dop_dir.empty()) {
+    if (png.empty()) {
+      std::fprintf(stderr, "navview: --sky / --dop need --png FILE\n");
+      return 2;
+    }
+    if (!size_given) {
+      copt.width_px = sky_dir.empty() ? 1000 : 900;
+      copt.height_px = sky_dir.empty() ? 700 : 800;
+    }
+    std::string e2;
+    const bool ok = sky_dir.empty() ? NavRenderDopChartPng(dop_dir, copt, png, &e2)
+                                    : NavRenderSkyPlotPng(sky_dir, copt, png, &e2);
+    if (!ok) {
       std::fprintf(stderr, "navview: %s\n", e2.c_str());
       return 1;
     }

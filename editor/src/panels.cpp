@@ -197,7 +197,7 @@ QWidget *ScenePanels::BuildModel() {
   auto *w = new QWidget;
   auto *form = new QFormLayout(w);
   QStringList schemes, algs, earths, frames;
-  for (int i = 0; i <= 3; ++i) schemes << nav_nav_scheme_name(static_cast<nav_nav_scheme>(i));
+  for (int i = 0; i <= 4; ++i) schemes << nav_nav_scheme_name(static_cast<nav_nav_scheme>(i));
   for (int i = 0; i <= 1; ++i) algs << nav_mech_algorithm_name(static_cast<nav_mech_algorithm>(i));
   for (int i = 0; i <= 1; ++i) earths << nav_earth_model_name(static_cast<nav_earth_model>(i));
   for (int i = 0; i <= 1; ++i) frames << nav_mech_frame_name(static_cast<nav_mech_frame>(i));
@@ -206,6 +206,9 @@ QWidget *ScenePanels::BuildModel() {
   scheme_->setItemData(1, tr("loosely coupled INS/GNSS Kalman filter"), Qt::ToolTipRole);
   scheme_->setItemData(2, tr("gyro-free INS from an accelerometer array"), Qt::ToolTipRole);
   scheme_->setItemData(3, tr("gyro-free INS (accelerometer array) aided by GNSS: loosely coupled Kalman filter"),
+                       Qt::ToolTipRole);
+  scheme_->setItemData(4, tr("tightly coupled INS/GNSS: pseudoranges and range rates of the satellites in view "
+                             "(gnss.constellation), receiver clock states; works with fewer than four satellites"),
                        Qt::ToolTipRole);
   algorithm_ = Combo("algorithm", algs);
   earth_ = Combo("earthModel", earths);
@@ -217,7 +220,11 @@ QWidget *ScenePanels::BuildModel() {
   connect(scheme_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
     doc_->Edit(tr("Set scheme"), [i](nav_scene &s) {
       s.navigation.scheme = static_cast<nav_nav_scheme>(i);
-      if (i == NAV_SCHEME_INS_GNSS || i == NAV_SCHEME_GYRO_FREE_GNSS) s.gnss.enabled = true;
+      if (i == NAV_SCHEME_INS_GNSS || i == NAV_SCHEME_GYRO_FREE_GNSS || i == NAV_SCHEME_INS_GNSS_TIGHT)
+        s.gnss.enabled = true;
+      // The tightly coupled scheme needs satellites: the section's settings (the defaults, GPS
+      // nominal, when it was never set) switched on.
+      if (i == NAV_SCHEME_INS_GNSS_TIGHT) s.gnss.constellation.enabled = true;
     });
   });
   connect(algorithm_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
@@ -570,7 +577,8 @@ QWidget *ScenePanels::BuildRequirements() {
       nav_requirement r;
       std::memset(&r, 0, sizeof r);
       const bool outage = s.gnss.enabled && s.gnss.model.outage_count > 0 &&
-                          (s.navigation.scheme == NAV_SCHEME_INS_GNSS || s.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS);
+                          (s.navigation.scheme == NAV_SCHEME_INS_GNSS || s.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+                           s.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT);
       r.metric = NAV_REQ_HORIZONTAL_POSITION;
       r.statistic = outage ? NAV_REQ_OUTAGE_END : NAV_REQ_RMS;
       r.limit = outage ? 5.0 : 10.0;

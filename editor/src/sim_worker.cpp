@@ -169,7 +169,8 @@ void SimWorker::RunJob(SimWorker *self, Job *job, SimResult *out) {
     for (size_t i = 0; env && i < n; ++i) {
       out->env_t_s.push_back(env[i].t_s);
       out->env_h_rms_m.push_back(env[i].pos_h_rms_m);
-      if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS || scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)
+      if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS || scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+          scene.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT)
         out->env_sd_h_m.push_back(std::hypot(env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y));
     }
     if (ev) {

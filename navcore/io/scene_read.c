@@ -184,6 +184,7 @@ static const nav_io_enum_value k_schemes[] = {{"free_ins", NAV_SCHEME_FREE_INS},
                                               {"ins_gnss", NAV_SCHEME_INS_GNSS},
                                               {"gyro_free", NAV_SCHEME_GYRO_FREE},
                                               {"gyro_free_gnss", NAV_SCHEME_GYRO_FREE_GNSS},
+                                              {"ins_gnss_tight", NAV_SCHEME_INS_GNSS_TIGHT},
                                               {NULL, 0}};
 static const nav_io_enum_value k_array_layouts[] = {{"cube6", NAV_ARRAY_LAYOUT_CUBE6},
                                                     {"nine", NAV_ARRAY_LAYOUT_NINE},

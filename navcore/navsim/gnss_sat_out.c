@@ -3,6 +3,10 @@
  *               solvable geometry: fewer than 3 + systems satellites)
  * gnss_sats.csv: t_s, system, prn, az_deg, el_deg, mask_el_deg, visible, one row per satellite
  *               above the horizon at each output epoch of run 0
+ * gnss_mask.csv: t_s, in_canyon, heading_deg, az_deg, mask_el_deg: the sky mask (elevation mask,
+ *               per-azimuth profile, canyon walls at the vehicle's heading) every 5 deg of azimuth,
+ *               at the first output epoch and at the first output epoch at or after the middle of
+ *               each canyon interval (the sky plot of navsim render --view sky draws them)
  */
 #include "gnss_sat_out.h"
 
@@ -16,13 +20,15 @@
 struct navsim_gnss_sat_out {
   FILE *dop;
   FILE *sats;
+  FILE *mask;
+  int masks_written; /* 0: none; k > 0: the open-sky mask and k - 1 canyons */
   nav_gnss_constellation_config cfg;
   nav_gnss_constellation c;
   nav_gnss_sat_view views[NAV_GNSS_MAX_SATS];
 };
 
 nav_status navsim_gnss_sat_out_begin(const nav_scene *scene, const char *dop_path, const char *sats_path,
-                                     navsim_gnss_sat_out **out) {
+                                     const char *mask_path, navsim_gnss_sat_out **out) {
   *out = NULL;
   if (!scene->gnss.constellation.enabled) return NAV_OK;
   navsim_gnss_sat_out *g = calloc(1, sizeof *g);
@@ -35,7 +41,8 @@ nav_status navsim_gnss_sat_out_begin(const nav_scene *scene, const char *dop_pat
   }
   g->dop = fopen(dop_path, "w");
   g->sats = fopen(sats_path, "w");
-  if (!g->dop || !g->sats ||
+  g->mask = fopen(mask_path, "w");
+  if (!g->dop || !g->sats || !g->mask || fputs("t_s,in_canyon,heading_deg,az_deg,mask_el_deg\n", g->mask) < 0 ||
       fputs("t_s,n_visible,gdop,pdop,hdop,vdop,tdop,in_canyon\n", g->dop) < 0 ||
       fputs("t_s,system,prn,az_deg,el_deg,mask_el_deg,visible\n", g->sats) < 0) {
     (void)navsim_gnss_sat_out_end(g);
@@ -64,6 +71,20 @@ nav_status navsim_gnss_sat_out_record(navsim_gnss_sat_out *g, const nav_sim_reco
   }
   if (n < 0) return NAV_ERR_IO;
   const double r2d = 180.0 / 3.14159265358979323846;
+  /* The mask: at the first epoch, then once per canyon (at its middle). */
+  const int k = g->masks_written;
+  const bool due = k == 0 || (k - 1 < g->cfg.n_canyons &&
+                              ts->t_s >= 0.5 * (g->cfg.canyons[k - 1].t0_s + g->cfg.canyons[k - 1].t1_s));
+  if (due) {
+    for (int a = 0; a <= 72; ++a) {
+      const double az = (double)a * 5.0 / r2d;
+      const double m = nav_gnss_mask_elevation_rad(&mask, az, heading);
+      if (fprintf(g->mask, "%.9g,%d,%.4f,%.1f,%.4f\n", ts->t_s, mask.canyon_height_m > 0.0, heading * r2d,
+                  (double)a * 5.0, m * r2d) < 0)
+        return NAV_ERR_IO;
+    }
+    g->masks_written++;
+  }
   for (int i = 0; i < g->c.n; ++i) {
     const nav_gnss_sat_view *s = &g->views[i];
     if (s->el_rad <= 0.0) continue;
@@ -79,8 +100,8 @@ bool navsim_gnss_sat_out_end(navsim_gnss_sat_out *g) {
   if (!g) return true;
   bool ok = true;
   /* Both files are closed whatever the first one gave. */
-  FILE *files[2] = {g->dop, g->sats};
-  for (int i = 0; i < 2; ++i) {
+  FILE *files[3] = {g->dop, g->sats, g->mask};
+  for (int i = 0; i < 3; ++i) {
     if (!files[i]) continue;
     const bool bad = ferror(files[i]) != 0;
     if (fclose(files[i]) != 0 || bad) ok = false;

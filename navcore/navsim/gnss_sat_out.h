@@ -12,9 +12,9 @@
 
 typedef struct navsim_gnss_sat_out navsim_gnss_sat_out;
 
-/* Open both files; *out stays NULL (NAV_OK) when the scene has no gnss.constellation section. */
+/* Open the three files (dop, sats, mask); *out stays NULL (NAV_OK) when the scene has no gnss.constellation section. */
 nav_status navsim_gnss_sat_out_begin(const nav_scene *scene, const char *dop_path, const char *sats_path,
-                                     navsim_gnss_sat_out **out);
+                                     const char *mask_path, navsim_gnss_sat_out **out);
 
 /* One output record (rows for run 0 only): the receiver at the body's true position, heading from
  * the true attitude. */

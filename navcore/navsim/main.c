@@ -51,8 +51,8 @@ static const char *k_usage =
     "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
     "  budget SCENE     error budget: each error source's share of each requirement\n"
     "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
-    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan, bench\n"
-    "                   or tradeoff view (navview)\n"
+    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan, bench,\n"
+    "                   tradeoff, sky or dop view (navview)\n"
     "  report DIR       HTML page with the figures, statistics and requirement verdicts of a result\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
     "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
@@ -439,7 +439,10 @@ static int cmd_run(int argc, char **argv) {
     char dp[4200];
     snprintf(dp, sizeof dp, "%s", df ? df : "");
     const char *sf = nav_resultdir_file(rd, "gnss_sats.csv");
-    const nav_status gst = (!df || !sf) ? NAV_ERR_IO : navsim_gnss_sat_out_begin(&scene, dp, sf, &o.gsat);
+    char sp[4200];
+    snprintf(sp, sizeof sp, "%s", sf ? sf : "");
+    const char *mf = nav_resultdir_file(rd, "gnss_mask.csv");
+    const nav_status gst = (!df || !sf || !mf) ? NAV_ERR_IO : navsim_gnss_sat_out_begin(&scene, dp, sp, mf, &o.gsat);
     if (gst != NAV_OK) {
       fprintf(stderr, "navsim run: cannot write gnss_dop.csv / gnss_sats.csv in \"%s\": %s\n", out_dir,
               nav_status_str(gst));

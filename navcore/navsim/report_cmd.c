@@ -136,6 +136,10 @@ static const char *k_usage_render =
     "  bench   speed against error of DIR/bench.csv (navsim bench --out DIR)\n"
     "  tradeoff  CPU time against each requirement of DIR/tradeoff.csv, one panel per requirement\n"
     "          (navsim tradeoff --out DIR)\n"
+    "  sky     sky plot of run 0's satellites: azimuth/elevation tracks, GPS and GLONASS, masks\n"
+    "          (a scene with gnss.constellation: gnss_sats.csv, gnss_mask.csv)\n"
+    "  dop     GDOP/PDOP/HDOP/VDOP and satellites in view over time, canyon spans and receiver\n"
+    "          outages (gnss_dop.csv)\n"
     "--out defaults to RESULT_DIR/VIEW.png. A SCENE file is run first (navsim run --out\n"
     "out/render-<file stem>). Without --view and --out (and with --png/--chart) the old form\n"
     "writes RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
@@ -173,8 +177,11 @@ int navsim_render(int argc, char **argv) {
   }
   if (view && strcmp(view, "3d") != 0 && strcmp(view, "top") != 0 && strcmp(view, "map") != 0 &&
       strcmp(view, "errors") != 0 && strcmp(view, "noise") != 0 && strcmp(view, "allan") != 0 &&
-      strcmp(view, "bench") != 0 && strcmp(view, "tradeoff") != 0) {
-    fprintf(stderr, "navsim render: --view: expected 3d, top, map, errors, noise, allan, bench or tradeoff, got \"%s\"\n",
+      strcmp(view, "bench") != 0 && strcmp(view, "tradeoff") != 0 && strcmp(view, "sky") != 0 &&
+      strcmp(view, "dop") != 0) {
+    fprintf(stderr,
+            "navsim render: --view: expected 3d, top, map, errors, noise, allan, bench, tradeoff, sky or dop, got "
+            "\"%s\"\n",
             view);
     return RC_INVALID;
   }
@@ -234,6 +241,9 @@ int navsim_render(int argc, char **argv) {
     snprintf(in_buf, sizeof in_buf, "%s/%s.csv", dir, view);
     av_add(&v, strcmp(view, "allan") == 0 ? "--allan" : strcmp(view, "bench") == 0 ? "--speed-vs-error" : "--tradeoff");
     av_add(&v, in_buf);
+  } else if (strcmp(view, "sky") == 0 || strcmp(view, "dop") == 0) {
+    av_add(&v, strcmp(view, "sky") == 0 ? "--sky" : "--dop");
+    av_add(&v, dir);
   } else {
     av_add(&v, dir);
     av_add(&v, "--view");

@@ -204,7 +204,8 @@ nav_status navsim_predict_requirements(const nav_scene *sc, nav_requirement_verd
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   nav_status st = NAV_OK;
-  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+      sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT)
     st = nav_req_scene_outages(sc, iv, NAV_REQ_MAX_OUTAGES, &ni);
   if (st != NAV_OK) return st;
   nav_sim *sim = NULL;
@@ -538,6 +539,13 @@ int navsim_select(int argc, char **argv) {
     rc = EXIT_INVALID;
     goto done;
   }
+  if (!schemes_s && base->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
+    fprintf(stderr, "%s: error: navigation.scheme: navsim select does not support ins_gnss_tight yet (the receiver "
+                    "catalog gives fix errors, not the raw-measurement errors of gnss.constellation); use "
+                    "--schemes ins_gnss, or navsim sweep\n", scene_path);
+    rc = EXIT_INVALID;
+    goto done;
+  }
   nav_nav_scheme schemes[3];
   int n_sch = 0;
   if (!schemes_s) {
@@ -550,7 +558,12 @@ int navsim_select(int argc, char **argv) {
       if (!strcmp(tok, "free_ins")) s = NAV_SCHEME_FREE_INS;
       else if (!strcmp(tok, "ins_gnss")) s = NAV_SCHEME_INS_GNSS;
       else if (!strcmp(tok, "gyro_free_gnss")) s = NAV_SCHEME_GYRO_FREE_GNSS;
-      else {
+      else if (!strcmp(tok, "ins_gnss_tight")) {
+        fprintf(stderr, "navsim select: --schemes: ins_gnss_tight is not supported by select yet (the receiver "
+                        "catalog gives fix errors, not the raw-measurement errors of gnss.constellation)\n");
+        rc = EXIT_INVALID;
+        goto done;
+      } else {
         fprintf(stderr, "navsim select: --schemes: expected free_ins, ins_gnss and/or gyro_free_gnss, got \"%s\"\n",
                 tok);
         rc = EXIT_INVALID;

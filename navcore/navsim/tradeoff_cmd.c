@@ -347,7 +347,7 @@ static int build_variants(const nav_scene *sc, to_variant *vs, nav_scene *tmp) {
   realise(va, sc);
   const bool wgs = sc->earth.model == NAV_EARTH_WGS84;
   const bool gf = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE;
-  const bool kf = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
+  const bool kf = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
 
   static const double k_rate_factor[2] = {0.5, 2.0};
   for (int i = 0; i < 2; ++i) {

@@ -45,6 +45,7 @@ struct Line {
   float width = 1.5f;
   bool points = false; // markers instead of a line
   int marker = vtkPlotPoints::CIRCLE;
+  bool legend = true; // false: a continuation of a series already in the legend
 };
 
 void StyleAxis2(vtkAxis *axis, const std::string &title, bool text, int font) {
@@ -81,6 +82,7 @@ void AddLines(vtkChartXY *chart, const std::vector<Line> &lines) {
     p->SetWidth(l.width);
     p->GetPen()->SetLineType(l.pen);
     p->SetLabel(l.name);
+    p->SetLegendVisibility(l.legend);
     if (l.points) {
       auto *pp = vtkPlotPoints::SafeDownCast(p);
       if (pp) {
@@ -732,4 +734,371 @@ bool NavRenderTradeoffPng(const std::string &csv, const std::string &requirement
   }
   cv.view->Render();
   return NavWriteWindowPng(cv.view->GetRenderWindow(), path, error);
+}
+
+// ------------------------------------------------------------------ GNSS sky plot and DOP chart
+
+namespace {
+
+// Numeric columns of a CSV by name (empty fields are NaN): the files navsim run writes.
+struct NumCsv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int Col(const char *name) const {
+    for (size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return static_cast<int>(i);
+    return -1;
+  }
+  double Num(size_t r, int c) const {
+    double v = NAN;
+    if (c >= 0 && static_cast<size_t>(c) < rows[r].size() && ParseNum(rows[r][static_cast<size_t>(c)], &v)) return v;
+    return NAN;
+  }
+  std::string Str(size_t r, int c) const {
+    return c >= 0 && static_cast<size_t>(c) < rows[r].size() ? rows[r][static_cast<size_t>(c)] : std::string();
+  }
+};
+
+bool ReadNumCsv(const std::string &path, const std::vector<const char *> &need, NumCsv *t, std::string *error) {
+  if (!ReadTextCsv(path, &t->header, &t->rows, error)) return false;
+  for (const char *n : need)
+    if (t->Col(n) < 0) {
+      *error = path + ":1: error: no column " + n + " (a file of navsim run was expected)";
+      return false;
+    }
+  return true;
+}
+
+// Polar (azimuth from north clockwise, elevation) to the plot plane: zenith at the origin, north
+// up, east right, radius 90 - elevation [deg].
+void SkyXY(double az_deg, double el_deg, double *x, double *y) {
+  const double r = 90.0 - el_deg, a = az_deg / kRadToDeg;
+  *x = r * std::sin(a);
+  *y = r * std::cos(a);
+}
+
+// Time spans [t0, t1) where a 0/1 column is 1 (rows sorted by time; a span ends at the next row).
+std::vector<std::pair<double, double>> Spans(const NumCsv &t, int ct, int cflag) {
+  std::vector<std::pair<double, double>> out;
+  bool on = false;
+  double t0 = 0.0, last = 0.0;
+  for (size_t r = 0; r < t.rows.size(); ++r) {
+    const double tt = t.Num(r, ct), f = t.Num(r, cflag);
+    if (!std::isfinite(tt)) continue;
+    const bool now = f > 0.5;
+    if (now && !on) t0 = tt;
+    if (!now && on) out.push_back({t0, tt});
+    on = now;
+    last = tt;
+  }
+  if (on) out.push_back({t0, last});
+  return out;
+}
+
+} // namespace
+
+bool NavRenderSkyPlotPng(const std::string &dir, const NavChartOptions &opt, const std::string &path,
+                         std::string *error) {
+  NumCsv sats, mask;
+  if (!ReadNumCsv(dir + "/gnss_sats.csv", {"t_s", "system", "prn", "az_deg", "el_deg", "visible"}, &sats, error))
+    return false;
+  const bool have_mask = ReadNumCsv(dir + "/gnss_mask.csv", {"t_s", "in_canyon", "az_deg", "mask_el_deg"}, &mask,
+                                    error);
+  if (!have_mask) error->clear(); // an older result directory: no mask file, the tracks only
+  const int ct = sats.Col("t_s"), cs = sats.Col("system"), cp = sats.Col("prn"), ca = sats.Col("az_deg"),
+            ce = sats.Col("el_deg"), cv = sats.Col("visible");
+  std::vector<Line> lines;
+  // Grid: elevation rings 0, 30, 60 deg and spokes every 30 deg of azimuth.
+  for (int ring = 0; ring < 3; ++ring) {
+    Line l;
+    l.name = "rings: elevation 0, 30, 60 deg";
+    l.legend = ring == 0;
+    for (int a = 0; a <= 360; a += 3) {
+      double x, y;
+      SkyXY(a, 30.0 * ring, &x, &y);
+      l.x.push_back(x);
+      l.y.push_back(y);
+    }
+    l.rgb[0] = l.rgb[1] = l.rgb[2] = 175;
+    l.width = 1.0f;
+    lines.push_back(l);
+  }
+  for (int a = 0; a < 360; a += 30) {
+    Line l;
+    l.name = "grid";
+    l.legend = false;
+    double x, y;
+    SkyXY(a, 90.0, &x, &y);
+    l.x.push_back(x);
+    l.y.push_back(y);
+    SkyXY(a, 0.0, &x, &y);
+    l.x.push_back(x);
+    l.y.push_back(y);
+    l.rgb[0] = l.rgb[1] = l.rgb[2] = 205;
+    l.width = 0.8f;
+    lines.push_back(l);
+  }
+  // Masks: one closed curve per block of gnss_mask.csv (the open-sky mask, each canyon).
+  if (have_mask) {
+    const int mt = mask.Col("t_s"), mc = mask.Col("in_canyon"), ma = mask.Col("az_deg"), me = mask.Col("mask_el_deg");
+    Line cur;
+    double cur_t = NAN;
+    auto flush = [&]() {
+      if (cur.x.empty()) return;
+      lines.push_back(cur);
+      cur = Line();
+    };
+    bool open_named = false, canyon_named = false;
+    for (size_t r = 0; r < mask.rows.size(); ++r) {
+      const double t = mask.Num(r, mt);
+      if (!(t == cur_t)) {
+        flush();
+        cur_t = t;
+        const bool canyon = mask.Num(r, mc) > 0.5;
+        cur.name = canyon ? "canyon walls (mid-canyon)" : "elevation mask";
+        cur.legend = canyon ? !canyon_named : !open_named;
+        (canyon ? canyon_named : open_named) = true;
+        const unsigned char brown[3] = {140, 86, 75}, black[3] = {40, 40, 40};
+        std::copy(canyon ? brown : black, (canyon ? brown : black) + 3, cur.rgb);
+        cur.width = canyon ? 2.5f : 2.0f;
+        cur.pen = canyon ? vtkPen::SOLID_LINE : vtkPen::DASH_LINE;
+      }
+      double x, y;
+      SkyXY(mask.Num(r, ma), mask.Num(r, me), &x, &y);
+      cur.x.push_back(x);
+      cur.y.push_back(y);
+    }
+    flush();
+  }
+  // Tracks: GPS blue, GLONASS red; visible epochs as markers, masked ones as small grey dots.
+  Line vis[2], hid;
+  const unsigned char col[2][3] = {{31, 119, 180}, {214, 39, 40}};
+  const char *sys_name[2] = {"GPS in view", "GLONASS in view"};
+  for (int k = 0; k < 2; ++k) {
+    vis[k].name = sys_name[k];
+    std::copy(col[k], col[k] + 3, vis[k].rgb);
+    vis[k].points = true;
+    vis[k].width = 2.4f;
+  }
+  hid.name = "masked (above the horizon)";
+  hid.rgb[0] = hid.rgb[1] = hid.rgb[2] = 120;
+  hid.points = true;
+  hid.width = 1.0f;
+  hid.marker = vtkPlotPoints::CROSS;
+  struct Last {
+    double x, y, t;
+    int seen, in_view;
+  };
+  std::map<std::string, Last> last; // label position of each satellite: its last point
+  double t_min = INFINITY, t_max = -INFINITY;
+  for (size_t r = 0; r < sats.rows.size(); ++r) {
+    const double az = sats.Num(r, ca), el = sats.Num(r, ce), t = sats.Num(r, ct);
+    if (!std::isfinite(az) || !std::isfinite(el) || !std::isfinite(t)) continue;
+    double x, y;
+    SkyXY(az, el, &x, &y);
+    const std::string sys = sats.Str(r, cs);
+    const int k = sys == "R" ? 1 : 0;
+    if (sats.Num(r, cv) > 0.5) {
+      vis[k].x.push_back(x);
+      vis[k].y.push_back(y);
+    } else {
+      hid.x.push_back(x);
+      hid.y.push_back(y);
+    }
+    const std::string id = sys + sats.Str(r, cp);
+    Last &L = last[id];
+    L.x = x;
+    L.y = y;
+    L.t = t;
+    L.seen++;
+    L.in_view += sats.Num(r, cv) > 0.5;
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
+  }
+  if (last.empty()) {
+    *error = dir + "/gnss_sats.csv: error: no satellite above the horizon";
+    return false;
+  }
+  for (int k = 0; k < 2; ++k) lines.push_back(vis[k]);
+  lines.push_back(hid);
+
+  ChartCanvas c;
+  if (!MakeCanvas(&c, opt, 1, error)) return false;
+  vtkChartXY *chart = Panel(&c, 0);
+  if (!chart) {
+    *error = "vtkChartMatrix did not create an XY chart";
+    return false;
+  }
+  AddLines(chart, lines);
+  // PRN labels at the end of each track.
+  vtkNew<vtkNavLabelledPoints> lab;
+  for (const auto &kv : last) {
+    lab->x.push_back(kv.second.x);
+    lab->y.push_back(kv.second.y);
+    // PRN and the share of its epochs above the horizon in which it was in view.
+    char text[48];
+    std::snprintf(text, sizeof text, "%s %d%%", kv.first.c_str(),
+                  static_cast<int>(std::lround(100.0 * kv.second.in_view / std::max(kv.second.seen, 1))));
+    lab->labels.push_back(text);
+  }
+  lab->y_lo = -95.0;
+  lab->y_hi = 95.0;
+  lab->font = std::max(9, c.font - 2);
+  if (opt.show_text) {
+    chart->AddPlot(lab);
+    lab->SetLegendVisibility(false);
+  }
+  char title[160];
+  std::snprintf(title, sizeof title, "sky plot of run 0, t = %.0f..%.0f s (north up, east right, zenith at the centre; label: PRN, share of time in view)",
+                t_min, t_max);
+  StyleChart(chart, title, "east  [deg from zenith]", "north  [deg from zenith]", opt, c.font);
+  // The legend in the empty left part of the wide plot area, clear of the sky circle.
+  if (opt.show_text) chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::LEFT);
+  // Equal scales on both axes: the x range follows the plot area's aspect (borders of MakeCanvas).
+  const double f = c.font;
+  const double pw = opt.width_px - (opt.show_text ? 6.7 : 2.5) * f, ph = opt.height_px - (opt.show_text ? 5.6 : 2.0) * f;
+  const double half_y = 95.0, half_x = half_y * std::max(1.0, pw / std::max(ph, 1.0));
+  chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+  chart->GetAxis(vtkAxis::LEFT)->SetRange(-half_y, half_y);
+  chart->GetAxis(vtkAxis::BOTTOM)->SetBehavior(vtkAxis::FIXED);
+  chart->GetAxis(vtkAxis::BOTTOM)->SetRange(-half_x, half_x);
+  chart->GetAxis(vtkAxis::LEFT)->SetGridVisible(false);
+  chart->GetAxis(vtkAxis::BOTTOM)->SetGridVisible(false);
+  c.view->Render();
+  return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
+}
+
+bool NavRenderDopChartPng(const std::string &dir, const NavChartOptions &opt, const std::string &path,
+                          std::string *error) {
+  NumCsv dop;
+  if (!ReadNumCsv(dir + "/gnss_dop.csv", {"t_s", "n_visible", "gdop", "pdop", "hdop", "vdop", "in_canyon"}, &dop,
+                  error))
+    return false;
+  if (dop.rows.empty()) {
+    *error = dir + "/gnss_dop.csv: error: no epoch";
+    return false;
+  }
+  const int ct = dop.Col("t_s");
+  const char *names[4] = {"gdop", "pdop", "hdop", "vdop"};
+  const char *labels[4] = {"GDOP", "PDOP", "HDOP", "VDOP"};
+  static const unsigned char pal[4][3] = {{148, 103, 189}, {31, 119, 180}, {44, 160, 44}, {255, 127, 14}};
+  std::vector<Line> top, bottom;
+  double dmax = 1.0, nmax = 1.0;
+  const double t_end = dop.Num(dop.rows.size() - 1, ct);
+  // DOP lines break where the geometry has no solution (empty fields): one segment per run of rows.
+  for (int k = 0; k < 4; ++k) {
+    const int cd = dop.Col(names[k]);
+    Line seg;
+    bool named = false;
+    auto flush = [&]() {
+      if (seg.x.empty()) return;
+      seg.name = labels[k];
+      seg.legend = !named;
+      named = true;
+      std::copy(pal[k], pal[k] + 3, seg.rgb);
+      seg.width = 2.0f;
+      top.push_back(seg);
+      seg = Line();
+    };
+    for (size_t r = 0; r < dop.rows.size(); ++r) {
+      const double v = dop.Num(r, cd), t = dop.Num(r, ct);
+      if (!std::isfinite(v) || !std::isfinite(t)) {
+        flush();
+        continue;
+      }
+      seg.x.push_back(t);
+      seg.y.push_back(v);
+      dmax = std::max(dmax, v);
+    }
+    flush();
+  }
+  Line count;
+  count.name = "satellites in view";
+  count.rgb[0] = 31;
+  count.rgb[1] = 119;
+  count.rgb[2] = 180;
+  count.width = 2.0f;
+  const int cn = dop.Col("n_visible");
+  for (size_t r = 0; r < dop.rows.size(); ++r) {
+    const double t = dop.Num(r, ct), n = dop.Num(r, cn);
+    if (!std::isfinite(t) || !std::isfinite(n)) continue;
+    // A step line: hold the count until the next epoch.
+    if (!count.x.empty()) {
+      count.x.push_back(t);
+      count.y.push_back(count.y.back());
+    }
+    count.x.push_back(t);
+    count.y.push_back(n);
+    nmax = std::max(nmax, n);
+  }
+  bottom.push_back(count);
+  Line four;
+  four.name = "4: fewest for a position fix (one system)";
+  four.x = {0.0, t_end};
+  four.y = {4.0, 4.0};
+  four.rgb[0] = four.rgb[1] = four.rgb[2] = 110;
+  four.pen = vtkPen::DASH_LINE;
+  four.width = 1.2f;
+  bottom.push_back(four);
+  // Canyon spans (gnss_dop.csv in_canyon) and receiver outages (gnss_outages.csv, loosely coupled
+  // runs) as vertical bars spanning each panel.
+  const double ytop[2] = {std::ceil(dmax * 1.15), std::ceil(nmax + 2.0)};
+  std::vector<std::pair<double, double>> canyons = Spans(dop, ct, dop.Col("in_canyon"));
+  std::vector<std::pair<double, double>> outages;
+  {
+    NumCsv o;
+    std::string e2;
+    if (ReadNumCsv(dir + "/gnss_outages.csv", {"t0_s", "t1_s"}, &o, &e2))
+      for (size_t r = 0; r < o.rows.size(); ++r)
+        outages.push_back({o.Num(r, o.Col("t0_s")), o.Num(r, o.Col("t1_s"))});
+  }
+  for (int panel = 0; panel < 2; ++panel) {
+    std::vector<Line> &ls = panel == 0 ? top : bottom;
+    for (int kind = 0; kind < 2; ++kind) {
+      const auto &spans = kind == 0 ? canyons : outages;
+      bool named = false;
+      for (const auto &sp : spans) {
+        Line b;
+        b.name = kind == 0 ? "street canyon" : "receiver outage (no fix)";
+        b.legend = !named;
+        named = true;
+        const double y0 = kind == 0 ? 0.0 : 0.03 * ytop[panel], y1 = kind == 0 ? ytop[panel] : 0.97 * ytop[panel];
+        b.x = {sp.first, sp.first, sp.second, sp.second};
+        b.y = {y0, y1, y1, y0};
+        if (kind == 0) {
+          b.rgb[0] = 140;
+          b.rgb[1] = 86;
+          b.rgb[2] = 75;
+          b.width = 2.5f;
+        } else {
+          b.rgb[0] = 214;
+          b.rgb[1] = 39;
+          b.rgb[2] = 40;
+          b.pen = vtkPen::DASH_LINE;
+          b.width = 1.5f;
+        }
+        ls.push_back(b);
+      }
+    }
+  }
+  ChartCanvas c;
+  if (!MakeCanvas(&c, opt, 2, error)) return false;
+  vtkChartXY *ch[2] = {Panel(&c, 1), Panel(&c, 0)}; // matrix row 1 is the top panel
+  if (!ch[0] || !ch[1]) {
+    *error = "vtkChartMatrix did not create an XY chart";
+    return false;
+  }
+  AddLines(ch[0], top);
+  AddLines(ch[1], bottom);
+  StyleChart(ch[0], "dilution of precision of run 0 (empty: fewer satellites than a position needs)", "time [s]",
+             "DOP [-]", opt, c.font);
+  StyleChart(ch[1], "satellites in view", "time [s]", "count [-]", opt, c.font);
+  for (int p = 0; p < 2; ++p) {
+    ch[p]->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+    ch[p]->GetAxis(vtkAxis::LEFT)->SetRange(0.0, ytop[p]);
+    ch[p]->GetAxis(vtkAxis::BOTTOM)->SetBehavior(vtkAxis::FIXED);
+    ch[p]->GetAxis(vtkAxis::BOTTOM)->SetRange(0.0, t_end);
+  }
+  c.view->Render();
+  return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
 }

@@ -1,6 +1,6 @@
 #!/bin/sh
 # navsim render --view for every view on the vendored tiny-gnss result (plus allan.csv and
-# bench.csv, tradeoff.csv), a bad --view (exit 2), a missing directory (exit 1), and a scene file as input
+# bench.csv, tradeoff.csv, and gnss-canyon's satellite files for sky and dop), a bad --view (exit 2), a missing directory (exit 1), and a scene file as input
 # (run first, then rendered). Usage: render_views.sh NAVSIM DATA_DIR SCENE WORK_DIR
 set -u
 NAVSIM=$1
@@ -10,8 +10,8 @@ WORK=$4
 fail() { echo "render_views: FAILED: $*" >&2; exit 1; }
 rm -rf "$WORK"
 mkdir -p "$WORK" || fail "cannot create $WORK"
-cp -r "$DATA/tiny-gnss" "$WORK/res" && cp "$DATA/allan.csv" "$DATA/bench.csv" "$DATA/tradeoff.csv" "$WORK/res/" || fail "copy"
-for v in 3d top map errors noise allan bench tradeoff; do
+cp -r "$DATA/tiny-gnss" "$WORK/res" && cp "$DATA/allan.csv" "$DATA/bench.csv" "$DATA/tradeoff.csv" "$DATA"/gnss-canyon/*.csv "$WORK/res/" || fail "copy"
+for v in 3d top map errors noise allan bench tradeoff sky dop; do
   "$NAVSIM" render "$WORK/res" --view $v --out "$WORK/$v.png" --size 400x300 || fail "--view $v exited $?"
   size=$(wc -c < "$WORK/$v.png") || fail "no $WORK/$v.png"
   [ "$size" -gt 3000 ] || fail "$v.png has only $size bytes"
@@ -30,6 +30,14 @@ cmp -s "$WORK/movie/frame_0000.png" "$WORK/movie/frame_0002.png" && fail "movie 
 rc=$?
 [ $rc -eq 2 ] || fail "bad --view: exit $rc, expected 2"
 grep -q "expected 3d, top, map" "$WORK/err.txt" || fail "bad --view: no message"
+# sky / dop of a result without gnss.constellation: exit 1, the missing file named.
+cp -r "$DATA/tiny-gnss" "$WORK/nosat" || fail "copy nosat"
+for v in sky dop; do
+  "$NAVSIM" render "$WORK/nosat" --view $v --out "$WORK/x.png" 2> "$WORK/err.txt"
+  rc=$?
+  [ $rc -eq 1 ] || fail "--view $v without satellite files: exit $rc, expected 1"
+  grep -q "gnss_" "$WORK/err.txt" || fail "--view $v without satellite files: no file named"
+done
 "$NAVSIM" render "$WORK/does-not-exist" --view 3d --out "$WORK/x.png" 2> /dev/null
 rc=$?
 [ $rc -eq 1 ] || fail "missing directory: exit $rc, expected 1"

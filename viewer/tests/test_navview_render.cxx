@@ -57,7 +57,8 @@ int main(int argc, char **argv) {
   if (argc != 2) {
     std::fprintf(stderr,
                  "usage: test_navview_render scene_oblique|scene_top_error|scene_exaggerated|scene_gnss|chart_errors|\n"
-                 "       chart_errors_req|chart_noise|chart_allan|chart_bench|map_local|map_region\n");
+                 "       chart_errors_req|chart_noise|chart_allan|chart_bench|chart_sky|chart_dop|map_local|\n"
+                 "       map_region\n");
     return 2;
   }
   const std::string name = argv[1];
@@ -99,6 +100,14 @@ int main(int argc, char **argv) {
     ok = NavRenderSensorErrorChartPng(*result, c, actual, &err);
   } else if (name == "chart_allan") {
     ok = NavRenderAllanChartPng(NAVVIEW_TEST_DATA_DIR "/allan.csv", c, actual, &err);
+  } else if (name == "chart_sky") {
+    // data/gnss-canyon: GPS (blue) and GLONASS (red) tracks, masked epochs (grey crosses), the
+    // 10 deg elevation mask (dashed) and the canyon walls at mid-canyon (brown).
+    ok = NavRenderSkyPlotPng(NAVVIEW_TEST_DATA_DIR "/gnss-canyon", c, actual, &err);
+  } else if (name == "chart_dop") {
+    // data/gnss-canyon: DOP lines with their gap where fewer than five satellites (two systems)
+    // are in view, the visible count, the canyon [40, 100) s and the receiver outage [40, 72) s.
+    ok = NavRenderDopChartPng(NAVVIEW_TEST_DATA_DIR "/gnss-canyon", c, actual, &err);
   } else if (name == "chart_bench") {
     ok = NavRenderSpeedVsErrorPng(NAVVIEW_TEST_DATA_DIR "/bench.csv", c, actual, &err);
   } else if (name == "map_local") {

@@ -15,6 +15,11 @@
  * | s_g    | NAV_FILTER_IDX_SG   | 3    | residual gyro scale factor (optional)                   | -     |
  * | s_a    | NAV_FILTER_IDX_SA   | 3    | residual accelerometer scale factor (optional)          | -     |
  * | e_gnss | layout.idx_gnss_pos | 3    | GNSS position error, Gauss-Markov, N/E/D (optional)     | m     |
+ * | clk    | layout.idx_clock    | 2    | receiver clock bias c dt_r and drift (optional, tight)  | m, m/s|
+ * | isb    | layout.idx_isb      | 1    | GLONASS - GPS inter-system bias (optional, tight)       | m     |
+ *
+ * The receiver-clock and inter-system-bias states (docs/ins-gnss-tight.md) are total quantities,
+ * not errors of an INS quantity: the feedback reset leaves them, like the GNSS GM states.
  *
  * dr is (d lat (R_M + h), d lon (R_N + h) cos lat, -d h). The phi convention is numerics.md
  * (E0.1): [SHIN] and KF-GINS; Groves' delta_psi is -phi. The sensor states are what is still
@@ -106,7 +111,8 @@ NAV_BEGIN_DECLS
 
 /** Number of states of the core model (dr, dv, phi, b_g, b_a). */
 #define NAV_FILTER_N_CORE 15
-/** Largest state count: core + scale factors + GNSS position GM. Arrays are sized for it. */
+/** Largest state count: core + scale factors + GNSS position GM (or receiver clock and inter-system
+ *  bias). Arrays are sized for it. */
 #define NAV_FILTER_MAX_STATES 24
 /** Largest measurement dimension accepted by nav_filter_update_linear(). */
 #define NAV_FILTER_MAX_MEAS 6
@@ -114,15 +120,25 @@ NAV_BEGIN_DECLS
 /** Optional state blocks, OR-ed into nav_filter_config.states. */
 typedef enum nav_filter_state_option {
   NAV_FILTER_STATE_SCALE_FACTORS = 1u << 0, /**< append s_g, s_a (21 states) */
-  NAV_FILTER_STATE_GNSS_POS_GM = 1u << 1    /**< append 3 GNSS position GM error states */
+  NAV_FILTER_STATE_GNSS_POS_GM = 1u << 1,   /**< append 3 GNSS position GM error states */
+  /** append the receiver clock: bias c dt_r [m] and drift c dt_r' [m/s], the two-state model
+   *  b' = d + w_f, d' = w_g (tightly coupled filter; not with NAV_FILTER_STATE_GNSS_POS_GM) */
+  NAV_FILTER_STATE_RX_CLOCK = 1u << 2,
+  /** append the GLONASS - GPS inter-system bias [m], a random constant (needs RX_CLOCK) */
+  NAV_FILTER_STATE_RX_ISB = 1u << 3
 } nav_filter_state_option;
 
 /** Where the blocks of a configured filter live. Plain value. */
 typedef struct nav_filter_layout {
-  size_t n_states;        /**< 15, 18, 21 or 24 */
+  size_t n_states;        /**< 15, 18, 21 or 24; with the receiver clock 17 or 18, 23 or 24 */
   bool has_scale_factors; /**< s_g at NAV_FILTER_IDX_SG, s_a at NAV_FILTER_IDX_SA */
   bool has_gnss_pos_gm;   /**< GNSS position-error block present at idx_gnss_pos */
   size_t idx_gnss_pos;    /**< first index of the GNSS block; meaningful only if has_gnss_pos_gm */
+  bool has_rx_clock;      /**< receiver clock bias at idx_clock, drift at idx_clock + 1 */
+  size_t idx_clock;       /**< meaningful only if has_rx_clock */
+  bool has_isb;           /**< GLONASS inter-system bias at idx_isb */
+  size_t idx_isb;         /**< meaningful only if has_isb */
+  size_t n_ins;           /**< the INS error blocks [0, n_ins) that the feedback reset zeroes (15 or 21) */
 } nav_filter_layout;
 
 /* ---------------------------------------------------------------- configuration */
@@ -167,6 +183,9 @@ typedef struct nav_filter_init_sd {
   nav_vec3 gyro_sf_sd;         /**< s_g, unitless (1e-6 = 1 ppm) */
   nav_vec3 accel_sf_sd;        /**< s_a, unitless */
   nav_vec3 gnss_pos_sd_m;      /**< GNSS position error, N/E/D [m] */
+  double clock_bias_sd_m;      /**< receiver clock bias c dt_r [m] (RX_CLOCK) */
+  double clock_drift_sd_mps;   /**< receiver clock drift [m/s] (RX_CLOCK) */
+  double isb_sd_m;             /**< inter-system bias [m] (RX_ISB) */
 } nav_filter_init_sd;
 
 /**
@@ -219,6 +238,14 @@ typedef struct nav_filter_config {
   nav_vec3 gnss_pos_gm_sd_m;  /**< GNSS GM states: stationary sigma, N/E/D [m], >= 0 */
   nav_vec3 gnss_pos_gm_tau_s; /**< GNSS GM states: correlation time [s], > 0, finite */
 
+  /** RX_CLOCK: spectral densities of the two-state clock model (docs/ins-gnss-tight.md 2.3):
+   *  white frequency noise on the bias, q_f = c^2 h_0 / 2 [m^2/s], and random-walk frequency
+   *  noise on the drift, q_g = 2 pi^2 c^2 h_-2 [m^2/s^3], from the oscillator's Allan (power-law)
+   *  coefficients h_0 and h_-2 (Brown and Hwang, Introduction to Random Signals and Applied
+   *  Kalman Filtering, 4th ed., section 9.3). Each >= 0. */
+  double clock_bias_q_m2ps;
+  double clock_drift_q_m2ps3;
+
   nav_filter_init_sd init; /**< P0 (diagonal) */
 
   nav_vec3 gnss_pos_sd_m;   /**< default R of position updates: sigma N/E/D [m], > 0 */
@@ -231,7 +258,8 @@ typedef struct nav_filter_config {
  * = 1.16667e-3 m/s/sqrt(s), GM biases 0.5 deg/h and 0.05 mg with T = 3600 s, no scale-factor
  * process; P0 1 m, 0.1 m/s, 0.1 deg (N, E) and 1 deg (D), biases at their GM sigma, scale
  * factors 100 ppm, GNSS GM 1 m; GNSS GM process sigma 1 m, T = 300 s; R sigmas 1.5, 1.5, 3 m
- * and 0.05 m/s.
+ * and 0.05 m/s; receiver clock (when its states are chosen) of a low-quality TCXO (h_0 = 2e-19 s,
+ * h_-2 = 2e-20 /s) with 100 m, 10 m/s and 10 m (inter-system bias) initial sigmas.
  */
 NAV_API nav_filter_config nav_filter_config_default(void);
 
@@ -347,6 +375,16 @@ NAV_API NAV_NODISCARD nav_status nav_filter_update_gnss_vel(nav_filter *f, const
  */
 NAV_API NAV_NODISCARD nav_status nav_filter_update_linear(nav_filter *f, size_t m, const double *H,
                                                           const double *z, const double *R);
+
+/**
+ * The normalised innovation squared y^T S^-1 y, y = z - H x, S = H P H^T + R, of a linear
+ * measurement without applying it (innovation gating before nav_filter_update_linear()). A
+ * pending decimated propagation is completed first (as an update would).
+ * @param[out] nis_out the NIS (chi-square with m degrees of freedom when the model holds)
+ * @return as nav_filter_update_linear(); x and P are not changed by the test itself.
+ */
+NAV_API NAV_NODISCARD nav_status nav_filter_nis(nav_filter *f, size_t m, const double *H, const double *z,
+                                                const double *R, double *nis_out);
 
 /**
  * Zero the error states that the INS absorbs on feedback (dr, dv, phi, b_g, b_a, s_g, s_a),

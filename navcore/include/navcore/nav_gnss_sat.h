@@ -202,6 +202,22 @@ typedef struct nav_gnss_canyon {
   double right_m;  /**< horizontal distance to the right wall [m], > 0 */
 } nav_gnss_canyon;
 
+/**
+ * The receiver's raw measurements (pseudorange and range rate) as the tightly coupled scheme
+ * (navigation.scheme: ins_gnss_tight) simulates and models them (docs/ins-gnss-tight.md 2):
+ * white code and range-rate noise, a two-state receiver clock from the oscillator's power-law
+ * (Allan) coefficients h_0 and h_-2, and a constant GLONASS - GPS inter-system bias.
+ */
+typedef struct nav_gnss_raw_config {
+  double code_sd_m;          /**< white pseudorange noise, 1 sigma [m], > 0 (default 3) */
+  double range_rate_sd_mps;  /**< white range-rate (Doppler) noise, 1 sigma [m/s], > 0 (default 0.1) */
+  double clock_h0_s;         /**< white frequency noise coefficient h_0 [s], >= 0 (default 2e-19, TCXO) */
+  double clock_hm2_per_s;    /**< random-walk frequency coefficient h_-2 [1/s], >= 0 (default 2e-20, TCXO) */
+  double clock_bias_sd_m;    /**< receiver clock bias c dt_r at t = 0, 1 sigma [m], > 0 (default 100) */
+  double clock_drift_sd_mps; /**< clock drift c dt_r' at t = 0, 1 sigma [m/s], > 0 (default 10) */
+  double isb_sd_m;           /**< GLONASS - GPS inter-system bias, 1 sigma [m], > 0 (default 10) */
+} nav_gnss_raw_config;
+
 /** The satellite constellation along a scene's trajectory (scene section gnss.constellation). */
 typedef struct nav_gnss_constellation_config {
   bool enabled;                 /**< the section is present */
@@ -217,13 +233,16 @@ typedef struct nav_gnss_constellation_config {
    *  fewer satellites are visible (outages added by the simulation); 0: fixes do not depend on
    *  the constellation. Default 4. */
   int min_satellites_for_fix;
+  /** Raw measurements of the tightly coupled scheme (ins_gnss_tight). */
+  nav_gnss_raw_config raw;
   /** ALMANAC: the YUMA file (navcore_io stores the resolved path) and its satellites (loaded by
    *  navcore_io when the scene is read). */
   char almanac_file[NAV_GNSS_ALMANAC_PATH_MAX];
   nav_gnss_constellation almanac;
 } nav_gnss_constellation_config;
 
-/** Disabled; when enabled: GPS nominal, GLONASS off, epoch 2026-01-01 00:00 GPS, 10 deg mask. */
+/** Disabled; when enabled: GPS nominal, GLONASS off, epoch 2026-01-01 00:00 GPS, 10 deg mask;
+ *  raw measurements as nav_gnss_raw_config documents. */
 NAV_API nav_gnss_constellation_config nav_gnss_constellation_config_default(void);
 
 /** Validation callback (the same signature as nav_scene_issue_fn). */

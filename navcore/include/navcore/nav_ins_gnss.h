@@ -18,6 +18,7 @@
 #include "nav_export.h"
 #include "nav_filter.h"
 #include "nav_frames.h"
+#include "nav_gnss_sat.h"
 #include "nav_ins.h"
 #include "nav_scene.h"
 #include "nav_smoother.h"
@@ -39,6 +40,14 @@ typedef struct nav_ins_gnss_config {
    * nav_smoother_mark() and run the backward pass with nav_smoother_run(). NULL (default): none.
    */
   nav_smoother *smoother;
+  /**
+   * Tightly coupled updates (nav_ins_gnss_update_raw()): innovation gating. A scalar pseudorange
+   * or range rate whose normalised innovation squared y^2 / S exceeds gate_chi2 (chi-square, one
+   * degree of freedom) is not applied. Default on, 10.83 (probability 0.999 of passing a
+   * measurement that fits the model).
+   */
+  bool gate;
+  double gate_chi2;
 } nav_ins_gnss_config;
 
 /** One GNSS measurement as the integration consumes it. */
@@ -52,6 +61,31 @@ typedef struct nav_ins_gnss_fix {
 } nav_ins_gnss_fix;
 
 typedef struct nav_ins_gnss nav_ins_gnss;
+
+/** One satellite's raw measurements at an epoch (tightly coupled scheme). */
+typedef struct nav_ins_gnss_sat_meas {
+  const nav_gnss_orbit *sat; /**< the satellite's orbit (borrowed for the call) */
+  bool has_pr;               /**< a pseudorange is given */
+  double pr_m;               /**< pseudorange P = rho + c dt_r (+ ISB for GLONASS) + e [m] */
+  bool has_rr;               /**< a range rate (Doppler times -wavelength) is given */
+  double rr_mps;             /**< range rate rho_dot + c dt_r' + e [m/s] */
+} nav_ins_gnss_sat_meas;
+
+/** The raw measurements of one receiver epoch. */
+typedef struct nav_ins_gnss_raw_epoch {
+  double t_s;     /**< time of validity (the IMU's time base) [s] */
+  double t_gps_s; /**< the same instant as GPS time (seconds since the GPS epoch), for the orbits */
+  int n;          /**< satellites, 0..NAV_GNSS_MAX_SATS */
+  const nav_ins_gnss_sat_meas *sats;
+  double pr_sd_m;    /**< pseudorange noise, 1 sigma [m], > 0 */
+  double rr_sd_mps;  /**< range-rate noise, 1 sigma [m/s], > 0 */
+} nav_ins_gnss_raw_epoch;
+
+/** What an epoch's tightly coupled update did. */
+typedef struct nav_ins_gnss_raw_result {
+  int pr_used, rr_used; /**< scalar pseudorange / range-rate updates applied */
+  int rejected;         /**< measurements gated out (nav_ins_gnss_config.gate) */
+} nav_ins_gnss_raw_result;
 
 /**
  * The filter's sensor model taken from a scene's IMU and GNSS error models (white noise
@@ -71,6 +105,27 @@ NAV_API NAV_NODISCARD nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_im
 
 /** Apply one GNSS fix at the current epoch (call right after the step it belongs to). */
 NAV_API NAV_NODISCARD nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix);
+
+/**
+ * Tightly coupled update (docs/ins-gnss-tight.md): one scalar update per pseudorange and range
+ * rate, in the order given (pseudorange before range rate of each satellite), each tested against
+ * the gate first, then one closed-loop feedback of the INS errors. The filter must have the
+ * receiver-clock states (nav_filter_config.states & NAV_FILTER_STATE_RX_CLOCK); with
+ * NAV_FILTER_STATE_RX_ISB, GLONASS pseudoranges also see the inter-system bias state (without it
+ * the clock is that of whichever system is measured). Works with any number of satellites.
+ * @param[out] res what was applied (may be NULL)
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, bad sigmas, no clock states); NAV_ERR_STATE (before
+ *         the first step); NAV_ERR_NUMERIC (non-finite measurement); the filter's status.
+ */
+NAV_API NAV_NODISCARD nav_status nav_ins_gnss_update_raw(nav_ins_gnss *x, const nav_ins_gnss_raw_epoch *ep,
+                                                         nav_ins_gnss_raw_result *res);
+
+/** Receiver clock estimate of the tightly coupled filter: bias c dt_r [m] and drift [m/s]; zeros
+ *  without the clock states. Either pointer may be NULL. */
+NAV_API void nav_ins_gnss_clock(const nav_ins_gnss *x, double *bias_m, double *drift_mps);
+
+/** Tightly coupled: scalar measurements applied and gated out so far. */
+NAV_API void nav_ins_gnss_raw_counts(const nav_ins_gnss *x, long *used, long *rejected);
 
 /** Current navigation state in F = ECEF (borrowed). */
 NAV_API const nav_ins_state *nav_ins_gnss_state(const nav_ins_gnss *x);

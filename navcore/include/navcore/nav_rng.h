@@ -125,6 +125,11 @@ typedef enum nav_rng_stream_kind {
   NAV_RNG_STREAM_INIT_POS = 0x31, /**< initial position error, channel N/E/D */
   NAV_RNG_STREAM_INIT_VEL = 0x32, /**< initial velocity error, channel N/E/D */
   NAV_RNG_STREAM_INIT_ATT = 0x33, /**< initial attitude error, channel x/y/z of the rotation vector */
+  /* Raw GNSS measurements of the tightly coupled scheme (docs/ins-gnss-tight.md 2). */
+  NAV_RNG_STREAM_GNSS_CLOCK = 0x41,   /**< receiver clock: channel 0 initial bias and drift, 1 driving noise */
+  NAV_RNG_STREAM_GNSS_CODE = 0x42,    /**< white pseudorange noise, channel = satellite index */
+  NAV_RNG_STREAM_GNSS_DOPPLER = 0x43, /**< white range-rate noise, channel = satellite index */
+  NAV_RNG_STREAM_GNSS_ISB = 0x44,     /**< GLONASS inter-system bias, channel 0, once per run */
   /** First kind free for applications and tests; navcore never uses kinds at or above it. */
   NAV_RNG_STREAM_USER = 0x1000
 } nav_rng_stream_kind;

@@ -440,7 +440,12 @@ typedef enum nav_nav_scheme {
   NAV_SCHEME_GYRO_FREE = 2,
   /** The gyro-free INS of the @c array section aided by the @c gnss receiver: loosely coupled
    *  error-state filter in closed loop (nav_gyrofree_gnss.h, docs/gyro-free-gnss.md); WGS-84. */
-  NAV_SCHEME_GYRO_FREE_GNSS = 3
+  NAV_SCHEME_GYRO_FREE_GNSS = 3,
+  /** Tightly coupled INS/GNSS: the loosely coupled filter's INS error states with receiver clock
+   *  (and GLONASS inter-system bias) states, updated by the pseudoranges and range rates of the
+   *  satellites of gnss.constellation in view (nav_ins_gnss.h, docs/ins-gnss-tight.md); works
+   *  with any number of satellites; WGS-84. */
+  NAV_SCHEME_INS_GNSS_TIGHT = 4
 } nav_nav_scheme;
 
 typedef struct nav_scene_navigation {

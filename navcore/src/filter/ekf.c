@@ -139,6 +139,12 @@ nav_status nav_filter_create(const nav_filter_config *cfg, nav_filter **out) {
     set_p0_block(f, NAV_FILTER_IDX_SA, cfg->init.accel_sf_sd);
   }
   if (f->lay.has_gnss_pos_gm) set_p0_block(f, f->lay.idx_gnss_pos, cfg->init.gnss_pos_sd_m);
+  if (f->lay.has_rx_clock) {
+    const size_t c = f->lay.idx_clock;
+    f->P[c * f->n + c] = cfg->init.clock_bias_sd_m * cfg->init.clock_bias_sd_m;
+    f->P[(c + 1) * f->n + c + 1] = cfg->init.clock_drift_sd_mps * cfg->init.clock_drift_sd_mps;
+  }
+  if (f->lay.has_isb) f->P[f->lay.idx_isb * f->n + f->lay.idx_isb] = cfg->init.isb_sd_m * cfg->init.isb_sd_m;
   f->q_isotropic = true;
   for (size_t i = 1; i < 3; ++i)
     if (f->qc[NAV_FILTER_IDX_DV + i] != f->qc[NAV_FILTER_IDX_DV] ||
@@ -1001,12 +1007,70 @@ nav_status nav_filter_update_linear(nav_filter *f, size_t m, const double *H, co
   return do_update(f, m, H, z, R, "update_linear");
 }
 
+nav_status nav_filter_nis(nav_filter *f, size_t m, const double *H, const double *z, const double *R,
+                          double *nis_out) {
+  assert(f != NULL && H != NULL && z != NULL && R != NULL && nis_out != NULL);
+  if (f == NULL || H == NULL || z == NULL || R == NULL || nis_out == NULL) return NAV_ERR_INVALID_ARG;
+  if (m < 1 || m > MMAX) {
+    set_error(f, "nis: m = %zu outside 1..%d", m, MMAX);
+    return NAV_ERR_INVALID_ARG;
+  }
+  const size_t n = f->n;
+  for (size_t i = 0; i < m * n; ++i)
+    if (!isfinite(H[i])) {
+      set_error(f, "nis: H is not finite");
+      return NAV_ERR_NUMERIC;
+    }
+  for (size_t i = 0; i < m; ++i)
+    if (!isfinite(z[i])) {
+      set_error(f, "nis: measurement z[%zu] = %g is not finite", i, z[i]);
+      return NAV_ERR_NUMERIC;
+    }
+  for (size_t i = 0; i < m * m; ++i)
+    if (!isfinite(R[i])) {
+      set_error(f, "nis: R is not finite");
+      return NAV_ERR_NUMERIC;
+    }
+  nav_status st = nav_filter_flush(f);
+  if (st != NAV_OK) return st;
+  double y[MMAX], S[MMAX * MMAX], Ls[MMAX * MMAX], u[MMAX];
+  for (size_t r = 0; r < m; ++r) {
+    double hx = 0.0;
+    for (size_t j = 0; j < n; ++j)
+      hx += H[r * n + j] * f->x[j];
+    y[r] = z[r] - hx;
+  }
+  for (size_t r = 0; r < m; ++r)
+    for (size_t c = 0; c < m; ++c) {
+      double sum = 0.0;
+      for (size_t i = 0; i < n; ++i) {
+        double ph = 0.0;
+        for (size_t j = 0; j < n; ++j)
+          ph += f->P[i * n + j] * H[c * n + j];
+        sum += H[r * n + i] * ph;
+      }
+      S[r * m + c] = sum + R[r * m + c];
+    }
+  nav_matn_symmetrize(S, m);
+  if (nav_matn_cholesky(Ls, S, m) != NAV_OK) {
+    set_error(f, "nis: innovation covariance S = H P H^T + R is not positive definite");
+    return NAV_ERR_NUMERIC;
+  }
+  nav_matn_chol_solve(u, Ls, y, m, 1);
+  double nis = 0.0;
+  for (size_t r = 0; r < m; ++r)
+    nis += y[r] * u[r];
+  *nis_out = nis;
+  return NAV_OK;
+}
+
 /* ---------------------------------------------------------------- state access */
 
 nav_status nav_filter_reset_errors(nav_filter *f) {
   assert(f != NULL);
   if (f == NULL) return NAV_ERR_INVALID_ARG;
-  const size_t end = f->lay.has_gnss_pos_gm ? f->lay.idx_gnss_pos : f->n;
+  /* Only the INS blocks: the GNSS GM, receiver-clock and inter-system-bias states keep theirs. */
+  const size_t end = f->lay.n_ins;
   for (size_t i = 0; i < end; ++i)
     f->x[i] = 0.0;
   return NAV_OK;

@@ -61,6 +61,15 @@ nav_filter_config nav_filter_config_default(void) {
   c.init.gnss_pos_sd_m = v3(1.0);
   c.gnss_pos_sd_m = nav_vec3_make(1.5, 1.5, 3.0);
   c.gnss_vel_sd_mps = v3(0.05);
+  /* Receiver clock (only with NAV_FILTER_STATE_RX_CLOCK / RX_ISB): a low-quality TCXO (Brown and
+   * Hwang, 4th ed., Table 9.2: h_0 = 2e-19 s, h_-2 = 2e-20 /s), q_f = c^2 h_0 / 2,
+   * q_g = 2 pi^2 c^2 h_-2; 100 m, 10 m/s and 10 m initial sigmas (docs/ins-gnss-tight.md). */
+  const double c2 = 299792458.0 * 299792458.0;
+  c.clock_bias_q_m2ps = 0.5 * 2e-19 * c2;
+  c.clock_drift_q_m2ps3 = 2.0 * NAV_PI * NAV_PI * 2e-20 * c2;
+  c.init.clock_bias_sd_m = 100.0;
+  c.init.clock_drift_sd_mps = 10.0;
+  c.init.isb_sd_m = 10.0;
   return c;
 }
 
@@ -110,8 +119,26 @@ static void check_process(checker *ck, const char *prefix, unsigned terms, nav_v
 nav_status nav_filter_config_validate(const nav_filter_config *cfg, nav_scene_issue_fn report, void *user) {
   if (cfg == NULL) return NAV_ERR_INVALID_ARG;
   checker ck = {report, user, 0};
-  const unsigned known = (unsigned)(NAV_FILTER_STATE_SCALE_FACTORS | NAV_FILTER_STATE_GNSS_POS_GM);
+  const unsigned known = (unsigned)(NAV_FILTER_STATE_SCALE_FACTORS | NAV_FILTER_STATE_GNSS_POS_GM |
+                                    NAV_FILTER_STATE_RX_CLOCK | NAV_FILTER_STATE_RX_ISB);
   if ((cfg->states & ~known) != 0u) complain(&ck, "states", "unknown state-option bits");
+  const bool clk = (cfg->states & NAV_FILTER_STATE_RX_CLOCK) != 0u;
+  if (clk && (cfg->states & NAV_FILTER_STATE_GNSS_POS_GM) != 0u)
+    complain(&ck, "states", "the receiver-clock states (tight coupling) exclude the GNSS position GM states");
+  if (!clk && (cfg->states & NAV_FILTER_STATE_RX_ISB) != 0u)
+    complain(&ck, "states", "the inter-system bias state needs the receiver-clock states");
+  if (clk) {
+    if (!(isfinite(cfg->clock_bias_q_m2ps) && cfg->clock_bias_q_m2ps >= 0.0))
+      complain(&ck, "clock_bias_q_m2ps", "must be finite and >= 0");
+    if (!(isfinite(cfg->clock_drift_q_m2ps3) && cfg->clock_drift_q_m2ps3 >= 0.0))
+      complain(&ck, "clock_drift_q_m2ps3", "must be finite and >= 0");
+    if (!(isfinite(cfg->init.clock_bias_sd_m) && cfg->init.clock_bias_sd_m > 0.0))
+      complain(&ck, "init.clock_bias_sd_m", "must be finite and > 0");
+    if (!(isfinite(cfg->init.clock_drift_sd_mps) && cfg->init.clock_drift_sd_mps > 0.0))
+      complain(&ck, "init.clock_drift_sd_mps", "must be finite and > 0");
+  }
+  if ((cfg->states & NAV_FILTER_STATE_RX_ISB) != 0u && !(isfinite(cfg->init.isb_sd_m) && cfg->init.isb_sd_m > 0.0))
+    complain(&ck, "init.isb_sd_m", "must be finite and > 0");
   if (cfg->discretisation != NAV_FILTER_DISC_SECOND_ORDER && cfg->discretisation != NAV_FILTER_DISC_VAN_LOAN)
     complain(&ck, "discretisation", "must be NAV_FILTER_DISC_SECOND_ORDER or NAV_FILTER_DISC_VAN_LOAN");
   if (cfg->cov_decimation < 1u) complain(&ck, "cov_decimation", "must be >= 1");
@@ -184,16 +211,34 @@ void nav_filter_process_model(const nav_filter_config *cfg, const nav_filter_lay
   if (lay->has_gnss_pos_gm)
     triad_process(proc_diag, qc, lay->idx_gnss_pos, NAV_FILTER_PROC_GM, cfg->gnss_pos_gm_sd_m,
                   cfg->gnss_pos_gm_tau_s, nav_vec3_zero());
+  if (lay->has_rx_clock) {
+    /* Two-state clock (docs/ins-gnss-tight.md 2.3): no damping; white noise on both states. */
+    proc_diag[lay->idx_clock] = 0.0;
+    proc_diag[lay->idx_clock + 1] = 0.0;
+    qc[lay->idx_clock] = cfg->clock_bias_q_m2ps;
+    qc[lay->idx_clock + 1] = cfg->clock_drift_q_m2ps3;
+  }
+  if (lay->has_isb) {
+    proc_diag[lay->idx_isb] = 0.0; /* random constant */
+    qc[lay->idx_isb] = 0.0;
+  }
 }
 
 nav_filter_layout nav_filter_layout_of(unsigned states) {
   nav_filter_layout l;
   l.has_scale_factors = (states & NAV_FILTER_STATE_SCALE_FACTORS) != 0u;
   l.has_gnss_pos_gm = (states & NAV_FILTER_STATE_GNSS_POS_GM) != 0u;
+  l.has_rx_clock = (states & NAV_FILTER_STATE_RX_CLOCK) != 0u;
+  l.has_isb = l.has_rx_clock && (states & NAV_FILTER_STATE_RX_ISB) != 0u;
   size_t n = NAV_FILTER_N_CORE;
   if (l.has_scale_factors) n += 6;
+  l.n_ins = n;
   l.idx_gnss_pos = n;
   if (l.has_gnss_pos_gm) n += 3;
+  l.idx_clock = n;
+  if (l.has_rx_clock) n += 2;
+  l.idx_isb = n;
+  if (l.has_isb) n += 1;
   l.n_states = n;
   return l;
 }
@@ -298,6 +343,8 @@ void nav_filter_build_F(double *F, const nav_filter_layout *lay, const nav_filte
   /* Sensor and GNSS states: -1/T (Gauss-Markov) or 0. */
   for (size_t i = NAV_FILTER_IDX_BG; i < n; ++i)
     F_(i, i) = proc_diag[i];
+  /* Receiver clock: the bias integrates the drift (docs/ins-gnss-tight.md 2.3). */
+  if (lay->has_rx_clock) F_(lay->idx_clock, lay->idx_clock + 1) = 1.0;
 #undef F_
 }
 

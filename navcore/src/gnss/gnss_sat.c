@@ -391,6 +391,15 @@ nav_gnss_constellation_config nav_gnss_constellation_config_default(void) {
   c.glonass_node1_lon_rad = 0.0;
   c.mask.elevation_mask_rad = 10.0 * DEG;
   c.min_satellites_for_fix = 4;
+  /* Low-quality TCXO of Brown and Hwang, 4th ed., Table 9.2 (h_0 = 2e-19 s, h_-2 = 2e-20 /s);
+   * 3 m code and 0.1 m/s Doppler noise of a single-frequency consumer receiver. */
+  c.raw.code_sd_m = 3.0;
+  c.raw.range_rate_sd_mps = 0.1;
+  c.raw.clock_h0_s = 2e-19;
+  c.raw.clock_hm2_per_s = 2e-20;
+  c.raw.clock_bias_sd_m = 100.0;
+  c.raw.clock_drift_sd_mps = 10.0;
+  c.raw.isb_sd_m = 10.0;
   return c;
 }
 
@@ -444,6 +453,25 @@ nav_status nav_gnss_constellation_config_validate(const nav_gnss_constellation_c
   }
   if (cfg->min_satellites_for_fix < 0 || cfg->min_satellites_for_fix > NAV_GNSS_MAX_SATS) {
     report_issue(report, user, &n, "min_satellites_for_fix", "must be in [0, %d]", NAV_GNSS_MAX_SATS);
+  }
+  const struct {
+    const char *key;
+    double v;
+    bool zero_ok;
+  } raw[] = {{"code_sd_m", cfg->raw.code_sd_m, false},
+             {"range_rate_sd_mps", cfg->raw.range_rate_sd_mps, false},
+             {"clock_h0_s", cfg->raw.clock_h0_s, true},
+             {"clock_hm2_per_s", cfg->raw.clock_hm2_per_s, true},
+             {"clock_bias_sd_m", cfg->raw.clock_bias_sd_m, false},
+             {"clock_drift_sd_mps", cfg->raw.clock_drift_sd_mps, false},
+             {"isb_sd_m", cfg->raw.isb_sd_m, false}};
+  for (size_t i = 0; i < sizeof raw / sizeof raw[0]; ++i) {
+    const double v = raw[i].v;
+    /* 1e6 bounds every sigma (m, m/s) far above any receiver; h coefficients are ~1e-19. */
+    const bool ok = isfinite(v) && (raw[i].zero_ok ? v >= 0.0 && v <= 1e-6 : v > 0.0 && v <= 1e6);
+    if (!ok) {
+      report_issue(report, user, &n, raw[i].key, raw[i].zero_ok ? "must be in [0, 1e-6]" : "must be in (0, 1e6]");
+    }
   }
   if (!isfinite(cfg->glonass_node1_lon_rad)) {
     report_issue(report, user, &n, "glonass_node_lon_deg", "must be finite");

@@ -9,21 +9,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_sensors.h"
-
-struct nav_ins_gnss {
-  nav_ins_gnss_config cfg;
-  nav_frame frame;
-  nav_ins *ins;
-  nav_filter *kf;
-  nav_vec3 b_g_rps, b_a_mps2;  /* estimated biases, subtracted from the raw increments */
-  nav_vec3 s_g, s_a;           /* estimated scale factors: compensated = (raw - b dt) / (1 + s) */
-  nav_imu_increment last;      /* compensated increment of the last step */
-  nav_vec3 w_prev_rps;         /* mean rate of the step before it */
-  bool have_step, have_prev;
-  bool sf_on;                  /* the filter estimates scale factors */
-  long updates;
-  char err[256];
-};
+#include "integration/ins_gnss_internal.h"
 
 static nav_filter_ins_state nominal_of(const nav_ins_gnss *x);
 
@@ -124,6 +110,9 @@ nav_ins_gnss_config nav_ins_gnss_config_from_scene(const nav_scene *sc) {
   c.r_ba_b_m = sc->gnss.model.r_ba_b_m;
   c.pos_sd_floor_m = 1e-3;
   c.vel_sd_floor_mps = 1e-3;
+  c.gate = true;
+  c.gate_chi2 = 10.83; /* chi-square, 1 degree of freedom, P = 0.999 */
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) nav_ins_gnss_tight_filter(sc, &c.filter);
   return c;
 }
 
@@ -131,6 +120,7 @@ nav_status nav_ins_gnss_create(const nav_ins_gnss_config *cfg, const nav_ins_sta
   if (!cfg || !initial || !out) return NAV_ERR_INVALID_ARG;
   if (cfg->ins.earth_model != NAV_EARTH_WGS84) return NAV_ERR_INVALID_ARG;
   if (!(cfg->pos_sd_floor_m > 0.0) || !(cfg->vel_sd_floor_mps > 0.0)) return NAV_ERR_INVALID_ARG;
+  if (cfg->gate && !(cfg->gate_chi2 > 0.0)) return NAV_ERR_INVALID_ARG;
   nav_ins_gnss *x = calloc(1, sizeof *x);
   if (!x) return NAV_ERR_NO_MEMORY;
   x->cfg = *cfg;
@@ -197,7 +187,7 @@ static nav_filter_ins_state nominal_of(const nav_ins_gnss *x) {
 /* Filter inputs from the INS and the compensated increment of the step just taken. A NED
  * mechanization hands over its geodetic state directly (no ECEF round trip at IMU rate); the
  * ECEF one through the frame view. */
-static nav_filter_nav filter_nav(const nav_frame *fr, const nav_ins *ins, const nav_imu_increment *imu) {
+nav_filter_nav nav_ins_gnss_filter_nav(const nav_frame *fr, const nav_ins *ins, const nav_imu_increment *imu) {
   nav_filter_nav n;
   nav_ins_ned ned;
   if (nav_ins_get_ned(ins, &ned)) {
@@ -234,7 +224,7 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
     snprintf(x->err, sizeof x->err, "strapdown navigation stopped at t = %.6f s: %s", m.t_s, nav_ins_last_error(x->ins));
     return st;
   }
-  const nav_filter_nav n = filter_nav(&x->frame, x->ins, &m);
+  const nav_filter_nav n = nav_ins_gnss_filter_nav(&x->frame, x->ins, &m);
   st = nav_filter_predict(x->kf, &n, m.dt_s);
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m.t_s, nav_filter_last_error(x->kf));
@@ -257,20 +247,28 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
   return NAV_OK;
 }
 
+/* The filter's linearisation point at the current epoch: the INS state (view), the filter inputs of
+ * the last step, with the angular rate extrapolated to the epoch for the lever-arm velocity. */
+nav_filter_nav nav_ins_gnss_epoch_nav(const nav_ins_gnss *x, nav_local_view *view) {
+  const nav_ins_state *s = nav_ins_get_state(x->ins);
+  *view = nav_frame_view(&x->frame, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
+  nav_filter_nav n = nav_ins_gnss_filter_nav(&x->frame, x->ins, &x->last);
+  /* The lever-arm velocity needs the angular rate AT the fix epoch; the increments give interval
+   * means at mid-intervals, so extrapolate linearly from the last two: w(t_k) = 1.5 w_(k-1/2) -
+   * 0.5 w_(k-3/2), an O(dt^2) error instead of the O(dt) of the plain mean (which, while
+   * turning, is w_dot dt / 2 x l, ~1 mm/s for a 1.3 m arm at 100 Hz). */
+  if (x->have_prev) n.w_ib_b_rps = nav_vec3_sub(nav_vec3_scale(n.w_ib_b_rps, 1.5), nav_vec3_scale(x->w_prev_rps, 0.5));
+  return n;
+}
+
 nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   if (!x || !fix) return NAV_ERR_INVALID_ARG;
   if (!x->have_step) {
     snprintf(x->err, sizeof x->err, "a GNSS fix before the first IMU step (t = %.6f s)", fix->t_s);
     return NAV_ERR_STATE;
   }
-  const nav_ins_state *s = nav_ins_get_state(x->ins);
-  const nav_local_view v = nav_frame_view(&x->frame, s->r_fb_f_m, s->v_fb_f_mps, s->q_b_f);
-  nav_filter_nav n = filter_nav(&x->frame, x->ins, &x->last);
-  /* The lever-arm velocity needs the angular rate AT the fix epoch; the increments give interval
-   * means at mid-intervals, so extrapolate linearly from the last two: w(t_k) = 1.5 w_(k-1/2) -
-   * 0.5 w_(k-3/2), an O(dt^2) error instead of the O(dt) of the plain mean (which, while
-   * turning, is w_dot dt / 2 x l, ~1 mm/s for a 1.3 m arm at 100 Hz). */
-  if (x->have_prev) n.w_ib_b_rps = nav_vec3_sub(nav_vec3_scale(n.w_ib_b_rps, 1.5), nav_vec3_scale(x->w_prev_rps, 0.5));
+  nav_local_view v;
+  const nav_filter_nav n = nav_ins_gnss_epoch_nav(x, &v);
   const nav_vec3 l = x->cfg.r_ba_b_m;
   nav_vec3 r_pos, r_vel;
   for (int i = 0; i < 3; ++i) {
@@ -289,9 +287,16 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
     snprintf(x->err, sizeof x->err, "GNSS update failed at t = %.6f s: %s", fix->t_s, nav_filter_last_error(x->kf));
     return st;
   }
-  /* Closed-loop feedback (numerics.md 6.5). */
+  return nav_ins_gnss_feedback(x, &v, fix->t_s);
+}
+
+/* Closed-loop feedback (numerics.md 6.5) of the filter's INS error estimates into the INS and the
+ * sensor estimates, then the reset of those states; the smoother records the update. */
+nav_status nav_ins_gnss_feedback(nav_ins_gnss *x, const nav_local_view *view, double t_s) {
+  const nav_ins_state *s = nav_ins_get_state(x->ins);
+  const nav_local_view v = *view;
   nav_filter_error dx;
-  st = nav_filter_get_error(x->kf, &dx);
+  nav_status st = nav_filter_get_error(x->kf, &dx);
   if (st != NAV_OK) return st;
   double x_before[NAV_FILTER_MAX_STATES];
   const size_t nx = nav_filter_get_layout(x->kf).n_states;
@@ -311,7 +316,7 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   st = nav_ins_set_state(x->ins, &corrected);
   if (st == NAV_OK) st = nav_filter_reset_errors(x->kf);
   if (st != NAV_OK) {
-    snprintf(x->err, sizeof x->err, "feedback failed at t = %.6f s: %s", fix->t_s, nav_status_str(st));
+    snprintf(x->err, sizeof x->err, "feedback failed at t = %.6f s: %s", t_s, nav_status_str(st));
     return st;
   }
   x->b_g_rps = fs.b_g_rps;
@@ -328,7 +333,7 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
     const nav_filter_ins_state nom = nominal_of(x);
     st = nav_smoother_update(x->cfg.smoother, &nom, nav_filter_get_cov(x->kf), x_after, x_before);
     if (st != NAV_OK) {
-      snprintf(x->err, sizeof x->err, "smoother record at t = %.6f s: %s", fix->t_s,
+      snprintf(x->err, sizeof x->err, "smoother record at t = %.6f s: %s", t_s,
                nav_smoother_last_error(x->cfg.smoother));
       return st;
     }

@@ -388,7 +388,7 @@ nav_status nav_budget_run(const nav_scene *sc, bool sources, nav_budget_fn fn, v
   if (active) *active = 0;
   if (!sc || !fn) return NAV_ERR_INVALID_ARG;
   if (sc->earth.model != NAV_EARTH_WGS84 || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE ||
-      sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+      sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS || sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
     if (msg) snprintf(msg, msg_size, "the covariance budget needs the wgs84 Earth and the free_ins or ins_gnss scheme");
     return NAV_ERR_INVALID_ARG;
   }
@@ -628,7 +628,8 @@ nav_status nav_budget_requirements(const nav_scene *scene, const nav_requirement
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   nav_status st = NAV_OK;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS)
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+      scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT)
     st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni);
   if (st != NAV_OK) {
     free(a);

@@ -237,8 +237,9 @@ nav_status nav_requirements_check_scene(const nav_scene *scene, nav_req_issue_fn
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   bool outages_known = true;
-  const bool has_gnss =
-      scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  const bool has_gnss = scene->navigation.scheme == NAV_SCHEME_INS_GNSS ||
+                        scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+                        scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
   if (has_gnss) outages_known = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni) == NAV_OK;
   int n_in_run = 0;
   for (int j = 0; j < ni; ++j)
@@ -256,7 +257,7 @@ nav_status nav_requirements_check_scene(const nav_scene *scene, nav_req_issue_fn
       if (!has_gnss)
         req_issue(report, user, &n, i, "statistic",
                   "outage_end needs a GNSS outage, and navigation.scheme %s has no GNSS: use scheme ins_gnss "
-                  "(or gyro_free_gnss) with gnss.outages, or another statistic",
+                  "(or gyro_free_gnss, ins_gnss_tight) with gnss.outages, or another statistic",
                   nav_nav_scheme_name(scene->navigation.scheme));
       else if (ni > 0)
         req_issue(report, user, &n, i, "statistic",
@@ -475,7 +476,8 @@ nav_status nav_req_evaluator_create_for_scene(const nav_scene *scene, bool ideal
   if (!scene || !out) return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int n = 0;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+      scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
     const nav_status st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &n);
     if (st != NAV_OK) return st;
   }
@@ -945,7 +947,9 @@ nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict
   if (!scene || (scene->n_requirements > 0 && !out)) return NAV_ERR_INVALID_ARG;
   if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE)
     return NAV_ERR_INVALID_ARG;
-  const bool gfg = scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  /* gyro_free_gnss and ins_gnss_tight: their filters' covariance analysis (nav_sim_covariance). */
+  const bool gfg = scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+                   scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   nav_status st = NAV_OK;
@@ -955,7 +959,8 @@ nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict
   cov_buf b = {NULL, 0, 0, false};
   if (gfg) {
     /* gyro_free_gnss: its filter's covariance analysis (no consider states: the scheme refuses
-     * the scale-factor terms the filter does not estimate). */
+     * the scale-factor terms the filter does not estimate). ins_gnss_tight: its filter's
+     * covariance analysis too, without consider states (docs/ins-gnss-tight.md 6). */
     nav_sim *sim = NULL;
     st = nav_sim_create(scene, &sim);
     if (st == NAV_OK) st = nav_sim_covariance(sim, keep_cov_point, &b);

@@ -465,8 +465,22 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   check_vec(&c, "initial_errors.velocity_mps", s->initial_errors.vel_sd_mps);
   check_vec(&c, "initial_errors.attitude_deg", s->initial_errors.att_sd_rad);
   if (s->navigation.scheme != NAV_SCHEME_FREE_INS && s->navigation.scheme != NAV_SCHEME_INS_GNSS &&
-      s->navigation.scheme != NAV_SCHEME_GYRO_FREE && s->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS)
+      s->navigation.scheme != NAV_SCHEME_GYRO_FREE && s->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS &&
+      s->navigation.scheme != NAV_SCHEME_INS_GNSS_TIGHT)
     issue(&c, "navigation.scheme", "unknown navigation scheme %g", (double)s->navigation.scheme);
+  if (s->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
+    /* The receiver section gives the epochs (update_rate_hz), the outages and the lever arm; the
+     * constellation section the satellites and the raw-measurement errors. */
+    if (!s->gnss.enabled)
+      issue_text(&c, "navigation.scheme", "ins_gnss_tight needs a GNSS receiver: set gnss.enabled: true");
+    if (!s->gnss.constellation.enabled)
+      issue_text(&c, "navigation.scheme",
+                 "ins_gnss_tight needs satellites: add a gnss.constellation section (docs/ins-gnss-tight.md)");
+    if (s->earth.model != NAV_EARTH_WGS84)
+      issue_text(&c, "navigation.scheme", "ins_gnss_tight needs the wgs84 Earth model");
+    if (s->navigation.aid_vertical)
+      issue_text(&c, "navigation.aid_vertical", "applies to the free INS only; ins_gnss_tight is aided by GNSS");
+  }
   if (s->navigation.scheme == NAV_SCHEME_GYRO_FREE && s->navigation.aid_vertical)
     issue_text(&c, "navigation.aid_vertical", "applies to the free INS only, not to gyro_free");
   check_array(&c, &s->array, report, user);
@@ -536,6 +550,7 @@ const char *nav_nav_scheme_name(nav_nav_scheme s) {
   case NAV_SCHEME_INS_GNSS: return "ins_gnss";
   case NAV_SCHEME_GYRO_FREE: return "gyro_free";
   case NAV_SCHEME_GYRO_FREE_GNSS: return "gyro_free_gnss";
+  case NAV_SCHEME_INS_GNSS_TIGHT: return "ins_gnss_tight";
   }
   return "unknown";
 }

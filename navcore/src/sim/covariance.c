@@ -4,6 +4,7 @@
  * (outages respected) for the integrated scheme; no random draws. It predicts the one-sigma
  * errors of the real filter (and of the free INS) in milliseconds, before any Monte Carlo.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -11,6 +12,7 @@
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
+#include "integration/ins_gnss_internal.h"
 #include "sim/sim_internal.h"
 
 static bool in_outage(const nav_gnss_model_config *g, double t) {
@@ -59,6 +61,38 @@ static nav_cov_point make_point(double t, const cov_filter *c) {
   return p;
 }
 
+/* ins_gnss_tight: one scalar update per pseudorange and range rate of every satellite visible from
+ * the reference (the simulation's visibility, nav_sim_gnss_raw_measure), with the rows of the
+ * real filter (nav_ins_gnss_tight_rows) at the reference; no gating (z = 0). The GNSS epochs are
+ * processed at the IMU step they fall in, as the simulation does, with that step's reference. */
+static nav_status tight_update(nav_filter *kf, const nav_scene *sc, const nav_gnss_constellation *sats,
+                               const nav_frame *fr, const nav_traj_state *ts, const nav_filter_nav *nv,
+                               nav_geodetic pos) {
+  const nav_gnss_constellation_config *cc = &sc->gnss.constellation;
+  const double t_gps = cc->epoch_gps_s + ts->t_s;
+  const double heading = atan2(nv->C_b_n.m[1][0], nv->C_b_n.m[0][0]);
+  const nav_gnss_sky_mask mask = nav_gnss_constellation_mask_at(cc, ts->t_s);
+  nav_gnss_sat_view views[NAV_GNSS_MAX_SATS];
+  nav_gnss_dop dop;
+  nav_status st = nav_gnss_visibility(sats, &mask, t_gps, pos, heading, views, &dop);
+  if (st != NAV_OK) return st;
+  (void)fr;
+  nav_tight_geom geom;
+  const nav_filter_layout lay = nav_filter_get_layout(kf);
+  nav_ins_gnss_tight_geometry(&geom, &lay, nv, pos, sc->gnss.model.r_ba_b_m);
+  const double rp = cc->raw.code_sd_m * cc->raw.code_sd_m, rr = cc->raw.range_rate_sd_mps * cc->raw.range_rate_sd_mps;
+  double Hp[NAV_FILTER_MAX_STATES], Hr[NAV_FILTER_MAX_STATES];
+  for (int i = 0; i < sats->n && st == NAV_OK; ++i) {
+    if (!views[i].visible) continue;
+    double rho, rdot;
+    nav_ins_gnss_tight_rows(&geom, &sats->sats[i], t_gps, Hp, Hr, &rho, &rdot);
+    const double z = 0.0;
+    st = nav_filter_update_linear(kf, 1, Hp, &z, &rp);
+    if (st == NAV_OK) st = nav_filter_update_linear(kf, 1, Hr, &z, &rr);
+  }
+  return st;
+}
+
 nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   if (!sim || !fn) return NAV_ERR_INVALID_ARG;
   const nav_scene *sc = nav_sim_scene(sim);
@@ -94,7 +128,8 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   const double dt = nav_truth_dt(truth);
   int64_t out_stride = (int64_t)llround(sc->imu.rate_hz / sc->output.rate_hz);
   if (out_stride < 1) out_stride = 1;
-  const bool gnss = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || gfg;
+  const bool tight = sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
+  const bool gnss = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || gfg || tight;
   nav_gnss_model_config gcfg;
   st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &gcfg, msg, sizeof msg);
   if (st != NAV_OK) {
@@ -106,6 +141,16 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   const double pos_floor_m = gfg ? xg.pos_sd_floor_m : xc.pos_sd_floor_m;
   const double vel_floor_mps = gfg ? xg.vel_sd_floor_mps : xc.vel_sd_floor_mps;
   int64_t next_epoch = 0;
+  /* ins_gnss_tight: the satellites the reference trajectory sees (as the simulation's receiver). */
+  nav_gnss_constellation sats;
+  sats.n = 0;
+  if (tight) {
+    st = nav_gnss_constellation_build(&sc->gnss.constellation, &sats);
+    if (st != NAV_OK) {
+      nav_sim_set_error(sim, "gnss.constellation: cannot build the constellation");
+      goto cleanup;
+    }
+  }
   nav_cov_point p0 = make_point(0.0, &cf);
   if (fn(user, &p0) == NAV_STOP) goto cleanup;
   for (int64_t k = 1; k <= n; ++k) {
@@ -131,6 +176,14 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
       if (!(t_fix <= imu.t_s + 0.5 * dt)) break;
       ++next_epoch;
       if (t_fix < imu.t_s - 0.5 * dt || in_outage(g, t_fix)) continue;
+      if (tight) {
+        st = tight_update(cf.kf, sc, &sats, &fr, &ts, &nv, v.pos);
+        if (st != NAV_OK) {
+          nav_sim_set_error(sim, cf_error(&cf));
+          goto cleanup;
+        }
+        continue;
+      }
       /* R as the simulation uses it: the receiver's reported sigmas (white part only when the
        * filter carries GNSS GM states), floored as in nav_ins_gnss. */
       nav_vec3 rp, rv;

@@ -267,12 +267,14 @@ nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_
 /* Per-run state of the INS/GNSS scheme: the receiver model and the closed-loop integration. */
 typedef struct aiding {
   nav_gnss_model *gnss;
+  nav_sim_gnss_raw *raw; /* ins_gnss_tight: pseudoranges and range rates instead of fixes */
   nav_ins_gnss *x;
   nav_sim_gyrofree *gf; /* gyro_free_gnss: the fixes go to the array INS's filter (borrowed) */
   int64_t next_epoch;
 } aiding;
 
 static void aiding_destroy(aiding *a) {
+  nav_sim_gnss_raw_destroy(a->raw);
   nav_ins_gnss_destroy(a->x);
   nav_gnss_model_destroy(a->gnss);
 }
@@ -306,6 +308,18 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
       return st;
     }
     if (!has_fix) continue;
+    if (a->raw) {
+      /* Tightly coupled: the receiver's epochs and outages, the satellites' raw measurements. */
+      nav_ins_gnss_raw_epoch ep;
+      const nav_frame fr = nav_truth_frame(truth);
+      st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
+      if (st == NAV_OK) st = nav_ins_gnss_update_raw(a->x, &ep, NULL);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(a->x));
+        return st;
+      }
+      continue;
+    }
     nav_ins_gnss_fix f;
     f.t_s = fix.t_s;
     f.pos = fix.pos;
@@ -477,7 +491,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     goto cleanup;
   }
   const bool aid = sc->navigation.aid_vertical;
-  const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
+  const bool tight = sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
+  const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || tight;
   if (integrated || gf_gnss) {
     /* --ideal: the receiver is perfect too (same epochs and outages, no error terms). */
     nav_gnss_model_config gcfg = j->gnss_cfg;
@@ -506,6 +521,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       xc.smoother = sm;
     }
     st = nav_ins_gnss_create(&xc, &s0, &aid_kf.x);
+    if (st == NAV_OK && tight) st = nav_sim_gnss_raw_create(sc, (uint64_t)run, j->ideal, &aid_kf.raw);
     if (st != NAV_OK) {
       job_error(j, "run %ld: INS/GNSS set-up: %s", run, nav_status_str(st));
       goto cleanup;
@@ -715,8 +731,10 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   /* Ideal runs are identical: one is enough. */
   j.runs = opts->ideal ? 1 : sc->simulation.runs;
   j.smooth = sc->navigation.smoother && sc->navigation.scheme == NAV_SCHEME_INS_GNSS;
-  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS) {
-    j.gm_states = sc->navigation.scheme == NAV_SCHEME_INS_GNSS
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS || sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+      sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
+    j.gm_states = sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT ? false
+                  : sc->navigation.scheme == NAV_SCHEME_INS_GNSS
                       ? (nav_ins_gnss_config_from_scene(sc).filter.states & NAV_FILTER_STATE_GNSS_POS_GM) != 0
                       : nav_gyrofree_gnss_config_from_scene(sc).filter.gnss_gm;
     char gmsg[200];

@@ -16,6 +16,8 @@ nav_status nav_sim_gnss_visibility_outages(const nav_scene *sc, double dt_s, nav
                                            size_t msg_size) {
   const nav_gnss_constellation_config *cc = &sc->gnss.constellation;
   if (!sc->gnss.enabled || !cc->enabled || cc->min_satellites_for_fix <= 0) return NAV_OK;
+  /* The tightly coupled scheme uses every satellite in view, however few: no fix is needed. */
+  if (sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) return NAV_OK;
   if (!(out->update_rate_hz > 0.0)) return NAV_ERR_INVALID_ARG;
   nav_gnss_constellation c;
   nav_status st = nav_gnss_constellation_build(cc, &c);

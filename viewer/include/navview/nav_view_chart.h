@@ -65,4 +65,22 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
 bool NavRenderTradeoffPng(const std::string &tradeoff_csv, const std::string &requirement,
                           const NavChartOptions &options, const std::string &path, std::string *error);
 
+/**
+ * Sky plot of a result directory of navsim run with gnss.constellation (issue 22): azimuth /
+ * elevation tracks of run 0's satellites from gnss_sats.csv (GPS blue, GLONASS red; epochs in view
+ * as markers, masked ones grey), PRN labels at each track's end, elevation rings at 0, 30 and
+ * 60 deg, and the sky masks of gnss_mask.csv (the open-sky mask dashed, each canyon's walls at
+ * the heading of its middle solid brown). North up, east right, zenith at the centre.
+ */
+bool NavRenderSkyPlotPng(const std::string &result_dir, const NavChartOptions &options, const std::string &path,
+                         std::string *error);
+
+/**
+ * DOP and visible count over time from gnss_dop.csv: GDOP, PDOP, HDOP and VDOP (gaps where the
+ * geometry has no solution) above the number of satellites in view, with the street-canyon
+ * spans (in_canyon) and, when gnss_outages.csv is present, the receiver's outages.
+ */
+bool NavRenderDopChartPng(const std::string &result_dir, const NavChartOptions &options, const std::string &path,
+                          std::string *error);
+
 #endif /* NAV_VIEW_CHART_H */
