@@ -260,7 +260,8 @@ void ArrayPanel::Refresh() {
     const nav_vec3 ax = custom ? s.array.custom[i].n_s_b : a.n_s_b[i];
     const double v[6] = {r.x, r.y, r.z, ax.x, ax.y, ax.z};
     for (int c = 0; c < 6; ++c) {
-      auto *it = new QTableWidgetItem(QString::number(v[c], 'g', 6));
+      // Positions to the millimetre of a metre-size array; axes to three digits (0.707).
+      auto *it = new QTableWidgetItem(QString::number(std::fabs(v[c]) < 1e-12 ? 0.0 : v[c], 'g', c < 3 ? 4 : 3));
       if (!custom) it->setFlags(it->flags() & ~Qt::ItemIsEditable);
       sensors_->setItem(i, c, it);
     }
