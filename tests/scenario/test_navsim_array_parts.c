@@ -128,11 +128,48 @@ static void test_part_errors(void **state) {
                                   "accelerometer scale factors: turn the scale-factor term off");
 }
 
+/* select --schemes ins_gnss,gyro_free_gnss --array-parts: the gyro-free/GNSS configurations range
+   over the array parts (N sensors x the part's cost), the gyro INS/GNSS ones over the IMUs. */
+static void test_select_over_parts(void **state) {
+  (void)state;
+  nav_cli_result *r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL,
+      "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss,gyro_free_gnss --imus 'Safran Sensonor STIM300' "
+      "--receivers 'standalone SPS typical (single-frequency code, open sky)' "
+      "--array-parts 'Safran Colibrys MS1002,Safran Colibrys MS1010' --runs 4 --out sel",
+      NAV_SOURCE_DIR);
+  if (r->code != 0) fail_msg("select exit %d: %s", r->code, r->err);
+  nav_test_assert_matches(r->out, "2 array parts \\(gyro_free_gnss, 6 sensors each\\) x 1 receiver x 2 schemes = 3 "
+                                  "configurations");
+  char *rank = nav_test_slurp_alloc(WORK "/sel/ranking.csv");
+  assert_non_null(rank);
+  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Colibrys MS1002\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
+  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Colibrys MS1010\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
+  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Sensonor STIM300\",\"standalone SPS[^\"]*\",ins_gnss,3,1,3,3030,");
+  free(rank);
+  char *rec = nav_test_slurp_alloc(WORK "/sel/recommended.yaml");
+  assert_non_null(rec);
+  nav_test_assert_matches(rec, "^  catalog: \"Safran Colibrys MS1002\""); /* the cheapest passing array */
+  free(rec);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes gyro_free_gnss --array-parts MS1011 "
+                        "--out sel2",
+                        NAV_SOURCE_DIR);
+  assert_int_equal(r->code, 2);
+  nav_test_assert_matches(r->err, "--array-parts: unknown accelerometer part \"MS1011\"");
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss --array-parts all --out sel3",
+                        NAV_SOURCE_DIR);
+  assert_int_equal(r->code, 2);
+  nav_test_assert_matches(r->err, "--array-parts applies to the gyro_free_gnss scheme");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_catalog_lists_parts_with_sources),
       cmocka_unit_test(test_part_changes_prediction),
       cmocka_unit_test(test_part_errors),
+      cmocka_unit_test(test_select_over_parts),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }
