@@ -196,6 +196,7 @@ static void assert_gnss_same(const nav_gnss_model_config *a, const nav_gnss_mode
 /* The accelerometer array of the gyro-free scheme, bit for bit. */
 static void assert_array_same(const nav_scene_array *a, const nav_scene_array *b) {
   assert_int_equal(a->layout, b->layout);
+  assert_string_equal(a->catalog, b->catalog);
   assert_same_double(a->radius_m, b->radius_m);
   assert_int_equal(a->custom_count, b->custom_count);
   for (int i = 0; i < a->custom_count && i < NAV_SCENE_ARRAY_MAX_SENSORS; ++i) {
@@ -1465,20 +1466,25 @@ static void test_catalog_rows_within_bounds(void **state) {
   nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
   assert_non_null(a);
   assert_non_null(b);
-  for (int kind = 0; kind < 2; ++kind) {
+  for (int kind = 0; kind < 3; ++kind) { /* IMU, GNSS receiver, array accelerometer part */
     nav_catalog *cat = NULL;
-    assert_int_equal(nav_catalog_load(kind == 0 ? NAV_SOURCE_DIR "/resources/imu_catalog.csv"
-                                                : NAV_SOURCE_DIR "/resources/gnss_receivers.csv",
+    assert_int_equal(nav_catalog_load(kind == 0   ? NAV_SOURCE_DIR "/resources/imu_catalog.csv"
+                                      : kind == 1 ? NAV_SOURCE_DIR "/resources/gnss_receivers.csv"
+                                                  : NAV_SOURCE_DIR "/resources/accel_catalog.csv",
                                       NULL, &cat, NULL, NULL),
                      NAV_OK);
     const size_t n = nav_catalog_count(cat);
     assert_true(n >= (kind == 0 ? 10u : 5u));
     for (size_t i = 0; i < n; ++i) {
-      const char *name = kind == 0 ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      const char *name = kind == 0   ? nav_catalog_imu_at(cat, i)->name
+                         : kind == 1 ? nav_catalog_gnss_at(cat, i)->name
+                                     : nav_catalog_accel_at(cat, i)->name;
       if (kind == 0)
         snprintf(text, sizeof text, "format_version: 1\nimu:\n  catalog: \"%s\"\n", name);
-      else
+      else if (kind == 1)
         snprintf(text, sizeof text, "format_version: 1\ngnss:\n  enabled: true\n  catalog: \"%s\"\n", name);
+      else
+        snprintf(text, sizeof text, "format_version: 1\narray:\n  catalog: \"%s\"\n", name);
       nav_status st = read_text(text, a, &log);
       if (st != NAV_OK) {
         print_log(&log);
@@ -1486,6 +1492,7 @@ static void test_catalog_rows_within_bounds(void **state) {
       }
       a->imu.catalog[0] = '\0';
       a->gnss.catalog[0] = '\0';
+      a->array.catalog[0] = '\0';
       assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
       st = read_path(path, b, &log);
       if (st != NAV_OK) {
