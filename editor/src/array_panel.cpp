@@ -21,7 +21,9 @@ namespace studio {
 
 namespace {
 // Three significant digits: datasheet figures are rarely given to more.
-QString Fig(double v) { return QString::number(v, 'g', 3); }
+QString Fig(double v) {
+  return QString::number(v, 'g', 3);
+}
 
 void CollectDiag(void *user, const nav_diag *d) {
   char buf[1600];
@@ -40,7 +42,8 @@ const char *const kLayoutTips[4] = {
 ArrayPanel::ArrayPanel(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
   setObjectName("arrayPanel");
   const QByteArray path = QFile::encodeName(ResourcesDir() + "/accel_catalog.csv");
-  if (nav_catalog_load(path.constData(), nullptr, &parts_, CollectDiag, &load_errors_) != NAV_OK) parts_ = nullptr;
+  if (nav_catalog_load(path.constData(), nullptr, &parts_, CollectDiag, &load_errors_) != NAV_OK)
+    parts_ = nullptr;
 
   auto *form = new QFormLayout(this);
   auto *intro = new QLabel(tr("Accelerometer array of the gyro-free schemes (gyro_free, gyro_free_gnss)."));
@@ -64,7 +67,8 @@ ArrayPanel::ArrayPanel(SceneDocument *doc, QWidget *parent) : QWidget(parent), d
     fields_.push_back(f);
     return f;
   };
-  add(tr("Arm length"), "m", "array.radius_m", [](const nav_scene &s) { return s.array.radius_m; },
+  add(
+      tr("Arm length"), "m", "array.radius_m", [](const nav_scene &s) { return s.array.radius_m; },
       [](nav_scene &s, double v) { s.array.radius_m = v; });
 
   part_ = new QComboBox;
@@ -99,10 +103,10 @@ ArrayPanel::ArrayPanel(SceneDocument *doc, QWidget *parent) : QWidget(parent), d
     double nav_array_error_config::*field;
   };
   const std::vector<Term> terms = {
-      {tr("Noise density"), "µg/√Hz", "array.accel.noise_density", NAV_IMU_TERM_NOISE, nav_unit_ug_to_mps2(1.0),
-       &nav_array_error_config::vrw_mps_per_sqrt_s},
-      {tr("Turn-on bias σ"), "mg", "array.accel.bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON, nav_unit_mg_to_mps2(1.0),
-       &nav_array_error_config::bias_turn_on_sd_mps2},
+      {tr("Noise density"), "µg/√Hz", "array.accel.noise_density", NAV_IMU_TERM_NOISE,
+       nav_unit_ug_to_mps2(1.0), &nav_array_error_config::vrw_mps_per_sqrt_s},
+      {tr("Turn-on bias σ"), "mg", "array.accel.bias_turn_on", NAV_IMU_TERM_BIAS_TURN_ON,
+       nav_unit_mg_to_mps2(1.0), &nav_array_error_config::bias_turn_on_sd_mps2},
       {tr("Bias GM σ"), "µg", "array.accel.bias_gm_sigma", NAV_IMU_TERM_BIAS_GM, nav_unit_ug_to_mps2(1.0),
        &nav_array_error_config::bias_gm_sd_mps2},
       {tr("Bias GM τ"), "s", "array.accel.bias_gm_tau", NAV_IMU_TERM_BIAS_GM, 1.0,
@@ -124,9 +128,12 @@ ArrayPanel::ArrayPanel(SceneDocument *doc, QWidget *parent) : QWidget(parent), d
                    [t](nav_scene &s) { s.array.accel.terms &= ~t.bit; });
   }
   const double r2d = 180.0 / M_PI;
-  add(tr("Initial rate σ"), "deg/s", "array.initial_rate_sd",
+  add(
+      tr("Initial rate σ"), "deg/s", "array.initial_rate_sd",
       [r2d](const nav_scene &s) { return s.array.initial_rate_sd_rps.x * r2d; },
-      [r2d](nav_scene &s, double v) { s.array.initial_rate_sd_rps = nav_vec3{v / r2d, v / r2d, v / r2d}; });
+      [r2d](nav_scene &s, double v) {
+        s.array.initial_rate_sd_rps = nav_vec3{v / r2d, v / r2d, v / r2d};
+      });
 
   sensors_ = new QTableWidget(0, 6);
   sensors_->setObjectName("arraySensors");
@@ -145,23 +152,28 @@ ArrayPanel::ArrayPanel(SceneDocument *doc, QWidget *parent) : QWidget(parent), d
   Refresh();
 }
 
-ArrayPanel::~ArrayPanel() { nav_catalog_destroy(parts_); }
+ArrayPanel::~ArrayPanel() {
+  nav_catalog_destroy(parts_);
+}
 
 QString ArrayPanel::FiguresText(const nav_catalog_accel_entry &e) {
   QStringList f;
   if (e.given & NAV_CATALOG_ACCEL_HAS_RANGE) f << tr("range ±%1 g").arg(Fig(e.range_g));
   if (e.given & NAV_CATALOG_ACCEL_HAS_BANDWIDTH) f << tr("bandwidth %1 Hz").arg(Fig(e.bandwidth_hz));
-  if (e.given & NAV_CATALOG_ACCEL_HAS_NOISE) f << tr("noise %1 µg/√Hz").arg(Fig(e.noise_density_ug_per_sqrt_hz));
+  if (e.given & NAV_CATALOG_ACCEL_HAS_NOISE)
+    f << tr("noise %1 µg/√Hz").arg(Fig(e.noise_density_ug_per_sqrt_hz));
   if (e.given & NAV_CATALOG_ACCEL_HAS_BIAS_INSTABILITY)
     f << tr("bias instability %1 µg").arg(Fig(e.bias_instability_ug));
   if (e.given & NAV_CATALOG_ACCEL_HAS_BIAS_REPEAT)
     f << tr("bias repeatability %1 mg").arg(Fig(e.bias_repeatability_mg));
-  if (e.given & NAV_CATALOG_ACCEL_HAS_SCALE_FACTOR) f << tr("scale factor %1 ppm").arg(Fig(e.scale_factor_ppm));
+  if (e.given & NAV_CATALOG_ACCEL_HAS_SCALE_FACTOR)
+    f << tr("scale factor %1 ppm").arg(Fig(e.scale_factor_ppm));
   const QString verified = e.verified == NAV_CATALOG_VERIFIED_NO
                                ? tr("NOT verified against a datasheet")
                                : tr("verified: %1").arg(QString::fromUtf8(e.verified_text));
   return tr("%1 (%2): %3.\nSource: %4\n%5")
-      .arg(QString::fromUtf8(e.name), QString::fromUtf8(e.grade), f.join(", "), QString::fromUtf8(e.source), verified);
+      .arg(QString::fromUtf8(e.name), QString::fromUtf8(e.grade), f.join(", "), QString::fromUtf8(e.source),
+           verified);
 }
 
 void ArrayPanel::ChooseLayout(int index) {
@@ -172,7 +184,8 @@ void ArrayPanel::ChooseLayout(int index) {
       nav_accel_array a;
       if (nav_array_layout_from_scene(&s.array, &a) == NAV_OK) {
         s.array.custom_count = a.n_sensors;
-        for (int i = 0; i < a.n_sensors; ++i) s.array.custom[i] = nav_scene_array_sensor{a.r_bs_b_m[i], a.n_s_b[i]};
+        for (int i = 0; i < a.n_sensors; ++i)
+          s.array.custom[i] = nav_scene_array_sensor{a.r_bs_b_m[i], a.n_s_b[i]};
       }
     }
     s.array.layout = kind;
@@ -202,7 +215,8 @@ void ArrayPanel::OnSensorCellChanged(int row, int col) {
   bool ok = false;
   const double v = sensors_->item(row, col)->text().trimmed().toDouble(&ok);
   if (!ok || !std::isfinite(v)) {
-    issues_->setText(tr("array.sensors[%1]: expected a number, got '%2'").arg(row).arg(sensors_->item(row, col)->text()));
+    issues_->setText(
+        tr("array.sensors[%1]: expected a number, got '%2'").arg(row).arg(sensors_->item(row, col)->text()));
     return;
   }
   doc_->Edit(tr("Array sensor %1").arg(row), [row, col, v](nav_scene &s) {
@@ -217,7 +231,8 @@ void ArrayPanel::Refresh() {
   refreshing_ = true;
   const nav_scene &s = doc_->Scene();
   const QVector<Issue> issues = Validate(s);
-  for (NumField *f : fields_) f->Refresh();
+  for (NumField *f : fields_)
+    f->Refresh();
   layout_->blockSignals(true);
   layout_->setCurrentIndex(static_cast<int>(s.array.layout));
   layout_->blockSignals(false);
@@ -226,7 +241,8 @@ void ArrayPanel::Refresh() {
   part_->setCurrentIndex(s.array.catalog[0] && pi > 0 ? pi : 0);
   part_->blockSignals(false);
 
-  const nav_catalog_accel_entry *e = s.array.catalog[0] ? nav_catalog_find_accel(parts_, s.array.catalog) : nullptr;
+  const nav_catalog_accel_entry *e =
+      s.array.catalog[0] ? nav_catalog_find_accel(parts_, s.array.catalog) : nullptr;
   if (!parts_)
     figures_->setText(tr("The accelerometer catalog could not be loaded:\n%1").arg(load_errors_.trimmed()));
   else if (e)
@@ -253,7 +269,8 @@ void ArrayPanel::Refresh() {
 
   sensors_->blockSignals(true);
   const bool custom = s.array.layout == NAV_ARRAY_LAYOUT_CUSTOM;
-  const int n = custom ? s.array.custom_count : (nav_array_layout_from_scene(&s.array, &a) == NAV_OK ? a.n_sensors : 0);
+  const int n =
+      custom ? s.array.custom_count : (nav_array_layout_from_scene(&s.array, &a) == NAV_OK ? a.n_sensors : 0);
   sensors_->setRowCount(n);
   for (int i = 0; i < n; ++i) {
     const nav_vec3 r = custom ? s.array.custom[i].r_bs_b_m : a.r_bs_b_m[i];
@@ -261,7 +278,8 @@ void ArrayPanel::Refresh() {
     const double v[6] = {r.x, r.y, r.z, ax.x, ax.y, ax.z};
     for (int c = 0; c < 6; ++c) {
       // Positions to the millimetre of a metre-size array; axes to three digits (0.707).
-      auto *it = new QTableWidgetItem(QString::number(std::fabs(v[c]) < 1e-12 ? 0.0 : v[c], 'g', c < 3 ? 4 : 3));
+      auto *it =
+          new QTableWidgetItem(QString::number(std::fabs(v[c]) < 1e-12 ? 0.0 : v[c], 'g', c < 3 ? 4 : 3));
       if (!custom) it->setFlags(it->flags() & ~Qt::ItemIsEditable);
       sensors_->setItem(i, c, it);
     }

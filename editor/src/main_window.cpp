@@ -722,7 +722,8 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
     // The gyro-free schemes have no IMU: their sensors are the array's (layout, arm, part).
     const bool gyro_free =
         sc.navigation.scheme == NAV_SCHEME_GYRO_FREE || sc.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
-    const QString part = sc.array.catalog[0] ? QString::fromUtf8(sc.array.catalog).toHtmlEscaped() : tr("(scene terms)");
+    const QString part =
+        sc.array.catalog[0] ? QString::fromUtf8(sc.array.catalog).toHtmlEscaped() : tr("(scene terms)");
     const QString sensors =
         gyro_free ? tr("array %1 %2 m, %3")
                         .arg(QString::fromUtf8(nav_array_layout_kind_name(sc.array.layout)))
@@ -732,7 +733,9 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
                                                        : tr("(scene terms)"));
     h += tr("<p>%1 · %2 · GNSS %3 · %4 GNSS outage(s) · %5 s at %6 Hz</p>")
              .arg(QString::fromUtf8(nav_nav_scheme_name(sc.navigation.scheme)), sensors,
-                  !sc.gnss.enabled ? tr("off") : sc.gnss.catalog[0] ? QString::fromUtf8(sc.gnss.catalog).toHtmlEscaped() : tr("(scene values)"))
+                  !sc.gnss.enabled     ? tr("off")
+                  : sc.gnss.catalog[0] ? QString::fromUtf8(sc.gnss.catalog).toHtmlEscaped()
+                                       : tr("(scene values)"))
              .arg(r->outages.size())
              .arg(s.duration_s, 0, 'f', 0)
              .arg(sc.imu.rate_hz);

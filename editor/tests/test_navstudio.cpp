@@ -270,8 +270,9 @@ private slots:
     QVERIFY(!(s.array.accel.terms & NAV_IMU_TERM_SCALE_FACTOR)); // gyro_free_gnss: no SF states
     QVERIFY2(note->text().contains("scale factor (120 ppm) is off"), qPrintable(note->text()));
     // The datasheet figures as the datasheet gives them, with the source and its check.
-    for (const char *want : {"range ±2 g", "noise 7 µg/√Hz", "bias instability 3 µg", "bias repeatability 0.24 mg",
-                             "scale factor 120 ppm", "MS1000 data sheet", "verified: yes"})
+    for (const char *want :
+         {"range ±2 g", "noise 7 µg/√Hz", "bias instability 3 µg", "bias repeatability 0.24 mg",
+          "scale factor 120 ppm", "MS1000 data sheet", "verified: yes"})
       QVERIFY2(figures->text().contains(QString::fromUtf8(want)), qPrintable(figures->text()));
     // The typed-term fields now show the part's figures in datasheet units.
     QCOMPARE(w->findChild<QLineEdit *>("array.accel.noise_density")->text(), QString("7"));
@@ -280,7 +281,8 @@ private slots:
 
     TypeInto(w->findChild<QLineEdit *>("array.radius_m"), "1");
     QCOMPARE(w->Doc()->Scene().array.radius_m, 1.0);
-    QVERIFY2(note->text().contains(QString::fromUtf8("κ/r = 0.707 /m")), qPrintable(note->text())); // 1/sqrt(2) / 1 m
+    QVERIFY2(note->text().contains(QString::fromUtf8("κ/r = 0.707 /m")),
+             qPrintable(note->text())); // 1/sqrt(2) / 1 m
     QCOMPARE(sensors->item(0, 0)->text(), QString("1"));
     // An unverified part says so.
     const int qa = part->findText("Honeywell QA-2000 Q-Flex");
@@ -293,7 +295,8 @@ private slots:
     auto r1 = w->LastResult();
     QVERIFY(r1 && r1->status == NAV_OK);
     const double sd1 = outage_sd(*r1);
-    qInfo("array_parts: filter horizontal sigma at the outage end %.3f m (20 ug/rtHz, 0.5 m) -> %.3f m (MS1002, 1 m); "
+    qInfo("array_parts: filter horizontal sigma at the outage end %.3f m (20 ug/rtHz, 0.5 m) -> %.3f m "
+          "(MS1002, 1 m); "
           "h-outage-end over 4 runs %.3f -> %.3f m",
           sd0, sd1, r0->verdicts[0].value, r1->verdicts[0].value);
     // navsim estimate predicts 3.18 m -> 2.40 m for the two scenes (ratio 0.75).

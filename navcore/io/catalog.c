@@ -381,10 +381,11 @@ static bool parse_header(ctx *c, record *r, header *h) {
   const int n_keys = (int)has_name + (int)has_mode + (int)has_part;
   if (n_keys != 1) {
     diag(c, r->line, 1, "",
-         n_keys > 1 ? "the header has more than one of the key columns 'name' (IMU), 'mode' (GNSS) and 'part' "
-                      "(accelerometer)"
-                    : "not a sensor catalog: the header needs a 'name' column (IMU catalog), a 'mode' column "
-                      "(GNSS catalog) or a 'part' column (accelerometer catalog)");
+         n_keys > 1
+             ? "the header has more than one of the key columns 'name' (IMU), 'mode' (GNSS) and 'part' "
+               "(accelerometer)"
+             : "not a sensor catalog: the header needs a 'name' column (IMU catalog), a 'mode' column "
+               "(GNSS catalog) or a 'part' column (accelerometer catalog)");
     return false;
   }
   h->kind = has_name ? NAV_CATALOG_IMU : has_mode ? NAV_CATALOG_GNSS : NAV_CATALOG_ACCEL;
@@ -417,7 +418,9 @@ static bool parse_header(ctx *c, record *r, header *h) {
         diag(c, r->f[i].line, r->f[i].col, s, "unknown column (did you mean '%s'?)", cols[best]);
       else
         diag(c, r->f[i].line, r->f[i].col, s, "unknown column of a %s catalog",
-             has_name ? "IMU" : has_mode ? "GNSS" : "accelerometer");
+             has_name   ? "IMU"
+             : has_mode ? "GNSS"
+                        : "accelerometer");
       ok = false;
     } else if (h->file_of_table[k] >= 0) {
       diag(c, r->f[i].line, r->f[i].col, s, "duplicate column (first in column %d)", h->file_of_table[k] + 1);
@@ -761,14 +764,16 @@ static void convert_accel(row *w, const nav_catalog_options *opt, nav_catalog_ac
     case NAV_CATALOG_BIAS_ALLAN_MIN:
       a->terms |= NAV_IMU_TERM_BIAS_GM;
       a->bias_gm_sd_mps2 = nav_gm_sigma_from_bias_instability(bi, opt->convention);
-      a->bias_gm_tau_s = has_t ? corr
-                               : (is_nav_grade(e->grade) ? opt->default_tau_min_nav_s : opt->default_tau_min_mems_s) /
-                                     NAV_GM_ALLAN_PEAK_TAU_RATIO;
+      a->bias_gm_tau_s =
+          has_t ? corr
+                : (is_nav_grade(e->grade) ? opt->default_tau_min_nav_s : opt->default_tau_min_mems_s) /
+                      NAV_GM_ALLAN_PEAK_TAU_RATIO;
       break;
     case NAV_CATALOG_BIAS_GM_SIGMA:
       if (!has_t) {
         const field *f = cell(w, A_BIAS_MODEL);
-        diag(w->c, f->line, f->col, accel_cols[A_BIAS_MODEL], "gm_sigma needs bias_corr_time_s (the GM correlation time)");
+        diag(w->c, f->line, f->col, accel_cols[A_BIAS_MODEL],
+             "gm_sigma needs bias_corr_time_s (the GM correlation time)");
         w->ok = false;
       }
       a->terms |= NAV_IMU_TERM_BIAS_GM;
@@ -865,13 +870,13 @@ void nav_catalog_destroy(nav_catalog *cat) {
 }
 
 static const char *entry_name(const nav_catalog *cat, size_t i) {
-  return cat->kind == NAV_CATALOG_IMU ? cat->imu[i].name
+  return cat->kind == NAV_CATALOG_IMU    ? cat->imu[i].name
          : cat->kind == NAV_CATALOG_GNSS ? cat->gnss[i].name
                                          : cat->accel[i].name;
 }
 
 static int entry_line(const nav_catalog *cat, size_t i) {
-  return cat->kind == NAV_CATALOG_IMU ? cat->imu[i].line
+  return cat->kind == NAV_CATALOG_IMU    ? cat->imu[i].line
          : cat->kind == NAV_CATALOG_GNSS ? cat->gnss[i].line
                                          : cat->accel[i].line;
 }

@@ -186,8 +186,9 @@ static void imu_table(const nav_catalog *cat, const char *path, const nav_catalo
 }
 
 static void accel_csv(const nav_catalog *cat) {
-  printf("part,grade,range_g,bandwidth_hz,vrw_mps_per_sqrt_s,bias_gm_sd_mps2,bias_gm_tau_s,bias_turn_on_sd_mps2,"
-         "scale_factor_sd,bias_model,cost_class,cost_band,verified,source\n");
+  printf(
+      "part,grade,range_g,bandwidth_hz,vrw_mps_per_sqrt_s,bias_gm_sd_mps2,bias_gm_tau_s,bias_turn_on_sd_mps2,"
+      "scale_factor_sd,bias_model,cost_class,cost_band,verified,source\n");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
     const nav_array_error_config *a = &e->config;
@@ -201,7 +202,8 @@ static void accel_csv(const nav_catalog *cat) {
     csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_tau_s);
     csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_TURN_ON, a->bias_turn_on_sd_mps2);
     csv_num(stdout, a->terms & NAV_IMU_TERM_SCALE_FACTOR, a->scale_factor_sd);
-    printf(",%s,%d,%s,", nav_catalog_bias_model_name(e->bias_model), e->cost_class, nav_catalog_cost_band(e->cost_class));
+    printf(",%s,%d,%s,", nav_catalog_bias_model_name(e->bias_model), e->cost_class,
+           nav_catalog_cost_band(e->cost_class));
     csv_text(stdout, e->verified_text);
     fputc(',', stdout);
     csv_text(stdout, e->source);
@@ -217,12 +219,12 @@ static void accel_table(const nav_catalog *cat, const char *path, const nav_cata
   printf("Datasheet figures of one sensitive axis; model per sensor, 1 sigma: noise density = VRW, bias\n"
          "instability B -> Gauss-Markov with %s, T = tau_min / 1.8926 (tau_min %g s MEMS, %g s\n"
          "navigation grades), bias repeatability -> turn-on bias, scale factor -> per-run constant.\n\n",
-         opt->convention == NAV_BI_ALLAN_PEAK ? "sigma = B / 0.61736" : "sigma = B", opt->default_tau_min_mems_s,
-         opt->default_tau_min_nav_s);
+         opt->convention == NAV_BI_ALLAN_PEAK ? "sigma = B / 0.61736" : "sigma = B",
+         opt->default_tau_min_mems_s, opt->default_tau_min_nav_s);
   printf("%-28s %-28s |%6s %6s %9s %8s %8s %6s |%9s %7s  %-4s %s\n", "", "", "range", "bw", "noise", "bias",
          "bias rep", "SF", "GM bias", "T", "cost", "verified");
-  printf("%-28s %-28s |%6s %6s %9s %8s %8s %6s |%9s %7s  %-4s\n", "part", "grade", "g", "Hz", "ug/rt-Hz", "ug",
-         "mg", "ppm", "ug", "s", "cls");
+  printf("%-28s %-28s |%6s %6s %9s %8s %8s %6s |%9s %7s  %-4s\n", "part", "grade", "g", "Hz", "ug/rt-Hz",
+         "ug", "mg", "ppm", "ug", "s", "cls");
   for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
     const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
     const nav_array_error_config *a = &e->config;

@@ -66,9 +66,7 @@ static const char *k_usage_select =
     "               monte_carlo) and the margin (smallest (limit - value) / limit); passing\n"
     "               configurations first, cheapest first, then not_confirmed, then failing ones\n"
     "  recommended.yaml  the scene with the recommended configuration\n"
-    "The terminal shows the recommendation and why each cheaper configuration fails.\n"
-    NAVSIM_OUT_HELP
-    "\n"
+    "The terminal shows the recommendation and why each cheaper configuration fails.\n" NAVSIM_OUT_HELP "\n"
     "options:\n"
     "  --imus NAMES       IMU names separated by commas, or all (default)\n"
     "  --receivers NAMES  receiver modes separated by commas, or all (default)\n"
@@ -508,15 +506,15 @@ int navsim_select(int argc, char **argv) {
       quiet = true;
     } else if (strcmp(a, "--force") == 0) {
       force = true;
-    } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") || !strcmp(a, "--schemes") ||
-               !strcmp(a, "--array-parts") ||
-               !strcmp(a, "--runs") || !strcmp(a, "--threads") || !strcmp(a, "--band") ||
-               !strcmp(a, "--predict-rate")) {
+    } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") ||
+               !strcmp(a, "--schemes") || !strcmp(a, "--array-parts") || !strcmp(a, "--runs") ||
+               !strcmp(a, "--threads") || !strcmp(a, "--band") || !strcmp(a, "--predict-rate")) {
       if (!navsim_need_value("select", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (!strcmp(a, "--out")) out_dir = v;
       else if (!strcmp(a, "--imus")) imus_s = v;
-      else if (!strcmp(a, "--array-parts")) parts_s = v;
+      else if (!strcmp(a, "--array-parts"))
+        parts_s = v;
       else if (!strcmp(a, "--receivers")) rcv_s = v;
       else if (!strcmp(a, "--schemes")) schemes_s = v;
       else if (!strcmp(a, "--runs")) {
@@ -561,7 +559,8 @@ int navsim_select(int argc, char **argv) {
   int rc = EXIT_FAIL;
   nav_scene *base = malloc(sizeof *base), *sc = malloc(sizeof *sc);
   nav_catalog *imus = NULL, *gnss = NULL, *parts = NULL;
-  int *imu_idx = NULL, *rcv_idx = NULL, *part_idx = NULL, n_imu = 0, n_rcv = 0, n_part = 0, n_array_sensors = 0;
+  int *imu_idx = NULL, *rcv_idx = NULL, *part_idx = NULL, n_imu = 0, n_rcv = 0, n_part = 0,
+      n_array_sensors = 0;
   combo *c = NULL;
   size_t n = 0;
   nav_resultdir *rd = NULL;
@@ -637,15 +636,18 @@ int navsim_select(int argc, char **argv) {
   if (rc == EXIT_OK) rc = parse_names(rcv_s, gnss, &rcv_idx, &n_rcv);
   if (rc == EXIT_OK && parts_s) {
     bool gf = false;
-    for (int k = 0; k < n_sch; ++k) gf = gf || schemes[k] == NAV_SCHEME_GYRO_FREE_GNSS;
+    for (int k = 0; k < n_sch; ++k)
+      gf = gf || schemes[k] == NAV_SCHEME_GYRO_FREE_GNSS;
     if (!gf) {
-      fprintf(stderr, "navsim select: --array-parts applies to the gyro_free_gnss scheme (add it to --schemes)\n");
+      fprintf(stderr,
+              "navsim select: --array-parts applies to the gyro_free_gnss scheme (add it to --schemes)\n");
       rc = EXIT_INVALID;
     } else {
       rc = parse_names(parts_s, parts, &part_idx, &n_part);
     }
     nav_accel_array layout;
-    if (rc == EXIT_OK && nav_array_layout_from_scene(&base->array, &layout) == NAV_OK) n_array_sensors = layout.n_sensors;
+    if (rc == EXIT_OK && nav_array_layout_from_scene(&base->array, &layout) == NAV_OK)
+      n_array_sensors = layout.n_sensors;
   }
   if (rc != EXIT_OK) goto done;
   rc = EXIT_FAIL;
@@ -697,7 +699,8 @@ int navsim_select(int argc, char **argv) {
            base->name, n_imu, n_imu == 1 ? "" : "s", n_rcv, n_rcv == 1 ? "" : "s", n_sch, n_sch == 1 ? "" : "s", n,
            x.n_req, x.n_req == 1 ? "" : "s");
   else if (!quiet)
-    printf("select     %s: %d IMU%s or %d array part%s (gyro_free_gnss, %d sensors each) x %d receiver%s x %d scheme%s = "
+    printf("select     %s: %d IMU%s or %d array part%s (gyro_free_gnss, %d sensors each) x %d receiver%s x "
+           "%d scheme%s = "
            "%zu configurations, %d requirement%s\n",
            base->name, n_imu, n_imu == 1 ? "" : "s", n_part, n_part == 1 ? "" : "s", n_array_sensors, n_rcv,
            n_rcv == 1 ? "" : "s", n_sch, n_sch == 1 ? "" : "s", n, x.n_req, x.n_req == 1 ? "" : "s");

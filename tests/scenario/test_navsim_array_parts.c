@@ -64,8 +64,10 @@ static void test_catalog_lists_parts_with_sources(void **state) {
   }
   free(csv);
   assert_true(rows >= 6);
-  nav_test_assert_matches(r->out, "^Safran Colibrys MS1010 +tactical MEMS +\\| +10 +- +34 +15 +1\\.2 +120 \\|");
-  nav_test_assert_matches(r->out, "MS1010 \\[line [0-9]+, verified: yes\\]: Safran Colibrys MS1000 data sheet");
+  nav_test_assert_matches(r->out,
+                          "^Safran Colibrys MS1010 +tactical MEMS +\\| +10 +- +34 +15 +1\\.2 +120 \\|");
+  nav_test_assert_matches(r->out,
+                          "MS1010 \\[line [0-9]+, verified: yes\\]: Safran Colibrys MS1000 data sheet");
   nav_test_assert_matches(r->out, "^Honeywell QA-2000 Q-Flex .*NO \\(unverified\\)$");
   /* CSV in SI: the model of each part. */
   r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "catalog --accel --csv");
@@ -118,48 +120,57 @@ static void test_part_errors(void **state) {
   write_car("unknown2.yaml", "  layout: cube6\n  radius_m: 0.5\n  catalog: ADXL999\n");
   r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "check unknown2.yaml");
   assert_int_equal(r->code, 2);
-  nav_test_assert_matches(r->err, "^unknown2\\.yaml:53:12: error: array\\.catalog: unknown accelerometer part "
-                                  "\"ADXL999\"; `navsim catalog --accel` lists the [0-9]+ entries of ");
+  nav_test_assert_matches(r->err,
+                          "^unknown2\\.yaml:53:12: error: array\\.catalog: unknown accelerometer part "
+                          "\"ADXL999\"; `navsim catalog --accel` lists the [0-9]+ entries of ");
   /* The part's scale factor is a term the gyro-free/GNSS filter refuses: said where, and how. */
   write_car("sf.yaml", "  layout: cube6\n  radius_m: 0.5\n  catalog: Safran Colibrys MS1010\n");
   r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "check sf.yaml");
   assert_int_equal(r->code, 2);
-  nav_test_assert_matches(r->err, "^sf\\.yaml:[0-9]+:[0-9]+: error: array\\.accel: gyro_free_gnss does not estimate "
-                                  "accelerometer scale factors: turn the scale-factor term off");
+  nav_test_assert_matches(r->err,
+                          "^sf\\.yaml:[0-9]+:[0-9]+: error: array\\.accel: gyro_free_gnss does not estimate "
+                          "accelerometer scale factors: turn the scale-factor term off");
 }
 
 /* select --schemes ins_gnss,gyro_free_gnss --array-parts: the gyro-free/GNSS configurations range
    over the array parts (N sensors x the part's cost), the gyro INS/GNSS ones over the IMUs. */
 static void test_select_over_parts(void **state) {
   (void)state;
-  nav_cli_result *r = nav_test_run_clif(
-      NAVSIM_EXE, WORK, NULL,
-      "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss,gyro_free_gnss --imus 'Safran Sensonor STIM300' "
-      "--receivers 'standalone SPS typical (single-frequency code, open sky)' "
-      "--array-parts 'Safran Colibrys MS1002,Safran Colibrys MS1010' --runs 4 --out sel",
-      NAV_SOURCE_DIR);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss,gyro_free_gnss --imus "
+                        "'Safran Sensonor STIM300' "
+                        "--receivers 'standalone SPS typical (single-frequency code, open sky)' "
+                        "--array-parts 'Safran Colibrys MS1002,Safran Colibrys MS1010' --runs 4 --out sel",
+                        NAV_SOURCE_DIR);
   if (r->code != 0) fail_msg("select exit %d: %s", r->code, r->err);
-  nav_test_assert_matches(r->out, "2 array parts \\(gyro_free_gnss, 6 sensors each\\) x 1 receiver x 2 schemes = 3 "
-                                  "configurations");
+  nav_test_assert_matches(r->out,
+                          "2 array parts \\(gyro_free_gnss, 6 sensors each\\) x 1 receiver x 2 schemes = 3 "
+                          "configurations");
   char *rank = nav_test_slurp_alloc(WORK "/sel/ranking.csv");
   assert_non_null(rank);
-  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Colibrys MS1002\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
-  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Colibrys MS1010\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
-  nav_test_assert_matches(rank, "^[0-9]+,\"Safran Sensonor STIM300\",\"standalone SPS[^\"]*\",ins_gnss,3,1,3,3030,");
+  nav_test_assert_matches(
+      rank, "^[0-9]+,\"Safran Colibrys MS1002\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
+  nav_test_assert_matches(
+      rank, "^[0-9]+,\"Safran Colibrys MS1010\",\"standalone SPS[^\"]*\",gyro_free_gnss,2,1,2,1830,");
+  nav_test_assert_matches(
+      rank, "^[0-9]+,\"Safran Sensonor STIM300\",\"standalone SPS[^\"]*\",ins_gnss,3,1,3,3030,");
   free(rank);
   char *rec = nav_test_slurp_alloc(WORK "/sel/recommended.yaml");
   assert_non_null(rec);
   nav_test_assert_matches(rec, "^  catalog: \"Safran Colibrys MS1002\""); /* the cheapest passing array */
   free(rec);
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                        "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes gyro_free_gnss --array-parts MS1011 "
-                        "--out sel2",
-                        NAV_SOURCE_DIR);
+  r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL,
+      "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes gyro_free_gnss --array-parts MS1011 "
+      "--out sel2",
+      NAV_SOURCE_DIR);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--array-parts: unknown accelerometer part \"MS1011\"");
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                        "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss --array-parts all --out sel3",
-                        NAV_SOURCE_DIR);
+  r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL,
+      "select '%s/scenes/gyro-free-gnss-car.yaml' --schemes ins_gnss --array-parts all --out sel3",
+      NAV_SOURCE_DIR);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--array-parts applies to the gyro_free_gnss scheme");
 }

@@ -1267,10 +1267,12 @@ static void test_imu_catalog(void **state) {
 static void test_array_catalog(void **state) {
   (void)state;
   nav_catalog *cat = NULL;
-  assert_int_equal(nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, NULL, NULL), NAV_OK);
+  assert_int_equal(nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, NULL, NULL),
+                   NAV_OK);
   const nav_catalog_accel_entry *e = nav_catalog_find_accel(cat, "Safran Colibrys MS1010");
   assert_non_null(e);
-  nav_scene s = read_ok("format_version: 1\narray: {layout: cube6, radius_m: 0.3, catalog: safran colibrys ms1010}\n");
+  nav_scene s =
+      read_ok("format_version: 1\narray: {layout: cube6, radius_m: 0.3, catalog: safran colibrys ms1010}\n");
   assert_string_equal(s.array.catalog, "Safran Colibrys MS1010");
   assert_int_equal(s.array.accel.terms, e->config.terms);
   assert_same_double(s.array.accel.vrw_mps_per_sqrt_s, e->config.vrw_mps_per_sqrt_s);
@@ -1278,7 +1280,7 @@ static void test_array_catalog(void **state) {
   assert_same_double(s.array.accel.bias_gm_sd_mps2, e->config.bias_gm_sd_mps2);
   assert_same_double(s.array.accel.bias_gm_tau_s, e->config.bias_gm_tau_s);
   assert_rel_near(s.array.accel.bias_turn_on_sd_mps2, 1.2e-3 * 9.80665, 1e-12); /* 1.2 mg */
-  assert_rel_near(s.array.accel.scale_factor_sd, 120e-6, 1e-12);                 /* 120 ppm */
+  assert_rel_near(s.array.accel.scale_factor_sd, 120e-6, 1e-12);                /* 120 ppm */
   /* Typed values override the part; the part is read first even when written last. */
   s = read_ok("format_version: 1\narray:\n  accel: {noise_density_ug_per_sqrt_hz: 20, off: [scale_factor]}\n"
               "  catalog: Safran Colibrys MS1010\n");

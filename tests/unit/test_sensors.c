@@ -1259,7 +1259,8 @@ static void test_accel_catalog_resources(void **state) {
   static diag_log log;
   memset(&log, 0, sizeof log);
   nav_catalog *cat = NULL;
-  const nav_status st = nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, collect, &log);
+  const nav_status st =
+      nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, collect, &log);
   print_log(&log);
   assert_int_equal(st, NAV_OK);
   assert_int_equal(nav_catalog_get_kind(cat), NAV_CATALOG_ACCEL);

@@ -75,7 +75,7 @@ NAV_BEGIN_DECLS
 
 /** Which catalog a file holds (recognised from its header). */
 typedef enum nav_catalog_kind {
-  NAV_CATALOG_IMU = 0, /**< resources/imu_catalog.csv */
+  NAV_CATALOG_IMU = 0,  /**< resources/imu_catalog.csv */
   NAV_CATALOG_GNSS = 1, /**< resources/gnss_receivers.csv */
   NAV_CATALOG_ACCEL = 2 /**< resources/accel_catalog.csv (parts for accelerometer arrays) */
 } nav_catalog_kind;
@@ -154,11 +154,11 @@ typedef struct nav_catalog_accel_entry {
   char verified_text[NAV_CATALOG_VERIFIED_MAX]; /**< verified_in_corpus, verbatim */
   nav_catalog_verification verified;
   nav_catalog_bias_model bias_model;
-  int cost_class; /**< indicative cost class 1..NAV_CATALOG_COST_CLASS_MAX; 0: not given */
-  int line;       /**< 1-based line of the row in the file */
-  unsigned given; /**< OR of ::nav_catalog_accel_given */
-  double range_g;                      /**< full scale, +/- [g] */
-  double bandwidth_hz;                 /**< bandwidth [Hz] */
+  int cost_class;      /**< indicative cost class 1..NAV_CATALOG_COST_CLASS_MAX; 0: not given */
+  int line;            /**< 1-based line of the row in the file */
+  unsigned given;      /**< OR of ::nav_catalog_accel_given */
+  double range_g;      /**< full scale, +/- [g] */
+  double bandwidth_hz; /**< bandwidth [Hz] */
   double noise_density_ug_per_sqrt_hz; /**< white-noise density [ug/sqrt(Hz)] */
   double bias_instability_ug;          /**< bias instability [ug] (meaning: bias_model) */
   double bias_repeatability_mg;        /**< run-to-run bias [mg] */
