@@ -314,6 +314,25 @@ private slots:
     w->Panels()->setCurrentIndex(tab);
     w->findChild<QTabWidget *>("bottomTabs")->setCurrentIndex(1);
     Shot(w.get(), "array-03-run");
+
+    // Layouts: nine shows its nine sensors; custom starts from the geometry in use and its table
+    // is editable, one undoable edit per cell.
+    Choose(layout, "nine", Qt::MatchExactly);
+    QCOMPARE(static_cast<int>(w->Doc()->Scene().array.layout), static_cast<int>(NAV_ARRAY_LAYOUT_NINE));
+    QCOMPARE(sensors->rowCount(), 9);
+    QVERIFY(!(sensors->item(0, 0)->flags() & Qt::ItemIsEditable));
+    Choose(layout, "custom", Qt::MatchExactly);
+    const nav_scene_array &arr = w->Doc()->Scene().array;
+    QCOMPARE(static_cast<int>(arr.layout), static_cast<int>(NAV_ARRAY_LAYOUT_CUSTOM));
+    QCOMPARE(arr.custom_count, 9);
+    QCOMPARE(sensors->rowCount(), 9);
+    QVERIFY(sensors->item(0, 0)->flags() & Qt::ItemIsEditable);
+    const double x_before = arr.custom[3].r_bs_b_m.x;
+    sensors->item(3, 0)->setText("0.9");
+    QCOMPARE(w->Doc()->Scene().array.custom[3].r_bs_b_m.x, 0.9);
+    w->Doc()->UndoStack()->undo();
+    QCOMPARE(w->Doc()->Scene().array.custom[3].r_bs_b_m.x, x_before);
+    Shot(w.get(), "array-04-custom");
   }
 
   // Fields validate as the user types, with the messages of `navsim check`; nothing is
