@@ -233,6 +233,8 @@ void ArrayPanel::Refresh() {
   const QVector<Issue> issues = Validate(s);
   for (NumField *f : fields_)
     f->Refresh();
+  // fields_[0] is the arm length: the custom layout has its own positions.
+  fields_[0]->setEnabled(s.array.layout != NAV_ARRAY_LAYOUT_CUSTOM);
   layout_->blockSignals(true);
   layout_->setCurrentIndex(static_cast<int>(s.array.layout));
   layout_->blockSignals(false);
