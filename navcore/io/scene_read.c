@@ -34,7 +34,8 @@
  *   Sensor figures are given in datasheet units (deg/h, deg/sqrt(h), mg, ug, ppm, mrad, ...) or
  *   in SI; they are converted once, here, by the factors of the nav_unit_* helpers.
  * - Keys are read in any order (YAML mappings are unordered): the keys that others build on
- *   (imu.bias_convention, imu.catalog, gnss.catalog) are applied first, "off" lists last.
+ *   (imu.bias_convention, imu.catalog, gnss.catalog, array.catalog) are applied first, "off" lists
+ *   last; array.catalog converts allan_min rows with imu.bias_convention, read before it.
  * - An empty section ("imu:") means all defaults.
  */
 #define _POSIX_C_SOURCE 200809L
