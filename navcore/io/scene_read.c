@@ -35,7 +35,7 @@
  *   in SI; they are converted once, here, by the factors of the nav_unit_* helpers.
  * - Keys are read in any order (YAML mappings are unordered): the keys that others build on
  *   (imu.bias_convention, imu.catalog, gnss.catalog, array.catalog) are applied first, "off" lists
- *   last; array.catalog converts allan_min rows with imu.bias_convention, read before it.
+ *   last; array.catalog converts allan_min rows with the default convention (allan_peak).
  * - An empty section ("imu:") means all defaults.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -2214,7 +2214,10 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
   }
   snprintf(path, sizeof path, "%s/%s", dir, file);
   nav_catalog_options opt = nav_catalog_options_default();
-  opt.convention = (nav_bi_convention)r->state.bias_convention;
+  /* imu.bias_convention belongs to the IMU section, which a file may place after the array: the
+     array's parts always use the default convention so that the order of the sections does not
+     matter (nav_catalog.h; docs/gyro-free-gnss.md section 8). */
+  if (!arr) opt.convention = (nav_bi_convention)r->state.bias_convention;
   const nav_status st = nav_catalog_load(path, &opt, &cat, forward_diag, r);
   if (st != NAV_OK) {
     nav_io_reader_error(r, v, key, "cannot load the %s catalog %s (%s)", what, path, nav_status_str(st));
