@@ -719,10 +719,23 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
            .arg(r->wall_s, 0, 'f', 1);
   {
     const nav_scene &sc = doc_.Scene();
-    h += tr("<p>%1 · IMU %2 · GNSS %3 · %4 GNSS outage(s) · %5 s at %6 Hz</p>")
-             .arg(QString::fromUtf8(nav_nav_scheme_name(sc.navigation.scheme)),
-                  sc.imu.catalog[0] ? QString::fromUtf8(sc.imu.catalog).toHtmlEscaped() : tr("(scene terms)"),
-                  !sc.gnss.enabled ? tr("off") : sc.gnss.catalog[0] ? QString::fromUtf8(sc.gnss.catalog).toHtmlEscaped() : tr("(scene values)"))
+    // The gyro-free schemes have no IMU: their sensors are the array's (layout, arm, part).
+    const bool gyro_free =
+        sc.navigation.scheme == NAV_SCHEME_GYRO_FREE || sc.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+    const QString part =
+        sc.array.catalog[0] ? QString::fromUtf8(sc.array.catalog).toHtmlEscaped() : tr("(scene terms)");
+    const QString sensors =
+        gyro_free ? tr("array %1 %2 m, %3")
+                        .arg(QString::fromUtf8(nav_array_layout_kind_name(sc.array.layout)))
+                        .arg(sc.array.radius_m)
+                        .arg(part)
+                  : tr("IMU %1").arg(sc.imu.catalog[0] ? QString::fromUtf8(sc.imu.catalog).toHtmlEscaped()
+                                                       : tr("(scene terms)"));
+    h += tr("<p>%1 · %2 · GNSS %3 · %4 GNSS outage(s) · %5 s at %6 Hz</p>")
+             .arg(QString::fromUtf8(nav_nav_scheme_name(sc.navigation.scheme)), sensors,
+                  !sc.gnss.enabled     ? tr("off")
+                  : sc.gnss.catalog[0] ? QString::fromUtf8(sc.gnss.catalog).toHtmlEscaped()
+                                       : tr("(scene values)"))
              .arg(r->outages.size())
              .arg(s.duration_s, 0, 'f', 0)
              .arg(sc.imu.rate_hz);

@@ -1,4 +1,5 @@
 #include "panels.h"
+#include "array_panel.h"
 #include "path_view.h"
 #include "schema_fields.h"
 #include "segment_editor.h"
@@ -169,6 +170,7 @@ ScenePanels::ScenePanels(SceneDocument *doc, Catalogs *catalogs, QWidget *parent
   addTab(new TrajectoryEditors(doc_, BuildTrajectory()), tr("Trajectory")); // waypoints, segments, parametric
   addTab(ScrolledPanel(BuildSimulation()), tr("Simulation"));
   addTab(BuildRequirements(), tr("Requirements"));
+  addTab(ScrolledPanel(new ArrayPanel(doc_)), tr("Array")); // issue 21: layout, arm, accelerometer part
   connect(doc_, &SceneDocument::Changed, this, &ScenePanels::Refresh);
   Refresh();
 }

@@ -320,6 +320,47 @@ static const char *const gnss_cols[G_COUNT] = {"mode",
 static const bool gnss_required[G_COUNT] = {[G_MODE] = true, [G_H_SD] = true,   [G_V_SD] = true,
                                             [G_RATE] = true, [G_SOURCE] = true, [G_VERIFIED] = true};
 
+enum accel_col {
+  A_PART,
+  A_GRADE,
+  A_RANGE_G,
+  A_BANDWIDTH_HZ,
+  A_NOISE_UG,
+  A_NOISE_SI,
+  A_BI_UG,
+  A_BI_SI,
+  A_REPEAT_MG,
+  A_SF_PPM,
+  A_CORR_TIME_S,
+  A_BIAS_MODEL,
+  A_SOURCE,
+  A_VERIFIED,
+  A_COST_CLASS,
+  A_COUNT
+};
+
+static const char *const accel_cols[A_COUNT] = {"part",
+                                                "grade",
+                                                "range_g",
+                                                "bandwidth_hz",
+                                                "noise_density_ug_per_sqrt_hz",
+                                                "noise_density_m_per_s2_per_sqrt_hz",
+                                                "bias_instability_ug",
+                                                "bias_instability_m_per_s2",
+                                                "bias_repeatability_mg",
+                                                "scale_factor_ppm",
+                                                "bias_corr_time_s",
+                                                "bias_model",
+                                                "source",
+                                                "verified_in_corpus",
+                                                "cost_class"};
+static const bool accel_required[A_COUNT] = {
+    [A_PART] = true, [A_GRADE] = true, [A_SOURCE] = true, [A_VERIFIED] = true};
+
+/* Largest accepted range and bandwidth (plausibility only: no scene key takes them). */
+#define ACCEL_MAX_RANGE_G 1.0e5
+#define ACCEL_MAX_BANDWIDTH_HZ 1.0e6
+
 /* Header: map file column -> table column (-1 unknown). */
 typedef struct header {
   nav_catalog_kind kind;
@@ -329,26 +370,28 @@ typedef struct header {
 } header;
 
 static bool parse_header(ctx *c, record *r, header *h) {
-  bool has_name = false, has_mode = false;
+  bool has_name = false, has_mode = false, has_part = false;
   for (size_t i = 0; i < r->n; ++i) {
     r->f[i].s = trim(r->f[i].s);
     const char *s = r->f[i].s;
     if (strcmp(s, "name") == 0) has_name = true;
     if (strcmp(s, "mode") == 0) has_mode = true;
+    if (strcmp(s, "part") == 0) has_part = true;
   }
-  if (has_name == has_mode) {
-    diag(
-        c, r->line, 1, "",
-        has_name
-            ? "the header has both a 'name' (IMU) and a 'mode' (GNSS) column"
-            : "not a sensor catalog: the header needs a 'name' column (IMU catalog) or a 'mode' column (GNSS "
-              "catalog)");
+  const int n_keys = (int)has_name + (int)has_mode + (int)has_part;
+  if (n_keys != 1) {
+    diag(c, r->line, 1, "",
+         n_keys > 1
+             ? "the header has more than one of the key columns 'name' (IMU), 'mode' (GNSS) and 'part' "
+               "(accelerometer)"
+             : "not a sensor catalog: the header needs a 'name' column (IMU catalog), a 'mode' column "
+               "(GNSS catalog) or a 'part' column (accelerometer catalog)");
     return false;
   }
-  h->kind = has_name ? NAV_CATALOG_IMU : NAV_CATALOG_GNSS;
-  const char *const *cols = has_name ? imu_cols : gnss_cols;
-  const bool *required = has_name ? imu_required : gnss_required;
-  const int ncols = has_name ? I_COUNT : G_COUNT;
+  h->kind = has_name ? NAV_CATALOG_IMU : has_mode ? NAV_CATALOG_GNSS : NAV_CATALOG_ACCEL;
+  const char *const *cols = has_name ? imu_cols : has_mode ? gnss_cols : accel_cols;
+  const bool *required = has_name ? imu_required : has_mode ? gnss_required : accel_required;
+  const int ncols = has_name ? I_COUNT : has_mode ? G_COUNT : A_COUNT;
   for (int k = 0; k < ncols; ++k)
     h->file_of_table[k] = -1;
   h->n_file = r->n;
@@ -374,7 +417,10 @@ static bool parse_header(ctx *c, record *r, header *h) {
       if (best >= 0 && best_d <= 3)
         diag(c, r->f[i].line, r->f[i].col, s, "unknown column (did you mean '%s'?)", cols[best]);
       else
-        diag(c, r->f[i].line, r->f[i].col, s, "unknown column of a %s catalog", has_name ? "IMU" : "GNSS");
+        diag(c, r->f[i].line, r->f[i].col, s, "unknown column of a %s catalog",
+             has_name   ? "IMU"
+             : has_mode ? "GNSS"
+                        : "accelerometer");
       ok = false;
     } else if (h->file_of_table[k] >= 0) {
       diag(c, r->f[i].line, r->f[i].col, s, "duplicate column (first in column %d)", h->file_of_table[k] + 1);
@@ -529,6 +575,18 @@ static bool is_nav_grade(const char *grade) {
   return strstr(g, "fog") || strstr(g, "rlg") || strncmp(g, "navigation", 10) == 0;
 }
 
+/* The bias_model column of table column k (IMU and accelerometer rows); allan_min when empty. */
+static nav_catalog_bias_model bias_model(row *w, int k) {
+  const field *bm = cell(w, k);
+  if (!bm || bm->s[0] == '\0') return NAV_CATALOG_BIAS_ALLAN_MIN;
+  if (strcmp(bm->s, "allan_min") == 0) return NAV_CATALOG_BIAS_ALLAN_MIN;
+  if (strcmp(bm->s, "gm_sigma") == 0) return NAV_CATALOG_BIAS_GM_SIGMA;
+  if (strcmp(bm->s, "turn_on") == 0) return NAV_CATALOG_BIAS_TURN_ON;
+  diag(w->c, bm->line, bm->col, w->cols[k], "'%s' must be allan_min, gm_sigma or turn_on", bm->s);
+  w->ok = false;
+  return NAV_CATALOG_BIAS_ALLAN_MIN;
+}
+
 /* ------------------------------------------------------------------ rows -> entries */
 
 static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_entry *e) {
@@ -541,21 +599,7 @@ static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_
   e->verified = verification(w, I_VERIFIED, e->verified_text);
   e->cost_class = cost_class(w, I_COST_CLASS);
 
-  e->bias_model = NAV_CATALOG_BIAS_ALLAN_MIN;
-  const field *bm = cell(w, I_BIAS_MODEL);
-  if (bm && bm->s[0] != '\0') {
-    if (strcmp(bm->s, "allan_min") == 0)
-      e->bias_model = NAV_CATALOG_BIAS_ALLAN_MIN;
-    else if (strcmp(bm->s, "gm_sigma") == 0)
-      e->bias_model = NAV_CATALOG_BIAS_GM_SIGMA;
-    else if (strcmp(bm->s, "turn_on") == 0)
-      e->bias_model = NAV_CATALOG_BIAS_TURN_ON;
-    else {
-      diag(w->c, bm->line, bm->col, imu_cols[I_BIAS_MODEL], "'%s' must be allan_min, gm_sigma or turn_on",
-           bm->s);
-      w->ok = false;
-    }
-  }
+  e->bias_model = bias_model(w, I_BIAS_MODEL);
 
   nav_imu_model_config cfg = nav_imu_model_config_default();
   nav_gyro_error_config *g = &cfg.gyro;
@@ -669,6 +713,102 @@ static void convert_imu(row *w, const nav_catalog_options *opt, nav_catalog_imu_
   }
 }
 
+/* One single-axis accelerometer part -> the per-sensor error model of an array. The bias
+ * instability follows the row's bias_model as for IMU rows; the run-to-run bias repeatability is
+ * a turn-on constant (drawn per sensor and run). */
+static void convert_accel(row *w, const nav_catalog_options *opt, nav_catalog_accel_entry *e) {
+  memset(e, 0, sizeof *e);
+  e->line = w->r->line;
+  text(w, A_PART, e->name, sizeof e->name, true);
+  text(w, A_GRADE, e->grade, sizeof e->grade, true);
+  text(w, A_SOURCE, e->source, sizeof e->source, true);
+  text(w, A_VERIFIED, e->verified_text, sizeof e->verified_text, true);
+  e->verified = verification(w, A_VERIFIED, e->verified_text);
+  e->cost_class = cost_class(w, A_COST_CLASS);
+  e->bias_model = bias_model(w, A_BIAS_MODEL);
+  nav_array_error_config *a = &e->config;
+  memset(a, 0, sizeof *a);
+  bool has = false;
+  e->range_g = number(w, A_RANGE_G, true, ACCEL_MAX_RANGE_G, &has);
+  if (has) e->given |= NAV_CATALOG_ACCEL_HAS_RANGE;
+  e->bandwidth_hz = number(w, A_BANDWIDTH_HZ, true, ACCEL_MAX_BANDWIDTH_HZ, &has);
+  if (has) e->given |= NAV_CATALOG_ACCEL_HAS_BANDWIDTH;
+  /* The noise density of one axis in ug/sqrt(Hz) is its VRW: 1 ug/sqrt(Hz) = 1e-6 g0 m/s/sqrt(s). */
+  const double ug = nav_unit_ug_to_mps2(1.0);
+  const double max_noise_ug = NAV_SCENE_MAX_ACCEL_VRW_M_PER_S_PER_SQRT_H / 60.0 / ug;
+  const double vrw = pair(w, A_NOISE_UG, A_NOISE_SI, ug, "m/s^2/sqrt(Hz)", max_noise_ug, &has);
+  if (has) {
+    e->given |= NAV_CATALOG_ACCEL_HAS_NOISE;
+    e->noise_density_ug_per_sqrt_hz = vrw / ug;
+    a->terms |= NAV_IMU_TERM_NOISE;
+    a->vrw_mps_per_sqrt_s = vrw;
+  }
+  bool has_bi = false, has_t = false, has_rep = false;
+  const double bi = pair(w, A_BI_UG, A_BI_SI, ug, "m/s^2", NAV_SCENE_MAX_ACCEL_BI_UG, &has_bi);
+  const double corr = number(w, A_CORR_TIME_S, true, NAV_SCENE_MAX_CORRELATION_TIME_S, &has_t);
+  const double rep_mg = number(w, A_REPEAT_MG, false, NAV_SCENE_MAX_ACCEL_BIAS_MG, &has_rep);
+  if (has_bi) {
+    e->given |= NAV_CATALOG_ACCEL_HAS_BIAS_INSTABILITY;
+    e->bias_instability_ug = bi / ug;
+  }
+  if (has_t) {
+    e->given |= NAV_CATALOG_ACCEL_HAS_CORR_TIME;
+    e->bias_corr_time_s = corr;
+  }
+  if (has_rep) {
+    e->given |= NAV_CATALOG_ACCEL_HAS_BIAS_REPEAT;
+    e->bias_repeatability_mg = rep_mg;
+  }
+  if (has_bi) {
+    switch (e->bias_model) {
+    case NAV_CATALOG_BIAS_ALLAN_MIN:
+      a->terms |= NAV_IMU_TERM_BIAS_GM;
+      a->bias_gm_sd_mps2 = nav_gm_sigma_from_bias_instability(bi, opt->convention);
+      a->bias_gm_tau_s =
+          has_t ? corr
+                : (is_nav_grade(e->grade) ? opt->default_tau_min_nav_s : opt->default_tau_min_mems_s) /
+                      NAV_GM_ALLAN_PEAK_TAU_RATIO;
+      break;
+    case NAV_CATALOG_BIAS_GM_SIGMA:
+      if (!has_t) {
+        const field *f = cell(w, A_BIAS_MODEL);
+        diag(w->c, f->line, f->col, accel_cols[A_BIAS_MODEL],
+             "gm_sigma needs bias_corr_time_s (the GM correlation time)");
+        w->ok = false;
+      }
+      a->terms |= NAV_IMU_TERM_BIAS_GM;
+      a->bias_gm_sd_mps2 = bi;
+      a->bias_gm_tau_s = corr;
+      break;
+    case NAV_CATALOG_BIAS_TURN_ON:
+      if (has_rep) {
+        const field *f = cell(w, A_BIAS_MODEL);
+        diag(w->c, f->line, f->col, accel_cols[A_BIAS_MODEL],
+             "turn_on bias model and bias_repeatability_mg give the same bias twice");
+        w->ok = false;
+      }
+      a->terms |= NAV_IMU_TERM_BIAS_TURN_ON;
+      a->bias_turn_on_sd_mps2 = bi;
+      break;
+    }
+  }
+  if (has_rep) {
+    a->terms |= NAV_IMU_TERM_BIAS_TURN_ON;
+    a->bias_turn_on_sd_mps2 = nav_unit_mg_to_mps2(rep_mg);
+  }
+  const double sf = number(w, A_SF_PPM, false, NAV_SCENE_MAX_SCALE_FACTOR_PPM, &has);
+  if (has) {
+    e->given |= NAV_CATALOG_ACCEL_HAS_SCALE_FACTOR;
+    e->scale_factor_ppm = sf;
+    a->terms |= NAV_IMU_TERM_SCALE_FACTOR;
+    a->scale_factor_sd = nav_unit_ppm_to_ratio(sf);
+  }
+  if (w->ok && a->terms & NAV_IMU_TERM_BIAS_GM && !(isfinite(a->bias_gm_tau_s) && a->bias_gm_tau_s > 0.0)) {
+    diag(w->c, w->r->line, 1, e->name, "the converted model is invalid (check the catalog options)");
+    w->ok = false;
+  }
+}
+
 static void convert_gnss(row *w, nav_catalog_gnss_entry *e) {
   memset(e, 0, sizeof *e);
   e->line = w->r->line;
@@ -710,6 +850,7 @@ struct nav_catalog {
   size_t count;
   nav_catalog_imu_entry *imu;
   nav_catalog_gnss_entry *gnss;
+  nav_catalog_accel_entry *accel;
 };
 
 nav_catalog_options nav_catalog_options_default(void) {
@@ -724,11 +865,20 @@ void nav_catalog_destroy(nav_catalog *cat) {
   if (!cat) return;
   free(cat->imu);
   free(cat->gnss);
+  free(cat->accel);
   free(cat);
 }
 
 static const char *entry_name(const nav_catalog *cat, size_t i) {
-  return cat->kind == NAV_CATALOG_IMU ? cat->imu[i].name : cat->gnss[i].name;
+  return cat->kind == NAV_CATALOG_IMU    ? cat->imu[i].name
+         : cat->kind == NAV_CATALOG_GNSS ? cat->gnss[i].name
+                                         : cat->accel[i].name;
+}
+
+static int entry_line(const nav_catalog *cat, size_t i) {
+  return cat->kind == NAV_CATALOG_IMU    ? cat->imu[i].line
+         : cat->kind == NAV_CATALOG_GNSS ? cat->gnss[i].line
+                                         : cat->accel[i].line;
 }
 
 nav_status nav_catalog_load_string(const char *text_in, size_t len, const char *display_name,
@@ -762,8 +912,9 @@ nav_status nav_catalog_load_string(const char *text_in, size_t len, const char *
   }
   cat->kind = h.kind;
   size_t cap = 0;
-  const size_t entry_size =
-      h.kind == NAV_CATALOG_IMU ? sizeof(nav_catalog_imu_entry) : sizeof(nav_catalog_gnss_entry);
+  const size_t entry_size = h.kind == NAV_CATALOG_IMU    ? sizeof(nav_catalog_imu_entry)
+                            : h.kind == NAV_CATALOG_GNSS ? sizeof(nav_catalog_gnss_entry)
+                                                         : sizeof(nav_catalog_accel_entry);
   while (read_record(&ps, &c, rec, &ok)) {
     if (cat->count == NAV_CATALOG_MAX_ENTRIES) {
       diag(&c, rec->line, 1, "", "more than %d rows", NAV_CATALOG_MAX_ENTRIES);
@@ -776,23 +927,34 @@ nav_status nav_catalog_load_string(const char *text_in, size_t len, const char *
     }
     if (cat->count == cap) {
       const size_t ncap = cap ? 2 * cap : 32;
-      void *p = realloc(h.kind == NAV_CATALOG_IMU ? (void *)cat->imu : (void *)cat->gnss, ncap * entry_size);
+      void *old_p = h.kind == NAV_CATALOG_IMU    ? (void *)cat->imu
+                    : h.kind == NAV_CATALOG_GNSS ? (void *)cat->gnss
+                                                 : (void *)cat->accel;
+      void *p = realloc(old_p, ncap * entry_size);
       if (!p) {
         st = NAV_ERR_NO_MEMORY;
         goto cleanup;
       }
       if (h.kind == NAV_CATALOG_IMU)
         cat->imu = p;
-      else
+      else if (h.kind == NAV_CATALOG_GNSS)
         cat->gnss = p;
+      else
+        cat->accel = p;
       cap = ncap;
     }
-    row w = {&c, rec, &h, h.kind == NAV_CATALOG_IMU ? imu_cols : gnss_cols, true};
+    row w = {&c, rec, &h,
+             h.kind == NAV_CATALOG_IMU    ? imu_cols
+             : h.kind == NAV_CATALOG_GNSS ? gnss_cols
+                                          : accel_cols,
+             true};
     c.hold = true;
     if (h.kind == NAV_CATALOG_IMU)
       convert_imu(&w, &opt, &cat->imu[cat->count]);
-    else
+    else if (h.kind == NAV_CATALOG_GNSS)
       convert_gnss(&w, &cat->gnss[cat->count]);
+    else
+      convert_accel(&w, &opt, &cat->accel[cat->count]);
     flush_row(&c);
     if (!w.ok) continue;
     /* Names identify rows in scenes: they must be unique. */
@@ -800,9 +962,11 @@ nav_status nav_catalog_load_string(const char *text_in, size_t len, const char *
     for (size_t i = 0; i < cat->count; ++i)
       if (equal_nocase(entry_name(cat, i), name)) {
         const field *f = &rec->f[h.file_of_table[0]];
-        diag(&c, f->line, f->col, h.kind == NAV_CATALOG_IMU ? "name" : "mode",
-             "'%s' is already used on line %d (names are compared ignoring case)", name,
-             h.kind == NAV_CATALOG_IMU ? cat->imu[i].line : cat->gnss[i].line);
+        diag(&c, f->line, f->col,
+             h.kind == NAV_CATALOG_IMU    ? "name"
+             : h.kind == NAV_CATALOG_GNSS ? "mode"
+                                          : "part",
+             "'%s' is already used on line %d (names are compared ignoring case)", name, entry_line(cat, i));
         w.ok = false;
         break;
       }
@@ -872,6 +1036,17 @@ const nav_catalog_imu_entry *nav_catalog_imu_at(const nav_catalog *cat, size_t i
 
 const nav_catalog_gnss_entry *nav_catalog_gnss_at(const nav_catalog *cat, size_t i) {
   return (cat && cat->kind == NAV_CATALOG_GNSS && i < cat->count) ? &cat->gnss[i] : NULL;
+}
+
+const nav_catalog_accel_entry *nav_catalog_accel_at(const nav_catalog *cat, size_t i) {
+  return (cat && cat->kind == NAV_CATALOG_ACCEL && i < cat->count) ? &cat->accel[i] : NULL;
+}
+
+const nav_catalog_accel_entry *nav_catalog_find_accel(const nav_catalog *cat, const char *name) {
+  if (!cat || !name || cat->kind != NAV_CATALOG_ACCEL) return NULL;
+  for (size_t i = 0; i < cat->count; ++i)
+    if (equal_nocase(cat->accel[i].name, name)) return &cat->accel[i];
+  return NULL;
 }
 
 const nav_catalog_imu_entry *nav_catalog_find_imu(const nav_catalog *cat, const char *name) {

@@ -34,7 +34,8 @@
  *   Sensor figures are given in datasheet units (deg/h, deg/sqrt(h), mg, ug, ppm, mrad, ...) or
  *   in SI; they are converted once, here, by the factors of the nav_unit_* helpers.
  * - Keys are read in any order (YAML mappings are unordered): the keys that others build on
- *   (imu.bias_convention, imu.catalog, gnss.catalog) are applied first, "off" lists last.
+ *   (imu.bias_convention, imu.catalog, gnss.catalog, array.catalog) are applied first, "off" lists
+ *   last; array.catalog converts allan_min rows with the default convention (allan_peak).
  * - An empty section ("imu:") means all defaults.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -627,6 +628,16 @@ static const nav_io_field k_array_sensor[] = {
 DEFINE_SECTION(k_array_sensor_section, k_array_sensor);
 
 static const nav_io_field k_array[] = {
+    {.key = "catalog",
+     .kind = NAV_IO_CUSTOM,
+     .flags = NAV_IO_EARLY,
+     .offset = OFF(array.catalog),
+     .size = NAV_SCENE_CATALOG_NAME_MAX,
+     .read = read_catalog,
+     .write = write_catalog,
+     .same = same_string,
+     .write_if = catalog_given,
+     .comment = "accelerometer part of resources/accel_catalog.csv; the accel keys below override it"},
     {.key = "layout",
      .doc = "placement of the accelerometers: cube6, nine, twelve or custom (sensors)",
      .kind = NAV_IO_ENUM,
@@ -2348,15 +2359,19 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
                          const nav_io_node *v, void *base) {
   nav_scene *s = base;
   const bool imu = f->offset == OFF(imu.catalog);
-  const char *what = imu ? "IMU" : "GNSS receiver";
+  const bool arr = f->offset == OFF(array.catalog);
+  const char *what = imu ? "IMU" : arr ? "accelerometer part" : "GNSS receiver";
+  const char *file = imu ? "imu_catalog.csv" : arr ? "accel_catalog.csv" : "gnss_receivers.csv";
+  const char *flag = imu ? "imu" : arr ? "accel" : "gnss";
   char name[NAV_SCENE_CATALOG_NAME_MAX], dir[NAV_IO_PATH_MAX], path[NAV_IO_PATH_MAX + 32],
       shown[SHOW_MAX + 4];
   nav_catalog *cat = NULL;
   if (reject_special(r, key, v)) return;
   if (v->kind != Y_SCALAR || is_null(v)) {
     nav_io_expected(r, key, v,
-                    imu ? "an IMU name from resources/imu_catalog.csv"
-                        : "a receiver mode from resources/gnss_receivers.csv");
+                    imu   ? "an IMU name from resources/imu_catalog.csv"
+                    : arr ? "an accelerometer part from resources/accel_catalog.csv"
+                          : "a receiver mode from resources/gnss_receivers.csv");
     return;
   }
   if (v->len >= sizeof name || memchr(v->text, '\0', v->len) != NULL) {
@@ -2371,9 +2386,12 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
         r, v, key, "cannot find the resources directory with the %s catalog; set NAV_RESOURCES_DIR", what);
     return;
   }
-  snprintf(path, sizeof path, "%s/%s", dir, imu ? "imu_catalog.csv" : "gnss_receivers.csv");
+  snprintf(path, sizeof path, "%s/%s", dir, file);
   nav_catalog_options opt = nav_catalog_options_default();
-  opt.convention = (nav_bi_convention)r->state.bias_convention;
+  /* imu.bias_convention belongs to the IMU section, which a file may place after the array: the
+     array's parts always use the default convention so that the order of the sections does not
+     matter (nav_catalog.h; docs/gyro-free-gnss.md section 8). */
+  if (!arr) opt.convention = (nav_bi_convention)r->state.bias_convention;
   const nav_status st = nav_catalog_load(path, &opt, &cat, forward_diag, r);
   if (st != NAV_OK) {
     nav_io_reader_error(r, v, key, "cannot load the %s catalog %s (%s)", what, path, nav_status_str(st));
@@ -2384,6 +2402,14 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     if (e != NULL) {
       s->imu.model = e->config;
       snprintf(s->imu.catalog, sizeof s->imu.catalog, "%s", e->name);
+      goto cleanup;
+    }
+  } else if (arr) {
+    /* The part's terms replace the array's; the accel keys of the section, read later, override. */
+    const nav_catalog_accel_entry *e = nav_catalog_find_accel(cat, name);
+    if (e != NULL) {
+      s->array.accel = e->config;
+      snprintf(s->array.catalog, sizeof s->array.catalog, "%s", e->name);
       goto cleanup;
     }
   } else {
@@ -2401,7 +2427,9 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     size_t n_sub = 0;
     const char *sub = NULL;
     for (size_t i = 0; i < n && i < COUNT(names); ++i) {
-      names[i] = imu ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      names[i] = imu   ? nav_catalog_imu_at(cat, i)->name
+                 : arr ? nav_catalog_accel_at(cat, i)->name
+                       : nav_catalog_gnss_at(cat, i)->name;
       if (contains_nocase(names[i], name, v->len)) {
         sub = names[i];
         ++n_sub;
@@ -2412,10 +2440,10 @@ static void read_catalog(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     if (best != NULL)
       nav_io_reader_error(r, v, key,
                           "unknown %s \"%s\"; did you mean \"%s\"? (`navsim catalog --%s` lists %s)", what,
-                          shown, best, imu ? "imu" : "gnss", path);
+                          shown, best, flag, path);
     else
       nav_io_reader_error(r, v, key, "unknown %s \"%s\"; `navsim catalog --%s` lists the %zu entries of %s",
-                          what, shown, imu ? "imu" : "gnss", n, path);
+                          what, shown, flag, n, path);
   }
 cleanup:
   nav_catalog_destroy(cat);
@@ -2580,7 +2608,7 @@ static size_t off_names(const nav_io_writer *w, const nav_io_field *f, char buf[
     }
   } else if (f->offset == OFF(array.accel)) {
     for (size_t k = 0; k < COUNT(k_array_terms) && n < cap; ++k)
-      if (needs_off(w, &k_array_accel_section, s->array.accel.terms, k_array_terms[k].bit, ""))
+      if (needs_off(w, &k_array_accel_section, s->array.accel.terms, k_array_terms[k].bit, s->array.catalog))
         snprintf(buf[n++], 40, "%s", k_array_terms[k].name);
   } else {
     for (size_t k = 0; k < COUNT(k_gnss_terms) && n < cap; ++k)

@@ -21,17 +21,19 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 #define PATH_CAP 4096
 
 static const char *k_usage_catalog =
-    "usage: navsim catalog [--imu | --gnss] [--csv] [--convention allan_peak|sigma_equals_b]\n"
+    "usage: navsim catalog [--imu | --gnss | --accel] [--csv] [--convention allan_peak|sigma_equals_b]\n"
     "\n"
-    "List the IMU catalog (resources/imu_catalog.csv) and the GNSS receiver catalog\n"
-    "(resources/gnss_receivers.csv) with the error model the simulator derives from each row\n"
+    "List the IMU catalog (resources/imu_catalog.csv), the GNSS receiver catalog\n"
+    "(resources/gnss_receivers.csv) and the accelerometer parts for arrays\n"
+    "(resources/accel_catalog.csv) with the error model the simulator derives from each row\n"
     "(1-sigma per axis). Rows whose numbers could not be checked against a datasheet are\n"
     "marked \"NO\" in the verified column: check the datasheet before relying on them.\n"
     "\n"
     "options:\n"
     "  --imu             only the IMU catalog\n"
     "  --gnss            only the GNSS receiver catalog\n"
-    "  --csv             CSV on stdout in SI units (needs --imu or --gnss)\n"
+    "  --accel           only the accelerometer parts (array.catalog in scenes), with their sources\n"
+    "  --csv             CSV on stdout in SI units (needs --imu, --gnss or --accel)\n"
     "  --convention C    bias instability B -> Gauss-Markov sigma for datasheet rows:\n"
     "                    allan_peak (default; sigma = B / 0.61736) or sigma_equals_b\n"
     "  -h, --help        print this help\n"
@@ -183,6 +185,68 @@ static void imu_table(const nav_catalog *cat, const char *path, const nav_catalo
   }
 }
 
+static void accel_csv(const nav_catalog *cat) {
+  printf(
+      "part,grade,range_g,bandwidth_hz,vrw_mps_per_sqrt_s,bias_gm_sd_mps2,bias_gm_tau_s,bias_turn_on_sd_mps2,"
+      "scale_factor_sd,bias_model,cost_class,cost_band,verified,source\n");
+  for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
+    const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
+    const nav_array_error_config *a = &e->config;
+    csv_text(stdout, e->name);
+    fputc(',', stdout);
+    csv_text(stdout, e->grade);
+    csv_num(stdout, e->given & NAV_CATALOG_ACCEL_HAS_RANGE, e->range_g);
+    csv_num(stdout, e->given & NAV_CATALOG_ACCEL_HAS_BANDWIDTH, e->bandwidth_hz);
+    csv_num(stdout, a->terms & NAV_IMU_TERM_NOISE, a->vrw_mps_per_sqrt_s);
+    csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_sd_mps2);
+    csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_tau_s);
+    csv_num(stdout, a->terms & NAV_IMU_TERM_BIAS_TURN_ON, a->bias_turn_on_sd_mps2);
+    csv_num(stdout, a->terms & NAV_IMU_TERM_SCALE_FACTOR, a->scale_factor_sd);
+    printf(",%s,%d,%s,", nav_catalog_bias_model_name(e->bias_model), e->cost_class,
+           nav_catalog_cost_band(e->cost_class));
+    csv_text(stdout, e->verified_text);
+    fputc(',', stdout);
+    csv_text(stdout, e->source);
+    fputc('\n', stdout);
+  }
+}
+
+/* The accelerometer parts: datasheet figures as given, the model they become, and the source of
+ * each row (the catalog's provenance is part of what a user chooses from). */
+static void accel_table(const nav_catalog *cat, const char *path, const nav_catalog_options *opt) {
+  printf("Accelerometer parts for arrays %s: %zu entries (array.catalog: NAME in a scene)\n", path,
+         nav_catalog_count(cat));
+  printf("Datasheet figures of one sensitive axis; model per sensor, 1 sigma: noise density = VRW, bias\n"
+         "instability B -> Gauss-Markov with %s, T = tau_min / 1.8926 (tau_min %g s MEMS, %g s\n"
+         "navigation grades), bias repeatability -> turn-on bias, scale factor -> per-run constant.\n\n",
+         opt->convention == NAV_BI_ALLAN_PEAK ? "sigma = B / 0.61736" : "sigma = B",
+         opt->default_tau_min_mems_s, opt->default_tau_min_nav_s);
+  printf("%-28s %-28s |%6s %6s %9s %8s %8s %6s |%9s %7s  %-4s %s\n", "", "", "range", "bw", "noise", "bias",
+         "bias rep", "SF", "GM bias", "T", "cost", "verified");
+  printf("%-28s %-28s |%6s %6s %9s %8s %8s %6s |%9s %7s  %-4s\n", "part", "grade", "g", "Hz", "ug/rt-Hz",
+         "ug", "mg", "ppm", "ug", "s", "cls");
+  for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
+    const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
+    const nav_array_error_config *a = &e->config;
+    printf("%-28.28s %-28.28s |", e->name, e->grade);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_RANGE, e->range_g, 5);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_BANDWIDTH, e->bandwidth_hz, 6);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_NOISE, e->noise_density_ug_per_sqrt_hz, 9);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_BIAS_INSTABILITY, e->bias_instability_ug, 8);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_BIAS_REPEAT, e->bias_repeatability_mg, 8);
+    col_num(e->given & NAV_CATALOG_ACCEL_HAS_SCALE_FACTOR, e->scale_factor_ppm, 6);
+    printf(" |");
+    col_num(a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_sd_mps2 / nav_unit_ug_to_mps2(1.0), 9);
+    col_num(a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_tau_s, 7);
+    printf("  %-4d %s\n", e->cost_class, verified_label(e->verified));
+  }
+  printf("\nsources:\n");
+  for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
+    const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
+    printf("  %s [line %d, verified: %s]: %s\n", e->name, e->line, e->verified_text, e->source);
+  }
+}
+
 /* The cost-class legend under both tables. */
 static void cost_legend(void) {
   printf("\ncost class (indicative unit-price band by grade, not a quote; resources/README.md):");
@@ -208,7 +272,7 @@ static void gnss_table(const nav_catalog *cat, const char *path) {
 }
 
 int navsim_catalog(int argc, char **argv, const char *resources_dir) {
-  bool want_imu = false, want_gnss = false, csv = false;
+  bool want_imu = false, want_gnss = false, want_accel = false, csv = false;
   nav_catalog_options opt = nav_catalog_options_default();
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -219,6 +283,8 @@ int navsim_catalog(int argc, char **argv, const char *resources_dir) {
       want_imu = true;
     } else if (strcmp(a, "--gnss") == 0) {
       want_gnss = true;
+    } else if (strcmp(a, "--accel") == 0) {
+      want_accel = true;
     } else if (strcmp(a, "--csv") == 0) {
       csv = true;
     } else if (strcmp(a, "--convention") == 0) {
@@ -240,16 +306,16 @@ int navsim_catalog(int argc, char **argv, const char *resources_dir) {
       return EXIT_INVALID;
     }
   }
-  if (!want_imu && !want_gnss) {
+  if (!want_imu && !want_gnss && !want_accel) {
     if (csv) {
       fprintf(stderr,
-              "navsim catalog: --csv needs --imu or --gnss (the two tables have different columns)\n");
+              "navsim catalog: --csv needs --imu, --gnss or --accel (the tables have different columns)\n");
       return EXIT_INVALID;
     }
-    want_imu = want_gnss = true;
+    want_imu = want_gnss = want_accel = true;
   }
-  if (want_imu && want_gnss && csv) {
-    fprintf(stderr, "navsim catalog: --csv prints one table: give either --imu or --gnss\n");
+  if ((int)want_imu + (int)want_gnss + (int)want_accel > 1 && csv) {
+    fprintf(stderr, "navsim catalog: --csv prints one table: give one of --imu, --gnss and --accel\n");
     return EXIT_INVALID;
   }
   if (resources_dir == NULL) {
@@ -278,6 +344,17 @@ int navsim_catalog(int argc, char **argv, const char *resources_dir) {
       gnss_csv(cat);
     else
       gnss_table(cat, path);
+    nav_catalog_destroy(cat);
+  }
+  if (want_accel) {
+    nav_catalog *cat = NULL;
+    const int rc = load(resources_dir, "accel_catalog.csv", &opt, &cat, path, sizeof path);
+    if (rc != EXIT_OK) return rc;
+    if (!csv && (want_imu || want_gnss)) printf("\n");
+    if (csv)
+      accel_csv(cat);
+    else
+      accel_table(cat, path, &opt);
     nav_catalog_destroy(cat);
   }
   if (!csv) cost_legend();

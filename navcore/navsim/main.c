@@ -55,7 +55,7 @@ static const char *k_usage =
     "                   tradeoff, sky or dop view (navview)\n"
     "  report DIR       HTML page with the figures, statistics and requirement verdicts of a result\n"
     "  bench            speed against error for each algorithm, Earth model and rate\n"
-    "  catalog          list the IMU and GNSS receiver catalogs and their models\n"
+    "  catalog          list the IMU, GNSS receiver and array accelerometer catalogs and their models\n"
     "  allan            Allan-deviation check of a catalog part or scene IMU against its spec\n"
     "  import FILE      GPX / KML track or gnss-ins-sim motion definition -> scene file\n"
     "  export DIR       KML (Google Earth) and CSV tracks of a result directory\n"

@@ -44,7 +44,8 @@
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_select =
-    "usage: navsim select SCENE [--imus NAMES|all] [--receivers NAMES|all] [--schemes LIST] [--runs N]\n"
+    "usage: navsim select SCENE [--imus NAMES|all] [--receivers NAMES|all] [--schemes LIST]\n"
+    "                    [--array-parts NAMES|all] [--runs N]\n"
     "                    [--threads N] [--band F] [--predict-rate HZ] --out DIR [--force] [--quiet]\n"
     "\n"
     "Find the least expensive catalog configuration that meets the scene's requirements. Each\n"
@@ -65,9 +66,7 @@ static const char *k_usage_select =
     "               monte_carlo) and the margin (smallest (limit - value) / limit); passing\n"
     "               configurations first, cheapest first, then not_confirmed, then failing ones\n"
     "  recommended.yaml  the scene with the recommended configuration\n"
-    "The terminal shows the recommendation and why each cheaper configuration fails.\n"
-    NAVSIM_OUT_HELP
-    "\n"
+    "The terminal shows the recommendation and why each cheaper configuration fails.\n" NAVSIM_OUT_HELP "\n"
     "options:\n"
     "  --imus NAMES       IMU names separated by commas, or all (default)\n"
     "  --receivers NAMES  receiver modes separated by commas, or all (default)\n"
@@ -75,6 +74,11 @@ static const char *k_usage_select =
     "                     scene's scheme); gyro_free_gnss puts the catalog IMU's accelerometers\n"
     "                     (noise, turn-on and Gauss-Markov bias; not its scale factors or bias random\n"
     "                     walk) into every sensor of the scene's array (layout and arm kept)\n"
+    "  --array-parts NAMES  gyro_free_gnss ranges over these accelerometer parts\n"
+    "                     (resources/accel_catalog.csv, comma-separated, or all) instead of the\n"
+    "                     IMUs' accelerometers: each fills every sensor of the scene's array (the\n"
+    "                     scale factor left out: the filter has no states for it); the imu column\n"
+    "                     of ranking.csv then names the part, its cost index is N sensors x part\n"
     "  --runs N           Monte Carlo runs per confirmed configuration (default 20)\n"
     "  --threads N        worker threads (default one per core); results do not depend on it\n"
     "  --band F           pruning band factor > 1 (default 1.5)\n"
@@ -87,6 +91,7 @@ enum { DEC_PREDICTION = 0, DEC_MONTE_CARLO = 1 };
 
 typedef struct combo {
   int imu, gnss; /* catalog indices; gnss -1: no receiver (free_ins) */
+  int part;      /* accelerometer-part index of a gyro_free_gnss array (--array-parts); -1: none */
   nav_nav_scheme scheme;
   int imu_cls, gnss_cls;
   double cost_usd;
@@ -102,7 +107,7 @@ typedef struct combo {
 
 typedef struct ctx {
   const nav_scene *base;
-  const nav_catalog *imus, *gnss;
+  const nav_catalog *imus, *gnss, *parts;
   combo *c;
   size_t n;
   int n_req;
@@ -146,11 +151,19 @@ static nav_array_error_config array_accel_of(const nav_accel_error_config *a) {
 /* The scene of a combination (heap). */
 static nav_status make_scene(const ctx *x, const combo *c, nav_scene *sc) {
   *sc = *x->base;
-  const nav_catalog_imu_entry *ie = nav_catalog_imu_at(x->imus, (size_t)c->imu);
-  sc->imu.model = ie->config;
-  snprintf(sc->imu.catalog, sizeof sc->imu.catalog, "%s", ie->name);
   sc->navigation.scheme = c->scheme;
-  if (c->scheme == NAV_SCHEME_GYRO_FREE_GNSS) sc->array.accel = array_accel_of(&ie->config.accel);
+  if (c->part >= 0) {
+    /* An array part: every sensor gets its datasheet model; the IMU section is not used. */
+    const nav_catalog_accel_entry *pe = nav_catalog_accel_at(x->parts, (size_t)c->part);
+    sc->array.accel = pe->config;
+    sc->array.accel.terms &= ~(unsigned)NAV_IMU_TERM_SCALE_FACTOR;
+    snprintf(sc->array.catalog, sizeof sc->array.catalog, "%s", pe->name);
+  } else {
+    const nav_catalog_imu_entry *ie = nav_catalog_imu_at(x->imus, (size_t)c->imu);
+    sc->imu.model = ie->config;
+    snprintf(sc->imu.catalog, sizeof sc->imu.catalog, "%s", ie->name);
+    if (c->scheme == NAV_SCHEME_GYRO_FREE_GNSS) sc->array.accel = array_accel_of(&ie->config.accel);
+  }
   if (c->gnss >= 0) {
     const nav_catalog_gnss_entry *ge = nav_catalog_gnss_at(x->gnss, (size_t)c->gnss);
     const nav_gnss_model_config old = x->base->gnss.model;
@@ -333,6 +346,7 @@ static int by_cost(const void *a, const void *b) {
   if (x->cost_usd != y->cost_usd) return x->cost_usd < y->cost_usd ? -1 : 1;
   if (x->scheme != y->scheme) return x->scheme < y->scheme ? -1 : 1;
   if (x->imu != y->imu) return x->imu < y->imu ? -1 : 1;
+  if (x->part != y->part) return x->part < y->part ? -1 : 1;
   return x->gnss < y->gnss ? -1 : x->gnss > y->gnss;
 }
 
@@ -347,7 +361,17 @@ static int by_rank(const void *a, const void *b) {
 
 /* Split a comma-separated list of catalog names (names may themselves hold commas: parts are
  * joined until they name an entry). */
-static int parse_names(const char *list, const nav_catalog *cat, bool imu, int **out, int *n_out) {
+static const char *catalog_name(const nav_catalog *cat, size_t i) {
+  switch (nav_catalog_get_kind(cat)) {
+  case NAV_CATALOG_IMU: return nav_catalog_imu_at(cat, i)->name;
+  case NAV_CATALOG_GNSS: return nav_catalog_gnss_at(cat, i)->name;
+  case NAV_CATALOG_ACCEL: return nav_catalog_accel_at(cat, i)->name;
+  }
+  return "";
+}
+
+static int parse_names(const char *list, const nav_catalog *cat, int **out, int *n_out) {
+  const nav_catalog_kind kind = nav_catalog_get_kind(cat);
   const size_t total = nav_catalog_count(cat);
   int *v = calloc(total > 0 ? total : 1, sizeof *v);
   if (!v) return EXIT_FAIL;
@@ -369,7 +393,7 @@ static int parse_names(const char *list, const nav_catalog *cat, bool imu, int *
     const char *s = cur;
     while (*s == ' ') ++s;
     for (size_t i = 0; i < total; ++i) {
-      const char *nm = imu ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      const char *nm = catalog_name(cat, i);
       if (strcasecmp(nm, s) == 0) {
         bool dup = false;
         for (int k = 0; k < n; ++k) dup |= v[k] == (int)i;
@@ -383,7 +407,16 @@ static int parse_names(const char *list, const nav_catalog *cat, bool imu, int *
   }
   if (cur[0] || n == 0) {
     fprintf(stderr, "navsim select: --%s: unknown %s \"%s\" (navsim catalog --%s lists them)\n",
-            imu ? "imus" : "receivers", imu ? "IMU" : "receiver", cur[0] ? cur : list, imu ? "imu" : "gnss");
+            kind == NAV_CATALOG_IMU    ? "imus"
+            : kind == NAV_CATALOG_GNSS ? "receivers"
+                                       : "array-parts",
+            kind == NAV_CATALOG_IMU    ? "IMU"
+            : kind == NAV_CATALOG_GNSS ? "receiver"
+                                       : "accelerometer part",
+            cur[0] ? cur : list,
+            kind == NAV_CATALOG_IMU    ? "imu"
+            : kind == NAV_CATALOG_GNSS ? "gnss"
+                                       : "accel");
     free(v);
     return EXIT_INVALID;
   }
@@ -406,6 +439,12 @@ static void csv_value(FILE *f, const nav_requirement_verdict *v) {
   else fputs(",", f);
 }
 
+/* The IMU of a combination, or its array part. */
+static const char *sensor_name(const ctx *x, const combo *k) {
+  return k->part >= 0 ? nav_catalog_accel_at(x->parts, (size_t)k->part)->name
+                      : nav_catalog_imu_at(x->imus, (size_t)k->imu)->name;
+}
+
 static int write_ranking(const char *path, const ctx *x, const combo *c, size_t n) {
   FILE *f = fopen(path, "w");
   if (!f) return EXIT_FAIL;
@@ -419,7 +458,7 @@ static int write_ranking(const char *path, const ctx *x, const combo *c, size_t 
   for (size_t i = 0; i < n; ++i) {
     const combo *k = &c[i];
     fprintf(f, "%zu,", i + 1);
-    csv_text(f, nav_catalog_imu_at(x->imus, (size_t)k->imu)->name);
+    csv_text(f, sensor_name(x, k));
     fputc(',', f);
     csv_text(f, k->gnss >= 0 ? nav_catalog_gnss_at(x->gnss, (size_t)k->gnss)->name : "");
     fprintf(f, ",%s,%d,", nav_nav_scheme_name(k->scheme), k->imu_cls);
@@ -447,14 +486,15 @@ static int write_ranking(const char *path, const ctx *x, const combo *c, size_t 
 
 static void label(char *buf, size_t size, const ctx *x, const combo *k) {
   if (k->gnss >= 0)
-    snprintf(buf, size, "%s + %s (%s)", nav_catalog_imu_at(x->imus, (size_t)k->imu)->name,
+    snprintf(buf, size, "%s%s + %s (%s)", k->part >= 0 ? "array of " : "", sensor_name(x, k),
              nav_catalog_gnss_at(x->gnss, (size_t)k->gnss)->name, nav_nav_scheme_name(k->scheme));
   else
-    snprintf(buf, size, "%s (%s)", nav_catalog_imu_at(x->imus, (size_t)k->imu)->name, nav_nav_scheme_name(k->scheme));
+    snprintf(buf, size, "%s (%s)", sensor_name(x, k), nav_nav_scheme_name(k->scheme));
 }
 
 int navsim_select(int argc, char **argv) {
-  const char *scene_path = NULL, *out_dir = NULL, *imus_s = "all", *rcv_s = "all", *schemes_s = NULL;
+  const char *scene_path = NULL, *out_dir = NULL, *imus_s = "all", *rcv_s = "all", *schemes_s = NULL,
+             *parts_s = NULL;
   long runs = 20, threads = 0;
   double band = 1.5, predict_rate = 10.0;
   bool quiet = false, force = false;
@@ -467,13 +507,15 @@ int navsim_select(int argc, char **argv) {
       quiet = true;
     } else if (strcmp(a, "--force") == 0) {
       force = true;
-    } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") || !strcmp(a, "--schemes") ||
-               !strcmp(a, "--runs") || !strcmp(a, "--threads") || !strcmp(a, "--band") ||
-               !strcmp(a, "--predict-rate")) {
+    } else if (!strcmp(a, "--out") || !strcmp(a, "--imus") || !strcmp(a, "--receivers") ||
+               !strcmp(a, "--schemes") || !strcmp(a, "--array-parts") || !strcmp(a, "--runs") ||
+               !strcmp(a, "--threads") || !strcmp(a, "--band") || !strcmp(a, "--predict-rate")) {
       if (!navsim_need_value("select", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (!strcmp(a, "--out")) out_dir = v;
       else if (!strcmp(a, "--imus")) imus_s = v;
+      else if (!strcmp(a, "--array-parts"))
+        parts_s = v;
       else if (!strcmp(a, "--receivers")) rcv_s = v;
       else if (!strcmp(a, "--schemes")) schemes_s = v;
       else if (!strcmp(a, "--runs")) {
@@ -517,8 +559,9 @@ int navsim_select(int argc, char **argv) {
 
   int rc = EXIT_FAIL;
   nav_scene *base = malloc(sizeof *base), *sc = malloc(sizeof *sc);
-  nav_catalog *imus = NULL, *gnss = NULL;
-  int *imu_idx = NULL, *rcv_idx = NULL, n_imu = 0, n_rcv = 0;
+  nav_catalog *imus = NULL, *gnss = NULL, *parts = NULL;
+  int *imu_idx = NULL, *rcv_idx = NULL, *part_idx = NULL, n_imu = 0, n_rcv = 0, n_part = 0,
+      n_array_sensors = 0;
   combo *c = NULL;
   size_t n = 0;
   nav_resultdir *rd = NULL;
@@ -593,42 +636,70 @@ int navsim_select(int argc, char **argv) {
       snprintf(path, sizeof path, "%s/gnss_receivers.csv", res);
       st = nav_catalog_load(path, NULL, &gnss, navsim_print_diag, &sink);
     }
+    if (st == NAV_OK && parts_s) {
+      snprintf(path, sizeof path, "%s/accel_catalog.csv", res);
+      st = nav_catalog_load(path, NULL, &parts, navsim_print_diag, &sink);
+    }
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", path, nav_status_str(st));
       goto done;
     }
   }
-  rc = parse_names(imus_s, imus, true, &imu_idx, &n_imu);
-  if (rc == EXIT_OK) rc = parse_names(rcv_s, gnss, false, &rcv_idx, &n_rcv);
+  rc = parse_names(imus_s, imus, &imu_idx, &n_imu);
+  if (rc == EXIT_OK) rc = parse_names(rcv_s, gnss, &rcv_idx, &n_rcv);
+  if (rc == EXIT_OK && parts_s) {
+    bool gf = false;
+    for (int k = 0; k < n_sch; ++k)
+      gf = gf || schemes[k] == NAV_SCHEME_GYRO_FREE_GNSS;
+    if (!gf) {
+      fprintf(stderr,
+              "navsim select: --array-parts applies to the gyro_free_gnss scheme (add it to --schemes)\n");
+      rc = EXIT_INVALID;
+    } else {
+      rc = parse_names(parts_s, parts, &part_idx, &n_part);
+    }
+    nav_accel_array layout;
+    if (rc == EXIT_OK && nav_array_layout_from_scene(&base->array, &layout) == NAV_OK)
+      n_array_sensors = layout.n_sensors;
+  }
   if (rc != EXIT_OK) goto done;
   rc = EXIT_FAIL;
 
   /* The combinations. */
   {
-    size_t cap = (size_t)n_imu * (size_t)(n_rcv + 1) * (size_t)n_sch;
+    const int n_sens = n_imu > n_part ? n_imu : n_part;
+    size_t cap = (size_t)n_sens * (size_t)(n_rcv + 1) * (size_t)n_sch;
     c = calloc(cap, sizeof *c);
     if (!c) goto done;
-    for (int s = 0; s < n_sch; ++s)
-      for (int i = 0; i < n_imu; ++i) {
+    for (int s = 0; s < n_sch; ++s) {
+      /* gyro_free_gnss over the array parts when --array-parts is given, else over the IMUs. */
+      const bool by_part = parts_s != NULL && schemes[s] == NAV_SCHEME_GYRO_FREE_GNSS;
+      for (int i = 0; i < (by_part ? n_part : n_imu); ++i) {
         const bool aided = schemes[s] == NAV_SCHEME_INS_GNSS || schemes[s] == NAV_SCHEME_GYRO_FREE_GNSS;
         const int nr = aided ? n_rcv : 1;
         for (int g = 0; g < nr; ++g) {
           combo *k = &c[n++];
-          k->imu = imu_idx[i];
+          k->imu = by_part ? -1 : imu_idx[i];
+          k->part = by_part ? part_idx[i] : -1;
           k->gnss = aided ? rcv_idx[g] : -1;
           k->scheme = schemes[s];
-          k->imu_cls = nav_catalog_imu_at(imus, (size_t)k->imu)->cost_class;
+          k->imu_cls = by_part ? nav_catalog_accel_at(parts, (size_t)k->part)->cost_class
+                               : nav_catalog_imu_at(imus, (size_t)k->imu)->cost_class;
           k->gnss_cls = k->gnss >= 0 ? nav_catalog_gnss_at(gnss, (size_t)k->gnss)->cost_class : 0;
-          k->cost_usd = class_usd(k->imu_cls) + (k->gnss >= 0 ? class_usd(k->gnss_cls) : 0.0);
+          /* An array costs its N sensors. */
+          k->cost_usd = (by_part ? n_array_sensors : 1) * class_usd(k->imu_cls) +
+                        (k->gnss >= 0 ? class_usd(k->gnss_cls) : 0.0);
           k->pred = calloc((size_t)base->n_requirements, sizeof *k->pred);
           if (!k->pred) goto done;
         }
       }
+    }
   }
   qsort(c, n, sizeof *c, by_cost);
   x.base = base;
   x.imus = imus;
   x.gnss = gnss;
+  x.parts = parts;
   x.c = c;
   x.n = n;
   x.n_req = base->n_requirements;
@@ -636,10 +707,16 @@ int navsim_select(int argc, char **argv) {
   x.predict_rate = predict_rate;
   pthread_mutex_init(&x.mu, NULL);
 
-  if (!quiet)
+  if (!quiet && !parts_s)
     printf("select     %s: %d IMU%s x %d receiver%s x %d scheme%s = %zu configurations, %d requirement%s\n",
            base->name, n_imu, n_imu == 1 ? "" : "s", n_rcv, n_rcv == 1 ? "" : "s", n_sch, n_sch == 1 ? "" : "s", n,
            x.n_req, x.n_req == 1 ? "" : "s");
+  else if (!quiet)
+    printf("select     %s: %d IMU%s or %d array part%s (gyro_free_gnss, %d sensors each) x %d receiver%s x "
+           "%d scheme%s = "
+           "%zu configurations, %d requirement%s\n",
+           base->name, n_imu, n_imu == 1 ? "" : "s", n_part, n_part == 1 ? "" : "s", n_array_sensors, n_rcv,
+           n_rcv == 1 ? "" : "s", n_sch, n_sch == 1 ? "" : "s", n, x.n_req, x.n_req == 1 ? "" : "s");
   const double t0 = navsim_now_s();
   {
     pthread_t th[256];
@@ -791,6 +868,8 @@ done:
   free(imu_idx);
   free(rcv_idx);
   nav_catalog_destroy(imus);
+  nav_catalog_destroy(parts);
+  free(part_idx);
   nav_catalog_destroy(gnss);
   free(base);
   free(sc);

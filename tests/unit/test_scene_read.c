@@ -196,6 +196,7 @@ static void assert_gnss_same(const nav_gnss_model_config *a, const nav_gnss_mode
 /* The accelerometer array of the gyro-free scheme, bit for bit. */
 static void assert_array_same(const nav_scene_array *a, const nav_scene_array *b) {
   assert_int_equal(a->layout, b->layout);
+  assert_string_equal(a->catalog, b->catalog);
   assert_same_double(a->radius_m, b->radius_m);
   assert_int_equal(a->custom_count, b->custom_count);
   for (int i = 0; i < a->custom_count && i < NAV_SCENE_ARRAY_MAX_SENSORS; ++i) {
@@ -1260,6 +1261,49 @@ static void test_imu_catalog(void **state) {
   assert_same_vec3(s.imu.model.accel.vrw_mps_per_sqrt_s, cfg.accel.vrw_mps_per_sqrt_s);
 }
 
+/* Issue 21 item 3: array.catalog fills the array's per-sensor terms with the part's datasheet
+ * figures in SI, whatever its place among the keys; the accel keys override it, "off" removes a
+ * term; an unknown part is an error at its FILE:LINE:COL. */
+static void test_array_catalog(void **state) {
+  (void)state;
+  nav_catalog *cat = NULL;
+  assert_int_equal(nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, NULL, NULL),
+                   NAV_OK);
+  const nav_catalog_accel_entry *e = nav_catalog_find_accel(cat, "Safran Colibrys MS1010");
+  assert_non_null(e);
+  nav_scene s =
+      read_ok("format_version: 1\narray: {layout: cube6, radius_m: 0.3, catalog: safran colibrys ms1010}\n");
+  assert_string_equal(s.array.catalog, "Safran Colibrys MS1010");
+  assert_int_equal(s.array.accel.terms, e->config.terms);
+  assert_same_double(s.array.accel.vrw_mps_per_sqrt_s, e->config.vrw_mps_per_sqrt_s);
+  assert_rel_near(s.array.accel.vrw_mps_per_sqrt_s, 34e-6 * 9.80665, 1e-12); /* MS1010: 34 ug/rtHz */
+  assert_same_double(s.array.accel.bias_gm_sd_mps2, e->config.bias_gm_sd_mps2);
+  assert_same_double(s.array.accel.bias_gm_tau_s, e->config.bias_gm_tau_s);
+  assert_rel_near(s.array.accel.bias_turn_on_sd_mps2, 1.2e-3 * 9.80665, 1e-12); /* 1.2 mg */
+  assert_rel_near(s.array.accel.scale_factor_sd, 120e-6, 1e-12);                /* 120 ppm */
+  /* Typed values override the part; the part is read first even when written last. */
+  s = read_ok("format_version: 1\narray:\n  accel: {noise_density_ug_per_sqrt_hz: 20, off: [scale_factor]}\n"
+              "  catalog: Safran Colibrys MS1010\n");
+  assert_rel_near(s.array.accel.vrw_mps_per_sqrt_s, 20e-6 * 9.80665, 1e-15);
+  assert_int_equal(s.array.accel.terms, e->config.terms & ~(unsigned)NAV_IMU_TERM_SCALE_FACTOR);
+  assert_same_double(s.array.accel.bias_turn_on_sd_mps2, e->config.bias_turn_on_sd_mps2);
+  /* Written and read back: the part's name and the overrides survive. */
+  char *text = NULL;
+  size_t len = 0;
+  assert_int_equal(nav_scene_write_string(&s, &text, &len), NAV_OK);
+  assert_non_null(strstr(text, "catalog: \"Safran Colibrys MS1010\""));
+  nav_scene back = read_ok(text);
+  free(text);
+  assert_string_equal(back.array.catalog, s.array.catalog);
+  assert_int_equal(back.array.accel.terms, s.array.accel.terms);
+  assert_same_double(back.array.accel.vrw_mps_per_sqrt_s, s.array.accel.vrw_mps_per_sqrt_s);
+  nav_catalog_destroy(cat);
+  expect_one("format_version: 1\narray:\n  catalog: MS1011\n", 3, 12, "array.catalog",
+             "unknown accelerometer part \"MS1011\"");
+  expect_one("format_version: 1\narray:\n  catalog: [1]\n", 3, 12, "array.catalog",
+             "an accelerometer part from resources/accel_catalog.csv");
+}
+
 static void test_gnss_catalog(void **state) {
   (void)state;
   nav_scene s =
@@ -1424,20 +1468,25 @@ static void test_catalog_rows_within_bounds(void **state) {
   nav_scene *a = malloc(sizeof *a), *b = malloc(sizeof *b);
   assert_non_null(a);
   assert_non_null(b);
-  for (int kind = 0; kind < 2; ++kind) {
+  for (int kind = 0; kind < 3; ++kind) { /* IMU, GNSS receiver, array accelerometer part */
     nav_catalog *cat = NULL;
-    assert_int_equal(nav_catalog_load(kind == 0 ? NAV_SOURCE_DIR "/resources/imu_catalog.csv"
-                                                : NAV_SOURCE_DIR "/resources/gnss_receivers.csv",
+    assert_int_equal(nav_catalog_load(kind == 0   ? NAV_SOURCE_DIR "/resources/imu_catalog.csv"
+                                      : kind == 1 ? NAV_SOURCE_DIR "/resources/gnss_receivers.csv"
+                                                  : NAV_SOURCE_DIR "/resources/accel_catalog.csv",
                                       NULL, &cat, NULL, NULL),
                      NAV_OK);
     const size_t n = nav_catalog_count(cat);
     assert_true(n >= (kind == 0 ? 10u : 5u));
     for (size_t i = 0; i < n; ++i) {
-      const char *name = kind == 0 ? nav_catalog_imu_at(cat, i)->name : nav_catalog_gnss_at(cat, i)->name;
+      const char *name = kind == 0   ? nav_catalog_imu_at(cat, i)->name
+                         : kind == 1 ? nav_catalog_gnss_at(cat, i)->name
+                                     : nav_catalog_accel_at(cat, i)->name;
       if (kind == 0)
         snprintf(text, sizeof text, "format_version: 1\nimu:\n  catalog: \"%s\"\n", name);
-      else
+      else if (kind == 1)
         snprintf(text, sizeof text, "format_version: 1\ngnss:\n  enabled: true\n  catalog: \"%s\"\n", name);
+      else
+        snprintf(text, sizeof text, "format_version: 1\narray:\n  catalog: \"%s\"\n", name);
       nav_status st = read_text(text, a, &log);
       if (st != NAV_OK) {
         print_log(&log);
@@ -1445,6 +1494,7 @@ static void test_catalog_rows_within_bounds(void **state) {
       }
       a->imu.catalog[0] = '\0';
       a->gnss.catalog[0] = '\0';
+      a->array.catalog[0] = '\0';
       assert_int_equal(nav_scene_write_file(path, a), NAV_OK);
       st = read_path(path, b, &log);
       if (st != NAV_OK) {
@@ -2275,6 +2325,7 @@ int main(void) {
       cmocka_unit_test(test_bias_instability_conventions),
       cmocka_unit_test(test_imu_catalog),
       cmocka_unit_test(test_gnss_catalog),
+      cmocka_unit_test(test_array_catalog),
       cmocka_unit_test(test_sensor_bounds),
       cmocka_unit_test(test_issue_25_initial_error_bounds),
       cmocka_unit_test(test_catalog_rows_within_bounds),

@@ -1250,6 +1250,113 @@ static void test_catalog_resources(void **state) {
 }
 
 /* One of each kind of row error, with its exact place; nothing is returned. */
+/* Issue 21 item 3: the accelerometer parts for arrays (resources/accel_catalog.csv). Every row
+ * loads; a verified row's model is its datasheet figures in SI (Safran Colibrys MS1000 data sheet,
+ * MS1010 column: 34 ug/rtHz, in-run bias 15 ug, long-term bias repeatability 1.2 mg, 120 ppm);
+ * rows not checked against a data sheet say so. */
+static void test_accel_catalog_resources(void **state) {
+  (void)state;
+  static diag_log log;
+  memset(&log, 0, sizeof log);
+  nav_catalog *cat = NULL;
+  const nav_status st =
+      nav_catalog_load(NAV_SOURCE_DIR "/resources/accel_catalog.csv", NULL, &cat, collect, &log);
+  print_log(&log);
+  assert_int_equal(st, NAV_OK);
+  assert_int_equal(nav_catalog_get_kind(cat), NAV_CATALOG_ACCEL);
+  assert_true(nav_catalog_count(cat) >= 6);
+  for (size_t i = 0; i < nav_catalog_count(cat); ++i) {
+    const nav_catalog_accel_entry *e = nav_catalog_accel_at(cat, i);
+    assert_non_null(e);
+    assert_true(strlen(e->source) > 20); /* every row cites its source */
+    assert_true(e->given & NAV_CATALOG_ACCEL_HAS_NOISE);
+    assert_true(e->config.terms & NAV_IMU_TERM_NOISE);
+    assert_true(e->cost_class >= 1);
+  }
+  assert_null(nav_catalog_accel_at(cat, nav_catalog_count(cat)));
+  assert_null(nav_catalog_imu_at(cat, 0));
+  assert_null(nav_catalog_find_imu(cat, "Safran Colibrys MS1010"));
+
+  const double g0 = 9.80665, ug = 1e-6 * g0;
+  const nav_catalog_accel_entry *ms = nav_catalog_find_accel(cat, "safran colibrys ms1010");
+  assert_non_null(ms);
+  assert_string_equal(ms->name, "Safran Colibrys MS1010");
+  assert_int_equal(ms->verified, NAV_CATALOG_VERIFIED_YES);
+  assert_near(ms->noise_density_ug_per_sqrt_hz, 34.0, 1e-12);
+  assert_near(ms->bias_instability_ug, 15.0, 1e-12);
+  assert_near(ms->bias_repeatability_mg, 1.2, 1e-15);
+  assert_near(ms->scale_factor_ppm, 120.0, 0.0);
+  assert_near(ms->range_g, 10.0, 0.0);
+  const nav_array_error_config *a = &ms->config;
+  assert_int_equal(a->terms, NAV_IMU_TERM_NOISE | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_TURN_ON |
+                                 NAV_IMU_TERM_SCALE_FACTOR);
+  assert_rel_near(a->vrw_mps_per_sqrt_s, 34.0 * ug, 1e-12);
+  /* Allan floor B -> GM sigma B / 0.61736, T = 300 s / 1.8926 (MEMS default, nav_catalog.h). */
+  assert_rel_near(a->bias_gm_sd_mps2, 15.0 * ug / 0.61736, 1e-4);
+  assert_rel_near(a->bias_gm_tau_s, 300.0 / 1.8926, 1e-4);
+  assert_rel_near(a->bias_turn_on_sd_mps2, 1.2e-3 * g0, 1e-12);
+  assert_rel_near(a->scale_factor_sd, 120e-6, 1e-12);
+
+  /* A part with only a noise figure gives only the noise term. */
+  const nav_catalog_accel_entry *sca = nav_catalog_find_accel(cat, "Murata SCA3300-D01");
+  assert_non_null(sca);
+  assert_int_equal(sca->config.terms, NAV_IMU_TERM_NOISE);
+  assert_rel_near(sca->config.vrw_mps_per_sqrt_s, 37.0 * ug, 1e-12);
+  assert_near(sca->bandwidth_hz, 70.0, 0.0);
+  /* Navigation-grade quartz: the long default Allan time; quoted from memory, flagged as such. */
+  const nav_catalog_accel_entry *qa = nav_catalog_find_accel(cat, "Honeywell QA-2000 Q-Flex");
+  assert_non_null(qa);
+  assert_int_equal(qa->verified, NAV_CATALOG_VERIFIED_NO);
+  assert_non_null(strstr(qa->verified_text, "unverified"));
+  assert_null(nav_catalog_find_accel(cat, "no such part"));
+  nav_catalog_destroy(cat);
+}
+
+/* Bad accelerometer rows: FILE:LINE:COL of the cell, the column and what was expected. */
+static void test_accel_catalog_invalid_rows(void **state) {
+  (void)state;
+  static const char text[] =
+      "part,grade,noise_density_ug_per_sqrt_hz,noise_density_m_per_s2_per_sqrt_hz,bias_instability_ug,"
+      "bias_repeatability_mg,bias_model,source,verified_in_corpus\n"
+      "P1,MEMS,10,9.80665e-05,,,allan_min,src,yes\n"
+      "P2,MEMS,10,1e-4,,,allan_min,src,yes\n"
+      "P3,MEMS,99999,,,,allan_min,src,yes\n"
+      "P4,MEMS,10,,5,1,turn_on,src,yes\n"
+      "p1,MEMS,10,,,,allan_min,src,yes\n"
+      "P5,MEMS,10,,3,,gm_sigma,src,yes\n";
+  static diag_log log;
+  memset(&log, 0, sizeof log);
+  nav_catalog *cat = NULL;
+  assert_int_equal(nav_catalog_load_string(text, sizeof text - 1, "acc.csv", NULL, &cat, collect, &log),
+                   NAV_ERR_PARSE);
+  print_log(&log);
+  assert_null(cat);
+  assert_int_equal(log.n, 5);
+  const struct {
+    int line, col;
+    const char *path, *msg;
+  } want[5] = {
+      {3, 12, "noise_density_m_per_s2_per_sqrt_hz", "disagrees with noise_density_ug_per_sqrt_hz"},
+      {4, 9, "noise_density_ug_per_sqrt_hz", "plausibility bound"},
+      {5, 17, "bias_model", "give the same bias twice"},
+      {6, 1, "part", "already used on line 2"},
+      {7, 16, "bias_model", "needs bias_corr_time_s"},
+  };
+  for (int i = 0; i < 5; ++i) {
+    assert_string_equal(log.d[i].file, "acc.csv");
+    assert_int_equal(log.d[i].line, want[i].line);
+    assert_int_equal(log.d[i].col, want[i].col);
+    assert_string_equal(log.d[i].path, want[i].path);
+    assert_non_null(strstr(log.d[i].message, want[i].msg));
+  }
+  /* Two key columns: not one kind of catalog. */
+  static const char two[] = "part,name,source\nA,B,C\n";
+  memset(&log, 0, sizeof log);
+  assert_int_equal(nav_catalog_load_string(two, sizeof two - 1, "two.csv", NULL, &cat, collect, &log),
+                   NAV_ERR_PARSE);
+  assert_non_null(strstr(log.d[0].message, "more than one of the key columns"));
+}
+
 static void test_catalog_invalid_rows(void **state) {
   (void)state;
   static const char text[] =
@@ -1466,6 +1573,8 @@ int main(void) {
       cmocka_unit_test(test_gnss_lever_arm_geometry),
       cmocka_unit_test(test_catalog_resources),
       cmocka_unit_test(test_catalog_invalid_rows),
+      cmocka_unit_test(test_accel_catalog_resources),
+      cmocka_unit_test(test_accel_catalog_invalid_rows),
       cmocka_unit_test(test_issue_25_catalog_plausibility),
       cmocka_unit_test(test_catalog_hostile_input),
   };

@@ -7,7 +7,8 @@
  * RFC 4180 CSV, UTF-8, first row = column names, units in the column names, one sensor per row,
  * an empty cell = "not specified by the source" (the term is then off in the model). Quoted cells
  * may contain commas and doubled quotes, not line breaks. The kind of catalog is recognised from
- * the header: an IMU catalog has a @c name column, a GNSS catalog a @c mode column.
+ * the header: an IMU catalog has a @c name column, a GNSS catalog a @c mode column, an
+ * accelerometer catalog (single-axis parts for the arrays of the gyro-free INS) a @c part column.
  *
  * Every problem is reported as a ::nav_diag "FILE:LINE:COL: error: COLUMN: MESSAGE" pointing at
  * the offending cell, and loading goes on to report every problem it can find (up to
@@ -32,6 +33,14 @@
  * - Turn-on bias columns -> BIAS_TURN_ON sd; scale factor ppm -> SCALE_FACTOR sd; misalignment
  *   mrad -> MISALIGNMENT sd of every off-diagonal element, gyro and accelerometer.
  *
+ * @par Conversion of an accelerometer row (one sensitive axis; nav_array_error_config)
+ * - noise density (ug/sqrt(Hz), = the VRW of the axis) -> NOISE, vrw_mps_per_sqrt_s = value * 1e-6 g0;
+ * - bias instability by @c bias_model as for an IMU row (allan_min: GM with sigma = B / 0.61736 or
+ *   B, T = bias_corr_time_s or the grade's default tau_min / 1.8926; gm_sigma; turn_on);
+ * - bias repeatability (mg; run-to-run / turn-on, often a typical or maximum figure) -> BIAS_TURN_ON sd;
+ * - scale factor (ppm) -> SCALE_FACTOR sd.
+ * Range and bandwidth are kept for display and checks; the array model has no saturation term.
+ *
  * @par Conversion of a GNSS row
  * horizontal / vertical sigma and correlation_time_s -> POS_GM (N, E / D; tau 0 = white);
  * velocity sigma -> VEL_WHITE on N, E and D; update_rate_hz. No lever arm, latency or outage.
@@ -45,6 +54,7 @@
 
 #include "nav_export.h"
 #include "nav_io.h"
+#include "nav_scene.h"
 #include "nav_sensors.h"
 #include "nav_status.h"
 
@@ -65,8 +75,9 @@ NAV_BEGIN_DECLS
 
 /** Which catalog a file holds (recognised from its header). */
 typedef enum nav_catalog_kind {
-  NAV_CATALOG_IMU = 0, /**< resources/imu_catalog.csv */
-  NAV_CATALOG_GNSS = 1 /**< resources/gnss_receivers.csv */
+  NAV_CATALOG_IMU = 0,  /**< resources/imu_catalog.csv */
+  NAV_CATALOG_GNSS = 1, /**< resources/gnss_receivers.csv */
+  NAV_CATALOG_ACCEL = 2 /**< resources/accel_catalog.csv (parts for accelerometer arrays) */
 } nav_catalog_kind;
 
 /** How far a row's numbers were checked against their source (column verified_in_corpus). */
@@ -120,6 +131,42 @@ typedef struct nav_catalog_gnss_entry {
   nav_gnss_model_config config; /**< the converted model */
 } nav_catalog_gnss_entry;
 
+/** Which datasheet figures an accelerometer row gives (bits of nav_catalog_accel_entry.given). */
+typedef enum nav_catalog_accel_given {
+  NAV_CATALOG_ACCEL_HAS_RANGE = 1u << 0,            /**< range_g */
+  NAV_CATALOG_ACCEL_HAS_BANDWIDTH = 1u << 1,        /**< bandwidth_hz */
+  NAV_CATALOG_ACCEL_HAS_NOISE = 1u << 2,            /**< noise_density_ug_per_sqrt_hz */
+  NAV_CATALOG_ACCEL_HAS_BIAS_INSTABILITY = 1u << 3, /**< bias_instability_ug */
+  NAV_CATALOG_ACCEL_HAS_BIAS_REPEAT = 1u << 4,      /**< bias_repeatability_mg */
+  NAV_CATALOG_ACCEL_HAS_SCALE_FACTOR = 1u << 5,     /**< scale_factor_ppm */
+  NAV_CATALOG_ACCEL_HAS_CORR_TIME = 1u << 6         /**< bias_corr_time_s */
+} nav_catalog_accel_given;
+
+/**
+ * One accelerometer part of the array catalog: its datasheet figures in datasheet units (for
+ * display; a figure is given when its bit is set in @c given) and the per-sensor error model of an
+ * array they convert to (nav_scene_array.accel).
+ */
+typedef struct nav_catalog_accel_entry {
+  char name[NAV_CATALOG_NAME_MAX];              /**< the part column, e.g. "Safran Colibrys MS1010" */
+  char grade[NAV_CATALOG_GRADE_MAX];            /**< e.g. "tactical MEMS" */
+  char source[NAV_CATALOG_SOURCE_MAX];          /**< citation, verbatim */
+  char verified_text[NAV_CATALOG_VERIFIED_MAX]; /**< verified_in_corpus, verbatim */
+  nav_catalog_verification verified;
+  nav_catalog_bias_model bias_model;
+  int cost_class;      /**< indicative cost class 1..NAV_CATALOG_COST_CLASS_MAX; 0: not given */
+  int line;            /**< 1-based line of the row in the file */
+  unsigned given;      /**< OR of ::nav_catalog_accel_given */
+  double range_g;      /**< full scale, +/- [g] */
+  double bandwidth_hz; /**< bandwidth [Hz] */
+  double noise_density_ug_per_sqrt_hz; /**< white-noise density [ug/sqrt(Hz)] */
+  double bias_instability_ug;          /**< bias instability [ug] (meaning: bias_model) */
+  double bias_repeatability_mg;        /**< run-to-run bias [mg] */
+  double scale_factor_ppm;             /**< scale-factor error [ppm] */
+  double bias_corr_time_s;             /**< GM correlation time given by the row [s] */
+  nav_array_error_config config;       /**< the converted per-sensor model (SI) */
+} nav_catalog_accel_entry;
+
 /** A loaded catalog (one kind). Opaque; owns its entries. */
 typedef struct nav_catalog nav_catalog;
 
@@ -166,6 +213,12 @@ NAV_API const nav_catalog_imu_entry *nav_catalog_imu_at(const nav_catalog *cat, 
 
 /** Entry @p i of a GNSS catalog; NULL if out of range or not a GNSS catalog. Borrowed until destroy. */
 NAV_API const nav_catalog_gnss_entry *nav_catalog_gnss_at(const nav_catalog *cat, size_t i);
+
+/** Entry @p i of an accelerometer catalog; NULL if out of range or another kind. Borrowed until destroy. */
+NAV_API const nav_catalog_accel_entry *nav_catalog_accel_at(const nav_catalog *cat, size_t i);
+
+/** Accelerometer part by name (ASCII case-insensitive); NULL if absent. Borrowed until destroy. */
+NAV_API const nav_catalog_accel_entry *nav_catalog_find_accel(const nav_catalog *cat, const char *name);
 
 /** IMU entry by name (ASCII case-insensitive, exact otherwise); NULL if absent. Borrowed until destroy. */
 NAV_API const nav_catalog_imu_entry *nav_catalog_find_imu(const nav_catalog *cat, const char *name);

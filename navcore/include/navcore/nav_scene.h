@@ -530,6 +530,9 @@ typedef struct nav_array_error_config {
  */
 typedef struct nav_scene_array {
   nav_array_layout_kind layout;
+  /** Part of resources/accel_catalog.csv whose figures filled @c accel before the scene's own
+   *  accel keys overrode them ("" = none); the same part for every sensor. */
+  char catalog[NAV_SCENE_CATALOG_NAME_MAX];
   double radius_m;  /**< arm r of the built-in layouts [m], > 0 (not used by CUSTOM) */
   int custom_count; /**< CUSTOM: number of sensors, 6..NAV_SCENE_ARRAY_MAX_SENSORS */
   nav_scene_array_sensor custom[NAV_SCENE_ARRAY_MAX_SENSORS]; /**< CUSTOM: the sensors */
