@@ -1,5 +1,7 @@
 #include "path_view.h"
 
+#include "navview/nav_view_scene.h"
+
 #include <QResizeEvent>
 #include <QShowEvent>
 #include <QVBoxLayout>
@@ -407,7 +409,60 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   ResetCamera();
 }
 
+bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const NavViewOptions &options, bool keep_time,
+                              QString *error) {
+  if (mode_ != Mode::ThreeD) return false;
+  scene_result_ = result;
+  const bool show = result != nullptr;
+  // The scene draws the estimate, its band and the envelope: the editor's own stay hidden.
+  for (auto &a : {estimate_, result_, envelope_})
+    a->SetVisibility(!show);
+  if (!show) {
+    scene_.reset();
+    scene_stale_ = false;
+    Render();
+    return true;
+  }
+  const double t = scene_ && keep_time ? scene_->GetTime() : NAN;
+  const bool follow = scene_ && scene_->GetOptions().follow;
+  const double follow_m = scene_ ? scene_->GetOptions().follow_distance_m : 0.0;
+  if (!scene_) {
+    scene_ = std::make_unique<NavSceneView>();
+    scene_->AttachToWindow(window_, renderer_);
+  }
+  NavViewOptions o = options;
+  o.follow = follow;
+  o.follow_distance_m = follow_m;
+  o.time_s = t;
+  scene_->SetResult(result);
+  scene_->SetOptions(o);
+  SyncSize();
+  std::string err;
+  if (!scene_->Rebuild(&err)) {
+    if (error) *error = QString::fromStdString(err);
+    scene_.reset();
+    scene_result_.reset();
+    for (auto &a : {estimate_, result_, envelope_})
+      a->SetVisibility(true);
+    Render();
+    return false;
+  }
+  scene_->SetStale(scene_stale_);
+  Render();
+  return true;
+}
+
+void PathView::SetSceneStale(bool stale) {
+  scene_stale_ = stale;
+  if (scene_) scene_->SetStale(stale);
+  // The live preview keeps following in the editor's own estimate and band, over the greyed run.
+  for (auto &a : {estimate_, envelope_})
+    a->SetVisibility(!scene_ || stale);
+  Render();
+}
+
 PathView::~PathView() {
+  scene_.reset(); // takes its renderers out of our window
   // The observers point into this object; the renderer and its camera may outlive it.
   if (camera_observer_) renderer_->GetActiveCamera()->RemoveObserver(camera_observer_);
   if (render_observer_) renderer_->RemoveObserver(render_observer_);
