@@ -17,6 +17,7 @@ NAV_PACKAGES=(
   help2man man-db bsdextrautils     # man pages from --help; tests render them (man, col)
   dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
   rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions (issue 22)
+  ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -665,7 +665,11 @@ void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
   view3d_->SetEstimate(r->nav_ned, true);
   // Before any Monte Carlo run the 3D scene shows the preview once the edits settle (rebuilding
   // it for every preview of a drag would cost the live preview its frame time).
-  if (!last_result_) scene_preview_timer_.start();
+  if (!last_result_) {
+    // The scene shows an older preview meanwhile: greyed, the new estimate drawn over it.
+    if (view3d_->Scene() && !view3d_->SceneStale()) view3d_->SetSceneStale(true);
+    scene_preview_timer_.start();
+  }
   if (r->scene_change_ns == doc_.LastChangeNs()) {
     // The views have drawn the current scene's estimate; the latency ends when every visible
     // view has swapped the frame that shows it (OnViewFrame), or now for a hidden window.

@@ -316,8 +316,10 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   if (mode == Mode::Map) {
     renderer_->SetBackground(0.93, 0.95, 0.92);
   } else {
-    renderer_->SetBackground(0.20, 0.22, 0.26);
-    renderer_->SetBackground2(0.55, 0.62, 0.72);
+    // navview's light sky: the scene of a result (libnavview, drawn over this view) is coloured
+    // for it (black reference, grey reference triads, translucent blue tube).
+    renderer_->SetBackground(1.0, 1.0, 1.0);
+    renderer_->SetBackground2(0.90, 0.93, 0.97);
     renderer_->GradientBackgroundOn();
   }
 
@@ -329,7 +331,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     renderer_->AddActor(coast_);
   }
   grid_ = MakeActor(vtkNew<vtkPolyData>(), 0.70, 0.74, 0.70, 1.0);
-  if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.45, 0.50, 0.45);
+  if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.74, 0.77, 0.74);
   renderer_->AddActor(grid_);
   if (mode == Mode::ThreeD) {
     vtkNew<vtkPlaneSource> plane;
@@ -339,7 +341,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     plane->Update();
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     pd->DeepCopy(plane->GetOutput());
-    ground_ = MakeActor(pd, 0.36, 0.45, 0.33, 1.0);
+    ground_ = MakeActor(pd, 0.90, 0.93, 0.88, 1.0);
     ground_->GetProperty()->SetOpacity(0.55);
     renderer_->AddActor(ground_);
   }
@@ -362,14 +364,13 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     renderer_->AddActor(a);
   if (mode == Mode::ThreeD) {
     // Drop lines from waypoints off the ground plane (Shift+drag) to it: their height is read.
-    stems_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.95, 0.95, 1.5);
+    stems_ = MakeActor(vtkNew<vtkPolyData>(), 0.35, 0.35, 0.40, 1.5);
     renderer_->AddActor(stems_);
   }
 
   caption_ = vtkSmartPointer<vtkTextActor>::New();
   caption_->GetTextProperty()->SetFontSize(14);
-  caption_->GetTextProperty()->SetColor(mode == Mode::Map ? 0.1 : 0.95, mode == Mode::Map ? 0.1 : 0.95,
-                                        mode == Mode::Map ? 0.1 : 0.95);
+  caption_->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
   caption_->SetPosition(8, 8);
   renderer_->AddViewProp(caption_);
   problem_ = vtkSmartPointer<vtkTextActor>::New();

@@ -8,6 +8,8 @@
 #include <QLabel>
 #include <QSlider>
 #include <QSpinBox>
+#include <QStyle>
+#include <QVBoxLayout>
 #include <QToolButton>
 
 #include <algorithm>
@@ -101,31 +103,37 @@ NavViewOptions StudioViewOptions(const SimResult &r) {
 
 PlaybackBar::PlaybackBar(PathView *view, QWidget *parent) : QWidget(parent), view_(view) {
   setObjectName("playbackBar");
-  auto *lay = new QHBoxLayout(this);
-  lay->setContentsMargins(4, 2, 4, 2);
+  // Two rows: the time slider across the view, the buttons and settings under it.
+  auto *rows = new QVBoxLayout(this);
+  rows->setContentsMargins(4, 2, 4, 2);
+  rows->setSpacing(2);
+  auto *top = new QHBoxLayout;
+  auto *lay = new QHBoxLayout;
   lay->setSpacing(4);
-  auto button = [&](const QString &text, const QString &tip, const char *name) {
+  rows->addLayout(top);
+  rows->addLayout(lay);
+  auto button = [&](QStyle::StandardPixmap icon, const QString &tip, const char *name) {
     auto *b = new QToolButton;
-    b->setText(text);
+    b->setIcon(style()->standardIcon(icon));
     b->setToolTip(tip);
     b->setObjectName(name);
     b->setAutoRaise(true);
     lay->addWidget(b);
     return b;
   };
-  back_ = button(QStringLiteral("\u23ee"), tr("Step back (1 s of the run)"), "stepBack");
-  play_ = button(QStringLiteral("\u25b6"), tr("Play / pause the run"), "playButton");
-  play_->setCheckable(true);
-  fwd_ = button(QStringLiteral("\u23ed"), tr("Step forward (1 s of the run)"), "stepForward");
   slider_ = new QSlider(Qt::Horizontal);
   slider_->setObjectName("timeSlider");
   slider_->setRange(0, kSliderSteps);
   slider_->setToolTip(tr("Playback time: the vehicle, the attitude triads at t and the read-out"));
-  lay->addWidget(slider_, 1);
+  top->addWidget(slider_, 1);
   time_label_ = new QLabel(tr("no result"));
   time_label_->setObjectName("playbackTime");
   time_label_->setMinimumWidth(time_label_->fontMetrics().horizontalAdvance(QStringLiteral("t = 0000.0 / 0000 s")));
-  lay->addWidget(time_label_);
+  top->addWidget(time_label_);
+  back_ = button(QStyle::SP_MediaSkipBackward, tr("Step back (1 s of the run)"), "stepBack");
+  play_ = button(QStyle::SP_MediaPlay, tr("Play / pause the run"), "playButton");
+  play_->setCheckable(true);
+  fwd_ = button(QStyle::SP_MediaSkipForward, tr("Step forward (1 s of the run)"), "stepForward");
   speed_ = new QComboBox;
   speed_->setObjectName("playbackSpeed");
   for (double x : kSpeeds)
@@ -144,6 +152,7 @@ PlaybackBar::PlaybackBar(PathView *view, QWidget *parent) : QWidget(parent), vie
   distance_->setSuffix(QStringLiteral(" m"));
   distance_->setToolTip(tr("Follow-camera distance"));
   lay->addWidget(distance_);
+  lay->addStretch(1);
   auto *xl = new QLabel(tr("attitude error \u00d7"));
   lay->addWidget(xl);
   exag_ = new QDoubleSpinBox;
@@ -215,7 +224,7 @@ void PlaybackBar::SetPlaying(bool on) {
     timer_.stop();
   }
   if (play_->isChecked() != on) play_->setChecked(on);
-  play_->setText(on ? QStringLiteral("\u23f8") : QStringLiteral("\u25b6"));
+  play_->setIcon(style()->standardIcon(on ? QStyle::SP_MediaPause : QStyle::SP_MediaPlay));
 }
 
 void PlaybackBar::Tick() {

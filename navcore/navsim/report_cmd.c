@@ -174,7 +174,12 @@ int navsim_render(int argc, char **argv) {
     }
     if (strcmp(argv[i], "--view") == 0) view = argv[++i];
     else if (strcmp(argv[i], "--out") == 0) out = argv[++i];
-    else if (strcmp(argv[i], "--movie") == 0) movie = argv[++i];
+    else if (strcmp(argv[i], "--movie") == 0) {
+      /* A video file; a directory (PNG frames and .ogv) passes through to navview as before. */
+      const char *m = argv[++i];
+      const size_t ml = strlen(m);
+      if ((ml > 4 && strcmp(m + ml - 4, ".mp4") == 0) || (ml > 5 && strcmp(m + ml - 5, ".webm") == 0)) movie = m;
+    }
     else if (strcmp(argv[i], "--png") == 0) has_png = true;
     else if (strcmp(argv[i], "--chart") == 0) has_chart = true;
   }
@@ -213,11 +218,9 @@ int navsim_render(int argc, char **argv) {
   if (navsim_refuse_special_result_files(dir) != 0) return RC_INVALID;
   if (movie) {
     /* The playback movie of the 3D view (navview --movie FILE.mp4|FILE.webm). */
-    const size_t ml = strlen(movie);
-    if ((view && strcmp(view, "3d") != 0) || out ||
-        !((ml > 4 && strcmp(movie + ml - 4, ".mp4") == 0) || (ml > 5 && strcmp(movie + ml - 5, ".webm") == 0))) {
-      fprintf(stderr, "navsim render: --movie: expected --view 3d (the default), no --out, and a file ending in "
-                      ".mp4 or .webm, got \"%s\"\n", movie);
+    if ((view && strcmp(view, "3d") != 0) || out) {
+      fprintf(stderr, "navsim render: --movie %s: a video of the 3D view: expected --view 3d (the default) and no "
+                      "--out\n", movie);
       return RC_INVALID;
     }
     av_add(&v, dir);

@@ -757,6 +757,7 @@ void NavSceneViewImpl::AddTriads() {
   add_set(Model.triads_ref, grey, true, 1.0, nullptr);
   add_set(Model.triads_est, kTriadRGB, false, 0.92, nullptr);
   // The pair at the playback time, a little larger, moved by UpdateTime.
+  if (!Options.show_triads_at_time) return;
   NavTriadSet now_ref, now_est;
   NavAppendTriadsAt(*Result, Options.att_exaggeration, Model.t_begin_s, &now_ref, &now_est);
   add_set(now_ref, grey, true, 1.3, &NowRef);

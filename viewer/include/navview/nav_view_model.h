@@ -79,6 +79,8 @@ struct NavViewOptions {
   bool show_grid = true;
   bool show_axes = true;
   bool show_triads = true;
+  /** A triad pair (reference and estimate) at the playback time, moving with it. */
+  bool show_triads_at_time = true;
   bool show_vehicle = true;
   /** Screen-space decimation tolerance [pixels]. */
   double decimate_px = 0.5;
