@@ -267,7 +267,7 @@ void NavSceneViewImpl::ApplyStale() {
     a->GetProperty()->SetColor(c[0] / 3.0 + 0.5, c[1] / 3.0 + 0.5, c[2] / 3.0 + 0.5);
   }
   if (Title) {
-    Title->SetInput((TitleText + "  \u2013  OUT OF DATE: edited after this run").c_str());
+    Title->SetInput((TitleText + "  \u2013  OUT OF DATE").c_str());
     Title->GetTextProperty()->SetColor(0.55, 0.30, 0.0);
   }
 }
