@@ -12,6 +12,8 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QProcess>
+#include <QProgressDialog>
+#include <QTimer>
 #include <QSlider>
 #include <QSurfaceFormat>
 #include <QTabWidget>
@@ -176,6 +178,9 @@ private slots:
     QCOMPARE(QImage(pic3d).size(), QSize(1600, 900));
     QVERIFY(!w->ExportPicture(pic3d + "-big.png", "3d", 4000, 3000, &err));
     QVERIFY(err.contains("3840x2160"));
+    const QString picmap = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/playback-picture-map.png");
+    QVERIFY2(w->ExportPicture(picmap, "map", 1280, 720, &err), qPrintable(err));
+    QCOMPARE(QImage(picmap).size(), QSize(1280, 720));
   }
 
   // The exaggeration control: the triad at t turns k times the attitude error away from the
@@ -208,6 +213,24 @@ private slots:
     qInfo("attitude error %.4f deg; k=50 triad %.3f deg from k=1", a1 * 180 / M_PI, a49 * 180 / M_PI);
     QVERIFY(a1 > 1e-5);
     QVERIFY(std::fabs(a49 / a1 - 49.0) < 0.5);
+
+    // File > Export movie's Cancel (in its progress dialog) stops it and leaves no file.
+    const QString movie = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/playback-cancelled.webm");
+    QFile::remove(movie);
+    QTimer::singleShot(1500, [&] {
+      auto *dlg = w->findChild<QProgressDialog *>("movieProgress");
+      if (dlg) dlg->cancel();
+    });
+    MainWindow::MovieRequest req;
+    req.duration_s = 60.0;
+    req.width_px = 640;
+    req.height_px = 360;
+    QString err;
+    QVERIFY(!w->ExportMovie(movie, req, &err));
+    qInfo("cancelled movie: %s", qPrintable(err));
+    QVERIFY(err.contains("cancelled"));
+    QVERIFY(!QFileInfo::exists(movie));
+    QVERIFY(!QFileInfo::exists(movie + ".part"));
   }
 
   // Honest result state: an edit after a run marks the results out of date (greyed scene, tabs
