@@ -462,6 +462,11 @@ void PathView::SetSceneStale(bool stale) {
   Render();
 }
 
+void PathView::SetEditOverlayHidden(bool hidden) {
+  overlay_hidden_ = hidden;
+  Render();
+}
+
 PathView::~PathView() {
   scene_.reset(); // takes its renderers out of our window
   // The observers point into this object; the renderer and its camera may outlive it.
@@ -514,6 +519,10 @@ void PathView::Render() {
     return;
   }
   render_pending_ = false;
+  for (auto &a : {handles_, selected_actor_, bad_actor_, stems_})
+    if (a) a->SetVisibility(!overlay_hidden_);
+  for (auto &l : labels_)
+    l->SetVisibility(!overlay_hidden_);
   // While a drag is live the views render without multisampling: with Mesa's software renderer
   // 8x MSAA about doubles the cost of a frame (measured: 20-30 ms -> 11-15 ms per view); the
   // committed edit is drawn smooth again.

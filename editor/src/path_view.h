@@ -77,6 +77,9 @@ public:
   /** Mark the shown result as out of date (greyed caption "out of date: edited after the run"). */
   void SetSceneStale(bool stale);
   bool SceneStale() const { return scene_stale_; }
+  /** Hide the editing overlay (waypoint handles, labels, drop lines) while the follow camera is
+   *  close to the vehicle: a handle sphere near the camera would fill the view. */
+  void SetEditOverlayHidden(bool hidden);
   /** Fit the camera to the scene and rebuild the grid. */
   void ResetCamera();
   /** Render now (a hidden view, or one collapsed to no area, renders when it is shown again). */
@@ -160,6 +163,7 @@ private:
   std::unique_ptr<NavSceneView> scene_;
   std::shared_ptr<const NavResult> scene_result_;
   bool scene_stale_ = false;
+  bool overlay_hidden_ = false;
   vtkSmartPointer<vtkTextActor> stale_text_;
   QVTKOpenGLStereoWidget *widget_ = nullptr;
   vtkSmartPointer<vtkGenericOpenGLRenderWindow> window_;

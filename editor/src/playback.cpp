@@ -186,6 +186,7 @@ void PlaybackBar::SceneChanged() {
     w->setEnabled(have);
   if (!have) {
     SetPlaying(false);
+    view_->SetEditOverlayHidden(false);
     time_label_->setText(tr("no result"));
     return;
   }
@@ -193,6 +194,7 @@ void PlaybackBar::SceneChanged() {
   t1_ = sc->Model().t_end_s;
   t_s_ = std::clamp(sc->GetTime(), t0_, t1_);
   sc->SetFollow(follow_->isChecked(), distance_->value());
+  view_->SetEditOverlayHidden(follow_->isChecked());
   ShowTime();
 }
 
@@ -258,6 +260,7 @@ void PlaybackBar::SetFollow(bool on) {
   NavSceneView *sc = view_->Scene();
   if (sc && sc->IsBuilt()) {
     sc->SetFollow(on, distance_->value());
+    view_->SetEditOverlayHidden(on);
     if (!on) view_->ResetCamera();
     view_->Render();
   }
