@@ -1228,16 +1228,6 @@ void NavSceneViewImpl::UpdateTime() {
 
   if (Options.follow) {
     PlaceFollowCamera(p_ref);
-    // An ellipsoid around the close camera would fill the view with its inside: hidden while
-    // the camera is within it.
-    const double *cp = Renderer->GetActiveCamera()->GetPosition();
-    for (size_t i = 0; i < EllipsoidActors.size() && i < Model.ellipsoids.size(); ++i) {
-      const NavEllipsoid &e = Model.ellipsoids[i];
-      double q = 0.0;
-      for (int k = 0; k < 3; ++k)
-        q += Sq((cp[k] - e.center_r[k]) / std::max(e.semi_axes_r[k], 1e-9));
-      EllipsoidActors[i]->SetVisibility(q > 1.1);
-    }
   } else if (Follow && VehiclePlaced) {
     vtkCamera *cam = Renderer->GetActiveCamera();
     double f[3], p[3];
