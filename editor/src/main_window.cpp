@@ -26,7 +26,13 @@
 #include <QToolBar>
 #include <QUndoStack>
 #include <QImage>
+#include <QInputDialog>
 #include <QPainter>
+#include <QProgressDialog>
+#include <QVBoxLayout>
+
+#include "navview/nav_view_map.h"
+#include "navview/nav_view_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -103,7 +109,27 @@ void MainWindow::BuildUi() {
   view3d_ = new PathView(&doc_, PathView::Mode::ThreeD);
   auto *views = new QSplitter(Qt::Horizontal);
   views->addWidget(map_);
-  views->addWidget(view3d_);
+  {
+    // The 3D view with its playback bar under it.
+    auto *box = new QWidget;
+    box->setObjectName("view3dBox");
+    auto *vl = new QVBoxLayout(box);
+    vl->setContentsMargins(0, 0, 0, 0);
+    vl->setSpacing(0);
+    vl->addWidget(view3d_, 1);
+    playback_ = new PlaybackBar(view3d_);
+    vl->addWidget(playback_);
+    views->addWidget(box);
+    connect(playback_, &PlaybackBar::ExaggerationChanged, this, [this](double) {
+      const std::shared_ptr<const SimResult> r = last_result_ ? last_result_ : last_preview_;
+      if (view3d_->Scene() && r) ShowScene(r);
+    });
+    scene_preview_timer_.setSingleShot(true);
+    scene_preview_timer_.setInterval(400);
+    connect(&scene_preview_timer_, &QTimer::timeout, this, [this] {
+      if (!last_result_ && last_preview_ && !doc_.IsLive()) ShowScene(last_preview_);
+    });
+  }
   views->setSizes({560, 440});
 
   bottom_tabs_ = new QTabWidget;
@@ -194,6 +220,45 @@ void MainWindow::BuildActions() {
   });
   QAction *shot = act(tr("Export &screenshot..."), "actionScreenshot", QKeySequence(tr("Ctrl+Shift+P")));
   QAction *report = act(tr("Export &report..."), "actionReport", QKeySequence(tr("Ctrl+Shift+R")));
+  QAction *movie = act(tr("Export &movie..."), "actionMovie", QKeySequence(tr("Ctrl+Shift+M")));
+  QAction *picture = act(tr("Export &picture..."), "actionPicture", QKeySequence(tr("Ctrl+Shift+I")));
+  connect(movie, &QAction::triggered, this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export movie"), "navstudio-playback.mp4",
+                                                   tr("H.264 MP4 (*.mp4);;VP9 WebM (*.webm)"));
+    if (p.isEmpty()) return;
+    MovieRequest req;
+    bool ok = false;
+    req.duration_s = QInputDialog::getDouble(this, tr("Export movie"), tr("Length of the movie [s]:"), 10.0, 1.0, 600.0,
+                                             0, &ok);
+    if (!ok) return;
+    const QString size = QInputDialog::getItem(this, tr("Export movie"), tr("Size:"),
+                                               {"1920x1080", "1280x720", "3840x2160"}, 0, false, &ok);
+    if (!ok) return;
+    req.width_px = size.section('x', 0, 0).toInt();
+    req.height_px = size.section('x', 1, 1).toInt();
+    req.follow = playback_->Follow();
+    QString err;
+    if (ExportMovie(p, req, &err))
+      statusBar()->showMessage(tr("Movie written to %1").arg(p), 8000);
+    else if (!err.contains("cancelled"))
+      QMessageBox::warning(this, tr("Export movie"), err);
+  });
+  connect(picture, &QAction::triggered, this, [this] {
+    bool ok = false;
+    const QString which = QInputDialog::getItem(this, tr("Export picture"), tr("View:"), {"3d", "map"}, 0, false, &ok);
+    if (!ok) return;
+    const QString size = QInputDialog::getItem(this, tr("Export picture"), tr("Size:"),
+                                               {"1920x1080", "1280x720", "2560x1440", "3840x2160"}, 0, true, &ok);
+    if (!ok) return;
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export picture"), "navstudio-" + which + ".png",
+                                                   tr("PNG (*.png)"));
+    if (p.isEmpty()) return;
+    QString err;
+    if (ExportPicture(p, which, size.section('x', 0, 0).toInt(), size.section('x', 1, 1).toInt(), &err))
+      statusBar()->showMessage(tr("Picture written to %1").arg(p), 8000);
+    else
+      QMessageBox::warning(this, tr("Export picture"), err);
+  });
   QAction *quit = act(tr("&Quit"), "actionQuit", QKeySequence::Quit);
   connect(nw, &QAction::triggered, this, [this] { NewDrive(); });
   connect(open, &QAction::triggered, this, [this] {
@@ -226,6 +291,8 @@ void MainWindow::BuildActions() {
   file->addSeparator();
   file->addAction(import);
   file->addAction(shot);
+  file->addAction(picture);
+  file->addAction(movie);
   file->addAction(report);
   file->addSeparator();
   file->addAction(quit);
@@ -372,6 +439,7 @@ bool MainWindow::ImportTrack(const QString &path, QStringList *errors_out) {
 bool MainWindow::NewDrive() {
   if (!MaybeSave()) return false;
   doc_.Reset(*NewDriveScene());
+  ClearResults();
   map_->ResetCamera();
   view3d_->ResetCamera();
   status_->setText(tr("New drive: click on the map to add waypoints"));
@@ -492,6 +560,8 @@ void MainWindow::ShowIssues() {
 
 void MainWindow::OnSceneChanged() {
   setWindowModified(doc_.IsModified());
+  // A result of another scene than the one edited is out of date until the next run.
+  if (last_result_ && !results_stale_ && last_result_->scene_change_ns != doc_.LastChangeNs()) MarkResultsStale(true);
   ShowIssues();
   ShowResultsHint();
 }
@@ -593,6 +663,13 @@ void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
   SetEnvelopes(*r, true);
   map_->SetEstimate(r->nav_ned, true);
   view3d_->SetEstimate(r->nav_ned, true);
+  // Before any Monte Carlo run the 3D scene shows the preview once the edits settle (rebuilding
+  // it for every preview of a drag would cost the live preview its frame time).
+  if (!last_result_) {
+    // The scene shows an older preview meanwhile: greyed, the new estimate drawn over it.
+    if (view3d_->Scene() && !view3d_->SceneStale()) view3d_->SetSceneStale(true);
+    scene_preview_timer_.start();
+  }
   if (r->scene_change_ns == doc_.LastChangeNs()) {
     // The views have drawn the current scene's estimate; the latency ends when every visible
     // view has swapped the frame that shows it (OnViewFrame), or now for a hidden window.
@@ -704,12 +781,14 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
   if (r->status != NAV_OK) {
     progress_->setValue(0);
     const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1) : r->message;
-    status_->setText(what);
-    results_->setHtml(QStringLiteral("<p><b>%1</b></p>").arg(what.toHtmlEscaped()));
+    // The last complete results stay (the cancelled or failed run has none to show).
+    status_->setText(last_result_ ? tr("%1 — the last complete results are kept").arg(what) : what);
+    if (!last_result_) results_->setHtml(QStringLiteral("<p><b>%1</b></p>").arg(what.toHtmlEscaped()));
     emit ResultShown(false);
     return;
   }
   last_result_ = r;
+  scene_preview_timer_.stop();
   progress_->setValue(1000);
   const nav_sim_summary &s = r->summary;
   QString h;
@@ -782,6 +861,8 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
            .arg(Fmt(s.final_rms.pos_err_h_m))
            .arg(s.duration_s, 0, 'f', 1)
            .arg(static_cast<long long>(s.imu_samples));
+  results_html_ = h;
+  results_stale_ = false;
   results_->setHtml(h);
   bottom_tabs_->setCurrentWidget(results_);
   chart_->SetResult(r);
@@ -789,6 +870,8 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
   SetEnvelopes(*r, false);
   map_->SetEstimate(r->nav_ned, false);
   view3d_->SetEstimate(r->nav_ned, false);
+  ShowScene(r);
+  MarkResultsStale(r->scene_change_ns != doc_.LastChangeNs()); // edited while it ran
   QString verdict;
   if (!r->verdicts.empty())
     verdict = nav_req_all_pass(r->verdicts.data(), static_cast<int>(r->verdicts.size())) ? tr(" — verdict PASS")
@@ -827,6 +910,136 @@ void MainWindow::SetEnvelopes(const SimResult &r, bool preview) {
   }
   map_->SetEnvelope(ned, half, preview);
   view3d_->SetEnvelope(ned, half, preview);
+}
+
+} // namespace studio
+
+namespace studio {
+
+void MainWindow::ShowScene(const std::shared_ptr<const SimResult> &r) {
+  NavViewOptions o = StudioViewOptions(*r);
+  o.att_exaggeration = playback_->Exaggeration();
+  QString err;
+  const bool same = view3d_->Scene() && view3d_->SceneResult() && last_result_ == r;
+  if (!view3d_->SetSceneResult(ToNavResult(*r, doc_.Scene()), o, same, &err))
+    status_->setText(tr("3D view: %1").arg(err));
+  if (view3d_->Scene() && !same) view3d_->Scene()->SetTime(view3d_->Scene()->Model().t_begin_s);
+  view3d_->SetSceneStale(results_stale_ && !r->preview);
+  playback_->SceneChanged();
+}
+
+void MainWindow::MarkResultsStale(bool stale) {
+  results_stale_ = stale;
+  view3d_->SetSceneStale(stale && view3d_->Scene() && last_result_);
+  bottom_tabs_->setTabText(bottom_tabs_->indexOf(results_), stale ? tr("Results (out of date)") : tr("Results"));
+  bottom_tabs_->setTabText(bottom_tabs_->indexOf(chart_), stale ? tr("Errors (out of date)") : tr("Errors"));
+  chart_->setEnabled(!stale); // greyed
+  if (!last_result_) return;
+  if (stale)
+    results_->setHtml(tr("<p style='color:#a05000'><b>Out of date:</b> the scene was edited after this run; "
+                         "Run (F5) again for current results. The live preview follows the edits.</p>") +
+                      QStringLiteral("<div style='color:#8a8a8a'>%1</div>").arg(results_html_));
+  else
+    results_->setHtml(results_html_);
+}
+
+void MainWindow::ClearResults() {
+  last_result_.reset();
+  last_preview_.reset();
+  scene_preview_timer_.stop();
+  results_stale_ = false;
+  results_html_.clear();
+  view3d_->SetSceneResult(nullptr, NavViewOptions(), false, nullptr);
+  playback_->SceneChanged();
+  for (PathView *v : {map_, view3d_}) {
+    v->SetEstimate({}, false);
+    v->SetEstimate({}, true);
+    v->SetEnvelope({}, {}, true);
+  }
+  chart_->SetResult(nullptr);
+  chart_->setEnabled(true);
+  panels_->SetVerdicts({});
+  bottom_tabs_->setTabText(bottom_tabs_->indexOf(results_), tr("Results"));
+  bottom_tabs_->setTabText(bottom_tabs_->indexOf(chart_), tr("Errors"));
+  hint_type_ = -1;
+  ShowResultsHint();
+}
+
+bool MainWindow::ExportMovie(const QString &path, const MovieRequest &req, QString *error) {
+  const std::shared_ptr<const NavResult> res = view3d_->SceneResult();
+  if (!res || !view3d_->Scene()) {
+    *error = tr("no result to play back: Run (F5) first");
+    return false;
+  }
+  if (req.width_px < 16 || req.height_px < 16 || req.width_px > 3840 || req.height_px > 2160) {
+    *error = tr("movie size %1x%2: expected 16x16 to 3840x2160").arg(req.width_px).arg(req.height_px);
+    return false;
+  }
+  // Its own offscreen view of the same result and options: the window stays as it is.
+  NavSceneView movie;
+  NavViewOptions o = view3d_->Scene()->GetOptions();
+  o.width_px = req.width_px;
+  o.height_px = req.height_px;
+  o.show_grid = true;
+  o.show_axes = true;
+  o.multisamples = 0;
+  o.follow = req.follow;
+  o.follow_distance_m = playback_->FollowDistance();
+  o.time_s = NAN;
+  movie.SetResult(res);
+  movie.SetOptions(o);
+  NavMovieOptions mo;
+  mo.duration_s = req.duration_s;
+  mo.fps = req.fps;
+  QProgressDialog dlg(tr("Writing %1...").arg(QFileInfo(path).fileName()), tr("Cancel"), 0, 1000, this);
+  dlg.setObjectName("movieProgress");
+  dlg.setWindowTitle(tr("Export movie"));
+  dlg.setWindowModality(Qt::WindowModal);
+  dlg.setMinimumDuration(0);
+  dlg.setValue(0);
+  std::string err;
+  const bool ok = movie.RenderMovieFile(path.toStdString(), mo, [&](double f) {
+    dlg.setValue(static_cast<int>(std::lround(1000.0 * f)));
+    QCoreApplication::processEvents();
+    return !dlg.wasCanceled();
+  }, &err);
+  dlg.reset();
+  if (!ok) *error = QString::fromStdString(err);
+  return ok;
+}
+
+bool MainWindow::ExportPicture(const QString &path, const QString &view, int width, int height, QString *error) {
+  const std::shared_ptr<const NavResult> res = view3d_->SceneResult();
+  if (!res || !view3d_->Scene()) {
+    *error = tr("no result to draw: Run (F5) first");
+    return false;
+  }
+  if (width < 16 || height < 16 || width > 3840 || height > 2160) {
+    *error = tr("picture size %1x%2: expected 16x16 to 3840x2160").arg(width).arg(height);
+    return false;
+  }
+  std::string err;
+  bool ok = false;
+  if (view == "map") {
+    NavMapOptions mo;
+    mo.width_px = width;
+    mo.height_px = height;
+    ok = NavRenderMapPng(*res, mo, path.toStdString(), &err);
+  } else {
+    NavSceneView pic;
+    NavViewOptions o = view3d_->Scene()->GetOptions();
+    o.width_px = width;
+    o.height_px = height;
+    o.show_grid = true;
+    o.show_axes = true;
+    o.multisamples = 8;
+    o.time_s = view3d_->Scene()->GetTime();
+    pic.SetResult(res);
+    pic.SetOptions(o);
+    ok = pic.RenderPng(path.toStdString(), &err);
+  }
+  if (!ok) *error = QString::fromStdString(err);
+  return ok;
 }
 
 } // namespace studio

@@ -19,6 +19,7 @@
 #include "panels.h"
 #include "profile_chart.h"
 #include "path_view.h"
+#include "playback.h"
 #include "sim_worker.h"
 #include "studio_scene.h"
 #include "tradeoff_run.h"
@@ -79,6 +80,24 @@ public:
    *  scene is unsaved or modified (navsim reads the file) or a tradeoff is running. */
   bool StartTradeoff(const QString &out_dir, int runs, QString *error);
   TradeoffRun *Tradeoff() { return &tradeoff_; }
+  /** What File > Export movie writes. */
+  struct MovieRequest {
+    double duration_s = 10.0;
+    int width_px = 1920, height_px = 1080;
+    double fps = 30.0;
+    bool follow = true;        /**< the follow camera (at the playback bar's distance) */
+  };
+  /** File > Export movie: the shown result's playback (the 3D view's scene, libnavview) as H.264
+   *  MP4 or VP9 WebM (by the file's ending) with a progress dialog whose Cancel stops it and
+   *  leaves no file. false with @p error (also "cancelled"). */
+  bool ExportMovie(const QString &path, const MovieRequest &req, QString *error);
+  /** File > Export picture: one view without the forms, at @p width x @p height (up to
+   *  3840x2160), with its legend: @p view "3d" (the 3D view's scene at the playback time, framed
+   *  as navview frames it, or from the follow camera when it is on) or "map" (libnavview's geodetic map of the result). */
+  bool ExportPicture(const QString &path, const QString &view, int width, int height, QString *error);
+  PlaybackBar *Playback() { return playback_; }
+  /** The results shown are out of date (the scene was edited after the run). */
+  bool ResultsStale() const { return results_stale_; }
   /** Start the Monte Carlo run of the scene. false when the scene has issues. */
   bool Run();
   void Cancel();
@@ -193,6 +212,14 @@ private:
   std::shared_ptr<const SimResult> last_result_, last_preview_;
   int hint_type_ = -1; /**< trajectory type the Results hint was written for */
   std::vector<double> latencies_ms_;
+  PlaybackBar *playback_ = nullptr;
+  bool results_stale_ = false;
+  QString results_html_; /**< the Results tab of the last complete run (greyed when stale) */
+  QTimer scene_preview_timer_; /**< before any run the 3D scene shows the settled preview */
+  /** Show @p r (Monte Carlo result or preview) in the 3D view's scene. */
+  void ShowScene(const std::shared_ptr<const SimResult> &r);
+  void MarkResultsStale(bool stale);
+  void ClearResults();
 };
 
 } // namespace studio

@@ -1,5 +1,7 @@
 #include "path_view.h"
 
+#include "navview/nav_view_scene.h"
+
 #include <QResizeEvent>
 #include <QShowEvent>
 #include <QVBoxLayout>
@@ -314,8 +316,10 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   if (mode == Mode::Map) {
     renderer_->SetBackground(0.93, 0.95, 0.92);
   } else {
-    renderer_->SetBackground(0.20, 0.22, 0.26);
-    renderer_->SetBackground2(0.55, 0.62, 0.72);
+    // navview's light sky: the scene of a result (libnavview, drawn over this view) is coloured
+    // for it (black reference, grey reference triads, translucent blue tube).
+    renderer_->SetBackground(1.0, 1.0, 1.0);
+    renderer_->SetBackground2(0.90, 0.93, 0.97);
     renderer_->GradientBackgroundOn();
   }
 
@@ -327,7 +331,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     renderer_->AddActor(coast_);
   }
   grid_ = MakeActor(vtkNew<vtkPolyData>(), 0.70, 0.74, 0.70, 1.0);
-  if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.45, 0.50, 0.45);
+  if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.74, 0.77, 0.74);
   renderer_->AddActor(grid_);
   if (mode == Mode::ThreeD) {
     vtkNew<vtkPlaneSource> plane;
@@ -337,7 +341,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     plane->Update();
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     pd->DeepCopy(plane->GetOutput());
-    ground_ = MakeActor(pd, 0.36, 0.45, 0.33, 1.0);
+    ground_ = MakeActor(pd, 0.90, 0.93, 0.88, 1.0);
     ground_->GetProperty()->SetOpacity(0.55);
     renderer_->AddActor(ground_);
   }
@@ -360,14 +364,13 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     renderer_->AddActor(a);
   if (mode == Mode::ThreeD) {
     // Drop lines from waypoints off the ground plane (Shift+drag) to it: their height is read.
-    stems_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.95, 0.95, 1.5);
+    stems_ = MakeActor(vtkNew<vtkPolyData>(), 0.35, 0.35, 0.40, 1.5);
     renderer_->AddActor(stems_);
   }
 
   caption_ = vtkSmartPointer<vtkTextActor>::New();
   caption_->GetTextProperty()->SetFontSize(14);
-  caption_->GetTextProperty()->SetColor(mode == Mode::Map ? 0.1 : 0.95, mode == Mode::Map ? 0.1 : 0.95,
-                                        mode == Mode::Map ? 0.1 : 0.95);
+  caption_->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
   caption_->SetPosition(8, 8);
   renderer_->AddViewProp(caption_);
   problem_ = vtkSmartPointer<vtkTextActor>::New();
@@ -407,7 +410,65 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   ResetCamera();
 }
 
+bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const NavViewOptions &options, bool keep_time,
+                              QString *error) {
+  if (mode_ != Mode::ThreeD) return false;
+  scene_result_ = result;
+  const bool show = result != nullptr;
+  // The scene draws the estimate, its band and the envelope: the editor's own stay hidden.
+  for (auto &a : {estimate_, result_, envelope_})
+    a->SetVisibility(!show);
+  if (!show) {
+    scene_.reset();
+    scene_stale_ = false;
+    Render();
+    return true;
+  }
+  const double t = scene_ && keep_time ? scene_->GetTime() : NAN;
+  const bool follow = scene_ && scene_->GetOptions().follow;
+  const double follow_m = scene_ ? scene_->GetOptions().follow_distance_m : 0.0;
+  if (!scene_) {
+    scene_ = std::make_unique<NavSceneView>();
+    scene_->AttachToWindow(window_, renderer_);
+  }
+  NavViewOptions o = options;
+  o.follow = follow;
+  o.follow_distance_m = follow_m;
+  o.time_s = t;
+  scene_->SetResult(result);
+  scene_->SetOptions(o);
+  SyncSize();
+  std::string err;
+  if (!scene_->Rebuild(&err)) {
+    if (error) *error = QString::fromStdString(err);
+    scene_.reset();
+    scene_result_.reset();
+    for (auto &a : {estimate_, result_, envelope_})
+      a->SetVisibility(true);
+    Render();
+    return false;
+  }
+  scene_->SetStale(scene_stale_);
+  Render();
+  return true;
+}
+
+void PathView::SetSceneStale(bool stale) {
+  scene_stale_ = stale;
+  if (scene_) scene_->SetStale(stale);
+  // The live preview keeps following in the editor's own estimate and band, over the greyed run.
+  for (auto &a : {estimate_, envelope_})
+    a->SetVisibility(!scene_ || stale);
+  Render();
+}
+
+void PathView::SetEditOverlayHidden(bool hidden) {
+  overlay_hidden_ = hidden;
+  Render();
+}
+
 PathView::~PathView() {
+  scene_.reset(); // takes its renderers out of our window
   // The observers point into this object; the renderer and its camera may outlive it.
   if (camera_observer_) renderer_->GetActiveCamera()->RemoveObserver(camera_observer_);
   if (render_observer_) renderer_->RemoveObserver(render_observer_);
@@ -458,6 +519,10 @@ void PathView::Render() {
     return;
   }
   render_pending_ = false;
+  for (auto &a : {handles_, selected_actor_, bad_actor_, stems_})
+    if (a) a->SetVisibility(!overlay_hidden_);
+  for (auto &l : labels_)
+    l->SetVisibility(!overlay_hidden_);
   // While a drag is live the views render without multisampling: with Mesa's software renderer
   // 8x MSAA about doubles the cost of a frame (measured: 20-30 ms -> 11-15 ms per view); the
   // committed edit is drawn smooth again.

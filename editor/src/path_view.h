@@ -27,6 +27,9 @@
 
 #include "studio_scene.h"
 
+class NavSceneView;
+struct NavResult;
+struct NavViewOptions;
 class QImage;
 class QWindow;
 class QVTKOpenGLStereoWidget;
@@ -62,6 +65,21 @@ public:
   void SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview);
   /** Points of the drawn envelope band (2 per epoch; tests). */
   size_t EnvelopePointCount();
+  /** 3D view: show @p result through libnavview's scene (NavSceneView, the scene of navview and
+   *  `navsim render`): reference and estimate, attitude triads, vehicle, outages, error tube and
+   *  ellipsoids, legend, read-out; the editor's own estimate and band are hidden meanwhile.
+   *  nullptr clears it. The playback time is kept when @p keep_time. false with @p error. */
+  bool SetSceneResult(std::shared_ptr<const NavResult> result, const NavViewOptions &options, bool keep_time,
+                      QString *error);
+  /** The result's scene (nullptr when none is shown). */
+  NavSceneView *Scene() { return scene_.get(); }
+  std::shared_ptr<const NavResult> SceneResult() const { return scene_result_; }
+  /** Mark the shown result as out of date (greyed caption "out of date: edited after the run"). */
+  void SetSceneStale(bool stale);
+  bool SceneStale() const { return scene_stale_; }
+  /** Hide the editing overlay (waypoint handles, labels, drop lines) while the follow camera is
+   *  close to the vehicle: a handle sphere near the camera would fill the view. */
+  void SetEditOverlayHidden(bool hidden);
   /** Fit the camera to the scene and rebuild the grid. */
   void ResetCamera();
   /** Render now (a hidden view, or one collapsed to no area, renders when it is shown again). */
@@ -142,6 +160,11 @@ private:
 
   SceneDocument *doc_;
   Mode mode_;
+  std::unique_ptr<NavSceneView> scene_;
+  std::shared_ptr<const NavResult> scene_result_;
+  bool scene_stale_ = false;
+  bool overlay_hidden_ = false;
+  vtkSmartPointer<vtkTextActor> stale_text_;
   QVTKOpenGLStereoWidget *widget_ = nullptr;
   vtkSmartPointer<vtkGenericOpenGLRenderWindow> window_;
   vtkSmartPointer<vtkRenderer> renderer_;

@@ -9,6 +9,7 @@
 extern "C" {
 #include "navcore/nav_errors.h"
 #include "navcore/nav_frames.h"
+#include "navcore/nav_math.h"
 }
 
 namespace studio {
@@ -40,6 +41,13 @@ nav_callback_result OnRecord(void *user, const nav_sim_record *r) {
   o->truth_ned.insert(o->truth_ned.end(), {tv.r_ned_m.x, tv.r_ned_m.y, tv.r_ned_m.z});
   o->nav_ned.insert(o->nav_ned.end(), {nv.r_ned_m.x, nv.r_ned_m.y, nv.r_ned_m.z});
   o->err_h_m.push_back(r->err->pos_err_h_m);
+  const nav_euler te = nav_quat_to_euler(tv.q_b_n, nullptr), ne = nav_quat_to_euler(nv.q_b_n, nullptr);
+  o->truth_euler.insert(o->truth_euler.end(), {te.roll_rad, te.pitch_rad, te.yaw_rad});
+  o->nav_euler.insert(o->nav_euler.end(), {ne.roll_rad, ne.pitch_rad, ne.yaw_rad});
+  o->err_ned_m.insert(o->err_ned_m.end(), {r->err->pos_err_n_m.x, r->err->pos_err_n_m.y, r->err->pos_err_n_m.z});
+  o->err_v_m.push_back(r->err->pos_err_v_m);
+  o->att_err_rad.push_back(r->err->att_err_rad);
+  o->euler_err_rad.insert(o->euler_err_rad.end(), {r->err->euler_err.roll_rad, r->err->euler_err.pitch_rad, r->err->euler_err.yaw_rad});
   return c->cancel->load() ? NAV_STOP : NAV_CONTINUE;
 }
 } // namespace
@@ -169,9 +177,14 @@ void SimWorker::RunJob(SimWorker *self, Job *job, SimResult *out) {
     for (size_t i = 0; env && i < n; ++i) {
       out->env_t_s.push_back(env[i].t_s);
       out->env_h_rms_m.push_back(env[i].pos_h_rms_m);
+      out->env_rms_ned_m.insert(out->env_rms_ned_m.end(), {env[i].pos_rms_n_m.x, env[i].pos_rms_n_m.y, env[i].pos_rms_n_m.z});
+      out->env_att_rms_rad.push_back(env[i].att_rms_rad);
       if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS || scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
-          scene.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT)
+          scene.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
         out->env_sd_h_m.push_back(std::hypot(env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y));
+        out->env_sd_ned_m.insert(out->env_sd_ned_m.end(), {env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y,
+                                                           env[i].pos_sd_reported_n_m.z});
+      }
     }
     if (ev) {
       out->verdicts.resize(static_cast<size_t>(nav_req_evaluator_count(ev)));

@@ -38,6 +38,15 @@ struct SimResult {
   std::vector<double> truth_ned;  /**< 3 per epoch: reference, local NED [m] */
   std::vector<double> nav_ned;    /**< 3 per epoch: estimate of run 0, local NED [m] */
   std::vector<double> err_h_m;    /**< horizontal error of run 0 [m] */
+  std::vector<double> truth_euler; /**< 3 per epoch: reference roll, pitch, yaw of C_b_n [rad] */
+  std::vector<double> nav_euler;   /**< 3 per epoch: estimated roll, pitch, yaw of run 0 [rad] */
+  std::vector<double> err_ned_m;   /**< 3 per epoch: position error N/E/D of run 0 [m] */
+  std::vector<double> err_v_m;     /**< vertical error of run 0 [m] */
+  std::vector<double> att_err_rad; /**< attitude error angle of run 0 [rad] */
+  std::vector<double> euler_err_rad; /**< 3 per epoch: roll/pitch/yaw error of run 0 [rad] */
+  std::vector<double> env_rms_ned_m; /**< 3 per envelope epoch: RMS over runs of N/E/D error [m] */
+  std::vector<double> env_att_rms_rad; /**< RMS over runs of the attitude error [rad] */
+  std::vector<double> env_sd_ned_m;  /**< 3 per envelope epoch: filter's reported sigma N/E/D [m] */
   std::vector<double> env_t_s;    /**< Monte Carlo envelope epochs */
   std::vector<double> env_h_rms_m; /**< RMS over runs of the horizontal error [m] */
   /** The filter's reported horizontal 1-sigma, mean over runs [m] (INS/GNSS; else empty) */

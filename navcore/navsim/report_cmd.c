@@ -124,6 +124,8 @@ static void self_exe(char *buf, size_t cap, const char *argv0) {
 static const char *k_usage_render =
     "usage: navsim render RESULT_DIR|SCENE [--view VIEW] [--out FILE.png] [--size WxH] [--time T_S]\n"
     "                     [navview options]\n"
+    "       navsim render RESULT_DIR|SCENE --view 3d --movie FILE.mp4|FILE.webm [--duration-s S]\n"
+    "                     [--size WxH] [--follow] [--follow-distance M] [navview options]\n"
     "\n"
     "Render one view of a result directory of navsim run with the VTK viewer (navview):\n"
     "  3d      reference and estimated paths, GNSS fixes and outages, attitude triads, error tube\n"
@@ -140,6 +142,9 @@ static const char *k_usage_render =
     "          (a scene with gnss.constellation: gnss_sats.csv, gnss_mask.csv)\n"
     "  dop     GDOP/PDOP/HDOP/VDOP and satellites in view over time, canyon spans and receiver\n"
     "          outages (gnss_dop.csv)\n"
+    "--movie writes a playback movie of the 3D view instead of a PNG: H.264 MP4 or VP9 WebM\n"
+    "(encoded by ffmpeg), S seconds long (default 10) at 30 frames/s, 1920x1080 unless --size,\n"
+    "the time read-out in each frame, --follow: the camera follows the vehicle.\n"
     "--out defaults to RESULT_DIR/VIEW.png. A SCENE file is run first (navsim run --out\n"
     "out/render-<file stem>). Without --view and --out (and with --png/--chart) the old form\n"
     "writes RESULT_DIR/view.png and RESULT_DIR/errors.png. Other options go to navview\n"
@@ -153,7 +158,7 @@ int navsim_render(int argc, char **argv) {
     fputs(k_usage_render, argc < 1 ? stderr : stdout);
     return argc < 1 ? RC_INVALID : RC_OK;
   }
-  const char *view = NULL, *out = NULL;
+  const char *view = NULL, *out = NULL, *movie = NULL;
   bool has_png = false, has_chart = false;
   argvec v;
   av_init(&v);
@@ -166,12 +171,19 @@ int navsim_render(int argc, char **argv) {
       fputs(k_usage_render, stdout);
       return RC_OK;
     }
-    if ((strcmp(argv[i], "--view") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 >= argc) {
+    if ((strcmp(argv[i], "--view") == 0 || strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--movie") == 0) &&
+        i + 1 >= argc) {
       fprintf(stderr, "navsim render: %s needs a value\n", argv[i]);
       return RC_INVALID;
     }
     if (strcmp(argv[i], "--view") == 0) view = argv[++i];
     else if (strcmp(argv[i], "--out") == 0) out = argv[++i];
+    else if (strcmp(argv[i], "--movie") == 0) {
+      /* A video file; a directory (PNG frames and .ogv) passes through to navview as before. */
+      const char *m = argv[++i];
+      const size_t ml = strlen(m);
+      if ((ml > 4 && strcmp(m + ml - 4, ".mp4") == 0) || (ml > 5 && strcmp(m + ml - 5, ".webm") == 0)) movie = m;
+    }
     else if (strcmp(argv[i], "--png") == 0) has_png = true;
     else if (strcmp(argv[i], "--chart") == 0) has_chart = true;
   }
@@ -211,6 +223,27 @@ int navsim_render(int argc, char **argv) {
     return RC_FAIL;
   }
   if (navsim_refuse_special_result_files(dir) != 0) return RC_INVALID;
+  if (movie) {
+    /* The playback movie of the 3D view (navview --movie FILE.mp4|FILE.webm). */
+    if ((view && strcmp(view, "3d") != 0) || out) {
+      fprintf(stderr, "navsim render: --movie %s: a video of the 3D view: expected --view 3d (the default) and no "
+                      "--out\n", movie);
+      return RC_INVALID;
+    }
+    av_add(&v, dir);
+    av_add(&v, "--view");
+    av_add(&v, "3d");
+    for (int i = 1; i < argc; ++i) {
+      if (strcmp(argv[i], "--view") == 0) {
+        ++i;
+        continue;
+      }
+      av_add(&v, argv[i]);
+    }
+    const int rc = run_child(v.a, false);
+    if (rc == 0) record_output(dir, movie);
+    return rc;
+  }
 
   char out_buf[4200], in_buf[4200], png2[4200];
   const bool legacy = !view && !out;

@@ -388,36 +388,39 @@ bool NavBuildSceneModel(const NavResult &result, const NavViewOptions &opt, doub
 
   // Triads at t0 + k * interval (computed, never accumulated).
   if (m.triad_interval_s > 0.0 && std::isfinite(m.triad_interval_s)) {
-    const double k_att = opt.att_exaggeration;
     for (long k = 0;; ++k) {
       const double t = m.t_begin_s + static_cast<double>(k) * m.triad_interval_s;
       if (t > m.t_end_s + 1e-9 * std::max(1.0, std::fabs(m.t_end_s)) || k > 100000) break;
-      double p_ref[3], c_ref[9];
-      NavTrackSample(result.truth, t, p_ref, c_ref);
-      m.triads_ref.t_s.push_back(t);
-      m.triads_ref.xyz_r.insert(m.triads_ref.xyz_r.end(), p_ref, p_ref + 3);
-      nav_mat3 c_truth;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          c_truth.m[r][c] = c_ref[3 * r + c];
-      QuatOut(c_truth, &m.triads_ref.q_b_r);
-
-      if (!result.nav.HasAttitude()) continue;
-      double p_est[3], c_est_a[9];
-      NavTrackSample(result.nav, t, p_est, c_est_a);
-      nav_mat3 c_nav;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          c_nav.m[r][c] = c_est_a[3 * r + c];
-      // Attitude error as a rotation of frame n: C_nav = exp([phi x]) C_truth. Showing
-      // exp([k phi x]) C_truth scales the error angle by k and keeps its axis.
-      const nav_vec3 phi = nav_dcm_log(nav_mat3_mul(c_nav, nav_mat3_transpose(c_truth)));
-      const nav_mat3 c_show = nav_mat3_mul(nav_dcm_exp(nav_vec3_scale(phi, k_att)), c_truth);
-      m.triads_est.t_s.push_back(t);
-      m.triads_est.xyz_r.insert(m.triads_est.xyz_r.end(), p_est, p_est + 3);
-      QuatOut(c_show, &m.triads_est.q_b_r);
+      NavAppendTriadsAt(result, opt.att_exaggeration, t, &m.triads_ref, &m.triads_est);
     }
   }
   *out = std::move(m);
   return true;
+}
+
+void NavAppendTriadsAt(const NavResult &result, double k_att, double t, NavTriadSet *ref, NavTriadSet *est) {
+  double p_ref[3], c_ref[9];
+  if (!NavTrackSample(result.truth, t, p_ref, c_ref)) return;
+  ref->t_s.push_back(t);
+  ref->xyz_r.insert(ref->xyz_r.end(), p_ref, p_ref + 3);
+  nav_mat3 c_truth;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      c_truth.m[r][c] = c_ref[3 * r + c];
+  QuatOut(c_truth, &ref->q_b_r);
+
+  if (!result.nav.HasAttitude()) return;
+  double p_est[3], c_est_a[9];
+  NavTrackSample(result.nav, t, p_est, c_est_a);
+  nav_mat3 c_nav;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      c_nav.m[r][c] = c_est_a[3 * r + c];
+  // Attitude error as a rotation of frame n: C_nav = exp([phi x]) C_truth. Showing
+  // exp([k phi x]) C_truth scales the error angle by k and keeps its axis.
+  const nav_vec3 phi = nav_dcm_log(nav_mat3_mul(c_nav, nav_mat3_transpose(c_truth)));
+  const nav_mat3 c_show = nav_mat3_mul(nav_dcm_exp(nav_vec3_scale(phi, k_att)), c_truth);
+  est->t_s.push_back(t);
+  est->xyz_r.insert(est->xyz_r.end(), p_est, p_est + 3);
+  QuatOut(c_show, &est->q_b_r);
 }

@@ -240,6 +240,25 @@ int NavSceneViewImpl::FontSize(double scale) const {
 }
 
 bool NavSceneViewImpl::EnsureWindow(bool offscreen, std::string *error) {
+  if (External) {
+    if (Window == External) return true;
+    Window = External;
+    Renderer = vtkSmartPointer<vtkRenderer>::New();
+    // One layer above the host's renderer, through its camera: the host's picture (ground,
+    // handles) stays underneath, our renderer clears only depth.
+    const int layer = Under ? Under->GetLayer() + 1 : 1;
+    if (Window->GetNumberOfLayers() < layer + 1) Window->SetNumberOfLayers(layer + 1);
+    Renderer->SetLayer(layer);
+    Renderer->InteractiveOff();
+    if (Under) Renderer->SetActiveCamera(Under->GetActiveCamera());
+    Window->AddRenderer(Renderer);
+    Panel = vtkSmartPointer<vtkRenderer>::New();
+    Panel->InteractiveOff();
+    Window->AddRenderer(Panel);
+    Offscreen = false;
+    Built = false;
+    return true;
+  }
   if (Window && Offscreen == offscreen) return true;
   if (!NavCheckDisplay(error)) return false;
   if (Window) Window->Finalize();
@@ -400,8 +419,23 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
     return false;
   }
   if (!EnsureWindow(offscreen, error)) return false;
-  Window->SetSize(Options.width_px, Options.height_px);
+  if (External) {
+    const int *wsz = Window->GetSize();
+    if (wsz && wsz[0] >= 16 && wsz[1] >= 16) {
+      Options.width_px = wsz[0];
+      Options.height_px = wsz[1];
+    }
+  } else {
+    Window->SetSize(Options.width_px, Options.height_px);
+  }
   Renderer->RemoveAllViewProps();
+  TriadMappers.clear();
+  TriadFactors.clear();
+  NowRef = NowEst = nullptr;
+  EnvelopeActor = nullptr;
+  EllipsoidActors.clear();
+  StaleColors.clear();
+  ScaleMpp = 0.0;
   Panel->RemoveAllViewProps();
   Renderer->SetBackground(1.0, 1.0, 1.0);
   Renderer->SetBackground2(0.90, 0.93, 0.97);
@@ -409,6 +443,7 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
   // No depth peeling: with multisampling it hid the translucent tube entirely (llvmpipe,
   // VTK 9.1). The tube is the only translucent surface, so plain blending is enough.
   Renderer->SetUseDepthPeeling(0);
+  Renderer->SetUseFXAA(Options.fxaa);
   Panel->SetBackground(0.985, 0.985, 0.99);
   Vehicle = nullptr;
   EstimateMarker = nullptr;
@@ -427,11 +462,13 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
   PanelFraction = 0.0;
   if (Options.show_text) AddPanel();
   Renderer->SetViewport(0.0, 0.0, 1.0 - PanelFraction, 1.0);
+  if (Under) Under->SetViewport(0.0, 0.0, 1.0 - PanelFraction, 1.0);
   Panel->SetViewport(1.0 - PanelFraction, 0.0, 1.0, 1.0);
   Panel->SetDraw(PanelFraction > 0.0);
 
-  if (!keep_camera) SetupCamera();
+  if (!keep_camera && !External) SetupCamera();
   const double m_per_px = MetresPerPixel();
+  ScaleMpp = Options.follow ? 0.0 : m_per_px;
   const double tol_m = std::max(Options.decimate_px, 0.0) * m_per_px;
   if (!NavBuildSceneModel(*Result, Options, tol_m, &Model, error)) return false;
   PickRadiusM = 12.0 * m_per_px;
@@ -449,8 +486,72 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
   Built = true;
   if (!std::isfinite(TimeS)) TimeS = std::isfinite(Options.time_s) ? Options.time_s : Model.t_end_s;
   UpdateTime();
+  ApplyStale();
   Renderer->ResetCameraClippingRange();
   return true;
+}
+
+double NavSceneViewImpl::FollowDistance() const {
+  if (Options.follow_distance_m > 0.0) return Options.follow_distance_m;
+  // 60 m shows a car and its surroundings; a small scene gets a third of its extent.
+  const double extent = Model.triad_size_m / 0.06;
+  return std::max(2.0, std::min(60.0, 0.3 * extent));
+}
+
+double NavSceneViewImpl::ViewTriadSize() const {
+  // Following, the triads and the vehicle are sized for the camera distance (about a twelfth of
+  // it), else for the scene's extent (the model's).
+  return Options.follow ? std::min(Model.triad_size_m, 0.08 * FollowDistance()) : Model.triad_size_m;
+}
+
+void NavSceneViewImpl::PlaceFollowCamera(const double p_ref[3]) {
+  // Behind the vehicle along its direction of travel over the last few seconds (steadier than
+  // the instantaneous heading), 25 deg above the horizon, looking at the vehicle.
+  const double span = std::max(2.0, 0.01 * (Model.t_end_s - Model.t_begin_s));
+  double pa[3], pb[3];
+  NavTrackSample(Result->truth, std::max(Model.t_begin_s, TimeS - span), pa, nullptr);
+  NavTrackSample(Result->truth, std::min(Model.t_end_s, TimeS + 0.25 * span), pb, nullptr);
+  double hx = pb[0] - pa[0], hy = pb[1] - pa[1];
+  const double hn = std::hypot(hx, hy);
+  if (hn > 1e-6) {
+    hx /= hn;
+    hy /= hn;
+    FollowHeading[0] = hx;
+    FollowHeading[1] = hy;
+  } else {
+    hx = FollowHeading[0];
+    hy = FollowHeading[1];
+  }
+  const double d = FollowDistance(), el = 25.0 * kPi / 180.0;
+  vtkCamera *cam = Renderer->GetActiveCamera();
+  cam->SetParallelProjection(false);
+  cam->SetViewAngle(30.0);
+  cam->SetWindowCenter(0.0, 0.0);
+  cam->SetFocalPoint(p_ref[0], p_ref[1], p_ref[2]);
+  cam->SetPosition(p_ref[0] - d * std::cos(el) * hx, p_ref[1] - d * std::cos(el) * hy, p_ref[2] + d * std::sin(el));
+  cam->SetViewUp(0.0, 0.0, 1.0);
+  Renderer->ResetCameraClippingRange();
+}
+
+void NavSceneViewImpl::UpdateScale(bool force) {
+  const int *size = Renderer->GetSize();
+  const double h = size && size[1] > 0 ? size[1] : Options.height_px;
+  const double mpp = Options.follow ? 2.0 * FollowDistance() * std::tan(15.0 * kPi / 180.0) / h : MetresPerPixel();
+  const double ts = ViewTriadSize();
+  for (size_t i = 0; i < TriadMappers.size(); ++i)
+    TriadMappers[i]->SetScaleFactor(ts * TriadFactors[i]);
+  if (EstimateMarker) EstimateMarker->SetScale(0.14 * ts);
+  if (!force && ScaleMpp > 0.0 && mpp < 1.5 * ScaleMpp && mpp > ScaleMpp / 1.5) return;
+  ScaleMpp = mpp;
+  // The envelope floor is in pixels: rebuild the blended surfaces (drawn last, as BuildScene).
+  if (EnvelopeActor) Renderer->RemoveActor(EnvelopeActor);
+  for (auto &a : EllipsoidActors)
+    Renderer->RemoveActor(a);
+  EllipsoidActors.clear();
+  EnvelopeActor = nullptr;
+  AddEllipsoids();
+  AddEnvelope();
+  ApplyStale();
 }
 
 void NavSceneViewImpl::AddPaths() {
@@ -508,7 +609,7 @@ void NavSceneViewImpl::AddEnvelope() {
   r->SetNumberOfValues(static_cast<vtkIdType>(tube.Size()));
   // vtkTubeFilter needs a positive radius to form its frame; a floor far below a pixel keeps the
   // geometry valid where sigma is zero without showing anything there.
-  const double floor_m = 1e-3 * Model.decimation_tol_m + 1e-9;
+  const double floor_m = std::max(1e-3 * Model.decimation_tol_m + 1e-9, 0.5 * Options.min_envelope_px * ScaleMpp);
   for (size_t i = 0; i < tube.Size(); ++i)
     r->SetValue(static_cast<vtkIdType>(i), std::max(tube.radius_m[i], floor_m));
   pd->GetPointData()->SetScalars(r);
@@ -534,6 +635,7 @@ void NavSceneViewImpl::AddEnvelope() {
   actor->GetProperty()->SetSpecular(0.0);
   actor->GetProperty()->SetAmbient(0.25);
   Renderer->AddActor(actor);
+  EnvelopeActor = actor;
 }
 
 void NavSceneViewImpl::AddGnss() {
@@ -593,34 +695,43 @@ void NavSceneViewImpl::AddEllipsoids() {
     vtkNew<vtkActor> a;
     a->SetMapper(m);
     // A floor far below a pixel keeps a zero sigma from collapsing the matrix.
-    const double fl = 1e-6 * std::max(Model.triad_size_m, 1e-9);
+    const double fl = std::max(1e-6 * std::max(Model.triad_size_m, 1e-9), 0.5 * Options.min_envelope_px * ScaleMpp);
     a->SetScale(std::max(e.semi_axes_r[0], fl), std::max(e.semi_axes_r[1], fl), std::max(e.semi_axes_r[2], fl));
     a->SetPosition(e.center_r[0], e.center_r[1], e.center_r[2]);
     a->GetProperty()->SetColor(kEllipsoidColor[0], kEllipsoidColor[1], kEllipsoidColor[2]);
-    a->GetProperty()->SetOpacity(0.45);
+    // Following, the camera is close to the ellipsoids: fainter, so the vehicle shows through.
+    a->GetProperty()->SetOpacity(Options.follow ? 0.2 : 0.45);
     a->ForceOpaqueOn(); // blended in the opaque pass, before the tube: see AddEnvelope
     a->GetProperty()->BackfaceCullingOn();
     a->GetProperty()->SetSpecular(0.2);
     a->GetProperty()->SetAmbient(0.3);
     Renderer->AddActor(a);
+    EllipsoidActors.push_back(a);
   }
 }
 
+vtkSmartPointer<vtkPolyData> TriadPolyData(const NavTriadSet &set) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> q;
+  q->SetName("q_b_r");
+  q->SetNumberOfComponents(4);
+  for (size_t i = 0; i < set.Size(); ++i) {
+    pts->InsertNextPoint(&set.xyz_r[3 * i]);
+    q->InsertNextTuple(&set.q_b_r[4 * i]);
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->GetPointData()->AddArray(q);
+  return pd;
+}
+
 void NavSceneViewImpl::AddTriads() {
-  auto add_set = [&](const NavTriadSet &set, const double colors[3][3], bool thin) {
+  auto add_set = [&](const NavTriadSet &set, const double colors[3][3], bool thin, double factor,
+                     vtkSmartPointer<vtkPolyData> *keep) {
     if (set.Size() == 0) return;
-    vtkNew<vtkPoints> pts;
-    pts->SetDataTypeToDouble();
-    vtkNew<vtkDoubleArray> q;
-    q->SetName("q_b_r");
-    q->SetNumberOfComponents(4);
-    for (size_t i = 0; i < set.Size(); ++i) {
-      pts->InsertNextPoint(&set.xyz_r[3 * i]);
-      q->InsertNextTuple(&set.q_b_r[4 * i]);
-    }
-    vtkNew<vtkPolyData> pd;
-    pd->SetPoints(pts);
-    pd->GetPointData()->AddArray(q);
+    auto pd = TriadPolyData(set);
+    if (keep) *keep = pd;
     for (int axis = 0; axis < 3; ++axis) {
       // One mapper per axis: vtkGlyph3DMapper ignores source colours (toolchain.md section 3).
       vtkNew<vtkGlyph3DMapper> gm;
@@ -629,8 +740,10 @@ void NavSceneViewImpl::AddTriads() {
       gm->SetOrientationModeToQuaternion();
       gm->SetOrientationArray("q_b_r");
       gm->SetScaleModeToNoDataScaling();
-      gm->SetScaleFactor(Model.triad_size_m * (thin ? 1.0 : 0.92));
+      gm->SetScaleFactor(Model.triad_size_m * factor);
       gm->ScalarVisibilityOff();
+      TriadMappers.push_back(gm.GetPointer());
+      TriadFactors.push_back(factor);
       vtkNew<vtkActor> a;
       a->SetMapper(gm);
       a->GetProperty()->SetColor(colors[axis][0], colors[axis][1], colors[axis][2]);
@@ -641,8 +754,14 @@ void NavSceneViewImpl::AddTriads() {
   const double grey[3][3] = {{kTriadRefGrey[0], kTriadRefGrey[1], kTriadRefGrey[2]},
                              {kTriadRefGrey[0], kTriadRefGrey[1], kTriadRefGrey[2]},
                              {kTriadRefGrey[0], kTriadRefGrey[1], kTriadRefGrey[2]}};
-  add_set(Model.triads_ref, grey, true);
-  add_set(Model.triads_est, kTriadRGB, false);
+  add_set(Model.triads_ref, grey, true, 1.0, nullptr);
+  add_set(Model.triads_est, kTriadRGB, false, 0.92, nullptr);
+  // The pair at the playback time, a little larger, moved by UpdateTime.
+  if (!Options.show_triads_at_time) return;
+  NavTriadSet now_ref, now_est;
+  NavAppendTriadsAt(*Result, Options.att_exaggeration, Model.t_begin_s, &now_ref, &now_est);
+  add_set(now_ref, grey, true, 1.3, &NowRef);
+  add_set(now_est, kTriadRGB, false, 1.25, &NowEst);
 }
 
 void NavSceneViewImpl::AddGrid() {
@@ -794,6 +913,7 @@ void NavSceneViewImpl::AddText() {
     std::snprintf(buf, sizeof buf, "%s \u00b7 run 0 of %d", Result->scene_name.c_str(), Result->runs);
   else
     std::snprintf(buf, sizeof buf, "%s", Result->scene_name.c_str());
+  TitleText = buf;
   Title->SetInput(buf);
   StyleText(Title->GetTextProperty(), FontSize(1.15), true);
   Title->GetTextProperty()->SetVerticalJustificationToTop();
@@ -893,7 +1013,12 @@ void NavSceneViewImpl::AddPanel() {
     else
       std::snprintf(buf, sizeof buf, "tube: %g\u00d7 horizontal error\nof run 0 (\u2264 %s)",
                     Options.envelope_k, rbuf);
-    e.push_back({Sym::Box, buf, kTubeColor, 0.0});
+    std::string tube_text = buf;
+    if (Options.min_envelope_px > 0.0) {
+      std::snprintf(buf, sizeof buf, "\ndrawn at least %g px wide", Options.min_envelope_px);
+      tube_text += buf;
+    }
+    e.push_back({Sym::Box, tube_text, kTubeColor, 0.0});
     const size_t n_ell = NavEllipsoidTimes(*Result, Options).size();
     if (n_ell > 0) {
       std::snprintf(buf, sizeof buf, "ellipsoids: %g\u03c3 N/E/D\n(%s), at %zu epochs%s", Options.envelope_k,
@@ -922,7 +1047,9 @@ void NavSceneViewImpl::AddPanel() {
   const double line_h = 1.3 * fs, row_pad = 0.45 * fs, pad = 0.9 * fs, sym_w = 2.4 * fs, gap = 0.6 * fs;
   double text_w = 0.0;
   std::vector<vtkSmartPointer<vtkTextActor>> texts;
+  Legend.clear();
   for (const Entry &x : e) {
+    Legend += x.text + "\n";
     auto t = vtkSmartPointer<vtkTextActor>::New();
     t->SetInput(x.text.c_str());
     StyleText(t->GetTextProperty(), fs);
@@ -1068,7 +1195,7 @@ void NavSceneViewImpl::UpdateTime() {
   if (Vehicle) {
     // C_b_r column by column through the render-frame adapter.
     vtkNew<vtkMatrix4x4> mtx;
-    const double sc = 1.6 * Model.triad_size_m;
+    const double sc = 1.6 * ViewTriadSize();
     for (int c = 0; c < 3; ++c) {
       const double col_n[3] = {c_ref[c], c_ref[3 + c], c_ref[6 + c]};
       double col_r[3];
@@ -1083,8 +1210,25 @@ void NavSceneViewImpl::UpdateTime() {
   double p_est[3];
   const bool have_est = NavTrackSample(Result->nav, TimeS, p_est, nullptr);
   if (EstimateMarker && have_est) EstimateMarker->SetPosition(p_est);
+  if (NowRef || NowEst) {
+    NavTriadSet now_ref, now_est;
+    NavAppendTriadsAt(*Result, Options.att_exaggeration, TimeS, &now_ref, &now_est);
+    auto move = [](vtkPolyData *pd, const NavTriadSet &set) {
+      if (!pd || set.Size() == 0) return;
+      pd->GetPoints()->SetPoint(0, &set.xyz_r[0]);
+      pd->GetPoints()->Modified();
+      vtkDataArray *q = pd->GetPointData()->GetArray("q_b_r");
+      q->SetTuple(0, &set.q_b_r[0]);
+      q->Modified();
+      pd->Modified();
+    };
+    move(NowRef, now_ref);
+    move(NowEst, now_est);
+  }
 
-  if (Follow && VehiclePlaced) {
+  if (Options.follow) {
+    PlaceFollowCamera(p_ref);
+  } else if (Follow && VehiclePlaced) {
     vtkCamera *cam = Renderer->GetActiveCamera();
     double f[3], p[3];
     cam->GetFocalPoint(f);
@@ -1100,10 +1244,11 @@ void NavSceneViewImpl::UpdateTime() {
   for (int k = 0; k < 3; ++k)
     VehiclePosR[k] = p_ref[k];
   VehiclePlaced = true;
+  UpdateScale(false);
 
   if (Readout) {
     char buf[256];
-    int n = std::snprintf(buf, sizeof buf, "t = %.1f s%s", TimeS,
+    int n = std::snprintf(buf, sizeof buf, "t = %.1f s of %.0f s%s", TimeS, Model.t_end_s,
                           Result->gnss.InOutage(TimeS) ? "  \u2013 GNSS outage" : "");
     const NavErrorSeries &er = Result->errors;
     if (er.Size() > 0 && n > 0 && n < static_cast<int>(sizeof buf)) {
@@ -1121,7 +1266,13 @@ void NavSceneViewImpl::UpdateTime() {
 
 NavSceneView::NavSceneView() : Impl(new NavSceneViewImpl) {}
 NavSceneView::~NavSceneView() {
-  if (Impl->Window) Impl->Window->Finalize();
+  if (Impl->External) {
+    if (Impl->Renderer) Impl->External->RemoveRenderer(Impl->Renderer);
+    if (Impl->Panel) Impl->External->RemoveRenderer(Impl->Panel);
+    if (Impl->Under) Impl->Under->SetViewport(0.0, 0.0, 1.0, 1.0);
+  } else if (Impl->Window) {
+    Impl->Window->Finalize();
+  }
 }
 
 void NavSceneView::SetResult(std::shared_ptr<const NavResult> result) {

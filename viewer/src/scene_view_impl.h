@@ -5,7 +5,9 @@
 #ifndef NAV_SCENE_VIEW_IMPL_H
 #define NAV_SCENE_VIEW_IMPL_H
 
+#include <array>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "navview/nav_view_scene.h"
 
 class vtkActor;
+class vtkGlyph3DMapper;
 class vtkLookupTable;
 class vtkPolyData;
 class vtkRenderWindow;
@@ -50,6 +53,35 @@ public:
   bool VehiclePlaced = false;
   double PickRadiusM = 0.0;
   size_t GnssDrawn = 0; /**< GNSS fixes drawn after display thinning */
+
+  /** Embedded in another program's window (navstudio): our renderer draws over @c Under (its
+   *  camera, one layer up), the legend panel takes the window's right side. */
+  vtkRenderWindow *External = nullptr;
+  vtkRenderer *Under = nullptr;
+  /** Triad glyph mappers (their scale follows the view) and their nominal size factors. */
+  std::vector<vtkSmartPointer<vtkGlyph3DMapper>> TriadMappers;
+  std::vector<double> TriadFactors;
+  /** The triads at the playback time (reference and estimate), moved by UpdateTime. */
+  vtkSmartPointer<vtkPolyData> NowRef, NowEst;
+  vtkSmartPointer<vtkActor> EnvelopeActor;
+  std::vector<vtkSmartPointer<vtkActor>> EllipsoidActors;
+  double ScaleMpp = 0.0;
+  std::string Legend; /**< the legend entries' text (AddPanel) */
+  /** Out-of-date marking: every actor's colour faded towards grey (originals kept), title says so. */
+  bool Stale = false;
+  std::vector<std::pair<vtkSmartPointer<vtkActor>, std::array<double, 3>>> StaleColors;
+  std::string TitleText;
+  void ApplyStale();
+  double FollowHeading[2] = {0.0, 1.0}; /**< last horizontal direction of travel (frame r) */ /**< metres per pixel the scale-dependent sizes were set for */
+
+  /** Triad arrow length for the current view [m]: the model's, or sized for the follow camera. */
+  double ViewTriadSize() const;
+  /** Follow-camera distance [m] (the options' or automatic). */
+  double FollowDistance() const;
+  /** Place the follow camera at the vehicle (reference position and heading at TimeS). */
+  void PlaceFollowCamera(const double p_ref[3]);
+  /** Re-size the triads, the vehicle and the envelope floor for the current view scale. */
+  void UpdateScale(bool force);
 
   /** Create (or re-create, when the on/offscreen mode changes) the window and renderer. */
   bool EnsureWindow(bool offscreen, std::string *error);

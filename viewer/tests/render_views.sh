@@ -23,6 +23,29 @@ for i in 0000 0001 0002; do [ -s "$WORK/movie/frame_$i.png" ] || fail "movie fra
 [ ! -e "$WORK/movie/frame_0003.png" ] || fail "more movie frames than asked for"
 [ "$(wc -c < "$WORK/movie/playback.ogv")" -gt 1000 ] || fail "playback.ogv missing or empty"
 cmp -s "$WORK/movie/frame_0000.png" "$WORK/movie/frame_0002.png" && fail "movie frames do not move"
+# Playback movie as one video file (issue 19): H.264 MP4 and VP9 WebM by ffmpeg, the asked size and
+# duration (ffprobe), the follow camera; no .part left; bad combinations exit 2.
+if command -v ffprobe >/dev/null 2>&1; then
+  probe() { ffprobe -v error -select_streams v:0 -show_entries "$2" -of default=noprint_wrappers=1:nokey=1 "$1"; }
+  "$NAVSIM" render "$WORK/res" --view 3d --movie "$WORK/play.mp4" --duration-s 2 --size 320x240 --follow \
+    || fail "--movie play.mp4 exited $?"
+  [ "$(probe "$WORK/play.mp4" stream=codec_name)" = h264 ] || fail "play.mp4 is not H.264"
+  [ "$(probe "$WORK/play.mp4" stream=width)x$(probe "$WORK/play.mp4" stream=height)" = 320x240 ] || fail "play.mp4 size"
+  d=$(probe "$WORK/play.mp4" format=duration)
+  awk -v d="$d" 'BEGIN { exit !(d > 1.95 && d < 2.05) }' || fail "play.mp4 lasts $d s, expected 2"
+  "$NAVSIM" render "$WORK/res" --movie "$WORK/play.webm" --duration-s 1 --size 320x240 || fail "--movie play.webm exited $?"
+  [ "$(probe "$WORK/play.webm" stream=codec_name)" = vp9 ] || fail "play.webm is not VP9"
+  [ ! -e "$WORK/play.mp4.part" ] && [ ! -e "$WORK/play.webm.part" ] || fail "a .part file was left"
+  "$NAVSIM" render "$WORK/res" --view map --movie "$WORK/x.mp4" 2> "$WORK/err.txt"
+  [ $? -eq 2 ] || fail "--view map --movie x.mp4: expected exit 2"
+  grep -q "expected --view 3d" "$WORK/err.txt" || fail "no message for --view map --movie"
+  "$NAVSIM" render "$WORK/res" --movie "$WORK/odd.mp4" --size 321x240 2> "$WORK/err.txt"
+  [ $? -ne 0 ] || fail "odd width: expected a failure"
+  grep -q "even width and height" "$WORK/err.txt" || fail "no message for an odd width"
+  [ ! -e "$WORK/odd.mp4" ] && [ ! -e "$WORK/odd.mp4.part" ] || fail "odd.mp4 left behind"
+else
+  echo "render_views: ffprobe missing (Debian package ffmpeg): video movie checks skipped"
+fi
 # Default output name: RESULT_DIR/VIEW.png
 "$NAVSIM" render "$WORK/res" --view map --size 300x200 || fail "default --out"
 [ -s "$WORK/res/map.png" ] || fail "no RESULT_DIR/map.png"

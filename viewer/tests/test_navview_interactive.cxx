@@ -63,6 +63,7 @@ int setup(void **state) {
   o.height_px = 420;
   o.multisamples = 0;
   o.time_s = 10.0;
+  o.att_exaggeration = 1.0; // +/- below: 1 -> 2 -> 4 -> 2
   f->view.SetResult(f->result);
   f->view.SetOptions(o);
   if (!f->st.Open(&f->view, &err)) {

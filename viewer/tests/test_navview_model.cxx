@@ -217,6 +217,7 @@ void test_triad_orientation(void **) {
   const NavResult r = load_tiny();
   NavViewOptions opt;
   opt.triad_interval_s = 10.0; // epochs at whole seconds: triads fall on samples
+  opt.att_exaggeration = 1.0;  // the true estimate (the default is kNavDefaultAttExaggeration)
   NavSceneModel m;
   std::string err;
   assert_true(NavBuildSceneModel(r, opt, 0.05, &m, &err));

@@ -34,6 +34,11 @@ NavViewOptions BaseOptions() {
   o.ellipsoid_count = 0;
   o.show_gnss = false;
   o.vehicle = NavVehicleKind::Car;
+  // Also predating the baselines: exaggeration 1 (now 20 by default), no triad pair at the
+  // playback time, no pixel floor of the envelope.
+  o.att_exaggeration = 1.0;
+  o.show_triads_at_time = false;
+  o.min_envelope_px = 0.0;
   return o;
 }
 

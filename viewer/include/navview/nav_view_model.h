@@ -44,6 +44,11 @@ bool NavSigmaNed(const NavResult &result, NavEnvelopeSource src, double t, doubl
 /** Horizontal 1-sigma [m] at time @p t from @p src (NaN when the source has no data). */
 double NavSigmaH(const NavResult &result, NavEnvelopeSource src, double t);
 
+/** Attitude-error exaggeration of the estimated triads when the user gives none: navview,
+ *  `navsim render`, the report and navstudio all start from it. A 0.1 deg error of a good INS
+ *  becomes 2 deg, visible on a triad; the legend always states the factor. */
+constexpr double kNavDefaultAttExaggeration = 20.0;
+
 /** Camera presets of the 3D view. */
 enum class NavCameraPreset {
   Oblique, /**< from the south-south-west, 50 deg above the horizon, perspective */
@@ -58,7 +63,7 @@ struct NavViewOptions {
   double time_s = NAN;
   /** Attitude-error exaggeration k: the estimated triad shows exp(k*phi) C_b_n(truth), where
    *  phi is the rotation vector of C_b_n(nav) C_b_n(truth)^T; k = 1 shows the true estimate. */
-  double att_exaggeration = 1.0;
+  double att_exaggeration = kNavDefaultAttExaggeration;
   /** Envelope tube radius = envelope_k * sigma_h [m]. */
   double envelope_k = 3.0;
   NavEnvelopeSource envelope_source = NavEnvelopeSource::Auto;
@@ -74,6 +79,8 @@ struct NavViewOptions {
   bool show_grid = true;
   bool show_axes = true;
   bool show_triads = true;
+  /** A triad pair (reference and estimate) at the playback time, moving with it. */
+  bool show_triads_at_time = true;
   bool show_vehicle = true;
   /** Screen-space decimation tolerance [pixels]. */
   double decimate_px = 0.5;
@@ -86,6 +93,9 @@ struct NavViewOptions {
   double camera_view_angle_deg = 30.0;
   /** Multisample anti-aliasing samples (0: off). */
   int multisamples = 8;
+  /** Fast approximate anti-aliasing (a screen-space pass; movies: about a quarter of the cost
+   *  of 4x multisampling per frame on llvmpipe). */
+  bool fxaa = false;
   /** Covariance ellipsoids (semi-axes envelope_k x sigma N/E/D of the envelope source) at this
    *  many epochs spread evenly over the run (0: none). */
   int ellipsoid_count = 6;
@@ -94,6 +104,15 @@ struct NavViewOptions {
   /** GNSS fixes as points and outage intervals highlighted on the reference path. */
   bool show_gnss = true;
   NavVehicleKind vehicle = NavVehicleKind::Auto;
+  /** Follow camera: at every time the camera looks at the vehicle from behind and above (25 deg)
+   *  at follow_distance_m; the triads and the vehicle are sized for that distance. */
+  bool follow = false;
+  /** Follow-camera distance [m]; <= 0: automatic (12 x the vehicle's length, at least 40 m). */
+  double follow_distance_m = 0.0;
+  /** The envelope tube and the ellipsoids are drawn at least this many pixels across at the
+   *  current view scale, so a metre-level envelope stays visible at city scale (the legend says
+   *  so); re-applied when the scale changes by more than 1.5x (zoom, follow camera). */
+  double min_envelope_px = 3.0;
 };
 
 /** Epochs of the covariance ellipsoids: the options' explicit times, else ellipsoid_count epochs
@@ -159,6 +178,12 @@ struct NavSceneModel {
   double decimation_tol_m = 0.0;
   size_t full_points = 0; /**< epochs of all drawn paths before decimation */
 };
+
+/** Append the triads at time @p t: the reference attitude at the reference position to @p ref and,
+ *  when the estimate has attitude, exp(k phi) C_b_n(truth) at the estimated position to @p est
+ *  (phi = the attitude error as a rotation vector, k = @p k_att). The one triad computation of
+ *  the scene (the model's triads every N s and the view's triad at the playback time). */
+void NavAppendTriadsAt(const NavResult &result, double k_att, double t, NavTriadSet *ref, NavTriadSet *est);
 
 /** Bounds {xmin xmax ymin ymax zmin zmax} in frame r of the reference, estimate and extra runs. */
 void NavResultBoundsRender(const NavResult &result, double bounds_r[6]);

@@ -20,6 +20,7 @@
 #ifndef NAV_VIEW_SCENE_H
 #define NAV_VIEW_SCENE_H
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -28,6 +29,20 @@
 
 class NavSceneViewImpl;
 class NavInteractive;
+// Only for embedding the scene in a host program's VTK window (AttachToWindow); the library's
+// headers otherwise carry no VTK types.
+class vtkRenderWindow;
+class vtkRenderer;
+
+/** A playback movie (RenderMovieFile). */
+struct NavMovieOptions {
+  double duration_s = 10.0; /**< length of the movie [s]; the run is played back over it */
+  double fps = 30.0;        /**< frames per second */
+  double t_begin_s = NAN;   /**< part of the run shown (NaN: its start / its end) [s] */
+  double t_end_s = NAN;
+  /** The encoder program (ffmpeg; its argv is fixed, no shell). */
+  std::string ffmpeg = "ffmpeg";
+};
 
 /** Result of picking the nearest full-rate epoch of the estimated path. */
 struct NavPickResult {
@@ -86,6 +101,44 @@ public:
    *  camera, the vehicle, estimate marker and read-out moving), written as DIR/frame_NNNN.png and,
    *  when @p video is set, as DIR/playback.ogv (Ogg Theora, vtkOggTheoraWriter) at @p fps. */
   bool RenderMovie(const std::string &dir, int frames, double fps, bool video, std::string *error);
+
+  /** Playback movie as one video file: H.264 in MP4 (FILE.mp4, libx264, yuv420p) or VP9 in
+   *  WebM (FILE.webm, libvpx-vp9), encoded by the ffmpeg program fed raw RGB frames through a
+   *  pipe. The options' size (even width and height), the follow camera when options.follow,
+   *  the time read-out in every frame. Written to FILE.part and renamed when complete.
+   *  @p progress (may be empty) gets the fraction done after each frame and returns false to
+   *  cancel (then nothing is left behind and @p error says "cancelled"). */
+  bool RenderMovieFile(const std::string &path, const NavMovieOptions &movie,
+                       const std::function<bool(double)> &progress, std::string *error);
+
+  /** Embed the scene in a host's window: our renderer draws one layer above @p under, through
+   *  its camera (the host keeps the camera), and the legend panel takes the window's right side
+   *  (both viewports set by each build). Call before the first Rebuild; the view removes its
+   *  renderers from the window when destroyed. */
+  void AttachToWindow(vtkRenderWindow *window, vtkRenderer *under);
+  /** Build (or rebuild after SetResult/SetOptions) keeping the current camera; the embedded
+   *  view's build. @return false with a message on failure. */
+  bool Rebuild(std::string *error);
+  bool IsBuilt() const;
+  /** The follow camera on or off, at @p distance_m (<= 0: automatic); takes effect at once. */
+  void SetFollow(bool on, double distance_m);
+  /** The follow-camera distance in use [m]. */
+  double FollowDistance() const;
+  /** Arrow length of the triads as drawn now [m] (tests: they scale with the view). */
+  double TriadSizeNow() const;
+  /** The estimated triad at the playback time: position (frame r) and body-to-r quaternion. */
+  bool NowTriad(double xyz_r[3], double q_b_r[4]) const;
+  /** Position of the vehicle glyph (frame r). */
+  bool VehiclePosition(double xyz_r[3]) const;
+  /** Legend entries' text, top to bottom, one entry per line group (tests). */
+  std::string LegendText() const;
+  /** Mark the scene out of date (its result no longer matches the edited scene): every drawn
+   *  object faded towards grey and the title says "OUT OF DATE"; false restores it. */
+  void SetStale(bool stale);
+  bool IsStale() const;
+  /** Horizontal 1-sigma floor the envelope is drawn with now (min_envelope_px at the view's
+   *  scale) [m] (tests). */
+  double EnvelopeFloorM() const;
 
   /** Build the default view offscreen and render @p frames frames while orbiting the camera. */
   bool Benchmark(int frames, NavBenchResult *out, std::string *error);
