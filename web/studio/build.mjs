@@ -8,7 +8,7 @@
 //
 // No file of the bundle refers to another origin: the page loads only what this script writes.
 import { createRequire } from 'node:module';
-import { mkdirSync, copyFileSync, writeFileSync, existsSync, rmSync, readdirSync, statSync } from 'node:fs';
+import { mkdirSync, copyFileSync, writeFileSync, existsSync, rmSync, readdirSync, statSync, readFileSync } from 'node:fs';
 import { dirname, join, resolve, relative } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
@@ -29,7 +29,11 @@ let mapData = process.env.NAVVIEW_MAP_DATA || '/usr/share/cartopy/data';
 const i = args.indexOf('--map-data');
 if (i >= 0 && args[i + 1]) mapData = args[i + 1];
 
-rmSync(out, { recursive: true, force: true });
+// Files of an earlier build (its manifest) are removed; nothing else in OUT_DIR is touched.
+const oldManifest = join(out, 'manifest.txt');
+if (existsSync(oldManifest))
+  for (const f of readFileSync(oldManifest, 'utf8').split('\n'))
+    if (f && !f.includes('..')) rmSync(join(out, f), { force: true });
 mkdirSync(join(out, 'map'), { recursive: true });
 
 await build({
@@ -99,7 +103,7 @@ if (existsSync(relief)) {
 }
 writeFileSync(join(out, 'map', 'credits.json'), JSON.stringify({ credits }, null, 1));
 
-// manifest.txt: every file of the bundle (the server serves only these).
+// manifest.txt: every file of the bundle (the server serves only these): what this script wrote.
 const files = [];
 (function walk(d) {
   for (const e of readdirSync(d)) {
@@ -107,8 +111,9 @@ const files = [];
     if (statSync(p).isDirectory()) walk(p);
     else files.push(relative(out, p));
   }
-})(out);
-files.push('manifest.txt');
+})(join(out, 'map'));
+files.push('index.html', 'studio.js', 'studio.css', 'manifest.txt');
+if (existsSync(join(out, 'studio.js.LEGAL.txt'))) files.push('studio.js.LEGAL.txt');
 files.sort();
 writeFileSync(join(out, 'manifest.txt'), files.join('\n') + '\n');
 console.log(`studio: ${files.length} files in ${out}`);

@@ -125,7 +125,14 @@ export function renderNode(parent, root, s, key, path, scene, onStructure) {
     if (s.description) lg.title = s.description;
     fs.appendChild(lg);
     const props = objectProperties(root, s, value);
-    for (const [k, ps] of Object.entries(props)) renderNode(fs, root, ps, k, [...path, k], scene, onStructure);
+    // Of two spellings of one quantity (allOf: not both required, e.g. lat_deg / lat_rad) the
+    // second is shown only when the scene uses it.
+    const hidden = new Set();
+    for (const b of s.allOf || []) {
+      const pair = b.not && b.not.required;
+      if (Array.isArray(pair) && pair.length === 2 && !(isObj(value) && value[pair[1]] !== undefined)) hidden.add(pair[1]);
+    }
+    for (const [k, ps] of Object.entries(props)) if (!hidden.has(k)) renderNode(fs, root, ps, k, [...path, k], scene, onStructure);
     if (Array.isArray(value) || (value !== undefined && !isObj(value))) {
       const p = document.createElement('p');
       p.className = 'hint';

@@ -80,7 +80,7 @@ function changed(source, structure = false) {
   history.replaceState(null, '', '#scene=' + b64(scene.text()));
   clearTimeout(pendingCheck);
   $('estimate').dataset.state = 'pending';
-  pendingCheck = setTimeout(checkAndEstimate, source === 'yaml' ? 300 : 250);
+  pendingCheck = setTimeout(checkAndEstimate, source === 'load' ? 0 : source === 'yaml' ? 300 : 250);
 }
 const b64 = (s) => btoa(String.fromCharCode(...new TextEncoder().encode(s))).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
 const unb64 = (s) => new TextDecoder().decode(Uint8Array.from(atob(s.replace(/-/g, '+').replace(/_/g, '/')), (c) => c.charCodeAt(0)));
@@ -134,7 +134,8 @@ const schemeHelp = {
 function syncFlow() {
   const scheme = scene.get(['navigation', 'scheme']);
   const schemes = enumOf(['navigation', 'scheme'], []);
-  fillSelect($('scheme'), schemes, scheme ?? (schemaAt(schema || {}, ['navigation', 'scheme'], scene) || {}).default, schemeHelp);
+  fillSelect($('scheme'), schemes, scheme ?? (schemaAt(schema || {}, ['navigation', 'scheme'], scene) || {}).default,
+    Object.fromEntries(schemes.map((v) => [v, schemeHelp[v] ? `${v} — ${schemeHelp[v]}` : v])));
   $('scheme-help').textContent = schemeHelp[$('scheme').value] || '';
   fillSelect($('imu-catalog'), ['', ...catalogs.imu.map((c) => c.name)], scene.get(['imu', 'catalog']) ?? '', { '': '(typed in below)' });
   const cur = catalogs.imu.find((c) => c.name === scene.get(['imu', 'catalog']));
@@ -165,8 +166,10 @@ function syncFlow() {
   }
 }
 function describeImu(c) {
-  const bits = [c.grade && `grade ${c.grade}`, c.cost_class !== undefined && `cost class ${c.cost_class}`];
-  for (const [k, v] of Object.entries(c)) if (/(_deg_per_h|_deg_per_sqrt_h|_ug|_mg|_per_sqrt_h)$/.test(k) && v !== null && v !== '') bits.push(`${k} ${v}`);
+  const bits = [c.grade, c.cost_band && `cost ${c.cost_band}`];
+  const fmt = (o, pre) => Object.entries(o || {}).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${pre} ${k} ${+v.toPrecision(3)}`);
+  bits.push(...fmt(c.gyro, 'gyro'), ...fmt(c.accel, 'accel'));
+  if (c.verified) bits.push(`verified: ${c.verified}`);
   return bits.filter(Boolean).join(' · ');
 }
 function waypoints() {
@@ -327,7 +330,9 @@ function showEstimate(e) {
   $('estimate').dataset.state = 'ok';
   if (studio.timings.sceneLoadStart !== undefined && studio.timings.scene_to_picture_ms === undefined) {
     mapView.whenRendered().then(() => {
-      studio.timings.scene_to_picture_ms = performance.now() - studio.timings.sceneLoadStart;
+      const now = performance.now();
+      studio.timings.scene_to_picture_ms = now - studio.timings.sceneLoadStart;
+      studio.timings.page_to_picture_ms = now; // from the navigation start
     });
     mapView.map.render();
   }

@@ -48,7 +48,7 @@ export class StudioMap {
     this.relief = new ImageLayer({
       source: new ImageStatic({ url: 'map/relief.png', imageExtent: [-180, -90, 180, 90], projection: 'EPSG:4326' }),
       opacity: 0.85,
-      maxResolution: 2000,
+      minResolution: 300, // from a few hundred km across, as navview's map
     });
     const land = new VectorLayer({
       source: new VectorSource({ url: 'map/land.geojson', format: geo }),

@@ -1,0 +1,188 @@
+// End-to-end tests of the browser studio in Debian's chromium against the real `navsim serve`
+// (issue 20, Done when): A) a catalog IMU, four waypoints drawn on the map, a 60 s outage, 100
+// Monte Carlo runs, the verdict read; B) the gyro-free scheme on the paper's parametric
+// trajectory with its live preview. Every test asserts no page errors and no console errors,
+// counts the ink of the canvases and saves screenshots into the build tree (web/shots).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { missing, startServer, launch, openPage, canvasInk, shotPath, waitAttr } from './helpers.mjs';
+
+const why = missing();
+let server = null, browser = null;
+
+before(async () => {
+  if (why) return;
+  server = await startServer();
+  browser = await launch();
+});
+after(async () => {
+  if (browser) await browser.close();
+  if (server) assert.equal(await server.stop(), 0, 'navsim serve exits 0 on SIGTERM');
+});
+
+async function selectTab(page, id) {
+  await page.click(`#${id}`);
+  await page.waitForFunction((t) => document.getElementById(t).getAttribute('aria-selected') === 'true', {}, id);
+}
+
+async function api(path, init) {
+  const r = await fetch(server.url + path, init);
+  return { status: r.status, text: await r.text() };
+}
+
+test('A: catalog IMU, four waypoints on the map, a 60 s outage, 100 Monte Carlo runs, the verdict', { skip: why || false, timeout: 400000 }, async () => {
+  const { page, problems } = await openPage(browser, server.url);
+  // The default scene (urban-drive) is loaded and estimated.
+  assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok',
+    await page.$eval('#estimate', (e) => e.textContent));
+  const schemes = await page.$$eval('#scheme option', (os) => os.map((o) => o.value));
+  for (const s of ['free_ins', 'gyro_free', 'ins_gnss', 'gyro_free_gnss']) assert.ok(schemes.includes(s), `scheme ${s} offered (${schemes})`);
+
+  // A catalog IMU other than the scene's.
+  const imus = await page.$$eval('#imu-catalog option', (os) => os.map((o) => o.value).filter(Boolean));
+  assert.ok(imus.length >= 3, `the IMU catalog has entries (${imus.length})`);
+  const current = await page.$eval('#imu-catalog', (s) => s.value);
+  const pick = imus.find((n) => n !== current && /ADIS|Honeywell|Xsens|Epson/i.test(n)) || imus.find((n) => n !== current);
+  await page.select('#imu-catalog', pick);
+  await page.waitForFunction((n) => document.getElementById('yaml').value.includes(`catalog: ${n}`) || document.getElementById('yaml').value.includes(`catalog: "${n}"`), {}, pick);
+
+  // Four waypoints clicked on the map (real mouse clicks on the OpenLayers canvas).
+  await page.click('#draw-waypoints');
+  const box = await (await page.$('#map')).boundingBox();
+  const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
+  const clicks = [[-160, 110], [-160, -110], [160, -110], [160, 110]];
+  for (let i = 0; i < clicks.length; ++i) {
+    await page.mouse.click(cx + clicks[i][0], cy + clicks[i][1]);
+    await page.waitForFunction((n) => document.querySelectorAll('#wp-list li').length === n, {}, i + 1);
+  }
+  await page.click('#draw-waypoints');
+  const wp = await page.evaluate(() => window.__studio && document.getElementById('yaml').value);
+  assert.match(wp, /type: waypoints/);
+  // The clicked points are where the page says they are: about 320 px apart east-west.
+  const pts = await page.$$eval('#wp-list li', (ls) => ls.map((l) => l.textContent));
+  assert.equal(pts.length, 4, pts.join(' | '));
+
+  // One 60 s outage (the library scene's own are removed first), 100 runs.
+  await page.click('#clear-outages');
+  await page.$eval('#outage-start', (e) => { e.value = ''; });
+  await page.type('#outage-start', '80');
+  await page.$eval('#outage-length', (e) => { e.value = ''; });
+  await page.type('#outage-length', '60');
+  await page.click('#add-outage');
+  await page.waitForFunction(() => document.querySelectorAll('#outage-list li').length === 1);
+  assert.match(await page.$eval('#yaml', (e) => e.value), /outages: \[ ?\[ ?80, 140 ?\] ?\]/);
+  await page.$eval('#runs', (e) => { e.value = ''; });
+  await page.type('#runs', '100');
+  await page.$eval('#runs', (e) => e.dispatchEvent(new Event('change')));
+  assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok',
+    await page.$eval('#estimate', (e) => e.textContent));
+  await page.screenshot({ path: shotPath('A1-setup-1280x800.png') });
+
+  await page.click('#run');
+  const state = await waitAttr(page, '#run-state', 'data-state', ['done', 'failed', 'cancelled'], 300000);
+  assert.equal(state, 'done', await page.$eval('#run-state', (e) => e.textContent));
+  const verdict = await waitAttr(page, '#verdicts', 'data-state', ['pass', 'fail', 'none', 'missing'], 60000);
+  assert.ok(['pass', 'fail'].includes(verdict), `a verdict (${verdict})`);
+  const heading = await page.$eval('#verdicts h2', (e) => e.textContent);
+  assert.match(heading, /^(PASS|FAIL).*\(100 runs\)$/);
+
+  // The server ran what the page showed: 100 runs, the one outage, the drawn waypoints.
+  const id = await page.evaluate(() => window.__studio.lastRun.id);
+  const summary = JSON.parse((await api(`api/runs/${id}/files/summary.json`)).text);
+  assert.equal(summary.runs, 100);
+  assert.equal(summary.trajectory, 'waypoints');
+  const oe = summary.requirements.find((r) => r.statistic === 'outage_end');
+  assert.ok(oe && oe.outages.length === 1 && oe.outages[0].t0_s === 80 && oe.outages[0].t1_s === 140, JSON.stringify(oe));
+  assert.equal(heading.startsWith('PASS'), summary.requirements.every((r) => r.pass === true));
+
+  // Map with the results, charts and 3D: not blank.
+  await page.waitForFunction(() => true);
+  const mapInk = await canvasInk(page, '#map');
+  assert.ok(mapInk.ink > 0.02 * mapInk.pixels, `map has ink ${JSON.stringify(mapInk)}`);
+  await page.screenshot({ path: shotPath('A2-map-results.png') });
+  await selectTab(page, 'tab-charts');
+  const chartInk = await canvasInk(page, '#charts .chart canvas');
+  assert.ok(chartInk.ink > 0.01 * chartInk.pixels, `chart has ink ${JSON.stringify(chartInk)}`);
+  assert.ok((await page.$$('#charts .chart')).length >= 3);
+  await page.screenshot({ path: shotPath('A3-charts.png'), fullPage: true });
+  await selectTab(page, 'tab-3d');
+  const threeInk = await canvasInk(page, '#three canvas');
+  assert.ok(threeInk.ink > 0.01 * threeInk.pixels, `3D has ink ${JSON.stringify(threeInk)}`);
+  await page.screenshot({ path: shotPath('A4-3d.png') });
+  await selectTab(page, 'tab-results');
+  const links = await page.$$eval('#downloads a', (as) => as.map((a) => a.textContent));
+  for (const f of ['summary.json', 'nav.csv', 'errors.csv']) assert.ok(links.includes(f), `download ${f} (${links})`);
+  await page.screenshot({ path: shotPath('A5-verdicts.png') });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('B: gyro-free scheme on the paper\'s parametric trajectory, live preview, run and verdict', { skip: why || false, timeout: 300000 }, async () => {
+  const { page, problems } = await openPage(browser, server.url);
+  await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000);
+  await page.select('#library', 'paper-parametric');
+  await page.waitForFunction(() => document.getElementById('yaml').value.includes('name: paper-parametric'));
+  await page.select('#scheme', 'gyro_free');
+  await page.waitForFunction(() => /scheme: gyro_free\b/.test(document.getElementById('yaml').value) && /\narray:/.test(document.getElementById('yaml').value));
+  assert.equal(await page.$eval('#traj-type', (s) => s.value), 'parametric');
+  assert.equal(await page.$eval('#traj-parametric', (e) => e.hidden), false);
+  // The live preview follows the formula's parameters.
+  const ink0 = await canvasInk(page, '#param-preview');
+  assert.ok(ink0.ink > 500, `preview drawn ${JSON.stringify(ink0)}`);
+  const before = await page.$eval('#param-preview', (c) => c.toDataURL());
+  const b0 = await page.$('[aria-label="B_m [1]"]');
+  assert.ok(b0, 'the form has the B_m vector (from the schema)');
+  await b0.click({ clickCount: 3 });
+  await b0.type('40');
+  await page.waitForFunction((b) => document.getElementById('param-preview').toDataURL() !== b, {}, before);
+  assert.match(await page.$eval('#yaml', (e) => e.value), /B_m: \[ ?1, 40, 0.5 ?\]/);
+  assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok',
+    await page.$eval('#estimate', (e) => e.textContent));
+  await page.$eval('#runs', (e) => { e.value = ''; });
+  await page.type('#runs', '20');
+  await page.$eval('#runs', (e) => e.dispatchEvent(new Event('change')));
+  await page.screenshot({ path: shotPath('B1-gyro-free-parametric.png') });
+  await page.click('#run');
+  assert.equal(await waitAttr(page, '#run-state', 'data-state', ['done', 'failed', 'cancelled'], 200000), 'done',
+    await page.$eval('#run-state', (e) => e.textContent));
+  const verdict = await waitAttr(page, '#verdicts', 'data-state', ['pass', 'fail', 'none', 'missing'], 60000);
+  assert.ok(['pass', 'fail'].includes(verdict), verdict);
+  const id = await page.evaluate(() => window.__studio.lastRun.id);
+  const summary = JSON.parse((await api(`api/runs/${id}/files/summary.json`)).text);
+  assert.equal(summary.runs, 20);
+  assert.equal(summary.trajectory, 'parametric');
+  await selectTab(page, 'tab-3d');
+  const threeInk = await canvasInk(page, '#three canvas');
+  assert.ok(threeInk.ink > 0.01 * threeInk.pixels, `3D has ink ${JSON.stringify(threeInk)}`);
+  await page.screenshot({ path: shotPath('B2-3d.png') });
+  await selectTab(page, 'tab-charts');
+  await page.screenshot({ path: shotPath('B3-charts.png'), fullPage: true });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('tablet-sized window and keyboard: tabs by arrow keys, the YAML view reports reader errors', { skip: why || false, timeout: 120000 }, async () => {
+  const { page, problems } = await openPage(browser, server.url, 820, 1180);
+  await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000);
+  const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+  assert.ok(overflow <= 0, `no horizontal scrolling at 820 px (${overflow} px too wide)`);
+  await page.focus('#tab-map');
+  await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('ArrowRight');
+  await page.keyboard.press('ArrowRight');
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'tab-yaml');
+  assert.equal(await page.$eval('#view-yaml', (e) => e.hidden), false);
+  // A reader error is shown with its line and column, and the estimate says the scene is invalid.
+  await page.focus('#yaml');
+  await page.$eval('#yaml', (e) => {
+    e.value = e.value.replace(/rate_hz: 100/, 'rate_hz: -5');
+    e.dispatchEvent(new Event('input'));
+  });
+  assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'invalid');
+  const msg = await page.$eval('#yaml-status', (e) => e.textContent);
+  assert.match(msg, /^\d+:\d+: \S*rate_hz/);
+  await page.screenshot({ path: shotPath('C1-tablet-yaml-error.png') });
+  // The server answered 422 to the page's validation; that is not a page error.
+  assert.deepEqual(problems.filter((p) => !/status of 422/.test(p)), []);
+  await page.close();
+});
