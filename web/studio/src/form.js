@@ -109,7 +109,7 @@ function numberInput(s, value, onValue, aria) {
 
 // Render the schema node s (value at path) into parent. scene: {get(path), set(path, v), del(path)}.
 // onStructure: called when the set of fields may change (kind switch, item added/removed).
-export function renderNode(parent, root, s, key, path, scene, onStructure) {
+export function renderNode(parent, root, s, key, path, scene, onStructure, skip = null) {
   s = deref(root, s);
   const value = scene.get(path);
   const t = types(s);
@@ -132,7 +132,7 @@ export function renderNode(parent, root, s, key, path, scene, onStructure) {
       const pair = b.not && b.not.required;
       if (Array.isArray(pair) && pair.length === 2 && !(isObj(value) && value[pair[1]] !== undefined)) hidden.add(pair[1]);
     }
-    for (const [k, ps] of Object.entries(props)) if (!hidden.has(k)) renderNode(fs, root, ps, k, [...path, k], scene, onStructure);
+    for (const [k, ps] of Object.entries(props)) if (!hidden.has(k) && !(skip && skip.includes(k))) renderNode(fs, root, ps, k, [...path, k], scene, onStructure);
     if (Array.isArray(value) || (value !== undefined && !isObj(value))) {
       const p = document.createElement('p');
       p.className = 'hint';

@@ -57,7 +57,7 @@ class Scene {
     this.doc.setIn(path, node);
   }
   del(path) { if (this.doc.hasIn(path)) this.doc.deleteIn(path); }
-  text() { return this.doc.toString({ lineWidth: 0 }); }
+  text() { return this.doc.toString({ lineWidth: 0, flowCollectionPadding: false }); }
 }
 
 const scene = new Scene();
@@ -93,19 +93,20 @@ const formScene = {
 };
 function renderForms() {
   for (const host of document.querySelectorAll('.form[data-section]')) {
-    const key = host.dataset.section;
+    const path = host.dataset.section.split('.');
+    const key = path[path.length - 1];
     host.textContent = '';
     if (!schema) {
       host.innerHTML = '<p class="hint">The scene schema is not available from this server: edit the YAML view.</p>';
       continue;
     }
-    const s = schemaAt(schema, [key], scene);
+    const s = schemaAt(schema, path, scene);
     if (!s) continue;
     if (key === 'array' && !scene.get(['array'])) {
       host.innerHTML = '<p class="hint">The accelerometer array (gyro-free schemes) is set when such a scheme is chosen.</p>';
       continue;
     }
-    renderNode(host, schema, s, key, [key], formScene, () => changed('form', true));
+    renderNode(host, schema, s, key, path, formScene, () => changed('form', true), host.dataset.skip ? host.dataset.skip.split(',') : null);
   }
 }
 

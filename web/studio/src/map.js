@@ -60,7 +60,7 @@ export class StudioMap {
     });
     // The sources report load errors (a bundle built without map data): no console noise, a note.
     for (const l of [land, lakes]) l.getSource().on('featuresloaderror', () => { this.missing = true; });
-    const graticule = new Graticule({ strokeStyle: new Stroke({ color: 'rgba(60,70,90,0.35)', width: 1, lineDash: [2, 3] }), showLabels: true, wrapX: false });
+    const graticule = new Graticule({ strokeStyle: new Stroke({ color: 'rgba(60,70,90,0.35)', width: 1, lineDash: [2, 3] }), showLabels: true, wrapX: false, minResolution: 25 });
     this.refSrc = new VectorSource();
     this.estSrc = new VectorSource();
     this.fixSrc = new VectorSource();

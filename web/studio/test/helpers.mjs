@@ -1,7 +1,7 @@
 // Shared set-up of the studio's end-to-end tests: the real `navsim serve` on a free port with a
 // fresh data directory, Debian's chromium through puppeteer-core, and the page checks every test
 // makes (no page errors, canvases with ink, screenshots into the build tree).
-import { spawn } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
 import { createRequire } from 'node:module';
 import { mkdtempSync, mkdirSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -21,6 +21,8 @@ const requireNm = createRequire(join(env.nodeModules, 'noop.js'));
 // Why the tests cannot run here ('' when they can).
 export function missing() {
   if (!env.navsim || !existsSync(env.navsim)) return 'NAVSIM (the navsim executable) is not set';
+  const help = spawnSync(env.navsim, ['serve', '--help'], { encoding: 'utf8' });
+  if (help.status !== 0) return `navsim serve is not built here (navsim serve --help: exit ${help.status})`;
   if (!env.studio || !existsSync(join(env.studio, 'manifest.txt'))) return 'NAV_STUDIO_DIR has no built studio';
   if (!existsSync(env.chromium)) return `no chromium at ${env.chromium}`;
   return '';
