@@ -27,6 +27,7 @@
 #include "import_cmd.h"
 #include "interrupt.h"
 #include "kfgins_out.h"
+#include "schema_cmd.h"
 #include "select_cmd.h"
 #include "replay_cmd.h"
 #include "report_cmd.h"
@@ -65,6 +66,7 @@ static const char *k_usage =
     "  select SCENE     cheapest catalog IMU / receiver / scheme meeting the scene's requirements\n"
     "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
     "  tradeoff SCENE   CPU time against error of each modelling choice; the cheapest within tolerance\n"
+    "  schema           JSON Schema of scene files: keys, types, units, bounds, defaults\n"
     "  serve            HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)\n"
     "\n"
     "options:\n"
@@ -732,6 +734,7 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "select") == 0) return navsim_select(argc - 2, argv + 2);
   if (strcmp(cmd, "sweep") == 0) return navsim_sweep(argc - 2, argv + 2);
   if (strcmp(cmd, "tradeoff") == 0) return navsim_tradeoff(argc - 2, argv + 2);
+  if (strcmp(cmd, "schema") == 0) return navsim_schema(argc - 2, argv + 2);
   if (strcmp(cmd, "serve") == 0) {
 #ifdef NAVSIM_HAVE_SERVE
     return navserve_main(argc - 2, argv + 2);
