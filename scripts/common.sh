@@ -6,6 +6,7 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
+  libmicrohttpd-dev libzip-dev curl # navsim serve (web/server; curl in its API tests)
   libexpat1-dev libxml2-utils       # GPX/KML import (expat); xmllint checks exported KML in tests
   libvtk9-dev fonts-dejavu-core
   xvfb xauth
@@ -17,6 +18,7 @@ NAV_PACKAGES=(
   help2man man-db bsdextrautils     # man pages from --help; tests render them (man, col)
   dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
   rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions (issue 22)
+  python3-yaml python3-jsonschema   # scenes against `navsim schema` (issue 18, test_navsim_schema)
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

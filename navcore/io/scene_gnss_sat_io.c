@@ -182,12 +182,17 @@ static bool same_sky_mask(const nav_io_field *f, const void *a, const void *b) {
 
 #define POS_LE_1000 (NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE | NAV_IO_REQUIRED)
 static const nav_io_field k_canyon[] = {
-    {.key = "t0_s", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t0_s), .scale = 1.0},
-    {.key = "t1_s", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t1_s), .scale = 1.0},
-    {.key = "height_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(height_m), .scale = 1.0,
+    {.key = "t0_s",
+     .doc = "time the vehicle enters the canyon", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t0_s), .scale = 1.0},
+    {.key = "t1_s",
+     .doc = "time the vehicle leaves the canyon", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_REQUIRED, .offset = KOFF(t1_s), .scale = 1.0},
+    {.key = "height_m",
+     .doc = "height of the walls above the antenna", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(height_m), .scale = 1.0,
      .max = 1000.0},
-    {.key = "left_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(left_m), .scale = 1.0, .max = 1000.0},
-    {.key = "right_m", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(right_m), .scale = 1.0,
+    {.key = "left_m",
+     .doc = "distance to the left wall", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(left_m), .scale = 1.0, .max = 1000.0},
+    {.key = "right_m",
+     .doc = "distance to the right wall", .kind = NAV_IO_DOUBLE, .flags = POS_LE_1000, .offset = KOFF(right_m), .scale = 1.0,
      .max = 1000.0},
 };
 static const nav_io_section k_canyon_section = {k_canyon, COUNT(k_canyon), NULL};
@@ -247,6 +252,30 @@ static bool same_canyons(const nav_io_field *f, const void *a, const void *b) {
   return true;
 }
 
+/* ---------------------------------------------------------------- JSON Schema of the custom values */
+
+static void schema_epoch(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "string");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}T[0-9]{1,2}:[0-9]{1,2}:[0-9]+(\\.[0-9]*)?$");
+}
+
+/* [[azimuth_deg, elevation_deg], ...]: the bounds of read_sky_mask's az_f and el_f (azimuths below
+   360, increasing: not expressible here). */
+static void schema_sky_mask(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "array");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, "{\"type\": \"array\", \"prefixItems\": [{\"type\": \"number\", \"minimum\": 0, "
+                     "\"exclusiveMaximum\": 360}, {\"type\": \"number\", \"minimum\": 0, \"maximum\": 90}], "
+                     "\"minItems\": 2, \"maxItems\": 2}");
+  nav_io_json_key(j, "x-unit");
+  nav_io_json_string(j, "deg");
+}
+
 /* ---------------------------------------------------------------- the section */
 
 static bool almanac_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
@@ -258,23 +287,27 @@ static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void 
 
 static const nav_io_field k_constellation[] = {
     {.key = "epoch", .kind = NAV_IO_CUSTOM, .offset = OFF(C(epoch_gps_s)), .read = read_epoch, .write = write_epoch,
-     .same = same_epoch, .comment = "GPS time of scene time 0"},
+     .same = same_epoch, .comment = "GPS time of scene time 0", .schema = schema_epoch},
     {.key = "gps", .kind = NAV_IO_ENUM, .offset = OFF(C(gps)), .enums = k_gps_sources,
      .comment = "nominal: SPS PS 24 slots; almanac: the YUMA file below"},
     {.key = "almanac", .kind = NAV_IO_STRING, .offset = OFF(C(almanac_file)), .size = NAV_GNSS_ALMANAC_PATH_MAX,
      .write_if = almanac_given, .comment = "YUMA almanac, relative to this file"},
-    {.key = "glonass", .kind = NAV_IO_ENUM, .offset = OFF(C(glonass)), .enums = k_glo_sources},
+    {.key = "glonass",
+     .doc = "GLONASS satellites: their source", .kind = NAV_IO_ENUM, .offset = OFF(C(glonass)), .enums = k_glo_sources},
     {.key = "glonass_node_lon_deg", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE,
      .offset = OFF(C(glonass_node1_lon_rad)), .scale = DEG, .comment = "plane 1 ascending node at the epoch"},
-    {.key = "elevation_mask_deg", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE,
+    {.key = "elevation_mask_deg",
+     .doc = "lowest elevation of a visible satellite", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE,
      .offset = OFF(C(mask.elevation_mask_rad)), .scale = DEG, .min = 0.0},
     {.key = "sky_mask_deg", .kind = NAV_IO_CUSTOM, .offset = OFF(C(mask)), .read = read_sky_mask,
-     .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline"},
+     .write = write_sky_mask, .same = same_sky_mask, .comment = "[azimuth, elevation] skyline",
+     .max_items = NAV_GNSS_MASK_MAX_POINTS, .schema = schema_sky_mask},
     {.key = "min_satellites_for_fix", .kind = NAV_IO_INT, .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(C(min_satellites_for_fix)), .min = 0.0, .max = NAV_GNSS_MAX_SATS,
      .comment = "receiver (gnss.enabled): no fix below this many visible satellites; 0: off"},
     {.key = "canyons", .kind = NAV_IO_CUSTOM, .offset = OFF(gnss.constellation), .read = read_canyons,
-     .write = write_canyons, .same = same_canyons, .comment = "street walls along the direction of travel"},
+     .write = write_canyons, .same = same_canyons, .comment = "street walls along the direction of travel",
+     .items = &k_canyon_section, .max_items = NAV_GNSS_MAX_CANYONS},
 };
 const nav_io_section nav_io_gnss_constellation_section = {k_constellation, COUNT(k_constellation),
                                                           finish_constellation};

@@ -82,7 +82,12 @@ enum {
   NAV_IO_STATE = 1u << 7,     /**< offset into nav_io_read_state; read only, never written */
   NAV_IO_EARLY = 1u << 8,     /**< read before the other keys of its mapping, wherever it is */
   NAV_IO_LATE = 1u << 9,      /**< read after the other keys of its mapping, wherever it is */
-  NAV_IO_WRITE_ALT = 1u << 10 /**< an ALT spelling the writer may choose when it is shorter */
+  NAV_IO_WRITE_ALT = 1u << 10, /**< an ALT spelling the writer may choose when it is shorter */
+  /** The range (min/max, max_axis) is checked on the SI value after reading, by nav_scene_validate
+      or a section's finish function, with its own message; the reader's number check applies only
+      NAV_IO_FINITE. The table still states the range: the schema publishes it and
+      test_scene_schema checks that it is the range enforced. */
+  NAV_IO_RANGE_LATER = 1u << 11
 };
 
 typedef struct nav_io_enum_value {
@@ -111,6 +116,23 @@ typedef bool (*nav_io_same_fn)(const nav_io_field *f, const void *a, const void 
 /** Called after all keys of a section's mapping @p map were read into @p base. */
 typedef void (*nav_io_finish_fn)(nav_io_reader *r, const nav_io_node *map, void *base);
 
+/** JSON Schema writer state (scene_schema.c). */
+typedef struct nav_io_json nav_io_json;
+/** Writes the JSON Schema of the value of CUSTOM field @p f (one schema object). */
+typedef void (*nav_io_schema_fn)(nav_io_json *j, const nav_io_field *f);
+
+/**
+ * A mapping whose keys depend on its "kind" (trajectory.segments.items[], trajectory.test_motion):
+ * one section per kind value, each starting with the kind descriptor itself, so unknown keys are
+ * matched against that kind's keys only.
+ */
+typedef struct nav_io_kinded {
+  const nav_io_enum_value *kinds;
+  const struct nav_io_section *const *sections; /**< indexed by kind value */
+  size_t nsections;
+  size_t kind_offset; /**< of the int kind in the base object */
+} nav_io_kinded;
+
 typedef struct nav_io_section {
   const nav_io_field *fields;
   size_t count;
@@ -136,6 +158,17 @@ struct nav_io_field {
   const char *mark_as;            /**< also locate the value under this key (the SI field name used
                                        by the validators), may be NULL */
   const char *comment;            /**< written after the value, may be NULL */
+  /* Schema only (scene_schema.c: navsim schema, nav_schema_keys); the reader and writer ignore these. */
+  const char *doc;                   /**< one-line description (NULL: .comment, else none) */
+  const char *unit;                  /**< unit as written in the file (NULL: from the key's suffix) */
+  const nav_io_section *items;       /**< CUSTOM: a sequence of mappings of this section */
+  const nav_io_kinded *kinded;       /**< CUSTOM: a mapping (or, with .items_kinded, a sequence of
+                                          mappings) whose keys depend on its kind */
+  bool items_kinded;                 /**< CUSTOM with .kinded: a sequence of such mappings */
+  size_t max_items;                  /**< CUSTOM sequences: the most items the reader accepts (0: none) */
+  const double *max_axis;            /**< VEC3S: per-axis maxima x, y, z (file units), tighter than .max;
+                                          enforced by the section's finish function (NULL: none) */
+  nav_io_schema_fn schema;           /**< CUSTOM: JSON Schema of the value (NULL: from the above) */
 };
 
 /** The root mapping of a scene file (format_version, name, earth, trajectory, ...). */
@@ -270,6 +303,22 @@ nav_status nav_io_writef(nav_io_writer *w, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+
+/* ================================================================ JSON Schema (scene_schema.c) */
+
+/** Append raw JSON text (a whole schema object, e.g. {"type": "string"}) as the current value. */
+void nav_io_json_raw(nav_io_json *j, const char *json);
+/** Append the schema of a mapping read against @p sec (defaults from @p def, may be NULL). */
+void nav_io_json_section(nav_io_json *j, const nav_io_section *sec, const void *def);
+/** Into the open object: the keywords of a mapping read against @p sec (properties, required, ...). */
+void nav_io_json_section_members(nav_io_json *j, const nav_io_section *sec, const void *def);
+/** Begin / end an object value; inside it, nav_io_json_key names the next value. */
+void nav_io_json_begin(nav_io_json *j);
+void nav_io_json_end(nav_io_json *j);
+void nav_io_json_key(nav_io_json *j, const char *key);
+/** A JSON string / number value. */
+void nav_io_json_string(nav_io_json *j, const char *s);
+void nav_io_json_number(nav_io_json *j, double v);
 
 /* ================================================================ trajectory part (scene_traj_io.c) */
 

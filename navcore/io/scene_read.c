@@ -157,6 +157,11 @@ static void read_reported(nav_io_reader *r, const nav_io_field *f, const nav_io_
                           const nav_io_node *value, void *base);
 static nav_status write_reported(nav_io_writer *w, const nav_io_field *f, const void *base, int indent);
 static bool same_reported(const nav_io_field *f, const void *a, const void *b);
+static void schema_format_version(nav_io_json *j, const nav_io_field *f);
+static void schema_catalog(nav_io_json *j, const nav_io_field *f);
+static void schema_off(nav_io_json *j, const nav_io_field *f);
+static void schema_outages(nav_io_json *j, const nav_io_field *f);
+static void schema_reported(nav_io_json *j, const nav_io_field *f);
 static void finish_gyro(nav_io_reader *r, const nav_io_node *map, void *base);
 static void finish_accel(nav_io_reader *r, const nav_io_node *map, void *base);
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def);
@@ -189,23 +194,32 @@ static const nav_io_enum_value k_bi_conventions[] = {
     {"allan_peak", NAV_BI_ALLAN_PEAK}, {"sigma_equals_b", NAV_BI_SIGMA_EQUALS_B}, {NULL, 0}};
 
 /* Plain descriptors; each field's range and flags are spelled out where it is listed. */
-#define F_DOUBLE(k, member, sc, fl)                                                                          \
-  { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = OFF(member), .scale = (sc) }
+#define F_DOUBLE(k, member, sc, fl, ...)                                                                     \
+  { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = OFF(member), .scale = (sc), __VA_ARGS__ }
 /* One angle in degrees (preferred, as in the canonical example) or radians. */
-#define ANGLE_DEG_RAD(name, member)                                                                          \
-  F_DOUBLE(name "_deg", member, NAV_DEG2RAD, NAV_IO_FINITE),                                                 \
-      F_DOUBLE(name "_rad", member, 1.0, NAV_IO_FINITE | NAV_IO_ALT)
+#define ANGLE_DEG_RAD(name, member, text)                                                                    \
+  F_DOUBLE(name "_deg", member, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                  \
+      F_DOUBLE(name "_rad", member, 1.0, NAV_IO_FINITE | NAV_IO_ALT, .doc = (text))
 
+/* The latitude range and the height range are nav_scene_validate's (NAV_IO_RANGE_LATER). */
 static const nav_io_field k_origin[] = {
-    ANGLE_DEG_RAD("lat", earth.origin_lat_rad),
-    ANGLE_DEG_RAD("lon", earth.origin_lon_rad),
-    F_DOUBLE("h_m", earth.origin_h_m, 1.0, NAV_IO_FINITE),
+    F_DOUBLE("lat_deg", earth.origin_lat_rad, NAV_DEG2RAD, NAV_IO_FINITE | NAV_IO_RANGE_LATER | NAV_IO_MIN_GE |
+                                                               NAV_IO_MAX_LE, .min = -90.0, .max = 90.0,
+             .doc = "geodetic latitude of the scene origin (WGS-84)"),
+    F_DOUBLE("lat_rad", earth.origin_lat_rad, 1.0,
+             NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_RANGE_LATER | NAV_IO_MIN_GE | NAV_IO_MAX_LE, .min = -NAV_PI / 2,
+             .max = NAV_PI / 2, .doc = "geodetic latitude of the scene origin (WGS-84)"),
+    ANGLE_DEG_RAD("lon", earth.origin_lon_rad, "longitude of the scene origin"),
+    F_DOUBLE("h_m", earth.origin_h_m, 1.0, NAV_IO_FINITE | NAV_IO_RANGE_LATER | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
+             .min = -1.0e5, .max = 1.0e8, .doc = "ellipsoidal height of the scene origin"),
 };
 DEFINE_SECTION(k_origin_section, k_origin);
 
 static const nav_io_field k_earth[] = {
-    {.key = "model", .kind = NAV_IO_ENUM, .offset = OFF(earth.model), .enums = k_earth_models},
-    {.key = "origin", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_origin_section},
+    {.key = "model",
+     .doc = "flat: uniform gravity in a local frame; wgs84: the WGS-84 ellipsoid with Earth rate", .kind = NAV_IO_ENUM, .offset = OFF(earth.model), .enums = k_earth_models},
+    {.key = "origin",
+     .doc = "scene origin: the origin of the local NED frame", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_origin_section},
     {.key = "gravity_mps2",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_FINITE,
@@ -220,10 +234,10 @@ static const nav_io_field k_earth[] = {
 };
 DEFINE_SECTION(k_earth_section, k_earth);
 
-#define RATE_HZ(member)                                                                                      \
+#define RATE_HZ(member, text)                                                                                \
   {                                                                                                          \
     .key = "rate_hz", .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,         \
-    .offset = OFF(member), .scale = 1.0, .min = 0.0, .max = NAV_SCENE_MAX_RATE_HZ                            \
+    .offset = OFF(member), .scale = 1.0, .min = 0.0, .max = NAV_SCENE_MAX_RATE_HZ, .doc = (text)             \
   }
 
 /* ---------------------------------------------------------------- IMU error model */
@@ -233,13 +247,16 @@ DEFINE_SECTION(k_earth_section, k_earth);
 #define Q(k, kd, fl, member, sc, ...)                                                                        \
   { .key = (k), .kind = (kd), .flags = (fl), .offset = OFF(member), .scale = (sc), __VA_ARGS__ }
 /* An input kept in the reader state (bias instability and the location of the Allan minimum). */
-#define QS(k, fl, member, sc)                                                                                \
-  { .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc) }
-/* A bounded one (flags with NAV_IO_MAX_LE). */
-#define QSB(k, fl, member, sc, mx)                                                                           \
+#define QS(k, fl, member, sc, ...)                                                                           \
   {                                                                                                          \
     .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc),   \
-    .max = (mx)                                                                                              \
+    __VA_ARGS__                                                                                              \
+  }
+/* A bounded one (flags with NAV_IO_MAX_LE). */
+#define QSB(k, fl, member, sc, mx, ...)                                                                      \
+  {                                                                                                          \
+    .key = (k), .kind = NAV_IO_VEC3S, .flags = (fl) | NAV_IO_STATE, .offset = SOFF(member), .scale = (sc),   \
+    .max = (mx), __VA_ARGS__                                                                                 \
   }
 #define G_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.gyro.terms)
 #define A_TERM(b) .bit = (b), .bits_offset = OFF(imu.model.accel.terms)
@@ -255,65 +272,65 @@ DEFINE_SECTION(k_earth_section, k_earth);
  */
 static const nav_io_field k_gyro[] = {
     Q("arw_deg_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, GM(arw_rad_per_sqrt_s), K_DEG_PER_SQRT_H,
-      .max = B_ARW(K_DEG_PER_SQRT_H), G_TERM(NAV_IMU_TERM_NOISE)),
+      .max = B_ARW(K_DEG_PER_SQRT_H), G_TERM(NAV_IMU_TERM_NOISE), .doc = "angle random walk (white rate noise), per axis"),
     Q("arw_rad_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(arw_rad_per_sqrt_s), 1.0,
       .max = B_ARW(1.0), G_TERM(NAV_IMU_TERM_NOISE)),
     Q("noise_density_deg_per_s_per_sqrt_hz", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(arw_rad_per_sqrt_s),
       NAV_DEG2RAD, .max = B_ARW(NAV_DEG2RAD), G_TERM(NAV_IMU_TERM_NOISE)),
     Q("bias_turn_on_deg_per_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_turn_on_sd_rps), K_DEG_PER_H,
-      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_rps"),
+      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_rps", .doc = "turn-on bias, 1-sigma drawn once per run, per axis"),
     Q("bias_turn_on_dps", NAV_IO_VEC3S, NONNEG_LE | ALTS, GM(bias_turn_on_sd_rps), NAV_DEG2RAD,
       .max = B_GBIAS(NAV_DEG2RAD), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_turn_on_rps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_turn_on_sd_rps), 1.0,
       .max = B_GBIAS(1.0), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_turn_on_fixed_deg_per_h", NAV_IO_VEC3S, SIGNED_LE, GM(bias_turn_on_fixed_rps), K_DEG_PER_H,
-      PM(B_GBIAS(K_DEG_PER_H)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+      PM(B_GBIAS(K_DEG_PER_H)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .doc = "turn-on bias: a fixed value per axis, added to the drawn one"),
     Q("bias_turn_on_fixed_dps", NAV_IO_VEC3S, SIGNED_LE | ALTS, GM(bias_turn_on_fixed_rps), NAV_DEG2RAD,
       PM(B_GBIAS(NAV_DEG2RAD)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_turn_on_fixed_rps", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, GM(bias_turn_on_fixed_rps), 1.0,
       PM(B_GBIAS(1.0)), G_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    QSB("bias_instability_deg_per_h", NONNEG_LE, bi[0], K_DEG_PER_H, B_GBI(K_DEG_PER_H)),
-    QSB("bias_instability_rps", NONNEG_LE | NAV_IO_ALT, bi[0], 1.0, B_GBI(1.0)),
-    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[0], 1.0),
+    QSB("bias_instability_deg_per_h", NONNEG_LE, bi[0], K_DEG_PER_H, B_GBI(K_DEG_PER_H), .doc = "bias instability B (Allan minimum), made a Gauss-Markov bias by imu.bias_convention"),
+    QSB("bias_instability_rps", NONNEG_LE | NAV_IO_ALT, bi[0], 1.0, B_GBI(1.0), .doc = NULL),
+    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[0], 1.0, .doc = "averaging time of the Allan minimum of the bias instability"),
     Q("bias_gm_sigma_deg_per_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_gm_sd_rps), K_DEG_PER_H,
-      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_rps"),
+      .max = B_GBIAS(K_DEG_PER_H), G_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_rps", .doc = "Gauss-Markov (in-run) bias, 1-sigma per axis"),
     Q("bias_gm_sigma_rps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_gm_sd_rps), 1.0, .max = B_GBIAS(1.0),
       G_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, GM(bias_gm_tau_s), 1.0, G_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, GM(bias_gm_tau_s), 1.0, G_TERM(NAV_IMU_TERM_BIAS_GM), .doc = "correlation time of the Gauss-Markov bias, per axis"),
     Q("rrw_deg_per_h_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, GM(bias_rw_rps_per_sqrt_s), K_DEG_PER_H_PER_SQRT_H,
       .max = B_RRW(K_DEG_PER_H_PER_SQRT_H), G_TERM(NAV_IMU_TERM_BIAS_RW),
-      .mark_as = "bias_rw_rps_per_sqrt_s"),
+      .mark_as = "bias_rw_rps_per_sqrt_s", .doc = "rate random walk (random-walk bias), per axis"),
     Q("rrw_rps_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(bias_rw_rps_per_sqrt_s), 1.0,
       .max = B_RRW(1.0), G_TERM(NAV_IMU_TERM_BIAS_RW)),
     Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG_LE, GM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
-      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR), .doc = "scale-factor error, 1-sigma drawn per run, per axis"),
     Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, GM(scale_factor_sd), 1.0, .max = B_SF(1.0),
-      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR), .unit = "1"),
     Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, SIGNED_LE, GM(scale_factor_fixed), K_PPM, PM(B_SF(K_PPM)),
-      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR), .doc = "scale-factor error, a fixed value per axis"),
     Q("scale_factor_fixed", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, GM(scale_factor_fixed), 1.0, PM(B_SF(1.0)),
-      G_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      G_TERM(NAV_IMU_TERM_SCALE_FACTOR), .unit = "1"),
     Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE, GM(misalignment_sd_rad), K_MRAD,
-      .max = B_MIS(K_MRAD), G_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+      .max = B_MIS(K_MRAD), G_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad", .doc = "axis misalignment: 1-sigma of each off-diagonal element (one number or 3 rows of 3)"),
     Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE | NAV_IO_ALT, GM(misalignment_sd_rad), 1.0,
       .max = B_MIS(1.0), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE, GM(misalignment_fixed_rad), K_MRAD,
-      PM(B_MIS(K_MRAD)), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+      PM(B_MIS(K_MRAD)), G_TERM(NAV_IMU_TERM_MISALIGNMENT), .doc = "axis misalignment: fixed off-diagonal elements (one number or 3 rows of 3)"),
     Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE | NAV_IO_ALT, GM(misalignment_fixed_rad), 1.0,
       PM(B_MIS(1.0)), G_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("g_sensitivity_deg_per_h_per_g", NAV_IO_MAT3_DIAG, NONNEG_LE, GM(g_sensitivity_sd_rps_per_mps2),
       K_DEG_PER_H_PER_G, .max = B_GSENS(K_DEG_PER_H_PER_G), G_TERM(NAV_IMU_TERM_G_SENSITIVITY),
-      .mark_as = "g_sensitivity_sd_rps_per_mps2"),
+      .mark_as = "g_sensitivity_sd_rps_per_mps2", .doc = "g-sensitive bias, 1-sigma (diagonal: one or 3 numbers; or 3 rows of 3)"),
     Q("g_sensitivity_rps_per_mps2", NAV_IO_MAT3_DIAG, NONNEG_LE | NAV_IO_ALT,
       GM(g_sensitivity_sd_rps_per_mps2), 1.0, .max = B_GSENS(1.0), G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
     Q("g_sensitivity_fixed_deg_per_h_per_g", NAV_IO_MAT3_DIAG, SIGNED_LE,
       GM(g_sensitivity_fixed_rps_per_mps2), K_DEG_PER_H_PER_G, PM(B_GSENS(K_DEG_PER_H_PER_G)),
-      G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
+      G_TERM(NAV_IMU_TERM_G_SENSITIVITY), .doc = "g-sensitive bias, fixed values (diagonal: one or 3 numbers; or 3 rows of 3)"),
     Q("g_sensitivity_fixed_rps_per_mps2", NAV_IO_MAT3_DIAG, SIGNED_LE | NAV_IO_ALT,
       GM(g_sensitivity_fixed_rps_per_mps2), 1.0, PM(B_GSENS(1.0)), G_TERM(NAV_IMU_TERM_G_SENSITIVITY)),
     Q("quantisation_rad", NAV_IO_VEC3S, POSITIVE, GM(quant_step_rad), 1.0, G_TERM(NAV_IMU_TERM_QUANTISATION),
-      .mark_as = "quant_step_rad"),
-    Q("range_dps", NAV_IO_VEC3S, POSITIVE, GM(range_rps), NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_SATURATION)),
+      .mark_as = "quant_step_rad", .doc = "quantisation step of the angle increments"),
+    Q("range_dps", NAV_IO_VEC3S, POSITIVE, GM(range_rps), NAV_DEG2RAD, G_TERM(NAV_IMU_TERM_SATURATION), .doc = "measurement range (saturation), per axis"),
     Q("range_rps", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, GM(range_rps), 1.0, G_TERM(NAV_IMU_TERM_SATURATION)),
 };
 DEFINE_SECTION_FINISH(k_gyro_section, k_gyro, finish_gyro);
@@ -321,59 +338,61 @@ DEFINE_SECTION_FINISH(k_gyro_section, k_gyro, finish_gyro);
 /* Accelerometer triad (nav_accel_error_config); as the gyro, in g-based datasheet units. */
 static const nav_io_field k_accel[] = {
     Q("vrw_m_per_s_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, AM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
-      .max = B_VRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_NOISE)),
+      .max = B_VRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_NOISE), .doc = "velocity random walk (white acceleration noise), per axis"),
     Q("vrw_mps_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), 1.0,
       .max = B_VRW(1.0), A_TERM(NAV_IMU_TERM_NOISE)),
     Q("noise_density_ug_per_sqrt_hz", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(vrw_mps_per_sqrt_s), K_UG,
       .max = B_VRW(K_UG), A_TERM(NAV_IMU_TERM_NOISE)),
     Q("bias_turn_on_mg", NAV_IO_VEC3S, NONNEG_LE, AM(bias_turn_on_sd_mps2), K_MG, .max = B_ABIAS(K_MG),
-      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2"),
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .mark_as = "bias_turn_on_sd_mps2", .doc = "turn-on bias, 1-sigma drawn once per run, per axis"),
     Q("bias_turn_on_mps2", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_turn_on_sd_mps2), 1.0,
       .max = B_ABIAS(1.0), A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_turn_on_fixed_mg", NAV_IO_VEC3S, SIGNED_LE, AM(bias_turn_on_fixed_mps2), K_MG, PM(B_ABIAS(K_MG)),
-      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
+      A_TERM(NAV_IMU_TERM_BIAS_TURN_ON), .doc = "turn-on bias: a fixed value per axis, added to the drawn one"),
     Q("bias_turn_on_fixed_mps2", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, AM(bias_turn_on_fixed_mps2), 1.0,
       PM(B_ABIAS(1.0)), A_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
-    QSB("bias_instability_ug", NONNEG_LE, bi[1], K_UG, B_ABI(K_UG)),
-    QSB("bias_instability_mps2", NONNEG_LE | NAV_IO_ALT, bi[1], 1.0, B_ABI(1.0)),
-    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[1], 1.0),
+    QSB("bias_instability_ug", NONNEG_LE, bi[1], K_UG, B_ABI(K_UG), .doc = "bias instability B (Allan minimum), made a Gauss-Markov bias by imu.bias_convention"),
+    QSB("bias_instability_mps2", NONNEG_LE | NAV_IO_ALT, bi[1], 1.0, B_ABI(1.0), .doc = NULL),
+    QS("bias_instability_tau_min_s", POSITIVE, bi_tau_min_s[1], 1.0, .doc = "averaging time of the Allan minimum of the bias instability"),
     Q("bias_gm_sigma_ug", NAV_IO_VEC3S, NONNEG_LE, AM(bias_gm_sd_mps2), K_UG, .max = B_ABIAS(K_UG),
-      A_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2"),
+      A_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2", .doc = "Gauss-Markov (in-run) bias, 1-sigma per axis"),
     Q("bias_gm_sigma_mps2", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_gm_sd_mps2), 1.0,
       .max = B_ABIAS(1.0), A_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, AM(bias_gm_tau_s), 1.0, A_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_VEC3S, POSITIVE, AM(bias_gm_tau_s), 1.0, A_TERM(NAV_IMU_TERM_BIAS_GM), .doc = "correlation time of the Gauss-Markov bias, per axis"),
     Q("bias_rw_m_per_s2_per_sqrt_h", NAV_IO_VEC3S, NONNEG_LE, AM(bias_rw_mps2_per_sqrt_s), K_PER_SQRT_H,
-      .max = B_ABRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_BIAS_RW)),
+      .max = B_ABRW(K_PER_SQRT_H), A_TERM(NAV_IMU_TERM_BIAS_RW), .doc = "bias random walk, per axis"),
     Q("bias_rw_mps2_per_sqrt_s", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(bias_rw_mps2_per_sqrt_s), 1.0,
       .max = B_ABRW(1.0), A_TERM(NAV_IMU_TERM_BIAS_RW)),
     Q("scale_factor_ppm", NAV_IO_VEC3S, NONNEG_LE, AM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
-      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR), .doc = "scale-factor error, 1-sigma drawn per run, per axis"),
     Q("scale_factor_sd", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, AM(scale_factor_sd), 1.0, .max = B_SF(1.0),
-      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR), .unit = "1"),
     Q("scale_factor_fixed_ppm", NAV_IO_VEC3S, SIGNED_LE, AM(scale_factor_fixed), K_PPM, PM(B_SF(K_PPM)),
-      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR), .doc = "scale-factor error, a fixed value per axis"),
     Q("scale_factor_fixed", NAV_IO_VEC3S, SIGNED_LE | NAV_IO_ALT, AM(scale_factor_fixed), 1.0, PM(B_SF(1.0)),
-      A_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      A_TERM(NAV_IMU_TERM_SCALE_FACTOR), .unit = "1"),
     Q("misalignment_mrad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE, AM(misalignment_sd_rad), K_MRAD,
-      .max = B_MIS(K_MRAD), A_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad"),
+      .max = B_MIS(K_MRAD), A_TERM(NAV_IMU_TERM_MISALIGNMENT), .mark_as = "misalignment_sd_rad", .doc = "axis misalignment: 1-sigma of each off-diagonal element (one number or 3 rows of 3)"),
     Q("misalignment_rad", NAV_IO_MAT3_OFFDIAG, NONNEG_LE | NAV_IO_ALT, AM(misalignment_sd_rad), 1.0,
       .max = B_MIS(1.0), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("misalignment_fixed_mrad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE, AM(misalignment_fixed_rad), K_MRAD,
-      PM(B_MIS(K_MRAD)), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
+      PM(B_MIS(K_MRAD)), A_TERM(NAV_IMU_TERM_MISALIGNMENT), .doc = "axis misalignment: fixed off-diagonal elements (one number or 3 rows of 3)"),
     Q("misalignment_fixed_rad", NAV_IO_MAT3_OFFDIAG, SIGNED_LE | NAV_IO_ALT, AM(misalignment_fixed_rad), 1.0,
       PM(B_MIS(1.0)), A_TERM(NAV_IMU_TERM_MISALIGNMENT)),
     Q("quantisation_mps", NAV_IO_VEC3S, POSITIVE, AM(quant_step_mps), 1.0, A_TERM(NAV_IMU_TERM_QUANTISATION),
-      .mark_as = "quant_step_mps"),
-    Q("range_g", NAV_IO_VEC3S, POSITIVE, AM(range_mps2), NAV_G0_MPS2, A_TERM(NAV_IMU_TERM_SATURATION)),
+      .mark_as = "quant_step_mps", .doc = "quantisation step of the velocity increments"),
+    Q("range_g", NAV_IO_VEC3S, POSITIVE, AM(range_mps2), NAV_G0_MPS2, A_TERM(NAV_IMU_TERM_SATURATION), .doc = "measurement range (saturation), per axis"),
     Q("range_mps2", NAV_IO_VEC3S, POSITIVE | NAV_IO_ALT, AM(range_mps2), 1.0,
       A_TERM(NAV_IMU_TERM_SATURATION)),
 };
 DEFINE_SECTION_FINISH(k_accel_section, k_accel, finish_accel);
 
 static const nav_io_field k_imu[] = {
-    RATE_HZ(imu.rate_hz),
-    {.key = "quadrature_nodes", .kind = NAV_IO_INT, .offset = OFF(imu.quadrature_nodes)},
+    RATE_HZ(imu.rate_hz, "IMU sample rate"),
+    {.key = "quadrature_nodes",
+     .doc = "Gauss-Legendre nodes of the ideal increments over one IMU interval (1..16)", .kind = NAV_IO_INT, .offset = OFF(imu.quadrature_nodes)},
     {.key = "bias_convention",
+     .doc = "how a bias instability B becomes a Gauss-Markov sigma: allan_peak (B / 0.6648) or sigma_equals_b",
      .kind = NAV_IO_ENUM,
      .flags = NAV_IO_STATE | NAV_IO_EARLY,
      .offset = SOFF(bias_convention),
@@ -387,9 +406,12 @@ static const nav_io_field k_imu[] = {
      .write = write_catalog,
      .same = same_string,
      .write_if = catalog_given,
-     .comment = "resources/imu_catalog.csv; the keys below override it"},
-    {.key = "gyro", .kind = NAV_IO_SECTION, .section = &k_gyro_section},
-    {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_accel_section},
+     .comment = "resources/imu_catalog.csv; the keys below override it",
+     .schema = schema_catalog},
+    {.key = "gyro",
+     .doc = "gyro triad error model (1-sigma per axis; one number applies to all three axes)", .kind = NAV_IO_SECTION, .section = &k_gyro_section},
+    {.key = "accel",
+     .doc = "accelerometer triad error model (1-sigma per axis; one number applies to all three axes)", .kind = NAV_IO_SECTION, .section = &k_accel_section},
     {.key = "off",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_LATE,
@@ -398,7 +420,8 @@ static const nav_io_field k_imu[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
 };
 DEFINE_SECTION(k_imu_section, k_imu);
 
@@ -409,14 +432,15 @@ DEFINE_SECTION(k_imu_section, k_imu);
 
 static const nav_io_field k_reported[] = {
     Q("position_m", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_REQUIRED, NM(reported_pos_sd_m), 1.0,
-      .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, .bit = 0),
+      .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, .bit = 0, .doc = "position sigma each fix reports, N, E, D"),
     Q("velocity_mps", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_REQUIRED, NM(reported_vel_sd_mps), 1.0,
-      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, .bit = 0),
+      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, .bit = 0, .doc = "velocity sigma each fix reports, N, E, D"),
 };
 DEFINE_SECTION(k_reported_section, k_reported);
 
 static const nav_io_field k_gnss[] = {
-    {.key = "enabled", .kind = NAV_IO_BOOL, .offset = OFF(gnss.enabled)},
+    {.key = "enabled",
+     .doc = "simulate a GNSS receiver (and aid the navigation with its fixes)", .kind = NAV_IO_BOOL, .offset = OFF(gnss.enabled)},
     {.key = "catalog",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_EARLY,
@@ -426,41 +450,49 @@ static const nav_io_field k_gnss[] = {
      .write = write_catalog,
      .same = same_string,
      .write_if = catalog_given,
-     .comment = "resources/gnss_receivers.csv; the keys below override it"},
+     .comment = "resources/gnss_receivers.csv; the keys below override it",
+     .schema = schema_catalog},
     {.key = "update_rate_hz",
+     .doc = "fix rate",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
      .offset = OFF(NM(update_rate_hz)),
      .scale = 1.0,
      .max = NAV_SCENE_MAX_GNSS_RATE_HZ},
     Q("latency_s", NAV_IO_DOUBLE, NONNEG_LE, NM(latency_s), 1.0, .max = NAV_SCENE_MAX_GNSS_LATENCY_S,
-      .bit = 0),
+      .bit = 0, .doc = "output latency of a fix"),
     Q("position_sigma_m", NAV_IO_VEC3S, NONNEG_LE, NM(pos_gm_sd_m), 1.0,
       .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, N_TERM(NAV_GNSS_TERM_POS_GM), .mark_as = "pos_gm_sd_m",
-      .comment = "N, E, D; Gauss-Markov"),
+      .comment = "N, E, D; Gauss-Markov", .doc = "position error: Gauss-Markov 1-sigma, N, E, D"),
     Q("position_corr_time_s", NAV_IO_VEC3S, NONNEG, NM(pos_gm_tau_s), 1.0, N_TERM(NAV_GNSS_TERM_POS_GM),
-      .mark_as = "pos_gm_tau_s", .comment = "0: white"),
+      .mark_as = "pos_gm_tau_s", .comment = "0: white", .doc = "correlation time of the position error, N, E, D (0: white)"),
     Q("position_white_sigma_m", NAV_IO_VEC3S, NONNEG_LE, NM(pos_white_sd_m), 1.0,
       .max = NAV_SCENE_MAX_GNSS_POSITION_SIGMA_M, N_TERM(NAV_GNSS_TERM_POS_WHITE),
-      .mark_as = "pos_white_sd_m"),
+      .mark_as = "pos_white_sd_m", .doc = "position error: white 1-sigma per fix, N, E, D"),
     Q("velocity_sigma_mps", NAV_IO_VEC3S, NONNEG_LE, NM(vel_sd_mps), 1.0,
-      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, N_TERM(NAV_GNSS_TERM_VEL_WHITE), .mark_as = "vel_sd_mps"),
+      .max = NAV_SCENE_MAX_GNSS_VELOCITY_SIGMA_MPS, N_TERM(NAV_GNSS_TERM_VEL_WHITE), .mark_as = "vel_sd_mps", .doc = "velocity error: white 1-sigma per fix, N, E, D"),
     Q("lever_arm_b_m", NAV_IO_VEC3, SIGNED_LE, NM(r_ba_b_m), 1.0, PM(NAV_SCENE_MAX_LEVER_ARM_M), .mark_as = "r_ba_b_m",
-      .comment = "antenna relative to the IMU, body axes"),
+      .comment = "antenna relative to the IMU, body axes", .doc = "antenna position relative to the IMU, body axes"),
     {.key = "outages",
+     .doc = "intervals [t0_s, t1_s) without fixes",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(gnss.model),
      .read = read_outages,
      .write = write_outages,
      .same = same_outages,
-     .comment = "[t0_s, t1_s): no fix"},
+     .comment = "[t0_s, t1_s): no fix",
+     .unit = "s",
+     .max_items = NAV_GNSS_MAX_OUTAGES,
+     .schema = schema_outages},
     {.key = "reported_sigma",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(gnss.model),
      .section = &k_reported_section,
      .read = read_reported,
      .write = write_reported,
-     .same = same_reported},
+     .same = same_reported,
+     .doc = "sigmas the receiver reports with each fix: model (the error model's) or given values",
+     .schema = schema_reported},
     {.key = "off",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_LATE,
@@ -469,7 +501,8 @@ static const nav_io_field k_gnss[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
     {.key = "constellation",
      .kind = NAV_IO_SECTION,
      .section = &nav_io_gnss_constellation_section,
@@ -495,20 +528,20 @@ static const nav_io_field k_array_accel[] = {
     Q("bias_turn_on_mps2", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(bias_turn_on_sd_mps2), 1.0,
       .max = B_ABIAS(1.0), R_TERM(NAV_IMU_TERM_BIAS_TURN_ON)),
     Q("bias_gm_sigma_ug", NAV_IO_DOUBLE, NONNEG_LE, RM(bias_gm_sd_mps2), K_UG, .max = B_ABIAS(K_UG),
-      R_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2"),
+      R_TERM(NAV_IMU_TERM_BIAS_GM), .mark_as = "bias_gm_sd_mps2", .doc = "Gauss-Markov bias of each accelerometer, 1-sigma"),
     Q("bias_gm_sigma_mps2", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(bias_gm_sd_mps2), 1.0,
       .max = B_ABIAS(1.0), R_TERM(NAV_IMU_TERM_BIAS_GM)),
-    Q("bias_gm_tau_s", NAV_IO_DOUBLE, POSITIVE, RM(bias_gm_tau_s), 1.0, R_TERM(NAV_IMU_TERM_BIAS_GM)),
+    Q("bias_gm_tau_s", NAV_IO_DOUBLE, POSITIVE, RM(bias_gm_tau_s), 1.0, R_TERM(NAV_IMU_TERM_BIAS_GM), .doc = "correlation time of the Gauss-Markov bias"),
     Q("vrw_m_per_s_per_sqrt_h", NAV_IO_DOUBLE, NONNEG_LE, RM(vrw_mps_per_sqrt_s), K_PER_SQRT_H,
-      .max = B_VRW(K_PER_SQRT_H), R_TERM(NAV_IMU_TERM_NOISE), .mark_as = "vrw_mps_per_sqrt_s"),
+      .max = B_VRW(K_PER_SQRT_H), R_TERM(NAV_IMU_TERM_NOISE), .mark_as = "vrw_mps_per_sqrt_s", .doc = "velocity random walk of each accelerometer"),
     Q("vrw_mps_per_sqrt_s", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), 1.0,
       .max = B_VRW(1.0), R_TERM(NAV_IMU_TERM_NOISE)),
     Q("noise_density_ug_per_sqrt_hz", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(vrw_mps_per_sqrt_s), K_UG,
       .max = B_VRW(K_UG), R_TERM(NAV_IMU_TERM_NOISE)),
     Q("scale_factor_ppm", NAV_IO_DOUBLE, NONNEG_LE, RM(scale_factor_sd), K_PPM, .max = B_SF(K_PPM),
-      R_TERM(NAV_IMU_TERM_SCALE_FACTOR), .mark_as = "scale_factor_sd"),
+      R_TERM(NAV_IMU_TERM_SCALE_FACTOR), .mark_as = "scale_factor_sd", .doc = "scale-factor error of each accelerometer, 1-sigma"),
     Q("scale_factor_sd", NAV_IO_DOUBLE, NONNEG_LE | NAV_IO_ALT, RM(scale_factor_sd), 1.0, .max = B_SF(1.0),
-      R_TERM(NAV_IMU_TERM_SCALE_FACTOR)),
+      R_TERM(NAV_IMU_TERM_SCALE_FACTOR), .unit = "1"),
     {.key = "off",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_LATE,
@@ -517,7 +550,8 @@ static const nav_io_field k_array_accel[] = {
      .write = write_off,
      .same = same_terms,
      .write_if = off_needed,
-     .comment = "terms switched off"},
+     .comment = "terms switched off",
+     .schema = schema_off},
 };
 DEFINE_SECTION(k_array_accel_section, k_array_accel);
 
@@ -525,22 +559,26 @@ DEFINE_SECTION(k_array_accel_section, k_array_accel);
    centre and its sensitive axis (any non-zero length), body axes. */
 static const nav_io_field k_array_sensor[] = {
     {.key = "position_m",
+     .doc = "position of the accelerometer from the array centre, body axes",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE | NAV_IO_REQUIRED,
      .offset = offsetof(nav_scene_array_sensor, r_bs_b_m),
      .scale = 1.0,
      .mark_as = "r_bs_b_m"},
     {.key = "axis",
+     .doc = "sensitive axis, body axes (any non-zero length)",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE | NAV_IO_REQUIRED,
      .offset = offsetof(nav_scene_array_sensor, n_s_b),
      .scale = 1.0,
-     .mark_as = "n_s_b"},
+     .mark_as = "n_s_b",
+     .unit = "1"},
 };
 DEFINE_SECTION(k_array_sensor_section, k_array_sensor);
 
 static const nav_io_field k_array[] = {
     {.key = "layout",
+     .doc = "placement of the accelerometers: cube6, nine, twelve or custom (sensors)",
      .kind = NAV_IO_ENUM,
      .offset = OFF(array.layout),
      .enums = k_array_layouts,
@@ -558,8 +596,12 @@ static const nav_io_field k_array[] = {
      .read = read_array_sensors,
      .write = write_array_sensors,
      .same = same_array_sensors,
-     .write_if = array_sensors_written},
-    {.key = "accel", .kind = NAV_IO_SECTION, .section = &k_array_accel_section},
+     .write_if = array_sensors_written,
+     .doc = "accelerometers of a custom layout: position and sensitive axis of each",
+     .items = &k_array_sensor_section,
+     .max_items = NAV_SCENE_ARRAY_MAX_SENSORS},
+    {.key = "accel",
+     .doc = "error model of every accelerometer of the array (each draws its own errors)", .kind = NAV_IO_SECTION, .section = &k_array_accel_section},
     Q("initial_rate_sd_dps", NAV_IO_VEC3S, NONNEG_LE, array.initial_rate_sd_rps, NAV_DEG2RAD,
       .max = NAV_SCENE_MAX_INITIAL_RATE_SD_DPS, .mark_as = "initial_rate_sd_rps",
       .comment = "1-sigma error of the initial angular rate, body x, y, z"),
@@ -573,21 +615,30 @@ DEFINE_SECTION(k_array_section, k_array);
 /* Plausibility bounds (scene_bounds.h): the table bounds every component by the largest (the
    heading's); finish_initial_errors bounds the tilt about north and east. */
 static void finish_initial_errors(nav_io_reader *r, const nav_io_node *map, void *base);
+/* Per-axis maxima of the attitude sigmas (about N, E, D): the tilt bound for N and E, the heading
+   bound for D (finish_initial_errors enforces the tilt; .max the heading). */
+static const double k_att_sd_max_deg[3] = {NAV_SCENE_MAX_INITIAL_TILT_SD_DEG, NAV_SCENE_MAX_INITIAL_TILT_SD_DEG,
+                                           NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG};
+static const double k_att_sd_max_rad[3] = {NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD,
+                                           NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD,
+                                           NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG * NAV_DEG2RAD};
 static const nav_io_field k_initial_errors[] = {
     Q("position_m", NAV_IO_VEC3S, NONNEG_LE, initial_errors.pos_sd_m, 1.0,
-      .max = NAV_SCENE_MAX_INITIAL_POSITION_SD_M, .comment = "1-sigma N, E, D"),
+      .max = NAV_SCENE_MAX_INITIAL_POSITION_SD_M, .comment = "1-sigma N, E, D", .doc = "initial position error, 1-sigma N, E, D"),
     Q("velocity_mps", NAV_IO_VEC3S, NONNEG_LE, initial_errors.vel_sd_mps, 1.0,
-      .max = NAV_SCENE_MAX_INITIAL_VELOCITY_SD_MPS, .comment = "1-sigma N, E, D"),
+      .max = NAV_SCENE_MAX_INITIAL_VELOCITY_SD_MPS, .comment = "1-sigma N, E, D", .doc = "initial velocity error, 1-sigma N, E, D"),
     Q("attitude_deg", NAV_IO_VEC3S, NONNEG_LE, initial_errors.att_sd_rad, NAV_DEG2RAD,
-      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG, .comment = "1-sigma about N, E, D"),
+      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG, .max_axis = k_att_sd_max_deg, .comment = "1-sigma about N, E, D", .doc = "initial attitude error, 1-sigma about N, E, D (tilt at most 90 deg, heading 180 deg)"),
     Q("attitude_rad", NAV_IO_VEC3S, NONNEG_LE | NAV_IO_ALT, initial_errors.att_sd_rad, 1.0,
-      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG * NAV_DEG2RAD, .bit = 0),
+      .max = NAV_SCENE_MAX_INITIAL_HEADING_SD_DEG * NAV_DEG2RAD, .max_axis = k_att_sd_max_rad, .bit = 0),
 };
 DEFINE_SECTION_FINISH(k_initial_errors_section, k_initial_errors, finish_initial_errors);
 
 static const nav_io_field k_navigation[] = {
-    {.key = "scheme", .kind = NAV_IO_ENUM, .offset = OFF(navigation.scheme), .enums = k_schemes},
+    {.key = "scheme",
+     .doc = "navigation scheme: free INS, INS/GNSS, gyro-free INS, gyro-free INS with GNSS", .kind = NAV_IO_ENUM, .offset = OFF(navigation.scheme), .enums = k_schemes},
     {.key = "algorithm",
+     .doc = "strapdown integration: first_order, or high_order (coning and sculling corrections)",
      .kind = NAV_IO_ENUM,
      .offset = OFF(navigation.algorithm),
      .enums = k_mech_algorithms},
@@ -626,18 +677,21 @@ static const nav_io_field k_navigation[] = {
 };
 DEFINE_SECTION(k_navigation_section, k_navigation);
 
-static const nav_io_field k_output[] = {RATE_HZ(output.rate_hz)};
+static const nav_io_field k_output[] = {RATE_HZ(output.rate_hz, "rate of the written navigation results and errors")};
 DEFINE_SECTION(k_output_section, k_output);
 
 static const nav_io_field k_simulation[] = {
-    {.key = "seed", .kind = NAV_IO_U64, .offset = OFF(simulation.seed)},
+    {.key = "seed",
+     .doc = "seed of the random streams: the same seed gives the same results", .kind = NAV_IO_U64, .offset = OFF(simulation.seed)},
     {.key = "runs",
+     .doc = "Monte Carlo runs",
      .kind = NAV_IO_LONG,
      .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(simulation.runs),
      .min = 1.0,
      .max = (double)NAV_SCENE_MAX_RUNS},
     {.key = "threads",
+     .doc = "worker threads (0: one per core); results do not depend on it",
      .kind = NAV_IO_INT,
      .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(simulation.threads),
@@ -677,21 +731,27 @@ static const nav_io_enum_value k_req_units[] = {
 
 #define RQ(member) offsetof(nav_requirement, member)
 static const nav_io_field k_requirement[] = {
-    {.key = "id", .kind = NAV_IO_STRING, .flags = NAV_IO_REQUIRED, .offset = RQ(id), .size = NAV_REQ_ID_MAX},
-    {.key = "metric", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(metric), .enums = k_req_metrics},
+    {.key = "id",
+     .doc = "name of the requirement (unique)", .kind = NAV_IO_STRING, .flags = NAV_IO_REQUIRED, .offset = RQ(id), .size = NAV_REQ_ID_MAX},
+    {.key = "metric",
+     .doc = "the error it limits", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(metric), .enums = k_req_metrics},
     {.key = "statistic",
+     .doc = "statistic of that error over the runs and the time",
      .kind = NAV_IO_ENUM,
      .flags = NAV_IO_REQUIRED,
      .offset = RQ(statistic),
      .enums = k_req_statistics},
     {.key = "limit",
+     .doc = "largest allowed value, in unit",
      .kind = NAV_IO_DOUBLE,
      .flags = POSITIVE | NAV_IO_REQUIRED,
      .offset = RQ(limit),
      .scale = 1.0,
      .mark_as = "limit"},
-    {.key = "unit", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(unit), .enums = k_req_units},
+    {.key = "unit",
+     .doc = "unit of limit", .kind = NAV_IO_ENUM, .flags = NAV_IO_REQUIRED, .offset = RQ(unit), .enums = k_req_units},
     {.key = "time_s",
+     .doc = "time at which at_time is evaluated",
      .kind = NAV_IO_DOUBLE,
      .flags = NONNEG,
      .offset = RQ(time_s),
@@ -706,23 +766,38 @@ static const nav_io_field k_root[] = {
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_REQUIRED,
      .read = read_format_version,
-     .write = write_format_version},
-    {.key = "name", .kind = NAV_IO_STRING, .offset = OFF(name), .size = NAV_SCENE_NAME_MAX},
-    {.key = "earth", .kind = NAV_IO_SECTION, .section = &k_earth_section},
-    {.key = "trajectory", .kind = NAV_IO_SECTION, .section = &nav_io_trajectory_section},
-    {.key = "imu", .kind = NAV_IO_SECTION, .section = &k_imu_section},
-    {.key = "gnss", .kind = NAV_IO_SECTION, .section = &k_gnss_section, .write_if = gnss_written},
-    {.key = "array", .kind = NAV_IO_SECTION, .section = &k_array_section, .write_if = array_written},
-    {.key = "initial_errors", .kind = NAV_IO_SECTION, .section = &k_initial_errors_section},
-    {.key = "navigation", .kind = NAV_IO_SECTION, .section = &k_navigation_section},
-    {.key = "output", .kind = NAV_IO_SECTION, .section = &k_output_section},
-    {.key = "simulation", .kind = NAV_IO_SECTION, .section = &k_simulation_section},
+     .write = write_format_version,
+     .doc = "version of the scene format the file is written in",
+     .schema = schema_format_version},
+    {.key = "name",
+     .doc = "name of the scene (results and reports are named after it)", .kind = NAV_IO_STRING, .offset = OFF(name), .size = NAV_SCENE_NAME_MAX},
+    {.key = "earth",
+     .doc = "Earth model and scene origin", .kind = NAV_IO_SECTION, .section = &k_earth_section},
+    {.key = "trajectory",
+     .doc = "the reference trajectory (truth)", .kind = NAV_IO_SECTION, .section = &nav_io_trajectory_section},
+    {.key = "imu",
+     .doc = "the inertial measurement unit: rate and error model", .kind = NAV_IO_SECTION, .section = &k_imu_section},
+    {.key = "gnss",
+     .doc = "the GNSS receiver: rate, errors, lever arm, outages", .kind = NAV_IO_SECTION, .section = &k_gnss_section, .write_if = gnss_written},
+    {.key = "array",
+     .doc = "accelerometer array of the gyro-free INS", .kind = NAV_IO_SECTION, .section = &k_array_section, .write_if = array_written},
+    {.key = "initial_errors",
+     .doc = "errors of the navigation's initial state", .kind = NAV_IO_SECTION, .section = &k_initial_errors_section},
+    {.key = "navigation",
+     .doc = "navigation scheme and its settings", .kind = NAV_IO_SECTION, .section = &k_navigation_section},
+    {.key = "output",
+     .doc = "rate of the results", .kind = NAV_IO_SECTION, .section = &k_output_section},
+    {.key = "simulation",
+     .doc = "Monte Carlo runs, seed and threads", .kind = NAV_IO_SECTION, .section = &k_simulation_section},
     {.key = "requirements",
      .kind = NAV_IO_CUSTOM,
      .read = read_requirements,
      .write = write_requirements,
      .same = same_requirements,
-     .write_if = requirements_written},
+     .write_if = requirements_written,
+     .doc = "accuracy requirements the results are judged against",
+     .items = &k_requirement_section,
+     .max_items = NAV_SCENE_MAX_REQUIREMENTS},
 };
 _Static_assert(COUNT(k_root) <= MAX_SECTION_FIELDS, "k_root: too many fields");
 const nav_io_section nav_io_scene_schema = {k_root, COUNT(k_root), NULL};
@@ -1445,6 +1520,7 @@ static bool check_double(nav_io_reader *r, const nav_io_field *f, const nav_io_n
     nav_io_reader_error(r, v, key, "must be finite (got %s)", shown);
     return false;
   }
+  if (f->flags & NAV_IO_RANGE_LATER) return true; /* the validator's check, with its own message */
   const bool has_lo = (f->flags & (NAV_IO_MIN_GT | NAV_IO_MIN_GE)) != 0,
              has_hi = (f->flags & NAV_IO_MAX_LE) != 0;
   const bool lo_ok = !has_lo || ((f->flags & NAV_IO_MIN_GT) ? d > f->min : d >= f->min);
@@ -2551,6 +2627,73 @@ static bool same_reported(const nav_io_field *f, const void *a, const void *b) {
          (ma->report_model_sigmas || nav_io_section_same(f->section, a, b));
 }
 
+/* ---------------------------------------------------------------- JSON Schema of the custom values */
+
+static void schema_format_version(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "integer");
+  nav_io_json_key(j, "minimum");
+  nav_io_json_number(j, 1);
+  nav_io_json_key(j, "maximum");
+  nav_io_json_number(j, NAV_SCENE_FORMAT_VERSION);
+}
+
+static void schema_catalog(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "string");
+  nav_io_json_key(j, "maxLength");
+  nav_io_json_number(j, (double)(f->size - 1));
+}
+
+/* "off": one term name or a list of them (read_off); IMU names may carry "gyro." / "accel.". */
+static void schema_off(nav_io_json *j, const nav_io_field *f) {
+  const bool imu = f->offset == OFF(imu.model);
+  const bool arr = f->offset == OFF(array.accel);
+  const term_name *terms = imu ? k_imu_terms : arr ? k_array_terms : k_gnss_terms;
+  const size_t nterms = imu ? COUNT(k_imu_terms) : arr ? COUNT(k_array_terms) : COUNT(k_gnss_terms);
+  char names[1024], pattern[512];
+  size_t ln = 0, lp = 0;
+  const char *prefixes[3] = {"", "gyro.", "accel."};
+  for (size_t p = 0; p < (imu ? 3u : 1u); ++p)
+    for (size_t k = 0; k < nterms; ++k) {
+      const int m = snprintf(names + ln, sizeof names - ln, "%s\"%s%s\"", ln ? ", " : "", prefixes[p], terms[k].name);
+      if (m > 0 && (size_t)m < sizeof names - ln) ln += (size_t)m;
+    }
+  lp = (size_t)snprintf(pattern, sizeof pattern, "^%s(", imu ? "((gyro|accel)\\.)?" : "");
+  for (size_t k = 0; k < nterms && lp < sizeof pattern; ++k) {
+    const int m = snprintf(pattern + lp, sizeof pattern - lp, "%s%s", k ? "|" : "", terms[k].name);
+    if (m > 0 && (size_t)m < sizeof pattern - lp) lp += (size_t)m;
+  }
+  if (lp < sizeof pattern) snprintf(pattern + lp, sizeof pattern - lp, ")$");
+  char items[1200];
+  snprintf(items, sizeof items, "{\"type\": \"string\", \"enum\": [%s]}", names);
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"array\", \"string\", \"null\"]");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, items);
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, pattern);
+}
+
+static void schema_outages(nav_io_json *j, const nav_io_field *f) {
+  (void)f;
+  nav_io_json_key(j, "type");
+  nav_io_json_string(j, "array");
+  nav_io_json_key(j, "items");
+  nav_io_json_raw(j, "{\"type\": \"array\", \"items\": {\"type\": \"number\"}, \"minItems\": 2, \"maxItems\": 2}");
+}
+
+/* reported_sigma: "model", or the mapping of k_reported_section (the object keywords apply to the
+   mapping form only). */
+static void schema_reported(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"string\", \"object\"]");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^model$");
+  nav_io_json_section_members(j, f->section, NULL);
+}
+
 static bool gnss_written(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
   (void)w;
   const nav_scene *s = base;
@@ -2730,10 +2873,12 @@ static void finish_initial_errors(nav_io_reader *r, const nav_io_node *map, void
     path_pop(r, saved);
     return;
   }
-  const double bound_rad = NAV_SCENE_MAX_INITIAL_TILT_SD_DEG * NAV_DEG2RAD;
+  /* The tilt bounds of the table (k_att_sd_max_*: N and E), compared in SI. */
+  const double *max_deg = k_initial_errors[2].max_axis;
   const nav_io_node *item = v->kind == Y_SEQ ? v->child : NULL;
   for (int i = 0; i < 2; ++i) {
     const double a = nav_vec3_get(s->initial_errors.att_sd_rad, i);
+    const double bound_rad = max_deg[i] * NAV_DEG2RAD;
     if (a > bound_rad) {
       const size_t saved_i = item != NULL ? path_push_index(r, (size_t)i) : r->path_len;
       const nav_io_node *at = item != NULL ? item : v;
@@ -2743,7 +2888,7 @@ static void finish_initial_errors(nav_io_reader *r, const nav_io_node *map, void
                           "the tilt about %s must be <= %.9g %s (got %s): levelling from the accelerometers "
                           "gives roll and pitch to within 90 deg; only the heading (about D) may be unknown, up "
                           "to 180 deg",
-                          i == 0 ? "north" : "east", deg ? NAV_SCENE_MAX_INITIAL_TILT_SD_DEG : bound_rad,
+                          i == 0 ? "north" : "east", deg ? max_deg[i] : bound_rad,
                           deg ? "deg" : "rad", shown);
       path_pop(r, saved_i);
       if (item == NULL) break; /* one number for all three axes: one message */

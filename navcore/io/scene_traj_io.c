@@ -96,54 +96,56 @@ static bool never(const nav_io_writer *w, const nav_io_field *f, const void *bas
 }
 
 /* One double (a base-relative offset) in a unit; the angle and rate spellings. */
-#define D(k, off, sc, fl)                                                                                    \
-  { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = (off), .scale = (sc) }
-#define ANGLE(name, off)                                                                                     \
-  D(name "_deg", off, NAV_DEG2RAD, NAV_IO_FINITE), D(name "_rad", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT)
-#define RATE(name, off)                                                                                      \
-  D(name "_dps", off, NAV_DEG2RAD, NAV_IO_FINITE), D(name "_rps", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT)
+#define D(k, off, sc, fl, ...)                                                                               \
+  { .key = (k), .kind = NAV_IO_DOUBLE, .flags = (fl), .offset = (off), .scale = (sc), __VA_ARGS__ }
+#define ANGLE(name, off, text)                                                                                \
+  D(name "_deg", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                             \
+      D(name "_rad", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT, .doc = (text))
+#define RATE(name, off, text)                                                                                 \
+  D(name "_dps", off, NAV_DEG2RAD, NAV_IO_FINITE, .doc = (text)),                                             \
+      D(name "_rps", off, 1.0, NAV_IO_FINITE | NAV_IO_ALT, .doc = (text))
 /* A rate that may also be given in Hz (cycles per second); written so when that is shorter. */
-#define RATE_HZ_ALT(name, off)                                                                               \
-  RATE(name, off), D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT)
+#define RATE_HZ_ALT(name, off, text)                                                                          \
+  RATE(name, off, text), D(name "_hz", off, NAV_TWO_PI, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT, .doc = (text))
 #define NONNEG (NAV_IO_FINITE | NAV_IO_MIN_GE)
 #define POSITIVE (NAV_IO_FINITE | NAV_IO_MIN_GT)
 /* A speed within the plausibility bound of scene_bounds.h, in magnitude. */
-#define SPEED(k, off)                                                                                        \
+#define SPEED(k, off, d)                                                                                     \
   {                                                                                                          \
     .key = (k), .kind = NAV_IO_DOUBLE, .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,               \
-    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS           \
+    .offset = (off), .scale = 1.0, .min = -NAV_SCENE_MAX_SPEED_MPS, .max = NAV_SCENE_MAX_SPEED_MPS, .doc = (d) \
   }
 
 /* ================================================================ initial attitude, parametric */
 
 static const nav_io_field k_attitude[] = {
-    ANGLE("roll", OFF(trajectory.initial_attitude.roll_rad)),
-    ANGLE("pitch", OFF(trajectory.initial_attitude.pitch_rad)),
-    ANGLE("yaw", OFF(trajectory.initial_attitude.yaw_rad)),
+    ANGLE("roll", OFF(trajectory.initial_attitude.roll_rad), "initial roll of the reference (ZYX Euler)"),
+    ANGLE("pitch", OFF(trajectory.initial_attitude.pitch_rad), "initial pitch of the reference (ZYX Euler)"),
+    ANGLE("yaw", OFF(trajectory.initial_attitude.yaw_rad), "initial heading of the reference (ZYX Euler, from north)"),
 };
 SECTION_OF(k_attitude_section, k_attitude);
 
-#define PV(k, member, sc, fl)                                                                                \
+#define PV(k, member, sc, fl, d)                                                                             \
   {                                                                                                          \
     .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE | (fl),                                          \
-    .offset = OFF(trajectory.parametric.member), .scale = (sc)                                               \
+    .offset = OFF(trajectory.parametric.member), .scale = (sc), .doc = (d)                                   \
   }
 
 static const nav_io_field k_rate[] = {
-    PV("a_rps", wa_rps, 1.0, 0),
-    PV("a_dps", wa_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    PV("b_rps", wb_rps, 1.0, 0),
-    PV("b_dps", wb_rps, NAV_DEG2RAD, NAV_IO_ALT),
-    PV("c_hz", wc_hz, 1.0, 0),
-    PV("d_rad", wd_rad, 1.0, 0),
-    PV("d_deg", wd_rad, NAV_DEG2RAD, NAV_IO_ALT),
+    PV("a_rps", wa_rps, 1.0, 0, "angular rate law: constant term a per axis (w = a + b sin(2 pi c t + d))"),
+    PV("a_dps", wa_rps, NAV_DEG2RAD, NAV_IO_ALT, NULL),
+    PV("b_rps", wb_rps, 1.0, 0, "angular rate law: amplitude b per axis"),
+    PV("b_dps", wb_rps, NAV_DEG2RAD, NAV_IO_ALT, NULL),
+    PV("c_hz", wc_hz, 1.0, 0, "angular rate law: frequency c per axis"),
+    PV("d_rad", wd_rad, 1.0, 0, "angular rate law: phase d per axis"),
+    PV("d_deg", wd_rad, NAV_DEG2RAD, NAV_IO_ALT, NULL),
 };
 SECTION_OF(k_rate_section, k_rate);
 
 static const nav_io_enum_value k_attitude_modes[] = {{"magnus", NAV_ATT_RATE_MAGNUS}, {NULL, 0}};
 
 static const nav_io_field k_parametric[] = {
-    PV("R0_m", r0_m, 1.0, 0),
+    PV("R0_m", r0_m, 1.0, 0, "position law: start position R0 per axis (paper's formula 3)"),
     /* Start velocity within the speed bound (scene_bounds.h), each component. */
     {.key = "V0_mps",
      .kind = NAV_IO_VEC3,
@@ -151,19 +153,24 @@ static const nav_io_field k_parametric[] = {
      .offset = OFF(trajectory.parametric.v0_mps),
      .scale = 1.0,
      .min = -NAV_SCENE_MAX_SPEED_MPS,
-     .max = NAV_SCENE_MAX_SPEED_MPS},
-    PV("A_mps2", a_mps2, 1.0, 0),
-    PV("B_m", b_m, 1.0, 0),
-    PV("C_hz", c_hz, 1.0, 0),
-    PV("D_rad", d_rad, 1.0, 0),
-    PV("D_deg", d_rad, NAV_DEG2RAD, NAV_IO_ALT),
-    {.key = "rate", .kind = NAV_IO_SECTION, .section = &k_rate_section},
+     .max = NAV_SCENE_MAX_SPEED_MPS,
+     .doc = "position law: start velocity V0 per axis"},
+    PV("A_mps2", a_mps2, 1.0, 0, "position law: constant acceleration A per axis"),
+    PV("B_m", b_m, 1.0, 0, "position law: oscillation amplitude B per axis"),
+    PV("C_hz", c_hz, 1.0, 0, "position law: oscillation frequency C per axis"),
+    PV("D_rad", d_rad, 1.0, 0, "position law: oscillation phase D per axis"),
+    PV("D_deg", d_rad, NAV_DEG2RAD, NAV_IO_ALT, NULL),
+    {.key = "rate", .kind = NAV_IO_SECTION, .section = &k_rate_section, .doc = "angular rate law of the body, per axis"},
     {.key = "attitude",
      .kind = NAV_IO_ENUM,
      .offset = OFF(trajectory.parametric.attitude_mode),
-     .enums = k_attitude_modes},
+     .enums = k_attitude_modes,
+     .doc = "how the attitude follows from the rate law: magnus (Magnus expansion of the rate)"},
     /* Ranges of integers that only the simulation constrains are left to nav_scene_validate. */
-    {.key = "magnus_substeps", .kind = NAV_IO_INT, .offset = OFF(trajectory.parametric.magnus_substeps)},
+    {.key = "magnus_substeps",
+     .kind = NAV_IO_INT,
+     .offset = OFF(trajectory.parametric.magnus_substeps),
+     .doc = "sub-steps of the Magnus integration per IMU interval"},
 };
 SECTION_OF(k_parametric_section, k_parametric);
 
@@ -171,15 +178,15 @@ SECTION_OF(k_parametric_section, k_parametric);
 
 #define LIMITS(name, base)                                                                                   \
   static const nav_io_field name##_fields[] = {                                                              \
-      D("max_accel_mps2", OFF(base.max_accel_mps2), 1.0, POSITIVE),                                          \
-      D("max_jerk_mps3", OFF(base.max_jerk_mps3), 1.0, POSITIVE),                                            \
-      D("max_lateral_accel_mps2", OFF(base.max_lateral_accel_mps2), 1.0, POSITIVE),                          \
-      D("max_rate_dps", OFF(base.max_rate_rps), NAV_DEG2RAD, POSITIVE),                                      \
-      D("max_rate_rps", OFF(base.max_rate_rps), 1.0, POSITIVE | NAV_IO_ALT),                                 \
-      D("max_ang_accel_dps2", OFF(base.max_ang_accel_rps2), NAV_DEG2RAD, POSITIVE),                          \
-      D("max_ang_accel_rps2", OFF(base.max_ang_accel_rps2), 1.0, POSITIVE | NAV_IO_ALT),                     \
-      D("max_ang_jerk_dps3", OFF(base.max_ang_jerk_rps3), NAV_DEG2RAD, POSITIVE),                            \
-      D("max_ang_jerk_rps3", OFF(base.max_ang_jerk_rps3), 1.0, POSITIVE | NAV_IO_ALT),                       \
+      D("max_accel_mps2", OFF(base.max_accel_mps2), 1.0, POSITIVE, .doc = "largest acceleration the planner may use"),                                          \
+      D("max_jerk_mps3", OFF(base.max_jerk_mps3), 1.0, POSITIVE, .doc = "largest jerk the planner may use"),                                            \
+      D("max_lateral_accel_mps2", OFF(base.max_lateral_accel_mps2), 1.0, POSITIVE, .doc = "largest lateral (turn) acceleration"),                          \
+      D("max_rate_dps", OFF(base.max_rate_rps), NAV_DEG2RAD, POSITIVE, .doc = "largest turn rate"),                                      \
+      D("max_rate_rps", OFF(base.max_rate_rps), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest turn rate"),                                 \
+      D("max_ang_accel_dps2", OFF(base.max_ang_accel_rps2), NAV_DEG2RAD, POSITIVE, .doc = "largest angular acceleration"),                          \
+      D("max_ang_accel_rps2", OFF(base.max_ang_accel_rps2), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest angular acceleration"),                     \
+      D("max_ang_jerk_dps3", OFF(base.max_ang_jerk_rps3), NAV_DEG2RAD, POSITIVE, .doc = "largest angular jerk"),                            \
+      D("max_ang_jerk_rps3", OFF(base.max_ang_jerk_rps3), 1.0, POSITIVE | NAV_IO_ALT, .doc = "largest angular jerk"),                       \
   };                                                                                                         \
   SECTION_OF(name, name##_fields)
 
@@ -203,21 +210,23 @@ static bool wp_attitude_written(const nav_io_writer *w, const nav_io_field *f, c
 static void finish_point(nav_io_reader *r, const nav_io_node *map, void *base);
 
 static const nav_io_field k_wp_attitude[] = {
-    ANGLE("roll", WOFF(attitude.roll_rad)),
-    ANGLE("pitch", WOFF(attitude.pitch_rad)),
-    ANGLE("yaw", WOFF(attitude.yaw_rad)),
+    ANGLE("roll", WOFF(attitude.roll_rad), "roll at the waypoint (attitude_mode euler)"),
+    ANGLE("pitch", WOFF(attitude.pitch_rad), "pitch at the waypoint (attitude_mode euler)"),
+    ANGLE("yaw", WOFF(attitude.yaw_rad), "heading at the waypoint (attitude_mode euler)"),
 };
 SECTION_OF(k_wp_attitude_section, k_wp_attitude);
 
 /* One waypoint (base: nav_waypoint). lat/lon/h go to the reader state and are converted later. */
 static const nav_io_field k_point[] = {
     {.key = "ned_m",
+     .doc = "waypoint position in the local NED frame (or lat/lon/h)",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE,
      .offset = WOFF(r_ned_m),
      .scale = 1.0,
      .mark_as = "r_ned_m"},
     {.key = "lat_deg",
+     .doc = "waypoint latitude (with lon and h, instead of ned_m)",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_STATE | NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = SOFF(llh[0]),
@@ -231,16 +240,18 @@ static const nav_io_field k_point[] = {
      .scale = 1.0,
      .min = -NAV_PI / 2,
      .max = NAV_PI / 2},
-    D("lon_deg", SOFF(llh[1]), NAV_DEG2RAD, NAV_IO_STATE | NAV_IO_FINITE),
-    D("lon_rad", SOFF(llh[1]), 1.0, NAV_IO_STATE | NAV_IO_FINITE | NAV_IO_ALT),
-    D("h_m", SOFF(llh[2]), 1.0, NAV_IO_STATE | NAV_IO_FINITE),
+    D("lon_deg", SOFF(llh[1]), NAV_DEG2RAD, NAV_IO_STATE | NAV_IO_FINITE, .doc = "waypoint longitude (with lat and h, instead of ned_m)"),
+    D("lon_rad", SOFF(llh[1]), 1.0, NAV_IO_STATE | NAV_IO_FINITE | NAV_IO_ALT, .doc = NULL),
+    D("h_m", SOFF(llh[2]), 1.0, NAV_IO_STATE | NAV_IO_FINITE, .doc = "waypoint ellipsoidal height (with lat and lon)"),
     {.key = "speed_mps",
+     .doc = "speed at the waypoint (timing speed)",
      .kind = NAV_IO_DOUBLE,
      .flags = NONNEG,
      .offset = WOFF(speed_mps),
      .scale = 1.0,
      .write_if = wp_speed_written},
     {.key = "time_s",
+     .doc = "time at the waypoint after the start of the motion (timing time)",
      .kind = NAV_IO_DOUBLE,
      .flags = NONNEG,
      .offset = WOFF(time_s),
@@ -250,6 +261,7 @@ static const nav_io_field k_point[] = {
      .kind = NAV_IO_SECTION,
      .flags = NAV_IO_FLOW,
      .section = &k_wp_attitude_section,
+     .doc = "attitude at the waypoint (attitude_mode euler)",
      .write_if = wp_attitude_written},
 };
 static const nav_io_section k_point_section = {k_point, COUNT(k_point), finish_point};
@@ -375,43 +387,44 @@ static const nav_io_enum_value k_wp_attitude_modes[] = {{"ground", NAV_WP_ATT_GR
 
 static const nav_io_field k_waypoints[] = {
     {.key = "timing",
+     .doc = "how the motion between waypoints is timed",
      .kind = NAV_IO_ENUM,
      .offset = OFF(trajectory.waypoints.timing),
      .enums = k_timings,
      .comment = "speed: speed_mps at every waypoint; time: time_s at every waypoint"},
     {.key = "attitude_mode",
+     .doc = "how the attitude follows the path: ground, aircraft (banked), fixed or euler (per waypoint)",
      .kind = NAV_IO_ENUM,
      .offset = OFF(trajectory.waypoints.attitude_mode),
      .enums = k_wp_attitude_modes},
-    D("hold_start_s", OFF(trajectory.waypoints.hold_start_s), 1.0, NONNEG),
-    D("hold_end_s", OFF(trajectory.waypoints.hold_end_s), 1.0, NONNEG),
+    D("hold_start_s", OFF(trajectory.waypoints.hold_start_s), 1.0, NONNEG, .doc = "stationary time before the motion"),
+    D("hold_end_s", OFF(trajectory.waypoints.hold_end_s), 1.0, NONNEG, .doc = "stationary time after the motion"),
     {.key = "cruise_mps",
+     .doc = "speed between two stops (timing speed)",
      .kind = NAV_IO_DOUBLE,
      .flags = NONNEG,
      .offset = OFF(trajectory.waypoints.cruise_mps),
      .scale = 1.0,
      .write_if = if_changed,
      .comment = "speed between two stops (timing speed)"},
-    {.key = "limits", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_wp_limits_section},
+    {.key = "limits",
+     .doc = "dynamic limits the planner respects", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_wp_limits_section},
     {.key = "points",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(trajectory.waypoints),
      .read = read_points,
      .write = write_points,
-     .same = same_points},
+     .same = same_points,
+     .doc = "waypoints: a position (ned_m, or lat/lon/h), and speed_mps or time_s by the timing",
+     .items = &k_point_section,
+     .max_items = NAV_MAX_WAYPOINTS},
 };
 SECTION_OF(k_waypoints_section, k_waypoints);
 
 /* ================================================================ kind-dependent mappings */
 
-/* A mapping whose keys depend on its "kind": one section per kind value (each starting with the
-   kind descriptor itself), so unknown keys are matched against that kind's keys only. */
-typedef struct kinded {
-  const nav_io_enum_value *kinds;
-  const nav_io_section *const *sections; /* indexed by kind value */
-  size_t nsections;
-  size_t kind_offset; /* of the int kind in the base object */
-} kinded;
+/* Kind-dependent mappings: nav_io_kinded (scene_io_internal.h). */
+typedef nav_io_kinded kinded;
 
 static void read_kinded(nav_io_reader *r, const kinded *kd, const nav_io_node *key, const nav_io_node *v,
                         void *base) {
@@ -470,36 +483,42 @@ static const nav_io_enum_value k_seg_kinds[] = {{"hold", NAV_SEG_HOLD},
 
 /* Keys shared by the segment kinds (base: nav_segment). */
 #define SEG_KIND                                                                                             \
-  { .key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds }
+  { .key = "kind", .kind = NAV_IO_ENUM, .offset = GOFF(kind), .enums = k_seg_kinds, .doc = "what the segment does" }
 #define SEG_DURATION                                                                                         \
   {                                                                                                          \
     .key = "duration_s", .kind = NAV_IO_DOUBLE, .flags = NONNEG | NAV_IO_MAX_LE, .offset = GOFF(duration_s), \
-    .scale = 1.0, .max = NAV_SCENE_MAX_DURATION_S                                                            \
+    .scale = 1.0, .max = NAV_SCENE_MAX_DURATION_S, .doc = "duration (motion_abs/rel kinds: the most it may take)" \
   }
 #define SEG_COORDINATED                                                                                      \
-  { .key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed }
+  {                                                                                                          \
+    .key = "coordinated", .kind = NAV_IO_BOOL, .offset = GOFF(coordinated), .write_if = if_changed,           \
+    .doc = "bank into turns (roll = atan(V yaw rate / g))"                                                   \
+  }
 #define SEG_GNSS_VISIBLE                                                                                     \
-  { .key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed }
-#define SEG_V3(k, member)                                                                                    \
-  { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0 }
+  {                                                                                                          \
+    .key = "gnss_visible", .kind = NAV_IO_BOOL, .offset = GOFF(gnss_visible), .write_if = if_changed,         \
+    .doc = "GNSS visible during the segment (motion-definition column, for outages)"                         \
+  }
+#define SEG_V3(k, member, d)                                                                                    \
+  { .key = (k), .kind = NAV_IO_VEC3, .flags = NAV_IO_FINITE, .offset = GOFF(member), .scale = 1.0, .doc = (d) }
 
 static const nav_io_field k_seg_hold[] = {SEG_KIND, SEG_DURATION, SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_accelerate[] = {SEG_KIND, SPEED("speed_mps", GOFF(speed_mps)),
+static const nav_io_field k_seg_accelerate[] = {SEG_KIND, SPEED("speed_mps", GOFF(speed_mps), "speed at the end of the segment"),
                                                 SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
-                                          RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_COORDINATED,
+static const nav_io_field k_seg_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
+                                          RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_COORDINATED,
                                           SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_coord_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad)),
-                                                RATE("yaw_rate", GOFF(yaw_rate_rps)), SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_climb[] = {SEG_KIND, D("height_m", GOFF(height_m), 1.0, NAV_IO_FINITE),
-                                           ANGLE("pitch", GOFF(pitch_rad)), SEG_GNSS_VISIBLE};
-static const nav_io_field k_seg_circle[] = {SEG_KIND, D("radius_m", GOFF(radius_m), 1.0, POSITIVE),
-                                            D("turns", GOFF(turns), 1.0, NAV_IO_FINITE), SEG_COORDINATED,
+static const nav_io_field k_seg_coord_turn[] = {SEG_KIND, ANGLE("yaw", GOFF(yaw_rad), "heading change of the turn (+ = right)"),
+                                                RATE("yaw_rate", GOFF(yaw_rate_rps), "turn rate (0: the largest the limits allow)"), SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_climb[] = {SEG_KIND, D("height_m", GOFF(height_m), 1.0, NAV_IO_FINITE, .doc = "height gained (+ = up)"),
+                                           ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the climb"), SEG_GNSS_VISIBLE};
+static const nav_io_field k_seg_circle[] = {SEG_KIND, D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
+                                            D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1", .doc = "number of turns (+ = right; figure_eight: per lobe)"), SEG_COORDINATED,
                                             SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_helix[] = {SEG_KIND,
-                                           D("radius_m", GOFF(radius_m), 1.0, POSITIVE),
-                                           D("turns", GOFF(turns), 1.0, NAV_IO_FINITE),
-                                           ANGLE("pitch", GOFF(pitch_rad)),
+                                           D("radius_m", GOFF(radius_m), 1.0, POSITIVE, .doc = "turn radius"),
+                                           D("turns", GOFF(turns), 1.0, NAV_IO_FINITE, .unit = "1", .doc = "number of turns (+ = right; figure_eight: per lobe)"),
+                                           ANGLE("pitch", GOFF(pitch_rad), "flight-path angle of the helix (+ = climbing)"),
                                            SEG_COORDINATED,
                                            SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_lawnmower[] = {SEG_KIND,
@@ -508,24 +527,25 @@ static const nav_io_field k_seg_lawnmower[] = {SEG_KIND,
                                                 .flags = NAV_IO_MIN_GE | NAV_IO_MAX_LE,
                                                 .offset = GOFF(legs),
                                                 .min = 1.0,
-                                                .max = 100000.0},
-                                               D("length_m", GOFF(length_m), 1.0, NONNEG),
-                                               D("spacing_m", GOFF(spacing_m), 1.0, NAV_IO_FINITE),
+                                                .max = 100000.0,
+                                                .doc = "number of straight legs"},
+                                               D("length_m", GOFF(length_m), 1.0, NONNEG, .doc = "straight length of each leg"),
+                                               D("spacing_m", GOFF(spacing_m), 1.0, NAV_IO_FINITE, .doc = "distance between legs (+ = first turn right)"),
                                                SEG_COORDINATED,
                                                SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_rates[] = {SEG_KIND,
-                                           RATE("yaw_rate", GOFF(yaw_rate_rps)),
-                                           RATE("pitch_rate", GOFF(pitch_rate_rps)),
-                                           RATE("roll_rate", GOFF(roll_rate_rps)),
-                                           SEG_V3("accel_b_mps2", accel_b_mps2),
+                                           RATE("yaw_rate", GOFF(yaw_rate_rps), "yaw rate held over the segment"),
+                                           RATE("pitch_rate", GOFF(pitch_rate_rps), "pitch rate held over the segment"),
+                                           RATE("roll_rate", GOFF(roll_rate_rps), "roll rate held over the segment"),
+                                           SEG_V3("accel_b_mps2", accel_b_mps2, "body-axis acceleration held over the segment"),
                                            SEG_DURATION,
                                            SEG_COORDINATED,
                                            SEG_GNSS_VISIBLE};
 static const nav_io_field k_seg_motion[] = {SEG_KIND,
-                                            ANGLE("yaw", GOFF(yaw_rad)),
-                                            ANGLE("pitch", GOFF(pitch_rad)),
-                                            ANGLE("roll", GOFF(roll_rad)),
-                                            SEG_V3("v_b_mps", v_b_mps),
+                                            ANGLE("yaw", GOFF(yaw_rad), "yaw command: absolute or change, by the kind (gnss-ins-sim types 2-5)"),
+                                            ANGLE("pitch", GOFF(pitch_rad), "pitch command: absolute or change, by the kind"),
+                                            ANGLE("roll", GOFF(roll_rad), "roll command: absolute or change, by the kind"),
+                                            SEG_V3("v_b_mps", v_b_mps, "body velocity command: absolute or change, by the kind"),
                                             SEG_DURATION,
                                             SEG_COORDINATED,
                                             SEG_GNSS_VISIBLE};
@@ -627,12 +647,14 @@ static bool same_items(const nav_io_field *f, const void *a, const void *b) {
 
 static const nav_io_field k_segments[] = {
     {.key = "r0_ned_m",
+     .doc = "start position in the local NED frame",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE,
      .offset = OFF(trajectory.segments.r0_ned_m),
      .scale = 1.0,
      .comment = "start position, local NED"},
     {.key = "v0_b_mps",
+     .doc = "start velocity in body axes",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GE | NAV_IO_MAX_LE,
      .offset = OFF(trajectory.segments.v0_b_mps),
@@ -640,15 +662,22 @@ static const nav_io_field k_segments[] = {
      .min = -NAV_SCENE_MAX_SPEED_MPS,
      .max = NAV_SCENE_MAX_SPEED_MPS,
      .comment = "start velocity, body axes"},
-    {.key = "allow_unconverged", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.allow_unconverged)},
-    {.key = "fit_rate_ramps", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.fit_rate_ramps)},
-    {.key = "limits", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_seg_limits_section},
+    {.key = "allow_unconverged",
+     .doc = "accept a segment whose planner did not converge (kept as planned)", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.allow_unconverged)},
+    {.key = "fit_rate_ramps",
+     .doc = "fit the rate ramps of a motion definition instead of stepping them", .kind = NAV_IO_BOOL, .offset = OFF(trajectory.segments.fit_rate_ramps)},
+    {.key = "limits",
+     .doc = "dynamic limits the planner respects", .kind = NAV_IO_SECTION, .flags = NAV_IO_FLOW, .section = &k_seg_limits_section},
     {.key = "items",
      .kind = NAV_IO_CUSTOM,
      .offset = OFF(trajectory.segments),
      .read = read_items,
      .write = write_items,
-     .same = same_items},
+     .same = same_items,
+     .doc = "the segments, flown in order; each a kind and that kind's keys",
+     .kinded = &k_seg_kinded,
+     .items_kinded = true,
+     .max_items = NAV_MAX_SEGMENTS},
 };
 SECTION_OF(k_segments_section, k_segments);
 
@@ -663,30 +692,33 @@ static const nav_io_enum_value k_tm_kinds[] = {{"stationary", NAV_TEST_MOTION_ST
                                                {"vertical_loop", NAV_TEST_MOTION_VERTICAL_LOOP},
                                                {NULL, 0}};
 #define TM_KIND                                                                                              \
-  { .key = "kind", .kind = NAV_IO_ENUM, .offset = TM(kind), .enums = k_tm_kinds }
+  { .key = "kind", .kind = NAV_IO_ENUM, .offset = TM(kind), .enums = k_tm_kinds, .doc = "which test motion" }
 
 static const nav_io_field k_tm_stationary[] = {TM_KIND};
-static const nav_io_field k_tm_coning[] = {TM_KIND, ANGLE("cone_half_angle", TM(cone_half_angle_rad)),
-                                           RATE_HZ_ALT("cone_rate", TM(cone_rate_rps))};
-static const nav_io_field k_tm_sculling[] = {TM_KIND, ANGLE("scull_angle", TM(scull_angle_rad)),
-                                             D("scull_accel_mps2", TM(scull_accel_mps2), 1.0, NAV_IO_FINITE),
-                                             RATE_HZ_ALT("scull_rate", TM(scull_rate_rps))};
+static const nav_io_field k_tm_coning[] = {TM_KIND, ANGLE("cone_half_angle", TM(cone_half_angle_rad), "half angle of the coning cone"),
+                                           RATE_HZ_ALT("cone_rate", TM(cone_rate_rps), "coning frequency")};
+static const nav_io_field k_tm_sculling[] = {TM_KIND, ANGLE("scull_angle", TM(scull_angle_rad), "angular amplitude of the sculling motion"),
+                                             D("scull_accel_mps2", TM(scull_accel_mps2), 1.0, NAV_IO_FINITE, .doc = "acceleration amplitude of the sculling motion"),
+                                             RATE_HZ_ALT("scull_rate", TM(scull_rate_rps), "sculling frequency")};
 static const nav_io_field k_tm_spin[] = {
     TM_KIND,
-    RATE_HZ_ALT("spin_rate", TM(spin_rate_rps)),
-    D("spin_rate_rpm", TM(spin_rate_rps), NAV_TWO_PI / 60.0, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT),
+    RATE_HZ_ALT("spin_rate", TM(spin_rate_rps), "spin rate about the spin axis"),
+    D("spin_rate_rpm", TM(spin_rate_rps), NAV_TWO_PI / 60.0, NAV_IO_FINITE | NAV_IO_ALT | NAV_IO_WRITE_ALT,
+      .doc = "spin rate about the spin axis"),
     {.key = "spin_axis_b",
      .kind = NAV_IO_VEC3,
      .flags = NAV_IO_FINITE,
      .offset = TM(spin_axis_b),
      .scale = 1.0,
-     .comment = "body axes; any non-zero length"}};
+     .comment = "body axes; any non-zero length",
+     .unit = "1",
+     .doc = "spin axis in body axes (any non-zero length)"}};
 static const nav_io_field k_tm_great_circle[] = {
-    TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE),
-    SPEED("gc_speed_mps", TM(gc_speed_mps)), ANGLE("gc_start_angle", TM(gc_start_angle_rad)),
-    ANGLE("gc_lon", TM(gc_lon_rad))};
-static const nav_io_field k_tm_loop[] = {TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps)),
-                                         RATE("loop_pitch_rate", TM(loop_pitch_rate_rps))};
+    TM_KIND, D("gc_height_m", TM(gc_height_m), 1.0, NAV_IO_FINITE, .doc = "height of the great circle above the ellipsoid"),
+    SPEED("gc_speed_mps", TM(gc_speed_mps), "speed along the great circle"), ANGLE("gc_start_angle", TM(gc_start_angle_rad), "geocentric angle from the equator at t = 0"),
+    ANGLE("gc_lon", TM(gc_lon_rad), "longitude of the meridian plane")};
+static const nav_io_field k_tm_loop[] = {TM_KIND, SPEED("loop_speed_mps", TM(loop_speed_mps), "speed around the loop"),
+                                         RATE("loop_pitch_rate", TM(loop_pitch_rate_rps), "pitch rate around the loop")};
 SECTION_OF(k_tm_stationary_section, k_tm_stationary);
 SECTION_OF(k_tm_coning_section, k_tm_coning);
 SECTION_OF(k_tm_sculling_section, k_tm_sculling);
@@ -735,15 +767,18 @@ static bool same_test_motion(const nav_io_field *f, const void *a, const void *b
 
 static const nav_io_field k_motion_def[] = {
     {.key = "file",
+     .doc = "file of the trajectory (relative to the scene file)",
      .kind = NAV_IO_STRING,
      .flags = NAV_IO_STATE | NAV_IO_REQUIRED,
      .offset = SOFF(md_file),
      .size = NAV_IO_PATH_MAX},
     {.key = "allow_unconverged",
+     .doc = "accept a segment whose planner did not converge (kept as planned)",
      .kind = NAV_IO_BOOL,
      .flags = NAV_IO_STATE,
      .offset = SOFF(md_allow_unconverged)},
-    {.key = "fit_rate_ramps", .kind = NAV_IO_BOOL, .flags = NAV_IO_STATE, .offset = SOFF(md_fit_rate_ramps)},
+    {.key = "fit_rate_ramps",
+     .doc = "fit the rate ramps of a motion definition instead of stepping them", .kind = NAV_IO_BOOL, .flags = NAV_IO_STATE, .offset = SOFF(md_fit_rate_ramps)},
 };
 SECTION_OF(k_motion_def_section, k_motion_def);
 
@@ -752,12 +787,15 @@ SECTION_OF(k_motion_def_section, k_motion_def);
 static const nav_io_enum_value k_recorded_formats[] = {{"kf_gins_nav", NAV_RECORDED_KF_GINS_NAV}, {NULL, 0}};
 static const nav_io_field k_recorded[] = {
     {.key = "file",
+     .doc = "file of the trajectory (relative to the scene file)",
      .kind = NAV_IO_STRING,
      .flags = NAV_IO_REQUIRED,
      .offset = RO(file),
      .size = NAV_RECORDED_PATH_MAX},
-    {.key = "format", .kind = NAV_IO_ENUM, .offset = RO(format), .enums = k_recorded_formats},
+    {.key = "format",
+     .doc = "format of the recorded file", .kind = NAV_IO_ENUM, .offset = RO(format), .enums = k_recorded_formats},
     {.key = "start_s",
+     .doc = "first recorded time used (file time base)",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_FINITE,
      .offset = RO(start_s),
@@ -766,6 +804,7 @@ static const nav_io_field k_recorded[] = {
      .bits_offset = RO(window),
      .comment = "file time base"},
     {.key = "end_s",
+     .doc = "last recorded time used (file time base)",
      .kind = NAV_IO_DOUBLE,
      .flags = NAV_IO_FINITE,
      .offset = RO(end_s),
@@ -773,14 +812,15 @@ static const nav_io_field k_recorded[] = {
      .bit = NAV_RECORDED_HAS_END,
      .bits_offset = RO(window)},
     {.key = "knot_rate_hz",
+     .doc = "B-spline knots per second of the fit (its bandwidth)",
      .kind = NAV_IO_DOUBLE,
      .flags = POSITIVE | NAV_IO_MAX_LE,
      .offset = RO(knot_rate_hz),
      .scale = 1.0,
      .min = 0.0,
      .max = 1000.0},
-    D("pos_sd_m", RO(pos_sd_m), 1.0, POSITIVE),
-    D("vel_sd_mps", RO(vel_sd_mps), 1.0, POSITIVE),
+    D("pos_sd_m", RO(pos_sd_m), 1.0, POSITIVE, .doc = "fit weight of a recorded position (1 / sigma^2 per axis)"),
+    D("vel_sd_mps", RO(vel_sd_mps), 1.0, POSITIVE, .doc = "fit weight of a recorded velocity (1 / sigma^2 per axis)"),
 };
 SECTION_OF(k_recorded_section, k_recorded);
 
@@ -808,6 +848,18 @@ static nav_status write_duration(nav_io_writer *w, const nav_io_field *f, const 
 static bool same_duration(const nav_io_field *f, const void *a, const void *b) {
   return same_bits(*(const double *)((const char *)a + f->offset),
                    *(const double *)((const char *)b + f->offset));
+}
+
+/* A number within the descriptor's bounds, or the word auto (the bounds apply to numbers only). */
+static void schema_duration(nav_io_json *j, const nav_io_field *f) {
+  nav_io_json_key(j, "type");
+  nav_io_json_raw(j, "[\"number\", \"string\"]");
+  nav_io_json_key(j, "pattern");
+  nav_io_json_string(j, "^auto$");
+  nav_io_json_key(j, "exclusiveMinimum");
+  nav_io_json_number(j, f->min);
+  nav_io_json_key(j, "maximum");
+  nav_io_json_number(j, f->max);
 }
 
 /* Sections of trajectory types: the selected one always, the others when they hold non-defaults. */
@@ -838,7 +890,8 @@ static bool attitude_written(const nav_io_writer *w, const nav_io_field *f, cons
 }
 
 static const nav_io_field k_trajectory[] = {
-    {.key = "type", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
+    {.key = "type",
+     .doc = "which trajectory model the scene uses", .kind = NAV_IO_ENUM, .offset = OFF(trajectory.type), .enums = k_traj_types},
     {.key = "duration_s",
      .kind = NAV_IO_CUSTOM,
      .flags = NAV_IO_FINITE | NAV_IO_MIN_GT | NAV_IO_MAX_LE,
@@ -848,23 +901,33 @@ static const nav_io_field k_trajectory[] = {
      .max = NAV_SCENE_MAX_DURATION_S,
      .read = read_duration,
      .write = write_duration,
-     .same = same_duration},
+     .same = same_duration,
+     .doc = "length of the trajectory, or auto: the length of a waypoint or segment script",
+     .schema = schema_duration},
     {.key = "initial_attitude",
+     .doc = "attitude of the reference at t = 0 (parametric, segments, test motions)",
      .kind = NAV_IO_SECTION,
      .flags = NAV_IO_FLOW,
      .section = &k_attitude_section,
      .write_if = attitude_written},
-    {.key = "parametric", .kind = NAV_IO_SECTION, .section = &k_parametric_section, .write_if = type_written},
-    {.key = "waypoints", .kind = NAV_IO_SECTION, .section = &k_waypoints_section, .write_if = type_written},
-    {.key = "segments", .kind = NAV_IO_SECTION, .section = &k_segments_section, .write_if = type_written},
+    {.key = "parametric",
+     .doc = "the paper's parametric trajectory: position and rate laws (type parametric)", .kind = NAV_IO_SECTION, .section = &k_parametric_section, .write_if = type_written},
+    {.key = "waypoints",
+     .doc = "a path through waypoints with speeds or times (type waypoints)", .kind = NAV_IO_SECTION, .section = &k_waypoints_section, .write_if = type_written},
+    {.key = "segments",
+     .doc = "a script of segments: hold, accelerate, turn, climb, ... (type segments)", .kind = NAV_IO_SECTION, .section = &k_segments_section, .write_if = type_written},
     {.key = "test_motion",
      .kind = NAV_IO_CUSTOM,
      .read = read_test_motion,
      .write = write_test_motion,
      .same = same_test_motion,
-     .write_if = type_written},
-    {.key = "motion_def", .kind = NAV_IO_SECTION, .section = &k_motion_def_section, .write_if = never},
-    {.key = "recorded", .kind = NAV_IO_SECTION, .section = &k_recorded_section, .write_if = type_written},
+     .write_if = type_written,
+     .doc = "a test motion (type test_motion): its kind and that kind's keys",
+     .kinded = &k_tm_kinded},
+    {.key = "motion_def",
+     .doc = "a gnss-ins-sim motion definition file, imported as segments (type motion_def)", .kind = NAV_IO_SECTION, .section = &k_motion_def_section, .write_if = never},
+    {.key = "recorded",
+     .doc = "a recorded reference trajectory fitted by a B-spline (type recorded)", .kind = NAV_IO_SECTION, .section = &k_recorded_section, .write_if = type_written},
 };
 const nav_io_section nav_io_trajectory_section = {k_trajectory, COUNT(k_trajectory), NULL};
 
