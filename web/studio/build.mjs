@@ -58,6 +58,7 @@ await build({
   logLevel: 'warning',
 });
 copyFileSync(join(here, 'src/index.html'), join(out, 'index.html'));
+copyFileSync(join(here, 'src/favicon.svg'), join(out, 'favicon.svg'));
 
 // Offline map data. Coordinates are rounded to 1e-4 degree (about 10 m), far below the crude
 // coastline's own resolution (about 25 km), to keep the files small.
@@ -112,7 +113,7 @@ const files = [];
     else files.push(relative(out, p));
   }
 })(join(out, 'map'));
-files.push('index.html', 'studio.js', 'studio.css', 'manifest.txt');
+files.push('index.html', 'favicon.svg', 'studio.js', 'studio.css', 'manifest.txt');
 if (existsSync(join(out, 'studio.js.LEGAL.txt'))) files.push('studio.js.LEGAL.txt');
 files.sort();
 writeFileSync(join(out, 'manifest.txt'), files.join('\n') + '\n');

@@ -72,7 +72,9 @@ function chart(host, title, unitLabel, t, series, outages, limits, width) {
   const div = document.createElement('div');
   div.className = 'chart';
   host.appendChild(div);
-  const maxY = Math.max(...limits.map((l) => l.value * 1.15), ...series.flatMap((s) => s.data.filter(Number.isFinite)).slice(0, 200000).map(Math.abs).reduce((a, b) => Math.max(a, b), 0) * 1.05, 1e-9);
+  let peak = 0;
+  for (const se of series) for (const v of se.data) if (Number.isFinite(v) && Math.abs(v) > peak) peak = Math.abs(v);
+  const maxY = Math.max(peak * 1.05, ...limits.map((l) => l.value * 1.15), 1e-9);
   const opts = {
     title,
     width,

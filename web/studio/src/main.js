@@ -267,13 +267,36 @@ function drawPreview() {
 }
 
 // ---------------------------------------------------------------- validation and estimate
-let checkSeq = 0;
+// One validation + estimate at a time: a change made meanwhile runs one more afterwards (the
+// server computes a bounded number of estimates at once and answers 429 beyond).
+let checking = false, checkAgain = false;
 async function checkAndEstimate() {
-  const seq = ++checkSeq;
+  if (checking) { checkAgain = true; return; }
+  checking = true;
+  try {
+    await checkOnce();
+  } catch (err) {
+    $('estimate').dataset.state = 'error';
+    $('estimate-body').textContent = `estimate failed: ${err.message}`;
+  } finally {
+    checking = false;
+    if (checkAgain) { checkAgain = false; checkAndEstimate(); }
+  }
+}
+const sleep = (ms) => new Promise((res) => setTimeout(res, ms));
+async function postRetrying(url, text) {
+  for (let i = 0; ; ++i) {
+    const r = await api('POST', url, text);
+    if (r.status !== 429 || i >= 20 || checkAgain) return r;
+    const after = Math.min(2, Math.max(0.2, +(r.headers.get('Retry-After') || 0.5)));
+    await sleep(after * 1000);
+  }
+}
+async function checkOnce() {
   const text = scene.text();
   const t0 = performance.now();
-  const v = await api('POST', 'api/validate', text);
-  if (seq !== checkSeq) return;
+  const v = await postRetrying('api/validate', text);
+  if (checkAgain) return;
   const st = $('yaml-status');
   if (v.status === 200) {
     st.className = 'good';
@@ -286,8 +309,8 @@ async function checkAndEstimate() {
     $('estimate-body').textContent = 'The scene is not valid: ' + st.textContent.split('\n')[0];
     return;
   }
-  const e = await api('POST', 'api/estimate', text);
-  if (seq !== checkSeq) return;
+  const e = await postRetrying('api/estimate', text);
+  if (checkAgain) return;
   studio.timings.estimate_ms = performance.now() - t0;
   showEstimate(e);
 }
@@ -297,9 +320,10 @@ function requirementTable(reqs, predicted) {
   const tb = document.createElement('tbody');
   for (const r of reqs) {
     const tr = document.createElement('tr');
-    const verdict = r.pass === true ? 'PASS' : r.pass === false ? 'FAIL' : 'n/a';
+    const known = typeof r.value === 'number';
+    const verdict = !known ? 'n/a' : r.pass === true ? 'PASS' : r.pass === false ? 'FAIL' : 'n/a';
     const val = typeof r.value === 'number' ? r.value.toPrecision(4) : '—';
-    for (const [txt, cls] of [[r.id, ''], [r.statistic + (r.time_s !== undefined ? ` @ ${r.time_s} s` : ''), ''], [`${val} ${r.unit || ''}`, ''], [`${r.limit} ${r.unit || ''}`, ''], [verdict, r.pass === true ? 'pass' : r.pass === false ? 'fail' : '']]) {
+    for (const [txt, cls] of [[r.id, ''], [r.statistic + (r.time_s !== undefined ? ` @ ${r.time_s} s` : ''), ''], [`${val} ${r.unit || ''}`, ''], [`${r.limit} ${r.unit || ''}`, ''], [verdict, verdict === 'PASS' ? 'pass' : verdict === 'FAIL' ? 'fail' : '']]) {
       const td = document.createElement('td');
       td.textContent = txt;
       if (cls) td.className = cls;
@@ -369,11 +393,16 @@ async function startRun() {
     currentRun.finished = true;
     if (es) es.close();
     runState(state, state === 'done' ? 1 : undefined);
-    if (state === 'done') await loadResults(id, text);
+    if (state === 'failed' && currentRun.error) $('run-state').textContent = `failed: ${currentRun.error}`;
+    if (state === 'done') await loadResults(id, text, currentRun.files);
   };
   const onState = (j) => {
     if (!j || !j.state) return;
-    if (['done', 'failed', 'cancelled'].includes(j.state)) finish(j.state);
+    if (['done', 'failed', 'cancelled'].includes(j.state)) {
+      currentRun.files = Array.isArray(j.files) ? j.files : null;
+      if (j.error) currentRun.error = j.error;
+      finish(j.state);
+    }
     else if (!currentRun.finished) runState(j.state, typeof j.progress === 'number' ? j.progress : undefined);
   };
   try {
@@ -396,9 +425,15 @@ async function cancelRun() {
   await api('DELETE', `api/runs/${currentRun.id}`);
 }
 
-const resultFiles = ['summary.json', 'nav.csv', 'truth.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'tracks.kml', 'report.html'];
-async function loadResults(id, text) {
+const resultFiles = ['summary.json', 'nav.csv', 'truth.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'tracks.kml', 'report.html', 'results.zip'];
+async function loadResults(id, text, files) {
+  // Only the files the run has (the state lists them): no request ends in a 404.
+  if (!files) {
+    const s = await api('GET', `api/runs/${id}`);
+    files = s.ok && s.json && Array.isArray(s.json.files) ? s.json.files : [];
+  }
   const get = async (name) => {
+    if (!files.includes(name)) return null;
     const r = await fetch(`api/runs/${id}/files/${name}`);
     return r.ok ? r.text() : null;
   };
@@ -429,9 +464,8 @@ async function loadResults(id, text) {
   sceneLink.download = `${scene.get(['name']) || 'scene'}.yaml`;
   sceneLink.textContent = 'scene YAML (reruns this result bit-identically)';
   ul.appendChild(Object.assign(document.createElement('li'), {})).appendChild(sceneLink);
-  for (const name of resultFiles) {
-    const head = await fetch(`api/runs/${id}/files/${name}`, { method: 'HEAD' }).catch(() => null);
-    if (head && !head.ok && head.status !== 405) continue;
+  for (const name of [...resultFiles, ...files.filter((f) => !resultFiles.includes(f))]) {
+    if (!files.includes(name)) continue;
     const a = document.createElement('a');
     a.href = `api/runs/${id}/files/${name}`;
     a.download = name;
