@@ -59,7 +59,8 @@ function spansPlugin(outages, limits) {
           ctx.moveTo(u.bbox.left, y);
           ctx.lineTo(u.bbox.left + u.bbox.width, y);
           ctx.stroke();
-          ctx.fillText(lim.label, u.bbox.left + 6, y - 4);
+          const w = ctx.measureText(lim.label).width;
+          ctx.fillText(lim.label, u.bbox.left + u.bbox.width - w - 6, y - 4);
         }
         ctx.restore();
       }],

@@ -375,6 +375,8 @@ function runState(state, progress) {
 }
 async function startRun() {
   const runs = Math.max(1, Math.round(+$('runs').value || 1));
+  // The scene saved with the result names its run count, so that it reruns the same campaign.
+  if (scene.get(['simulation', 'runs']) !== runs) { scene.set(['simulation', 'runs'], runs); changed('flow'); }
   const text = scene.text();
   runState('starting', 0);
   const r = await api('POST', `api/runs?runs=${runs}`, text);
@@ -391,7 +393,8 @@ async function startRun() {
   const finish = async (state) => {
     if (!currentRun || currentRun.id !== id || currentRun.finished) return;
     currentRun.finished = true;
-    if (es) es.close();
+    // The server ends the event stream itself ("end"); closed here only if it does not.
+    if (es) setTimeout(() => es.close(), 15000);
     runState(state, state === 'done' ? 1 : undefined);
     if (state === 'failed' && currentRun.error) $('run-state').textContent = `failed: ${currentRun.error}`;
     if (state === 'done') await loadResults(id, text, currentRun.files);
@@ -410,6 +413,7 @@ async function startRun() {
     es.onmessage = (ev) => { try { onState(JSON.parse(ev.data)); } catch { /* not JSON */ } };
     for (const name of ['progress', 'state', 'done', 'failed', 'cancelled'])
       es.addEventListener(name, (ev) => { try { onState(JSON.parse(ev.data)); } catch { /* not JSON */ } });
+    es.addEventListener('end', () => es.close());
     es.onerror = () => { if (es) es.close(); };
   } catch { es = null; }
   // The state is also polled: events may be lost behind a proxy; the poll settles the end state.
@@ -611,6 +615,7 @@ $('draw-waypoints').addEventListener('click', () => {
   document.body.classList.toggle('ol-waypoint-mode', drawing);
   mapView.onClick = drawing ? addWaypoint : null;
   if (drawing) status('click on the map to place waypoints (they replace the current ones)');
+  else mapView.fit();
 });
 $('add-centre').addEventListener('click', () => { const [lon, lat] = mapView.centre(); if (!drawing) drawnThisSession = waypoints().length; addWaypoint(lon, lat); });
 $('undo-waypoint').addEventListener('click', () => {

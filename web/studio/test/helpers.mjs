@@ -85,8 +85,9 @@ export async function openPage(browser, url, width = 1280, height = 800) {
 
 // Pixels that differ from the most common colour of the canvases under a selector (all of them
 // composed in document order, as the user sees them).
-export function canvasInk(page, selector) {
-  return page.evaluate((sel) => {
+// colours: optional [[r, g, b], ...]: the count of pixels within 40 of each (per channel).
+export function canvasInk(page, selector, colours = []) {
+  return page.evaluate((sel, cols) => {
     const host = document.querySelector(sel);
     const cvs = host.tagName === 'CANVAS' ? [host] : [...host.querySelectorAll('canvas')];
     if (!cvs.length) return { canvases: 0, ink: 0, pixels: 0 };
@@ -104,12 +105,16 @@ export function canvasInk(page, selector) {
     let bg = 0, best = -1;
     for (const [k, n] of count) if (n > best) { best = n; bg = k; }
     let ink = 0;
+    const near = cols.map(() => 0);
     for (let i = 0; i < d.length; i += 4) {
       const k = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
       if (d[i + 3] > 0 && k !== bg) ++ink;
+      cols.forEach((c, j) => {
+        if (Math.abs(d[i] - c[0]) <= 40 && Math.abs(d[i + 1] - c[1]) <= 40 && Math.abs(d[i + 2] - c[2]) <= 40) ++near[j];
+      });
     }
-    return { canvases: cvs.length, ink, pixels: w * h };
-  }, selector);
+    return { canvases: cvs.length, ink, pixels: w * h, colours: near };
+  }, selector, colours);
 }
 
 export function shotPath(name) {

@@ -96,19 +96,20 @@ test('A: catalog IMU, four waypoints on the map, a 60 s outage, 100 Monte Carlo 
   assert.equal(heading.startsWith('PASS'), summary.requirements.every((r) => r.pass === true));
 
   // Map with the results, charts and 3D: not blank.
-  await page.waitForFunction(() => true);
-  const mapInk = await canvasInk(page, '#map');
-  assert.ok(mapInk.ink > 0.02 * mapInk.pixels, `map has ink ${JSON.stringify(mapInk)}`);
   await page.screenshot({ path: shotPath('A2-map-results.png') });
+  // The reference (black), the estimate (red-orange) and the GNSS fixes (green) are drawn.
+  const mapInk = await canvasInk(page, '#map', [[17, 17, 17], [209, 64, 31], [42, 157, 58]]);
+  assert.ok(mapInk.ink > 0.005 * mapInk.pixels, `map has ink ${JSON.stringify(mapInk)}`);
+  assert.ok(mapInk.colours.every((c) => c > 100), `reference, estimate and fixes on the map ${JSON.stringify(mapInk)}`);
   await selectTab(page, 'tab-charts');
+  await page.screenshot({ path: shotPath('A3-charts.png'), fullPage: true });
   const chartInk = await canvasInk(page, '#charts .chart canvas');
   assert.ok(chartInk.ink > 0.01 * chartInk.pixels, `chart has ink ${JSON.stringify(chartInk)}`);
   assert.ok((await page.$$('#charts .chart')).length >= 3);
-  await page.screenshot({ path: shotPath('A3-charts.png'), fullPage: true });
   await selectTab(page, 'tab-3d');
+  await page.screenshot({ path: shotPath('A4-3d.png') });
   const threeInk = await canvasInk(page, '#three canvas');
   assert.ok(threeInk.ink > 0.01 * threeInk.pixels, `3D has ink ${JSON.stringify(threeInk)}`);
-  await page.screenshot({ path: shotPath('A4-3d.png') });
   await selectTab(page, 'tab-results');
   const links = await page.$$eval('#downloads a', (as) => as.map((a) => a.textContent));
   for (const f of ['summary.json', 'nav.csv', 'errors.csv']) assert.ok(links.includes(f), `download ${f} (${links})`);
@@ -152,9 +153,9 @@ test('B: gyro-free scheme on the paper\'s parametric trajectory, live preview, r
   assert.equal(summary.runs, 20);
   assert.equal(summary.trajectory, 'parametric');
   await selectTab(page, 'tab-3d');
+  await page.screenshot({ path: shotPath('B2-3d.png') });
   const threeInk = await canvasInk(page, '#three canvas');
   assert.ok(threeInk.ink > 0.01 * threeInk.pixels, `3D has ink ${JSON.stringify(threeInk)}`);
-  await page.screenshot({ path: shotPath('B2-3d.png') });
   await selectTab(page, 'tab-charts');
   await page.screenshot({ path: shotPath('B3-charts.png'), fullPage: true });
   assert.deepEqual(problems, []);
