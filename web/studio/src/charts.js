@@ -82,7 +82,7 @@ function chart(host, title, unitLabel, t, series, outages, limits, width) {
     height: 220,
     plugins: [spansPlugin(outages, limits)],
     scales: { x: { time: false }, y: { range: (u, lo, hi) => [Math.min(lo, 0), Math.max(hi, maxY)] } },
-    axes: [{ label: 't [s]' }, { label: unitLabel, size: 60 }],
+    axes: [{ label: 't [s]' }, { label: unitLabel, size: 60, values: (u, ticks) => ticks.map((v) => +v.toPrecision(3)) }],
     series: [{ label: 't [s]' }, ...series.map((s) => ({ label: s.label, stroke: s.color, width: s.width || 1.5, dash: s.dash, fill: s.fill, points: { show: false } }))],
     bands: series.map((s, i) => (s.bandWith !== undefined ? { series: [i + 1, s.bandWith + 1], fill: s.bandFill } : null)).filter(Boolean),
   };
