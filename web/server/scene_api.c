@@ -54,7 +54,7 @@ static void add_diag(serve_diags *d, int line, int col, const char *path, const 
 static void frame_path(const scan_frame *st, int depth, const char *last, char *out, size_t size) {
   size_t n = 0;
   out[0] = '\0';
-  for (int i = 0; i < depth; ++i) {
+  for (int i = 0; i + 1 < depth; ++i) { /* the ancestors: each frame's key holds the child */
     if (!st[i].is_map || st[i].key[0] == '\0') continue;
     const int w = snprintf(out + n, size - n, "%s%s", n ? "." : "", st[i].key);
     if (w < 0 || (size_t)w >= size - n) return;
