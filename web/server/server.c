@@ -603,6 +603,28 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *
   return route_static(c, method, url);
 }
 
+/* Percent-decoding of the URL and query values in place, except %00: a NUL would cut the text
+ * short ("/index.html%00.png" read as "/index.html"), so it stays as the three characters. */
+static size_t unescape(void *cls, struct MHD_Connection *c, char *s) {
+  (void)cls;
+  (void)c;
+  char *w = s;
+  for (const char *r = s; *r;) {
+    if (r[0] == '%' && isxdigit((unsigned char)r[1]) && isxdigit((unsigned char)r[2])) {
+      const char hex[3] = {r[1], r[2], '\0'};
+      const long v = strtol(hex, NULL, 16);
+      if (v != 0) {
+        *w++ = (char)v;
+        r += 3;
+        continue;
+      }
+    }
+    *w++ = *r++;
+  }
+  *w = '\0';
+  return (size_t)(w - s);
+}
+
 static void completed(void *cls, struct MHD_Connection *c, void **con_cls, enum MHD_RequestTerminationCode toe) {
   (void)cls;
   (void)c;
@@ -819,7 +841,7 @@ int navserve_main(int argc, char **argv) {
                        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_client,
                        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.connection_timeout_s,
                        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024), MHD_OPTION_NOTIFY_COMPLETED,
-                       completed, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE,
+                       completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE,
                        (size_t)(2u << 20), MHD_OPTION_END);
   if (!d) {
     fprintf(stderr, "navsim serve: cannot listen on %s port %d (in use, or not an address of this machine)\n",
