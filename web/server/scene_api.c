@@ -137,6 +137,26 @@ cleanup:
 
 /* ------------------------------------------------------------------ the check of a scene */
 
+static pthread_mutex_t g_check_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_check_cv = PTHREAD_COND_INITIALIZER;
+static int g_check_free = 4;
+
+void serve_checks_init(int max) { g_check_free = max > 0 ? max : 1; }
+
+void serve_check_enter(void) {
+  pthread_mutex_lock(&g_check_mu);
+  while (g_check_free == 0) pthread_cond_wait(&g_check_cv, &g_check_mu);
+  --g_check_free;
+  pthread_mutex_unlock(&g_check_mu);
+}
+
+void serve_check_leave(void) {
+  pthread_mutex_lock(&g_check_mu);
+  ++g_check_free;
+  pthread_cond_signal(&g_check_cv);
+  pthread_mutex_unlock(&g_check_mu);
+}
+
 static void collect(void *user, const nav_diag *d) {
   add_diag(user, d->line, d->col, d->path, d->message);
 }
