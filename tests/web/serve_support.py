@@ -7,6 +7,7 @@ import http.client
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -25,7 +26,13 @@ def check(cond, what):
     return cond
 
 
+SERVERS = []
+
+
 def finish(name):
+    if not FAILS:  # keep everything of a failed test for a look
+        for s in SERVERS:
+            shutil.rmtree(s.root, ignore_errors=True)
     if FAILS:
         print(f"{name}: {len(FAILS)} failed expectation(s)")
         sys.exit(1)
@@ -69,6 +76,7 @@ class Server:
         if not m:
             raise RuntimeError(f"unexpected first line {line!r}")
         self.port = int(m.group(1))
+        SERVERS.append(self)
         self.host = f"127.0.0.1:{self.port}"
 
     def request(self, method, path, body=None, headers=None, timeout=120):
