@@ -21,6 +21,24 @@ MINIMAL = read(os.path.join(SRC, "tests/data/scenes/valid-minimal.yaml"))
 URBAN = read(os.path.join(SCENES, "urban-drive.yaml"))
 CSP = "default-src 'self'; frame-ancestors 'none'"
 
+# ---------------------------------------------------------------- options and configuration
+r = subprocess.run([NAVSIM, "serve", "--port", "abc"], capture_output=True, text=True, timeout=30)
+check(r.returncode == 2 and "--port" in r.stderr, f"--port abc -> exit 2 ({r.returncode} {r.stderr!r})")
+r = subprocess.run([NAVSIM, "serve", "--frobnicate"], capture_output=True, text=True, timeout=30)
+check(r.returncode == 2, f"unknown option -> exit 2 ({r.returncode})")
+r = subprocess.run([NAVSIM, "serve", "--bind", "localhost"], capture_output=True, text=True, timeout=30)
+check(r.returncode == 2 and "numeric" in r.stderr, f"--bind of a name -> exit 2 ({r.returncode})")
+r = subprocess.run([NAVSIM, "serve", "--help"], capture_output=True, text=True, timeout=30)
+check(r.returncode == 0 and r.stdout.startswith("usage: navsim serve"), "navsim serve --help")
+check("  serve " in subprocess.run([NAVSIM, "--help"], capture_output=True, text=True).stdout, "navsim --help lists serve")
+import tempfile  # noqa: E402
+with tempfile.NamedTemporaryFile("w", suffix=".conf", delete=False) as f:
+    f.write("# comment\njob_cpu_s = 60\nmax_runz = 3\nmax_runs = -1\nport 80\n")
+r = subprocess.run([NAVSIM, "serve", "--config", f.name, "--port", "0"], capture_output=True, text=True, timeout=30)
+os.unlink(f.name)
+check(r.returncode == 2 and f"{f.name}:3: error: unknown key \"max_runz\"" in r.stderr and f"{f.name}:4: error: max_runs"
+      in r.stderr and f"{f.name}:5: error: expected" in r.stderr, f"bad configuration -> exit 2 with FILE:LINE ({r.stderr!r})")
+
 srv = Server(NAVSIM, {
     "max_body_bytes": 262144,
     "max_jobs_per_client": 3,
@@ -28,6 +46,7 @@ srv = Server(NAVSIM, {
     "max_queued_jobs": 8,
     "max_runs": 500,
     "retry_after_s": 7,
+    "estimate_cpu_s": 120,  # the sanitizer build is 10-20 times slower
 })
 print("server on", srv.host)
 
@@ -243,6 +262,11 @@ st, _, j = srv.json("GET", "/api/estimate")
 check(st == 405, f"GET /api/estimate -> 405 ({st})")
 st, _, j = srv.json("GET", "/api/limits")
 check(st == 200 and j["max_runs"] == 500 and "summary.json" in j["result_files"], f"GET /api/limits ({st})")
+
+# ---------------------------------------------------------------- a second server on the same port
+r = subprocess.run([NAVSIM, "serve", "--port", str(srv.port), "--data-dir", srv.data + "-2"], capture_output=True,
+                   text=True, timeout=30)
+check(r.returncode == 1 and "cannot listen" in r.stderr, f"port in use -> exit 1 ({r.returncode} {r.stderr!r})")
 
 # ---------------------------------------------------------------- SIGTERM with a job running
 st, _, j = srv.json("POST", "/api/runs?runs=100", URBAN)
