@@ -7,6 +7,7 @@ usage: test_serve_hostile.py NAVSIM SOURCE_DIR"""
 
 import http.client
 import os
+import signal
 import socket
 import sys
 import threading
@@ -171,6 +172,24 @@ j = srv.wait_run(cpu_id, timeout=120)
 check(j and j["state"] == "failed" and "CPU limit of 2 s" in (j["error"] or ""), f"CPU limit ends the job ({j})")
 check(j and "summary.json" not in j["files"], "no results from a job ended by its limit")
 alive("a job beyond its CPU limit")
+
+# ---------------------------------------------------------------- a job that crashes
+st, _, j = srv.json("POST", "/api/runs?runs=100", URBAN)
+crash_id = j["id"]
+st, _, j = srv.json("POST", "/api/runs?runs=3", MINIMAL)
+neighbour = j["id"]
+check(srv.wait_run(crash_id, states=("running",), timeout=60) is not None, "the run to crash starts")
+pids = [p for p in srv.job_processes() if os.readlink(f"/proc/{p}/cwd").endswith(crash_id)]
+check(len(pids) == 1, f"its process found ({pids})")
+for p in pids:
+    os.kill(p, signal.SIGSEGV)
+j = srv.wait_run(crash_id, timeout=60)
+check(j and j["state"] == "failed" and "SIGSEGV" in (j["error"] or ""), f"a crashed run is failed with the reason ({j})")
+j = srv.wait_run(neighbour, timeout=120)
+check(j and j["state"] == "done" and "summary.json" in j["files"], "the neighbouring run is untouched and done")
+st, _, body = srv.request("GET", f"/api/runs/{neighbour}/files/summary.json")
+check(st == 200 and b'"runs": 3' in body, "its results are served")
+alive("a crashed job")
 
 # ---------------------------------------------------------------- a flood of runs
 results = {}
