@@ -6,7 +6,7 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
-  libmicrohttpd-dev libzip-dev curl # navsim serve (web/server; curl in its API tests)
+  libmicrohttpd-dev libzip-dev python3 # navsim serve (web/server) and its tests (Python standard library)
   libexpat1-dev libxml2-utils       # GPX/KML import (expat); xmllint checks exported KML in tests
   libvtk9-dev fonts-dejavu-core
   xvfb xauth

@@ -40,6 +40,11 @@
 #include "navcore/nav_version.h"
 #ifdef NAVSIM_HAVE_SERVE
 #include "navserve.h"
+/* Listed only when built: the man pages and bash completion are made from this list. */
+#define NAVSIM_SERVE_HELP \
+  "  serve            HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)\n"
+#else
+#define NAVSIM_SERVE_HELP ""
 #endif
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2, EXIT_REQUIREMENT = 3 };
@@ -67,7 +72,7 @@ static const char *k_usage =
     "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
     "  tradeoff SCENE   CPU time against error of each modelling choice; the cheapest within tolerance\n"
     "  schema           JSON Schema of scene files: keys, types, units, bounds, defaults\n"
-    "  serve            HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)\n"
+    NAVSIM_SERVE_HELP
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"

@@ -54,6 +54,7 @@ struct job {
   int refs;
   bool removed;
   double predicted_bytes, disk_bytes;
+  double cpu_s; /* CPU time of the job's process (user + system) */
   unsigned files; /* bit i: serve_result_files[i] exists (done jobs) */
   job *next;
 };
@@ -372,6 +373,8 @@ static void run_job(job *j) {
   }
   if (st != JOB_DONE) files &= (1u << FILE_SCENE) | (1u << FILE_LOG);
   j->files = files; /* read by clients only once the state below is final */
+  const double cpu_used = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                          (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
   if (st == JOB_DONE) make_zip(j, dir);
   const double bytes = serve_tree_bytes(dir);
   pthread_mutex_lock(&g.mu);
@@ -382,6 +385,7 @@ static void run_job(job *j) {
   j->finished_mono = serve_now_s();
   j->pid = 0;
   j->disk_bytes = bytes;
+  j->cpu_s = cpu_used;
   g.used_bytes += bytes;
   g.reserved_bytes -= j->predicted_bytes;
   --g.n_running;
@@ -687,6 +691,7 @@ static void job_json_locked(const job *j, sbuf *b) {
   iso_time(b, j->started);
   sb_puts(b, ",\"finished\":");
   iso_time(b, j->finished);
+  if (finished(j) && j->started) sb_printf(b, ",\"cpu_s\":%.3f", j->cpu_s);
   sb_puts(b, ",\"error\":");
   if (j->error[0])
     sb_json_str(b, j->error);

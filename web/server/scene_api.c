@@ -54,7 +54,7 @@ static void add_diag(serve_diags *d, int line, int col, const char *path, const 
 static void frame_path(const scan_frame *st, int depth, const char *last, char *out, size_t size) {
   size_t n = 0;
   out[0] = '\0';
-  for (int i = 0; i < depth; ++i) {
+  for (int i = 0; i + 1 < depth; ++i) { /* the ancestors: each frame's key holds the child */
     if (!st[i].is_map || st[i].key[0] == '\0') continue;
     const int w = snprintf(out + n, size - n, "%s%s", n ? "." : "", st[i].key);
     if (w < 0 || (size_t)w >= size - n) return;
@@ -136,6 +136,26 @@ cleanup:
 }
 
 /* ------------------------------------------------------------------ the check of a scene */
+
+static pthread_mutex_t g_check_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_check_cv = PTHREAD_COND_INITIALIZER;
+static int g_check_free = 4;
+
+void serve_checks_init(int max) { g_check_free = max > 0 ? max : 1; }
+
+void serve_check_enter(void) {
+  pthread_mutex_lock(&g_check_mu);
+  while (g_check_free == 0) pthread_cond_wait(&g_check_cv, &g_check_mu);
+  --g_check_free;
+  pthread_mutex_unlock(&g_check_mu);
+}
+
+void serve_check_leave(void) {
+  pthread_mutex_lock(&g_check_mu);
+  ++g_check_free;
+  pthread_cond_signal(&g_check_cv);
+  pthread_mutex_unlock(&g_check_mu);
+}
 
 static void collect(void *user, const nav_diag *d) {
   add_diag(user, d->line, d->col, d->path, d->message);

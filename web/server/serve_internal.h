@@ -111,6 +111,14 @@ typedef struct serve_diags {
  */
 bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene, serve_diags *diags);
 
+/**
+ * Scene checks at once are bounded (each holds scenes of about 0.5 MB): enter blocks while
+ * @p max checks run. serve_checks_init() sets the bound once at start-up.
+ */
+void serve_checks_init(int max);
+void serve_check_enter(void);
+void serve_check_leave(void);
+
 /** JSON of @p diags: {"ok":false,"error":MSG,"errors":[{"line","col","path","message"}...]}. */
 char *serve_diags_json(const serve_diags *diags, const char *error, size_t *len);
 

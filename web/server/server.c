@@ -349,7 +349,10 @@ static enum MHD_Result api_estimate(struct MHD_Connection *c, const req *r) {
   serve_diags *d = malloc(sizeof *d);
   if (!d) return send_error(c, 500, "out of memory");
   const char *text = r->body.s ? r->body.s : "";
-  if (!serve_scene_check(text, r->body.len, serve_tmp_dir(), NULL, d)) {
+  serve_check_enter();
+  const bool valid = serve_scene_check(text, r->body.len, serve_tmp_dir(), NULL, d);
+  serve_check_leave();
+  if (!valid) {
     size_t len = 0;
     char *j = serve_diags_json(d, "the scene is not valid", &len);
     free(d);
@@ -520,9 +523,14 @@ static enum MHD_Result route_api(struct MHD_Connection *c, const char *method, c
       if (strcmp(S.lib.e[i].name, p + 7) == 0) return send_file(c, S.lib.e[i].path, "scene.yaml", false, true);
     return send_error(c, 404, "no such scene in the library (GET /api/scenes lists them)");
   }
-  if (strcmp(p, "validate") == 0) return post ? api_validate(c, r) : send_405(c, "POST");
+  if (strcmp(p, "validate") == 0 || strcmp(p, "runs") == 0) {
+    if (!post) return send_405(c, "POST");
+    serve_check_enter();
+    const enum MHD_Result ret = p[0] == 'v' ? api_validate(c, r) : api_post_run(c, r);
+    serve_check_leave();
+    return ret;
+  }
   if (strcmp(p, "estimate") == 0) return post ? api_estimate(c, r) : send_405(c, "POST");
-  if (strcmp(p, "runs") == 0) return post ? api_post_run(c, r) : send_405(c, "POST");
   if (strncmp(p, "runs/", 5) == 0) return api_runs(c, method, p + 5);
   return send_error(c, 404, "no such API resource");
 }
@@ -601,6 +609,28 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *
   if (strncmp(url, "/api/", 5) == 0) return route_api(c, method, url, r);
   if (strcmp(url, "/api") == 0) return send_error(c, 404, "no such API resource");
   return route_static(c, method, url);
+}
+
+/* Percent-decoding of the URL and query values in place, except %00: a NUL would cut the text
+ * short ("/index.html%00.png" read as "/index.html"), so it stays as the three characters. */
+static size_t unescape(void *cls, struct MHD_Connection *c, char *s) {
+  (void)cls;
+  (void)c;
+  char *w = s;
+  for (const char *r = s; *r;) {
+    if (r[0] == '%' && isxdigit((unsigned char)r[1]) && isxdigit((unsigned char)r[2])) {
+      const char hex[3] = {r[1], r[2], '\0'};
+      const long v = strtol(hex, NULL, 16);
+      if (v != 0) {
+        *w++ = (char)v;
+        r += 3;
+        continue;
+      }
+    }
+    *w++ = *r++;
+  }
+  *w = '\0';
+  return (size_t)(w - s);
 }
 
 static void completed(void *cls, struct MHD_Connection *c, void **con_cls, enum MHD_RequestTerminationCode toe) {
@@ -765,6 +795,7 @@ int navserve_main(int argc, char **argv) {
   if (studio) snprintf(cfg.studio_dir, sizeof cfg.studio_dir, "%s", studio);
   if (cfg.max_streams_per_client > cfg.max_streams) cfg.max_streams_per_client = cfg.max_streams;
   S.cfg = cfg;
+  serve_checks_init(cfg.max_parallel_jobs + 2);
 
   /* The address: a numeric IPv4 or IPv6 literal. */
   struct sockaddr_in sa4;
@@ -819,7 +850,7 @@ int navserve_main(int argc, char **argv) {
                        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_client,
                        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.connection_timeout_s,
                        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024), MHD_OPTION_NOTIFY_COMPLETED,
-                       completed, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE,
+                       completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE,
                        (size_t)(2u << 20), MHD_OPTION_END);
   if (!d) {
     fprintf(stderr, "navsim serve: cannot listen on %s port %d (in use, or not an address of this machine)\n",
