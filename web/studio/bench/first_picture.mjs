@@ -4,7 +4,8 @@
 // timings of urban-drive, its default scene: from the navigation start, and from choosing the
 // scene in the library, to the estimate shown and the map drawn with the path.
 //   node first_picture.mjs SAMPLES   (env as the tests: NAVSIM, NAV_STUDIO_DIR, NAV_NODE_MODULES)
-// Prints one line: first_picture_ms: samples=N median=.. p90=.. select_median=.. estimate_median=..
+// Prints one line: first_picture_ms: samples=N median=.. p90=.. select_median=.. preview_median=..
+// estimate_median=.. loadavg=.. (preview: the map drawn with the path, before the estimate)
 import { missing, startServer, launch, openPage, waitAttr } from '../test/helpers.mjs';
 import { loadavg } from 'node:os';
 
@@ -16,7 +17,7 @@ if (why) {
 }
 const server = await startServer();
 const browser = await launch();
-const page_ms = [], select_ms = [], est_ms = [];
+const page_ms = [], select_ms = [], est_ms = [], preview_ms = [];
 const get = (p) => p.evaluate(() => window.__studio.timings);
 const waitPicture = (p) => p.waitForFunction(() => window.__studio.timings.scene_to_picture_ms !== undefined, { timeout: 60000, polling: 20 });
 try {
@@ -38,6 +39,7 @@ try {
     const t2 = await get(page);
     select_ms.push(t2.scene_to_picture_ms);
     est_ms.push(t2.estimate_ms);
+    preview_ms.push(t2.preview_ms);
     if (problems.length) throw new Error(problems.join('; '));
     await page.close();
   }
@@ -47,4 +49,4 @@ try {
 }
 const q = (a, f) => { const s = [...a].sort((x, y) => x - y); return s[Math.min(s.length - 1, Math.floor(f * s.length))]; };
 console.log(`first_picture_ms: samples=${n} median=${q(page_ms, 0.5).toFixed(0)} p90=${q(page_ms, 0.9).toFixed(0)} ` +
-  `select_median=${q(select_ms, 0.5).toFixed(0)} estimate_median=${q(est_ms, 0.5).toFixed(0)} loadavg=${loadavg()[0].toFixed(2)}`);
+  `select_median=${q(select_ms, 0.5).toFixed(0)} preview_median=${q(preview_ms, 0.5).toFixed(0)} estimate_median=${q(est_ms, 0.5).toFixed(0)} loadavg=${loadavg()[0].toFixed(2)}`);

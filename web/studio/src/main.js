@@ -540,6 +540,10 @@ async function loadText(text, label) {
   if (Number.isFinite(runs)) $('runs').value = runs;
   changed('load', true);
   mapView.fit();
+  if (studio.timings.sceneLoadStart !== undefined) {
+    mapView.whenRendered().then(() => { studio.timings.preview_ms = performance.now() - studio.timings.sceneLoadStart; });
+    mapView.map.render();
+  }
   status(`${label} loaded`);
   return true;
 }
