@@ -393,8 +393,7 @@ async function startRun() {
   const finish = async (state) => {
     if (!currentRun || currentRun.id !== id || currentRun.finished) return;
     currentRun.finished = true;
-    // The server ends the event stream itself ("end"); closed here only if it does not.
-    if (es) setTimeout(() => es.close(), 15000);
+    if (es) es.close(); // the stream would otherwise hold one of the client's stream slots
     runState(state, state === 'done' ? 1 : undefined);
     if (state === 'failed' && currentRun.error) $('run-state').textContent = `failed: ${currentRun.error}`;
     if (state === 'done') await loadResults(id, text, currentRun.files);

@@ -3,7 +3,7 @@
 // makes (no page errors, canvases with ink, screenshots into the build tree).
 import { spawn, spawnSync } from 'node:child_process';
 import { createRequire } from 'node:module';
-import { mkdtempSync, mkdirSync, rmSync, existsSync } from 'node:fs';
+import { mkdtempSync, mkdirSync, rmSync, existsSync, readdirSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -76,7 +76,12 @@ export async function openPage(browser, url, width = 1280, height = 800) {
   const problems = [];
   page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
   page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'assert') problems.push(`console ${m.type()}: ${m.text()}`); });
-  page.on('requestfailed', (r) => problems.push(`request failed: ${r.url()} ${r.failure() && r.failure().errorText}`));
+  page.on('requestfailed', (r) => {
+    const why = r.failure() && r.failure().errorText;
+    // The page closes a run's event stream itself once the run has ended (by design, not a fault).
+    if (why === 'net::ERR_ABORTED' && /\/api\/runs\/[0-9a-f]{32}\/events$/.test(r.url())) return;
+    problems.push(`request failed: ${r.url()} ${why}`);
+  });
   page.on('request', (r) => { if (!r.url().startsWith(url) && !r.url().startsWith('blob:') && !r.url().startsWith('data:')) problems.push(`external request: ${r.url()}`); });
   await page.goto(url, { waitUntil: 'load' });
   await page.waitForSelector('body[data-ready="1"]', { timeout: 60000 });
@@ -115,6 +120,26 @@ export function canvasInk(page, selector, colours = []) {
     }
     return { canvases: cvs.length, ink, pixels: w * h, colours: near };
   }, selector, colours);
+}
+
+// Click a download link and wait until its file is complete in a new directory; its text.
+export async function download(browser, page, selector) {
+  const dir = mkdtempSync(join(tmpdir(), 'studio-dl-'));
+  const session = await browser.target().createCDPSession();
+  await session.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: dir, eventsEnabled: true });
+  const done = new Promise((resolve, reject) => {
+    session.on('Browser.downloadProgress', (e) => {
+      if (e.state === 'completed') resolve();
+      if (e.state === 'canceled') reject(new Error('download cancelled'));
+    });
+  });
+  await page.click(selector);
+  await done;
+  const files = readdirSync(dir);
+  const text = readFileSync(join(dir, files[0]), 'utf8');
+  rmSync(dir, { recursive: true, force: true });
+  await session.detach();
+  return { name: files[0], text };
 }
 
 export function shotPath(name) {

@@ -5,7 +5,10 @@
 // counts the ink of the canvases and saves screenshots into the build tree (web/shots).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { missing, startServer, launch, openPage, canvasInk, shotPath, waitAttr } from './helpers.mjs';
+import { writeFileSync, mkdtempSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { missing, startServer, launch, openPage, canvasInk, shotPath, waitAttr, download } from './helpers.mjs';
 
 const why = missing();
 let server = null, browser = null;
@@ -158,6 +161,58 @@ test('B: gyro-free scheme on the paper\'s parametric trajectory, live preview, r
   assert.ok(threeInk.ink > 0.01 * threeInk.pixels, `3D has ink ${JSON.stringify(threeInk)}`);
   await selectTab(page, 'tab-charts');
   await page.screenshot({ path: shotPath('B3-charts.png'), fullPage: true });
+
+  // The permalink: the downloaded scene is what the server ran, and opening it in a fresh page
+  // and running it again gives the same summary (timing aside).
+  await selectTab(page, 'tab-results');
+  const dl = await download(browser, page, '#downloads a[download$=".yaml"]');
+  assert.equal(dl.name, 'paper-parametric.yaml');
+  const saved = dl.text;
+  assert.equal(saved, (await api(`api/runs/${id}/files/scene.yaml`)).text);
+  const file = join(mkdtempSync(join(tmpdir(), 'studio-')), 'saved.yaml');
+  writeFileSync(file, saved);
+  const again = await openPage(browser, server.url);
+  await waitAttr(again.page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000);
+  const input = await again.page.$('#open-file');
+  await input.uploadFile(file);
+  await again.page.waitForFunction((t) => document.getElementById('yaml').value === t, {}, saved);
+  assert.equal(await again.page.$eval('#runs', (e) => e.value), '20');
+  await again.page.click('#run');
+  assert.equal(await waitAttr(again.page, '#run-state', 'data-state', ['done', 'failed', 'cancelled'], 200000), 'done');
+  const id2 = await again.page.evaluate(() => window.__studio.lastRun.id);
+  assert.notEqual(id2, id);
+  const strip = (t) => { const j = JSON.parse(t); delete j.timing; return j; };
+  assert.deepEqual(strip((await api(`api/runs/${id2}/files/summary.json`)).text), strip((await api(`api/runs/${id}/files/summary.json`)).text));
+  assert.equal((await api(`api/runs/${id2}/files/nav.csv`)).text, (await api(`api/runs/${id}/files/nav.csv`)).text);
+  assert.deepEqual(again.problems, []);
+  await again.page.close();
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('Cancel stops a running campaign; a GPX track becomes waypoints', { skip: why || false, timeout: 200000 }, async () => {
+  const { page, problems } = await openPage(browser, server.url);
+  await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000);
+  await page.$eval('#runs', (e) => { e.value = ''; });
+  await page.type('#runs', '200');
+  await page.click('#run');
+  await waitAttr(page, '#run-state', 'data-state', ['running', 'done', 'failed'], 120000);
+  assert.equal(await page.$eval('#cancel', (b) => b.disabled), false);
+  await page.click('#cancel');
+  assert.equal(await waitAttr(page, '#run-state', 'data-state', ['done', 'failed', 'cancelled'], 60000), 'cancelled');
+  assert.equal(await page.$eval('#run', (b) => b.disabled), false);
+  // A GPX track of five points around the Brandenburg Gate.
+  const pts = [[52.5163, 13.3777], [52.5170, 13.3800], [52.5180, 13.3820], [52.5175, 13.3850], [52.5160, 13.3860]];
+  const gpx = `<?xml version="1.0"?><gpx version="1.1" creator="test"><trk><trkseg>${pts.map(([la, lo]) => `<trkpt lat="${la}" lon="${lo}"/>`).join('')}</trkseg></trk></gpx>`;
+  const file = join(mkdtempSync(join(tmpdir(), 'studio-')), 'track.gpx');
+  writeFileSync(file, gpx);
+  await (await page.$('#open-file')).uploadFile(file);
+  await page.waitForFunction(() => document.querySelectorAll('#wp-list li').length === 5);
+  const yaml = await page.$eval('#yaml', (e) => e.value);
+  assert.match(yaml, /lat_deg: 52\.5163/);
+  assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok',
+    await page.$eval('#yaml-status', (e) => e.textContent));
+  await page.screenshot({ path: shotPath('D1-gpx-waypoints.png') });
   assert.deepEqual(problems, []);
   await page.close();
 });
