@@ -79,7 +79,7 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
   r->pos_err_m = r->vel_err_mps = r->att_err_rad = r->rms_h_m = NAN;
   (*n)++;
   char exe[PATH_MAX], node[PATH_MAX], chromium[PATH_MAX], studio[PATH_MAX], modules[PATH_MAX];
-  char res[PATH_MAX], script[PATH_MAX + 64], manifest[PATH_MAX + 16], puppeteer[PATH_MAX + 64], log[PATH_MAX];
+  char res[PATH_MAX], script[PATH_MAX], manifest[PATH_MAX + 16], puppeteer[PATH_MAX + 64], log[PATH_MAX];
   if (!bench_self_exe(exe, sizeof exe)) {
     snprintf(r->error, sizeof r->error, "not measured: this executable's path is unknown");
     return;
@@ -111,9 +111,12 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
     snprintf(r->error, sizeof r->error, "not measured: resources directory not found");
     return;
   }
-  snprintf(script, sizeof script, "%s/../web/studio/bench/first_picture.mjs", res);
-  if (!is_file(script)) {
-    snprintf(r->error, sizeof r->error, "not measured: %.200s is missing (a source tree is needed)", script);
+  /* resources/ is a symbolic link in the build tree: the source tree is its physical parent, which
+   * realpath resolves (node would drop "resources/.." textually). */
+  char rel[PATH_MAX + 64];
+  snprintf(rel, sizeof rel, "%s/../web/studio/bench/first_picture.mjs", res);
+  if (realpath(rel, script) == NULL || !is_file(script)) {
+    snprintf(r->error, sizeof r->error, "not measured: %.200s is missing (a source tree is needed)", rel);
     return;
   }
   snprintf(log, sizeof log, "%s/logs/studio-first-picture.log", out_dir);

@@ -61,6 +61,9 @@ export class StudioMap {
     // The sources report load errors (a bundle built without map data): no console noise, a note.
     for (const l of [land, lakes]) l.getSource().on('featuresloaderror', () => { this.missing = true; });
     const graticule = new Graticule({ strokeStyle: new Stroke({ color: 'rgba(60,70,90,0.35)', width: 1, lineDash: [2, 3] }), showLabels: true, wrapX: false, minResolution: 25 });
+    // At street scale (where the graticule is off) a local metric grid around the scene origin,
+    // as navview's map draws: lines every 1, 2 or 5 x 10^k m, about eight across the view.
+    this.gridSrc = new VectorSource();
     this.refSrc = new VectorSource();
     this.estSrc = new VectorSource();
     this.fixSrc = new VectorSource();
@@ -71,6 +74,7 @@ export class StudioMap {
       controls: defaultControls({ attribution: false }).extend([new ScaleLine()]),
       layers: [
         this.relief, land, lakes, graticule,
+        new VectorLayer({ source: this.gridSrc, maxResolution: 25, style: new Style({ stroke: new Stroke({ color: 'rgba(60,70,90,0.28)', width: 1 }) }) }),
         new VectorLayer({ source: this.fixSrc, style: new Style({ image: new CircleStyle({ radius: 2.2, fill: new Fill({ color: '#2a9d3a' }) }) }) }),
         new VectorLayer({ source: this.refSrc, style: line('#111', 3) }),
         new VectorLayer({ source: this.estSrc, style: line('#d1401f', 2, [6, 4]) }),
@@ -84,6 +88,7 @@ export class StudioMap {
       ],
       view: new View({ center: fromLonLat([0, 0]), zoom: 2, maxZoom: 21 }),
     });
+    this.map.on('moveend', () => this.metricGrid());
     this.map.on('click', (ev) => {
       if (!this.onClick) return;
       const [lon, lat] = toLonLat(ev.coordinate);
@@ -93,7 +98,23 @@ export class StudioMap {
       creditsEl.textContent = `Map data: ${c.credits.join(' ')} Graticule and scale drawn locally; no tiles are fetched.`;
     }).catch(() => {});
   }
-  setOrigin(lat, lon) { this.origin = { lat, lon }; }
+  setOrigin(lat, lon) { this.origin = { lat, lon }; this.metricGrid(); }
+  metricGrid() {
+    this.gridSrc.clear();
+    const view = this.map.getView();
+    if (!(view.getResolution() < 25)) return;
+    const ext = view.calculateExtent(this.map.getSize());
+    const [w, sth] = toLonLat([ext[0], ext[1]]), [e, nth] = toLonLat([ext[2], ext[3]]);
+    const [n0, e0] = lonLatToNed(this.origin, w, sth), [n1, e1] = lonLatToNed(this.origin, e, nth);
+    const span = Math.max(e1 - e0, n1 - n0);
+    const p = Math.pow(10, Math.floor(Math.log10(span / 8)));
+    const step = [1, 2, 5, 10].map((k) => k * p).find((x) => span / x <= 10);
+    const lines = [];
+    for (let n = Math.ceil(n0 / step) * step; n <= n1; n += step) lines.push([[n, e0], [n, e1]]);
+    for (let x = Math.ceil(e0 / step) * step; x <= e1; x += step) lines.push([[n0, x], [n1, x]]);
+    for (const l of lines) this.gridSrc.addFeature(new Feature(new LineString(l.map(([a, b]) => fromLonLat(nedToLonLat(this.origin, a, b))))));
+    this.gridStep = step;
+  }
   centre() { return toLonLat(this.map.getView().getCenter()); }
   // Pixel of a local NED point (for tests and keyboard help).
   pixelOfNed(n, e) { return this.map.getPixelFromCoordinate(fromLonLat(nedToLonLat(this.origin, n, e))); }
