@@ -71,6 +71,7 @@ export class StudioMap {
     const line = (color, width, dash) => new Style({ stroke: new Stroke({ color, width, lineDash: dash }) });
     this.map = new Map({
       target,
+      keyboardEventTarget: target, // the focusable #map: arrow keys pan, + and - zoom
       controls: defaultControls({ attribution: false }).extend([new ScaleLine()]),
       layers: [
         this.relief, land, lakes, graticule,

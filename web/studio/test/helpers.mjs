@@ -75,7 +75,22 @@ export async function openPage(browser, url, width = 1280, height = 800) {
   await page.setViewport({ width, height });
   const problems = [];
   page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
-  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'assert') problems.push(`console ${m.type()}: ${m.text()}`); });
+  // Chrome logs every HTTP error answer as a console error without its address; such answers are
+  // judged by the response listener below (with the address), the other console errors here.
+  page.on('console', (m) => {
+    if (m.type() !== 'error' && m.type() !== 'assert') return;
+    if (/^Failed to load resource: the server responded with a status of \d+/.test(m.text())) return;
+    problems.push(`console ${m.type()}: ${m.text()}`);
+  });
+  // Expected error answers: 422 from /api/validate for a scene being edited (shown to the user as
+  // the reader's messages), 429 from /api/validate and /api/estimate (the page waits and retries).
+  page.on('response', (r) => {
+    if (r.status() < 400) return;
+    const u = new URL(r.url());
+    if (r.status() === 422 && u.pathname === '/api/validate') return;
+    if (r.status() === 429 && (u.pathname === '/api/validate' || u.pathname === '/api/estimate')) return;
+    problems.push(`HTTP ${r.status()}: ${r.url()}`);
+  });
   page.on('requestfailed', (r) => {
     const why = r.failure() && r.failure().errorText;
     // The page closes a run's event stream itself once the run has ended (by design, not a fault).
