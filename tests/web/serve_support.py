@@ -79,7 +79,7 @@ class Server:
         SERVERS.append(self)
         self.host = f"127.0.0.1:{self.port}"
 
-    def request(self, method, path, body=None, headers=None, timeout=120):
+    def request(self, method, path, body=None, headers=None, timeout=900):
         """(status, headers dict (lower-case keys), body bytes)."""
         c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=timeout)
         h = dict(headers or {})

@@ -250,12 +250,19 @@ check(not os.path.exists(os.path.join(srv.data, "jobs", ids[0], "result")), "a c
 check(srv.job_processes() == [], "no job process is left after cancelling")
 
 # ---------------------------------------------------------------- estimate
+PARAMETRIC = read(os.path.join(SCENES, "paper-parametric.yaml"))
 t0 = time.time()
-st, _, j = srv.json("POST", "/api/estimate", URBAN)
+st, _, j = srv.json("POST", "/api/estimate", PARAMETRIC)
 dt = time.time() - t0
-check(st == 200 and j and j.get("scene", {}).get("name") == "urban-drive" and "requirements" in j,
-      f"estimate urban-drive ({st})")
-print(f"POST /api/estimate urban-drive: {dt:.2f} s wall (machine load {os.getloadavg()[0]:.1f})")
+check(st == 200 and j and j.get("scene", {}).get("name") == "paper-parametric" and j.get("requirements"),
+      f"estimate paper-parametric ({st})")
+cli_dir = os.path.join(srv.root, "estimate-cli")
+subprocess.run([NAVSIM, "estimate", os.path.join(SCENES, "paper-parametric.yaml"), "--out", cli_dir, "--quiet"],
+               check=True)
+cli = json.loads(read(os.path.join(cli_dir, "estimate.json")))
+for k in ("analytic_final", "requirements"):
+    check(j and j.get(k) == cli.get(k), f"estimate {k} equals navsim estimate's")
+print(f"POST /api/estimate paper-parametric: {dt:.2f} s wall (machine load {os.getloadavg()[0]:.1f})")
 st, _, j = srv.json("POST", "/api/estimate", b"format_version: 1\nimu: {rate_hz: -1}\n")
 check(st == 422 and j["errors"][0]["path"] == "imu.rate_hz", f"estimate of an invalid scene -> 422 ({st})")
 st, _, j = srv.json("GET", "/api/estimate")
