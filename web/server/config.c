@@ -90,9 +90,11 @@ static const key_def k_keys[] = {
 };
 
 static char *trim(char *s) {
-  while (*s && isspace((unsigned char)*s)) ++s;
+  while (*s && isspace((unsigned char)*s))
+    ++s;
   size_t n = strlen(s);
-  while (n > 0 && isspace((unsigned char)s[n - 1])) s[--n] = '\0';
+  while (n > 0 && isspace((unsigned char)s[n - 1]))
+    s[--n] = '\0';
   return s;
 }
 
@@ -115,9 +117,12 @@ static bool set_value(const key_def *k, const char *v, serve_config *c, char *wh
              k->k == K_DOUBLE ? "a number" : "an integer", k->lo, k->hi, v);
     return false;
   }
-  if (k->k == K_INT) *(int *)(void *)base = (int)d;
-  else if (k->k == K_LONG) *(long *)(void *)base = (long)d;
-  else *(double *)(void *)base = d;
+  if (k->k == K_INT)
+    *(int *)(void *)base = (int)d;
+  else if (k->k == K_LONG)
+    *(long *)(void *)base = (long)d;
+  else
+    *(double *)(void *)base = d;
   return true;
 }
 
@@ -146,7 +151,8 @@ bool serve_config_read(const char *path, serve_config *c) {
     for (size_t i = 0; i < sizeof k_keys / sizeof k_keys[0]; ++i)
       if (strcmp(k_keys[i].key, key) == 0) k = &k_keys[i];
     if (!k) {
-      fprintf(stderr, "%s:%d: error: unknown key \"%s\" (docs/web-server.md lists the keys)\n", path, lineno, key);
+      fprintf(stderr, "%s:%d: error: unknown key \"%s\" (docs/web-server.md lists the keys)\n", path, lineno,
+              key);
       ok = false;
       continue;
     }

@@ -27,10 +27,12 @@
 #include <zip.h>
 
 const char *const serve_result_files[] = {
-    "summary.json",    "truth.csv",         "nav.csv",      "errors.csv",   "imu_errors.csv",
-    "mc_stats.csv",    "mc_final.csv",      "gnss.csv",     "gnss_outages.csv", "gnss_dop.csv",
-    "gnss_sats.csv",   "nav_smoothed.csv",  "smoothed_errors.csv", "tracks.kml", "tracks.csv",
-    "scene.yaml",      "log.txt",           "results.zip",
+    "summary.json",        "truth.csv",      "nav.csv",
+    "errors.csv",          "imu_errors.csv", "mc_stats.csv",
+    "mc_final.csv",        "gnss.csv",       "gnss_outages.csv",
+    "gnss_dop.csv",        "gnss_sats.csv",  "nav_smoothed.csv",
+    "smoothed_errors.csv", "tracks.kml",     "tracks.csv",
+    "scene.yaml",          "log.txt",        "results.zip",
 };
 const int serve_n_result_files = (int)(sizeof serve_result_files / sizeof serve_result_files[0]);
 /* Files of the job directory itself; the others are navsim run's, in result/. */
@@ -54,7 +56,7 @@ struct job {
   int refs;
   bool removed;
   double predicted_bytes, disk_bytes;
-  double cpu_s; /* CPU time of the job's process (user + system) */
+  double cpu_s;   /* CPU time of the job's process (user + system) */
   unsigned files; /* bit i: serve_result_files[i] exists (done jobs) */
   job *next;
 };
@@ -87,7 +89,9 @@ const char *job_state_name(job_state s) {
   return "unknown";
 }
 
-static bool finished(const job *j) { return j->state == JOB_DONE || j->state == JOB_FAILED || j->state == JOB_CANCELLED; }
+static bool finished(const job *j) {
+  return j->state == JOB_DONE || j->state == JOB_FAILED || j->state == JOB_CANCELLED;
+}
 
 static void bump(job *j) {
   ++j->seq;
@@ -100,15 +104,17 @@ static job *find_locked(const char *id) {
   return NULL;
 }
 
-static void job_dir(const job *j, char *out, size_t size) { snprintf(out, size, "%s/%s", g.jobs_dir, j->id); }
+static void job_dir(const job *j, char *out, size_t size) {
+  snprintf(out, size, "%s/%s", g.jobs_dir, j->id);
+}
 
 /* ------------------------------------------------------------------ the sandboxed child */
 
 static void build_env(void) {
   /* A fixed, small environment: the share-directory overrides (the child finds the catalogs as
    * the server does) and the sanitizer options of the test builds. */
-  static const char *const keep[] = {"NAV_SHARE_DIR", "NAV_RESOURCES_DIR", "ASAN_OPTIONS", "UBSAN_OPTIONS",
-                                     "LSAN_OPTIONS",  "TSAN_OPTIONS"};
+  static const char *const keep[] = {"NAV_SHARE_DIR", "NAV_RESOURCES_DIR", "ASAN_OPTIONS",
+                                     "UBSAN_OPTIONS", "LSAN_OPTIONS",      "TSAN_OPTIONS"};
   int n = 0;
   snprintf(g.env_store[n], sizeof g.env_store[n], "PATH=/usr/bin:/bin");
   g.envp[n] = g.env_store[n];
@@ -156,7 +162,8 @@ pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu
   if (dup2(in, 0) < 0 || dup2(log, 1) < 0 || dup2(log, 2) < 0) _exit(126);
   if (pfd >= 0 && dup2(pfd, 3) < 0) _exit(126);
   if (close_range(pfd >= 0 ? 4 : 3, ~0U, 0) != 0)
-    for (int fd = pfd >= 0 ? 4 : 3; fd < 1024; ++fd) close(fd);
+    for (int fd = pfd >= 0 ? 4 : 3; fd < 1024; ++fd)
+      close(fd);
   set_limit(RLIMIT_CPU, (rlim_t)cpu_s, (rlim_t)cpu_s + 5); /* SIGXCPU, then SIGKILL */
   set_limit(RLIMIT_FSIZE, fsize, fsize);
   set_limit(RLIMIT_NOFILE, nofile, nofile);
@@ -191,7 +198,8 @@ static void log_tail(const char *path, char *out, size_t size) {
     if (nl) s = nl + 1;
   }
   size_t m = strlen(s);
-  while (m > 0 && (s[m - 1] == '\n' || s[m - 1] == '\r')) s[--m] = '\0';
+  while (m > 0 && (s[m - 1] == '\n' || s[m - 1] == '\r'))
+    s[--m] = '\0';
   /* navsim's terminal progress uses carriage returns: keep the text after the last one per line. */
   snprintf(out, size, "%s", s);
 }
@@ -310,8 +318,8 @@ static void run_job(job *j) {
   job_dir(j, dir, sizeof dir);
   snprintf(runs, sizeof runs, "%ld", j->runs);
   snprintf(threads, sizeof threads, "%d", g.cfg.job_threads);
-  char *argv[] = {"navsim",  "run", "scene.yaml", "--out",       "result", "--runs", runs, "--threads",
-                  threads, "--quiet", "--kml",    "--progress-fd", "3",      NULL};
+  char *argv[] = {"navsim",    "run",   "scene.yaml", "--out", "result",        "--runs", runs,
+                  "--threads", threads, "--quiet",    "--kml", "--progress-fd", "3",      NULL};
   int p[2] = {-1, -1};
   pid_t pid = -1;
   if (pipe2(p, O_CLOEXEC) == 0) pid = serve_spawn(dir, argv, p[1], g.cfg.job_cpu_s, "log.txt");
@@ -328,8 +336,8 @@ static void run_job(job *j) {
     pthread_mutex_unlock(&g.mu);
     bool watchdog = false;
     const int status = supervise(j, pid, p[0], (double)g.cfg.job_wall_s, &ru, &watchdog);
-    const double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-                       1e-6 * (double)ru.ru_stime.tv_usec;
+    const double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                       (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
     snprintf(summary, sizeof summary, "%s/result/summary.json", dir);
     snprintf(logp, sizeof logp, "%s/log.txt", dir);
     struct stat sb;
@@ -347,8 +355,10 @@ static void run_job(job *j) {
       snprintf(err, sizeof err, "the run exceeded its wall-clock limit of %ld s (job_wall_s) and was ended",
                g.cfg.job_wall_s);
     } else if (WIFSIGNALED(status) &&
-               (WTERMSIG(status) == SIGXCPU || (WTERMSIG(status) == SIGKILL && cpu >= (double)g.cfg.job_cpu_s - 0.5))) {
-      snprintf(err, sizeof err, "the run exceeded its CPU limit of %ld s (job_cpu_s) and was ended", g.cfg.job_cpu_s);
+               (WTERMSIG(status) == SIGXCPU ||
+                (WTERMSIG(status) == SIGKILL && cpu >= (double)g.cfg.job_cpu_s - 0.5))) {
+      snprintf(err, sizeof err, "the run exceeded its CPU limit of %ld s (job_cpu_s) and was ended",
+               g.cfg.job_cpu_s);
     } else if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXFSZ) {
       snprintf(err, sizeof err, "a result file exceeded %ld MiB (job_output_mb) and the run was ended",
                g.cfg.job_output_mb);
@@ -356,8 +366,8 @@ static void run_job(job *j) {
       snprintf(err, sizeof err, "the simulation process ended by signal %d, %s: %s", WTERMSIG(status),
                signal_name(WTERMSIG(status)), tail);
     } else {
-      snprintf(err, sizeof err, "navsim run exited with code %d: %s", WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-               tail);
+      snprintf(err, sizeof err, "navsim run exited with code %d: %s",
+               WIFEXITED(status) ? WEXITSTATUS(status) : -1, tail);
     }
   }
   if (p[0] >= 0) close(p[0]);
@@ -402,7 +412,8 @@ static void *worker(void *arg) {
   pthread_mutex_lock(&g.mu);
   while (!g.stopping) {
     job *j = g.head;
-    while (j && (j->removed || j->state != JOB_QUEUED)) j = j->next;
+    while (j && (j->removed || j->state != JOB_QUEUED))
+      j = j->next;
     if (!j) {
       pthread_cond_wait(&g.work, &g.mu);
       continue;
@@ -516,7 +527,8 @@ static void clear_dir(const char *dir, bool ids_only) {
   if (!d) return;
   struct dirent *de;
   while ((de = readdir(d)) != NULL) {
-    if (de->d_name[0] == '.' && (de->d_name[1] == '\0' || (de->d_name[1] == '.' && de->d_name[2] == '\0'))) continue;
+    if (de->d_name[0] == '.' && (de->d_name[1] == '\0' || (de->d_name[1] == '.' && de->d_name[2] == '\0')))
+      continue;
     if (ids_only && !serve_is_id(de->d_name)) continue;
     char p[SERVE_PATH_MAX + 300];
     snprintf(p, sizeof p, "%s/%s", dir, de->d_name);
@@ -560,7 +572,9 @@ bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size) {
 }
 
 const char *serve_tmp_dir(void);
-const char *serve_tmp_dir(void) { return g.tmp_dir; }
+const char *serve_tmp_dir(void) {
+  return g.tmp_dir;
+}
 
 void serve_jobs_stop(void) {
   if (!g.started) return;
@@ -582,15 +596,16 @@ void serve_jobs_stop(void) {
   pthread_cond_broadcast(&g.jan);
   pthread_cond_broadcast(&g.changed);
   pthread_mutex_unlock(&g.mu);
-  for (int i = 0; i < g.n_workers; ++i) pthread_join(g.workers[i], NULL);
+  for (int i = 0; i < g.n_workers; ++i)
+    pthread_join(g.workers[i], NULL);
   pthread_join(g.janitor, NULL);
   g.started = false;
 }
 
 /* ------------------------------------------------------------------ the API */
 
-submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene, long runs,
-                            double predicted_bytes, char id[33]) {
+submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene,
+                            long runs, double predicted_bytes, char id[33]) {
   submit_rc rc = SUBMIT_OK;
   doomed *d = NULL;
   job *j = NULL;
@@ -651,7 +666,8 @@ submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, co
   ++g.n_queued;
   /* Append: the list is in creation order (the queue is FIFO, expiry takes the oldest first). */
   job **tail = &g.head;
-  while (*tail) tail = &(*tail)->next;
+  while (*tail)
+    tail = &(*tail)->next;
   *tail = j;
   snprintf(id, 33, "%s", j->id);
   j = NULL;
@@ -676,7 +692,8 @@ static void iso_time(sbuf *b, time_t t) {
 }
 
 static void job_json_locked(const job *j, sbuf *b) {
-  sb_printf(b, "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":%.4f", j->id, job_state_name(j->state), j->progress);
+  sb_printf(b, "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":%.4f", j->id, job_state_name(j->state),
+            j->progress);
   sb_printf(b, ",\"runs\":%ld,\"scene\":", j->runs);
   sb_json_str(b, j->scene_name);
   if (j->state == JOB_QUEUED) {
@@ -858,7 +875,8 @@ void serve_streams_leave(const char *client) {
 
 /* ------------------------------------------------------------------ estimates */
 
-estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why, size_t why_size) {
+estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
+                           size_t why_size) {
   *json = NULL;
   pthread_mutex_lock(&g.mu);
   const bool busy = g.n_estimates >= g.cfg.max_parallel_estimates || g.stopping;
@@ -890,8 +908,10 @@ estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *js
     snprintf(path, sizeof path, "%s/est/estimate.json", dir);
     *json = serve_read_file(path, 64u << 20, json_len);
     if (*json) rc = EST_OK;
-  } else if (watchdog || (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))) {
-    snprintf(why, why_size, "the estimate exceeded its CPU limit of %ld s (estimate_cpu_s)", g.cfg.estimate_cpu_s);
+  } else if (watchdog ||
+             (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))) {
+    snprintf(why, why_size, "the estimate exceeded its CPU limit of %ld s (estimate_cpu_s)",
+             g.cfg.estimate_cpu_s);
   } else {
     char tail[800];
     snprintf(path, sizeof path, "%s/log.txt", dir);

@@ -109,7 +109,8 @@ typedef struct serve_diags {
  * for the reader. @p scene may be NULL. Returns true when valid; otherwise @p diags holds the
  * problems.
  */
-bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene, serve_diags *diags);
+bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene,
+                       serve_diags *diags);
 
 /**
  * Scene checks at once are bounded (each holds scenes of about 0.5 MB): enter blocks while
@@ -127,7 +128,7 @@ bool serve_catalogs_load(char **imu_json, char **gnss_json, char *why, size_t wh
 
 /** The scene library: file stems and descriptions of the scenes a client may run. */
 typedef struct serve_scene_entry {
-  char name[96];  /**< file stem, e.g. "urban-drive" */
+  char name[96]; /**< file stem, e.g. "urban-drive" */
   char path[SERVE_PATH_MAX];
 } serve_scene_entry;
 
@@ -153,15 +154,21 @@ extern const int serve_n_result_files;
 typedef struct job job;
 
 /** Outcome of serve_jobs_submit. */
-typedef enum submit_rc { SUBMIT_OK, SUBMIT_CLIENT_BUSY, SUBMIT_QUEUE_FULL, SUBMIT_NO_SPACE, SUBMIT_ERROR } submit_rc;
+typedef enum submit_rc {
+  SUBMIT_OK,
+  SUBMIT_CLIENT_BUSY,
+  SUBMIT_QUEUE_FULL,
+  SUBMIT_NO_SPACE,
+  SUBMIT_ERROR
+} submit_rc;
 
 bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size);
 /** Stop: queued jobs are cancelled, running ones are ended (their process groups), workers joined. */
 void serve_jobs_stop(void);
 
 /** Enqueue a run of the scene @p text (already checked) with @p runs runs; @p id receives its id. */
-submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene, long runs,
-                            double predicted_bytes, char id[33]);
+submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene,
+                            long runs, double predicted_bytes, char id[33]);
 
 /** JSON of the job @p id ({"id","state","progress",...}); NULL when unknown. */
 char *serve_job_json(const char *id, size_t *len);
@@ -187,7 +194,8 @@ void serve_streams_leave(const char *client);
 
 /** POST /api/estimate: run `navsim estimate` on the (checked) scene in a sandboxed child. */
 typedef enum estimate_rc { EST_OK, EST_BUSY, EST_FAILED } estimate_rc;
-estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why, size_t why_size);
+estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
+                           size_t why_size);
 
 /** fork + exec of this program with @p argv in @p dir, limits applied; -1 on failure. */
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name);
