@@ -45,6 +45,11 @@ serve_config serve_config_default(void) {
   c.retry_after_s = 10;
   c.estimate_cpu_s = 10;
   c.max_parallel_estimates = 2;
+  c.slurm = 0;
+  c.slurm_max_runs = 100000;
+  c.slurm_tasks = 1;
+  c.slurm_time_min = 60;
+  snprintf(c.slurm_mpi, sizeof c.slurm_mpi, "pmix");
   return c;
 }
 
@@ -87,6 +92,13 @@ static const key_def k_keys[] = {
     {"retry_after_s", K_INT, OFF(retry_after_s), 0, 1, 86400},
     {"estimate_cpu_s", K_LONG, OFF(estimate_cpu_s), 0, 1, 3600},
     {"max_parallel_estimates", K_INT, OFF(max_parallel_estimates), 0, 1, 256},
+    {"slurm", K_INT, OFF(slurm), 0, 0, 1},
+    {"slurm_max_runs", K_LONG, OFF(slurm_max_runs), 0, 1, NAV_SCENE_MAX_RUNS},
+    {"slurm_tasks", K_INT, OFF(slurm_tasks), 0, 1, 100000},
+    {"slurm_time_min", K_LONG, OFF(slurm_time_min), 0, 1, 525600},
+    {"slurm_partition", K_STR, OFF(slurm_partition), sizeof(((serve_config *)0)->slurm_partition), 0, 0},
+    {"slurm_mpi", K_STR, OFF(slurm_mpi), sizeof(((serve_config *)0)->slurm_mpi), 0, 0},
+    {"slurm_bin_dir", K_STR, OFF(slurm_bin_dir), SERVE_PATH_MAX, 0, 0},
 };
 
 static char *trim(char *s) {

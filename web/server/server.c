@@ -285,15 +285,18 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     goto cleanup;
   }
   if (runs == 0) runs = sc->simulation.runs;
-  if (runs > S.cfg.max_runs) {
-    snprintf(msg, sizeof msg, "%ld Monte Carlo runs asked; this server runs at most %ld (max_runs)", runs,
-             S.cfg.max_runs);
+  /* Campaigns above the local limit go to Slurm when it is configured (up to slurm_max_runs). */
+  const bool slurm = S.cfg.slurm && runs > S.cfg.max_runs && runs <= S.cfg.slurm_max_runs;
+  if (runs > S.cfg.max_runs && !slurm) {
+    snprintf(msg, sizeof msg, "%ld Monte Carlo runs asked; this server runs at most %ld (%s)", runs,
+             S.cfg.slurm ? S.cfg.slurm_max_runs : S.cfg.max_runs,
+             S.cfg.slurm ? "slurm_max_runs" : "max_runs");
     ret = limit_error(c, "simulation.runs", msg);
     goto cleanup;
   }
   sc->simulation.runs = runs;
   const double samples = sc->trajectory.duration_s * sc->imu.rate_hz * (double)runs;
-  if (!(samples <= S.cfg.max_imu_samples)) {
+  if (!slurm && !(samples <= S.cfg.max_imu_samples)) {
     snprintf(msg, sizeof msg,
              "duration x IMU rate x runs = %.4g IMU samples; this server simulates at most %.4g "
              "(max_imu_samples): "
@@ -313,7 +316,7 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     ret = limit_error(c, "output.rate_hz", msg);
     goto cleanup;
   }
-  if (pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
+  if (!slurm && pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
     snprintf(msg, sizeof msg,
              "the run would need about %.0f MiB of memory (%s); this server allows %ld MiB a run",
              pred.memory_bytes / mib, pred.memory, S.cfg.job_memory_mb);
@@ -322,7 +325,7 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
   }
   char client[64], id[33];
   client_of(c, client, sizeof client);
-  const submit_rc rc = serve_jobs_submit(client, r->body.s ? r->body.s : "", r->body.len, sc, runs,
+  const submit_rc rc = serve_jobs_submit(client, r->body.s ? r->body.s : "", r->body.len, sc, slurm, runs,
                                          pred.output_bytes + 1e6, id);
   if (rc == SUBMIT_CLIENT_BUSY) {
     snprintf(msg, sizeof msg, "you have %d runs queued or running (max_jobs_per_client); try again later",
