@@ -273,7 +273,7 @@ check(st == 200 and j["max_runs"] == 500 and "summary.json" in j["result_files"]
 # ---------------------------------------------------------------- a second server on the same port
 r = subprocess.run([NAVSIM, "serve", "--port", str(srv.port), "--data-dir", srv.data + "-2"], capture_output=True,
                    text=True, timeout=30)
-check(r.returncode == 1 and "cannot listen" in r.stderr, f"port in use -> exit 1 ({r.returncode} {r.stderr!r})")
+check(r.returncode == 1 and "cannot listen" in r.stderr and "in use" in r.stderr, f"port in use -> exit 1 ({r.returncode} {r.stderr!r})")
 
 # ---------------------------------------------------------------- SIGTERM with a job running
 st, _, j = srv.json("POST", "/api/runs?runs=100", URBAN)

@@ -788,7 +788,7 @@ static bool parse_port(const char *v, int *out) {
 }
 
 int navserve_main(int argc, char **argv) {
-  const char *bind = NULL, *data_dir = NULL, *config = NULL, *studio = NULL;
+  const char *bind_arg = NULL, *data_dir = NULL, *config = NULL, *studio = NULL;
   int port = -1;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -808,7 +808,7 @@ int navserve_main(int argc, char **argv) {
     }
     const char *v = argv[++i];
     if (strcmp(a, "--bind") == 0)
-      bind = v;
+      bind_arg = v;
     else if (strcmp(a, "--data-dir") == 0)
       data_dir = v;
     else if (strcmp(a, "--config") == 0)
@@ -822,7 +822,7 @@ int navserve_main(int argc, char **argv) {
   }
   serve_config cfg = serve_config_default();
   if (config && !serve_config_read(config, &cfg)) return 2;
-  if (bind) snprintf(cfg.bind, sizeof cfg.bind, "%s", bind);
+  if (bind_arg) snprintf(cfg.bind, sizeof cfg.bind, "%s", bind_arg);
   if (port >= 0) cfg.port = port;
   if (data_dir) snprintf(cfg.data_dir, sizeof cfg.data_dir, "%s", data_dir);
   if (studio) snprintf(cfg.studio_dir, sizeof cfg.studio_dir, "%s", studio);
@@ -858,6 +858,7 @@ int navserve_main(int argc, char **argv) {
   umask(077); /* job directories and results are private to this user */
 
   int rc = 1;
+  int lsock = -1;
   struct MHD_Daemon *d = NULL;
   char why[SERVE_PATH_MAX + 256];
   if (!serve_jobs_start(&cfg, why, sizeof why)) {
@@ -875,24 +876,22 @@ int navserve_main(int argc, char **argv) {
   find_studio();
   if (S.n_files == 0) fprintf(stderr, "navsim serve: warning: %s; serving the API only\n", S.studio_why);
 
-  const unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
-                         MHD_USE_ITC | (v6 ? MHD_USE_IPv6 : 0);
-  d = MHD_start_daemon(
-      flags, (uint16_t)cfg.port, NULL, NULL, handler, NULL, MHD_OPTION_SOCK_ADDR,
-      v6 ? (const struct sockaddr *)(const void *)&sa6 : (const struct sockaddr *)(const void *)&sa4,
-      MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg.max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-      (unsigned)cfg.max_connections_per_client, MHD_OPTION_CONNECTION_TIMEOUT,
-      (unsigned)cfg.connection_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024),
-      MHD_OPTION_NOTIFY_COMPLETED, completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL,
-      MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE, (size_t)(2u << 20), MHD_OPTION_END);
-  if (!d) {
-    fprintf(stderr, "navsim serve: cannot listen on %s port %d (in use, or not an address of this machine)\n",
-            cfg.bind, cfg.port);
+  /* The listening socket is made here, so that its port (of --port 0) and the Host values this
+   * server answers to (a defence against DNS rebinding) are known before any request arrives. */
+  lsock = socket(v6 ? AF_INET6 : AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  const int one = 1;
+  if (lsock >= 0) (void)setsockopt(lsock, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  const struct sockaddr *sa =
+      v6 ? (const struct sockaddr *)(const void *)&sa6 : (const struct sockaddr *)(const void *)&sa4;
+  if (lsock < 0 || bind(lsock, sa, v6 ? sizeof sa6 : sizeof sa4) != 0 || listen(lsock, 128) != 0) {
+    fprintf(stderr, "navsim serve: cannot listen on %s port %d: %s\n", cfg.bind, cfg.port, strerror(errno));
     goto cleanup;
   }
-  const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
-  S.port = info ? (int)info->port : cfg.port;
-  /* Host values this server answers to (a defence against DNS rebinding). */
+  struct sockaddr_storage bound;
+  socklen_t blen = sizeof bound;
+  if (getsockname(lsock, (struct sockaddr *)(void *)&bound, &blen) != 0) goto cleanup;
+  S.port = ntohs(v6 ? ((struct sockaddr_in6 *)(void *)&bound)->sin6_port
+                    : ((struct sockaddr_in *)(void *)&bound)->sin_port);
   const char *fmt = v6 ? "[%s]:%d" : "%s:%d";
   snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], fmt, cfg.bind, S.port);
   snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], "localhost:%d", S.port);
@@ -902,6 +901,19 @@ int navserve_main(int argc, char **argv) {
     const char *h = strstr(cfg.allowed_origin, "://");
     snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], "%s", h ? h + 3 : cfg.allowed_origin);
   }
+  const unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
+                         MHD_USE_ITC | (v6 ? MHD_USE_IPv6 : 0);
+  d = MHD_start_daemon(
+      flags, (uint16_t)S.port, NULL, NULL, handler, NULL, MHD_OPTION_LISTEN_SOCKET, lsock,
+      MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg.max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+      (unsigned)cfg.max_connections_per_client, MHD_OPTION_CONNECTION_TIMEOUT,
+      (unsigned)cfg.connection_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024),
+      MHD_OPTION_NOTIFY_COMPLETED, completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL,
+      MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE, (size_t)(2u << 20), MHD_OPTION_END);
+  if (!d) {
+    fprintf(stderr, "navsim serve: cannot start the HTTP server on %s port %d\n", cfg.bind, S.port);
+    goto cleanup;
+  }
   printf(v6 ? "listening on http://[%s]:%d/\n" : "listening on http://%s:%d/\n", cfg.bind, S.port);
   fflush(stdout);
 
@@ -909,12 +921,13 @@ int navserve_main(int argc, char **argv) {
   while (sigwait(&stop_set, &sig) != 0) {
   }
   fprintf(stderr, "navsim serve: signal %d: stopping (running jobs are cancelled)\n", sig);
-  MHD_quiesce_daemon(d); /* no new connections */
+  (void)MHD_quiesce_daemon(d); /* no new connections (the socket comes back to us: closed below) */
   rc = 0;
 
 cleanup:
   serve_jobs_stop(); /* cancels jobs; event streams see the stop and end */
   if (d) MHD_stop_daemon(d);
+  if (lsock >= 0) close(lsock);
   for (int i = 0; i < S.n_files; ++i) {
     free(S.files[i].url);
     free(S.files[i].path);
