@@ -87,14 +87,18 @@ def pid_of(name):
 
 
 def stop_daemons():
+    """Stop the daemons this test started (by the pids they wrote) and wait until they are gone."""
+    pids = [pid_of(n) for n in ("slurmd.pid", "slurmctld.pid", "munged.pid")]
     subprocess.run(["scontrol", "shutdown"], env=env, capture_output=True, timeout=30)
-    for name in ("slurmd.pid", "slurmctld.pid", "munged.pid"):
-        pid = pid_of(name)
+    for pid in pids:
         if pid:
             try:
                 os.kill(pid, signal.SIGTERM)
             except ProcessLookupError:
                 pass
+    t0 = time.time()
+    while time.time() - t0 < 20 and any(p and os.path.exists(f"/proc/{p}") for p in pids):
+        time.sleep(0.2)
 
 
 try:
