@@ -3,6 +3,7 @@ and a small studio bundle made by the test, make raw HTTP requests, wait for run
 
 Only the Python standard library is used (Debian python3)."""
 
+import atexit
 import http.client
 import json
 import os
@@ -27,6 +28,15 @@ def check(cond, what):
 
 
 SERVERS = []
+
+
+@atexit.register
+def _no_server_left():
+    """A test that stops on an exception must not leave its server running."""
+    for s in SERVERS:
+        if s.proc.poll() is None:
+            s.proc.kill()
+            s.proc.wait()
 
 
 def finish(name):
@@ -79,7 +89,7 @@ class Server:
         SERVERS.append(self)
         self.host = f"127.0.0.1:{self.port}"
 
-    def request(self, method, path, body=None, headers=None, timeout=120):
+    def request(self, method, path, body=None, headers=None, timeout=900):
         """(status, headers dict (lower-case keys), body bytes)."""
         c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=timeout)
         h = dict(headers or {})

@@ -250,12 +250,19 @@ check(not os.path.exists(os.path.join(srv.data, "jobs", ids[0], "result")), "a c
 check(srv.job_processes() == [], "no job process is left after cancelling")
 
 # ---------------------------------------------------------------- estimate
+PARAMETRIC = read(os.path.join(SCENES, "paper-parametric.yaml"))
 t0 = time.time()
-st, _, j = srv.json("POST", "/api/estimate", URBAN)
+st, _, j = srv.json("POST", "/api/estimate", PARAMETRIC)
 dt = time.time() - t0
-check(st == 200 and j and j.get("scene", {}).get("name") == "urban-drive" and "requirements" in j,
-      f"estimate urban-drive ({st})")
-print(f"POST /api/estimate urban-drive: {dt:.2f} s wall (machine load {os.getloadavg()[0]:.1f})")
+check(st == 200 and j and j.get("scene", {}).get("name") == "paper-parametric" and j.get("requirements"),
+      f"estimate paper-parametric ({st})")
+cli_dir = os.path.join(srv.root, "estimate-cli")
+subprocess.run([NAVSIM, "estimate", os.path.join(SCENES, "paper-parametric.yaml"), "--out", cli_dir, "--quiet"],
+               check=True)
+cli = json.loads(read(os.path.join(cli_dir, "estimate.json")))
+for k in ("analytic_final", "requirements"):
+    check(j and j.get(k) == cli.get(k), f"estimate {k} equals navsim estimate's")
+print(f"POST /api/estimate paper-parametric: {dt:.2f} s wall (machine load {os.getloadavg()[0]:.1f})")
 st, _, j = srv.json("POST", "/api/estimate", b"format_version: 1\nimu: {rate_hz: -1}\n")
 check(st == 422 and j["errors"][0]["path"] == "imu.rate_hz", f"estimate of an invalid scene -> 422 ({st})")
 st, _, j = srv.json("GET", "/api/estimate")
@@ -266,7 +273,7 @@ check(st == 200 and j["max_runs"] == 500 and "summary.json" in j["result_files"]
 # ---------------------------------------------------------------- a second server on the same port
 r = subprocess.run([NAVSIM, "serve", "--port", str(srv.port), "--data-dir", srv.data + "-2"], capture_output=True,
                    text=True, timeout=30)
-check(r.returncode == 1 and "cannot listen" in r.stderr, f"port in use -> exit 1 ({r.returncode} {r.stderr!r})")
+check(r.returncode == 1 and "cannot listen" in r.stderr and "in use" in r.stderr, f"port in use -> exit 1 ({r.returncode} {r.stderr!r})")
 
 # ---------------------------------------------------------------- SIGTERM with a job running
 st, _, j = srv.json("POST", "/api/runs?runs=100", URBAN)
@@ -280,4 +287,21 @@ check(rc == 0, f"SIGTERM -> exit 0 (got {rc})")
 check(time.time() - t0 < 10, f"stopped in {time.time() - t0:.1f} s")
 time.sleep(0.2)
 check(srv.job_processes() == [], "no job process outlives the server")
+# ---------------------------------------------------------------- expiry by age, disk quota (503)
+srv2 = Server(NAVSIM, {"result_max_age_s": 2})
+st, _, j = srv2.json("POST", "/api/runs?runs=1", MINIMAL)
+j = srv2.wait_run(j["id"])
+check(j and j["state"] == "done", "a run to expire")
+jobdir = os.path.join(srv2.data, "jobs", j["id"])
+check(os.path.isdir(jobdir), "its directory exists")
+t0 = time.time()
+while time.time() - t0 < 30 and srv2.request("GET", f"/api/runs/{j['id']}")[0] == 200:
+    time.sleep(0.2)
+check(srv2.request("GET", f"/api/runs/{j['id']}")[0] == 404, f"expired after {time.time() - t0:.1f} s (age 2 s)")
+check(not os.path.exists(jobdir), "its directory is removed")
+check(srv2.stop() == 0, "clean stop of the expiry server")
+srv3 = Server(NAVSIM, {"disk_quota_mb": 1})
+st, hd, j = srv3.json("POST", "/api/runs?runs=1", MINIMAL)
+check(st == 503 and hd.get("retry-after") and "disk_quota_mb" in j.get("error", ""), f"over the disk quota -> 503 ({st})")
+check(srv3.stop() == 0, "clean stop of the quota server")
 finish("test_serve_api")

@@ -49,6 +49,12 @@ for name in ("truth.csv", "nav.csv", "errors.csv", "mc_final.csv", "gnss.csv", "
         if name == "tracks.kml":  # the document is named after the result directory
             mine = mine.replace(b"<name>local</name>", b"<name>result</name>", 1)
         check(st == 200 and body == mine, f"{name} identical to navsim run's")
+# The preliminary estimate of the same scene, timed (issue 20: well under a second is the aim).
+for i in range(3):
+    t0 = time.time()
+    st, _, e = srv.json("POST", "/api/estimate", URBAN)
+    check(st == 200 and e.get("requirements"), f"estimate urban-drive ({st})")
+    print(f"POST /api/estimate urban-drive: {time.time() - t0:.2f} s wall (load average {os.getloadavg()[0]:.1f})")
 check(srv.stop() == 0, "clean stop")
 if not check.__globals__["FAILS"]:
     shutil.rmtree(os.path.dirname(out), ignore_errors=True)

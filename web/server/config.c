@@ -45,6 +45,11 @@ serve_config serve_config_default(void) {
   c.retry_after_s = 10;
   c.estimate_cpu_s = 10;
   c.max_parallel_estimates = 2;
+  c.slurm = 0;
+  c.slurm_max_runs = 100000;
+  c.slurm_tasks = 1;
+  c.slurm_time_min = 60;
+  snprintf(c.slurm_mpi, sizeof c.slurm_mpi, "pmix");
   return c;
 }
 
@@ -87,12 +92,21 @@ static const key_def k_keys[] = {
     {"retry_after_s", K_INT, OFF(retry_after_s), 0, 1, 86400},
     {"estimate_cpu_s", K_LONG, OFF(estimate_cpu_s), 0, 1, 3600},
     {"max_parallel_estimates", K_INT, OFF(max_parallel_estimates), 0, 1, 256},
+    {"slurm", K_INT, OFF(slurm), 0, 0, 1},
+    {"slurm_max_runs", K_LONG, OFF(slurm_max_runs), 0, 1, NAV_SCENE_MAX_RUNS},
+    {"slurm_tasks", K_INT, OFF(slurm_tasks), 0, 1, 100000},
+    {"slurm_time_min", K_LONG, OFF(slurm_time_min), 0, 1, 525600},
+    {"slurm_partition", K_STR, OFF(slurm_partition), sizeof(((serve_config *)0)->slurm_partition), 0, 0},
+    {"slurm_mpi", K_STR, OFF(slurm_mpi), sizeof(((serve_config *)0)->slurm_mpi), 0, 0},
+    {"slurm_bin_dir", K_STR, OFF(slurm_bin_dir), SERVE_PATH_MAX, 0, 0},
 };
 
 static char *trim(char *s) {
-  while (*s && isspace((unsigned char)*s)) ++s;
+  while (*s && isspace((unsigned char)*s))
+    ++s;
   size_t n = strlen(s);
-  while (n > 0 && isspace((unsigned char)s[n - 1])) s[--n] = '\0';
+  while (n > 0 && isspace((unsigned char)s[n - 1]))
+    s[--n] = '\0';
   return s;
 }
 
@@ -115,9 +129,12 @@ static bool set_value(const key_def *k, const char *v, serve_config *c, char *wh
              k->k == K_DOUBLE ? "a number" : "an integer", k->lo, k->hi, v);
     return false;
   }
-  if (k->k == K_INT) *(int *)(void *)base = (int)d;
-  else if (k->k == K_LONG) *(long *)(void *)base = (long)d;
-  else *(double *)(void *)base = d;
+  if (k->k == K_INT)
+    *(int *)(void *)base = (int)d;
+  else if (k->k == K_LONG)
+    *(long *)(void *)base = (long)d;
+  else
+    *(double *)(void *)base = d;
   return true;
 }
 
@@ -146,7 +163,8 @@ bool serve_config_read(const char *path, serve_config *c) {
     for (size_t i = 0; i < sizeof k_keys / sizeof k_keys[0]; ++i)
       if (strcmp(k_keys[i].key, key) == 0) k = &k_keys[i];
     if (!k) {
-      fprintf(stderr, "%s:%d: error: unknown key \"%s\" (docs/web-server.md lists the keys)\n", path, lineno, key);
+      fprintf(stderr, "%s:%d: error: unknown key \"%s\" (docs/web-server.md lists the keys)\n", path, lineno,
+              key);
       ok = false;
       continue;
     }

@@ -27,10 +27,12 @@
 #include <zip.h>
 
 const char *const serve_result_files[] = {
-    "summary.json",    "truth.csv",         "nav.csv",      "errors.csv",   "imu_errors.csv",
-    "mc_stats.csv",    "mc_final.csv",      "gnss.csv",     "gnss_outages.csv", "gnss_dop.csv",
-    "gnss_sats.csv",   "nav_smoothed.csv",  "smoothed_errors.csv", "tracks.kml", "tracks.csv",
-    "scene.yaml",      "log.txt",           "results.zip",
+    "summary.json",        "truth.csv",      "nav.csv",
+    "errors.csv",          "imu_errors.csv", "mc_stats.csv",
+    "mc_final.csv",        "gnss.csv",       "gnss_outages.csv",
+    "gnss_dop.csv",        "gnss_sats.csv",  "nav_smoothed.csv",
+    "smoothed_errors.csv", "tracks.kml",     "tracks.csv",
+    "scene.yaml",          "log.txt",        "results.zip",
 };
 const int serve_n_result_files = (int)(sizeof serve_result_files / sizeof serve_result_files[0]);
 /* Files of the job directory itself; the others are navsim run's, in result/. */
@@ -54,8 +56,11 @@ struct job {
   int refs;
   bool removed;
   double predicted_bytes, disk_bytes;
-  double cpu_s; /* CPU time of the job's process (user + system) */
-  unsigned files; /* bit i: serve_result_files[i] exists (done jobs) */
+  double cpu_s;         /* CPU time of the job's process (user + system) */
+  bool slurm;           /* a campaign handed to Slurm (runs above max_runs) */
+  long slurm_id;        /* its Slurm job id, 0 before sbatch answered */
+  char slurm_state[32]; /* its JobState as scontrol reports it */
+  unsigned files;       /* bit i: serve_result_files[i] exists (done jobs) */
   job *next;
 };
 
@@ -74,6 +79,7 @@ static struct {
   char jobs_dir[SERVE_PATH_MAX], tmp_dir[SERVE_PATH_MAX];
   char *envp[12];
   char env_store[12][SERVE_PATH_MAX + 32];
+  char exe[SERVE_PATH_MAX]; /* this program's path, for Slurm batch scripts */
 } g = {.mu = PTHREAD_MUTEX_INITIALIZER};
 
 const char *job_state_name(job_state s) {
@@ -87,7 +93,9 @@ const char *job_state_name(job_state s) {
   return "unknown";
 }
 
-static bool finished(const job *j) { return j->state == JOB_DONE || j->state == JOB_FAILED || j->state == JOB_CANCELLED; }
+static bool finished(const job *j) {
+  return j->state == JOB_DONE || j->state == JOB_FAILED || j->state == JOB_CANCELLED;
+}
 
 static void bump(job *j) {
   ++j->seq;
@@ -100,15 +108,17 @@ static job *find_locked(const char *id) {
   return NULL;
 }
 
-static void job_dir(const job *j, char *out, size_t size) { snprintf(out, size, "%s/%s", g.jobs_dir, j->id); }
+static void job_dir(const job *j, char *out, size_t size) {
+  snprintf(out, size, "%s/%s", g.jobs_dir, j->id);
+}
 
 /* ------------------------------------------------------------------ the sandboxed child */
 
 static void build_env(void) {
   /* A fixed, small environment: the share-directory overrides (the child finds the catalogs as
-   * the server does) and the sanitizer options of the test builds. */
+   * the server does), the sanitizer options of the test builds and SLURM_CONF for the Slurm commands. */
   static const char *const keep[] = {"NAV_SHARE_DIR", "NAV_RESOURCES_DIR", "ASAN_OPTIONS", "UBSAN_OPTIONS",
-                                     "LSAN_OPTIONS",  "TSAN_OPTIONS"};
+                                     "LSAN_OPTIONS",  "TSAN_OPTIONS",      "SLURM_CONF"};
   int n = 0;
   snprintf(g.env_store[n], sizeof g.env_store[n], "PATH=/usr/bin:/bin");
   g.envp[n] = g.env_store[n];
@@ -132,6 +142,11 @@ static void set_limit(int resource, rlim_t soft, rlim_t hard) {
 }
 
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name) {
+  return serve_spawn_prog("/proc/self/exe", dir, argv, progress_fd, cpu_s, log_name);
+}
+
+pid_t serve_spawn_prog(const char *prog, const char *dir, char *const argv[], int progress_fd, long cpu_s,
+                       const char *log_name) {
   const rlim_t mib = 1024 * 1024;
   const rlim_t fsize = (rlim_t)g.cfg.job_output_mb * mib;
   const rlim_t as = (rlim_t)g.cfg.job_memory_mb * mib;
@@ -156,7 +171,8 @@ pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu
   if (dup2(in, 0) < 0 || dup2(log, 1) < 0 || dup2(log, 2) < 0) _exit(126);
   if (pfd >= 0 && dup2(pfd, 3) < 0) _exit(126);
   if (close_range(pfd >= 0 ? 4 : 3, ~0U, 0) != 0)
-    for (int fd = pfd >= 0 ? 4 : 3; fd < 1024; ++fd) close(fd);
+    for (int fd = pfd >= 0 ? 4 : 3; fd < 1024; ++fd)
+      close(fd);
   set_limit(RLIMIT_CPU, (rlim_t)cpu_s, (rlim_t)cpu_s + 5); /* SIGXCPU, then SIGKILL */
   set_limit(RLIMIT_FSIZE, fsize, fsize);
   set_limit(RLIMIT_NOFILE, nofile, nofile);
@@ -169,7 +185,7 @@ pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu
 #endif
   if (prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) _exit(126);
   umask(077);
-  execve("/proc/self/exe", argv, g.envp);
+  execve(prog, argv, g.envp);
   _exit(127);
 }
 
@@ -191,7 +207,8 @@ static void log_tail(const char *path, char *out, size_t size) {
     if (nl) s = nl + 1;
   }
   size_t m = strlen(s);
-  while (m > 0 && (s[m - 1] == '\n' || s[m - 1] == '\r')) s[--m] = '\0';
+  while (m > 0 && (s[m - 1] == '\n' || s[m - 1] == '\r'))
+    s[--m] = '\0';
   /* navsim's terminal progress uses carriage returns: keep the text after the last one per line. */
   snprintf(out, size, "%s", s);
 }
@@ -305,13 +322,15 @@ static void make_zip(job *j, const char *dir) {
   if (rename(tmp, path) == 0) j->files |= 1u << FILE_ZIP;
 }
 
+static void finish_job(job *j, const char *dir, job_state st, const char *err, const struct rusage *rup);
+
 static void run_job(job *j) {
   char dir[SERVE_PATH_MAX + 64], runs[32], threads[16], summary[2 * SERVE_PATH_MAX], logp[2 * SERVE_PATH_MAX];
   job_dir(j, dir, sizeof dir);
   snprintf(runs, sizeof runs, "%ld", j->runs);
   snprintf(threads, sizeof threads, "%d", g.cfg.job_threads);
-  char *argv[] = {"navsim",  "run", "scene.yaml", "--out",       "result", "--runs", runs, "--threads",
-                  threads, "--quiet", "--kml",    "--progress-fd", "3",      NULL};
+  char *argv[] = {"navsim",    "run",   "scene.yaml", "--out", "result",        "--runs", runs,
+                  "--threads", threads, "--quiet",    "--kml", "--progress-fd", "3",      NULL};
   int p[2] = {-1, -1};
   pid_t pid = -1;
   if (pipe2(p, O_CLOEXEC) == 0) pid = serve_spawn(dir, argv, p[1], g.cfg.job_cpu_s, "log.txt");
@@ -328,8 +347,8 @@ static void run_job(job *j) {
     pthread_mutex_unlock(&g.mu);
     bool watchdog = false;
     const int status = supervise(j, pid, p[0], (double)g.cfg.job_wall_s, &ru, &watchdog);
-    const double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-                       1e-6 * (double)ru.ru_stime.tv_usec;
+    const double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+                       (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
     snprintf(summary, sizeof summary, "%s/result/summary.json", dir);
     snprintf(logp, sizeof logp, "%s/log.txt", dir);
     struct stat sb;
@@ -347,8 +366,10 @@ static void run_job(job *j) {
       snprintf(err, sizeof err, "the run exceeded its wall-clock limit of %ld s (job_wall_s) and was ended",
                g.cfg.job_wall_s);
     } else if (WIFSIGNALED(status) &&
-               (WTERMSIG(status) == SIGXCPU || (WTERMSIG(status) == SIGKILL && cpu >= (double)g.cfg.job_cpu_s - 0.5))) {
-      snprintf(err, sizeof err, "the run exceeded its CPU limit of %ld s (job_cpu_s) and was ended", g.cfg.job_cpu_s);
+               (WTERMSIG(status) == SIGXCPU ||
+                (WTERMSIG(status) == SIGKILL && cpu >= (double)g.cfg.job_cpu_s - 0.5))) {
+      snprintf(err, sizeof err, "the run exceeded its CPU limit of %ld s (job_cpu_s) and was ended",
+               g.cfg.job_cpu_s);
     } else if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXFSZ) {
       snprintf(err, sizeof err, "a result file exceeded %ld MiB (job_output_mb) and the run was ended",
                g.cfg.job_output_mb);
@@ -356,11 +377,17 @@ static void run_job(job *j) {
       snprintf(err, sizeof err, "the simulation process ended by signal %d, %s: %s", WTERMSIG(status),
                signal_name(WTERMSIG(status)), tail);
     } else {
-      snprintf(err, sizeof err, "navsim run exited with code %d: %s", WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-               tail);
+      snprintf(err, sizeof err, "navsim run exited with code %d: %s",
+               WIFEXITED(status) ? WEXITSTATUS(status) : -1, tail);
     }
   }
   if (p[0] >= 0) close(p[0]);
+  finish_job(j, dir, st, err, &ru);
+}
+
+/* The end of a job: which result files exist, the zip, the disk use, the final state. */
+static void finish_job(job *j, const char *dir, job_state st, const char *err, const struct rusage *rup) {
+  const struct rusage ru = *rup;
   unsigned files = 0;
   for (int i = 0; i < serve_n_result_files; ++i) {
     char f[2 * SERVE_PATH_MAX];
@@ -393,6 +420,155 @@ static void run_job(job *j) {
   pthread_mutex_unlock(&g.mu);
 }
 
+/* ------------------------------------------------------------------ Slurm campaigns */
+
+/* Run a Slurm command (sbatch, scontrol, scancel) in @p dir; its output in @p out (NUL-terminated).
+ * Returns its exit code, -1 when it could not run. */
+static int slurm_cmd(const char *dir, char *const argv[], char *out, size_t out_size) {
+  char prog[SERVE_PATH_MAX + 64], path[2 * SERVE_PATH_MAX];
+  snprintf(prog, sizeof prog, "%s/%s", g.cfg.slurm_bin_dir[0] ? g.cfg.slurm_bin_dir : "/usr/bin", argv[0]);
+  const pid_t pid = serve_spawn_prog(prog, dir, argv, -1, 30, ".slurm-out.txt");
+  if (pid < 0) return -1;
+  struct rusage ru;
+  bool wd = false;
+  const int status = supervise(NULL, pid, -1, 60.0, &ru, &wd);
+  snprintf(path, sizeof path, "%s/.slurm-out.txt", dir);
+  size_t n = 0;
+  char *text = serve_read_file(path, 1u << 20, &n);
+  snprintf(out, out_size, "%s", text ? text : "");
+  free(text);
+  unlink(path);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void slurm_field(const char *text, const char *key, char *out, size_t size) {
+  out[0] = '\0';
+  const char *p = strstr(text, key);
+  if (!p) return;
+  p += strlen(key);
+  const size_t n = strcspn(p, " \n");
+  snprintf(out, size, "%.*s", (int)(n < size - 1 ? n : size - 1), p);
+}
+
+/*
+ * A campaign larger than the local limit: a batch script (fixed text: srun of this navsim with the
+ * same fixed arguments, under MPI when slurm_tasks > 1, which splits the runs across ranks with
+ * results bit-identical to one process) submitted with sbatch, then polled with scontrol every
+ * second until it ends; DELETE and shutdown scancel it. The results land in the job directory,
+ * which the cluster's nodes share with this server (the same path).
+ */
+static void run_slurm_job(job *j) {
+  char dir[SERVE_PATH_MAX + 64], script[2 * SERVE_PATH_MAX], out[4096], err[1024] = "";
+  job_state st = JOB_FAILED;
+  struct rusage ru;
+  memset(&ru, 0, sizeof ru);
+  job_dir(j, dir, sizeof dir);
+  snprintf(script, sizeof script, "%s/campaign.sh", dir);
+  FILE *f = fopen(script, "w");
+  if (!f || strchr(g.exe, '\'') || strchr(dir, '\'')) {
+    if (f) fclose(f);
+    snprintf(err, sizeof err, "the server could not write the batch script");
+    goto done;
+  }
+  char mpi[64] = "";
+  if (g.cfg.slurm_tasks > 1) snprintf(mpi, sizeof mpi, " --mpi=%s", g.cfg.slurm_mpi);
+  fprintf(f,
+          "#!/bin/sh\n# navsim serve: Slurm campaign %s\n"
+          "exec srun%s -n %d '%s' run scene.yaml --out result --runs %ld --threads %d --quiet --kml\n",
+          j->id, mpi, g.cfg.slurm_tasks, g.exe, j->runs, g.cfg.job_threads);
+  if (fclose(f) != 0) {
+    snprintf(err, sizeof err, "the server could not write the batch script");
+    goto done;
+  }
+  char tasks[16], time_min[32], name[48];
+  snprintf(tasks, sizeof tasks, "%d", g.cfg.slurm_tasks);
+  snprintf(time_min, sizeof time_min, "%ld", g.cfg.slurm_time_min);
+  snprintf(name, sizeof name, "navsim-%.8s", j->id);
+  char *argv[20] = {"sbatch",   "--parsable", "--chdir", dir,      "--output",   "log.txt",
+                    "--ntasks", tasks,        "--time",  time_min, "--job-name", name};
+  int a = 12;
+  if (g.cfg.slurm_partition[0]) {
+    argv[a++] = "--partition";
+    argv[a++] = g.cfg.slurm_partition;
+  }
+  argv[a++] = "campaign.sh";
+  argv[a] = NULL;
+  const int rc = slurm_cmd(dir, argv, out, sizeof out);
+  const long id = strtol(out, NULL, 10);
+  if (rc != 0 || id <= 0) {
+    snprintf(err, sizeof err, "sbatch refused the campaign: %.900s", out);
+    goto done;
+  }
+  pthread_mutex_lock(&g.mu);
+  j->slurm_id = id;
+  snprintf(j->slurm_state, sizeof j->slurm_state, "PENDING");
+  bump(j);
+  pthread_mutex_unlock(&g.mu);
+  char ids[32];
+  snprintf(ids, sizeof ids, "%ld", id);
+  bool cancel_sent = false;
+  int unknown = 0;
+  for (;;) {
+    pthread_mutex_lock(&g.mu);
+    const bool cancel = j->cancel || g.stopping;
+    pthread_mutex_unlock(&g.mu);
+    if (cancel && !cancel_sent) {
+      char *cv[] = {"scancel", ids, NULL};
+      (void)slurm_cmd(dir, cv, out, sizeof out);
+      cancel_sent = true;
+    }
+    char *sv[] = {"scontrol", "show", "job", "-o", ids, NULL};
+    char state[32];
+    if (slurm_cmd(dir, sv, out, sizeof out) != 0) {
+      if (++unknown > 10) {
+        snprintf(err, sizeof err, "Slurm job %ld is no longer known to scontrol", id);
+        break;
+      }
+    }
+    slurm_field(out, "JobState=", state, sizeof state);
+    if (state[0]) {
+      pthread_mutex_lock(&g.mu);
+      if (strcmp(state, j->slurm_state) != 0) {
+        snprintf(j->slurm_state, sizeof j->slurm_state, "%s", state);
+        bump(j);
+      }
+      pthread_mutex_unlock(&g.mu);
+    }
+    if (strcmp(state, "COMPLETED") == 0) {
+      char summary[2 * SERVE_PATH_MAX];
+      struct stat sb;
+      snprintf(summary, sizeof summary, "%s/result/summary.json", dir);
+      if (stat(summary, &sb) == 0) {
+        st = JOB_DONE;
+      } else {
+        char logp[2 * SERVE_PATH_MAX], tail[800];
+        snprintf(logp, sizeof logp, "%s/log.txt", dir);
+        log_tail(logp, tail, sizeof tail);
+        snprintf(err, sizeof err, "Slurm job %ld completed without results: %s", id, tail);
+      }
+      break;
+    }
+    if (strcmp(state, "CANCELLED") == 0 && cancel) {
+      st = JOB_CANCELLED;
+      snprintf(err, sizeof err, "cancelled");
+      break;
+    }
+    if (state[0] && strcmp(state, "PENDING") != 0 && strcmp(state, "RUNNING") != 0 &&
+        strcmp(state, "CONFIGURING") != 0 && strcmp(state, "COMPLETING") != 0 &&
+        strcmp(state, "SUSPENDED") != 0 && strcmp(state, "REQUEUED") != 0) {
+      char logp[2 * SERVE_PATH_MAX], tail[800];
+      snprintf(logp, sizeof logp, "%s/log.txt", dir);
+      log_tail(logp, tail, sizeof tail);
+      snprintf(err, sizeof err, "Slurm job %ld ended %s: %s", id, state, tail);
+      break;
+    }
+    const struct timespec ts = {1, 0};
+    nanosleep(&ts, NULL);
+  }
+done:
+  finish_job(j, dir, st, err, &ru);
+}
+
 static void release_locked(job *j) {
   if (--j->refs == 0 && j->removed) free(j);
 }
@@ -402,7 +578,8 @@ static void *worker(void *arg) {
   pthread_mutex_lock(&g.mu);
   while (!g.stopping) {
     job *j = g.head;
-    while (j && (j->removed || j->state != JOB_QUEUED)) j = j->next;
+    while (j && (j->removed || j->state != JOB_QUEUED))
+      j = j->next;
     if (!j) {
       pthread_cond_wait(&g.work, &g.mu);
       continue;
@@ -414,7 +591,10 @@ static void *worker(void *arg) {
     ++j->refs;
     bump(j);
     pthread_mutex_unlock(&g.mu);
-    run_job(j);
+    if (j->slurm)
+      run_slurm_job(j);
+    else
+      run_job(j);
     pthread_mutex_lock(&g.mu);
     release_locked(j);
   }
@@ -516,7 +696,8 @@ static void clear_dir(const char *dir, bool ids_only) {
   if (!d) return;
   struct dirent *de;
   while ((de = readdir(d)) != NULL) {
-    if (de->d_name[0] == '.' && (de->d_name[1] == '\0' || (de->d_name[1] == '.' && de->d_name[2] == '\0'))) continue;
+    if (de->d_name[0] == '.' && (de->d_name[1] == '\0' || (de->d_name[1] == '.' && de->d_name[2] == '\0')))
+      continue;
     if (ids_only && !serve_is_id(de->d_name)) continue;
     char p[SERVE_PATH_MAX + 300];
     snprintf(p, sizeof p, "%s/%s", dir, de->d_name);
@@ -541,6 +722,8 @@ bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size) {
   clear_dir(g.jobs_dir, true);
   clear_dir(g.tmp_dir, false);
   build_env();
+  const ssize_t en = readlink("/proc/self/exe", g.exe, sizeof g.exe - 1);
+  g.exe[en > 0 ? en : 0] = '\0';
   g.stream_client = calloc((size_t)cfg->max_streams, sizeof *g.stream_client);
   g.workers = calloc((size_t)cfg->max_parallel_jobs, sizeof *g.workers);
   if (!g.stream_client || !g.workers) {
@@ -560,7 +743,9 @@ bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size) {
 }
 
 const char *serve_tmp_dir(void);
-const char *serve_tmp_dir(void) { return g.tmp_dir; }
+const char *serve_tmp_dir(void) {
+  return g.tmp_dir;
+}
 
 void serve_jobs_stop(void) {
   if (!g.started) return;
@@ -582,15 +767,16 @@ void serve_jobs_stop(void) {
   pthread_cond_broadcast(&g.jan);
   pthread_cond_broadcast(&g.changed);
   pthread_mutex_unlock(&g.mu);
-  for (int i = 0; i < g.n_workers; ++i) pthread_join(g.workers[i], NULL);
+  for (int i = 0; i < g.n_workers; ++i)
+    pthread_join(g.workers[i], NULL);
   pthread_join(g.janitor, NULL);
   g.started = false;
 }
 
 /* ------------------------------------------------------------------ the API */
 
-submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene, long runs,
-                            double predicted_bytes, char id[33]) {
+submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene,
+                            bool slurm, long runs, double predicted_bytes, char id[33]) {
   submit_rc rc = SUBMIT_OK;
   doomed *d = NULL;
   job *j = NULL;
@@ -644,6 +830,7 @@ submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, co
   snprintf(j->client, sizeof j->client, "%s", client);
   snprintf(j->scene_name, sizeof j->scene_name, "%s", scene->name);
   j->state = JOB_QUEUED;
+  j->slurm = slurm;
   j->runs = runs;
   j->created = time(NULL);
   j->predicted_bytes = predicted_bytes;
@@ -651,7 +838,8 @@ submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, co
   ++g.n_queued;
   /* Append: the list is in creation order (the queue is FIFO, expiry takes the oldest first). */
   job **tail = &g.head;
-  while (*tail) tail = &(*tail)->next;
+  while (*tail)
+    tail = &(*tail)->next;
   *tail = j;
   snprintf(id, 33, "%s", j->id);
   j = NULL;
@@ -676,7 +864,8 @@ static void iso_time(sbuf *b, time_t t) {
 }
 
 static void job_json_locked(const job *j, sbuf *b) {
-  sb_printf(b, "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":%.4f", j->id, job_state_name(j->state), j->progress);
+  sb_printf(b, "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":%.4f", j->id, job_state_name(j->state),
+            j->progress);
   sb_printf(b, ",\"runs\":%ld,\"scene\":", j->runs);
   sb_json_str(b, j->scene_name);
   if (j->state == JOB_QUEUED) {
@@ -691,7 +880,11 @@ static void job_json_locked(const job *j, sbuf *b) {
   iso_time(b, j->started);
   sb_puts(b, ",\"finished\":");
   iso_time(b, j->finished);
-  if (finished(j) && j->started) sb_printf(b, ",\"cpu_s\":%.3f", j->cpu_s);
+  if (finished(j) && j->started && !j->slurm) sb_printf(b, ",\"cpu_s\":%.3f", j->cpu_s);
+  if (j->slurm) {
+    sb_printf(b, ",\"backend\":\"slurm\",\"slurm_job\":%ld,\"slurm_state\":", j->slurm_id);
+    sb_json_str(b, j->slurm_state);
+  }
   sb_puts(b, ",\"error\":");
   if (j->error[0])
     sb_json_str(b, j->error);
@@ -858,7 +1051,8 @@ void serve_streams_leave(const char *client) {
 
 /* ------------------------------------------------------------------ estimates */
 
-estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why, size_t why_size) {
+estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
+                           size_t why_size) {
   *json = NULL;
   pthread_mutex_lock(&g.mu);
   const bool busy = g.n_estimates >= g.cfg.max_parallel_estimates || g.stopping;
@@ -890,8 +1084,10 @@ estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *js
     snprintf(path, sizeof path, "%s/est/estimate.json", dir);
     *json = serve_read_file(path, 64u << 20, json_len);
     if (*json) rc = EST_OK;
-  } else if (watchdog || (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))) {
-    snprintf(why, why_size, "the estimate exceeded its CPU limit of %ld s (estimate_cpu_s)", g.cfg.estimate_cpu_s);
+  } else if (watchdog ||
+             (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))) {
+    snprintf(why, why_size, "the estimate exceeded its CPU limit of %ld s (estimate_cpu_s)",
+             g.cfg.estimate_cpu_s);
   } else {
     char tail[800];
     snprintf(path, sizeof path, "%s/log.txt", dir);

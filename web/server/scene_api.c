@@ -119,7 +119,8 @@ static bool scan_file_fields(const char *text, size_t len, serve_diags *diags) {
           add_diag(diags, line, col, path, msg);
           ok = false;
         }
-        if (depth > 0) snprintf(st[depth - 1].key, sizeof st[depth - 1].key, "%.*s", (int)(n < 63 ? n : 63), k ? k : "");
+        if (depth > 0)
+          snprintf(st[depth - 1].key, sizeof st[depth - 1].key, "%.*s", (int)(n < 63 ? n : 63), k ? k : "");
       } else if (depth > 0 && st[depth - 1].is_map && st[depth - 1].want_key) {
         st[depth - 1].key[0] = '\0';
       }
@@ -141,11 +142,14 @@ static pthread_mutex_t g_check_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t g_check_cv = PTHREAD_COND_INITIALIZER;
 static int g_check_free = 4;
 
-void serve_checks_init(int max) { g_check_free = max > 0 ? max : 1; }
+void serve_checks_init(int max) {
+  g_check_free = max > 0 ? max : 1;
+}
 
 void serve_check_enter(void) {
   pthread_mutex_lock(&g_check_mu);
-  while (g_check_free == 0) pthread_cond_wait(&g_check_cv, &g_check_mu);
+  while (g_check_free == 0)
+    pthread_cond_wait(&g_check_cv, &g_check_mu);
   --g_check_free;
   pthread_mutex_unlock(&g_check_mu);
 }
@@ -161,7 +165,8 @@ static void collect(void *user, const nav_diag *d) {
   add_diag(user, d->line, d->col, d->path, d->message);
 }
 
-bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene, serve_diags *diags) {
+bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene,
+                       serve_diags *diags) {
   diags->n = 0;
   if (!scan_file_fields(text, len, diags)) return false;
   char path[SERVE_PATH_MAX + 32];
@@ -246,20 +251,24 @@ static char *imu_json(const nav_catalog *cat) {
     sb_puts(&b, ",\"source\":");
     sb_json_str(&b, e->source);
     sb_puts(&b, ",\"gyro\":{");
-    num_or_null(&b, "arw_deg_per_sqrt_h", g->terms & NAV_IMU_TERM_NOISE, g->arw_rad_per_sqrt_s.x * arw_to_dpsh);
+    num_or_null(&b, "arw_deg_per_sqrt_h", g->terms & NAV_IMU_TERM_NOISE,
+                g->arw_rad_per_sqrt_s.x * arw_to_dpsh);
     num_or_null(&b, "bias_gm_deg_per_h", g->terms & NAV_IMU_TERM_BIAS_GM, g->bias_gm_sd_rps.x * rps_to_dph);
     num_or_null(&b, "bias_gm_tau_s", g->terms & NAV_IMU_TERM_BIAS_GM, g->bias_gm_tau_s.x);
-    num_or_null(&b, "bias_turn_on_deg_per_h", g->terms & NAV_IMU_TERM_BIAS_TURN_ON, g->bias_turn_on_sd_rps.x * rps_to_dph);
+    num_or_null(&b, "bias_turn_on_deg_per_h", g->terms & NAV_IMU_TERM_BIAS_TURN_ON,
+                g->bias_turn_on_sd_rps.x * rps_to_dph);
     num_or_null(&b, "scale_factor_ppm", g->terms & NAV_IMU_TERM_SCALE_FACTOR, g->scale_factor_sd.x * 1e6);
     sb_puts(&b, "},\"accel\":{");
     num_or_null(&b, "vrw_mps_per_sqrt_h", a->terms & NAV_IMU_TERM_NOISE, a->vrw_mps_per_sqrt_s.x * 60.0);
-    num_or_null(&b, "bias_gm_ug", a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_sd_mps2.x / nav_unit_ug_to_mps2(1.0));
+    num_or_null(&b, "bias_gm_ug", a->terms & NAV_IMU_TERM_BIAS_GM,
+                a->bias_gm_sd_mps2.x / nav_unit_ug_to_mps2(1.0));
     num_or_null(&b, "bias_gm_tau_s", a->terms & NAV_IMU_TERM_BIAS_GM, a->bias_gm_tau_s.x);
     num_or_null(&b, "bias_turn_on_mg", a->terms & NAV_IMU_TERM_BIAS_TURN_ON,
                 a->bias_turn_on_sd_mps2.x / nav_unit_mg_to_mps2(1.0));
     num_or_null(&b, "scale_factor_ppm", a->terms & NAV_IMU_TERM_SCALE_FACTOR, a->scale_factor_sd.x * 1e6);
     sb_puts(&b, "}");
-    num_or_null(&b, "misalignment_mrad", g->terms & NAV_IMU_TERM_MISALIGNMENT, g->misalignment_sd_rad.m[0][1] * 1e3);
+    num_or_null(&b, "misalignment_mrad", g->terms & NAV_IMU_TERM_MISALIGNMENT,
+                g->misalignment_sd_rad.m[0][1] * 1e3);
     sb_puts(&b, "}");
   }
   sb_puts(&b, "\n]\n");

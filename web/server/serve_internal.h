@@ -20,33 +20,40 @@
 
 /** Every limit and setting of the server; serve_config_default() holds the documented defaults. */
 typedef struct serve_config {
-  char bind[64];                   /**< bind (address; default 127.0.0.1) */
-  int port;                        /**< port (0: any free port) */
-  char data_dir[SERVE_PATH_MAX];   /**< data_dir: jobs/ and tmp/ live here */
-  char studio_dir[SERVE_PATH_MAX]; /**< studio_dir: the studio bundle with manifest.txt ("" default) */
-  char allowed_origin[256];        /**< allowed_origin: Origin accepted besides http://HOST ("" none) */
-  long max_body_bytes;             /**< max_body_bytes: request bodies above are refused (413) */
-  int max_connections;             /**< max_connections: open connections in all */
-  int max_connections_per_client;  /**< max_connections_per_client: per remote address */
-  int connection_timeout_s;        /**< connection_timeout_s: idle connections are closed */
-  int max_streams;                 /**< max_event_streams: open event streams in all */
-  int max_streams_per_client;      /**< max_event_streams_per_client */
-  int max_parallel_jobs;           /**< max_parallel_jobs: simulations running at once */
-  int max_queued_jobs;             /**< max_queued_jobs: waiting simulations (429 beyond) */
-  int max_jobs_per_client;         /**< max_jobs_per_client: queued + running per remote address */
-  int job_threads;                 /**< job_threads: navsim run --threads of each job */
-  long job_cpu_s;                  /**< job_cpu_s: CPU seconds of one job (RLIMIT_CPU) */
-  long job_wall_s;                 /**< job_wall_s: wall-clock seconds before the watchdog ends it */
-  long job_memory_mb;              /**< job_memory_mb: address space of a job (RLIMIT_AS) */
-  long job_output_mb;              /**< job_output_mb: predicted result files of one job */
-  long job_open_files;             /**< job_open_files: RLIMIT_NOFILE of a job */
-  long max_runs;                   /**< max_runs: Monte Carlo runs of one job */
-  double max_imu_samples;          /**< max_imu_samples: duration x IMU rate x runs of one job */
-  long result_max_age_s;           /**< result_max_age_s: finished jobs are removed after this */
-  long disk_quota_mb;              /**< disk_quota_mb: all job directories together */
-  int retry_after_s;               /**< retry_after_s: Retry-After of 429 answers */
-  long estimate_cpu_s;             /**< estimate_cpu_s: CPU seconds of one POST /api/estimate */
-  int max_parallel_estimates;      /**< max_parallel_estimates: estimates computed at once */
+  char bind[64];                      /**< bind (address; default 127.0.0.1) */
+  int port;                           /**< port (0: any free port) */
+  char data_dir[SERVE_PATH_MAX];      /**< data_dir: jobs/ and tmp/ live here */
+  char studio_dir[SERVE_PATH_MAX];    /**< studio_dir: the studio bundle with manifest.txt ("" default) */
+  char allowed_origin[256];           /**< allowed_origin: Origin accepted besides http://HOST ("" none) */
+  long max_body_bytes;                /**< max_body_bytes: request bodies above are refused (413) */
+  int max_connections;                /**< max_connections: open connections in all */
+  int max_connections_per_client;     /**< max_connections_per_client: per remote address */
+  int connection_timeout_s;           /**< connection_timeout_s: idle connections are closed */
+  int max_streams;                    /**< max_event_streams: open event streams in all */
+  int max_streams_per_client;         /**< max_event_streams_per_client */
+  int max_parallel_jobs;              /**< max_parallel_jobs: simulations running at once */
+  int max_queued_jobs;                /**< max_queued_jobs: waiting simulations (429 beyond) */
+  int max_jobs_per_client;            /**< max_jobs_per_client: queued + running per remote address */
+  int job_threads;                    /**< job_threads: navsim run --threads of each job */
+  long job_cpu_s;                     /**< job_cpu_s: CPU seconds of one job (RLIMIT_CPU) */
+  long job_wall_s;                    /**< job_wall_s: wall-clock seconds before the watchdog ends it */
+  long job_memory_mb;                 /**< job_memory_mb: address space of a job (RLIMIT_AS) */
+  long job_output_mb;                 /**< job_output_mb: predicted result files of one job */
+  long job_open_files;                /**< job_open_files: RLIMIT_NOFILE of a job */
+  long max_runs;                      /**< max_runs: Monte Carlo runs of one job */
+  double max_imu_samples;             /**< max_imu_samples: duration x IMU rate x runs of one job */
+  long result_max_age_s;              /**< result_max_age_s: finished jobs are removed after this */
+  long disk_quota_mb;                 /**< disk_quota_mb: all job directories together */
+  int retry_after_s;                  /**< retry_after_s: Retry-After of 429 answers */
+  long estimate_cpu_s;                /**< estimate_cpu_s: CPU seconds of one POST /api/estimate */
+  int max_parallel_estimates;         /**< max_parallel_estimates: estimates computed at once */
+  int slurm;                          /**< slurm: 1 hands campaigns above max_runs to Slurm */
+  long slurm_max_runs;                /**< slurm_max_runs: Monte Carlo runs of a Slurm campaign */
+  int slurm_tasks;                    /**< slurm_tasks: srun -n (MPI ranks) of a campaign */
+  long slurm_time_min;                /**< slurm_time_min: sbatch --time of a campaign [min] */
+  char slurm_partition[64];           /**< slurm_partition: sbatch --partition ("" default) */
+  char slurm_mpi[32];                 /**< slurm_mpi: srun --mpi plugin when slurm_tasks > 1 */
+  char slurm_bin_dir[SERVE_PATH_MAX]; /**< slurm_bin_dir: where sbatch, scontrol, scancel are */
 } serve_config;
 
 serve_config serve_config_default(void);
@@ -109,7 +116,8 @@ typedef struct serve_diags {
  * for the reader. @p scene may be NULL. Returns true when valid; otherwise @p diags holds the
  * problems.
  */
-bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene, serve_diags *diags);
+bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene,
+                       serve_diags *diags);
 
 /**
  * Scene checks at once are bounded (each holds scenes of about 0.5 MB): enter blocks while
@@ -127,7 +135,7 @@ bool serve_catalogs_load(char **imu_json, char **gnss_json, char *why, size_t wh
 
 /** The scene library: file stems and descriptions of the scenes a client may run. */
 typedef struct serve_scene_entry {
-  char name[96];  /**< file stem, e.g. "urban-drive" */
+  char name[96]; /**< file stem, e.g. "urban-drive" */
   char path[SERVE_PATH_MAX];
 } serve_scene_entry;
 
@@ -153,15 +161,22 @@ extern const int serve_n_result_files;
 typedef struct job job;
 
 /** Outcome of serve_jobs_submit. */
-typedef enum submit_rc { SUBMIT_OK, SUBMIT_CLIENT_BUSY, SUBMIT_QUEUE_FULL, SUBMIT_NO_SPACE, SUBMIT_ERROR } submit_rc;
+typedef enum submit_rc {
+  SUBMIT_OK,
+  SUBMIT_CLIENT_BUSY,
+  SUBMIT_QUEUE_FULL,
+  SUBMIT_NO_SPACE,
+  SUBMIT_ERROR
+} submit_rc;
 
 bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size);
 /** Stop: queued jobs are cancelled, running ones are ended (their process groups), workers joined. */
 void serve_jobs_stop(void);
 
-/** Enqueue a run of the scene @p text (already checked) with @p runs runs; @p id receives its id. */
-submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene, long runs,
-                            double predicted_bytes, char id[33]);
+/** Enqueue a run of the scene @p text (already checked) with @p runs runs; @p id receives its id.
+ *  @p slurm: a campaign handed to Slurm (slurm = 1, runs above max_runs). */
+submit_rc serve_jobs_submit(const char *client, const char *text, size_t len, const nav_scene *scene,
+                            bool slurm, long runs, double predicted_bytes, char id[33]);
 
 /** JSON of the job @p id ({"id","state","progress",...}); NULL when unknown. */
 char *serve_job_json(const char *id, size_t *len);
@@ -187,9 +202,13 @@ void serve_streams_leave(const char *client);
 
 /** POST /api/estimate: run `navsim estimate` on the (checked) scene in a sandboxed child. */
 typedef enum estimate_rc { EST_OK, EST_BUSY, EST_FAILED } estimate_rc;
-estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why, size_t why_size);
+estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
+                           size_t why_size);
 
 /** fork + exec of this program with @p argv in @p dir, limits applied; -1 on failure. */
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name);
+/** As serve_spawn, of the program @p prog (an absolute path). */
+pid_t serve_spawn_prog(const char *prog, const char *dir, char *const argv[], int progress_fd, long cpu_s,
+                       const char *log_name);
 
 #endif /* NAVSERVE_INTERNAL_H */

@@ -70,9 +70,10 @@ static void common_headers(struct MHD_Response *r, bool api) {
   MHD_add_response_header(r, "Cache-Control", api ? "no-store" : "no-cache");
 }
 
-static enum MHD_Result send_buf(struct MHD_Connection *c, unsigned status, const char *type, char *body, size_t len,
-                                bool take) {
-  struct MHD_Response *r = MHD_create_response_from_buffer(len, body, take ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+static enum MHD_Result send_buf(struct MHD_Connection *c, unsigned status, const char *type, char *body,
+                                size_t len, bool take) {
+  struct MHD_Response *r =
+      MHD_create_response_from_buffer(len, body, take ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
   if (!r) {
     if (take) free(body);
     return MHD_NO;
@@ -137,14 +138,22 @@ static const char *content_type(const char *name) {
   const char *dot = strrchr(name, '.');
   if (!dot) return "application/octet-stream";
   static const char *const map[][2] = {
-      {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
-      {".mjs", "text/javascript; charset=utf-8"}, {".css", "text/css; charset=utf-8"},
-      {".json", "application/json"},         {".geojson", "application/geo+json"},
-      {".png", "image/png"},                 {".svg", "image/svg+xml"},
-      {".ico", "image/x-icon"},              {".txt", "text/plain; charset=utf-8"},
-      {".csv", "text/csv; charset=utf-8"},   {".kml", "application/vnd.google-earth.kml+xml"},
-      {".yaml", "application/yaml"},         {".zip", "application/zip"},
-      {".woff2", "font/woff2"},              {".map", "application/json"},
+      {".html", "text/html; charset=utf-8"},
+      {".js", "text/javascript; charset=utf-8"},
+      {".mjs", "text/javascript; charset=utf-8"},
+      {".css", "text/css; charset=utf-8"},
+      {".json", "application/json"},
+      {".geojson", "application/geo+json"},
+      {".png", "image/png"},
+      {".svg", "image/svg+xml"},
+      {".ico", "image/x-icon"},
+      {".txt", "text/plain; charset=utf-8"},
+      {".csv", "text/csv; charset=utf-8"},
+      {".kml", "application/vnd.google-earth.kml+xml"},
+      {".yaml", "application/yaml"},
+      {".zip", "application/zip"},
+      {".woff2", "font/woff2"},
+      {".map", "application/json"},
   };
   for (size_t i = 0; i < sizeof map / sizeof map[0]; ++i)
     if (strcmp(dot, map[i][0]) == 0) return map[i][1];
@@ -152,8 +161,8 @@ static const char *content_type(const char *name) {
 }
 
 /* A file the server chose by a fixed list (never a path taken from the URL). */
-static enum MHD_Result send_file(struct MHD_Connection *c, const char *path, const char *name, bool attachment,
-                                 bool api) {
+static enum MHD_Result send_file(struct MHD_Connection *c, const char *path, const char *name,
+                                 bool attachment, bool api) {
   const int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   struct stat sb;
   if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
@@ -209,7 +218,8 @@ static bool body_type_ok(const char *type) {
   static const char *const ok[] = {"application/json", "application/yaml", "application/x-yaml", "text/yaml",
                                    "text/x-yaml"};
   size_t n = strcspn(type, ";");
-  while (n > 0 && isspace((unsigned char)type[n - 1])) --n;
+  while (n > 0 && isspace((unsigned char)type[n - 1]))
+    --n;
   for (size_t i = 0; i < sizeof ok / sizeof ok[0]; ++i)
     if (strlen(ok[i]) == n && strncasecmp(type, ok[i], n) == 0) return true;
   return false;
@@ -275,17 +285,21 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     goto cleanup;
   }
   if (runs == 0) runs = sc->simulation.runs;
-  if (runs > S.cfg.max_runs) {
-    snprintf(msg, sizeof msg, "%ld Monte Carlo runs asked; this server runs at most %ld (max_runs)", runs,
-             S.cfg.max_runs);
+  /* Campaigns above the local limit go to Slurm when it is configured (up to slurm_max_runs). */
+  const bool slurm = S.cfg.slurm && runs > S.cfg.max_runs && runs <= S.cfg.slurm_max_runs;
+  if (runs > S.cfg.max_runs && !slurm) {
+    snprintf(msg, sizeof msg, "%ld Monte Carlo runs asked; this server runs at most %ld (%s)", runs,
+             S.cfg.slurm ? S.cfg.slurm_max_runs : S.cfg.max_runs,
+             S.cfg.slurm ? "slurm_max_runs" : "max_runs");
     ret = limit_error(c, "simulation.runs", msg);
     goto cleanup;
   }
   sc->simulation.runs = runs;
   const double samples = sc->trajectory.duration_s * sc->imu.rate_hz * (double)runs;
-  if (!(samples <= S.cfg.max_imu_samples)) {
+  if (!slurm && !(samples <= S.cfg.max_imu_samples)) {
     snprintf(msg, sizeof msg,
-             "duration x IMU rate x runs = %.4g IMU samples; this server simulates at most %.4g (max_imu_samples): "
+             "duration x IMU rate x runs = %.4g IMU samples; this server simulates at most %.4g "
+             "(max_imu_samples): "
              "shorten trajectory.duration_s, lower imu.rate_hz or the runs",
              samples, S.cfg.max_imu_samples);
     ret = limit_error(c, "trajectory.duration_s", msg);
@@ -302,15 +316,16 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     ret = limit_error(c, "output.rate_hz", msg);
     goto cleanup;
   }
-  if (pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
-    snprintf(msg, sizeof msg, "the run would need about %.0f MiB of memory (%s); this server allows %ld MiB a run",
+  if (!slurm && pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
+    snprintf(msg, sizeof msg,
+             "the run would need about %.0f MiB of memory (%s); this server allows %ld MiB a run",
              pred.memory_bytes / mib, pred.memory, S.cfg.job_memory_mb);
     ret = limit_error(c, "simulation.runs", msg);
     goto cleanup;
   }
   char client[64], id[33];
   client_of(c, client, sizeof client);
-  const submit_rc rc = serve_jobs_submit(client, r->body.s ? r->body.s : "", r->body.len, sc, runs,
+  const submit_rc rc = serve_jobs_submit(client, r->body.s ? r->body.s : "", r->body.len, sc, slurm, runs,
                                          pred.output_bytes + 1e6, id);
   if (rc == SUBMIT_CLIENT_BUSY) {
     snprintf(msg, sizeof msg, "you have %d runs queued or running (max_jobs_per_client); try again later",
@@ -327,7 +342,8 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     snprintf(body, sizeof body, "{\"id\":\"%s\",\"state\":\"queued\"}\n", id);
     snprintf(loc, sizeof loc, "/api/runs/%s", id);
     char *b = strdup(body);
-    struct MHD_Response *resp = b ? MHD_create_response_from_buffer(strlen(b), b, MHD_RESPMEM_MUST_FREE) : NULL;
+    struct MHD_Response *resp =
+        b ? MHD_create_response_from_buffer(strlen(b), b, MHD_RESPMEM_MUST_FREE) : NULL;
     if (!resp) {
       free(b);
       ret = MHD_NO;
@@ -418,13 +434,15 @@ static enum MHD_Result api_events(struct MHD_Connection *c, const char *id) {
     serve_job_release(s->j);
     free(s);
     char msg[160];
-    snprintf(msg, sizeof msg, "too many event streams open (max_event_streams_per_client %d, max_event_streams %d)",
+    snprintf(msg, sizeof msg,
+             "too many event streams open (max_event_streams_per_client %d, max_event_streams %d)",
              S.cfg.max_streams_per_client, S.cfg.max_streams);
     return send_error(c, 429, msg);
   }
   s->seq = ULONG_MAX;
   s->heartbeat_s = S.cfg.connection_timeout_s / 2.0 < 15.0 ? S.cfg.connection_timeout_s / 2.0 : 15.0;
-  struct MHD_Response *r = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 4096, stream_read, s, stream_free);
+  struct MHD_Response *r =
+      MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 4096, stream_read, s, stream_free);
   if (!r) {
     stream_free(s);
     return MHD_NO;
@@ -451,7 +469,8 @@ static enum MHD_Result api_runs(struct MHD_Connection *c, const char *method, co
     if (get) {
       size_t len = 0;
       char *j = serve_job_json(id, &len);
-      return j ? send_json(c, 200, j, len) : send_error(c, 404, "no such run (unknown, or its results expired)");
+      return j ? send_json(c, 200, j, len)
+               : send_error(c, 404, "no such run (unknown, or its results expired)");
     }
     if (strcmp(method, "DELETE") == 0) {
       size_t len = 0;
@@ -486,21 +505,24 @@ static enum MHD_Result api_limits(struct MHD_Connection *c) {
   sbuf b = {0};
   const serve_config *g = &S.cfg;
   sb_printf(&b,
-            "{\"max_body_bytes\":%ld,\"max_runs\":%ld,\"max_imu_samples\":%.17g,\"job_cpu_s\":%ld,\"job_wall_s\":%ld,"
+            "{\"max_body_bytes\":%ld,\"max_runs\":%ld,\"max_imu_samples\":%.17g,\"job_cpu_s\":%ld,\"job_wall_"
+            "s\":%ld,"
             "\"job_output_mb\":%ld,\"job_memory_mb\":%ld,\"max_jobs_per_client\":%d,\"max_queued_jobs\":%d,"
             "\"max_parallel_jobs\":%d,\"max_event_streams_per_client\":%d,\"result_max_age_s\":%ld,"
             "\"estimate_cpu_s\":%ld,\"result_files\":[",
             g->max_body_bytes, g->max_runs, g->max_imu_samples, g->job_cpu_s, g->job_wall_s, g->job_output_mb,
             g->job_memory_mb, g->max_jobs_per_client, g->max_queued_jobs, g->max_parallel_jobs,
             g->max_streams_per_client, g->result_max_age_s, g->estimate_cpu_s);
-  for (int i = 0; i < serve_n_result_files; ++i) sb_printf(&b, "%s\"%s\"", i ? "," : "", serve_result_files[i]);
+  for (int i = 0; i < serve_n_result_files; ++i)
+    sb_printf(&b, "%s\"%s\"", i ? "," : "", serve_result_files[i]);
   sb_puts(&b, "]}\n");
   size_t len = 0;
   char *s = sb_take(&b, &len);
   return send_json(c, 200, s, len);
 }
 
-static enum MHD_Result route_api(struct MHD_Connection *c, const char *method, const char *url, const req *r) {
+static enum MHD_Result route_api(struct MHD_Connection *c, const char *method, const char *url,
+                                 const req *r) {
   const bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
   const bool post = strcmp(method, "POST") == 0;
   const char *p = url + 5; /* after "/api/" */
@@ -512,7 +534,8 @@ static enum MHD_Result route_api(struct MHD_Connection *c, const char *method, c
   if (strcmp(p, "schema") == 0) {
     if (!get) return send_405(c, "GET, HEAD");
     if (!S.schema_json)
-      return send_error(c, 503, "the scene JSON Schema is not available in this build (nav_schema_json is missing)");
+      return send_error(c, 503,
+                        "the scene JSON Schema is not available in this build (nav_schema_json is missing)");
     return send_buf(c, 200, "application/schema+json", S.schema_json, strlen(S.schema_json), false);
   }
   if (strcmp(p, "limits") == 0) return get ? api_limits(c) : send_405(c, "GET, HEAD");
@@ -520,7 +543,8 @@ static enum MHD_Result route_api(struct MHD_Connection *c, const char *method, c
   if (strncmp(p, "scenes/", 7) == 0) {
     if (!get) return send_405(c, "GET, HEAD");
     for (int i = 0; i < S.lib.n; ++i)
-      if (strcmp(S.lib.e[i].name, p + 7) == 0) return send_file(c, S.lib.e[i].path, "scene.yaml", false, true);
+      if (strcmp(S.lib.e[i].name, p + 7) == 0)
+        return send_file(c, S.lib.e[i].path, "scene.yaml", false, true);
     return send_error(c, 404, "no such scene in the library (GET /api/scenes lists them)");
   }
   if (strcmp(p, "validate") == 0 || strcmp(p, "runs") == 0) {
@@ -545,7 +569,8 @@ static enum MHD_Result route_static(struct MHD_Connection *c, const char *method
 }
 
 static bool is_body_route(const char *url) {
-  return strcmp(url, "/api/validate") == 0 || strcmp(url, "/api/estimate") == 0 || strcmp(url, "/api/runs") == 0;
+  return strcmp(url, "/api/validate") == 0 || strcmp(url, "/api/estimate") == 0 ||
+         strcmp(url, "/api/runs") == 0;
 }
 
 static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *url, const char *method,
@@ -572,8 +597,8 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *c, const char *
     if (strcmp(method, "POST") == 0 && is_body_route(url)) {
       if (!body_type_ok(hdr(c, "Content-Type"))) {
         r->answered = true;
-        return send_error(c, 415,
-                          "the body must be a scene: Content-Type application/yaml, text/yaml or application/json");
+        return send_error(
+            c, 415, "the body must be a scene: Content-Type application/yaml, text/yaml or application/json");
       }
       const char *cl = hdr(c, "Content-Length");
       if (cl && strtod(cl, NULL) > (double)S.cfg.max_body_bytes) {
@@ -633,7 +658,8 @@ static size_t unescape(void *cls, struct MHD_Connection *c, char *s) {
   return (size_t)(w - s);
 }
 
-static void completed(void *cls, struct MHD_Connection *c, void **con_cls, enum MHD_RequestTerminationCode toe) {
+static void completed(void *cls, struct MHD_Connection *c, void **con_cls,
+                      enum MHD_RequestTerminationCode toe) {
   (void)cls;
   (void)c;
   (void)toe;
@@ -669,12 +695,15 @@ static bool load_manifest(const char *dir) {
   }
   int cap = 0;
   for (char *line = strtok(text, "\r\n"); line; line = strtok(NULL, "\r\n")) {
-    while (*line == ' ' || *line == '\t') ++line;
+    while (*line == ' ' || *line == '\t')
+      ++line;
     size_t n = strlen(line);
-    while (n > 0 && (line[n - 1] == ' ' || line[n - 1] == '\t')) line[--n] = '\0';
+    while (n > 0 && (line[n - 1] == ' ' || line[n - 1] == '\t'))
+      line[--n] = '\0';
     if (n == 0 || line[0] == '#') continue;
     if (!manifest_name_ok(line)) {
-      fprintf(stderr, "navsim serve: %s: warning: \"%s\" is not a plain relative file name; not served\n", path, line);
+      fprintf(stderr, "navsim serve: %s: warning: \"%s\" is not a plain relative file name; not served\n",
+              path, line);
       continue;
     }
     char fp[SERVE_PATH_MAX + 512];
@@ -759,7 +788,7 @@ static bool parse_port(const char *v, int *out) {
 }
 
 int navserve_main(int argc, char **argv) {
-  const char *bind = NULL, *data_dir = NULL, *config = NULL, *studio = NULL;
+  const char *bind_arg = NULL, *data_dir = NULL, *config = NULL, *studio = NULL;
   int port = -1;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -778,10 +807,14 @@ int navserve_main(int argc, char **argv) {
       return 2;
     }
     const char *v = argv[++i];
-    if (strcmp(a, "--bind") == 0) bind = v;
-    else if (strcmp(a, "--data-dir") == 0) data_dir = v;
-    else if (strcmp(a, "--config") == 0) config = v;
-    else if (strcmp(a, "--studio-dir") == 0) studio = v;
+    if (strcmp(a, "--bind") == 0)
+      bind_arg = v;
+    else if (strcmp(a, "--data-dir") == 0)
+      data_dir = v;
+    else if (strcmp(a, "--config") == 0)
+      config = v;
+    else if (strcmp(a, "--studio-dir") == 0)
+      studio = v;
     else if (!parse_port(v, &port)) {
       fprintf(stderr, "navsim serve: --port: expected an integer in [0, 65535], got \"%s\"\n", v);
       return 2;
@@ -789,7 +822,7 @@ int navserve_main(int argc, char **argv) {
   }
   serve_config cfg = serve_config_default();
   if (config && !serve_config_read(config, &cfg)) return 2;
-  if (bind) snprintf(cfg.bind, sizeof cfg.bind, "%s", bind);
+  if (bind_arg) snprintf(cfg.bind, sizeof cfg.bind, "%s", bind_arg);
   if (port >= 0) cfg.port = port;
   if (data_dir) snprintf(cfg.data_dir, sizeof cfg.data_dir, "%s", data_dir);
   if (studio) snprintf(cfg.studio_dir, sizeof cfg.studio_dir, "%s", studio);
@@ -825,6 +858,7 @@ int navserve_main(int argc, char **argv) {
   umask(077); /* job directories and results are private to this user */
 
   int rc = 1;
+  int lsock = -1;
   struct MHD_Daemon *d = NULL;
   char why[SERVE_PATH_MAX + 256];
   if (!serve_jobs_start(&cfg, why, sizeof why)) {
@@ -842,24 +876,22 @@ int navserve_main(int argc, char **argv) {
   find_studio();
   if (S.n_files == 0) fprintf(stderr, "navsim serve: warning: %s; serving the API only\n", S.studio_why);
 
-  const unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
-                         MHD_USE_ITC | (v6 ? MHD_USE_IPv6 : 0);
-  d = MHD_start_daemon(flags, (uint16_t)cfg.port, NULL, NULL, handler, NULL, MHD_OPTION_SOCK_ADDR,
-                       v6 ? (const struct sockaddr *)(const void *)&sa6 : (const struct sockaddr *)(const void *)&sa4,
-                       MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg.max_connections,
-                       MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_client,
-                       MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.connection_timeout_s,
-                       MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024), MHD_OPTION_NOTIFY_COMPLETED,
-                       completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE,
-                       (size_t)(2u << 20), MHD_OPTION_END);
-  if (!d) {
-    fprintf(stderr, "navsim serve: cannot listen on %s port %d (in use, or not an address of this machine)\n",
-            cfg.bind, cfg.port);
+  /* The listening socket is made here, so that its port (of --port 0) and the Host values this
+   * server answers to (a defence against DNS rebinding) are known before any request arrives. */
+  lsock = socket(v6 ? AF_INET6 : AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  const int one = 1;
+  if (lsock >= 0) (void)setsockopt(lsock, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  const struct sockaddr *sa =
+      v6 ? (const struct sockaddr *)(const void *)&sa6 : (const struct sockaddr *)(const void *)&sa4;
+  if (lsock < 0 || bind(lsock, sa, v6 ? sizeof sa6 : sizeof sa4) != 0 || listen(lsock, 128) != 0) {
+    fprintf(stderr, "navsim serve: cannot listen on %s port %d: %s\n", cfg.bind, cfg.port, strerror(errno));
     goto cleanup;
   }
-  const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
-  S.port = info ? (int)info->port : cfg.port;
-  /* Host values this server answers to (a defence against DNS rebinding). */
+  struct sockaddr_storage bound;
+  socklen_t blen = sizeof bound;
+  if (getsockname(lsock, (struct sockaddr *)(void *)&bound, &blen) != 0) goto cleanup;
+  S.port = ntohs(v6 ? ((struct sockaddr_in6 *)(void *)&bound)->sin6_port
+                    : ((struct sockaddr_in *)(void *)&bound)->sin_port);
   const char *fmt = v6 ? "[%s]:%d" : "%s:%d";
   snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], fmt, cfg.bind, S.port);
   snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], "localhost:%d", S.port);
@@ -869,6 +901,19 @@ int navserve_main(int argc, char **argv) {
     const char *h = strstr(cfg.allowed_origin, "://");
     snprintf(S.hosts[S.n_hosts++], sizeof S.hosts[0], "%s", h ? h + 3 : cfg.allowed_origin);
   }
+  const unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
+                         MHD_USE_ITC | (v6 ? MHD_USE_IPv6 : 0);
+  d = MHD_start_daemon(
+      flags, (uint16_t)S.port, NULL, NULL, handler, NULL, MHD_OPTION_LISTEN_SOCKET, lsock,
+      MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg.max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+      (unsigned)cfg.max_connections_per_client, MHD_OPTION_CONNECTION_TIMEOUT,
+      (unsigned)cfg.connection_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)(64 * 1024),
+      MHD_OPTION_NOTIFY_COMPLETED, completed, NULL, MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL,
+      MHD_OPTION_STRICT_FOR_CLIENT, (int)1, MHD_OPTION_THREAD_STACK_SIZE, (size_t)(2u << 20), MHD_OPTION_END);
+  if (!d) {
+    fprintf(stderr, "navsim serve: cannot start the HTTP server on %s port %d\n", cfg.bind, S.port);
+    goto cleanup;
+  }
   printf(v6 ? "listening on http://[%s]:%d/\n" : "listening on http://%s:%d/\n", cfg.bind, S.port);
   fflush(stdout);
 
@@ -876,12 +921,13 @@ int navserve_main(int argc, char **argv) {
   while (sigwait(&stop_set, &sig) != 0) {
   }
   fprintf(stderr, "navsim serve: signal %d: stopping (running jobs are cancelled)\n", sig);
-  MHD_quiesce_daemon(d); /* no new connections */
+  (void)MHD_quiesce_daemon(d); /* no new connections (the socket comes back to us: closed below) */
   rc = 0;
 
 cleanup:
   serve_jobs_stop(); /* cancels jobs; event streams see the stop and end */
   if (d) MHD_stop_daemon(d);
+  if (lsock >= 0) close(lsock);
   for (int i = 0; i < S.n_files; ++i) {
     free(S.files[i].url);
     free(S.files[i].path);

@@ -24,7 +24,8 @@ static bool sb_reserve(sbuf *b, size_t extra) {
   if (b->failed) return false;
   if (b->len + extra + 1 <= b->cap) return true;
   size_t cap = b->cap ? b->cap : 256;
-  while (cap < b->len + extra + 1) cap *= 2;
+  while (cap < b->len + extra + 1)
+    cap *= 2;
   char *s = realloc(b->s, cap);
   if (!s) {
     b->failed = true;
@@ -42,7 +43,9 @@ void sb_add(sbuf *b, const char *text, size_t n) {
   b->s[b->len] = '\0';
 }
 
-void sb_puts(sbuf *b, const char *text) { sb_add(b, text, strlen(text)); }
+void sb_puts(sbuf *b, const char *text) {
+  sb_add(b, text, strlen(text));
+}
 
 void sb_printf(sbuf *b, const char *fmt, ...) {
   va_list ap;
@@ -174,7 +177,9 @@ static int remove_one(const char *path, const struct stat *sb, int flag, struct 
   return 0;
 }
 
-void serve_remove_tree(const char *path) { nftw(path, remove_one, 16, FTW_DEPTH | FTW_PHYS); }
+void serve_remove_tree(const char *path) {
+  nftw(path, remove_one, 16, FTW_DEPTH | FTW_PHYS);
+}
 
 static _Thread_local double g_tree_bytes;
 
