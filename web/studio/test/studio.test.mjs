@@ -220,6 +220,13 @@ test('Cancel stops a running campaign; a GPX track becomes waypoints', { skip: w
   assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok',
     await page.$eval('#yaml-status', (e) => e.textContent));
   await page.screenshot({ path: shotPath('D1-gpx-waypoints.png') });
+  // A KML line string (lon,lat[,h] triples) likewise.
+  const kml = `<?xml version="1.0"?><kml xmlns="http://www.opengis.net/kml/2.2"><Placemark><LineString><coordinates>
+    13.3777,52.5163,0 13.3800,52.5170,0 13.3820,52.5180,0</coordinates></LineString></Placemark></kml>`;
+  const kfile = join(mkdtempSync(join(tmpdir(), 'studio-')), 'track.kml');
+  writeFileSync(kfile, kml);
+  await (await page.$('#open-file')).uploadFile(kfile);
+  await page.waitForFunction(() => document.querySelectorAll('#wp-list li').length === 3);
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -236,7 +243,13 @@ test('tablet-sized window and keyboard: tabs by arrow keys, the YAML view report
   await page.keyboard.press('Enter');
   await page.waitForFunction(() => document.querySelectorAll('#wp-list li').length === 1);
   await page.focus('#map');
+  const c0 = await page.evaluate(() => window.__studio.map.centre());
   for (let i = 0; i < 4; ++i) await page.keyboard.press('ArrowRight');
+  // The pan is animated: wait until the view has settled east of where it was.
+  await page.waitForFunction((x0) => {
+    const v = window.__studio.map.map.getView();
+    return !v.getAnimating() && window.__studio.map.centre()[0] > x0;
+  }, { polling: 50 }, c0[0]);
   await page.focus('#add-centre');
   await page.keyboard.press('Enter');
   await page.waitForFunction(() => document.querySelectorAll('#wp-list li').length === 2);
