@@ -73,14 +73,22 @@ function status(msg) { $('status').textContent = msg; }
 // ---------------------------------------------------------------- change propagation
 let pendingCheck = null;
 function changed(source, structure = false) {
+  // A loaded scene is validated and estimated at once: the requests go out before the forms
+  // and the map are built, which overlap the server's work.
+  if (source === 'load') {
+    clearTimeout(pendingCheck);
+    $('estimate').dataset.state = 'pending';
+    checkAndEstimate();
+  }
   if (source !== 'yaml') $('yaml').value = scene.text();
   if (source !== 'form' || structure) renderForms();
   syncFlow();
   drawPreview();
   history.replaceState(null, '', '#scene=' + b64(scene.text()));
+  if (source === 'load') return;
   clearTimeout(pendingCheck);
   $('estimate').dataset.state = 'pending';
-  pendingCheck = setTimeout(checkAndEstimate, source === 'load' ? 0 : source === 'yaml' ? 300 : 250);
+  pendingCheck = setTimeout(checkAndEstimate, source === 'yaml' ? 300 : 250);
 }
 const b64 = (s) => btoa(String.fromCharCode(...new TextEncoder().encode(s))).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
 const unb64 = (s) => new TextDecoder().decode(Uint8Array.from(atob(s.replace(/-/g, '+').replace(/_/g, '/')), (c) => c.charCodeAt(0)));

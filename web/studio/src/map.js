@@ -50,11 +50,15 @@ export class StudioMap {
       opacity: 0.85,
       minResolution: 300, // from a few hundred km across, as navview's map
     });
+    // Coastlines and lakes from regional scale up (navview: views wider than 15 km); at street
+    // scale they are neither drawn nor loaded (OpenLayers loads a layer's source when it shows).
     const land = new VectorLayer({
+      minResolution: 18,
       source: new VectorSource({ url: 'map/land.geojson', format: geo }),
       style: new Style({ fill: new Fill({ color: 'rgba(236,232,220,0.55)' }), stroke: new Stroke({ color: '#4d5c73', width: 1.2 }) }),
     });
     const lakes = new VectorLayer({
+      minResolution: 18,
       source: new VectorSource({ url: 'map/lakes.geojson', format: geo }),
       style: new Style({ fill: new Fill({ color: 'rgba(170,200,230,0.8)' }), stroke: new Stroke({ color: '#4d5c73', width: 0.8 }) }),
     });
@@ -87,7 +91,9 @@ export class StudioMap {
           }),
         }),
       ],
-      view: new View({ center: fromLonLat([0, 0]), zoom: 2, maxZoom: 21 }),
+      // Street scale until a scene is loaded and fitted: the world's coastlines are not parsed
+      // for a picture nobody sees.
+      view: new View({ center: fromLonLat([0, 0]), zoom: 16, maxZoom: 21 }),
     });
     this.map.on('moveend', () => this.metricGrid());
     this.map.on('click', (ev) => {
