@@ -298,6 +298,9 @@ t0 = time.time()
 while time.time() - t0 < 30 and srv2.request("GET", f"/api/runs/{j['id']}")[0] == 200:
     time.sleep(0.2)
 check(srv2.request("GET", f"/api/runs/{j['id']}")[0] == 404, f"expired after {time.time() - t0:.1f} s (age 2 s)")
+t1 = time.time()
+while time.time() - t1 < 10 and os.path.exists(jobdir):  # removed just after it leaves the list
+    time.sleep(0.1)
 check(not os.path.exists(jobdir), "its directory is removed")
 check(srv2.stop() == 0, "clean stop of the expiry server")
 srv3 = Server(NAVSIM, {"disk_quota_mb": 1})
