@@ -168,6 +168,9 @@ check(st == 422 and len(j["errors"]) > 5, f"invalid scene run -> 422 ({st})")
 long_scene = MINIMAL + b"trajectory: {type: parametric, duration_s: 100000}\nimu: {rate_hz: 1000}\n"
 st, _, j = srv.json("POST", "/api/runs", long_scene)
 check(st == 422 and "max_imu_samples" in j["errors"][0]["message"], f"duration x rate cap -> 422 ({st} {j})")
+st, _, v = srv.json("POST", "/api/validate", long_scene)
+check(st == 200 and v["ok"] is True and v["warnings"][0]["message"] == j["errors"][0]["message"],
+      f"validate: valid, with the run limit as a warning ({st} {v})")
 
 st, hd, j = srv.json("POST", "/api/runs?runs=3", read(os.path.join(SCENES, "car-figure-eight.yaml")))
 check(st == 202 and len(j.get("id", "")) == 32 and j["state"] == "queued", f"POST /api/runs -> 202 ({st} {j})")
