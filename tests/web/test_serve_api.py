@@ -290,6 +290,21 @@ check(rc == 0, f"SIGTERM -> exit 0 (got {rc})")
 check(time.time() - t0 < 10, f"stopped in {time.time() - t0:.1f} s")
 time.sleep(0.2)
 check(srv.job_processes() == [], "no job process outlives the server")
+# ---------------------------------------------------------------- IPv6
+p6 = subprocess.Popen([NAVSIM, "serve", "--bind", "::1", "--port", "0", "--data-dir", srv.data + "-v6"],
+                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+line = p6.stdout.readline()
+check(line.startswith("listening on http://[::1]:"), f"--bind ::1 ({line!r})")
+if line.startswith("listening on http://[::1]:"):
+    port6 = int(line.strip().rstrip("/").rsplit(":", 1)[1])
+    c6 = __import__("http.client").client.HTTPConnection("::1", port6, timeout=30)
+    c6.request("GET", "/api/limits")
+    r6 = c6.getresponse()
+    check(r6.status == 200 and b"max_runs" in r6.read(), f"GET over IPv6 ({r6.status})")
+    c6.close()
+p6.send_signal(__import__("signal").SIGINT)
+check(p6.wait(timeout=30) == 0, "SIGINT -> exit 0")
+
 # ---------------------------------------------------------------- expiry by age, disk quota (503)
 srv2 = Server(NAVSIM, {"result_max_age_s": 2})
 st, _, j = srv2.json("POST", "/api/runs?runs=1", MINIMAL)
