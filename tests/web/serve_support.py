@@ -164,10 +164,10 @@ class Server:
                 found.append(int(p))
         return found
 
-    def stop(self):
-        """SIGTERM; the exit code (0 expected)."""
+    def stop(self, sig=signal.SIGTERM):
+        """Stop with @p sig (SIGTERM or SIGINT); the exit code (0 expected)."""
         if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
+            self.proc.send_signal(sig)
         try:
             rc = self.proc.wait(timeout=30)
         except subprocess.TimeoutExpired:

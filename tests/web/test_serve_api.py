@@ -168,6 +168,9 @@ check(st == 422 and len(j["errors"]) > 5, f"invalid scene run -> 422 ({st})")
 long_scene = MINIMAL + b"trajectory: {type: parametric, duration_s: 100000}\nimu: {rate_hz: 1000}\n"
 st, _, j = srv.json("POST", "/api/runs", long_scene)
 check(st == 422 and "max_imu_samples" in j["errors"][0]["message"], f"duration x rate cap -> 422 ({st} {j})")
+st, _, v = srv.json("POST", "/api/validate", long_scene)
+check(st == 200 and v["ok"] is True and v["warnings"][0]["message"] == j["errors"][0]["message"],
+      f"validate: valid, with the run limit as a warning ({st} {v})")
 
 st, hd, j = srv.json("POST", "/api/runs?runs=3", read(os.path.join(SCENES, "car-figure-eight.yaml")))
 check(st == 202 and len(j.get("id", "")) == 32 and j["state"] == "queued", f"POST /api/runs -> 202 ({st} {j})")
@@ -287,6 +290,21 @@ check(rc == 0, f"SIGTERM -> exit 0 (got {rc})")
 check(time.time() - t0 < 10, f"stopped in {time.time() - t0:.1f} s")
 time.sleep(0.2)
 check(srv.job_processes() == [], "no job process outlives the server")
+# ---------------------------------------------------------------- IPv6
+p6 = subprocess.Popen([NAVSIM, "serve", "--bind", "::1", "--port", "0", "--data-dir", srv.data + "-v6"],
+                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+line = p6.stdout.readline()
+check(line.startswith("listening on http://[::1]:"), f"--bind ::1 ({line!r})")
+if line.startswith("listening on http://[::1]:"):
+    port6 = int(line.strip().rstrip("/").rsplit(":", 1)[1])
+    c6 = __import__("http.client").client.HTTPConnection("::1", port6, timeout=30)
+    c6.request("GET", "/api/limits")
+    r6 = c6.getresponse()
+    check(r6.status == 200 and b"max_runs" in r6.read(), f"GET over IPv6 ({r6.status})")
+    c6.close()
+p6.send_signal(__import__("signal").SIGINT)
+check(p6.wait(timeout=30) == 0, "SIGINT -> exit 0")
+
 # ---------------------------------------------------------------- expiry by age, disk quota (503)
 srv2 = Server(NAVSIM, {"result_max_age_s": 2})
 st, _, j = srv2.json("POST", "/api/runs?runs=1", MINIMAL)
@@ -298,6 +316,9 @@ t0 = time.time()
 while time.time() - t0 < 30 and srv2.request("GET", f"/api/runs/{j['id']}")[0] == 200:
     time.sleep(0.2)
 check(srv2.request("GET", f"/api/runs/{j['id']}")[0] == 404, f"expired after {time.time() - t0:.1f} s (age 2 s)")
+t1 = time.time()
+while time.time() - t1 < 10 and os.path.exists(jobdir):  # removed just after it leaves the list
+    time.sleep(0.1)
 check(not os.path.exists(jobdir), "its directory is removed")
 check(srv2.stop() == 0, "clean stop of the expiry server")
 srv3 = Server(NAVSIM, {"disk_quota_mb": 1})

@@ -18,7 +18,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <linux/landlock.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/time.h>
@@ -141,6 +143,47 @@ static void set_limit(int resource, rlim_t soft, rlim_t hard) {
   (void)setrlimit(resource, &rl);
 }
 
+/*
+ * Landlock (Linux 5.13+, when the kernel has it): the process may create, write, rename or remove
+ * files only beneath its working directory (the job's own directory). Reading stays open (the
+ * program, its libraries, the catalogs). Without Landlock this does nothing; the other limits
+ * stay. Called in the child after fork, with no-new-privileges set: system calls only.
+ */
+static void confine_writes(void) {
+  const long abi = syscall(SYS_landlock_create_ruleset, NULL, 0, LANDLOCK_CREATE_RULESET_VERSION);
+  if (abi < 1) return;
+  __u64 w = LANDLOCK_ACCESS_FS_WRITE_FILE | LANDLOCK_ACCESS_FS_REMOVE_DIR | LANDLOCK_ACCESS_FS_REMOVE_FILE |
+            LANDLOCK_ACCESS_FS_MAKE_CHAR | LANDLOCK_ACCESS_FS_MAKE_DIR | LANDLOCK_ACCESS_FS_MAKE_REG |
+            LANDLOCK_ACCESS_FS_MAKE_SOCK | LANDLOCK_ACCESS_FS_MAKE_FIFO | LANDLOCK_ACCESS_FS_MAKE_BLOCK |
+            LANDLOCK_ACCESS_FS_MAKE_SYM;
+  if (abi >= 2) w |= LANDLOCK_ACCESS_FS_REFER;
+#ifdef LANDLOCK_ACCESS_FS_TRUNCATE
+  if (abi >= 3) w |= LANDLOCK_ACCESS_FS_TRUNCATE;
+#endif
+  struct landlock_ruleset_attr ra;
+  memset(&ra, 0, sizeof ra);
+  ra.handled_access_fs = w;
+  const int rs = (int)syscall(SYS_landlock_create_ruleset, &ra, sizeof ra, 0);
+  if (rs < 0) return;
+  const int here = open(".", O_PATH | O_CLOEXEC);
+  struct landlock_path_beneath_attr pb;
+  memset(&pb, 0, sizeof pb);
+  pb.allowed_access = w;
+  pb.parent_fd = here;
+  /* A rule that cannot be added would leave the job unable to write its results: then no
+   * confinement rather than a broken job. */
+  bool ok = here >= 0 && syscall(SYS_landlock_add_rule, rs, LANDLOCK_RULE_PATH_BENEATH, &pb, 0) == 0;
+  /* Writing to /dev/null stays allowed (output thrown away). */
+  const int null = open("/dev/null", O_PATH | O_CLOEXEC);
+  pb.allowed_access = LANDLOCK_ACCESS_FS_WRITE_FILE;
+  pb.parent_fd = null;
+  ok = ok && null >= 0 && syscall(SYS_landlock_add_rule, rs, LANDLOCK_RULE_PATH_BENEATH, &pb, 0) == 0;
+  if (ok) (void)syscall(SYS_landlock_restrict_self, rs, 0);
+  if (here >= 0) close(here);
+  if (null >= 0) close(null);
+  close(rs);
+}
+
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name) {
   return serve_spawn_prog("/proc/self/exe", dir, argv, progress_fd, cpu_s, log_name);
 }
@@ -184,6 +227,7 @@ pid_t serve_spawn_prog(const char *prog, const char *dir, char *const argv[], in
   (void)as;
 #endif
   if (prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) _exit(126);
+  confine_writes();
   umask(077);
   execve(prog, argv, g.envp);
   _exit(127);

@@ -231,18 +231,83 @@ static const char *hdr(struct MHD_Connection *c, const char *name) {
   return MHD_lookup_connection_value(c, MHD_HEADER_KIND, name);
 }
 
+/*
+ * The limits a run of @p sc with @p runs Monte Carlo runs is held to before it is queued. False
+ * with the field to change (@p path) and why (@p msg) when it is beyond them; otherwise *slurm
+ * (a campaign for Slurm) and the predicted bytes of its result files.
+ */
+static bool run_limits(nav_scene *sc, long runs, bool *slurm, double *predicted, char *path, size_t path_size,
+                       char *msg, size_t msg_size) {
+  /* Campaigns above the local limit go to Slurm when it is configured (up to slurm_max_runs). */
+  *slurm = S.cfg.slurm && runs > S.cfg.max_runs && runs <= S.cfg.slurm_max_runs;
+  if (runs > S.cfg.max_runs && !*slurm) {
+    snprintf(path, path_size, "simulation.runs");
+    snprintf(msg, msg_size, "%ld Monte Carlo runs asked; this server runs at most %ld (%s)", runs,
+             S.cfg.slurm ? S.cfg.slurm_max_runs : S.cfg.max_runs,
+             S.cfg.slurm ? "slurm_max_runs" : "max_runs");
+    return false;
+  }
+  sc->simulation.runs = runs;
+  const double samples = sc->trajectory.duration_s * sc->imu.rate_hz * (double)runs;
+  if (!*slurm && !(samples <= S.cfg.max_imu_samples)) {
+    snprintf(path, path_size, "trajectory.duration_s");
+    snprintf(msg, msg_size,
+             "duration x IMU rate x runs = %.4g IMU samples; this server simulates at most %.4g "
+             "(max_imu_samples): shorten trajectory.duration_s, lower imu.rate_hz or the runs",
+             samples, S.cfg.max_imu_samples);
+    return false;
+  }
+  navsim_size_prediction pred;
+  navsim_predict_run(sc, false, S.cfg.job_threads, true, &pred);
+  const double mib = 1024.0 * 1024.0;
+  *predicted = pred.output_bytes;
+  if (pred.output_bytes > (double)S.cfg.job_output_mb * mib) {
+    snprintf(path, path_size, "output.rate_hz");
+    snprintf(msg, msg_size,
+             "the result files would take up to %.0f MiB (%s); this server keeps at most %ld MiB a run "
+             "(job_output_mb): lower output.rate_hz or shorten the trajectory",
+             pred.output_bytes / mib, pred.files, S.cfg.job_output_mb);
+    return false;
+  }
+  if (!*slurm && pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
+    snprintf(path, path_size, "simulation.runs");
+    snprintf(msg, msg_size,
+             "the run would need about %.0f MiB of memory (%s); this server allows %ld MiB a run",
+             pred.memory_bytes / mib, pred.memory, S.cfg.job_memory_mb);
+    return false;
+  }
+  return true;
+}
+
 static enum MHD_Result api_validate(struct MHD_Connection *c, const req *r) {
   serve_diags *d = malloc(sizeof *d);
   if (!d) return send_error(c, 500, "out of memory");
-  const bool ok = serve_scene_check(r->body.s ? r->body.s : "", r->body.len, serve_tmp_dir(), NULL, d);
+  nav_scene *sc = malloc(sizeof *sc);
+  const bool ok = sc && serve_scene_check(r->body.s ? r->body.s : "", r->body.len, serve_tmp_dir(), sc, d);
   enum MHD_Result ret;
-  if (ok) {
+  char path[64], msg[512];
+  double predicted = 0.0;
+  bool slurm = false;
+  if (ok && run_limits(sc, sc->simulation.runs, &slurm, &predicted, path, sizeof path, msg, sizeof msg)) {
     ret = send_static_json(c, 200, "{\"ok\":true}\n");
+  } else if (ok) {
+    /* Valid, but a run as it stands is beyond this server's limits: said as a warning (POST
+     * /api/runs would answer 422 with the same text). */
+    sbuf b = {0};
+    sb_puts(&b, "{\"ok\":true,\"warnings\":[{\"path\":");
+    sb_json_str(&b, path);
+    sb_puts(&b, ",\"message\":");
+    sb_json_str(&b, msg);
+    sb_puts(&b, "}]}\n");
+    size_t len = 0;
+    char *j = sb_take(&b, &len);
+    ret = send_json(c, 200, j, len);
   } else {
     size_t len = 0;
     char *j = serve_diags_json(d, "the scene is not valid", &len);
     ret = send_json(c, 422, j, len);
   }
+  free(sc);
   free(d);
   return ret;
 }
@@ -285,48 +350,17 @@ static enum MHD_Result api_post_run(struct MHD_Connection *c, const req *r) {
     goto cleanup;
   }
   if (runs == 0) runs = sc->simulation.runs;
-  /* Campaigns above the local limit go to Slurm when it is configured (up to slurm_max_runs). */
-  const bool slurm = S.cfg.slurm && runs > S.cfg.max_runs && runs <= S.cfg.slurm_max_runs;
-  if (runs > S.cfg.max_runs && !slurm) {
-    snprintf(msg, sizeof msg, "%ld Monte Carlo runs asked; this server runs at most %ld (%s)", runs,
-             S.cfg.slurm ? S.cfg.slurm_max_runs : S.cfg.max_runs,
-             S.cfg.slurm ? "slurm_max_runs" : "max_runs");
-    ret = limit_error(c, "simulation.runs", msg);
-    goto cleanup;
-  }
-  sc->simulation.runs = runs;
-  const double samples = sc->trajectory.duration_s * sc->imu.rate_hz * (double)runs;
-  if (!slurm && !(samples <= S.cfg.max_imu_samples)) {
-    snprintf(msg, sizeof msg,
-             "duration x IMU rate x runs = %.4g IMU samples; this server simulates at most %.4g "
-             "(max_imu_samples): "
-             "shorten trajectory.duration_s, lower imu.rate_hz or the runs",
-             samples, S.cfg.max_imu_samples);
-    ret = limit_error(c, "trajectory.duration_s", msg);
-    goto cleanup;
-  }
-  navsim_size_prediction pred;
-  navsim_predict_run(sc, false, S.cfg.job_threads, true, &pred);
-  const double mib = 1024.0 * 1024.0;
-  if (pred.output_bytes > (double)S.cfg.job_output_mb * mib) {
-    snprintf(msg, sizeof msg,
-             "the result files would take up to %.0f MiB (%s); this server keeps at most %ld MiB a run "
-             "(job_output_mb): lower output.rate_hz or shorten the trajectory",
-             pred.output_bytes / mib, pred.files, S.cfg.job_output_mb);
-    ret = limit_error(c, "output.rate_hz", msg);
-    goto cleanup;
-  }
-  if (!slurm && pred.memory_bytes > (double)S.cfg.job_memory_mb * mib * 0.5) {
-    snprintf(msg, sizeof msg,
-             "the run would need about %.0f MiB of memory (%s); this server allows %ld MiB a run",
-             pred.memory_bytes / mib, pred.memory, S.cfg.job_memory_mb);
-    ret = limit_error(c, "simulation.runs", msg);
+  double predicted = 0.0;
+  bool slurm = false;
+  char path[64];
+  if (!run_limits(sc, runs, &slurm, &predicted, path, sizeof path, msg, sizeof msg)) {
+    ret = limit_error(c, path, msg);
     goto cleanup;
   }
   char client[64], id[33];
   client_of(c, client, sizeof client);
   const submit_rc rc = serve_jobs_submit(client, r->body.s ? r->body.s : "", r->body.len, sc, slurm, runs,
-                                         pred.output_bytes + 1e6, id);
+                                         predicted + 1e6, id);
   if (rc == SUBMIT_CLIENT_BUSY) {
     snprintf(msg, sizeof msg, "you have %d runs queued or running (max_jobs_per_client); try again later",
              S.cfg.max_jobs_per_client);
