@@ -307,8 +307,10 @@ async function checkOnce() {
   if (checkAgain) return;
   const st = $('yaml-status');
   if (v.status === 200) {
-    st.className = 'good';
-    st.textContent = 'valid scene';
+    const warns = (v.json && Array.isArray(v.json.warnings)) ? v.json.warnings : [];
+    st.className = warns.length ? 'bad' : 'good';
+    st.textContent = warns.length ? 'valid scene, but: ' + warns.map((w) => `${w.path}: ${w.message}`).join('\n') : 'valid scene';
+    if (warns.length) status(`this server would not run the scene as it stands: ${warns[0].message}`);
   } else {
     st.className = 'bad';
     const errs = (v.json && v.json.errors) || [];
