@@ -6,6 +6,7 @@
 NAV_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcmocka-dev libfyaml-dev libgeographiclib-dev
+  libmicrohttpd-dev libzip-dev python3 # navsim serve (web/server) and its tests (Python standard library)
   libexpat1-dev libxml2-utils       # GPX/KML import (expat); xmllint checks exported KML in tests
   libvtk9-dev fonts-dejavu-core
   xvfb xauth
@@ -43,6 +44,21 @@ nav_ensure_packages() {
   export DEBIAN_FRONTEND=noninteractive
   "${sudo[@]}" apt-get update -q >/dev/null
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# The browser studio (web/studio, built when node and npm are found) needs node >= 18 and npm:
+# its packages come from the committed package-lock.json through `npm ci` at build time. A
+# machine that has neither gets Debian's (node 18); one that has a newer node keeps it.
+nav_ensure_node() {
+  if command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 &&
+     [ "$(node -p 'process.versions.node.split(".")[0]' 2>/dev/null || echo 0)" -ge 18 ]; then
+    return 0
+  fi
+  local sudo=()
+  [ "$(id -u)" -ne 0 ] && sudo=(sudo)
+  nav_log "installing node and npm (browser studio)"
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -q --no-install-recommends nodejs npm >/dev/null ||
+    nav_log "node/npm not installed: the browser studio (NAV_BUILD_WEB) is left out"
 }
 
 # navstudio (editor/) is built when Qt5 and VTK's Qt support are installed, in the plain build

@@ -454,4 +454,6 @@ void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int c
   }
   if (!quiet) fprintf(stderr, "  bench: navstudio live preview...\n");
   bench_case_studio_preview(full, out_dir, rows, n, cap);
+  if (!quiet) fprintf(stderr, "  bench: browser studio, scene to first picture...\n");
+  bench_case_web_first_picture(full, out_dir, rows, n, cap);
 }

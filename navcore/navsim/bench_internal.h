@@ -71,6 +71,9 @@ void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int c
 /* navstudio's live-preview latency (bench_studio.c): its row, and its line of the target table. */
 void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
 void bench_studio_target_md(FILE *md, const bench_row *rows, int n);
+/* The browser studio's scene to first picture (bench_web.c): its row, and its target line. */
+void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
+void bench_web_target_md(FILE *md, const bench_row *rows, int n);
 
 /* Per-stage floating-point operation counts (bench_report.c). */
 typedef struct bench_flops {

@@ -579,6 +579,7 @@ void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *
     snprintf(v, sizeof v, "%.3g frames/s", f ? f->fps : NAN);
     target_line(md, "viewer, one-hour 200 Hz case (20 paths)", "reported", f ? BENCH_MET : BENCH_NOT_MEASURED, v);
     bench_studio_target_md(md, rows, n);
+    bench_web_target_md(md, rows, n);
   }
   {
     struct rusage self, kids;

@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,6 +38,14 @@
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_version.h"
+#ifdef NAVSIM_HAVE_SERVE
+#include "navserve.h"
+/* Listed only when built: the man pages and bash completion are made from this list. */
+#define NAVSIM_SERVE_HELP \
+  "  serve            HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)\n"
+#else
+#define NAVSIM_SERVE_HELP ""
+#endif
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2, EXIT_REQUIREMENT = 3 };
 
@@ -63,6 +72,7 @@ static const char *k_usage =
     "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
     "  tradeoff SCENE   CPU time against error of each modelling choice; the cheapest within tolerance\n"
     "  schema           JSON Schema of scene files: keys, types, units, bounds, defaults\n"
+    NAVSIM_SERVE_HELP
     "\n"
     "options:\n"
     "  --version        print \"navsim X.Y.Z\" and exit\n"
@@ -82,7 +92,7 @@ static const char *k_usage_check =
 
 static const char *k_usage_run =
     "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
-    "                  [--kml] [--strict] [--allow-large] [--export kfgins]\n"
+    "                  [--kml] [--strict] [--allow-large] [--export kfgins] [--progress-fd N]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -137,6 +147,9 @@ static const char *k_usage_run_tail =
     "                navsim replay --imu DIR/kfgins/IMU.txt --gnss DIR/kfgins/GNSS.txt\n"
     "                --truth DIR/kfgins/truth.nav --init DIR/kfgins/init.nav --scene SCENE\n"
     "                reproduces run 0's nav.csv (10 Hz output epochs)\n"
+    "  --progress-fd N  also write the progress as lines \"progress F\" (F the fraction of the job\n"
+    "                done, 0 to 1, at most about ten lines a second and a last one at 1) to the\n"
+    "                open file descriptor N, for a program that runs navsim (navsim serve)\n"
     "  -h, --help    print this help\n"
     "\n" NAVSIM_LIMITS_HELP "\n"
     "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
@@ -193,6 +206,8 @@ typedef struct run_out {
   navsim_gnss_sat_out *gsat; /* gnss_dop.csv, gnss_sats.csv (gnss.constellation), or NULL */
   navsim_kfgins *kfgins;     /* --export kfgins, or NULL */
   char kfgins_msg[256];      /* what the kfgins export reported on failure */
+  int progress_fd;           /* --progress-fd, or -1 */
+  double t_last_fd;          /* wall clock of the last line written there */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -261,10 +276,28 @@ static nav_callback_result on_smoothed(void *user, const nav_sim_record *r) {
   return NAV_CONTINUE;
 }
 
+/* --progress-fd: one "progress F" line, at most about ten a second (the last one always). */
+static void progress_line(run_out *o, double fraction, double t) {
+  if (o->progress_fd < 0 || (t - o->t_last_fd < 0.1 && fraction < 1.0)) return;
+  char line[64];
+  const int n = snprintf(line, sizeof line, "progress %.6f\n", fraction);
+  for (int off = 0; n > 0 && off < n;) {
+    const ssize_t w = write(o->progress_fd, line + off, (size_t)(n - off));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      o->progress_fd = -1; /* the reader went away: stop reporting, keep running */
+      break;
+    }
+    off += (int)w;
+  }
+  o->t_last_fd = t;
+}
+
 static nav_callback_result on_progress(void *user, const nav_progress *p) {
   run_out *o = user;
-  if (o->quiet_progress) return NAV_CONTINUE;
   const double t = navsim_now_s();
+  progress_line(o, p->fraction, t);
+  if (o->quiet_progress) return NAV_CONTINUE;
   if (t - o->t_last_print > 0.2 || p->fraction >= 1.0) {
     /* Runs done and the time left, extrapolated from the fraction of the job done so far. */
     const long done = (long)floor(p->fraction * (double)o->runs + 1e-9);
@@ -288,6 +321,7 @@ static int cmd_run(int argc, char **argv) {
   bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false,
        allow_large = false, export_kfgins = false;
   uint64_t seed = 0, runs = 0, threads = 0;
+  int progress_fd = -1;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (navsim_is_help(a)) {
@@ -315,6 +349,15 @@ static int cmd_run(int argc, char **argv) {
         fprintf(stderr, "navsim run: %s: expected an integer in [1, %llu], got \"%s\"\n", a, (unsigned long long)max, v);
         return EXIT_INVALID;
       }
+    } else if (strcmp(a, "--progress-fd") == 0) {
+      if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      uint64_t fd = 0;
+      if (!navsim_parse_u64(v, &fd) || fd < 3 || fd > 1024 || fcntl((int)fd, F_GETFD) == -1) {
+        fprintf(stderr, "navsim run: --progress-fd: expected an open file descriptor in [3, 1024], got \"%s\"\n", v);
+        return EXIT_INVALID;
+      }
+      progress_fd = (int)fd;
     } else if (strcmp(a, "--export") == 0) {
       if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -388,7 +431,7 @@ static int cmd_run(int argc, char **argv) {
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
   run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, navsim_now_s(),
-               scene.simulation.runs, NULL, NULL, NULL, NULL, NULL, ""};
+               scene.simulation.runs, NULL, NULL, NULL, NULL, NULL, "", progress_fd, 0.0};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -700,6 +743,15 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "sweep") == 0) return navsim_sweep(argc - 2, argv + 2);
   if (strcmp(cmd, "tradeoff") == 0) return navsim_tradeoff(argc - 2, argv + 2);
   if (strcmp(cmd, "schema") == 0) return navsim_schema(argc - 2, argv + 2);
+  if (strcmp(cmd, "serve") == 0) {
+#ifdef NAVSIM_HAVE_SERVE
+    return navserve_main(argc - 2, argv + 2);
+#else
+    fprintf(stderr, "navsim serve: this navsim was built without the server (it needs libmicrohttpd-dev and "
+                    "libzip-dev; cmake -DNAV_BUILD_SERVER=ON)\n");
+    return EXIT_FAIL;
+#endif
+  }
   if (strcmp(cmd, "catalog") == 0) {
     char res[4096];
     return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);

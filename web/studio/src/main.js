@@ -1,0 +1,689 @@
+// navsim studio: the browser front end of `navsim serve`. The scene file is the one state: every
+// form field, the map, the parametric preview and the YAML editor read and write the same YAML
+// document (comments kept), which is what Run posts, what the estimate is made from, what the
+// Download button saves and what the page URL carries (#scene=...), so a saved file or a URL
+// reruns the same scene bit-identically in navsim and navstudio.
+import YAML from 'yaml';
+import { renderNode, schemaAt, deref, newItem } from './form.js';
+import { StudioMap, lonLatToNed, nedToLonLat } from './map.js';
+import { drawCharts, parseCsv } from './charts.js';
+import { View3D } from './view3d.js';
+
+void nedToLonLat;
+const $ = (id) => document.getElementById(id);
+const studio = (window.__studio = { timings: {}, errors: [] });
+
+// ---------------------------------------------------------------- API
+async function api(method, url, body, type = 'application/yaml') {
+  const init = { method, headers: {} };
+  if (body !== undefined) {
+    init.body = body;
+    init.headers['Content-Type'] = type;
+  }
+  const r = await fetch(url, init);
+  const text = await r.text();
+  let json = null;
+  try { json = text ? JSON.parse(text) : null; } catch { json = null; }
+  return { status: r.status, ok: r.ok, json, text, headers: r.headers };
+}
+
+// ---------------------------------------------------------------- the scene document
+class Scene {
+  constructor() { this.doc = new YAML.Document({}); }
+  load(text) {
+    const d = YAML.parseDocument(text, { prettyErrors: false });
+    if (d.errors.length) throw new Error(d.errors[0].message);
+    if (!YAML.isMap(d.contents)) throw new Error('a scene is a YAML mapping');
+    this.doc = d;
+  }
+  get(path) {
+    if (!path.length) return this.doc.toJS();
+    const v = this.doc.getIn(path);
+    return YAML.isNode(v) ? v.toJSON() : v;
+  }
+  set(path, v) {
+    const node = this.doc.createNode(v);
+    // Short vectors and small mappings in flow style, as the library scenes write them.
+    const flowable = (x) => Array.isArray(x) ? x.length <= 6 && x.every((e) => typeof e !== 'object' || flowable(e)) :
+      x && typeof x === 'object' ? Object.values(x).every((e) => typeof e !== 'object' || (Array.isArray(e) && flowable(e))) : false;
+    if (YAML.isCollection(node) && flowable(v) && !(path.length === 1)) node.flow = true;
+    if (YAML.isCollection(node) && Array.isArray(v) && v.length && typeof v[0] === 'object' && !Array.isArray(v[0])) node.flow = false;
+    // Parents that do not exist yet are made as block mappings.
+    for (let i = 1; i < path.length; ++i) {
+      const p = path.slice(0, i);
+      const cur = this.doc.getIn(p);
+      if (cur === undefined || cur === null) this.doc.setIn(p, this.doc.createNode(typeof path[i] === 'number' ? [] : {}));
+    }
+    this.doc.setIn(path, node);
+  }
+  del(path) { if (this.doc.hasIn(path)) this.doc.deleteIn(path); }
+  text() { return this.doc.toString({ lineWidth: 0, flowCollectionPadding: false }); }
+}
+
+const scene = new Scene();
+let schema = null;
+let catalogs = { imu: [], gnss: [] };
+const mapView = new StudioMap($('map'), $('map-credits'));
+studio.map = mapView;
+let view3d = null;
+let lastRun = null;
+
+function status(msg) { $('status').textContent = msg; }
+
+// ---------------------------------------------------------------- change propagation
+let pendingCheck = null;
+function changed(source, structure = false) {
+  // A loaded scene is validated and estimated at once: the requests go out before the forms
+  // and the map are built, which overlap the server's work.
+  if (source === 'load') {
+    clearTimeout(pendingCheck);
+    $('estimate').dataset.state = 'pending';
+    checkAndEstimate();
+  }
+  if (source !== 'yaml') $('yaml').value = scene.text();
+  if (source !== 'form' || structure) renderForms();
+  syncFlow();
+  drawPreview();
+  history.replaceState(null, '', '#scene=' + b64(scene.text()));
+  if (source === 'load') return;
+  clearTimeout(pendingCheck);
+  $('estimate').dataset.state = 'pending';
+  pendingCheck = setTimeout(checkAndEstimate, source === 'yaml' ? 300 : 250);
+}
+const b64 = (s) => btoa(String.fromCharCode(...new TextEncoder().encode(s))).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
+const unb64 = (s) => new TextDecoder().decode(Uint8Array.from(atob(s.replace(/-/g, '+').replace(/_/g, '/')), (c) => c.charCodeAt(0)));
+
+// ---------------------------------------------------------------- schema forms
+const formScene = {
+  get: (p) => scene.get(p),
+  set: (p, v) => { scene.set(p, v); changed('form'); },
+  del: (p) => { scene.del(p); changed('form'); },
+};
+function renderForms() {
+  for (const host of document.querySelectorAll('.form[data-section]')) {
+    const path = host.dataset.section.split('.');
+    const key = path[path.length - 1];
+    host.textContent = '';
+    if (!schema) {
+      host.innerHTML = '<p class="hint">The scene schema is not available from this server: edit the YAML view.</p>';
+      continue;
+    }
+    const s = schemaAt(schema, path, scene);
+    if (!s) continue;
+    if (key === 'array' && !scene.get(['array'])) {
+      host.innerHTML = '<p class="hint">The accelerometer array (gyro-free schemes) is set when such a scheme is chosen.</p>';
+      continue;
+    }
+    renderNode(host, schema, s, key, path, formScene, () => changed('form', true), host.dataset.skip ? host.dataset.skip.split(',') : null);
+  }
+}
+
+// ---------------------------------------------------------------- the paper's flow widgets
+function enumOf(path, fallback) {
+  const s = schema && schemaAt(schema, path, scene);
+  return s && s.enum ? s.enum : fallback;
+}
+function fillSelect(sel, values, current, labels = {}) {
+  const keep = sel.value;
+  sel.textContent = '';
+  for (const v of values) {
+    const o = document.createElement('option');
+    o.value = v;
+    o.textContent = labels[v] || v;
+    sel.appendChild(o);
+  }
+  sel.value = current !== undefined ? current : keep;
+}
+const schemeHelp = {
+  free_ins: 'free inertial navigation: the IMU alone',
+  gyro_free: 'gyro-free array INS: angular motion from an array of accelerometers',
+  ins_gnss: 'INS/GNSS: loosely coupled Kalman filter',
+  gyro_free_gnss: 'gyro-free array INS aided by GNSS',
+};
+function syncFlow() {
+  const scheme = scene.get(['navigation', 'scheme']);
+  const schemes = enumOf(['navigation', 'scheme'], []);
+  fillSelect($('scheme'), schemes, scheme ?? (schemaAt(schema || {}, ['navigation', 'scheme'], scene) || {}).default,
+    Object.fromEntries(schemes.map((v) => [v, schemeHelp[v] ? `${v} — ${schemeHelp[v]}` : v])));
+  $('scheme-help').textContent = schemeHelp[$('scheme').value] || '';
+  fillSelect($('imu-catalog'), ['', ...catalogs.imu.map((c) => c.name)], scene.get(['imu', 'catalog']) ?? '', { '': '(typed in below)' });
+  const cur = catalogs.imu.find((c) => c.name === scene.get(['imu', 'catalog']));
+  $('imu-catalog-info').textContent = cur ? describeImu(cur) : '';
+  fillSelect($('gnss-catalog'), ['', ...catalogs.gnss.map((c) => c.name)], scene.get(['gnss', 'catalog']) ?? '', { '': '(typed in below)' });
+  $('gnss-enabled').checked = scene.get(['gnss', 'enabled']) === true;
+  const tt = scene.get(['trajectory', 'type']);
+  fillSelect($('traj-type'), enumOf(['trajectory', 'type'], tt ? [tt] : []), tt);
+  $('traj-waypoints').hidden = tt !== 'waypoints';
+  $('traj-parametric').hidden = tt !== 'parametric';
+  const o = scene.get(['earth', 'origin']) || {};
+  mapView.setOrigin(o.lat_deg ?? 0, o.lon_deg ?? 0);
+  const pts = waypoints();
+  $('wp-list').textContent = '';
+  pts.forEach((p, i) => {
+    const li = document.createElement('li');
+    li.textContent = `N ${p.ned_m[0].toFixed(0)} m, E ${p.ned_m[1].toFixed(0)} m, ${p.speed_mps ?? '?'} m/s`;
+    li.dataset.index = i;
+    $('wp-list').appendChild(li);
+  });
+  mapView.setWaypoints(tt === 'waypoints' ? pts.map((p) => p.ned_m) : []);
+  const outs = scene.get(['gnss', 'outages']) || [];
+  $('outage-list').textContent = '';
+  for (const [a, b] of outs) {
+    const li = document.createElement('li');
+    li.textContent = `${a} s … ${b} s (${b - a} s)`;
+    $('outage-list').appendChild(li);
+  }
+}
+function describeImu(c) {
+  const bits = [c.grade, c.cost_band && `cost ${c.cost_band}`];
+  const fmt = (o, pre) => Object.entries(o || {}).filter(([, v]) => typeof v === 'number').map(([k, v]) => `${pre} ${k} ${+v.toPrecision(3)}`);
+  bits.push(...fmt(c.gyro, 'gyro'), ...fmt(c.accel, 'accel'));
+  if (c.verified) bits.push(`verified: ${c.verified}`);
+  return bits.filter(Boolean).join(' · ');
+}
+function waypoints() {
+  const p = scene.get(['trajectory', 'waypoints', 'points']);
+  return Array.isArray(p) ? p.filter((x) => x && Array.isArray(x.ned_m)) : [];
+}
+
+// Trajectory kind switch: keep the scalar keys, drop the sections of the other kinds.
+function setTrajectoryType(kind) {
+  const kinds = enumOf(['trajectory', 'type'], [kind]);
+  for (const k of kinds) if (k !== kind && scene.get(['trajectory', k]) !== undefined) scene.del(['trajectory', k]);
+  scene.set(['trajectory', 'type'], kind);
+  if (kind === 'waypoints') scene.del(['trajectory', 'duration_s']);
+  if (kind !== 'waypoints' && scene.get(['trajectory', 'duration_s']) === undefined) scene.set(['trajectory', 'duration_s'], 60);
+  const sub = schema && schemaAt(schema, ['trajectory', kind], scene);
+  if (sub && scene.get(['trajectory', kind]) === undefined && kind !== 'waypoints') scene.set(['trajectory', kind], newItem(schema, sub));
+}
+
+let drawing = false, drawnThisSession = 0;
+function addWaypoint(lon, lat) {
+  if (scene.get(['trajectory', 'type']) !== 'waypoints') setTrajectoryType('waypoints');
+  if (scene.get(['earth', 'origin']) === undefined) {
+    scene.set(['earth', 'origin'], { lat_deg: +lat.toFixed(6), lon_deg: +lon.toFixed(6), h_m: 0 });
+    mapView.setOrigin(lat, lon);
+  }
+  const [n, e] = lonLatToNed(mapView.origin, lon, lat);
+  const speed = Math.max(0.1, +$('wp-speed').value || 10);
+  let pts = drawnThisSession === 0 ? [] : scene.get(['trajectory', 'waypoints', 'points']) || [];
+  // Start and end at rest; the points between at the chosen speed.
+  if (pts.length) pts[pts.length - 1].speed_mps = pts.length === 1 ? 0 : speed;
+  pts.push({ ned_m: [Math.round(n * 10) / 10, Math.round(e * 10) / 10, 0], speed_mps: pts.length === 0 ? 0 : 0 });
+  if (pts.length >= 2) pts[pts.length - 2].speed_mps = pts.length === 2 ? 0 : speed;
+  ++drawnThisSession;
+  scene.set(['trajectory', 'waypoints', 'points'], pts);
+  if (scene.get(['trajectory', 'waypoints', 'timing']) === undefined) scene.set(['trajectory', 'waypoints', 'timing'], 'speed');
+  changed('flow', true);
+}
+
+// ---------------------------------------------------------------- previews
+function parametricPath() {
+  const p = scene.get(['trajectory', 'parametric']) || {};
+  const T = +scene.get(['trajectory', 'duration_s']) || 0;
+  const v = (k) => (Array.isArray(p[k]) ? p[k].map(Number) : [0, 0, 0]);
+  const R0 = v('R0_m'), V0 = v('V0_mps'), A = v('A_mps2'), B = v('B_m'), C = v('C_hz'), D = v('D_rad');
+  const n = 400, out = { t: [], n: [], e: [], d: [] };
+  for (let i = 0; i <= n; ++i) {
+    const t = (T * i) / n;
+    // R(t) = R0 + V0 t + A t^2 + B sin(2 pi C t + D), per axis of the scene frame (NED).
+    const r = [0, 1, 2].map((k) => R0[k] + V0[k] * t + A[k] * t * t + B[k] * Math.sin(2 * Math.PI * C[k] * t + D[k]));
+    out.t.push(t); out.n.push(r[0]); out.e.push(r[1]); out.d.push(r[2]);
+  }
+  return out;
+}
+function drawPreview() {
+  const tt = scene.get(['trajectory', 'type']);
+  if (lastRun && lastRun.truth && lastRun.sceneText === scene.text()) return; // the run's truth is shown
+  if (tt === 'parametric') {
+    const p = parametricPath();
+    mapView.setReference(p.n, p.e);
+    const cv = $('param-preview'), ctx = cv.getContext('2d');
+    const W = cv.width, H = cv.height;
+    ctx.clearRect(0, 0, W, H);
+    ctx.fillStyle = '#fff';
+    ctx.fillRect(0, 0, W, H);
+    const split = W * 0.62;
+    const box = (xs, ys, x0, w, equal) => {
+      let [a, b, c, d] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+      if (b - a < 1e-9) { a -= 1; b += 1; }
+      if (d - c < 1e-9) { c -= 1; d += 1; }
+      let sx = (w - 30) / (b - a), sy = (H - 30) / (d - c);
+      if (equal) sx = sy = Math.min(sx, sy);
+      return (x, y) => [x0 + 15 + (x - a) * sx, H - 15 - (y - c) * sy];
+    };
+    const line = (xs, ys, f, color) => {
+      ctx.strokeStyle = color; ctx.lineWidth = 2; ctx.beginPath();
+      xs.forEach((x, i) => { const [px, py] = f(x, ys[i]); i ? ctx.lineTo(px, py) : ctx.moveTo(px, py); });
+      ctx.stroke();
+    };
+    line(p.e, p.n, box(p.e, p.n, 0, split, true), '#1f5fbf');
+    const up = p.d.map((x) => -x);
+    line(p.t, up, box(p.t, up, split, W - split, false), '#2a9d3a');
+    ctx.fillStyle = '#333'; ctx.font = '12px sans-serif';
+    ctx.fillText('north (up) vs east', 8, 14);
+    ctx.fillText('height vs time', split + 8, 14);
+    cv.dataset.drawn = String(p.t.length);
+  } else if (tt === 'waypoints') {
+    const pts = waypoints();
+    mapView.setReference(pts.map((x) => x.ned_m[0]), pts.map((x) => x.ned_m[1]));
+  } else {
+    mapView.setReference([], []);
+  }
+  mapView.setEstimate(null);
+  mapView.setFixes(null);
+}
+
+// ---------------------------------------------------------------- validation and estimate
+// One validation + estimate at a time: a change made meanwhile runs one more afterwards (the
+// server computes a bounded number of estimates at once and answers 429 beyond).
+let checking = false, checkAgain = false;
+async function checkAndEstimate() {
+  if (checking) { checkAgain = true; return; }
+  checking = true;
+  try {
+    await checkOnce();
+  } catch (err) {
+    $('estimate').dataset.state = 'error';
+    $('estimate-body').textContent = `estimate failed: ${err.message}`;
+  } finally {
+    checking = false;
+    if (checkAgain) { checkAgain = false; checkAndEstimate(); }
+  }
+}
+const sleep = (ms) => new Promise((res) => setTimeout(res, ms));
+async function postRetrying(url, text) {
+  for (let i = 0; ; ++i) {
+    const r = await api('POST', url, text);
+    if (r.status !== 429 || i >= 20 || checkAgain) return r;
+    const after = Math.min(2, Math.max(0.2, +(r.headers.get('Retry-After') || 0.5)));
+    await sleep(after * 1000);
+  }
+}
+async function checkOnce() {
+  const text = scene.text();
+  const t0 = performance.now();
+  const v = await postRetrying('api/validate', text);
+  if (checkAgain) return;
+  const st = $('yaml-status');
+  if (v.status === 200) {
+    const warns = (v.json && Array.isArray(v.json.warnings)) ? v.json.warnings : [];
+    st.className = warns.length ? 'bad' : 'good';
+    st.textContent = warns.length ? 'valid scene, but: ' + warns.map((w) => `${w.path}: ${w.message}`).join('\n') : 'valid scene';
+    if (warns.length) status(`this server would not run the scene as it stands: ${warns[0].message}`);
+  } else {
+    st.className = 'bad';
+    const errs = (v.json && v.json.errors) || [];
+    st.textContent = errs.length ? errs.map((e) => `${e.line}:${e.col}: ${e.path}: ${e.message}`).join('\n') : `validation failed (HTTP ${v.status})`;
+    $('estimate').dataset.state = 'invalid';
+    $('estimate-body').textContent = 'The scene is not valid: ' + st.textContent.split('\n')[0];
+    return;
+  }
+  const e = await postRetrying('api/estimate', text);
+  if (checkAgain) return;
+  studio.timings.estimate_ms = performance.now() - t0;
+  showEstimate(e);
+}
+function requirementTable(reqs, predicted) {
+  const t = document.createElement('table');
+  t.innerHTML = `<thead><tr><th>requirement</th><th>statistic</th><th>${predicted ? 'predicted' : 'value'}</th><th>limit</th><th>verdict</th></tr></thead>`;
+  const tb = document.createElement('tbody');
+  for (const r of reqs) {
+    const tr = document.createElement('tr');
+    const known = typeof r.value === 'number';
+    const verdict = !known ? 'n/a' : r.pass === true ? 'PASS' : r.pass === false ? 'FAIL' : 'n/a';
+    const val = typeof r.value === 'number' ? r.value.toPrecision(4) : '—';
+    for (const [txt, cls] of [[r.id, ''], [r.statistic + (r.time_s !== undefined ? ` @ ${r.time_s} s` : ''), ''], [`${val} ${r.unit || ''}`, ''], [`${r.limit} ${r.unit || ''}`, ''], [verdict, verdict === 'PASS' ? 'pass' : verdict === 'FAIL' ? 'fail' : '']]) {
+      const td = document.createElement('td');
+      td.textContent = txt;
+      if (cls) td.className = cls;
+      tr.appendChild(td);
+    }
+    tb.appendChild(tr);
+  }
+  t.appendChild(tb);
+  return t;
+}
+function showEstimate(e) {
+  const body = $('estimate-body');
+  body.textContent = '';
+  if (!e.ok || !e.json) {
+    $('estimate').dataset.state = 'error';
+    body.textContent = `estimate failed (HTTP ${e.status}): ${(e.json && (e.json.error || e.json.message)) || e.text.slice(0, 200)}`;
+    return;
+  }
+  const j = e.json;
+  const p = document.createElement('p');
+  const cov = j.covariance_final || {};
+  const hs = cov.pos_h_sd_m ?? cov.pos_sd_h_m;
+  p.textContent = `scheme ${j.scheme || scene.get(['navigation', 'scheme']) || '?'}, ${j.t_s !== undefined ? `${(+j.t_s).toFixed(0)} s` : ''}` +
+    (typeof hs === 'number' ? `, predicted horizontal 1σ at the end ${hs.toPrecision(3)} m` : '');
+  body.appendChild(p);
+  const reqs = j.requirements || [];
+  if (reqs.length) body.appendChild(requirementTable(reqs, true));
+  else body.appendChild(Object.assign(document.createElement('p'), { className: 'hint', textContent: 'no requirements in the scene' }));
+  $('estimate').dataset.state = 'ok';
+  if (studio.timings.sceneLoadStart !== undefined && studio.timings.scene_to_picture_ms === undefined) {
+    mapView.whenRendered().then(() => {
+      const now = performance.now();
+      studio.timings.scene_to_picture_ms = now - studio.timings.sceneLoadStart;
+      studio.timings.page_to_picture_ms = now; // from the navigation start
+    });
+    mapView.map.render();
+  }
+}
+
+// ---------------------------------------------------------------- runs
+let currentRun = null;
+function runState(state, progress) {
+  $('run-state').textContent = state + (progress !== undefined && state === 'running' ? ` ${(progress * 100).toFixed(0)} %` : '');
+  $('run-state').dataset.state = state;
+  if (progress !== undefined) $('progress').value = progress;
+  const active = state === 'queued' || state === 'running' || state === 'starting';
+  $('run').disabled = active;
+  $('cancel').disabled = !active;
+}
+async function startRun() {
+  const runs = Math.max(1, Math.round(+$('runs').value || 1));
+  // The scene saved with the result names its run count, so that it reruns the same campaign.
+  if (scene.get(['simulation', 'runs']) !== runs) { scene.set(['simulation', 'runs'], runs); changed('flow'); }
+  const text = scene.text();
+  runState('starting', 0);
+  const r = await api('POST', `api/runs?runs=${runs}`, text);
+  if (r.status !== 202 || !r.json || !r.json.id) {
+    runState('failed');
+    $('run-state').textContent = `not started (HTTP ${r.status}): ${(r.json && (r.json.error || r.json.message)) || r.text.slice(0, 200)}` +
+      (r.headers.get('Retry-After') ? ` — retry after ${r.headers.get('Retry-After')} s` : '');
+    return;
+  }
+  const id = r.json.id;
+  currentRun = { id, text, runs };
+  runState('queued', 0);
+  let es = null;
+  const finish = async (state) => {
+    if (!currentRun || currentRun.id !== id || currentRun.finished) return;
+    currentRun.finished = true;
+    if (es) es.close(); // the stream would otherwise hold one of the client's stream slots
+    runState(state, state === 'done' ? 1 : undefined);
+    if (state === 'failed' && currentRun.error) $('run-state').textContent = `failed: ${currentRun.error}`;
+    if (state === 'done') await loadResults(id, text, currentRun.files);
+  };
+  const onState = (j) => {
+    if (!j || !j.state) return;
+    if (['done', 'failed', 'cancelled'].includes(j.state)) {
+      currentRun.files = Array.isArray(j.files) ? j.files : null;
+      if (j.error) currentRun.error = j.error;
+      finish(j.state);
+    }
+    else if (!currentRun.finished) runState(j.state, typeof j.progress === 'number' ? j.progress : undefined);
+  };
+  try {
+    es = new EventSource(`api/runs/${id}/events`);
+    es.onmessage = (ev) => { try { onState(JSON.parse(ev.data)); } catch { /* not JSON */ } };
+    for (const name of ['progress', 'state', 'done', 'failed', 'cancelled'])
+      es.addEventListener(name, (ev) => { try { onState(JSON.parse(ev.data)); } catch { /* not JSON */ } });
+    es.addEventListener('end', () => es.close());
+    es.onerror = () => { if (es) es.close(); };
+  } catch { es = null; }
+  // The state is also polled: events may be lost behind a proxy; the poll settles the end state.
+  while (currentRun && currentRun.id === id && !currentRun.finished) {
+    await new Promise((res) => setTimeout(res, 500));
+    const s = await api('GET', `api/runs/${id}`);
+    if (s.ok) onState(s.json);
+    else if (s.status === 404) { finish('failed'); break; }
+  }
+}
+async function cancelRun() {
+  if (!currentRun) return;
+  await api('DELETE', `api/runs/${currentRun.id}`);
+}
+
+const resultFiles = ['summary.json', 'nav.csv', 'truth.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'tracks.kml', 'report.html', 'results.zip'];
+async function loadResults(id, text, files) {
+  // Only the files the run has (the state lists them): no request ends in a 404.
+  if (!files) {
+    const s = await api('GET', `api/runs/${id}`);
+    files = s.ok && s.json && Array.isArray(s.json.files) ? s.json.files : [];
+  }
+  const get = async (name) => {
+    if (!files.includes(name)) return null;
+    const r = await fetch(`api/runs/${id}/files/${name}`);
+    return r.ok ? r.text() : null;
+  };
+  const [summaryText, truthT, navT, errT, mcT, gnssT] = await Promise.all(['summary.json', 'truth.csv', 'nav.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv'].map(get));
+  const summary = summaryText ? JSON.parse(summaryText) : null;
+  const truth = truthT && parseCsv(truthT), nav = navT && parseCsv(navT), errors = errT && parseCsv(errT);
+  const mc = mcT && parseCsv(mcT), gnss = gnssT && parseCsv(gnssT);
+  lastRun = { id, sceneText: text, summary, truth, nav, errors, mc, gnss };
+  studio.lastRun = { id, summary };
+  // Verdicts.
+  const v = $('verdicts');
+  v.textContent = '';
+  const reqs = (summary && summary.requirements) || [];
+  const h = document.createElement('h2');
+  const failed = reqs.filter((r) => r.pass === false).length;
+  h.textContent = !summary ? 'No summary.json in the results' : reqs.length === 0 ? 'No requirements in the scene' :
+    failed ? `FAIL: ${failed} of ${reqs.length} requirements not met (${summary.runs} runs)` : `PASS: all ${reqs.length} requirements met (${summary.runs} runs)`;
+  h.className = failed ? 'fail' : reqs.length ? 'pass' : '';
+  v.appendChild(h);
+  if (reqs.length) v.appendChild(requirementTable(reqs, false));
+  v.dataset.state = !summary ? 'missing' : reqs.length === 0 ? 'none' : failed ? 'fail' : 'pass';
+  // Downloads.
+  const dl = $('downloads');
+  dl.innerHTML = '<h2>Downloads</h2>';
+  const ul = document.createElement('ul');
+  const sceneLink = document.createElement('a');
+  sceneLink.href = URL.createObjectURL(new Blob([text], { type: 'application/yaml' }));
+  sceneLink.download = `${scene.get(['name']) || 'scene'}.yaml`;
+  sceneLink.textContent = 'scene YAML (reruns this result bit-identically)';
+  ul.appendChild(Object.assign(document.createElement('li'), {})).appendChild(sceneLink);
+  for (const name of [...resultFiles, ...files.filter((f) => !resultFiles.includes(f))]) {
+    if (!files.includes(name)) continue;
+    const a = document.createElement('a');
+    a.href = `api/runs/${id}/files/${name}`;
+    a.download = name;
+    a.textContent = name;
+    ul.appendChild(document.createElement('li')).appendChild(a);
+  }
+  dl.appendChild(ul);
+  // Map: truth, estimate, fixes.
+  if (truth) mapView.setReference(truth.pos_n_m, truth.pos_e_m);
+  if (nav) mapView.setEstimate(nav.pos_n_m, nav.pos_e_m);
+  if (gnss && gnss.lon_deg) mapView.setFixes(gnss.lon_deg, gnss.lat_deg);
+  mapView.setWaypoints([]);
+  mapView.fit();
+  // Charts and 3D.
+  const outages = (parseYamlSafe(text).gnss || {}).outages || [];
+  if (errors) {
+    studio.charts = drawCharts($('charts'), { errors, mc_stats: mc }, outages, reqs, Math.max(320, $('work').clientWidth - 40));
+  }
+  if (truth) {
+    if (!view3d) view3d = new View3D($('three'));
+    const sig = mc && mc.pos_h_rms_m && mc.length === truth.length ? mc.pos_h_rms_m : errors && errors.length === truth.length ? errors.pos_err_h_m : null;
+    view3d.setData(truth, nav, sig);
+    studio.view3d = view3d;
+  }
+  $('view-results').hidden || null;
+  status(`run ${id.slice(0, 8)}… done`);
+}
+function parseYamlSafe(t) { try { return YAML.parse(t) || {}; } catch { return {}; } }
+
+// ---------------------------------------------------------------- tabs
+const tabs = [...document.querySelectorAll('[role=tab]')];
+function selectTab(tab) {
+  for (const t of tabs) {
+    const on = t === tab;
+    t.setAttribute('aria-selected', String(on));
+    t.tabIndex = on ? 0 : -1;
+    $(t.getAttribute('aria-controls')).hidden = !on;
+  }
+  if (tab.id === 'tab-3d' && view3d) view3d.resize();
+  if (tab.id === 'tab-map') mapView.map.updateSize();
+  if (tab.id === 'tab-charts' && studio.charts) for (const c of studio.charts) c.setSize({ width: Math.max(320, $('work').clientWidth - 40), height: 220 });
+}
+tabs.forEach((t, i) => {
+  t.tabIndex = t.getAttribute('aria-selected') === 'true' ? 0 : -1;
+  t.addEventListener('click', () => selectTab(t));
+  t.addEventListener('keydown', (ev) => {
+    const d = ev.key === 'ArrowRight' ? 1 : ev.key === 'ArrowLeft' ? -1 : 0;
+    if (!d) return;
+    const next = tabs[(i + d + tabs.length) % tabs.length];
+    next.focus();
+    selectTab(next);
+  });
+});
+
+// ---------------------------------------------------------------- loading scenes
+async function loadText(text, label) {
+  try {
+    scene.load(text);
+  } catch (err) {
+    $('yaml').value = text;
+    status(`${label}: ${err.message}`);
+    return false;
+  }
+  lastRun = null;
+  drawnThisSession = 0;
+  $('yaml').value = scene.text();
+  const runs = scene.get(['simulation', 'runs']);
+  if (Number.isFinite(runs)) $('runs').value = runs;
+  changed('load', true);
+  mapView.fit();
+  if (studio.timings.sceneLoadStart !== undefined) {
+    mapView.whenRendered().then(() => { studio.timings.preview_ms = performance.now() - studio.timings.sceneLoadStart; });
+    mapView.map.render();
+  }
+  status(`${label} loaded`);
+  return true;
+}
+async function loadLibrary(name) {
+  studio.timings = { sceneLoadStart: performance.now() };
+  const r = await fetch(`api/scenes/${encodeURIComponent(name)}`);
+  if (!r.ok) { status(`scene ${name}: HTTP ${r.status}`); return; }
+  await loadText(await r.text(), `library scene ${name}`);
+}
+// GPX tracks: their points become waypoints around the first one.
+function gpxToWaypoints(text) {
+  const xml = new DOMParser().parseFromString(text, 'application/xml');
+  const pts = [...xml.querySelectorAll('trkpt, rtept, wpt')].map((p) => [+p.getAttribute('lon'), +p.getAttribute('lat')]);
+  const kml = [...xml.getElementsByTagName('coordinates')].flatMap((c) => c.textContent.trim().split(/\s+/).map((s) => s.split(',').map(Number)));
+  return pts.length ? pts : kml.filter((p) => p.length >= 2).map((p) => [p[0], p[1]]);
+}
+
+// ---------------------------------------------------------------- wiring
+$('library').addEventListener('change', () => { if ($('library').value) loadLibrary($('library').value); });
+$('open-file').addEventListener('change', async () => {
+  const f = $('open-file').files[0];
+  if (!f) return;
+  const text = await f.text();
+  if (/\.(gpx|kml)$/i.test(f.name)) {
+    const ll = gpxToWaypoints(text).filter((p) => Number.isFinite(p[0]) && Number.isFinite(p[1]));
+    if (ll.length < 2) { status(`${f.name}: no track points found`); return; }
+    const step = Math.max(1, Math.ceil(ll.length / 200));
+    scene.set(['earth', 'origin'], { lat_deg: ll[0][1], lon_deg: ll[0][0], h_m: 0 });
+    mapView.setOrigin(ll[0][1], ll[0][0]);
+    drawnThisSession = 0;
+    for (let i = 0; i < ll.length; i += step) addWaypoint(ll[i][0], ll[i][1]);
+    mapView.fit();
+    status(`${f.name}: ${Math.ceil(ll.length / step)} waypoints`);
+  } else await loadText(text, f.name);
+});
+$('download-scene').addEventListener('click', () => {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(new Blob([scene.text()], { type: 'application/yaml' }));
+  a.download = `${scene.get(['name']) || 'scene'}.yaml`;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+});
+$('scheme').addEventListener('change', () => {
+  const s = $('scheme').value;
+  scene.set(['navigation', 'scheme'], s);
+  if (/gyro_free/.test(s) && scene.get(['array']) === undefined && schema) {
+    const a = schemaAt(schema, ['array'], scene);
+    if (a) scene.set(['array'], newItem(schema, a));
+  }
+  if (!/gyro_free/.test(s)) scene.del(['array']);
+  if (/gnss/.test(s)) scene.set(['gnss', 'enabled'], true);
+  else if (scene.get(['gnss']) !== undefined) scene.set(['gnss', 'enabled'], false);
+  changed('flow', true);
+});
+$('imu-catalog').addEventListener('change', () => {
+  const v = $('imu-catalog').value;
+  if (v) scene.set(['imu', 'catalog'], v); else scene.del(['imu', 'catalog']);
+  changed('flow', true);
+});
+$('gnss-catalog').addEventListener('change', () => {
+  const v = $('gnss-catalog').value;
+  if (v) scene.set(['gnss', 'catalog'], v); else scene.del(['gnss', 'catalog']);
+  changed('flow', true);
+});
+$('gnss-enabled').addEventListener('change', () => { scene.set(['gnss', 'enabled'], $('gnss-enabled').checked); changed('flow', true); });
+$('traj-type').addEventListener('change', () => { setTrajectoryType($('traj-type').value); changed('flow', true); mapView.fit(); });
+$('draw-waypoints').addEventListener('click', () => {
+  drawing = !drawing;
+  drawnThisSession = 0;
+  $('draw-waypoints').setAttribute('aria-pressed', String(drawing));
+  $('draw-waypoints').textContent = drawing ? 'Stop drawing' : 'Draw waypoints';
+  document.body.classList.toggle('ol-waypoint-mode', drawing);
+  mapView.onClick = drawing ? addWaypoint : null;
+  if (drawing) status('click on the map to place waypoints (they replace the current ones)');
+  else mapView.fit();
+});
+$('add-centre').addEventListener('click', () => { const [lon, lat] = mapView.centre(); if (!drawing) drawnThisSession = waypoints().length; addWaypoint(lon, lat); });
+$('undo-waypoint').addEventListener('click', () => {
+  const pts = scene.get(['trajectory', 'waypoints', 'points']) || [];
+  if (pts.length) { pts.pop(); if (pts.length) pts[pts.length - 1].speed_mps = 0; scene.set(['trajectory', 'waypoints', 'points'], pts); changed('flow', true); }
+});
+$('add-outage').addEventListener('click', () => {
+  const a = +$('outage-start').value, len = +$('outage-length').value;
+  if (!(a >= 0 && len > 0)) { status('an outage needs a start >= 0 s and a length > 0 s'); return; }
+  const outs = scene.get(['gnss', 'outages']) || [];
+  outs.push([a, a + len]);
+  outs.sort((x, y) => x[0] - y[0]);
+  scene.set(['gnss', 'outages'], outs);
+  changed('flow', true);
+});
+$('clear-outages').addEventListener('click', () => { scene.del(['gnss', 'outages']); changed('flow', true); });
+$('yaml').addEventListener('input', () => {
+  try {
+    scene.load($('yaml').value);
+  } catch (err) {
+    $('yaml-status').className = 'bad';
+    $('yaml-status').textContent = `YAML: ${err.message}`;
+    $('estimate').dataset.state = 'invalid';
+    return;
+  }
+  changed('yaml', true);
+});
+$('run').addEventListener('click', startRun);
+$('cancel').addEventListener('click', cancelRun);
+$('runs').addEventListener('change', () => {
+  const n = Math.round(+$('runs').value);
+  if (n >= 1) { scene.set(['simulation', 'runs'], n); changed('flow', true); }
+});
+$('exaggeration').addEventListener('input', () => {
+  const k = +$('exaggeration').value;
+  $('exaggeration-out').textContent = `${k}×`;
+  if (view3d) view3d.setExaggeration(k);
+});
+window.addEventListener('resize', () => { mapView.map.updateSize(); if (view3d && !$('view-3d').hidden) view3d.resize(); });
+
+// ---------------------------------------------------------------- start
+async function start() {
+  const [sc, sl, ci, cg] = await Promise.all([api('GET', 'api/schema'), api('GET', 'api/scenes'), api('GET', 'api/catalog/imu'), api('GET', 'api/catalog/gnss')]);
+  if (sc.ok && sc.json) schema = sc.json;
+  else status(`no scene schema from the server (HTTP ${sc.status}): forms are off, the YAML view works`);
+  const arr = (j, k) => (Array.isArray(j) ? j : j && Array.isArray(j[k]) ? j[k] : []);
+  catalogs = { imu: ci.ok ? arr(ci.json, 'imu') : [], gnss: cg.ok ? arr(cg.json, 'gnss') : [] };
+  const scenes = sl.ok ? arr(sl.json, 'scenes') : [];
+  fillSelect($('library'), ['', ...scenes.map((s) => s.name)], '', Object.fromEntries([['', '(choose a scene)'], ...scenes.map((s) => [s.name, s.description ? `${s.name} — ${s.description.slice(0, 60)}` : s.name])]));
+  const m = location.hash.match(/#scene=([A-Za-z0-9_-]+)/);
+  if (m) await loadText(unb64(m[1]), 'scene from the URL');
+  else if (scenes.some((s) => s.name === 'urban-drive')) { $('library').value = 'urban-drive'; await loadLibrary('urban-drive'); }
+  else if (scenes.length) { $('library').value = scenes[0].name; await loadLibrary(scenes[0].name); }
+  document.body.dataset.ready = '1';
+}
+window.addEventListener('error', (e) => studio.errors.push(String(e.message)));
+start().catch((err) => { status(`start failed: ${err.message}`); studio.errors.push(String(err)); });
+void deref;
