@@ -10,6 +10,7 @@
 
 #include "fast_format.h"
 #include "navcore/nav_filter.h"
+#include "navcore/nav_recorded.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 
@@ -260,6 +261,27 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
     fputs(", \"max_gap_t_s\": ", f);
     json_number(f, fs->max_gap_t_s);
     fputs("},\n", f);
+  }
+  if (scene->gnss.file[0] != '\0') {
+    /* gnss.file (docs/gnss-file.md): the fixes came from a file, not from the receiver model. */
+    nav_ins_gnss_fix *fx = NULL;
+    size_t nfx = 0, used = 0, with_vel = 0;
+    double t0 = 0.0;
+    if (nav_gnss_file_load(scene, &fx, &nfx, &t0, NULL) != NAV_OK) nfx = 0;
+    for (size_t i = 0; i < nfx; ++i) {
+      bool out = fx[i].t_s < 0.0 || fx[i].t_s > sum->duration_s;
+      for (size_t k = 0; k < scene->gnss.model.outage_count && !out; ++k)
+        out = fx[i].t_s >= scene->gnss.model.outages[k].t0_s && fx[i].t_s < scene->gnss.model.outages[k].t1_s;
+      if (!out) used++;
+      if (fx[i].has_vel) with_vel++;
+    }
+    free(fx);
+    fputs("  \"gnss_source\": {\"kind\": \"file\", \"file\": ", f);
+    nav_json_write_string(f, scene->gnss.file);
+    fprintf(f, ", \"fixes\": %zu, \"fixes_with_velocity\": %zu, \"fixes_in_run_outside_outages\": %zu, "
+               "\"t0_file_s\": ", nfx, with_vel, used);
+    json_number(f, t0);
+    fputs(", \"sigma\": \"the file's\"},\n", f);
   }
   fputs("  \"requirements\": ", f);
   if (nav_requirements_write_json(f, info->requirements, info->requirements ? info->n_requirements : 0, 2) !=

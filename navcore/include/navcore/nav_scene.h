@@ -415,6 +415,11 @@ typedef struct nav_scene_gnss {
   /** Satellites along the trajectory (issue 22): visibility and DOP outputs; independent of
    *  @c enabled (the receiver model of the integrated schemes). */
   nav_gnss_constellation_config constellation;
+  /** gnss.file: recorded fixes (KF-GINS GNSS text, 7 or 13 columns) that replace the receiver
+   *  model's fixes; "" for none. navcore_io stores it resolved (absolute). navcore reads no
+   *  file: the caller loads it (nav_gnss_file_load(), nav_recorded.h) and attaches the fixes to
+   *  the simulation (nav_sim_set_gnss_fixes()). Time base: docs/gnss-file.md. */
+  char file[NAV_RECORDED_PATH_MAX];
 } nav_scene_gnss;
 
 /** Initial navigation errors, drawn once per Monte Carlo run (1-sigma, zero mean). */
