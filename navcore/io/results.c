@@ -11,6 +11,7 @@
 #include "fast_format.h"
 #include "navcore/nav_filter.h"
 #include "navcore/nav_recorded.h"
+#include "navcore/nav_track.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 
@@ -260,6 +261,12 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
     json_number(f, fs->max_gap_s);
     fputs(", \"max_gap_t_s\": ", f);
     json_number(f, fs->max_gap_t_s);
+    char w[1200];
+    if (nav_track_warnings(&scene->trajectory.recorded, w, sizeof w) != 0) {
+      /* Only when there is one: the model's dynamics against the samples (docs/recorded-fit.md). */
+      fputs(",\n    \"warning\": ", f);
+      nav_json_write_string(f, w);
+    }
     fputs("},\n", f);
   }
   if (scene->gnss.file[0] != '\0') {

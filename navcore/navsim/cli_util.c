@@ -11,6 +11,7 @@
 
 #include "navcore/nav_recorded.h"
 #include "navcore/nav_sim.h"
+#include "navcore/nav_track.h"
 
 bool navsim_is_help(const char *arg) {
   return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
@@ -52,6 +53,9 @@ void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scen
           label ? label : "", scene->trajectory.recorded.file, s->samples, s->pos_rms_m, s->pos_h_rms_m,
           s->pos_v_rms_m, s->pos_max_m, s->pos_max_t_s, s->vel_rms_mps, s->vel_max_mps, s->vel_max_t_s,
           s->att_rms_rad * NAV_RAD2DEG, s->att_max_rad * NAV_RAD2DEG, s->att_max_t_s, s->max_gap_s, s->max_gap_t_s);
+  char w[1200];
+  if (nav_track_warnings(&scene->trajectory.recorded, w, sizeof w) != 0)
+    fprintf(stderr, "%swarning: trajectory.recorded: %s\n", label ? label : "", w);
 }
 
 int navsim_attach_gnss_file(const char *cmd, const nav_scene *scene, nav_sim *sim, size_t *count) {
