@@ -101,7 +101,10 @@ static void expect_valid_kml(const char *path) {
  * the result's coordinates to its 9 decimals. */
 static void test_round_trip(void **state) {
   (void)state;
-  nav_cli_result *r = navsim("import '%s/drive.gpx' --out drive.yaml", TRACKS);
+  /* --accept-distance (issue 18): this plan strays 7.8 m from the track, beyond the default
+   * --tolerance 5 m, which is now refused (test_navsim_import_distance); here the round trip of
+   * the plan as it was is what is tested. */
+  nav_cli_result *r = navsim("import '%s/drive.gpx' --accept-distance --out drive.yaml", TRACKS);
   expect_code(r, 0);
   const double dev1 = number_after(r->out, "from the flown path ");
   assert_true(dev1 > 0 && dev1 < 20.0);
@@ -217,7 +220,7 @@ static void test_import_errors(void **state) {
   assert_non_null(strstr(r->err, "max_lateral_accel_mps2"));
   assert_false(nav_test_is_file(WORK "/bad.yaml"));
   /* Merging makes the same track feasible, and says what it did. */
-  r = navsim("import '%s/sharp.kml' --speed 15 --out sharp.yaml", TRACKS);
+  r = navsim("import '%s/sharp.kml' --speed 15 --accept-distance --out sharp.yaml", TRACKS); /* 19 m off: issue 18 */
   expect_code(r, 0);
   assert_non_null(strstr(r->out, "1 turn merged"));
   expect_code(navsim("import '%s/drive.gpx'", TRACKS), 2);
