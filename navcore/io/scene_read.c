@@ -474,6 +474,7 @@ static const nav_io_field k_gnss[] = {
      .kind = NAV_IO_STRING,
      .offset = OFF(gnss.file),
      .size = NAV_RECORDED_PATH_MAX,
+     .write_if = catalog_given, /* written only when given, like the catalog names */
      .comment = "recorded fixes (KF-GINS GNSS text) instead of the receiver model; docs/gnss-file.md"},
     {.key = "constellation",
      .kind = NAV_IO_SECTION,

@@ -149,6 +149,28 @@ static void test_real_drive(void **state) {
                 s.h_rms_m, bound);
   assert_true(s.h_rms_m > 0.0);
   assert_true(s.h_rms_m < bound);
+  /* summary.json "setup" and the report state what produced the run (issue 18). */
+  summary = nav_test_slurp_alloc(WORK "/real/summary.json");
+  assert_non_null(summary);
+  nav_test_assert_matches(summary, "\"setup\": \\{\"scheme\": \"ins_gnss\",\n +\"imu\": \\{\"catalog\": \"ADIS16465-1\"");
+  nav_test_assert_matches(summary, "\"  +arw_deg_per_sqrt_h: 0\\.15\"");
+  nav_test_assert_matches(summary, "\"receiver\": \\{\"source\": \"file\"");
+  nav_test_assert_matches(summary, "\"outages_s\": \\[\\[20, 45\\]\\]");
+  free(summary);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "report '%s/real' --out '%s/rep'", WORK, WORK);
+  char *page = nav_test_slurp_alloc(WORK "/rep/report.html");
+  if (!page) fail_msg("no report.html (exit %d): %s", r->code, r->err);
+  nav_test_assert_matches(page, "<h2>Setup</h2>");
+  nav_test_assert_matches(page, "navigation scheme</th><td class=\"l\">ins_gnss<");
+  nav_test_assert_matches(page, "IMU</th><td class=\"l\">ADIS16465-1<pre>");
+  nav_test_assert_matches(page, "arw_deg_per_sqrt_h: 0\\.15\n");
+  nav_test_assert_matches(page, "recorded fixes from a file");
+  nav_test_assert_matches(page, "GNSS outages \\[s\\]</th><td class=\"l\">\\[\\[20, 45\\]\\]<");
+  nav_test_assert_matches(page, "lever arm.*<td class=\"l\">-0\\.37, 0\\.008, 0\\.353<");
+  nav_test_assert_matches(page, "seed</th><td class=\"l\">1<");
+  nav_test_assert_matches(page, "Recorded reference: fit residuals");
+  nav_test_assert_matches(page, "<td class=\"l\">position</td><td>[0-9.e-]+</td><td>[0-9.e-]+</td>");
+  free(page);
 }
 
 /* WGS-84 meridian radius of curvature at latitude @p lat [rad] (Groves 2.105). */
