@@ -233,6 +233,8 @@ int navsim_import(int argc, char **argv) {
   int rc = EXIT_OK;
   nav_geotrack tr = {0};
   navsim_diag_sink sink = {0};
+  static char stray[2400]; /* the flown path strays beyond --tolerance: the message, else "" */
+  stray[0] = '\0';
   if (templ) {
     const int lrc = navsim_load_scene(templ, sc);
     if (lrc != EXIT_OK) {
@@ -320,25 +322,22 @@ int navsim_import(int argc, char **argv) {
       goto done;
     }
     if (rep.max_dev_m > limit_m && !accept_distance) {
-      /* Where the plan strays, and what to change; nothing is written. */
+      /* Where the plan strays, and what to change; reported after the scene's own checks (a scene
+       * that is not valid is refused for that first), and nothing is written. */
       const long w = rep.max_dev_point;
       const bool where = w >= 0 && (size_t)w < tr.count;
-      char at[160] = "";
+      char at[160] = "", loc[600];
       if (where && tr.points[w].has_time && tr.points[0].has_time)
         snprintf(at, sizeof at, ", %.1f s into the track", tr.points[w].t_s - tr.points[0].t_s);
-      if (where)
-        fprintf(stderr, "%s:%d:%d: error: ", in, tr.points[w].line, tr.points[w].col);
-      else
-        fprintf(stderr, "%s: error: ", in);
-      fprintf(stderr,
-              "the planned path passes %.2f m from this track point%s, beyond --tolerance %g m: the vehicle "
-              "cannot follow the track there within the planner's limits at its speed. Lower the speed "
-              "(--speed, or --no-time with a lower --speed), keep the track's stops and times (a timed GPX/KML, "
-              "without --no-time), raise the limits (--template with larger trajectory.waypoints.limits), or "
-              "accept the distance with --accept-distance; \"%s\" was not written\n",
-              rep.max_dev_m, at, limit_m, out);
-      rc = EXIT_INVALID;
-      goto done;
+      if (where) snprintf(loc, sizeof loc, "%s:%d:%d", in, tr.points[w].line, tr.points[w].col);
+      else snprintf(loc, sizeof loc, "%s", in);
+      snprintf(stray, sizeof stray,
+               "%s: error: the planned path passes %.2f m from this track point%s, beyond --tolerance %g m: the "
+               "vehicle cannot follow the track there within the planner's limits at its speed. Lower the speed "
+               "(--speed, or --no-time with a lower --speed), keep the track's stops and times (a timed GPX/KML, "
+               "without --no-time), raise the limits (--template with larger trajectory.waypoints.limits), or "
+               "accept the distance with --accept-distance; \"%s\" was not written\n",
+               loc, rep.max_dev_m, at, limit_m, out);
     }
     if (o2.tolerance_m != opt.tolerance_m)
       printf("refined    thinned with %g m instead of %g m to keep the flown path within %g m of the track\n",
@@ -357,6 +356,11 @@ int navsim_import(int argc, char **argv) {
   /* Nothing is written, and no existing scene replaced, unless the scene is valid. */
   rc = validate_import(in, out, fmt == NAV_TRACK_FORMAT_MOTION_DEF ? NULL : &tr, sc);
   if (rc != EXIT_OK) goto done;
+  if (stray[0] != '\0') {
+    fputs(stray, stderr);
+    rc = EXIT_INVALID;
+    goto done;
+  }
   {
     const nav_status st = nav_scene_write_file(out, sc);
     if (st != NAV_OK) {
