@@ -40,15 +40,17 @@ void nav_io_gnss_file_finish(nav_io_reader *r, nav_scene *scene) {
   const nav_status s = nav_rec_check_file(path, NAV_REC_GNSS, &count, &d);
   if (s != NAV_OK) {
     if (d.message[0] != '\0') nav_io_forward_diag(r, &d);
-    nav_io_reader_error_at_path(r, "gnss.file", "the GNSS file \"%s\" was not loaded (%s)", path, nav_status_str(s));
+    nav_io_reader_error_at_path(r, "gnss.file", "the GNSS file \"%s\" was not loaded (%s)", path,
+                                nav_status_str(s));
     return;
   }
   if (count == 0) {
-    nav_io_reader_error_at_path(r, "gnss.file",
-                                "the GNSS file \"%s\" holds no fix (expected KF-GINS GNSS text: time, latitude, "
-                                "longitude [deg], height [m], sigma N E D [m], optionally velocity N E D [m/s] "
-                                "and its sigmas)",
-                                path);
+    nav_io_reader_error_at_path(
+        r, "gnss.file",
+        "the GNSS file \"%s\" holds no fix (expected KF-GINS GNSS text: time, latitude, "
+        "longitude [deg], height [m], sigma N E D [m], optionally velocity N E D [m/s] "
+        "and its sigmas)",
+        path);
     return;
   }
   const size_t len = strlen(path);
@@ -59,8 +61,8 @@ void nav_io_gnss_file_finish(nav_io_reader *r, nav_scene *scene) {
   memcpy(g->file, path, len + 1);
 }
 
-nav_status nav_gnss_file_load(const nav_scene *scene, nav_ins_gnss_fix **out, size_t *count, double *t0_file_s,
-                              nav_diag *diag) {
+nav_status nav_gnss_file_load(const nav_scene *scene, nav_ins_gnss_fix **out, size_t *count,
+                              double *t0_file_s, nav_diag *diag) {
   if (!scene || !out || !count || scene->gnss.file[0] == '\0') return NAV_ERR_INVALID_ARG;
   size_t n = 0;
   nav_status st = nav_rec_check_file(scene->gnss.file, NAV_REC_GNSS, &n, diag);
@@ -84,7 +86,8 @@ nav_status nav_gnss_file_load(const nav_scene *scene, nav_ins_gnss_fix **out, si
   /* docs/gnss-file.md: a recorded reference shares the file's time base (scene time 0 is its
    * first sample, t0_s); otherwise the first fix is at scene time 0. */
   const double t0 = scene->trajectory.type == NAV_TRAJ_RECORDED ? scene->trajectory.recorded.t0_s : f[0].t_s;
-  for (size_t i = 0; i < got; ++i) f[i].t_s -= t0;
+  for (size_t i = 0; i < got; ++i)
+    f[i].t_s -= t0;
   *out = f;
   *count = got;
   if (t0_file_s) *t0_file_s = t0;

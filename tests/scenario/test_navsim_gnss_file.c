@@ -79,7 +79,9 @@ static table load_csv(const char *path, size_t cols) {
   return t;
 }
 
-static double at(const table *t, size_t r, size_t c) { return t->v[r * t->cols + c]; }
+static double at(const table *t, size_t r, size_t c) {
+  return t->v[r * t->cols + c];
+}
 
 /* Errors of run 0 at the epochs of gnss.csv (the applied fixes; output rate 10 Hz holds them). */
 typedef struct fix_stats {
@@ -100,7 +102,8 @@ static fix_stats fix_epoch_errors(const char *dir, double out_t0, double out_t1)
     const double t = at(&g, i, 0);
     if (t >= out_t0 && t < out_t1) s.in_outage++;
     s2 += pow(at(&g, i, 7), 2) + pow(at(&g, i, 8), 2);
-    while (j < e.rows && at(&e, j, 0) < t - 1e-6) ++j;
+    while (j < e.rows && at(&e, j, 0) < t - 1e-6)
+      ++j;
     if (j == e.rows || fabs(at(&e, j, 0) - t) > 1e-6) continue;
     s.matched++;
     h2 += pow(at(&e, j, 4), 2);
@@ -126,15 +129,16 @@ static long json_long(const char *json, const char *key) {
 
 static void test_real_drive(void **state) {
   (void)state;
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s' --runs 1 --quiet --out '%s/real'", SCENE, WORK);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s' --runs 1 --out '%s/real'", SCENE, WORK);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s' --runs 1 --out '%s/real' --force", SCENE, WORK);
-  assert_int_equal(r->code, 0);
-  nav_test_assert_matches(r->out, "gnss +recorded fixes from .*adis16465-gnss-posvel\\.txt: 203 fixes \\(position \\+ "
-                                  "velocity\\).*scene time = file time - 116454\\.000 s");
+  nav_test_assert_matches(
+      r->out, "gnss +recorded fixes from .*adis16465-gnss-posvel\\.txt: 203 fixes \\(position \\+ "
+              "velocity\\).*scene time = file time - 116454\\.000 s");
   char *summary = nav_test_slurp_alloc(WORK "/real/summary.json");
   assert_non_null(summary);
-  nav_test_assert_matches(summary, "\"gnss_source\": \\{\"kind\": \"file\", \"file\": \"[^\"]*adis16465-gnss-posvel\\.txt\"");
+  nav_test_assert_matches(
+      summary, "\"gnss_source\": \\{\"kind\": \"file\", \"file\": \"[^\"]*adis16465-gnss-posvel\\.txt\"");
   const long used = json_long(summary, "fixes_in_run_outside_outages");
   free(summary);
   const fix_stats s = fix_epoch_errors(WORK "/real", 20.0, 45.0);
@@ -145,14 +149,15 @@ static void test_real_drive(void **state) {
   assert_int_equal(s.in_outage, 0);
   /* The fixes' sigmas say how well the reference can be followed: RTK level, 0.25 m RMS here. */
   const double bound = 3.0 * s.sigma_h_rms_m;
-  print_message("horizontal error at %zu fix epochs: RMS %.3f m; bound 3 x RMS fix sigma = %.3f m\n", s.matched,
-                s.h_rms_m, bound);
+  print_message("horizontal error at %zu fix epochs: RMS %.3f m; bound 3 x RMS fix sigma = %.3f m\n",
+                s.matched, s.h_rms_m, bound);
   assert_true(s.h_rms_m > 0.0);
   assert_true(s.h_rms_m < bound);
   /* summary.json "setup" and the report state what produced the run (issue 18). */
   summary = nav_test_slurp_alloc(WORK "/real/summary.json");
   assert_non_null(summary);
-  nav_test_assert_matches(summary, "\"setup\": \\{\"scheme\": \"ins_gnss\",\n +\"imu\": \\{\"catalog\": \"ADIS16465-1\"");
+  nav_test_assert_matches(
+      summary, "\"setup\": \\{\"scheme\": \"ins_gnss\",\n +\"imu\": \\{\"catalog\": \"ADIS16465-1\"");
   nav_test_assert_matches(summary, "\"  +arw_deg_per_sqrt_h: 0\\.15\"");
   nav_test_assert_matches(summary, "\"receiver\": \\{\"source\": \"file\"");
   nav_test_assert_matches(summary, "\"outages_s\": \\[\\[20, 45\\]\\]");
@@ -183,7 +188,8 @@ static double meridian_radius(double lat) {
 /* @p scene_text with every occurrence of @p from replaced by @p to (malloc'd). */
 static char *replace_all(const char *text, const char *from, const char *to) {
   size_t n = 0;
-  for (const char *p = strstr(text, from); p; p = strstr(p + strlen(from), from)) ++n;
+  for (const char *p = strstr(text, from); p; p = strstr(p + strlen(from), from))
+    ++n;
   char *out = malloc(strlen(text) + n * strlen(to) + 1);
   assert_non_null(out);
   char *o = out;
@@ -229,13 +235,13 @@ static void test_fixes_drive_the_filter(void **state) {
   fclose(f);
   free(text);
   write_scene("shifted.yaml", WORK "/shifted.txt");
-  nav_cli_result *r =
-      nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s/shifted.yaml' --runs 1 --quiet --out '%s/shifted'", WORK, WORK);
+  nav_cli_result *r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL, "run '%s/shifted.yaml' --runs 1 --quiet --out '%s/shifted'", WORK, WORK);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   const fix_stats s = fix_epoch_errors(WORK "/shifted", 20.0, 45.0);
   const double bound = 3.0 * s.sigma_h_rms_m;
-  print_message("10 m north shift: mean north error at %zu fixes %.3f m (bound %.3f m)\n", s.matched, s.n_mean_m,
-                bound);
+  print_message("10 m north shift: mean north error at %zu fixes %.3f m (bound %.3f m)\n", s.matched,
+                s.n_mean_m, bound);
   assert_near(s.n_mean_m, 10.0, bound);
 }
 
@@ -245,18 +251,22 @@ static void test_simulated_reference_7_columns(void **state) {
    * scene time = file time - 500000 s (the first fix). */
   FILE *f = fopen(WORK "/still.txt", "w");
   assert_non_null(f);
-  for (int k = 0; k <= 60; ++k) fprintf(f, "%d.000 30.5 114.3 20.0 0.02 0.02 0.05\n", 500000 + k);
+  for (int k = 0; k <= 60; ++k)
+    fprintf(f, "%d.000 30.5 114.3 20.0 0.02 0.02 0.05\n", 500000 + k);
   fclose(f);
-  nav_test_write_file(WORK, "still.yaml",
-                      "format_version: 1\nname: still\nearth: {model: wgs84, origin: {lat_deg: 30.5, lon_deg: 114.3, "
-                      "h_m: 20}}\ntrajectory:\n  type: test_motion\n  duration_s: 60\n  initial_attitude: {roll_deg: 0, "
-                      "pitch_deg: 0, yaw_deg: 0}\n  test_motion: {kind: stationary}\n"
-                      "imu: {rate_hz: 100, catalog: \"ADIS16465-1\"}\ngnss: {enabled: true, file: still.txt}\n"
-                      "navigation: {scheme: ins_gnss}\noutput: {rate_hz: 1}\nsimulation: {seed: 3, runs: 1}\n");
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s/still.yaml' --out '%s/still'", WORK, WORK);
+  nav_test_write_file(
+      WORK, "still.yaml",
+      "format_version: 1\nname: still\nearth: {model: wgs84, origin: {lat_deg: 30.5, lon_deg: 114.3, "
+      "h_m: 20}}\ntrajectory:\n  type: test_motion\n  duration_s: 60\n  initial_attitude: {roll_deg: 0, "
+      "pitch_deg: 0, yaw_deg: 0}\n  test_motion: {kind: stationary}\n"
+      "imu: {rate_hz: 100, catalog: \"ADIS16465-1\"}\ngnss: {enabled: true, file: still.txt}\n"
+      "navigation: {scheme: ins_gnss}\noutput: {rate_hz: 1}\nsimulation: {seed: 3, runs: 1}\n");
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s/still.yaml' --out '%s/still'", WORK, WORK);
   if (r->code != 0) fail_msg("exit %d: %s %s", r->code, r->out, r->err);
-  nav_test_assert_matches(r->out, "61 fixes \\(position\\), file time 500000\\.000 to 500060\\.000 s; scene time = "
-                                  "file time - 500000\\.000 s \\(the first fix at scene time 0\\)");
+  nav_test_assert_matches(r->out,
+                          "61 fixes \\(position\\), file time 500000\\.000 to 500060\\.000 s; scene time = "
+                          "file time - 500000\\.000 s \\(the first fix at scene time 0\\)");
   const fix_stats s = fix_epoch_errors(WORK "/still", 1e9, 1e9);
   assert_int_equal(s.fixes, 61);
   assert_int_equal(s.matched, 61);
@@ -265,10 +275,12 @@ static void test_simulated_reference_7_columns(void **state) {
 
 static void test_bad_input(void **state) {
   (void)state;
-  nav_test_write_file(WORK, "bad.txt", "116454.0 30.5284656653 114.3557363642 20.65 0.01 0.011 0.054\n"
-                                       "116455.0 30.5284656653 north 20.65 0.01 0.011 0.054\n");
+  nav_test_write_file(WORK, "bad.txt",
+                      "116454.0 30.5284656653 114.3557363642 20.65 0.01 0.011 0.054\n"
+                      "116455.0 30.5284656653 north 20.65 0.01 0.011 0.054\n");
   write_scene("bad.yaml", WORK "/bad.txt");
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s/bad.yaml' --out '%s/bad'", WORK, WORK);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s/bad.yaml' --out '%s/bad'", WORK, WORK);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "bad\\.txt:2:[0-9]+: ");
   assert_false(nav_test_is_file(WORK "/bad/summary.json"));

@@ -37,45 +37,53 @@ static void test_distance_checked(void **state) {
   (void)state;
   nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/drive.gpx' --out d.yaml", TRACKS);
   assert_int_equal(r->code, 2);
-  nav_test_assert_matches(r->err, "drive\\.gpx:[0-9]+:[0-9]+: error: the planned path passes [0-9.]+ m from this "
-                                  "track point, [0-9.]+ s into the track, beyond --tolerance 5 m");
+  nav_test_assert_matches(r->err,
+                          "drive\\.gpx:[0-9]+:[0-9]+: error: the planned path passes [0-9.]+ m from this "
+                          "track point, [0-9.]+ s into the track, beyond --tolerance 5 m");
   nav_test_assert_matches(r->err, "Lower the speed.*keep the track's stops.*--accept-distance");
   const double d = number_after(r->err, "the planned path passes ");
   assert_true(d > 5.0);
   assert_false(nav_test_is_file(WORK "/d.yaml"));
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/drive.gpx' --accept-distance --out d.yaml", TRACKS);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/drive.gpx' --accept-distance --out d.yaml",
+                        TRACKS);
   assert_int_equal(r->code, 0);
   assert_true(nav_test_is_file(WORK "/d.yaml"));
   assert_near(number_after(r->out, "from the flown path "), d, 0.006);
   /* Within a larger tolerance the same plan is accepted without the flag. */
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/drive.gpx' --tolerance 10 --out d10.yaml", TRACKS);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/drive.gpx' --tolerance 10 --out d10.yaml",
+                        TRACKS);
   assert_int_equal(r->code, 0);
   assert_true(number_after(r->out, "from the flown path ") <= 10.0);
 }
 
 static void test_kml_tracks(void **state) {
   (void)state;
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/two-tracks.kml' --out k.yaml", TRACKS);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/two-tracks.kml' --out k.yaml", TRACKS);
   assert_int_equal(r->code, 2);
-  nav_test_assert_matches(r->err, "two-tracks\\.kml:1:1: error: the file holds 2 tracks .*1 \"Tessellated\" "
-                                  "\\(line 7, 2 points\\); 2 \"Untitled Path\" \\(line 16, 3 points\\); pick one with "
-                                  "--track");
+  nav_test_assert_matches(
+      r->err, "two-tracks\\.kml:1:1: error: the file holds 2 tracks .*1 \"Tessellated\" "
+              "\\(line 7, 2 points\\); 2 \"Untitled Path\" \\(line 16, 3 points\\); pick one with "
+              "--track");
   assert_false(nav_test_is_file(WORK "/k.yaml"));
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/two-tracks.kml' --track 2 --speed 2 --out k2.yaml", TRACKS);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "import '%s/two-tracks.kml' --track 2 --speed 2 --out k2.yaml", TRACKS);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   nav_test_assert_matches(r->out, "3 points -> 3 waypoints");
   char *text = nav_test_slurp_alloc(WORK "/k2.yaml");
   assert_non_null(text);
   nav_test_assert_matches(text, "\nname: \"?two-tracks\"?\n");
   free(text);
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/two-tracks.kml' --track Tessellated --out k1.yaml", TRACKS);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "import '%s/two-tracks.kml' --track Tessellated --out k1.yaml", TRACKS);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   nav_test_assert_matches(r->out, "2 points -> 2 waypoints");
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/two-tracks.kml' --track 3 --out k3.yaml", TRACKS);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "no track named or numbered \"3\".*the file holds 2");
   /* A named Placemark keeps its name. */
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import '%s/sharp.kml' --speed 5 --accept-distance --out z.yaml", TRACKS);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "import '%s/sharp.kml' --speed 5 --accept-distance --out z.yaml", TRACKS);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   text = nav_test_slurp_alloc(WORK "/z.yaml");
   assert_non_null(text);

@@ -77,7 +77,8 @@ static void assert_no_placeholders(const char *text) {
 
 static int count(const char *text, const char *what) {
   int n = 0;
-  for (const char *p = strstr(text, what); p; p = strstr(p + 1, what)) ++n;
+  for (const char *p = strstr(text, what); p; p = strstr(p + 1, what))
+    ++n;
   return n;
 }
 
@@ -85,17 +86,20 @@ static void half_second_reference(void **state) {
   (void)state;
   skip_without_data();
   decimate("half.nav", 0.5);
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                        "replay --imu '" DATA "IMU.txt' --gnss '" DATA "GNSS_outage.txt' --truth "
-                                        "'%s/half.nav' --scene '" SCENE "' --smooth --out '%s/half'",
-                                        WORK, WORK);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "replay --imu '" DATA "IMU.txt' --gnss '" DATA "GNSS_outage.txt' --truth "
+                        "'%s/half.nav' --scene '" SCENE "' --smooth --out '%s/half'",
+                        WORK, WORK);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   assert_no_placeholders(r->out);
   nav_test_assert_matches(r->out, "100299\\.000 +100360\\.000 +no ref\\. row +no ref\\. row +[0-9.]+\n");
-  nav_test_assert_matches(r->out, "gap 100299\\.000\\.\\.100360\\.000 s: end horiz\\. not scored \\(no reference row");
+  nav_test_assert_matches(
+      r->out, "gap 100299\\.000\\.\\.100360\\.000 s: end horiz\\. not scored \\(no reference row");
   /* The files' time base everywhere, the offset once. */
   assert_int_equal(count(r->out, "count from the first IMU epoch, t = 100000.500 s"), 1);
-  nav_test_assert_matches(r->out, "outage \\[100299\\.000, 100360\\.000\\) s: [0-9.]+ m at t = 100359\\.500 s");
+  nav_test_assert_matches(r->out,
+                          "outage \\[100299\\.000, 100360\\.000\\) s: [0-9.]+ m at t = 100359\\.500 s");
   nav_test_assert_matches(r->out, "outage \\[100599\\.000, 100660\\.000\\) s: ");
 }
 
@@ -110,17 +114,18 @@ static void whole_second_reference_no_gaps(void **state) {
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   assert_no_placeholders(r->out);
   assert_null(strstr(r->out, "gap 1 end"));
-  nav_test_assert_matches(r->out, "N/A +h-outage-end +horizontal_position outage_end: not evaluated: the run has no "
-                                  "GNSS outage");
+  nav_test_assert_matches(r->out,
+                          "N/A +h-outage-end +horizontal_position outage_end: not evaluated: the run has no "
+                          "GNSS outage");
   assert_null(strstr(r->out, "PASS  h-outage-end"));
 }
 
 static void free_ins_no_empty_column(void **state) {
   (void)state;
   skip_without_data();
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                        "replay --imu '" DATA "IMU.txt' --truth '%s/whole.nav' --out '%s/free'",
-                                        WORK, WORK);
+  nav_cli_result *r =
+      nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "replay --imu '" DATA "IMU.txt' --truth '%s/whole.nav' --out '%s/free'", WORK, WORK);
   if (r->code != 0) fail_msg("exit %d: %s", r->code, r->err);
   assert_no_placeholders(r->out);
   nav_test_assert_matches(r->out, "\n +navsim +KF-GINS\n");
