@@ -87,6 +87,14 @@ int navsim_attach_gnss_file(const char *cmd, const nav_scene *scene, nav_sim *si
   return 0;
 }
 
+void navsim_warn_gnss_file_model(const char *cmd, const char *scene_path, const nav_scene *scene) {
+  if (!scene || scene->gnss.file[0] == '\0') return;
+  fprintf(stderr,
+          "%s: warning: gnss.file: navsim %s analyses the covariance with the receiver model's epochs and "
+          "sigmas, not the recorded fixes of the file (navsim run uses those)\n",
+          scene_path ? scene_path : "", cmd);
+}
+
 void navsim_print_gnss_file(FILE *f, const char *label, const nav_scene *scene) {
   if (!f || !scene || scene->gnss.file[0] == '\0') return;
   nav_ins_gnss_fix *fixes = NULL;

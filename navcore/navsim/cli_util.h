@@ -45,6 +45,10 @@ void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scen
  * ..."; returns EXIT_OK, 2 (a bad file) or 1. @p count receives the number of fixes (may be NULL). */
 int navsim_attach_gnss_file(const char *cmd, const nav_scene *scene, nav_sim *sim, size_t *count);
 
+/* gnss.file with a covariance analysis (estimate, budget): a warning on stderr that it uses the
+ * receiver model's epochs and sigmas, not the file's fixes (docs/gnss-file.md). */
+void navsim_warn_gnss_file_model(const char *cmd, const char *scene_path, const nav_scene *scene);
+
 /* gnss.file: "LABEL<file> (N fixes, scene time = file time - T0 s; the file's sigmas ...)" on @p f. */
 void navsim_print_gnss_file(FILE *f, const char *label, const nav_scene *scene);
 
