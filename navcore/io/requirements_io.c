@@ -71,7 +71,21 @@ nav_status nav_requirements_write_json(FILE *f, const nav_requirement_verdict *v
 }
 
 void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count) {
+  nav_requirements_print_at(f, v, count, 0.0);
+}
+
+/* A time of a verdict as printed: "%g" as always without an offset; with one (a recorded file's
+ * time base, seconds of week) "%.3f", which keeps the milliseconds that "%g" would round off. */
+static const char *time_text(char *buf, size_t cap, double t_s, double off) {
+  if (off != 0.0) snprintf(buf, cap, "%.3f", t_s + off);
+  else snprintf(buf, cap, "%g", t_s);
+  return buf;
+}
+
+void nav_requirements_print_at(FILE *f, const nav_requirement_verdict *v, int count, double t_offset_s) {
   if (!f || count <= 0 || !v) return;
+  const double off = t_offset_s;
+  char t1[64], t2[64], t3[64];
   int pass = 0, na = 0;
   for (int i = 0; i < count; ++i) {
     pass += v[i].pass ? 1 : 0;
@@ -84,20 +98,23 @@ void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count
     const char *u = nav_req_unit_name(q->unit);
     fprintf(f, "  %s  %-20s %s %s", !q->evaluated ? "N/A " : q->pass ? "PASS" : "FAIL",
             q->id, nav_req_metric_name(q->metric), nav_req_statistic_name(q->statistic));
-    if (q->statistic == NAV_REQ_AT_TIME && q->evaluated) fprintf(f, " (t = %g s)", q->at_time_s);
+    if (q->statistic == NAV_REQ_AT_TIME && q->evaluated)
+      fprintf(f, " (t = %s s)", time_text(t1, sizeof t1, q->at_time_s, off));
     if (q->evaluated) fprintf(f, " = %.4g %s %s %.4g %s\n", q->value, u, q->pass ? "<=" : ">", q->limit, u);
     else if (q->na_reason == NAV_REQ_NA_TIME_OUTSIDE)
-      fprintf(f, ": not evaluated: t = %g s lies outside the run's epochs [%g, %g] s (limit %.4g %s)\n", q->at_time_s,
-              q->span_t0_s, q->span_t1_s, q->limit, u);
+      fprintf(f, ": not evaluated: t = %s s lies outside the run's epochs [%s, %s] s (limit %.4g %s)\n",
+              time_text(t1, sizeof t1, q->at_time_s, off), time_text(t2, sizeof t2, q->span_t0_s, off),
+              time_text(t3, sizeof t3, q->span_t1_s, off), q->limit, u);
     else
       fprintf(f, ": not evaluated: %s (limit %.4g %s)\n",
               q->na_reason != NAV_REQ_NA_NONE ? nav_req_na_reason_text(q->na_reason) : "no data", q->limit, u);
     if (q->statistic == NAV_REQ_OUTAGE_END)
       for (int j = 0; j < q->outage_count && j < NAV_REQ_MAX_OUTAGES; ++j) {
-        if (isnan(q->outage_value[j])) fprintf(f, "        outage [%g, %g) s: no output epoch inside\n",
-                                               q->outage_t0_s[j], q->outage_t1_s[j]);
-        else fprintf(f, "        outage [%g, %g) s: %.4g %s at t = %g s\n", q->outage_t0_s[j], q->outage_t1_s[j],
-                     q->outage_value[j], u, q->outage_end_t_s[j]);
+        time_text(t1, sizeof t1, q->outage_t0_s[j], off);
+        time_text(t2, sizeof t2, q->outage_t1_s[j], off);
+        if (isnan(q->outage_value[j])) fprintf(f, "        outage [%s, %s) s: no output epoch inside\n", t1, t2);
+        else fprintf(f, "        outage [%s, %s) s: %.4g %s at t = %s s\n", t1, t2, q->outage_value[j], u,
+                     time_text(t3, sizeof t3, q->outage_end_t_s[j], off));
       }
   }
 }

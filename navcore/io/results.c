@@ -10,6 +10,9 @@
 
 #include "fast_format.h"
 #include "navcore/nav_filter.h"
+#include "navcore/nav_recorded.h"
+#include "navcore/nav_track.h"
+#include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 
@@ -157,6 +160,73 @@ static void json_sim_stats(FILE *f, const nav_sim_stats *st, bool last) {
   json_stat(f, "yaw_err_rad", st->yaw_err_rad, last);
 }
 
+/* The lines of section @p key ("imu:", "gnss:") of the scene as the writer writes it (keys with
+ * their units: datasheet units), as a JSON array of strings; [] when absent. */
+static void write_section_lines(FILE *f, const char *yaml, const char *key) {
+  fputc('[', f);
+  const size_t kl = strlen(key);
+  const char *p = yaml;
+  while (p && *p && strncmp(p, key, kl) != 0) {
+    p = strchr(p, '\n');
+    if (p) ++p;
+  }
+  bool first = true;
+  while (p && *p) {
+    const char *e = strchr(p, '\n');
+    const size_t n = e ? (size_t)(e - p) : strlen(p);
+    if (!first && n > 0 && p[0] != ' ' && p[0] != '#') break; /* the next top-level key */
+    if (n > 0) {
+      char line[600];
+      snprintf(line, sizeof line, "%.*s", (int)(n < sizeof line - 1 ? n : sizeof line - 1), p);
+      fputs(first ? "\n      " : ",\n      ", f);
+      nav_json_write_string(f, line);
+      first = false;
+    }
+    p = e ? e + 1 : NULL;
+  }
+  fputc(']', f);
+}
+
+/* "setup": what produced the run (issue 18: the report states it): scheme, IMU (catalog name and
+ * the error model as the scene writer writes it, in datasheet units), receiver (model, file or
+ * none), the scene's outages, the lever arm. Seed and runs are at the top of summary.json. */
+static void write_setup(FILE *f, const nav_scene *scene) {
+  const bool aided =
+      scene->navigation.scheme == NAV_SCHEME_INS_GNSS || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  const bool array = scene->navigation.scheme == NAV_SCHEME_GYRO_FREE || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  fprintf(f, "  \"setup\": {\"scheme\": \"%s\",\n    \"imu\": {\"catalog\": ", nav_nav_scheme_name(scene->navigation.scheme));
+  nav_json_write_string(f, array ? "(accelerometer array)" : scene->imu.catalog);
+  char *yaml = NULL;
+  size_t len = 0;
+  if (nav_scene_write_string(scene, &yaml, &len) != NAV_OK) yaml = NULL;
+  fputs(", \"model_yaml\": ", f);
+  write_section_lines(f, yaml, array ? "array:" : "imu:");
+  fputs("},\n    \"receiver\": {\"source\": ", f);
+  nav_json_write_string(f, !aided ? "none" : scene->gnss.file[0] ? "file" : "model");
+  fputs(", \"catalog\": ", f);
+  nav_json_write_string(f, aided ? scene->gnss.catalog : "");
+  fputs(", \"model_yaml\": ", f);
+  if (aided) write_section_lines(f, yaml, "gnss:");
+  else fputs("[]", f);
+  fputs("},\n    \"outages_s\": [", f);
+  for (size_t i = 0; aided && i < scene->gnss.model.outage_count; ++i) {
+    fputs(i ? ", [" : "[", f);
+    json_number(f, scene->gnss.model.outages[i].t0_s);
+    fputs(", ", f);
+    json_number(f, scene->gnss.model.outages[i].t1_s);
+    fputc(']', f);
+  }
+  fputs("],\n    \"lever_arm_b_m\": [", f);
+  const nav_vec3 la = scene->gnss.model.r_ba_b_m;
+  json_number(f, aided ? la.x : 0.0);
+  fputs(", ", f);
+  json_number(f, aided ? la.y : 0.0);
+  fputs(", ", f);
+  json_number(f, aided ? la.z : 0.0);
+  fputs("]},\n", f);
+  free(yaml);
+}
+
 nav_status nav_summary_write_json(const char *path, const nav_scene *scene, const nav_run_info *info,
                                   const nav_sim_summary *sum) {
   if (!path || !scene || !info || !sum) return NAV_ERR_INVALID_ARG;
@@ -259,8 +329,36 @@ nav_status nav_summary_write_json(const char *path, const nav_scene *scene, cons
     json_number(f, fs->max_gap_s);
     fputs(", \"max_gap_t_s\": ", f);
     json_number(f, fs->max_gap_t_s);
+    char w[1200];
+    if (nav_track_warnings(&scene->trajectory.recorded, w, sizeof w) != 0) {
+      /* Only when there is one: the model's dynamics against the samples (docs/recorded-fit.md). */
+      fputs(",\n    \"warning\": ", f);
+      nav_json_write_string(f, w);
+    }
     fputs("},\n", f);
   }
+  if (scene->gnss.file[0] != '\0') {
+    /* gnss.file (docs/gnss-file.md): the fixes came from a file, not from the receiver model. */
+    nav_ins_gnss_fix *fx = NULL;
+    size_t nfx = 0, used = 0, with_vel = 0;
+    double t0 = 0.0;
+    if (nav_gnss_file_load(scene, &fx, &nfx, &t0, NULL) != NAV_OK) nfx = 0;
+    for (size_t i = 0; i < nfx; ++i) {
+      bool out = fx[i].t_s < 0.0 || fx[i].t_s > sum->duration_s;
+      for (size_t k = 0; k < scene->gnss.model.outage_count && !out; ++k)
+        out = fx[i].t_s >= scene->gnss.model.outages[k].t0_s && fx[i].t_s < scene->gnss.model.outages[k].t1_s;
+      if (!out) used++;
+      if (fx[i].has_vel) with_vel++;
+    }
+    free(fx);
+    fputs("  \"gnss_source\": {\"kind\": \"file\", \"file\": ", f);
+    nav_json_write_string(f, scene->gnss.file);
+    fprintf(f, ", \"fixes\": %zu, \"fixes_with_velocity\": %zu, \"fixes_in_run_outside_outages\": %zu, "
+               "\"t0_file_s\": ", nfx, with_vel, used);
+    json_number(f, t0);
+    fputs(", \"sigma\": \"the file's\"},\n", f);
+  }
+  write_setup(f, scene);
   fputs("  \"requirements\": ", f);
   if (nav_requirements_write_json(f, info->requirements, info->requirements ? info->n_requirements : 0, 2) !=
       NAV_OK)

@@ -229,6 +229,8 @@ void nav_io_reader_forward(nav_io_reader *r, const nav_diag *d);
 /* nav_io_reader_forward as a nav_diag_fn (@p user is the nav_io_reader): for the readers of files
    that a scene names (motion definition, recorded reference, GNSS almanac). */
 void nav_io_forward_diag(void *user, const nav_diag *d);
+/** gnss.file (gnss_file.c): resolve it against the scene file and check its lines. */
+void nav_io_gnss_file_finish(nav_io_reader *r, nav_scene *scene);
 /* A file named in a scene, relative to the scene file's directory (made absolute when that
    directory exists, so messages name the file unambiguously), or as given when absolute or when
    the scene was read from memory under a name without a directory part (then relative to the

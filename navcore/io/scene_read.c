@@ -550,6 +550,13 @@ static const nav_io_field k_gnss[] = {
      .write_if = off_needed,
      .comment = "terms switched off",
      .schema = schema_off},
+    {.key = "file",
+     .doc = "recorded GNSS fixes (KF-GINS GNSS text, 7 or 13 columns) used instead of the receiver model",
+     .kind = NAV_IO_STRING,
+     .offset = OFF(gnss.file),
+     .size = NAV_RECORDED_PATH_MAX,
+     .write_if = catalog_given, /* written only when given, like the catalog names */
+     .comment = "recorded fixes (KF-GINS GNSS text) instead of the receiver model; docs/gnss-file.md"},
     {.key = "constellation",
      .kind = NAV_IO_SECTION,
      .section = &nav_io_gnss_constellation_section,
@@ -3099,6 +3106,7 @@ static nav_status read_buffer(const char *text, size_t len, const char *name, bo
   if (r->newer_format || r->oom || root->kind != Y_MAP) goto cleanup;
   /* Whatever needs the whole file: geodetic waypoints, motion-definition imports, script lengths. */
   if (!r->stop) nav_io_traj_finish(r, root, scene);
+  if (!r->stop) nav_io_gnss_file_finish(r, scene);
   if (r->oom || r->stop) goto cleanup;
 
   /* Cross-field and domain checks shared with the editor; their paths are placed in the file. */

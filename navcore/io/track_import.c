@@ -158,6 +158,22 @@ typedef struct pt_list {
   size_t n, cap;
 } pt_list;
 
+/* Geometries of one Placemark kept apart (more are appended to the last one) and tracks of a
+ * file listed by name (more are counted). */
+#define KML_MAX_GEOM 64
+#define KML_MAX_LIST 64
+
+typedef struct geom_range {
+  size_t start, end;
+  int line, col;
+} geom_range;
+
+typedef struct kml_track_info {
+  char name[128];
+  size_t points;
+  int line, col;
+} kml_track_info;
+
 typedef struct ti_xml {
   ti_reader *r;
   XML_Parser p;
@@ -194,6 +210,13 @@ typedef struct ti_xml {
   pt_list kml;
   char kml_name[128];
   bool saw_placemark_name;
+  /* Every LineString / gx:Track is one track (issue 18): the geometries of the current
+   * Placemark as ranges of pm_pts, and every track of the file for the selection and its list. */
+  size_t geom_start;
+  int n_geom;
+  geom_range geom[KML_MAX_GEOM];
+  int n_tracks;
+  kml_track_info tracks[KML_MAX_LIST];
 } ti_xml;
 
 static const char *local_name(const char *name) {
@@ -325,8 +348,61 @@ static void gpx_start_point(ti_xml *x, const XML_Char **atts, int kind) {
 
 static void kml_reset_placemark(ti_xml *x) {
   x->pm_pts.n = 0;
+  x->n_geom = 0;
   x->pm_name[0] = '\0';
   x->saw_placemark_name = false;
+}
+
+static void kml_geom_begin(ti_xml *x) {
+  if (x->n_geom < KML_MAX_GEOM) {
+    x->geom[x->n_geom].start = x->pm_pts.n;
+    x->geom[x->n_geom].line = cur_line(x);
+    x->geom[x->n_geom].col = cur_col(x);
+  }
+  x->geom_start = x->pm_pts.n;
+}
+
+static void kml_geom_end(ti_xml *x) {
+  if (x->pm_pts.n == x->geom_start) return; /* no point: not a track */
+  if (x->n_geom < KML_MAX_GEOM) x->geom[x->n_geom++].end = x->pm_pts.n;
+  else x->geom[KML_MAX_GEOM - 1].end = x->pm_pts.n;
+}
+
+/* Does @p sel pick track number @p index (1-based) named @p name? A selection of digits only is
+ * an index; else it is the Placemark's name (its first geometry) or the listed name. */
+static bool kml_selected(const char *sel, int index, const char *name, const char *pm_name, int k) {
+  if (!sel) return index == 1;
+  bool digits = sel[0] != '\0';
+  for (const char *c = sel; *c; ++c)
+    if (*c < '0' || *c > '9') digits = false;
+  if (digits) return strtol(sel, NULL, 10) == index;
+  return strcmp(sel, name) == 0 || (k == 0 && strcmp(sel, pm_name) == 0);
+}
+
+/* A Placemark ends: each of its geometries becomes a track, named after the Placemark (with
+ * " (k)" when it holds several); the selected one is kept. false when out of memory. */
+static bool kml_placemark_end(ti_xml *x) {
+  for (int k = 0; k < x->n_geom; ++k) {
+    const geom_range *g = &x->geom[k];
+    const int index = ++x->n_tracks;
+    char name[128];
+    if (x->n_geom > 1) snprintf(name, sizeof name, "%.100s (%d)", x->pm_name, k + 1);
+    else snprintf(name, sizeof name, "%s", x->pm_name);
+    if (index <= KML_MAX_LIST) {
+      kml_track_info *t = &x->tracks[index - 1];
+      snprintf(t->name, sizeof t->name, "%s", name);
+      t->points = g->end - g->start;
+      t->line = g->line;
+      t->col = g->col;
+    }
+    if (!x->chosen && kml_selected(x->select, index, name, x->pm_name, k)) {
+      x->chosen = true;
+      for (size_t i = g->start; i < g->end; ++i)
+        if (!pt_push(x, &x->kml, &x->pm_pts.v[i])) return false;
+      snprintf(x->kml_name, sizeof x->kml_name, "%s", name);
+    }
+  }
+  return true;
 }
 
 static void XMLCALL on_start(void *ud, const XML_Char *name, const XML_Char **atts) {
@@ -362,10 +438,12 @@ static void XMLCALL on_start(void *ud, const XML_Char *name, const XML_Char **at
     } else if (x->in_placemark && strcmp(ln, "name") == 0 && !x->saw_placemark_name && !x->in_track) {
       text_begin(x, TX_NAME);
     } else if (x->in_placemark && strcmp(ln, "LineString") == 0) {
+      if (x->in_linestring == 0) kml_geom_begin(x);
       x->in_linestring++;
     } else if (x->in_linestring && strcmp(ln, "coordinates") == 0) {
       text_begin(x, TX_COORDS);
     } else if (x->in_placemark && strcmp(ln, "Track") == 0) {
+      if (x->in_track == 0) kml_geom_begin(x);
       x->in_track++;
       x->n_when = 0;
       x->gxc.n = 0;
@@ -541,6 +619,7 @@ static void XMLCALL on_end(void *ud, const XML_Char *name) {
       kml_parse_gxcoord(x);
     } else if (strcmp(ln, "LineString") == 0 && x->in_linestring > 0) {
       x->in_linestring--;
+      if (x->in_linestring == 0) kml_geom_end(x);
     } else if (strcmp(ln, "Track") == 0 && x->in_track > 0) {
       x->in_track--;
       if (x->n_when != 0 && x->n_when != x->gxc.n) {
@@ -556,14 +635,10 @@ static void XMLCALL on_end(void *ud, const XML_Char *name) {
           if (!pt_push(x, &x->pm_pts, &p)) return;
         }
       }
+      if (x->in_track == 0) kml_geom_end(x);
     } else if (strcmp(ln, "Placemark") == 0 && x->in_placemark > 0) {
       x->in_placemark--;
-      if (!x->chosen && x->pm_pts.n > 0 && (!x->select || strcmp(x->select, x->pm_name) == 0)) {
-        x->chosen = true;
-        for (size_t i = 0; i < x->pm_pts.n; ++i)
-          if (!pt_push(x, &x->kml, &x->pm_pts.v[i])) return;
-        snprintf(x->kml_name, sizeof x->kml_name, "%s", x->pm_name);
-      }
+      if (!kml_placemark_end(x)) return;
       kml_reset_placemark(x);
     }
   }
@@ -597,8 +672,18 @@ void nav_geotrack_free(nav_geotrack *t) {
   t->count = 0;
 }
 
+static nav_status read_string_info(const char *text, size_t len, const char *display_name, nav_track_format format,
+                                   const char *select_name, nav_geotrack *out, nav_geotrack_info *info,
+                                   nav_diag_fn report, void *user);
+
 nav_status nav_geotrack_read_string(const char *text, size_t len, const char *display_name, nav_track_format format,
                                     const char *select_name, nav_geotrack *out, nav_diag_fn report, void *user) {
+  return read_string_info(text, len, display_name, format, select_name, out, NULL, report, user);
+}
+
+static nav_status read_string_info(const char *text, size_t len, const char *display_name, nav_track_format format,
+                                   const char *select_name, nav_geotrack *out, nav_geotrack_info *info,
+                                   nav_diag_fn report, void *user) {
   if (!text || !out || !display_name) return NAV_ERR_INVALID_ARG;
   if (format == NAV_TRACK_FORMAT_MOTION_DEF) return NAV_ERR_INVALID_ARG;
   if (len > (size_t)INT32_MAX) return NAV_ERR_INVALID_ARG;
@@ -633,7 +718,8 @@ nav_status nav_geotrack_read_string(const char *text, size_t len, const char *di
       nm = x.kml_name;
       if (src->n == 0) {
         if (select_name)
-          ti_diag(&r, 1, 1, "Placemark", "no Placemark named \"%s\" with a <LineString> or <gx:Track>", select_name);
+          ti_diag(&r, 1, 1, "Placemark", "no track named or numbered \"%s\" (a Placemark with a <LineString> or "
+                                         "<gx:Track>; the file holds %d)", select_name, x.n_tracks);
         else
           ti_diag(&r, 1, 1, "Placemark", "no Placemark with a <LineString> or <gx:Track>");
       }
@@ -655,6 +741,19 @@ nav_status nav_geotrack_read_string(const char *text, size_t len, const char *di
       out->count = src->n;
       out->all_timed = all_timed && src->n > 0;
       snprintf(out->name, sizeof out->name, "%s", nm);
+      if (info) {
+        info->tracks_in_file = x.doc == DOC_KML ? x.n_tracks : 1;
+        info->track_list[0] = '\0';
+        size_t used = 0;
+        for (int i = 0; x.doc == DOC_KML && i < x.n_tracks && i < KML_MAX_LIST && used + 1 < sizeof info->track_list;
+             ++i) {
+          const int k = snprintf(info->track_list + used, sizeof info->track_list - used,
+                                 "%s%d \"%.60s\" (line %d, %zu points)", i ? "; " : "", i + 1, x.tracks[i].name,
+                                 x.tracks[i].line, x.tracks[i].points);
+          if (k > 0)
+            used += (size_t)k < sizeof info->track_list - used ? (size_t)k : sizeof info->track_list - used - 1;
+        }
+      }
       src->v = NULL;
     }
   }
@@ -672,6 +771,11 @@ nav_status nav_geotrack_read_string(const char *text, size_t len, const char *di
 
 nav_status nav_geotrack_read_file(const char *path, nav_track_format format, const char *select_name, nav_geotrack *out,
                                   nav_diag_fn report, void *user) {
+  return nav_geotrack_read_file_info(path, format, select_name, out, NULL, report, user);
+}
+
+nav_status nav_geotrack_read_file_info(const char *path, nav_track_format format, const char *select_name,
+                                       nav_geotrack *out, nav_geotrack_info *info, nav_diag_fn report, void *user) {
   if (!path || !out) return NAV_ERR_INVALID_ARG;
   FILE *fp = NULL;
   char why[320];
@@ -713,7 +817,7 @@ nav_status nav_geotrack_read_file(const char *path, nav_track_format format, con
   fclose(fp);
   if (st == NAV_OK) {
     if (format == NAV_TRACK_FORMAT_AUTO) format = nav_track_format_guess(path, buf, n);
-    st = nav_geotrack_read_string(buf ? buf : "", n, path, format, select_name, out, report, user);
+    st = read_string_info(buf ? buf : "", n, path, format, select_name, out, info, report, user);
   }
   free(buf);
   return st;
@@ -826,7 +930,7 @@ static void drop_waypoint(nav_traj_waypoints *W, int *src_of, int j) {
 /* Largest distance of a track point from the flown path, sampled every 0.1 s, or at most 10^5
  * times for long plans (then every T / 10^5 s, measured against the chords between samples), so
  * time and memory stay bounded whatever the track's duration. */
-static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t n, double *out) {
+static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t n, double *out, long *where) {
   nav_traj *tr = NULL;
   nav_status st = nav_traj_create(sc, 0.01, &tr);
   if (st != NAV_OK) return st;
@@ -866,7 +970,10 @@ static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t
       }
     }
     if (m == 1) best = nav_vec3_norm(nav_vec3_sub(r[i], f[0]));
-    if (best > worst) worst = best;
+    if (best > worst) {
+      worst = best;
+      *where = (long)i;
+    }
   }
   free(f);
   nav_traj_destroy(tr);
@@ -968,6 +1075,7 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   if (!rep) rep = &dummy;
   memset(rep, 0, sizeof *rep);
   rep->bad_point = -1;
+  rep->max_dev_point = -1;
   if (!track || !opt || !scene) return NAV_ERR_INVALID_ARG;
   rep->points_in = track->count;
   if (!(opt->speed_mps > 0) || !isfinite(opt->speed_mps) || !(opt->tolerance_m >= 0) || !isfinite(opt->tolerance_m) ||
@@ -1014,7 +1122,8 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   }
   st = build_attempt(track, opt, timed, r, idx, m, opt->tolerance_m, keep, src_of, sc, rep, msg, msg_size);
   if (st != NAV_OK) goto done;
-  st = flown_deviation(sc, r, n, &rep->max_dev_m);
+  rep->max_dev_point = -1;
+  st = flown_deviation(sc, r, n, &rep->max_dev_m, &rep->max_dev_point);
   if (st != NAV_OK) {
     if (msg) snprintf(msg, msg_size, "the planned trajectory cannot be evaluated: %s", nav_status_str(st));
     goto done;

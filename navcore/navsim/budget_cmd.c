@@ -299,6 +299,7 @@ int navsim_budget(int argc, char **argv) {
     free(sc);
     return 2;
   }
+  navsim_warn_gnss_file_model("budget", scene_path, sc);
   if (runs > 0) sc->simulation.runs = runs;
   if (threads == 0) {
     const long nc = sysconf(_SC_NPROCESSORS_ONLN);

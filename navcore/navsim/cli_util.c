@@ -9,6 +9,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "navcore/nav_recorded.h"
+#include "navcore/nav_sim.h"
+#include "navcore/nav_track.h"
+
 bool navsim_is_help(const char *arg) {
   return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
@@ -49,6 +53,65 @@ void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scen
           label ? label : "", scene->trajectory.recorded.file, s->samples, s->pos_rms_m, s->pos_h_rms_m,
           s->pos_v_rms_m, s->pos_max_m, s->pos_max_t_s, s->vel_rms_mps, s->vel_max_mps, s->vel_max_t_s,
           s->att_rms_rad * NAV_RAD2DEG, s->att_max_rad * NAV_RAD2DEG, s->att_max_t_s, s->max_gap_s, s->max_gap_t_s);
+  char w[1200];
+  if (nav_track_warnings(&scene->trajectory.recorded, w, sizeof w) != 0)
+    fprintf(stderr, "%swarning: trajectory.recorded: %s\n", label ? label : "", w);
+}
+
+int navsim_attach_gnss_file(const char *cmd, const nav_scene *scene, nav_sim *sim, size_t *count) {
+  if (count) *count = 0;
+  if (!scene || scene->gnss.file[0] == '\0') return 0;
+  nav_ins_gnss_fix *fixes = NULL;
+  size_t n = 0;
+  nav_diag d;
+  memset(&d, 0, sizeof d);
+  nav_status st = nav_gnss_file_load(scene, &fixes, &n, NULL, &d);
+  if (st != NAV_OK) {
+    char buf[1400];
+    if (d.message[0] != '\0') {
+      nav_diag_format(&d, buf, sizeof buf);
+      fprintf(stderr, "navsim %s: gnss.file: %s\n", cmd, buf);
+    } else {
+      fprintf(stderr, "navsim %s: gnss.file: %s: %s\n", cmd, scene->gnss.file, nav_status_str(st));
+    }
+    return st == NAV_ERR_PARSE ? 2 : 1;
+  }
+  st = nav_sim_set_gnss_fixes(sim, fixes, n);
+  free(fixes);
+  if (st != NAV_OK) {
+    fprintf(stderr, "navsim %s: gnss.file: %s: %s\n", cmd, scene->gnss.file,
+            nav_sim_last_error(sim)[0] ? nav_sim_last_error(sim) : nav_status_str(st));
+    return st == NAV_ERR_INVALID_ARG ? 2 : 1;
+  }
+  if (count) *count = n;
+  return 0;
+}
+
+void navsim_warn_gnss_file_model(const char *cmd, const char *scene_path, const nav_scene *scene) {
+  if (!scene || scene->gnss.file[0] == '\0') return;
+  fprintf(stderr,
+          "%s: warning: gnss.file: navsim %s analyses the covariance with the receiver model's epochs and "
+          "sigmas, not the recorded fixes of the file (navsim run uses those)\n",
+          scene_path ? scene_path : "", cmd);
+}
+
+void navsim_print_gnss_file(FILE *f, const char *label, const nav_scene *scene) {
+  if (!f || !scene || scene->gnss.file[0] == '\0') return;
+  nav_ins_gnss_fix *fixes = NULL;
+  size_t n = 0;
+  double t0 = 0.0;
+  if (nav_gnss_file_load(scene, &fixes, &n, &t0, NULL) != NAV_OK) return;
+  size_t vel = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (fixes[i].has_vel) vel++;
+  fprintf(f,
+          "%srecorded fixes from %s: %zu fixes (%s), file time %.3f to %.3f s; scene time = file time - %.3f s "
+          "(%s); the filter uses the file's sigmas, the receiver model is not used\n",
+          label ? label : "", scene->gnss.file, n, vel == n ? "position + velocity" : vel ? "some with velocity" : "position",
+          fixes[0].t_s + t0, fixes[n - 1].t_s + t0, t0,
+          scene->trajectory.type == NAV_TRAJ_RECORDED ? "the recorded reference's time base"
+                                                      : "the first fix at scene time 0");
+  free(fixes);
 }
 
 bool navsim_parse_u64(const char *s, uint64_t *out) {

@@ -13,6 +13,7 @@
 
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
+#include "navcore/nav_sim.h"
 
 /* "-h" or "--help". */
 bool navsim_is_help(const char *arg);
@@ -38,6 +39,18 @@ int navsim_load_scene(const char *path, nav_scene *scene);
  * of its spline fit against the recorded samples (issue 25); nothing for other scenes. @p label
  * starts the line ("reference  " or "PATH: "). */
 void navsim_print_recorded_fit(FILE *f, const char *label, const nav_scene *scene);
+
+/* gnss.file of @p scene (none: EXIT_OK, nothing done): load the recorded fixes
+ * (nav_gnss_file_load) and attach them to @p sim. Problems go to stderr as "CMD: FILE:LINE:COL:
+ * ..."; returns EXIT_OK, 2 (a bad file) or 1. @p count receives the number of fixes (may be NULL). */
+int navsim_attach_gnss_file(const char *cmd, const nav_scene *scene, nav_sim *sim, size_t *count);
+
+/* gnss.file with a covariance analysis (estimate, budget): a warning on stderr that it uses the
+ * receiver model's epochs and sigmas, not the file's fixes (docs/gnss-file.md). */
+void navsim_warn_gnss_file_model(const char *cmd, const char *scene_path, const nav_scene *scene);
+
+/* gnss.file: "LABEL<file> (N fixes, scene time = file time - T0 s; the file's sigmas ...)" on @p f. */
+void navsim_print_gnss_file(FILE *f, const char *label, const nav_scene *scene);
 
 /* Decimal digits only (no sign, no blanks), within uint64_t. */
 bool navsim_parse_u64(const char *s, uint64_t *out);

@@ -435,6 +435,7 @@ int navsim_estimate(int argc, char **argv) {
   nav_scene sc;
   const int lrc = navsim_load_scene(scene_path, &sc);
   if (lrc != 0) return lrc;
+  navsim_warn_gnss_file_model("estimate", scene_path, &sc);
   char default_dir[600];
   if (!out_dir) {
     char nm[NAV_SCENE_NAME_MAX];

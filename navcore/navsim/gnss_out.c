@@ -18,11 +18,15 @@
 #include "../src/sim/sim_internal.h" /* nav_sim_gnss_config: the receiver the simulation uses */
 #include "navcore/nav_frames.h"
 #include "navcore/nav_math.h"
+#include "navcore/nav_recorded.h"
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_truth.h"
 
 struct navsim_gnss_out {
   FILE *f;
+  nav_ins_gnss_fix *fixes; /* gnss.file: the recorded fixes (scene time base), else NULL */
+  size_t fix_count;
+  nav_gnss_model_config cfg; /* outages of the recorded fixes */
   nav_gnss_model *model;
   nav_truth *truth; /* the reference at the fix times */
   int64_t next_epoch;
@@ -49,15 +53,26 @@ nav_status navsim_gnss_out_begin(const nav_scene *scene, bool ideal, const char 
 
   navsim_gnss_out *g = calloc(1, sizeof *g);
   if (!g) return NAV_ERR_NO_MEMORY;
+  g->cfg = cfg;
+  if (scene->gnss.file[0] != '\0') {
+    /* The recorded fixes the simulation applies (its caller reported any problem with the file). */
+    st = nav_gnss_file_load(scene, &g->fixes, &g->fix_count, NULL, NULL);
+    if (st != NAV_OK) {
+      free(g);
+      return st;
+    }
+  }
   const nav_frame frame = nav_frame_from_scene(scene);
   st = nav_gnss_model_create(&cfg, &frame, scene->simulation.seed, 0u, &g->model);
   if (st != NAV_OK) {
+    free(g->fixes);
     free(g);
     return st;
   }
   st = nav_truth_create_msg(scene, &g->truth, msg, sizeof msg);
   if (st != NAV_OK) {
     nav_gnss_model_destroy(g->model);
+    free(g->fixes);
     free(g);
     return st;
   }
@@ -66,6 +81,7 @@ nav_status navsim_gnss_out_begin(const nav_scene *scene, bool ideal, const char 
     if (g->f) fclose(g->f);
     nav_gnss_model_destroy(g->model);
     nav_truth_destroy(g->truth);
+    free(g->fixes);
     free(g);
     return NAV_ERR_IO;
   }
@@ -73,9 +89,33 @@ nav_status navsim_gnss_out_begin(const nav_scene *scene, bool ideal, const char 
   return NAV_OK;
 }
 
+static bool in_outage(const nav_gnss_model_config *c, double t_s) {
+  for (size_t i = 0; i < c->outage_count; ++i)
+    if (t_s >= c->outages[i].t0_s && t_s < c->outages[i].t1_s) return true;
+  return false;
+}
+
+/* gnss.file: the recorded fixes up to this output epoch that the simulation applies (not before
+ * the run, not in an outage), with the file's sigmas. */
+static nav_status recorded_rows(navsim_gnss_out *g, const nav_sim_record *r, double t) {
+  while ((size_t)g->next_epoch < g->fix_count) {
+    const nav_ins_gnss_fix *fix = &g->fixes[g->next_epoch];
+    if (fix->t_s > t + 1e-6) break;
+    g->next_epoch++;
+    if (fix->t_s < 0.0 || in_outage(&g->cfg, fix->t_s)) continue;
+    const nav_vec3 ned = nav_frame_geodetic_to_local(r->frame, fix->pos);
+    if (fprintf(g->f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g\n", fix->t_s,
+                fix->pos.lat_rad * NAV_RAD2DEG, fix->pos.lon_rad * NAV_RAD2DEG, fix->pos.h_m, ned.x, ned.y, ned.z,
+                fix->pos_sd_m.x, fix->pos_sd_m.y, fix->pos_sd_m.z) < 0)
+      return NAV_ERR_IO;
+  }
+  return NAV_OK;
+}
+
 nav_status navsim_gnss_out_record(navsim_gnss_out *g, const nav_sim_record *r) {
   if (!g || r->run != 0) return NAV_OK;
   const double t = r->truth->t_s;
+  if (g->fixes) return recorded_rows(g, r, t);
   for (;;) {
     const double t_fix = nav_gnss_model_epoch_time_s(g->model, g->next_epoch);
     if (t_fix > t + 1e-6) break;
@@ -108,6 +148,7 @@ bool navsim_gnss_out_end(navsim_gnss_out *g) {
   if (fclose(g->f) != 0) ok = false;
   nav_gnss_model_destroy(g->model);
   nav_truth_destroy(g->truth);
+  free(g->fixes);
   free(g);
   return ok;
 }

@@ -9,6 +9,7 @@
 #include "cli_util.h"
 #include "import_cmd.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -25,11 +26,12 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_import =
     "usage: navsim import FILE --out SCENE.yaml [--speed M/S] [--name NAME] [--tolerance M] [--no-time]\n"
-    "                     [--no-merge] [--track NAME] [--format gpx|kml|motion_def] [--template SCENE] [--aircraft]\n"
+    "                     [--no-merge] [--track NAME|INDEX] [--format gpx|kml|motion_def] [--template SCENE] [--aircraft]\n"
+    "                     [--accept-distance]\n"
     "\n"
     "Turn a track into a scene trajectory and write a complete scene file:\n"
     "  GPX (.gpx)   <trk>/<trkseg>/<trkpt lat lon> with <ele> and <time> (or <rtept>)\n"
-    "  KML (.kml)   the first Placemark with a <LineString> or <gx:Track> (when/coord)\n"
+    "  KML (.kml)   a Placemark's <LineString> or <gx:Track> (when/coord); every one is a track\n"
     "  CSV (.csv)   a gnss-ins-sim motion definition (segment script)\n"
     "GPX/KML tracks become waypoint trajectories on WGS-84 with the origin at the first point: the\n"
     "track is thinned (Douglas-Peucker, --tolerance, default 5 m) and flown through its points at\n"
@@ -45,10 +47,15 @@ static const char *k_usage_import =
     "  --out FILE       scene file to write (atomically)\n"
     "  --speed M/S      speed at every waypoint for untimed tracks (or with --no-time)\n"
     "  --name NAME      scene name (default: the track's name, else the file name)\n"
-    "  --tolerance M    thinning tolerance in metres (0: keep every distinct point)\n"
+    "  --tolerance M    thinning tolerance in metres (0: keep every distinct point), and the largest\n"
+    "                   distance of a track point from the flown path (1 m with 0): beyond it the track\n"
+    "                   is thinned more finely, and a plan that still strays is refused (exit 2, where\n"
+    "                   and what to change)\n"
+    "  --accept-distance  write the scene even when the flown path strays beyond --tolerance\n"
     "  --no-merge       report the first infeasible turn instead of merging turns\n"
     "  --no-time        ignore the track's times; fly it at --speed\n"
-    "  --track NAME     KML: the Placemark with this name\n"
+    "  --track NAME|INDEX  KML: the track (LineString / gx:Track) of the Placemark with this name, or\n"
+    "                   the INDEX-th of the file (1-based); a file with several needs it (they are listed)\n"
     "  --format F       gpx, kml or motion_def (default: from the extension or content)\n"
     "  --template SCENE take IMU, GNSS, navigation, output and simulation from SCENE\n"
     "  --aircraft       aircraft attitude (coordinated bank in turns) instead of ground\n"
@@ -119,10 +126,25 @@ static int validate_import(const char *in, const char *out, const nav_geotrack *
   return EXIT_FAIL;
 }
 
+/* Names that drawing tools give a path by default (Google Earth, My Maps, GPS loggers). */
+static bool is_generic_name(const char *n) {
+  static const char *k[] = {"tessellated", "untitled", "untitled path", "path", "line", "track", "route",
+                            "linestring", "placemark", "new path", "unnamed", "default"};
+  char low[128];
+  size_t i = 0;
+  while (*n == ' ') ++n;
+  for (; n[i] && i + 1 < sizeof low; ++i) low[i] = (char)tolower((unsigned char)n[i]);
+  while (i > 0 && low[i - 1] == ' ') --i;
+  low[i] = '\0';
+  for (size_t j = 0; j < sizeof k / sizeof k[0]; ++j)
+    if (strcmp(low, k[j]) == 0) return true;
+  return false;
+}
+
 int navsim_import(int argc, char **argv) {
   const char *in = NULL, *out = NULL, *name = NULL, *track_name = NULL, *fmt_s = NULL, *templ = NULL;
   nav_track_import_options opt = nav_track_import_options_default();
-  bool speed_given = false;
+  bool speed_given = false, accept_distance = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
     if (navsim_is_help(a)) {
@@ -134,6 +156,8 @@ int navsim_import(int argc, char **argv) {
       opt.use_time = false;
     } else if (strcmp(a, "--aircraft") == 0) {
       opt.attitude_mode = NAV_WP_ATT_AIRCRAFT;
+    } else if (strcmp(a, "--accept-distance") == 0) {
+      accept_distance = true;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--speed") == 0 || strcmp(a, "--name") == 0 ||
                strcmp(a, "--tolerance") == 0 || strcmp(a, "--track") == 0 || strcmp(a, "--format") == 0 ||
                strcmp(a, "--template") == 0) {
@@ -209,6 +233,8 @@ int navsim_import(int argc, char **argv) {
   int rc = EXIT_OK;
   nav_geotrack tr = {0};
   navsim_diag_sink sink = {0};
+  static char stray[2400]; /* the flown path strays beyond --tolerance: the message, else "" */
+  stray[0] = '\0';
   if (templ) {
     const int lrc = navsim_load_scene(templ, sc);
     if (lrc != EXIT_OK) {
@@ -236,10 +262,20 @@ int navsim_import(int argc, char **argv) {
     printf("imported   %s: motion definition, %d segments, %.3f s\n", in, sc->trajectory.segments.count,
            sc->trajectory.duration_s);
   } else {
-    nav_status st = nav_geotrack_read_file(in, fmt, track_name, &tr, navsim_print_diag, &sink);
+    nav_geotrack_info info;
+    memset(&info, 0, sizeof info);
+    nav_status st = nav_geotrack_read_file_info(in, fmt, track_name, &tr, &info, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s\n", in, nav_status_str(st));
       rc = (st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG) ? EXIT_INVALID : EXIT_FAIL;
+      goto done;
+    }
+    if (!track_name && info.tracks_in_file > 1) {
+      /* Several tracks and none picked: list them instead of taking the first silently. */
+      fprintf(stderr, "%s:1:1: error: the file holds %d tracks (LineString / gx:Track): %s%s; pick one with --track "
+                      "NAME or --track INDEX\n", in, info.tracks_in_file, info.track_list,
+              info.tracks_in_file > 64 ? "; ..." : "");
+      rc = EXIT_INVALID;
       goto done;
     }
     if (!tr.all_timed && opt.use_time && !speed_given && tr.count > 0)
@@ -247,7 +283,32 @@ int navsim_import(int argc, char **argv) {
               opt.speed_mps);
     nav_track_import_report rep;
     char msg[1024];
-    st = nav_geotrack_to_scene(&tr, &opt, sc, &rep, msg, sizeof msg);
+    /* The flown path must stay within the distance limit of every track point (issue 18): the
+     * thinning tolerance, 1 m with --tolerance 0. Thinning uses part of it, the fly-by turns the
+     * rest; when the plan strays beyond it, the track is thinned more finely (tolerance / 2, / 4,
+     * / 8) before the import gives up, so an import that already fits is unchanged. */
+    const double limit_m = opt.tolerance_m > 0.0 ? opt.tolerance_m : 1.0;
+    nav_scene *base = malloc(sizeof *base);
+    if (!base) {
+      rc = EXIT_FAIL;
+      goto done;
+    }
+    *base = *sc;
+    nav_track_import_options o2 = opt;
+    st = nav_geotrack_to_scene(&tr, &o2, sc, &rep, msg, sizeof msg);
+    for (int refine = 0; refine < 3 && st == NAV_OK && rep.max_dev_m > limit_m && o2.tolerance_m > 0.0; ++refine) {
+      nav_track_import_report r2;
+      nav_scene *try_sc = malloc(sizeof *try_sc);
+      if (!try_sc) break;
+      *try_sc = *base;
+      o2.tolerance_m *= 0.5;
+      if (nav_geotrack_to_scene(&tr, &o2, try_sc, &r2, msg, sizeof msg) == NAV_OK && r2.max_dev_m < rep.max_dev_m) {
+        *sc = *try_sc;
+        rep = r2;
+      }
+      free(try_sc);
+    }
+    free(base);
     if (st != NAV_OK) {
       const char *hint = tr.all_timed && opt.use_time
                              ? "; use a larger --tolerance, or --no-time with a lower --speed"
@@ -260,7 +321,31 @@ int navsim_import(int argc, char **argv) {
       rc = st == NAV_ERR_NO_MEMORY ? EXIT_FAIL : EXIT_INVALID;
       goto done;
     }
-    snprintf(sc->name, sizeof sc->name, "%s", name ? name : (tr.name[0] ? tr.name : default_name));
+    if (rep.max_dev_m > limit_m && !accept_distance) {
+      /* Where the plan strays, and what to change; reported after the scene's own checks (a scene
+       * that is not valid is refused for that first), and nothing is written. */
+      const long w = rep.max_dev_point;
+      const bool where = w >= 0 && (size_t)w < tr.count;
+      char at[160] = "", loc[600];
+      if (where && tr.points[w].has_time && tr.points[0].has_time)
+        snprintf(at, sizeof at, ", %.1f s into the track", tr.points[w].t_s - tr.points[0].t_s);
+      if (where) snprintf(loc, sizeof loc, "%s:%d:%d", in, tr.points[w].line, tr.points[w].col);
+      else snprintf(loc, sizeof loc, "%s", in);
+      snprintf(stray, sizeof stray,
+               "%s: error: the planned path passes %.2f m from this track point%s, beyond --tolerance %g m: the "
+               "vehicle cannot follow the track there within the planner's limits at its speed. Lower the speed "
+               "(--speed, or --no-time with a lower --speed), keep the track's stops and times (a timed GPX/KML, "
+               "without --no-time), raise the limits (--template with larger trajectory.waypoints.limits), or "
+               "accept the distance with --accept-distance; \"%s\" was not written\n",
+               loc, rep.max_dev_m, at, limit_m, out);
+    }
+    if (o2.tolerance_m != opt.tolerance_m)
+      printf("refined    thinned with %g m instead of %g m to keep the flown path within %g m of the track\n",
+             o2.tolerance_m, opt.tolerance_m, limit_m);
+    /* A generic placemark name ("Tessellated", "Untitled", "Path", ...) names nothing: the file's
+     * name does (issue 18). */
+    const bool generic = tr.name[0] == '\0' || is_generic_name(tr.name);
+    snprintf(sc->name, sizeof sc->name, "%s", name ? name : (!generic ? tr.name : default_name));
     for (char *p = sc->name; *p; ++p)
       if ((unsigned char)*p < 0x20) *p = ' ';
     printf("imported   %s: %zu points -> %d waypoints (tolerance %g m, %d turn%s merged), %.1f m, %s, %.3f s; "
@@ -271,6 +356,11 @@ int navsim_import(int argc, char **argv) {
   /* Nothing is written, and no existing scene replaced, unless the scene is valid. */
   rc = validate_import(in, out, fmt == NAV_TRACK_FORMAT_MOTION_DEF ? NULL : &tr, sc);
   if (rc != EXIT_OK) goto done;
+  if (stray[0] != '\0') {
+    fputs(stray, stderr);
+    rc = EXIT_INVALID;
+    goto done;
+  }
   {
     const nav_status st = nav_scene_write_file(out, sc);
     if (st != NAV_OK) {

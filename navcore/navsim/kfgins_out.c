@@ -54,6 +54,9 @@ const char *navsim_kfgins_unsupported(const nav_scene *sc) {
     return "the kfgins export needs navigation.scheme ins_gnss (KF-GINS is an INS/GNSS filter)";
   if (sc->earth.model != NAV_EARTH_WGS84)
     return "the kfgins export needs earth.model wgs84 (the KF-GINS formats are geodetic on WGS-84)";
+  if (sc->gnss.file[0] != '\0')
+    return "the kfgins export writes the receiver model's fixes; this scene's fixes come from gnss.file, which "
+           "KF-GINS can read as it is";
   return NULL;
 }
 

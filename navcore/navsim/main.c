@@ -178,6 +178,7 @@ static int cmd_check(int argc, char **argv) {
       char label[4200];
       snprintf(label, sizeof label, "%s: ", argv[i]);
       navsim_print_recorded_fit(stdout, label, &scene);
+      navsim_print_gnss_file(stdout, label, &scene);
     }
     if (rc == EXIT_FAIL) worst = EXIT_FAIL;
     else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
@@ -439,6 +440,8 @@ static int cmd_run(int argc, char **argv) {
     rc = EXIT_FAIL;
     goto cleanup;
   }
+  rc = navsim_attach_gnss_file("run", &scene, sim, NULL);
+  if (rc != EXIT_OK) goto cleanup;
   navsim_interrupt_arm(sim); /* SIGINT / SIGTERM: cancel, remove the temporary directory */
   rc = navsim_out_begin("run", out_dir, force, &rd);
   if (rc != EXIT_OK) goto cleanup;
@@ -669,6 +672,7 @@ static int cmd_run(int argc, char **argv) {
            nav_earth_model_name(scene.earth.model), nav_mech_algorithm_name(scene.navigation.algorithm),
            ideal ? ", ideal sensors" : "");
     navsim_print_recorded_fit(stdout, "reference  ", &scene);
+    navsim_print_gnss_file(stdout, "gnss       ", &scene);
     printf("simulated  %ld run%s of %.3f s, %" PRId64 " IMU samples each at %g Hz in %.3f s wall (%.3g samples/s, "
            "%d thread%s)\n",
            sum.runs, sum.runs == 1 ? "" : "s", sum.duration_s, sum.imu_samples, scene.imu.rate_hz, wall,

@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli_util.h"
 #include "navcore/nav_requirements.h"
 #include "navcore/nav_sim_partial.h"
 
@@ -211,6 +212,7 @@ bool navsim_mpi_worker(const nav_scene *scene, bool ideal, int threads, int *exi
     if (!rec.runs) st = NAV_ERR_NO_MEMORY;
   }
   if (st == NAV_OK) st = nav_sim_create(scene, &sim);
+  if (st == NAV_OK && navsim_attach_gnss_file("run", scene, sim, NULL) != 0) st = NAV_ERR_PARSE;
   if (st == NAV_OK) {
     nav_sim_options o = nav_sim_options_default();
     o.ideal = ideal;

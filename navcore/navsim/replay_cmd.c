@@ -574,10 +574,18 @@ static void print_tables(const replay_job *j, bool show_published) {
   double ours[N_FIG], ours_out[N_FIG];
   figures_of(&s->stats, s, ours);
   figures_of(&s->stats_output, s, ours_out);
+  /* A published peer without figures for this case (pyins has no free-INS run) gets no column,
+   * and a row without any figure (the gap rows of a run without gaps) is not printed: no row or
+   * column of placeholders (issue 18). */
+  bool peer_shown[2] = {false, false};
+  if (show_published)
+    for (int p = 0; p < 2; ++p)
+      for (int k = 0; k < N_FIG; ++k)
+        if (isfinite(k_peers[p].v[j->dcase][k])) peer_shown[p] = true;
   printf("\n%-22s %12s", "", "navsim");
   if (show_published)
     for (int p = 0; p < 2; ++p)
-      printf(" %12s", k_peers[p].name);
+      if (peer_shown[p]) printf(" %12s", k_peers[p].name);
   if (j->n_peers > 0) {
     printf(" %12s", "navsim@out");
     for (int p = 0; p < j->n_peers; ++p)
@@ -589,11 +597,18 @@ static void print_tables(const replay_job *j, bool show_published) {
     figures_of(&j->peers[p].stats, NULL, pf[p]);
   for (int k = 0; k < N_FIG; ++k) {
     if (k >= F_GAP1_H && s->free_ins) break;
+    bool any = isfinite(ours[k]);
+    for (int p = 0; p < 2 && show_published; ++p)
+      if (peer_shown[p] && isfinite(k_peers[p].v[j->dcase][k])) any = true;
+    if (j->n_peers > 0) any = any || isfinite(ours_out[k]);
+    for (int p = 0; p < j->n_peers; ++p)
+      if (isfinite(pf[p][k])) any = true;
+    if (!any) continue;
     printf("%-22s", k_fig_labels[k]);
     print_cell(ours[k]);
     if (show_published)
       for (int p = 0; p < 2; ++p)
-        print_cell(k_peers[p].v[j->dcase][k]);
+        if (peer_shown[p]) print_cell(k_peers[p].v[j->dcase][k]);
     if (j->n_peers > 0) {
       print_cell(ours_out[k]);
       for (int p = 0; p < j->n_peers; ++p)
@@ -604,7 +619,7 @@ static void print_tables(const replay_job *j, bool show_published) {
   printf("%-22s %12ld", "scored epochs", s->stats.epochs);
   if (show_published)
     for (int p = 0; p < 2; ++p)
-      printf(" %12s", isfinite(k_peers[p].v[j->dcase][F_POS_H_RMS]) ? "193034" : "-");
+      if (peer_shown[p]) printf(" %12s", isfinite(k_peers[p].v[j->dcase][F_POS_H_RMS]) ? "193034" : "-");
   if (j->n_peers > 0) {
     printf(" %12ld", s->stats_output.epochs);
     for (int p = 0; p < j->n_peers; ++p)
@@ -622,14 +637,25 @@ static void print_tables(const replay_job *j, bool show_published) {
     printf("\nGNSS gaps (errors just before the first fix after the gap)\n");
     printf("  %14s %14s %12s %12s %12s\n", "last fix [s]", "next fix [s]", "end h [m]", "end v [m]",
            "max h [m]");
+    bool no_end = false;
     for (long i = 0; i < s->gap_count && i < NAV_REPLAY_MAX_GAPS; ++i) {
       const nav_replay_gap *g = &s->gaps[i];
       printf("  %14.3f %14.3f", g->t0_s, g->t1_s);
-      print_cell(g->has_end_errors ? g->pos_h_end_m : NAN);
-      print_cell(g->has_end_errors ? g->pos_v_end_m : NAN);
-      print_cell(g->pos_h_max_m);
+      if (g->has_end_errors) {
+        print_cell(g->pos_h_end_m);
+        print_cell(g->pos_v_end_m);
+      } else {
+        /* No reference row at the epoch before the fix (a reference slower than the IMU). */
+        printf(" %12s %12s", "no ref. row", "no ref. row");
+        no_end = true;
+      }
+      if (isfinite(g->pos_h_max_m)) print_cell(g->pos_h_max_m);
+      else printf(" %12s", "no ref. row");
       printf("%s\n", g->open ? "  (open: no fix after it)" : "");
     }
+    if (no_end)
+      printf("  (no ref. row: the reference has no row at the IMU epoch just before the fix; max h is over the "
+             "reference rows inside the gap)\n");
   }
   if (!s->free_ins)
     printf("\nbias estimates  gyro [%.3f, %.3f, %.3f] deg/h, accel [%.3e, %.3e, %.3e] m/s^2\n",
@@ -1036,7 +1062,14 @@ int navsim_replay(int argc, char **argv) {
   if (!quiet) {
     print_tables(&job, job.long_drive);
     smooth_out_print(o.so);
-    nav_requirements_print(stdout, job.verdicts, job.n_verdicts);
+    if (job.n_verdicts > 0) {
+      /* One time base on the terminal: the files' (issue 18). The verdicts count from the first
+       * IMU epoch; the offset is said once here. */
+      printf("times           the files' time base; requirement times of the scene count from the first IMU "
+             "epoch, t = %.3f s\n",
+             sum.t_first_s);
+      nav_requirements_print_at(stdout, job.verdicts, job.n_verdicts, sum.t_first_s);
+    }
     if (job.long_drive && (sum.t_first_s > 100000.0051 || sum.t_last_s < 100965.1749))
       printf("note: the published figures cover the whole data set (100000.005 .. 100965.175 s); this window "
              "differs\n");

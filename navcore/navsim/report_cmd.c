@@ -610,6 +610,138 @@ static char *json_block(const char *text, const char *key) {
   return NULL;
 }
 
+/* The strings of a JSON array text (as navsim writes them: escapes \" \\ \n), one line each, as
+ * HTML text. */
+static void html_string_lines(FILE *f, const char *arr) {
+  for (const char *q = arr ? strchr(arr, '"') : NULL; q; q = strchr(q, '"')) {
+    ++q;
+    while (*q && *q != '"') {
+      char c = *q;
+      if (c == '\\' && q[1]) {
+        ++q;
+        c = *q == 'n' ? '\n' : *q == 't' ? '\t' : *q;
+      }
+      html_escape(f, &c, 1);
+      ++q;
+    }
+    fputc('\n', f);
+    if (*q) ++q;
+  }
+}
+
+/* The "setup" of summary.json (issue 18): scheme, IMU, receiver, outages, lever arm, seed and
+ * runs; the fit residuals of a recorded reference and the source of recorded GNSS fixes. */
+static void write_setup(FILE *f, const char *summary) {
+  char *setup = json_block(summary, "setup");
+  char buf[512];
+  double x;
+  if (setup) {
+    fputs("<h2>Setup</h2>\n<table>\n", f);
+    if (json_str(setup, "scheme", buf, sizeof buf)) {
+      fputs("<tr><th class=\"l\">navigation scheme</th><td class=\"l\">", f);
+      html_text(f, buf);
+      fputs("</td></tr>\n", f);
+    }
+    char *imu = json_block(setup, "imu");
+    if (imu) {
+      fputs("<tr><th class=\"l\">IMU</th><td class=\"l\">", f);
+      if (json_str(imu, "catalog", buf, sizeof buf) && buf[0]) html_text(f, buf);
+      else fputs("(no catalog part: the scene's own terms)", f);
+      char *lines = json_block(imu, "model_yaml");
+      fputs("<pre>", f);
+      html_string_lines(f, lines);
+      fputs("</pre></td></tr>\n", f);
+      free(lines);
+      free(imu);
+    }
+    char *rx = json_block(setup, "receiver");
+    if (rx) {
+      char src[64] = "";
+      json_str(rx, "source", src, sizeof src);
+      fputs("<tr><th class=\"l\">GNSS receiver</th><td class=\"l\">", f);
+      if (strcmp(src, "none") == 0) fputs("none (the scheme uses no GNSS)", f);
+      else if (strcmp(src, "file") == 0) fputs("recorded fixes from a file (gnss.file; the file's sigmas)", f);
+      else if (json_str(rx, "catalog", buf, sizeof buf) && buf[0]) html_text(f, buf);
+      else fputs("receiver model of the scene", f);
+      char *lines = json_block(rx, "model_yaml");
+      if (lines && strchr(lines, '"')) {
+        fputs("<pre>", f);
+        html_string_lines(f, lines);
+        fputs("</pre>", f);
+      }
+      free(lines);
+      fputs("</td></tr>\n", f);
+      free(rx);
+    }
+    char *out = json_block(setup, "outages_s");
+    if (out) {
+      fputs("<tr><th class=\"l\">GNSS outages [s]</th><td class=\"l\">", f);
+      if (strcmp(out, "[]") == 0) fputs("none in the scene", f);
+      else html_text(f, out);
+      fputs("</td></tr>\n", f);
+      free(out);
+    }
+    char *la = json_block(setup, "lever_arm_b_m");
+    if (la) {
+      fputs("<tr><th class=\"l\">lever arm (antenna from IMU, body axes) [m]</th><td class=\"l\">", f);
+      const char *q = la + 1;
+      for (int k = 0; k < 3; ++k) {
+        char *end = NULL;
+        const double v = strtod(q, &end);
+        if (end == q) break;
+        fprintf(f, "%s%.6g", k ? ", " : "", v);
+        q = end + (*end == ',' ? 1 : 0);
+      }
+      fputs("</td></tr>\n", f);
+      free(la);
+    }
+    if (json_num(summary, "seed", &x)) fprintf(f, "<tr><th class=\"l\">seed</th><td class=\"l\">%.0f</td></tr>\n", x);
+    if (json_num(summary, "runs", &x)) fprintf(f, "<tr><th class=\"l\">runs</th><td class=\"l\">%.0f</td></tr>\n", x);
+    fputs("</table>\n", f);
+    free(setup);
+  }
+  char *gs = json_block(summary, "gnss_source");
+  if (gs) {
+    fputs("<p>GNSS fixes from the file <code>", f);
+    if (json_str(gs, "file", buf, sizeof buf)) html_text(f, buf);
+    fputs("</code>", f);
+    if (json_num(gs, "fixes", &x)) fprintf(f, ": %.0f fixes", x);
+    if (json_num(gs, "fixes_in_run_outside_outages", &x)) fprintf(f, ", %.0f in the run outside the outages", x);
+    if (json_num(gs, "t0_file_s", &x)) fprintf(f, "; scene time = file time &minus; %.3f s", x);
+    fputs("; the filter used the file's sigmas.</p>\n", f);
+    free(gs);
+  }
+  char *rf = json_block(summary, "recorded_fit");
+  if (rf) {
+    static const struct {
+      const char *rms, *max, *t, *label, *unit;
+    } rows[] = {{"pos_rms_m", "pos_max_m", "pos_max_t_s", "position", "m"},
+                {"vel_rms_mps", "vel_max_mps", "vel_max_t_s", "velocity", "m/s"},
+                {"att_rms_deg", "att_max_deg", "att_max_t_s", "attitude", "deg"}};
+    fputs("<h2>Recorded reference: fit residuals</h2>\n<p>The spline model against the recorded samples of <code>", f);
+    if (json_str(rf, "file", buf, sizeof buf)) html_text(f, buf);
+    fputs("</code>", f);
+    if (json_num(rf, "samples", &x)) fprintf(f, " (%.0f samples)", x);
+    fputs(".</p>\n<table>\n<tr><th class=\"l\">residual</th><th>RMS</th><th>max</th><th>at t [s]</th>"
+          "<th class=\"l\">unit</th></tr>\n",
+          f);
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+      double r = 0, m = 0, t = 0;
+      if (!json_num(rf, rows[i].rms, &r) || !json_num(rf, rows[i].max, &m)) continue;
+      json_num(rf, rows[i].t, &t);
+      fprintf(f, "<tr><td class=\"l\">%s</td><td>%.4g</td><td>%.4g</td><td>%.6g</td><td class=\"l\">%s</td></tr>\n",
+              rows[i].label, r, m, t, rows[i].unit);
+    }
+    fputs("</table>\n", f);
+    if (json_str(rf, "warning", buf, sizeof buf)) {
+      fputs("<p class=\"fail\">Warning: ", f);
+      html_text(f, buf);
+      fputs("</p>\n", f);
+    }
+    free(rf);
+  }
+}
+
 typedef struct figure {
   const char *key;   /* file stem */
   const char *title; /* caption */
@@ -919,6 +1051,8 @@ int navsim_report(int argc, char **argv) {
     fputs("<tr><td class=\"l\">summary.json not found</td></tr>\n", f);
   }
   fputs("</table>\n", f);
+
+  if (summary) write_setup(f, summary);
 
   /* Statistics. */
   char *stats = summary ? json_block(summary, "stats") : NULL;

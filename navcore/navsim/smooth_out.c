@@ -277,10 +277,16 @@ void smooth_out_print(const smooth_out *o) {
     printf("%-22s %12.4g %12.4g\n", rows[i].label, rows[i].f, rows[i].s);
   for (long g = 0; g < o->n_gaps; ++g) {
     const gap_cmp *c = &o->gaps[g];
-    printf("gap %.3f..%.3f s: end horiz. %.4g m forward (before the fix) -> %.4g m smoothed; inside: max "
-           "%.4g -> "
-           "%.4g m, RMS %.4g -> %.4g m; max horiz. sigma %.4g -> %.4g m\n",
-           c->t0_s, c->t1_s, c->fwd_end_h_m, c->sm_end_h_m, c->fwd_max_h_m, c->sm_max_h_m, c->fwd_rms_h_m,
-           c->sm_rms_h_m, c->fwd_sd_h_max_m, c->sm_sd_h_max_m);
+    if (isfinite(c->fwd_end_h_m) && isfinite(c->sm_end_h_m))
+      printf("gap %.3f..%.3f s: end horiz. %.4g m forward (before the fix) -> %.4g m smoothed; inside: max "
+             "%.4g -> "
+             "%.4g m, RMS %.4g -> %.4g m; max horiz. sigma %.4g -> %.4g m\n",
+             c->t0_s, c->t1_s, c->fwd_end_h_m, c->sm_end_h_m, c->fwd_max_h_m, c->sm_max_h_m, c->fwd_rms_h_m,
+             c->sm_rms_h_m, c->fwd_sd_h_max_m, c->sm_sd_h_max_m);
+    else /* issue 18: a reference without a row at the gap's end (1 Hz) made "nan" here */
+      printf("gap %.3f..%.3f s: end horiz. not scored (no reference row at the epoch before the fix); inside: "
+             "max %.4g -> %.4g m, RMS %.4g -> %.4g m; max horiz. sigma %.4g -> %.4g m\n",
+             c->t0_s, c->t1_s, c->fwd_max_h_m, c->sm_max_h_m, c->fwd_rms_h_m, c->sm_rms_h_m, c->fwd_sd_h_max_m,
+             c->sm_sd_h_max_m);
   }
 }

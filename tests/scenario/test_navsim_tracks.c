@@ -101,7 +101,10 @@ static void expect_valid_kml(const char *path) {
  * the result's coordinates to its 9 decimals. */
 static void test_round_trip(void **state) {
   (void)state;
-  nav_cli_result *r = navsim("import '%s/drive.gpx' --out drive.yaml", TRACKS);
+  /* --accept-distance (issue 18): this plan strays 7.8 m from the track, beyond the default
+   * --tolerance 5 m, which is now refused (test_navsim_import_distance); here the round trip of
+   * the plan as it was is what is tested. */
+  nav_cli_result *r = navsim("import '%s/drive.gpx' --accept-distance --out drive.yaml", TRACKS);
   expect_code(r, 0);
   const double dev1 = number_after(r->out, "from the flown path ");
   assert_true(dev1 > 0 && dev1 < 20.0);
@@ -149,7 +152,7 @@ static void test_round_trip(void **state) {
   }
 
   /* Import the exported KML and fly it again. */
-  r = navsim("import r1/tracks.kml --track reference --tolerance 1 --out back.yaml");
+  r = navsim("import r1/tracks.kml --track reference --tolerance 1 --accept-distance --out back.yaml");
   expect_code(r, 0);
   const double dev2 = number_after(r->out, "from the flown path ");
   r = navsim("run back.yaml --ideal --kml --out r2 --quiet");
@@ -217,7 +220,7 @@ static void test_import_errors(void **state) {
   assert_non_null(strstr(r->err, "max_lateral_accel_mps2"));
   assert_false(nav_test_is_file(WORK "/bad.yaml"));
   /* Merging makes the same track feasible, and says what it did. */
-  r = navsim("import '%s/sharp.kml' --speed 15 --out sharp.yaml", TRACKS);
+  r = navsim("import '%s/sharp.kml' --speed 15 --accept-distance --out sharp.yaml", TRACKS); /* 19 m off: issue 18 */
   expect_code(r, 0);
   assert_non_null(strstr(r->out, "1 turn merged"));
   expect_code(navsim("import '%s/drive.gpx'", TRACKS), 2);
@@ -233,7 +236,7 @@ static void test_import_errors(void **state) {
   assert_non_null(strstr(text, "type: segments"));
   assert_non_null(strstr(text, "name: \"turn\""));
   /* gx:Track with times: speeds from the times. */
-  r = navsim("import '%s/track_gx.kml' --out gx.yaml", TRACKS);
+  r = navsim("import '%s/track_gx.kml' --accept-distance --out gx.yaml", TRACKS); /* 14.5 m off: issue 18 */
   expect_code(r, 0);
   assert_non_null(strstr(r->out, "speeds from the track's times"));
 }

@@ -829,6 +829,48 @@ static void test_scene_files(void **state) {
   free(b);
 }
 
+/* Issue 18: knots faster than the samples fit every sample exactly (residuals ~0) with nothing
+ * between them; nav_track_warnings says so. The vendored slice (about 11 rows per second) at
+ * 4 Hz knots draws no warning; its rows at whole seconds (1 Hz with gaps) at 4 Hz knots draw the
+ * knots-outrun warning (and, here, the jerk warning), at 0.5 Hz knots not the outrun one. */
+static void test_issue_18_knots_outrun_samples(void **state) {
+  (void)state;
+  nav_track_sample *samples = NULL;
+  size_t n = 0;
+  nav_scene *s = slice_scene(&samples, &n);
+  char msg[1200];
+  const nav_traj_recorded *r = &s->trajectory.recorded;
+  assert_near(r->fit.sample_rate_hz, (double)(n - 1) / r->span_s, 1e-12);
+  assert_true(r->fit.rec_acc_max_mps2 > 0.0);
+  const unsigned w0 = nav_track_warnings(r, msg, sizeof msg);
+  print_message("10 Hz samples, 4 Hz knots: warnings %#x \"%s\"; fitted acc max %.3g, recorded %.3g m/s^2\n", w0, msg,
+                r->fit.fit_acc_max_mps2, r->fit.rec_acc_max_mps2);
+  assert_int_equal(w0, 0);
+  assert_string_equal(msg, "");
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (samples[i].t_s == floor(samples[i].t_s)) samples[m++] = samples[i];
+  assert_true(m > 100);
+  nav_traj_recorded *d = malloc(sizeof *d);
+  assert_non_null(d);
+  *d = nav_scene_default().trajectory.recorded;
+  d->knot_rate_hz = 4.0;
+  assert_int_equal(nav_track_fit(d, samples, m, msg, sizeof msg), NAV_OK);
+  const unsigned w1 = nav_track_warnings(d, msg, sizeof msg);
+  print_message("1 Hz samples, 4 Hz knots: residual max %.2e m; warnings %#x \"%s\"\n", d->fit.pos_max_m, w1, msg);
+  assert_true(d->fit.sample_rate_hz < 1.0);
+  assert_true((w1 & NAV_TRACK_WARN_KNOTS_OUTRUN) != 0);
+  assert_non_null(strstr(msg, "outrun the samples"));
+  d->knot_rate_hz = 0.5;
+  assert_int_equal(nav_track_fit(d, samples, m, msg, sizeof msg), NAV_OK);
+  const unsigned w2 = nav_track_warnings(d, msg, sizeof msg);
+  print_message("1 Hz samples, 0.5 Hz knots: residual max %.3g m; warnings %#x\n", d->fit.pos_max_m, w2);
+  assert_int_equal(w2 & NAV_TRACK_WARN_KNOTS_OUTRUN, 0);
+  free(d);
+  free(samples);
+  free(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_derivatives),  cmocka_unit_test(test_continuity),
@@ -836,6 +878,7 @@ int main(void) {
       cmocka_unit_test(test_closure),      cmocka_unit_test(test_malformed_files),
       cmocka_unit_test(test_issue_25_position_jump),
       cmocka_unit_test(test_fit_refusals), cmocka_unit_test(test_scene_files),
+      cmocka_unit_test(test_issue_18_knots_outrun_samples),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

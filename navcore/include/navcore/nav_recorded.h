@@ -177,6 +177,21 @@ NAV_API NAV_NODISCARD nav_status nav_rec_load_pva(const char *path, nav_rec_pva 
  */
 NAV_API nav_traj_state nav_rec_pva_to_state(const nav_rec_pva *row);
 
+/**
+ * The recorded fixes of a scene's gnss.file in the scene time base (docs/gnss-file.md): with a
+ * recorded reference (trajectory.type recorded) the file shares its time base, so scene time =
+ * file time - trajectory.recorded.t0_s; with a simulated reference the file's first fix is at
+ * scene time 0. Sigmas as written (nav_rec_read_gnss()).
+ * @param[out] out        the fixes (malloc'd; the caller frees them), for nav_sim_set_gnss_fixes()
+ * @param[out] count      number of fixes (at least 1)
+ * @param[out] t0_file_s  file time of scene time 0 [s]; may be NULL
+ * @param[out] diag       on failure, what and where (FILE:LINE:COL); may be NULL
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, no gnss.file); NAV_ERR_PARSE (malformed line, no
+ *         fix); NAV_ERR_IO; NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_gnss_file_load(const nav_scene *scene, nav_ins_gnss_fix **out, size_t *count,
+                                                    double *t0_file_s, nav_diag *diag);
+
 /* ================================================================ replay */
 
 /** Statistics of one non-negative error metric over the scored epochs. */

@@ -109,6 +109,13 @@ NAV_API NAV_NODISCARD nav_status nav_requirements_write_json(FILE *f, const nav_
 /** Terminal summary of the verdicts: "requirements N of M pass" and one line per requirement. */
 NAV_API void nav_requirements_print(FILE *f, const nav_requirement_verdict *v, int count);
 
+/**
+ * As nav_requirements_print(), with every time shown (at_time, the run's span, outage intervals
+ * and the epochs of their values) plus @p t_offset_s: navsim replay shows them in the recorded
+ * files' time base (its verdicts count from the first IMU epoch).
+ */
+NAV_API void nav_requirements_print_at(FILE *f, const nav_requirement_verdict *v, int count, double t_offset_s);
+
 NAV_END_DECLS
 
 #endif /* NAV_RESULTS_H */

@@ -339,7 +339,24 @@ typedef struct nav_recorded_fit_stats {
   double max_gap_s;    /**< longest time between consecutive samples [s]: the model bridges gaps
                             smoothly (quadratically where no sample constrains it) */
   double max_gap_t_s;  /**< scene time of the sample that ends that gap [s] */
+  /* ---- plausibility of the model's dynamics (nav_track_residuals; docs/recorded-fit.md) */
+  double sample_rate_hz;     /**< mean sample rate: (samples - 1) / span [Hz] */
+  double fit_acc_max_mps2;   /**< largest |d2 r/dt2| of the position spline at the samples and
+                                  midway between them [m/s^2] */
+  double fit_acc_max_t_s;    /**< its time [s] */
+  double rec_acc_max_mps2;   /**< largest |dv / dt| of the recorded velocities over steps of at
+                                  least half the mean sample spacing [m/s^2] */
+  double fit_jerk_max_mps3;  /**< largest |d3 r/dt3| of the spline at the same times [m/s^3] */
+  double fit_jerk_max_t_s;   /**< its time [s] */
+  double rec_jerk_max_mps3;  /**< largest change of those recorded accelerations per second [m/s^3] */
 } nav_recorded_fit_stats;
+
+/** Warnings about a fitted recorded reference (nav_track_warnings()). */
+enum {
+  NAV_TRACK_WARN_KNOTS_OUTRUN = 1u << 0, /**< knot_rate_hz above the mean sample rate */
+  NAV_TRACK_WARN_ACCEL = 1u << 1,        /**< fitted acceleration beyond what the velocities support */
+  NAV_TRACK_WARN_JERK = 1u << 2          /**< fitted jerk beyond what the velocities support */
+};
 
 /**
  * A recorded reference trajectory (recorded.c, nav_track.h). The settings come from the scene
@@ -415,6 +432,11 @@ typedef struct nav_scene_gnss {
   /** Satellites along the trajectory (issue 22): visibility and DOP outputs; independent of
    *  @c enabled (the receiver model of the integrated schemes). */
   nav_gnss_constellation_config constellation;
+  /** gnss.file: recorded fixes (KF-GINS GNSS text, 7 or 13 columns) that replace the receiver
+   *  model's fixes; "" for none. navcore_io stores it resolved (absolute). navcore reads no
+   *  file: the caller loads it (nav_gnss_file_load(), nav_recorded.h) and attaches the fixes to
+   *  the simulation (nav_sim_set_gnss_fixes()). Time base: docs/gnss-file.md. */
+  char file[NAV_RECORDED_PATH_MAX];
 } nav_scene_gnss;
 
 /** Initial navigation errors, drawn once per Monte Carlo run (1-sigma, zero mean). */

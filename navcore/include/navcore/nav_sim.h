@@ -25,6 +25,7 @@
 #include "nav_errors.h"
 #include "nav_export.h"
 #include "nav_ins.h"
+#include "nav_ins_gnss.h"
 #include "nav_scene.h"
 #include "nav_status.h"
 #include "nav_traj.h"
@@ -188,6 +189,21 @@ typedef nav_callback_result (*nav_cov_fn)(void *user, const nav_cov_point *p);
  *         the filter's statuses.
  */
 NAV_API NAV_NODISCARD nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user);
+
+/**
+ * Attach recorded GNSS fixes (scene gnss.file) to a simulation: the INS/GNSS and gyro-free/GNSS
+ * runs then apply these fixes instead of the receiver model's, each at the IMU epoch nearest its
+ * time of validity (as the model's fixes), except those inside the scene's outages
+ * (gnss.outages, segment-tied outages). The filter uses each fix's own sigmas (floored as any
+ * fix: nav_ins_gnss_config.pos_sd_floor_m); the receiver's error model is not used. Every Monte
+ * Carlo run sees the same fixes.
+ * @param[in] fixes  @p n fixes in the scene time base (t_s from the scene epoch), times strictly
+ *                   increasing, all finite; copied
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL sim, NULL fixes with n > 0, times not increasing, a
+ *         non-finite value or a sigma not positive: nav_sim_last_error() names the fix);
+ *         NAV_ERR_NO_MEMORY. n = 0 detaches.
+ */
+NAV_API NAV_NODISCARD nav_status nav_sim_set_gnss_fixes(nav_sim *sim, const nav_ins_gnss_fix *fixes, size_t n);
 
 /** The scene of a simulation (borrowed). */
 NAV_API const nav_scene *nav_sim_scene(const nav_sim *sim);

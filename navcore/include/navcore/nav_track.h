@@ -121,6 +121,18 @@ NAV_API NAV_NODISCARD nav_status nav_track_eval(const nav_traj_recorded *rec, do
 NAV_API NAV_NODISCARD nav_status nav_track_set_scene_start(const nav_traj_recorded *rec, nav_scene *scene,
                                                            bool origin_too);
 
+/**
+ * Warnings about the fitted model of @p rec from its fit statistics (docs/recorded-fit.md):
+ * NAV_TRACK_WARN_KNOTS_OUTRUN when knot_rate_hz exceeds the mean sample rate (the spline then
+ * has freedom between samples that no sample constrains); NAV_TRACK_WARN_ACCEL when the largest
+ * fitted acceleration exceeds 1.5 x the largest the recorded velocities show plus 0.1 m/s^2;
+ * NAV_TRACK_WARN_JERK likewise for the jerk (1.5 x plus 0.5 m/s^3).
+ * @param[out] msg  "" or one sentence per warning, each naming the figures and what to change
+ *                  (may be NULL)
+ * @return the NAV_TRACK_WARN_* bits (0: none, or not fitted).
+ */
+NAV_API unsigned nav_track_warnings(const nav_traj_recorded *rec, char *msg, size_t msg_size);
+
 /** Name of a format as written in scene files ("kf_gins_nav"). */
 NAV_API const char *nav_recorded_format_name(nav_recorded_format f);
 

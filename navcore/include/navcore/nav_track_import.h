@@ -47,6 +47,14 @@ typedef struct nav_geotrack {
   char name[128];       /**< track / Placemark name ("" if none) */
 } nav_geotrack;
 
+/** What a track file holds besides the track read (nav_geotrack_read_file_info()). */
+typedef struct nav_geotrack_info {
+  /** KML: LineStrings / gx:Tracks in the file (the one read is the selected or the first); GPX 1. */
+  int tracks_in_file;
+  /** KML: "1 \"NAME\" (line L, N points); 2 ..." for a message listing them (cut when long). */
+  char track_list[1600];
+} nav_geotrack_info;
+
 /** Input formats. */
 typedef enum nav_track_format {
   NAV_TRACK_FORMAT_AUTO = 0, /**< by extension (.gpx, .kml, .csv), else by content */
@@ -62,7 +70,10 @@ NAV_API nav_track_format nav_track_format_guess(const char *path, const char *he
  * Read a GPX or KML track.
  * @param[in]  path        file to read
  * @param[in]  format      NAV_TRACK_FORMAT_GPX / _KML / _AUTO
- * @param[in]  select_name KML: name of the Placemark to read (NULL: the first with a track)
+ * @param[in]  select_name KML: the track to read: its Placemark's name, its listed name ("NAME (k)" for
+ *                         the k-th geometry of a Placemark with several) or its 1-based number
+ *                         among every LineString / gx:Track of the file. NULL: the first
+ *                         (out->tracks_in_file says how many there are)
  * @param[out] out         the track (written on NAV_OK; free with nav_geotrack_free)
  * @return NAV_OK; NAV_ERR_IO; NAV_ERR_PARSE (each problem reported as FILE:LINE:COL); NAV_ERR_NO_MEMORY;
  *         NAV_ERR_INVALID_ARG.
@@ -75,6 +86,11 @@ NAV_API NAV_NODISCARD nav_status nav_geotrack_read_file(const char *path, nav_tr
 NAV_API NAV_NODISCARD nav_status nav_geotrack_read_string(const char *text, size_t len, const char *display_name,
                                                           nav_track_format format, const char *select_name,
                                                           nav_geotrack *out, nav_diag_fn report, void *user);
+
+/** As nav_geotrack_read_file(), and @p info (may be NULL) says how many tracks the file holds. */
+NAV_API NAV_NODISCARD nav_status nav_geotrack_read_file_info(const char *path, nav_track_format format,
+                                                             const char *select_name, nav_geotrack *out,
+                                                             nav_geotrack_info *info, nav_diag_fn report, void *user);
 
 NAV_API void nav_geotrack_free(nav_geotrack *t);
 
@@ -110,6 +126,7 @@ typedef struct nav_track_import_report {
                             at most 20000 track points, evenly spaced, the last included) [m] */
   double length_m;     /**< length of the kept polyline [m] */
   double duration_s;   /**< length of the planned trajectory [s] */
+  long max_dev_point;  /**< index of the track point at max_dev_m (-1: none checked) */
   bool timed;          /**< the speeds came from the track's times */
   int bad_point;       /**< on an infeasible plan: index into the track's points, else -1 */
 } nav_track_import_report;

@@ -499,6 +499,12 @@ nav_status nav_scene_validate(const nav_scene *scene, nav_scene_issue_fn report,
   }
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && !s->gnss.enabled)
     issue_text(&c, "navigation.scheme", "ins_gnss needs a GNSS receiver: set gnss.enabled: true");
+  if (s->gnss.file[0] != '\0' && s->navigation.scheme != NAV_SCHEME_INS_GNSS &&
+      s->navigation.scheme != NAV_SCHEME_GYRO_FREE_GNSS)
+    issue_text(&c, "gnss.file", "recorded GNSS fixes aid the ins_gnss and gyro_free_gnss schemes only: set "
+                                "navigation.scheme, or remove gnss.file");
+  if (memchr(s->gnss.file, '\0', sizeof s->gnss.file) == NULL)
+    issue_text(&c, "gnss.file", "the path is not NUL-terminated");
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->earth.model != NAV_EARTH_WGS84)
     issue_text(&c, "navigation.scheme", "ins_gnss needs the wgs84 Earth model");
   if (s->navigation.scheme == NAV_SCHEME_INS_GNSS && s->navigation.aid_vertical)

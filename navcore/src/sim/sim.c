@@ -62,6 +62,8 @@ struct nav_sim {
   nav_sim_run_final *finals; /* per run, from the last run */
   size_t finals_count;
   nav_sim_range_hook hook; /* sim_partial.c: a range of runs, or a merge of ranges */
+  nav_ins_gnss_fix *fixes; /* recorded GNSS fixes (gnss.file), scene time base; NULL: none */
+  size_t fix_count;
 };
 
 /* Values per output epoch and run kept for the envelopes: N, E, D, |dv|, attitude angle, and for
@@ -90,7 +92,39 @@ void nav_sim_destroy(nav_sim *sim) {
   if (!sim) return;
   free(sim->finals);
   free(sim->envelope);
+  free(sim->fixes);
   free(sim);
+}
+
+static bool vec3_positive(nav_vec3 v) { return v.x > 0.0 && v.y > 0.0 && v.z > 0.0; }
+
+nav_status nav_sim_set_gnss_fixes(nav_sim *sim, const nav_ins_gnss_fix *fixes, size_t n) {
+  if (!sim || (!fixes && n > 0)) return NAV_ERR_INVALID_ARG;
+  for (size_t i = 0; i < n; ++i) {
+    const nav_ins_gnss_fix *f = &fixes[i];
+    const bool finite = isfinite(f->t_s) && isfinite(f->pos.lat_rad) && isfinite(f->pos.lon_rad) &&
+                        isfinite(f->pos.h_m) && nav_vec3_isfinite(f->pos_sd_m) &&
+                        (!f->has_vel || (nav_vec3_isfinite(f->v_n_mps) && nav_vec3_isfinite(f->vel_sd_mps)));
+    const char *why = !finite                                       ? "a value is not finite"
+                      : i > 0 && !(f->t_s > fixes[i - 1].t_s)       ? "its time is not after the previous fix's"
+                      : !vec3_positive(f->pos_sd_m)                 ? "a position sigma is not positive"
+                      : f->has_vel && !vec3_positive(f->vel_sd_mps) ? "a velocity sigma is not positive"
+                                                                    : NULL;
+    if (why) {
+      snprintf(sim->last_error, sizeof sim->last_error, "recorded GNSS fix %zu (t = %.17g s): %s", i, f->t_s, why);
+      return NAV_ERR_INVALID_ARG;
+    }
+  }
+  nav_ins_gnss_fix *copy = NULL;
+  if (n > 0) {
+    copy = malloc(n * sizeof *copy);
+    if (!copy) return NAV_ERR_NO_MEMORY;
+    memcpy(copy, fixes, n * sizeof *copy);
+  }
+  free(sim->fixes);
+  sim->fixes = copy;
+  sim->fix_count = n;
+  return NAV_OK;
 }
 
 const nav_sim_run_final *nav_sim_finals(const nav_sim *sim, size_t *count) {
@@ -279,6 +313,31 @@ static void aiding_destroy(aiding *a) {
   nav_gnss_model_destroy(a->gnss);
 }
 
+/* In an outage of the job's receiver configuration: [t0_s, t1_s), as the receiver model. */
+static bool in_outage(const nav_gnss_model_config *c, double t_s) {
+  for (size_t i = 0; i < c->outage_count; ++i)
+    if (t_s >= c->outages[i].t0_s && t_s < c->outages[i].t1_s) return true;
+  return false;
+}
+
+/* gnss.file: the recorded fixes up to t_k + dt/2, as the model's (below); the file's sigmas. */
+static nav_status recorded_fixes(job *j, aiding *a, const nav_imu_increment *imu, long run) {
+  const nav_sim *sim = j->sim;
+  while ((size_t)a->next_epoch < sim->fix_count) {
+    const nav_ins_gnss_fix *f = &sim->fixes[a->next_epoch];
+    if (!(f->t_s <= imu->t_s + 0.5 * imu->dt_s)) break;
+    a->next_epoch++;
+    if (f->t_s < imu->t_s - 0.5 * imu->dt_s || in_outage(&j->gnss_cfg, f->t_s)) continue;
+    const nav_status st = a->gf ? nav_sim_gyrofree_update(a->gf, f) : nav_ins_gnss_update(a->x, f);
+    if (st != NAV_OK) {
+      job_error(j, "run %ld: recorded GNSS fix at t = %.6f s: %s", run, f->t_s,
+                a->gf ? nav_sim_gyrofree_last_error(a->gf) : nav_ins_gnss_last_error(a->x));
+      return st;
+    }
+  }
+  return NAV_OK;
+}
+
 /*
  * GNSS epochs whose time of validity falls within half an IMU interval of t_k are processed at
  * t_k (numerics.md 6.5: the residual offset is below dt/2; with rates that divide the IMU rate
@@ -286,6 +345,7 @@ static void aiding_destroy(aiding *a) {
  */
 static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_imu_increment *imu, long run) {
   const nav_scene *sc = &j->sim->scene;
+  if (j->sim->fixes) return recorded_fixes(j, a, imu, run);
   for (;;) {
     const double t_fix = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
     if (!(t_fix <= imu->t_s + 0.5 * imu->dt_s)) break;
@@ -742,6 +802,11 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
     if (st != NAV_OK) {
       snprintf(sim->last_error, sizeof sim->last_error, "GNSS outages: %s", gmsg);
       return st;
+    }
+    if (sc->gnss.file[0] != '\0' && !sim->fixes) {
+      snprintf(sim->last_error, sizeof sim->last_error,
+               "gnss.file: the recorded fixes of \"%.160s\" are not attached (nav_sim_set_gnss_fixes)", sc->gnss.file);
+      return NAV_ERR_STATE;
     }
   }
 

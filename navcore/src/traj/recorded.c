@@ -229,6 +229,105 @@ static void stat_add(run_stat *r, double v, double t) {
   r->any = true;
 }
 
+/* Position-spline acceleration at t (curvilinear N, E, D metres; the transport terms are far
+ * below the plausibility margins of nav_track_warnings). */
+static nav_vec3 spline_acc(const nav_traj_recorded *rec, double t) { return spline_at(rec, t).r[2]; }
+
+/*
+ * The model's acceleration and jerk at the samples and midway between them, against what the
+ * recorded velocities support: |v_j - v_i| / (t_j - t_i) over steps of at least half the mean
+ * sample spacing (closer rows, such as an extra row a few ms after another, would turn velocity
+ * noise into acceleration), and the change of those accelerations per second. The jerk of the
+ * model is a central difference of its analytic acceleration (h = knot spacing / 20: the
+ * acceleration is a quartic polynomial per interval, so the error is O(h^2) of its 5th
+ * derivative, far below the margins).
+ */
+static void dynamics(const nav_traj_recorded *rec, const nav_track_sample *s, size_t n, double m_lat, double m_lon,
+                     nav_recorded_fit_stats *f) {
+  (void)m_lat;
+  (void)m_lon;
+  const double span = s[n - 1].t_s - s[0].t_s;
+  f->sample_rate_hz = n > 1 && span > 0.0 ? (double)(n - 1) / span : 0.0;
+  const double h = rec->knot_dt_s / 20.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double t = s[i].t_s - rec->t0_s;
+    for (int mid = 0; mid < 2; ++mid) {
+      if (mid && i + 1 == n) break;
+      const double tt = mid ? 0.5 * (t + (s[i + 1].t_s - rec->t0_s)) : t;
+      const double a = nav_vec3_norm(spline_acc(rec, tt));
+      if (a > f->fit_acc_max_mps2) {
+        f->fit_acc_max_mps2 = a;
+        f->fit_acc_max_t_s = tt;
+      }
+      const double j = nav_vec3_norm(nav_vec3_scale(nav_vec3_sub(spline_acc(rec, tt + h), spline_acc(rec, tt - h)),
+                                                    0.5 / h));
+      if (j > f->fit_jerk_max_mps3) {
+        f->fit_jerk_max_mps3 = j;
+        f->fit_jerk_max_t_s = tt;
+      }
+    }
+  }
+  if (n < 2 || !(span > 0.0)) return;
+  const double step_min = 0.5 * span / (double)(n - 1);
+  bool have_prev = false;
+  nav_vec3 a_prev = {0.0, 0.0, 0.0};
+  double t_prev = 0.0;
+  size_t j = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (j <= i) j = i + 1;
+    while (j < n && s[j].t_s - s[i].t_s < step_min) ++j;
+    if (j >= n) break;
+    const double dt = s[j].t_s - s[i].t_s;
+    const nav_vec3 a = nav_vec3_scale(nav_vec3_sub(s[j].v_n_mps, s[i].v_n_mps), 1.0 / dt);
+    const double tm = 0.5 * (s[i].t_s + s[j].t_s);
+    if (nav_vec3_norm(a) > f->rec_acc_max_mps2) f->rec_acc_max_mps2 = nav_vec3_norm(a);
+    if (have_prev && tm - t_prev >= step_min) {
+      const double jr = nav_vec3_norm(nav_vec3_sub(a, a_prev)) / (tm - t_prev);
+      if (jr > f->rec_jerk_max_mps3) f->rec_jerk_max_mps3 = jr;
+    }
+    if (!have_prev || tm - t_prev >= step_min) {
+      a_prev = a;
+      t_prev = tm;
+      have_prev = true;
+    }
+  }
+}
+
+unsigned nav_track_warnings(const nav_traj_recorded *rec, char *msg, size_t msg_size) {
+  if (msg && msg_size) msg[0] = '\0';
+  if (!rec || !fitted(rec)) return 0;
+  const nav_recorded_fit_stats *f = &rec->fit;
+  unsigned w = 0;
+  size_t used = 0;
+#define ADD(...)                                                                      \
+  do {                                                                                \
+    if (msg && used < msg_size) {                                                     \
+      const int k = snprintf(msg + used, msg_size - used, __VA_ARGS__);              \
+      if (k > 0) used += (size_t)k < msg_size - used ? (size_t)k : msg_size - used - 1; \
+    }                                                                                 \
+  } while (0)
+  if (f->sample_rate_hz > 0.0 && rec->knot_rate_hz > f->sample_rate_hz) {
+    w |= NAV_TRACK_WARN_KNOTS_OUTRUN;
+    ADD("%sthe knots (%g Hz) outrun the samples (%.3g Hz on average): between samples the spline is free, and "
+        "residuals near 0 do not mean a good model; set trajectory.recorded.knot_rate_hz to %.3g Hz or less.",
+        used ? " " : "", rec->knot_rate_hz, f->sample_rate_hz, f->sample_rate_hz);
+  }
+  if (f->fit_acc_max_mps2 > 1.5 * f->rec_acc_max_mps2 + 0.1) {
+    w |= NAV_TRACK_WARN_ACCEL;
+    ADD("%sthe fitted acceleration reaches %.3g m/s^2 at t = %.6g s, while the recorded velocities show at most "
+        "%.3g m/s^2: lower trajectory.recorded.knot_rate_hz or raise vel_sd_mps.",
+        used ? " " : "", f->fit_acc_max_mps2, f->fit_acc_max_t_s, f->rec_acc_max_mps2);
+  }
+  if (f->fit_jerk_max_mps3 > 1.5 * f->rec_jerk_max_mps3 + 0.5) {
+    w |= NAV_TRACK_WARN_JERK;
+    ADD("%sthe fitted jerk reaches %.3g m/s^3 at t = %.6g s, while the recorded velocities show at most %.3g "
+        "m/s^3: lower trajectory.recorded.knot_rate_hz.",
+        used ? " " : "", f->fit_jerk_max_mps3, f->fit_jerk_max_t_s, f->rec_jerk_max_mps3);
+  }
+#undef ADD
+  return w;
+}
+
 nav_status nav_track_residuals(const nav_traj_recorded *rec, const nav_track_sample *samples, size_t n,
                                nav_recorded_fit_stats *out) {
   if (!rec || !samples || !out || n == 0 || !fitted(rec)) return NAV_ERR_INVALID_ARG;
@@ -257,6 +356,8 @@ nav_status nav_track_residuals(const nav_traj_recorded *rec, const nav_track_sam
   }
   const double dn = (double)n;
   nav_recorded_fit_stats f;
+  memset(&f, 0, sizeof f);
+  dynamics(rec, samples, n, m_lat, m_lon, &f);
   f.samples = (long)n;
   f.pos_rms_m = sqrt(pos.sum2 / dn);
   f.pos_max_m = pos.max;
