@@ -27,11 +27,19 @@ static bool dir_of(const char *file, char *dir, size_t size) {
   return true;
 }
 
+bool nav_paths_executable(char *buf, size_t size) {
+  char exe[DIR_CAP];
+  if (buf == NULL || size == 0) return false;
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0 || (size_t)n >= size) return false;
+  exe[n] = '\0';
+  memcpy(buf, exe, (size_t)n + 1);
+  return true;
+}
+
 static bool exe_dir(char *dir, size_t size) {
   char exe[DIR_CAP];
-  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n <= 0) return false;
-  exe[n] = '\0';
+  if (!nav_paths_executable(exe, sizeof exe)) return false;
   return dir_of(exe, dir, size);
 }
 
@@ -128,4 +136,13 @@ bool nav_paths_program(const char *name, char *buf, size_t size) {
     return true;
   }
   return false;
+}
+
+bool nav_paths_map_data_dir(char *buf, size_t size) {
+  if (buf == NULL || size == 0) return false;
+  const char *env = getenv("NAVVIEW_MAP_DATA");
+  const char *dir = env != NULL && env[0] != '\0' ? env : "/usr/share/cartopy/data";
+  if (strlen(dir) >= size) return false;
+  memcpy(buf, dir, strlen(dir) + 1);
+  return true;
 }

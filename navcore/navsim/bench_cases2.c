@@ -83,10 +83,7 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
 
 /* This executable (for the child runs). */
 bool bench_self_exe(char *buf, size_t cap) {
-  const ssize_t n = readlink("/proc/self/exe", buf, cap - 1);
-  if (n <= 0) return false;
-  buf[n] = '\0';
-  return true;
+  return nav_paths_executable(buf, cap);
 }
 
 const char *bench_navview_exe(void) {

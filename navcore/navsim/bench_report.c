@@ -618,9 +618,8 @@ void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *
       pk.model[0] ? pk.model : "unknown CPU", pk.mhz, pk.fma ? "yes" : "no", pk.avx2 ? "yes" : "no", doc_peak,
       pk.fma_gflops, peak_note, pk.scalar_gflops);
   char exe[4096];
-  const ssize_t el = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (el > 0) exe[el] = '\0';
-  const bool lackey = full && el > 0 && system("valgrind --version >/dev/null 2>&1") == 0;
+  const bool have_exe = bench_self_exe(exe, sizeof exe);
+  const bool lackey = full && have_exe && system("valgrind --version >/dev/null 2>&1") == 0;
   stage_ctx c;
   const bool ok = stage_setup(&c, STAGE_MAX_STEPS, "urban-drive.yaml");
   double ns[N_STAGES], ops[N_STAGES];

@@ -7,6 +7,9 @@
 #
 # Include rules: a file may include its own component's headers, the public headers of the
 # components its component "uses", and anything of the components it is a "whitebox" of.
+# Path rule: only the map's "paths" file finds the running executable ("/proc/self/exe") or reads
+# the variables that relocate the shared data (NAV_SHARE_DIR, NAV_RESOURCES_DIR, NAVVIEW_MAP_DATA):
+# resource and tool paths are resolved at run time by one function.
 # CMake rule: a target command (target_*, set_target_properties, set_property(TARGET),
 # add_dependencies, nav_warnings) may only change a target defined in the same folder; the
 # folder that defines a target decides its settings.
@@ -79,6 +82,8 @@ BEGIN {
       for (i = 3; i <= n; i++) { npub++; pubc[npub] = w[2]; pubp[npub] = w[i] }
     } else if (w[1] == "uses" || w[1] == "whitebox") {
       for (i = 3; i <= n; i++) { rel[w[1], w[2], w[i]] = 1; pend[++npend] = w[1] " " w[2] " " w[i] }
+    } else if (w[1] == "paths") {
+      pathsfile = w[2]
     } else if (w[1] == "root") {
       for (i = 2; i <= n; i++) root[++nroot] = w[i]
     } else if (w[1] != "skip") fail_map("unknown line: " line)
@@ -99,6 +104,8 @@ $1 == "S" && NF == 2 {
   ln = 0
   while ((getline l < f) > 0) {
     ln++
+    if (f != pathsfile && (index(l, "\"/proc/self/exe\"") || l ~ /getenv\("(NAV_SHARE_DIR|NAV_RESOURCES_DIR|NAVVIEW_MAP_DATA)"\)/))
+      viol(f ":" ln, "path-resolution", "finds a resource or program path itself; call the path function of " (pathsfile == "" ? "the map (paths line)" : pathsfile))
     if (l !~ /^[ \t]*#[ \t]*include[ \t]*["<]/) continue
     q = (l ~ /^[ \t]*#[ \t]*include[ \t]*"/)
     name = l; sub(/^[ \t]*#[ \t]*include[ \t]*["<]/, "", name); sub(/[">].*/, "", name)

@@ -1,7 +1,8 @@
 #!/bin/sh
 # Self-test of check_layers.sh, so the layering test cannot pass by checking nothing: the fixture
 # tree fixtures/bad breaks every rule once (a private header of a lower layer, an upward include,
-# a private header of a peer, a file in no layer, a CMake file changing another folder's target,
+# a private header of a peer, a file in no layer, a program finding its own path outside the
+# paths file (which itself may), a CMake file changing another folder's target,
 # on one line and over two) and must be rejected with exactly the lines of its expected.txt;
 # fixtures/good keeps every rule and must pass; fixtures/badmap declares an upward dependency
 # and must be refused as a wrong map (exit 2).

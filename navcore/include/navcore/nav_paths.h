@@ -53,6 +53,21 @@ NAV_API bool nav_paths_scenes_dir(char *buf, size_t size);
  */
 NAV_API bool nav_paths_program(const char *name, char *buf, size_t size);
 
+/**
+ * The running executable's own path (the link /proc/self/exe resolves to), for programs that
+ * start themselves again (navsim render runs navsim run; navsim bench times its commands).
+ * @return true when known and it fits in @p buf (written only on success). Thread-safe.
+ */
+NAV_API bool nav_paths_executable(char *buf, size_t size);
+
+/**
+ * The offline map background data (Natural Earth and GSHHS files in the layout of Debian's
+ * python-cartopy-data): $NAVVIEW_MAP_DATA when set and non-empty (used as given), else
+ * /usr/share/cartopy/data. Whether the files exist is the caller's question.
+ * @return true when it fits in @p buf (written only on success). Thread-safe.
+ */
+NAV_API bool nav_paths_map_data_dir(char *buf, size_t size);
+
 NAV_END_DECLS
 
 #endif /* NAV_PATHS_H */
