@@ -34,7 +34,6 @@
 
 #include "bench_internal.h"
 #include "bench_verdict.h"
-#include "catalog_cmd.h"
 #include "navcore/nav_errors.h"
 #include "navcore/nav_frames.h"
 #include "navcore/nav_ins.h"
@@ -195,7 +194,7 @@ int bench_stage_main(const char *stage, long steps) {
   return 0;
 }
 
-/* Floating-point ALU ops executed by `navsim bench --stage S --steps N` (lackey), or NAN. */
+/* Floating-point ALU ops executed by `navsim-bench --stage S --steps N` (lackey), or NAN. */
 static double lackey_ops(const char *exe, const char *out_dir, int s, long steps) {
   char log[1400], nsteps[32];
   snprintf(log, sizeof log, "%s/logs/lackey-%s-%ld.log", out_dir, k_stage_names[s], steps);
@@ -204,7 +203,6 @@ static double lackey_ops(const char *exe, const char *out_dir, int s, long steps
                   "--tool=lackey",
                   "--detailed-counts=yes",
                   (char *)exe,
-                  "bench",
                   "--stage",
                   (char *)k_stage_names[s],
                   "--steps",

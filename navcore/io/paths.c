@@ -113,20 +113,22 @@ bool nav_paths_scenes_dir(char *buf, size_t size) {
 bool nav_paths_program(const char *name, char *buf, size_t size) {
   static const struct {
     const char *name, *subdir;
-  } build_tree[] = {{"navview", "viewer"}, {"navstudio", "editor"}, {"navsim", "navcore"}};
+  } build_tree[] = {{"navview", "viewer"}, {"navstudio", "editor"}, {"navsim", "navcore"}, {"navsim-bench", "bench"}};
   char dir[DIR_CAP], cand[DIR_CAP + 256];
   if (name == NULL || name[0] == '\0' || strchr(name, '/') != NULL || buf == NULL || size == 0 ||
       !exe_dir(dir, sizeof dir))
     return false;
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < 3; ++pass) {
     const char *subdir = NULL;
-    if (pass == 1) {
+    if (pass == 2) {
       for (size_t i = 0; i < sizeof build_tree / sizeof build_tree[0]; ++i)
         if (strcmp(build_tree[i].name, name) == 0) subdir = build_tree[i].subdir;
       if (subdir == NULL) break;
     }
     if (pass == 0)
       snprintf(cand, sizeof cand, "%s/%s", dir, name);
+    else if (pass == 1)
+      snprintf(cand, sizeof cand, "%s/../libexec/navcore/%s", dir, name); /* installed helper */
     else
       snprintf(cand, sizeof cand, "%s/../%s/%s", dir, subdir, name);
     struct stat st;

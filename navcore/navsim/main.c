@@ -15,7 +15,7 @@
 #include <math.h>
 
 #include "allan_cmd.h"
-#include "bench.h"
+#include "bench_cmd.h"
 #include "budget_cmd.h"
 #include "catalog_cmd.h"
 #include "cli_util.h"

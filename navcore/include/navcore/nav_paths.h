@@ -45,9 +45,11 @@ NAV_API bool nav_paths_resources_dir(char *buf, size_t size);
 NAV_API bool nav_paths_scenes_dir(char *buf, size_t size);
 
 /**
- * A companion program of this installation (e.g. "navview" for navsim render): `D/name` or, in
- * the build tree, `D/../<subdir>/name` (subdir "viewer" for navview, "editor" for navstudio),
- * for D the directory of the running executable, when that file is executable.
+ * A companion program of this installation (e.g. "navview" for navsim render): `D/name`, the
+ * installed helper `D/../libexec/navcore/name` (navsim-bench) or, in the build tree,
+ * `D/../<subdir>/name` (subdir "viewer" for navview, "editor" for navstudio, "navcore" for navsim,
+ * "bench" for navsim-bench), for D the directory of the running executable, when that file is
+ * executable.
  * @return true when found and it fits in @p buf (written only on success); false means "look on
  *         PATH". Thread-safe.
  */
