@@ -12,6 +12,7 @@
 
 extern "C" {
 #include "navcore/nav_frames.h"
+#include "navcore/nav_paths.h"
 }
 
 namespace studio {
@@ -125,8 +126,8 @@ private:
 } // namespace
 
 std::string MapDataDir() {
-  const char *e = std::getenv("NAVVIEW_MAP_DATA");
-  return e && *e ? std::string(e) : std::string("/usr/share/cartopy/data");
+  char dir[4096];
+  return nav_paths_map_data_dir(dir, sizeof dir) ? std::string(dir) : std::string();
 }
 
 void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out) {

@@ -22,7 +22,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_motiondef.h"
 #include "scene_io_internal.h"
-#include "traj/traj_kin_internal.h"
+#include "navcore/nav_traj.h"
 
 #define MD_MAX_FIELDS 16
 #define MD_COLUMNS 9

@@ -27,11 +27,19 @@ static bool dir_of(const char *file, char *dir, size_t size) {
   return true;
 }
 
+bool nav_paths_executable(char *buf, size_t size) {
+  char exe[DIR_CAP];
+  if (buf == NULL || size == 0) return false;
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0 || (size_t)n >= size) return false;
+  exe[n] = '\0';
+  memcpy(buf, exe, (size_t)n + 1);
+  return true;
+}
+
 static bool exe_dir(char *dir, size_t size) {
   char exe[DIR_CAP];
-  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n <= 0) return false;
-  exe[n] = '\0';
+  if (!nav_paths_executable(exe, sizeof exe)) return false;
   return dir_of(exe, dir, size);
 }
 
@@ -105,20 +113,22 @@ bool nav_paths_scenes_dir(char *buf, size_t size) {
 bool nav_paths_program(const char *name, char *buf, size_t size) {
   static const struct {
     const char *name, *subdir;
-  } build_tree[] = {{"navview", "viewer"}, {"navstudio", "editor"}, {"navsim", "navcore"}};
+  } build_tree[] = {{"navview", "viewer"}, {"navstudio", "editor"}, {"navsim", "navcore"}, {"navsim-bench", "bench"}};
   char dir[DIR_CAP], cand[DIR_CAP + 256];
   if (name == NULL || name[0] == '\0' || strchr(name, '/') != NULL || buf == NULL || size == 0 ||
       !exe_dir(dir, sizeof dir))
     return false;
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < 3; ++pass) {
     const char *subdir = NULL;
-    if (pass == 1) {
+    if (pass == 2) {
       for (size_t i = 0; i < sizeof build_tree / sizeof build_tree[0]; ++i)
         if (strcmp(build_tree[i].name, name) == 0) subdir = build_tree[i].subdir;
       if (subdir == NULL) break;
     }
     if (pass == 0)
       snprintf(cand, sizeof cand, "%s/%s", dir, name);
+    else if (pass == 1)
+      snprintf(cand, sizeof cand, "%s/../libexec/navcore/%s", dir, name); /* installed helper */
     else
       snprintf(cand, sizeof cand, "%s/../%s/%s", dir, subdir, name);
     struct stat st;
@@ -128,4 +138,13 @@ bool nav_paths_program(const char *name, char *buf, size_t size) {
     return true;
   }
   return false;
+}
+
+bool nav_paths_map_data_dir(char *buf, size_t size) {
+  if (buf == NULL || size == 0) return false;
+  const char *env = getenv("NAVVIEW_MAP_DATA");
+  const char *dir = env != NULL && env[0] != '\0' ? env : "/usr/share/cartopy/data";
+  if (strlen(dir) >= size) return false;
+  memcpy(buf, dir, strlen(dir) + 1);
+  return true;
 }

@@ -57,7 +57,7 @@
 #include "navcore/nav_track_io.h"
 #include "scene_bounds.h"
 #include "scene_io_internal.h"
-#include "traj/traj_kin_internal.h"
+#include "navcore/nav_traj.h"
 
 #define OFF(member) offsetof(nav_scene, member)
 #define SOFF(member) offsetof(nav_io_read_state, member)

@@ -27,7 +27,6 @@
 #include "navcore/nav_traj.h"
 #include "navcore/nav_track_import.h"
 #include "scene_io_internal.h"
-#include "traj/traj_kin_internal.h"
 
 #define TI_MAX_FILE (256L * 1024 * 1024)
 

@@ -15,7 +15,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "../src/sim/sim_internal.h" /* nav_sim_gnss_config: the receiver the simulation uses */
+#include "navcore/nav_sim.h" /* nav_sim_gnss_config: the receiver the simulation uses */
 #include "navcore/nav_frames.h"
 #include "navcore/nav_math.h"
 #include "navcore/nav_recorded.h"

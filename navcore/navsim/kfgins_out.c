@@ -12,7 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "../src/sim/sim_internal.h" /* nav_sim_gnss_config: the receiver the simulation uses */
+#include "navcore/nav_sim.h" /* nav_sim_gnss_config: the receiver the simulation uses */
 #include "navcore/nav_frames.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_math.h"

@@ -116,9 +116,7 @@ static int run_child(char **args, bool quiet_stdout) {
 
 /* Path to this navsim executable, for `navsim run` on a scene given to render. */
 static void self_exe(char *buf, size_t cap, const char *argv0) {
-  const ssize_t n = readlink("/proc/self/exe", buf, cap - 1);
-  if (n > 0) buf[n] = '\0';
-  else snprintf(buf, cap, "%s", argv0 ? argv0 : "navsim");
+  if (!nav_paths_executable(buf, cap)) snprintf(buf, cap, "%s", argv0 ? argv0 : "navsim");
 }
 
 static const char *k_usage_render =

@@ -22,7 +22,7 @@
  * (it cannot see values beyond the runs drawn); the help says so.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "bench_internal.h"
+#include "child_run.h"
 #include "cli_util.h"
 #include "tradeoff_cmd.h"
 
@@ -841,7 +841,7 @@ int navsim_tradeoff(int argc, char **argv) {
   }
 
   /* Charts through navview, one per requirement. */
-  const char *nvx = bench_navview_exe();
+  const char *nvx = navsim_navview_exe();
   int charts = 0;
   if (nvx) {
     for (int q = 0; q < nreq; ++q) {
@@ -857,12 +857,13 @@ int navsim_tradeoff(int argc, char **argv) {
                         "--requirement", sc->requirements[q].id, "--png", paths[3], NULL};
       char *plain[] = {(char *)nvx, "--tradeoff", paths[0], "--requirement", sc->requirements[q].id, "--png", paths[3],
                        NULL};
-      const child_result cr = bench_run_child(bench_have_display() ? plain : with_x, paths[4], 120.0);
-      if (cr.exited_ok && access(paths[3], R_OK) == 0) {
+      int exit_code = 0;
+      const bool exited_ok = navsim_run_logged(navsim_have_display() ? plain : with_x, paths[4], 120.0, &exit_code);
+      if (exited_ok && access(paths[3], R_OK) == 0) {
         ++charts;
         remove(paths[4]);
       } else {
-        fprintf(stderr, "navsim tradeoff: %s: navview failed (exit %d; see %s/%s)\n", png_name, cr.exit_code, out_dir,
+        fprintf(stderr, "navsim tradeoff: %s: navview failed (exit %d; see %s/%s)\n", png_name, exit_code, out_dir,
                 log_name);
       }
     }

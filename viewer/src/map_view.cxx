@@ -5,6 +5,7 @@
 #include "map_interactive_internal.h"
 
 #include "navview_internal.h"
+#include "navcore/nav_paths.h"
 
 #include <algorithm>
 #include <cmath>
@@ -292,9 +293,10 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
   ren->SetBackground(street ? 0.97 : 0.86, street ? 0.97 : 0.91, street ? 0.95 : 0.96); // sea tint when zoomed out
   std::vector<std::string> notes;
 
+  char data_dir[4096];
   const std::string data = !opt.data_dir.empty() ? opt.data_dir
-                           : (std::getenv("NAVVIEW_MAP_DATA") ? std::getenv("NAVVIEW_MAP_DATA")
-                                                                : std::string("/usr/share/cartopy/data"));
+                           : nav_paths_map_data_dir(data_dir, sizeof data_dir) ? std::string(data_dir)
+                                                                              : std::string();
   // Shaded relief (0.5 deg per pixel): useful from a few hundred km across.
   const std::string relief = data + "/raster/natural_earth/50-natural-earth-1-downsampled.png";
   if (span_x > 250e3) {

@@ -45,13 +45,30 @@ NAV_API bool nav_paths_resources_dir(char *buf, size_t size);
 NAV_API bool nav_paths_scenes_dir(char *buf, size_t size);
 
 /**
- * A companion program of this installation (e.g. "navview" for navsim render): `D/name` or, in
- * the build tree, `D/../<subdir>/name` (subdir "viewer" for navview, "editor" for navstudio),
- * for D the directory of the running executable, when that file is executable.
+ * A companion program of this installation (e.g. "navview" for navsim render): `D/name`, the
+ * installed helper `D/../libexec/navcore/name` (navsim-bench) or, in the build tree,
+ * `D/../<subdir>/name` (subdir "viewer" for navview, "editor" for navstudio, "navcore" for navsim,
+ * "bench" for navsim-bench), for D the directory of the running executable, when that file is
+ * executable.
  * @return true when found and it fits in @p buf (written only on success); false means "look on
  *         PATH". Thread-safe.
  */
 NAV_API bool nav_paths_program(const char *name, char *buf, size_t size);
+
+/**
+ * The running executable's own path (the link /proc/self/exe resolves to), for programs that
+ * start themselves again (navsim render runs navsim run; navsim bench times its commands).
+ * @return true when known and it fits in @p buf (written only on success). Thread-safe.
+ */
+NAV_API bool nav_paths_executable(char *buf, size_t size);
+
+/**
+ * The offline map background data (Natural Earth and GSHHS files in the layout of Debian's
+ * python-cartopy-data): $NAVVIEW_MAP_DATA when set and non-empty (used as given), else
+ * /usr/share/cartopy/data. Whether the files exist is the caller's question.
+ * @return true when it fits in @p buf (written only on success). Thread-safe.
+ */
+NAV_API bool nav_paths_map_data_dir(char *buf, size_t size);
 
 NAV_END_DECLS
 

@@ -220,6 +220,20 @@ NAV_API void nav_sim_request_cancel(nav_sim *sim);
 /** Detailed message of the last failure on this handle ("" if none). */
 NAV_API const char *nav_sim_last_error(const nav_sim *sim);
 
+/**
+ * The GNSS receiver configuration the simulation uses for @p sc: the scene's receiver model with
+ * its outages, those tied to segments (gnss_visible: false) and those of too few visible
+ * satellites added. Programs that write what the receiver produced (gnss.csv, the KF-GINS
+ * export) call it so that they describe the very receiver the run simulated.
+ * @param[in]  sc    validated scene
+ * @param[in]  dt_s  IMU sample interval [s] (1 / imu.rate_hz)
+ * @param[out] out   the configuration (written on NAV_OK)
+ * @param[out] msg   on failure what is wrong (may be NULL)
+ * @return NAV_OK, NAV_ERR_INVALID_ARG, NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out,
+                                                     char *msg, size_t msg_size);
+
 NAV_END_DECLS
 
 #endif /* NAV_SIM_H */

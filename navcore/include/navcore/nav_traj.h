@@ -108,6 +108,30 @@ NAV_API nav_frame nav_traj_frame(const nav_traj *traj);
 NAV_API NAV_NODISCARD nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **out,
                                                      char *msg, size_t msg_size);
 
+/** Summary of a planned waypoint or segment script (nav_traj_*_plan_info). */
+typedef struct nav_traj_script_info {
+  double duration_s;     /**< natural length of the script [s] */
+  int unconverged;       /**< motion commands of types 2-5 that ended unconverged */
+  int first_unconverged; /**< index of the first of them, -1 if none */
+  int shortened_ramps;   /**< rate-step ramps shortened to fit, exceeding the limits */
+  double max_ramp_ang_accel_rps2; /**< largest Euler-angle acceleration of any rate-step ramp [rad/s^2] */
+} nav_traj_script_info;
+
+/**
+ * Plan the segment script of @p scene (trajectory type segments) without building positions:
+ * its natural duration and what the planner had to give up.
+ * @param[in]  scene      scene with a segment script
+ * @param[out] info       the plan's summary (written on NAV_OK)
+ * @param[out] bad_index  on failure the offending segment, -1 when not tied to one
+ * @param[out] msg        on failure what is wrong (may be NULL)
+ * @return NAV_OK, NAV_ERR_INVALID_ARG (infeasible script), NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_info *info,
+                                                             int *bad_index, char *msg, size_t msg_size);
+/** As nav_traj_segments_plan_info() for a waypoint list (@p bad_index = the offending waypoint). */
+NAV_API NAV_NODISCARD nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info,
+                                                              int *bad_index, char *msg, size_t msg_size);
+
 NAV_END_DECLS
 
 #endif /* NAV_TRAJ_H */

@@ -62,13 +62,11 @@ nav_status nav_sim_gyrofree_update(nav_sim_gyrofree *g, const nav_ins_gnss_fix *
 /** gyro_free_gnss: the filter covariance (n x n, borrowed) and *n; NULL for gyro_free. */
 const double *nav_sim_gyrofree_cov(const nav_sim_gyrofree *g, size_t *n);
 
-/** The receiver configuration of a scene with segment-tied outages added (gnss_visible: false). */
 /** Append to @p out the receiver outages of gnss.constellation.min_satellites_for_fix: every
  *  receiver epoch with fewer visible satellites (sim_gnss_sat.c). NAV_OK when not configured. */
 nav_status nav_sim_gnss_visibility_outages(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
                                            size_t msg_size);
-nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out, char *msg,
-                               size_t msg_size);
+/* nav_sim_gnss_config: public, navcore/nav_sim.h. */
 
 /* ------------------------------------------------------------------ raw GNSS (sim_gnss_raw.c) */
 

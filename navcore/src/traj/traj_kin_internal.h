@@ -225,26 +225,9 @@ size_t nav_kin_sort_unique(double *t, size_t n);
 
 /* ================================================================ model queries (tests, import) */
 
-/** Summary of a planned script. */
-typedef struct nav_traj_script_info {
-  double duration_s;     /**< natural length of the script */
-  int unconverged;       /**< motion commands of types 2-5 that ended unconverged */
-  int first_unconverged; /**< index of the first of them, -1 if none */
-  int shortened_ramps;   /**< rate-step ramps shortened to fit (fit_rate_ramps), exceeding the limits */
-  double max_ramp_ang_accel_rps2; /**< largest Euler-angle acceleration of any rate-step ramp */
-} nav_traj_script_info;
+/* nav_traj_script_info and nav_traj_segments_plan_info / nav_traj_waypoints_plan_info are public:
+ * navcore/nav_traj.h (the I/O library plans imported scripts with them). */
 
-/**
- * Plan the segment script of @p scene without building positions. On failure @p bad_index is the
- * offending segment (-1 when not tied to one) and msg says what is wrong.
- * Exported from libnavcore.so (NAV_API, though not in a public header): libnavcore_io.so calls
- * it, and a hidden symbol would fail that library's link.
- */
-NAV_API nav_status nav_traj_segments_plan_info(const nav_scene *scene, nav_traj_script_info *info,
-                                               int *bad_index, char *msg, size_t msg_size);
-/** Same for waypoints (bad_index = offending waypoint); exported like the one above. */
-NAV_API nav_status nav_traj_waypoints_plan_info(const nav_scene *scene, nav_traj_script_info *info,
-                                                int *bad_index, char *msg, size_t msg_size);
 /**
  * Times at which a model built by nav_traj_segments_create / nav_traj_waypoints_create changes
  * piece or starts/ends a ramp (transitions). Writes up to @p cap, returns the total count.

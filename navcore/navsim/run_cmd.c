@@ -1,8 +1,8 @@
 /*
- * navsim: the command-line program of the navigation simulation environment.
+ * navsim run: simulate a scene (one run or a Monte Carlo campaign) and write its result directory.
  *
  * Exit codes: 0 success; 1 failure other than invalid input (I/O, numerical); 2 invalid scene
- * or invalid command line.
+ * or invalid command line; 3 --strict and a requirement fails.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -15,10 +15,7 @@
 #include <unistd.h>
 #include <math.h>
 
-#include "allan_cmd.h"
-#include "bench.h"
-#include "budget_cmd.h"
-#include "catalog_cmd.h"
+#include "run_cmd.h"
 #include "cli_util.h"
 #include "mpi_run.h"
 #include "estimate_cmd.h"
@@ -27,7 +24,6 @@
 #include "import_cmd.h"
 #include "interrupt.h"
 #include "kfgins_out.h"
-#include "schema_cmd.h"
 #include "select_cmd.h"
 #include "replay_cmd.h"
 #include "report_cmd.h"
@@ -38,57 +34,8 @@
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_version.h"
-#ifdef NAVSIM_HAVE_SERVE
-#include "navserve.h"
-/* Listed only when built: the man pages and bash completion are made from this list. */
-#define NAVSIM_SERVE_HELP \
-  "  serve            HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)\n"
-#else
-#define NAVSIM_SERVE_HELP ""
-#endif
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2, EXIT_REQUIREMENT = 3 };
-
-static const char *k_usage =
-    "usage: navsim [--version] [--help] COMMAND [ARGS]\n"
-    "\n"
-    "Simulate inertial and integrated navigation systems from scene files.\n"
-    "\n"
-    "commands:\n"
-    "  check SCENE...   validate scene files; errors as FILE:LINE:COL: error: FIELD: MESSAGE\n"
-    "  estimate SCENE   preliminary estimate: closed-form error growth and covariance analysis\n"
-    "  run SCENE        simulate a scene (one run or Monte Carlo) and write the results\n"
-    "  budget SCENE     error budget: each error source's share of each requirement\n"
-    "  replay           run the navigation on recorded IMU/GNSS files and score it against a reference\n"
-    "  render DIR       headless image of a result directory: 3d, top, map, errors, noise, allan, bench,\n"
-    "                   tradeoff, sky or dop view (navview)\n"
-    "  report DIR       HTML page with the figures, statistics and requirement verdicts of a result\n"
-    "  bench            speed against error for each algorithm, Earth model and rate\n"
-    "  catalog          list the IMU, GNSS receiver and array accelerometer catalogs and their models\n"
-    "  allan            Allan-deviation check of a catalog part or scene IMU against its spec\n"
-    "  import FILE      GPX / KML track or gnss-ins-sim motion definition -> scene file\n"
-    "  export DIR       KML (Google Earth) and CSV tracks of a result directory\n"
-    "  select SCENE     cheapest catalog IMU / receiver / scheme meeting the scene's requirements\n"
-    "  sweep SCENE      requirements over a grid of scene parameters; largest value still passing\n"
-    "  tradeoff SCENE   CPU time against error of each modelling choice; the cheapest within tolerance\n"
-    "  schema           JSON Schema of scene files: keys, types, units, bounds, defaults\n"
-    NAVSIM_SERVE_HELP
-    "\n"
-    "options:\n"
-    "  --version        print \"navsim X.Y.Z\" and exit\n"
-    "  -h, --help       print this help (navsim COMMAND --help for a command)\n"
-    "\n"
-    "exit codes: 0 success, 1 failure (I/O, numerical), 2 invalid scene or command line\n";
-
-static const char *k_usage_check =
-    "usage: navsim check SCENE...\n"
-    "\n"
-    "Read and validate each scene file. Every problem is printed on stderr as\n"
-    "  FILE:LINE:COL: error: FIELD.PATH: what is wrong and what is expected\n"
-    "A valid scene whose navsim run would exceed the limits below is reported as\n"
-    "  FILE: warning: ... with the predicted result files and memory (the scene stays valid).\n"
-    "\n" NAVSIM_LIMITS_HELP "\n"
-    "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static const char *k_usage_run =
     "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
@@ -158,39 +105,6 @@ static const char *k_usage_run_tail =
 static long cores(void) {
   const long n = sysconf(_SC_NPROCESSORS_ONLN);
   return n > 0 ? n : 1;
-}
-
-static int cmd_check(int argc, char **argv) {
-  if (argc < 1) {
-    fprintf(stderr, "navsim check: missing SCENE\n%s", k_usage_check);
-    return EXIT_INVALID;
-  }
-  for (int i = 0; i < argc; ++i)
-    if (navsim_is_help(argv[i])) {
-      fputs(k_usage_check, stdout);
-      return EXIT_OK;
-    }
-  int worst = EXIT_OK;
-  for (int i = 0; i < argc; ++i) {
-    nav_scene scene;
-    const int rc = navsim_load_scene(argv[i], &scene);
-    if (rc == EXIT_OK) {
-      char label[4200];
-      snprintf(label, sizeof label, "%s: ", argv[i]);
-      navsim_print_recorded_fit(stdout, label, &scene);
-      navsim_print_gnss_file(stdout, label, &scene);
-    }
-    if (rc == EXIT_FAIL) worst = EXIT_FAIL;
-    else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
-    if (rc == EXIT_OK) {
-      /* A valid scene whose run would exceed the limits: a warning with the prediction. */
-      navsim_size_prediction pred;
-      navsim_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
-                         &pred);
-      (void)navsim_size_check("run", argv[i], &pred, false, true);
-    }
-  }
-  return worst;
 }
 
 /* Files a run writes, opened inside the temporary result directory. */
@@ -317,7 +231,7 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
   return NAV_CONTINUE;
 }
 
-static int cmd_run(int argc, char **argv) {
+int navsim_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false,
        allow_large = false, export_kfgins = false;
@@ -716,50 +630,4 @@ cleanup:
   nav_req_evaluator_destroy(req_ev);
   free(verdicts);
   return rc;
-}
-
-int main(int argc, char **argv) {
-  if (argc < 2) {
-    fputs(k_usage, stderr);
-    return EXIT_INVALID;
-  }
-  const char *cmd = argv[1];
-  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0) {
-    printf("navsim %s\n", nav_version_string());
-    return EXIT_OK;
-  }
-  if (navsim_is_help(cmd)) {
-    fputs(k_usage, stdout);
-    return EXIT_OK;
-  }
-  if (strcmp(cmd, "check") == 0) return cmd_check(argc - 2, argv + 2);
-  if (strcmp(cmd, "run") == 0) return cmd_run(argc - 2, argv + 2);
-  if (strcmp(cmd, "estimate") == 0) return navsim_estimate(argc - 2, argv + 2);
-  if (strcmp(cmd, "budget") == 0) return navsim_budget(argc - 2, argv + 2);
-  if (strcmp(cmd, "replay") == 0) return navsim_replay(argc - 2, argv + 2);
-  if (strcmp(cmd, "render") == 0) return navsim_render(argc - 2, argv + 2);
-  if (strcmp(cmd, "report") == 0) return navsim_report(argc - 2, argv + 2);
-  if (strcmp(cmd, "bench") == 0) return navsim_bench(argc - 2, argv + 2);
-  if (strcmp(cmd, "allan") == 0) return navsim_allan(argc - 2, argv + 2);
-  if (strcmp(cmd, "import") == 0) return navsim_import(argc - 2, argv + 2);
-  if (strcmp(cmd, "export") == 0) return navsim_export(argc - 2, argv + 2);
-  if (strcmp(cmd, "select") == 0) return navsim_select(argc - 2, argv + 2);
-  if (strcmp(cmd, "sweep") == 0) return navsim_sweep(argc - 2, argv + 2);
-  if (strcmp(cmd, "tradeoff") == 0) return navsim_tradeoff(argc - 2, argv + 2);
-  if (strcmp(cmd, "schema") == 0) return navsim_schema(argc - 2, argv + 2);
-  if (strcmp(cmd, "serve") == 0) {
-#ifdef NAVSIM_HAVE_SERVE
-    return navserve_main(argc - 2, argv + 2);
-#else
-    fprintf(stderr, "navsim serve: this navsim was built without the server (it needs libmicrohttpd-dev and "
-                    "libzip-dev; cmake -DNAV_BUILD_SERVER=ON)\n");
-    return EXIT_FAIL;
-#endif
-  }
-  if (strcmp(cmd, "catalog") == 0) {
-    char res[4096];
-    return navsim_catalog(argc - 2, argv + 2, navsim_find_resources_dir(res, sizeof res) ? res : NULL);
-  }
-  fprintf(stderr, "navsim: unknown command \"%s\" (see navsim --help)\n", cmd);
-  return EXIT_INVALID;
 }

@@ -16,7 +16,6 @@
 
 #include "bench_internal.h"
 #include "bench_verdict.h"
-#include "catalog_cmd.h"
 #include "navcore/nav_paths.h"
 
 #define STUDIO_CASE "navstudio-preview"
@@ -52,7 +51,7 @@ void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, 
     return;
   }
   char res[4096], scene[4400], log[4400];
-  if (!navsim_find_resources_dir(res, sizeof res)) {
+  if (!bench_resources_dir(res, sizeof res)) {
     snprintf(r->error, sizeof r->error, "resources directory not found");
     return;
   }

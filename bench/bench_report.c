@@ -34,7 +34,6 @@
 
 #include "bench_internal.h"
 #include "bench_verdict.h"
-#include "catalog_cmd.h"
 #include "navcore/nav_errors.h"
 #include "navcore/nav_frames.h"
 #include "navcore/nav_ins.h"
@@ -195,7 +194,7 @@ int bench_stage_main(const char *stage, long steps) {
   return 0;
 }
 
-/* Floating-point ALU ops executed by `navsim bench --stage S --steps N` (lackey), or NAN. */
+/* Floating-point ALU ops executed by `navsim-bench --stage S --steps N` (lackey), or NAN. */
 static double lackey_ops(const char *exe, const char *out_dir, int s, long steps) {
   char log[1400], nsteps[32];
   snprintf(log, sizeof log, "%s/logs/lackey-%s-%ld.log", out_dir, k_stage_names[s], steps);
@@ -204,7 +203,6 @@ static double lackey_ops(const char *exe, const char *out_dir, int s, long steps
                   "--tool=lackey",
                   "--detailed-counts=yes",
                   (char *)exe,
-                  "bench",
                   "--stage",
                   (char *)k_stage_names[s],
                   "--steps",
@@ -619,9 +617,8 @@ void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *
       pk.model[0] ? pk.model : "unknown CPU", pk.mhz, pk.fma ? "yes" : "no", pk.avx2 ? "yes" : "no", doc_peak,
       pk.fma_gflops, peak_note, pk.scalar_gflops);
   char exe[4096];
-  const ssize_t el = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (el > 0) exe[el] = '\0';
-  const bool lackey = full && el > 0 && system("valgrind --version >/dev/null 2>&1") == 0;
+  const bool have_exe = bench_self_exe(exe, sizeof exe);
+  const bool lackey = full && have_exe && system("valgrind --version >/dev/null 2>&1") == 0;
   stage_ctx c;
   const bool ok = stage_setup(&c, STAGE_MAX_STEPS, "urban-drive.yaml");
   double ns[N_STAGES], ops[N_STAGES];

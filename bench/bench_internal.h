@@ -63,8 +63,12 @@ void bench_sim(const nav_scene *sc, bool ideal, int threads, bench_row *row);
  * @p peer_row receives the side-by-side figures measured in this run. */
 void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *cfg_scene, const char *out_dir,
                   const char *peer_exe, bench_row *row, bench_row *peer_row);
-/* This executable (/proc/self/exe). */
+/* This executable (navsim-bench), for its own child runs (the FLOP counts under valgrind). */
 bool bench_self_exe(char *buf, size_t cap);
+/* The navsim program the cases time (next to navsim-bench when installed, the build tree's). */
+bool bench_navsim_exe(char *buf, size_t cap);
+/* The resources directory (nav_paths_resources_dir). */
+bool bench_resources_dir(char *buf, size_t size);
 
 /* Cases added by bench_cases2.c after bench.c's own: appends to rows[*n] (capacity cap). */
 void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int cap, bool quiet);

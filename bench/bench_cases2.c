@@ -28,7 +28,6 @@
 
 #include "bench_internal.h"
 #include "bench_verdict.h"
-#include "catalog_cmd.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_paths.h"
 #include "navcore/nav_recorded.h"
@@ -83,10 +82,11 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
 
 /* This executable (for the child runs). */
 bool bench_self_exe(char *buf, size_t cap) {
-  const ssize_t n = readlink("/proc/self/exe", buf, cap - 1);
-  if (n <= 0) return false;
-  buf[n] = '\0';
-  return true;
+  return nav_paths_executable(buf, cap);
+}
+
+bool bench_navsim_exe(char *buf, size_t cap) {
+  return nav_paths_program("navsim", buf, cap);
 }
 
 const char *bench_navview_exe(void) {
@@ -151,7 +151,7 @@ static void case_covariance_rate(bool full, bench_row *rows, int *n, int cap) {
   nav_scene *sc = malloc(sizeof *sc);
   char res[4096], data[4200], probe[4300];
   if (!sc || !bench_load_library_scene("long-drive-replay.yaml", sc) ||
-      !navsim_find_resources_dir(res, sizeof res)) {
+      !bench_resources_dir(res, sizeof res)) {
     free(sc);
     return;
   }
@@ -228,7 +228,7 @@ static void case_mpi(bool full, const char *out_dir, bench_row *rows, int *n, in
   if (*n + 2 > cap) return;
 #ifdef NAVSIM_MPIEXEC
   char exe[4096], scene[4400], res[4096], log[4400], outp[4400];
-  if (!bench_self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
+  if (!bench_navsim_exe(exe, sizeof exe) || !bench_resources_dir(res, sizeof res)) return;
   snprintf(scene, sizeof scene, "%s/../scenes/urban-drive.yaml", res);
   const char *runs = full ? "16" : "2";
   double wall[2] = {0.0, 0.0};
@@ -349,7 +349,7 @@ static void case_campaign(const char *case_name, long runs, double rate_hz, doub
                           bench_row *rows, int *n, int cap) {
   if (*n >= cap) return;
   char exe[4096], res[4096], src[4400], scene[4400], log[4400], outp[4400];
-  if (!bench_self_exe(exe, sizeof exe) || !navsim_find_resources_dir(res, sizeof res)) return;
+  if (!bench_navsim_exe(exe, sizeof exe) || !bench_resources_dir(res, sizeof res)) return;
   snprintf(src, sizeof src, "%s/../scenes/bench-mc-1h.yaml", res);
   snprintf(scene, sizeof scene, "%s/logs/%s.yaml", out_dir, case_name);
   bench_row *r = &rows[*n];

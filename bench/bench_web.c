@@ -21,7 +21,6 @@
 
 #include "bench_internal.h"
 #include "bench_verdict.h"
-#include "catalog_cmd.h"
 
 #define WEB_CASE "studio-first-picture"
 #define WEB_TARGET_MS 1000.0
@@ -80,8 +79,8 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
   (*n)++;
   char exe[PATH_MAX], node[PATH_MAX], chromium[PATH_MAX], studio[PATH_MAX], modules[PATH_MAX];
   char res[PATH_MAX], script[PATH_MAX], manifest[PATH_MAX + 16], puppeteer[PATH_MAX + 64], log[PATH_MAX];
-  if (!bench_self_exe(exe, sizeof exe)) {
-    snprintf(r->error, sizeof r->error, "not measured: this executable's path is unknown");
+  if (!bench_navsim_exe(exe, sizeof exe)) {
+    snprintf(r->error, sizeof r->error, "not measured: the navsim program was not found");
     return;
   }
   if (!find_in_path("node", node, sizeof node)) {
@@ -107,7 +106,7 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
     snprintf(r->error, sizeof r->error, "not measured: puppeteer-core is not installed in %.180s", modules);
     return;
   }
-  if (!navsim_find_resources_dir(res, sizeof res)) {
+  if (!bench_resources_dir(res, sizeof res)) {
     snprintf(r->error, sizeof r->error, "not measured: resources directory not found");
     return;
   }

@@ -19,17 +19,26 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "catalog_cmd.h"
-#include "cli_util.h"
 #include "navcore/nav_errors.h"
 #include "navcore/nav_io.h"
+#include "navcore/nav_paths.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_recorded.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_ins.h"
 #include "navcore/nav_truth.h"
 
-double bench_now_s(void) { return navsim_now_s(); }
+double bench_now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+bool bench_resources_dir(char *buf, size_t size) {
+  if (buf == NULL || size == 0) return false;
+  buf[0] = '\0';
+  return nav_paths_resources_dir(buf, size);
+}
 
 static int cmp_double(const void *a, const void *b) {
   const double x = *(const double *)a, y = *(const double *)b;
@@ -268,7 +277,7 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
   double whole = NAN, peer_wall = NAN;
   char exe[4096], res[4096], scene[4400], outp[4400], log[4400];
   snprintf(log, sizeof log, "%s/logs", out_dir);
-  if (bench_make_dir(log) == 0 && bench_self_exe(exe, sizeof exe) && navsim_find_resources_dir(res, sizeof res)) {
+  if (bench_make_dir(log) == 0 && bench_navsim_exe(exe, sizeof exe) && bench_resources_dir(res, sizeof res)) {
     snprintf(scene, sizeof scene, "%s/../scenes/long-drive-replay.yaml", res);
     snprintf(outp, sizeof outp, "%s/logs/replay-%s", out_dir, gnss_file);
     snprintf(log, sizeof log, "%s/logs/replay-%s.log", out_dir, gnss_file);
@@ -366,7 +375,7 @@ void bench_replay(const char *data_dir, const char *gnss_file, const nav_scene *
 /* A scene of the library, found next to the resources directory. */
 bool bench_load_library_scene(const char *name, nav_scene *sc) {
   char res[4096], path[4200];
-  if (!navsim_find_resources_dir(res, sizeof res)) return false;
+  if (!bench_resources_dir(res, sizeof res)) return false;
   snprintf(path, sizeof path, "%s/../scenes/%s", res, name);
   return nav_scene_read_file(path, sc, NULL, NULL) == NAV_OK;
 }
@@ -561,7 +570,7 @@ int navsim_bench(int argc, char **argv) {
     /* Peer comparison on the shared recording, when the data set is present next to the project. */
     if (sc && bench_load_library_scene("long-drive-replay.yaml", sc)) {
       char res[4096], data[4200];
-      if (navsim_find_resources_dir(res, sizeof res)) {
+      if (bench_resources_dir(res, sizeof res)) {
         snprintf(data, sizeof data, "%s/../../shared/data/gnss-ins-sim-long-drive", res);
         FILE *probe = NULL;
         char imu[4300];
