@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "cli_util.h"
-#include "size_limits.h"
+#include "navcore/nav_size_limits.h"
 #include "navcore/nav_scene.h"
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
@@ -21,7 +21,7 @@ static const char *k_usage_check =
     "  FILE:LINE:COL: error: FIELD.PATH: what is wrong and what is expected\n"
     "A valid scene whose navsim run would exceed the limits below is reported as\n"
     "  FILE: warning: ... with the predicted result files and memory (the scene stays valid).\n"
-    "\n" NAVSIM_LIMITS_HELP "\n"
+    "\n" NAV_LIMITS_HELP "\n"
     "exit codes: 0 every scene is valid; 2 at least one is invalid; 1 a file cannot be read\n";
 
 static long cores(void) {
@@ -53,10 +53,10 @@ int navsim_check(int argc, char **argv) {
     else if (rc == EXIT_INVALID && worst == EXIT_OK) worst = EXIT_INVALID;
     if (rc == EXIT_OK) {
       /* A valid scene whose run would exceed the limits: a warning with the prediction. */
-      navsim_size_prediction pred;
-      navsim_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
+      nav_size_prediction pred;
+      nav_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
                          &pred);
-      (void)navsim_size_check("run", argv[i], &pred, false, true);
+      (void)nav_size_check("run", argv[i], &pred, false, true);
     }
   }
   return worst;

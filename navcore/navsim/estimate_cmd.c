@@ -21,7 +21,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli_util.h"
 #include "estimate_cmd.h"
-#include "size_limits.h"
+#include "navcore/nav_size_limits.h"
 
 #include <errno.h>
 #include <math.h>
@@ -66,7 +66,7 @@ static const char *k_usage_estimate =
     "\n"
     "options:\n"
     "  --allow-large  go ahead above the limits below\n"
-    "\n" NAVSIM_LIMITS_HELP "\n"
+    "\n" NAV_LIMITS_HELP "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
 static double vmax(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
@@ -484,9 +484,9 @@ int navsim_estimate(int argc, char **argv) {
   }
   {
     /* estimate.csv predicted from the scene, refused beyond the limits before any work. */
-    navsim_size_prediction sp;
-    navsim_predict_estimate(&sc, header_columns(&ctx), &sp);
-    if (navsim_size_check("estimate", scene_path, &sp, allow_large, false) != 0) {
+    nav_size_prediction sp;
+    nav_predict_estimate(&sc, header_columns(&ctx), &sp);
+    if (nav_size_check("estimate", scene_path, &sp, allow_large, false) != 0) {
       rc = 2;
       goto cleanup;
     }

@@ -28,7 +28,7 @@
 #include "replay_cmd.h"
 #include "report_cmd.h"
 #include "run_smooth_out.h"
-#include "size_limits.h"
+#include "navcore/nav_size_limits.h"
 #include "tradeoff_cmd.h"
 #include "navcore/nav_io.h"
 #include "navcore/nav_results.h"
@@ -98,7 +98,7 @@ static const char *k_usage_run_tail =
     "                done, 0 to 1, at most about ten lines a second and a last one at 1) to the\n"
     "                open file descriptor N, for a program that runs navsim (navsim serve)\n"
     "  -h, --help    print this help\n"
-    "\n" NAVSIM_LIMITS_HELP "\n"
+    "\n" NAV_LIMITS_HELP "\n"
     "exit codes: 0 success (whether or not requirements pass); 3 --strict and a requirement fails;\n"
     "            2 invalid scene or options; 1 other failure\n";
 
@@ -330,10 +330,10 @@ int navsim_run(int argc, char **argv) {
   {
     /* Result files and memory predicted from the scene, refused beyond the limits before any
      * work (every MPI rank decides the same). */
-    navsim_size_prediction pred;
-    navsim_predict_run(&scene, ideal, (long)threads, kml, &pred);
-    if (export_kfgins) navsim_predict_add_kfgins(&scene, &pred);
-    rc = navsim_size_check("run", scene_path, &pred, allow_large, false);
+    nav_size_prediction pred;
+    nav_predict_run(&scene, ideal, (long)threads, kml, &pred);
+    if (export_kfgins) nav_predict_add_kfgins(&scene, &pred);
+    rc = nav_size_check("run", scene_path, &pred, allow_large, false);
     if (rc != EXIT_OK) return rc;
   }
   /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */

@@ -28,6 +28,8 @@
 #include <unistd.h>
 #include <zip.h>
 
+#include "navcore/nav_paths.h"
+
 const char *const serve_result_files[] = {
     "summary.json",        "truth.csv",      "nav.csv",
     "errors.csv",          "imu_errors.csv", "mc_stats.csv",
@@ -185,7 +187,9 @@ static void confine_writes(void) {
 }
 
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name) {
-  return serve_spawn_prog("/proc/self/exe", dir, argv, progress_fd, cpu_s, log_name);
+  char exe[SERVE_PATH_MAX];
+  if (!nav_paths_executable(exe, sizeof exe)) return -1;
+  return serve_spawn_prog(exe, dir, argv, progress_fd, cpu_s, log_name);
 }
 
 pid_t serve_spawn_prog(const char *prog, const char *dir, char *const argv[], int progress_fd, long cpu_s,
@@ -766,8 +770,7 @@ bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size) {
   clear_dir(g.jobs_dir, true);
   clear_dir(g.tmp_dir, false);
   build_env();
-  const ssize_t en = readlink("/proc/self/exe", g.exe, sizeof g.exe - 1);
-  g.exe[en > 0 ? en : 0] = '\0';
+  if (!nav_paths_executable(g.exe, sizeof g.exe)) g.exe[0] = '\0';
   g.stream_client = calloc((size_t)cfg->max_streams, sizeof *g.stream_client);
   g.workers = calloc((size_t)cfg->max_parallel_jobs, sizeof *g.workers);
   if (!g.stream_client || !g.workers) {

@@ -24,7 +24,7 @@
 #include <unistd.h>
 
 #include "navcore/nav_paths.h"
-#include "size_limits.h"
+#include "navcore/nav_size_limits.h"
 #ifdef NAVSERVE_HAVE_SCHEMA
 #include "navcore/nav_schema.h"
 #endif
@@ -257,8 +257,8 @@ static bool run_limits(nav_scene *sc, long runs, bool *slurm, double *predicted,
              samples, S.cfg.max_imu_samples);
     return false;
   }
-  navsim_size_prediction pred;
-  navsim_predict_run(sc, false, S.cfg.job_threads, true, &pred);
+  nav_size_prediction pred;
+  nav_predict_run(sc, false, S.cfg.job_threads, true, &pred);
   const double mib = 1024.0 * 1024.0;
   *predicted = pred.output_bytes;
   if (pred.output_bytes > (double)S.cfg.job_output_mb * mib) {

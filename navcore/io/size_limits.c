@@ -1,6 +1,6 @@
 /* Output size and memory predicted from a scene, and the limits (size_limits.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "size_limits.h"
+#include "navcore/nav_size_limits.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -51,14 +51,14 @@ static void epochs(const nav_scene *sc, int64_t *n_imu, int64_t *n_out) {
   *n_out = *n_imu / stride + 1 + (*n_imu % stride != 0 ? 1 : 0);
 }
 
-static void add_file(navsim_size_prediction *p, const char *name, double rows, int columns) {
+static void add_file(nav_size_prediction *p, const char *name, double rows, int columns) {
   if (rows <= 0.0 || columns <= 0) return;
-  p->output_bytes += rows * columns * NAVSIM_CSV_FIELD_MAX_BYTES;
+  p->output_bytes += rows * columns * NAV_CSV_FIELD_MAX_BYTES;
   const size_t l = strlen(p->files);
   snprintf(p->files + l, sizeof p->files - l, "%s%s", l ? ", " : "", name);
 }
 
-void navsim_predict_add_kfgins(const nav_scene *sc, navsim_size_prediction *p) {
+void nav_predict_add_kfgins(const nav_scene *sc, nav_size_prediction *p) {
   int64_t n_imu = 0, n_out = 0;
   epochs(sc, &n_imu, &n_out);
   const double n_gnss = sc->gnss.model.update_rate_hz > 0.0
@@ -70,7 +70,7 @@ void navsim_predict_add_kfgins(const nav_scene *sc, navsim_size_prediction *p) {
   add_file(p, "kfgins/GNSS.txt", n_gnss, 13);
 }
 
-void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, navsim_size_prediction *out) {
+void nav_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, nav_size_prediction *out) {
   memset(out, 0, sizeof *out);
   int64_t n_imu = 0, n_out = 0;
   epochs(sc, &n_imu, &n_out);
@@ -130,7 +130,7 @@ void navsim_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml,
   out->memory_bytes = mem;
 }
 
-void navsim_predict_estimate(const nav_scene *sc, int csv_columns, navsim_size_prediction *out) {
+void nav_predict_estimate(const nav_scene *sc, int csv_columns, nav_size_prediction *out) {
   memset(out, 0, sizeof *out);
   int64_t n_imu = 0, n_out = 0;
   epochs(sc, &n_imu, &n_out);
@@ -153,16 +153,16 @@ static void human(char *buf, size_t cap, double bytes) {
   snprintf(buf, cap, u == 0 ? "%.0f %s" : "%.3g %s", bytes, unit[u]);
 }
 
-int navsim_size_check(const char *cmd, const char *scene_path, const navsim_size_prediction *p,
+int nav_size_check(const char *cmd, const char *scene_path, const nav_size_prediction *p,
                       bool allow_large, bool warn_only) {
-  const bool big_out = p->output_bytes > NAVSIM_MAX_OUTPUT_BYTES;
-  const bool big_mem = p->memory_bytes > NAVSIM_MAX_MEMORY_BYTES;
+  const bool big_out = p->output_bytes > NAV_MAX_OUTPUT_BYTES;
+  const bool big_mem = p->memory_bytes > NAV_MAX_MEMORY_BYTES;
   if ((!big_out && !big_mem) || allow_large) return 0;
   const char *kind = warn_only ? "warning" : "error";
   char a[32], b[32];
   if (big_out) {
     human(a, sizeof a, p->output_bytes);
-    human(b, sizeof b, NAVSIM_MAX_OUTPUT_BYTES);
+    human(b, sizeof b, NAV_MAX_OUTPUT_BYTES);
     fprintf(
         stderr,
         "%s: %s: output.rate_hz: navsim %s would write up to %s of result files (%lld output epochs from "
@@ -173,7 +173,7 @@ int navsim_size_check(const char *cmd, const char *scene_path, const navsim_size
   }
   if (big_mem) {
     human(a, sizeof a, p->memory_bytes);
-    human(b, sizeof b, NAVSIM_MAX_MEMORY_BYTES);
+    human(b, sizeof b, NAV_MAX_MEMORY_BYTES);
     fprintf(
         stderr,
         "%s: %s: navsim %s would need about %s of memory (%s, for %lld output epochs), above the limit of %s "
