@@ -16,6 +16,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/resources/ DESTINATION ${NAV_SHARE_DEST}
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${NAV_SHARE_DEST}/scenes COMPONENT tools
   FILES_MATCHING PATTERN "*.yaml")
 install(FILES ${PROJECT_SOURCE_DIR}/tests/data/recorded/adis16465-truth-116454-116754.nav
+              ${PROJECT_SOURCE_DIR}/tests/data/recorded/adis16465-gnss-posvel.txt
               ${PROJECT_SOURCE_DIR}/tests/data/recorded/README.md
   DESTINATION ${NAV_SHARE_DEST}/tests/data/recorded COMPONENT tools)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/navsim.bash-completion
