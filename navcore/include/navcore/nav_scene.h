@@ -7,6 +7,11 @@
  * nav_scene_validate() performs the cross-field checks that do not depend on the file format,
  * so `navsim check`, the editor panels and the core report the same messages.
  *
+ * One part lives on the heap: the control points of a fitted recorded reference
+ * (trajectory.recorded). A scene that a reader or nav_track_fit() filled owns them; release it
+ * with nav_scene_release(), deep-copy it with nav_scene_copy(); a plain struct copy is a
+ * borrowed view (docs/recorded-fit.md, "Ownership of the control points").
+ *
  * Field paths used in validation messages are the YAML paths of the scene file, e.g.
  * "trajectory.parametric.C_hz[2]", so navcore_io can attach file:line:col to them.
  */
