@@ -217,6 +217,7 @@ bool ApplyFieldSets(const nav_scene &base, const QVector<FieldSet> &sets, nav_sc
     if (issues) *issues = found;
     return false;
   }
+  KeepSceneData(*s); // *out is copied as plain bytes (undo, workers)
   Normalize(s.get());
   *out = *s;
   if (issues) issues->clear();

@@ -39,6 +39,29 @@ QString ScenesDir() {
   return nav_paths_scenes_dir(dir, sizeof dir) ? QString::fromLocal8Bit(dir) : QString();
 }
 
+namespace {
+// Scenes whose heap data the editor keeps (KeepSceneData); released when the program ends.
+struct KeptScenes {
+  std::vector<nav_scene *> kept;
+  ~KeptScenes() {
+    for (nav_scene *s : kept) {
+      nav_scene_release(s);
+      delete s;
+    }
+  }
+};
+KeptScenes &Kept() {
+  static KeptScenes k;
+  return k;
+}
+} // namespace
+
+void KeepSceneData(const nav_scene &s) {
+  if (s.trajectory.recorded.ctrl_ned_m == nullptr) return;
+  auto *owner = new nav_scene(s);
+  Kept().kept.push_back(owner);
+}
+
 void Normalize(nav_scene *s) {
   // navigation.cov_decimation: 0 (nav_scene_default) and 1 both mean "every IMU step"
   // (nav_scene.h), but the reader accepts only >= 1, so a scene written with 0 would not read
@@ -111,7 +134,7 @@ QVector<Issue> Validate(const nav_scene &s) {
     auto back = std::make_unique<nav_scene>();
     IssueSink sink{&out};
     const nav_status st = nav_scene_read_string(text, len, "navstudio", back.get(), CollectDiagIssue, &sink);
-    (void)st;
+    if (st == NAV_OK) nav_scene_release(back.get()); // a temporary read-back
     std::free(text);
   } else {
     IssueSink sink{&out};
@@ -369,6 +392,7 @@ bool SceneDocument::Load(const QString &path, QStringList *errors) {
   DiagList dl{errors};
   const QByteArray p = QFile::encodeName(path);
   if (nav_scene_read_file(p.constData(), s.get(), CollectDiagList, &dl) != NAV_OK) return false;
+  KeepSceneData(*s);
   Normalize(s.get());
   RememberUserText(path, *s);
   path_ = QFileInfo(path).absoluteFilePath();
@@ -389,6 +413,7 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
   if (nav_scene_read_string(text.constData(), static_cast<size_t>(text.size()), name.constData(), s.get(),
                             CollectDiagList, &dl) != NAV_OK)
     return false;
+  KeepSceneData(*s);
   Normalize(s.get());
   // The file the recovered document belongs to is the base of its comment-preserving save.
   user_text_.clear();
@@ -397,6 +422,7 @@ bool SceneDocument::LoadText(const QByteArray &text, const QString &display, con
     auto f = std::make_unique<nav_scene>();
     const QByteArray fp = QFile::encodeName(path_for_save);
     if (nav_scene_read_file(fp.constData(), f.get(), nullptr, nullptr) == NAV_OK) {
+      KeepSceneData(*f);
       Normalize(f.get());
       RememberUserText(path_for_save, *f);
     }
@@ -521,7 +547,9 @@ QByteArray SceneDocument::SaveText(QString *note) const {
                               nullptr, nullptr) != NAV_OK)
       continue;
     Normalize(back.get());
-    if (CanonicalText(*back) != canon_new) continue;
+    const bool same = CanonicalText(*back) == canon_new;
+    nav_scene_release(back.get()); // a temporary read-back
+    if (!same) continue;
     if (note)
       *note = replaced.isEmpty() ? tr("comments and layout kept")
                                  : tr("comments and layout kept except where rewritten: %1").arg(replaced);

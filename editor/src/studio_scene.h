@@ -60,6 +60,14 @@ QString ScenesDir();
 /** Equivalent spellings the editor keeps in one form (see the .cpp). */
 void Normalize(nav_scene *s);
 
+/**
+ * Take over the heap data of a scene the reader just filled (the control points of a recorded
+ * reference, nav_scene_release): the editor copies scenes as plain bytes (undo stack, Pack,
+ * workers), so that data is kept until the program ends instead of belonging to one copy.
+ * Temporary read-backs release their scene instead.
+ */
+void KeepSceneData(const nav_scene &s);
+
 /** Speed of a drawn drive between its stops and at its interior waypoints [m/s]. */
 constexpr double kDriveCruiseMps = 10.0;
 

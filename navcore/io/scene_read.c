@@ -3134,7 +3134,8 @@ cleanup:
   else if (r->ndiag > 0)
     st = NAV_ERR_PARSE;
   else
-    *out = *scene;
+    *out = *scene; /* out takes over the heap data (the recorded control points) */
+  if (st != NAV_OK) nav_scene_release(scene);
   free(r);
   free(scene);
   return st;

@@ -548,6 +548,7 @@ int navsim_allan(int argc, char **argv) {
     channel_models(&src.cfg, ch);
     if (!a.have_rate) a.rate_hz = sc.imu.rate_hz;
     if (!a.have_seed) a.seed = sc.simulation.seed;
+    nav_scene_release(&sc);
   }
 
   const double n_real = floor(a.duration_s * a.rate_hz + 1e-9);

@@ -296,6 +296,7 @@ int navsim_budget(int argc, char **argv) {
                     "(its raw-measurement error sources are not budget sources); use navsim sweep over "
                     "gnss.constellation.code_sd_m or navsim estimate\n",
             scene_path);
+    nav_scene_release(sc);
     free(sc);
     return 2;
   }
@@ -327,6 +328,7 @@ int navsim_budget(int argc, char **argv) {
   {
     const int orc = navsim_out_check("budget", out_dir, force);
     if (orc != 0) {
+      nav_scene_release(sc);
       free(sc);
       return orc;
     }
@@ -499,6 +501,7 @@ cleanup:
   free(rb);
   free(res);
   free(mb);
+  nav_scene_release(sc);
   free(sc);
   return rc;
 }

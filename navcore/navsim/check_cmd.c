@@ -57,6 +57,7 @@ int navsim_check(int argc, char **argv) {
       nav_predict_run(&scene, false, scene.simulation.threads > 0 ? scene.simulation.threads : cores(), false,
                          &pred);
       (void)nav_size_check("run", argv[i], &pred, false, true);
+      nav_scene_release(&scene);
     }
   }
   return worst;

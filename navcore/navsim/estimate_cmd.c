@@ -444,7 +444,10 @@ int navsim_estimate(int argc, char **argv) {
     out_dir = default_dir;
   }
   const int orc = navsim_out_check("estimate", out_dir, force);
-  if (orc != 0) return orc;
+  if (orc != 0) {
+    nav_scene_release(&sc);
+    return orc;
+  }
 
   int rc = 1;
   nav_sim *sim = NULL;
@@ -700,5 +703,6 @@ cleanup:
   free(es.cov);
   free(es.tbuf);
   free(es.abuf);
+  nav_scene_release(&sc);
   return rc;
 }

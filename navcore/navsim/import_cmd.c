@@ -116,6 +116,7 @@ static int validate_import(const char *in, const char *out, const nav_geotrack *
   import_check c = {in, track, sc, 0};
   if (st == NAV_OK) st = nav_scene_read_string(text, len, out, back, import_diag, &c);
   free(text);
+  if (st == NAV_OK) nav_scene_release(back);
   free(back);
   if (st == NAV_OK) return EXIT_OK;
   if (st == NAV_ERR_PARSE) {
@@ -241,6 +242,9 @@ int navsim_import(int argc, char **argv) {
       free(sc);
       return lrc;
     }
+    /* The import replaces the trajectory: a recorded template's fitted model is not needed (and
+     * the scene copies below are plain struct copies). */
+    nav_scene_release(sc);
   } else {
     *sc = nav_scene_default();
     sc->imu.rate_hz = 100.0;
@@ -380,6 +384,7 @@ int navsim_import(int argc, char **argv) {
   }
 done:
   nav_geotrack_free(&tr);
+  nav_scene_release(sc); /* what the read-back check read */
   free(sc);
   return rc;
 }

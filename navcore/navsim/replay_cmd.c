@@ -834,11 +834,13 @@ int navsim_replay(int argc, char **argv) {
       if (!reqs || !verdicts) {
         free(reqs);
         free(verdicts);
+        nav_scene_release(scene);
         free(scene);
         return EXIT_FAIL;
       }
       for (int k = 0; k < n_reqs; ++k) reqs[k] = scene->requirements[k];
     }
+    nav_scene_release(scene);
     free(scene);
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;

@@ -313,6 +313,7 @@ int navsim_run(int argc, char **argv) {
   if (runs > 0) scene.simulation.runs = (long)runs;
   if (export_kfgins && navsim_kfgins_unsupported(&scene)) {
     fprintf(stderr, "%s: error: --export kfgins: %s\n", scene_path, navsim_kfgins_unsupported(&scene));
+    nav_scene_release(&scene);
     return EXIT_INVALID;
   }
   if (threads == 0) threads = scene.simulation.threads > 0 ? (uint64_t)scene.simulation.threads : (uint64_t)cores();
@@ -326,7 +327,10 @@ int navsim_run(int argc, char **argv) {
   /* Refuse an --out that holds what navsim did not write before any work (every rank sees the
      same file system, so under mpirun all ranks stop alike). */
   rc = navsim_out_check("run", out_dir, force);
-  if (rc != EXIT_OK) return rc;
+  if (rc != EXIT_OK) {
+    nav_scene_release(&scene);
+    return rc;
+  }
   {
     /* Result files and memory predicted from the scene, refused beyond the limits before any
      * work (every MPI rank decides the same). */
@@ -334,11 +338,17 @@ int navsim_run(int argc, char **argv) {
     nav_predict_run(&scene, ideal, (long)threads, kml, &pred);
     if (export_kfgins) nav_predict_add_kfgins(&scene, &pred);
     rc = nav_size_check("run", scene_path, &pred, allow_large, false);
-    if (rc != EXIT_OK) return rc;
+    if (rc != EXIT_OK) {
+      nav_scene_release(&scene);
+      return rc;
+    }
   }
   /* Under mpirun: ranks other than 0 simulate their share of the runs and stop here (mpi_run.c). */
   int mpi_rc = EXIT_OK;
-  if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) return mpi_rc;
+  if (navsim_mpi_worker(&scene, ideal, (int)threads, &mpi_rc)) {
+    nav_scene_release(&scene);
+    return mpi_rc;
+  }
 
   nav_sim *sim = NULL;
   bool committed = false; /* the result directory is in place */
@@ -629,5 +639,6 @@ cleanup:
   nav_sim_destroy(sim);
   nav_req_evaluator_destroy(req_ev);
   free(verdicts);
+  nav_scene_release(&scene);
   return rc;
 }

@@ -565,11 +565,13 @@ int navsim_select(int argc, char **argv) {
   combo *c = NULL;
   size_t n = 0;
   nav_resultdir *rd = NULL;
+  bool base_loaded = false;
   ctx x;
   memset(&x, 0, sizeof x);
   if (!base || !sc) goto done;
   rc = navsim_load_scene(scene_path, base);
   if (rc != EXIT_OK) goto done;
+  base_loaded = true; /* the combinations' scenes are plain copies of base (make_scene) */
   rc = EXIT_FAIL;
   if (base->n_requirements == 0) {
     fprintf(stderr, "%s: error: requirements: the scene has no requirements to select against (add a requirements "
@@ -871,6 +873,7 @@ done:
   nav_catalog_destroy(parts);
   free(part_idx);
   nav_catalog_destroy(gnss);
+  if (base_loaded) nav_scene_release(base);
   free(base);
   free(sc);
   return rc;

@@ -170,6 +170,7 @@ static int validate_grid(nav_scene_doc *doc, const sweep_param *prm, int np, lon
       }
     }
     grid_sink gs = {prm, np, vals, g, bad < SHOWN, 0};
+    nav_scene_release(sc); /* the previous point's recorded model, if any */
     const nav_status st = nav_scene_doc_read(doc, sc, grid_diag, &gs);
     if (st == NAV_OK) continue;
     if (st != NAV_ERR_PARSE) {
@@ -305,6 +306,7 @@ int navsim_sweep(int argc, char **argv) {
   FILE *f = NULL;
   int nreq = 0;
   if (!sc) goto done;
+  *sc = nav_scene_default(); /* owns nothing: nav_scene_release below is safe on every path */
   {
     char msg[512];
     const nav_status st = nav_scene_doc_load(scene_path, &doc, msg, sizeof msg);
@@ -369,6 +371,7 @@ int navsim_sweep(int argc, char **argv) {
     }
     strncat(context, ")", sizeof context - strlen(context) - 1);
     navsim_diag_sink sink = {0, context};
+    nav_scene_release(sc); /* the previous point's recorded model, if any */
     const nav_status st = nav_scene_doc_read(doc, sc, navsim_print_diag, &sink);
     if (st != NAV_OK) {
       if (sink.count == 0) fprintf(stderr, "%s: error: %s %s\n", scene_path, nav_status_str(st), context);
@@ -508,6 +511,7 @@ done:
   if (f) fclose(f);
   nav_resultdir_abort(rd);
   nav_scene_doc_destroy(doc);
+  if (sc) nav_scene_release(sc);
   free(sc);
   free(v);
   free(x);

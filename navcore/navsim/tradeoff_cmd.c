@@ -295,9 +295,11 @@ static void realise(to_variant *va, const nav_scene *edited) {
   nav_scene *s = malloc(sizeof *s);
   first_diag fd = {"", 0};
   nav_status st = s ? nav_scene_read_string(text, len, va->name, s, keep_first_diag, &fd) : NAV_ERR_NO_MEMORY;
+  const bool read_ok = st == NAV_OK;
   if (st == NAV_OK) st = nav_requirements_check_scene(s, keep_first_issue, &fd);
   free(text);
   if (st != NAV_OK) {
+    if (read_ok) nav_scene_release(s);
     free(s);
     va->skipped = true;
     snprintf(va->note, sizeof va->note, "not a valid scene: %s", fd.msg[0] ? fd.msg : nav_status_str(st));
@@ -619,6 +621,7 @@ int navsim_tradeoff(int argc, char **argv) {
   FILE *f = NULL;
   char paths[8][4400]; /* tradeoff.csv, recommended.yaml, tradeoff.md, a chart, its log, summary.json */
   if (!sc || !tmp || !vs) goto done;
+  *sc = nav_scene_default(); /* owns nothing: nav_scene_release below is safe on every path */
   rc = navsim_load_scene(scene_path, sc);
   if (rc != EXIT_OK) goto done;
   rc = EXIT_FAIL;
@@ -890,12 +893,14 @@ done:
   if (f) fclose(f);
   nav_resultdir_abort(rd);
   for (int i = 0; vs && i < nv; ++i) {
+    nav_scene_release(vs[i].scene); /* each variant's scene was read (realise) */
     free(vs[i].scene);
     free(vs[i].v);
     free(vs[i].ci_lo);
     free(vs[i].ci_hi);
   }
   free(vs);
+  if (sc) nav_scene_release(sc);
   free(sc);
   free(tmp);
   return rc;

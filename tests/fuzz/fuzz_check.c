@@ -68,5 +68,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     NAV_FUZZ_IGNORE(nav_sim_run(sim, &o, &sum));
   }
   nav_sim_destroy(sim);
+  nav_scene_release(&scene); /* a recorded reference's control points */
   return 0;
 }

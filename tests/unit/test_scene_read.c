@@ -1831,6 +1831,8 @@ static void test_scene_library_round_trip(void **state) {
     assert_non_null(first);
     assert_string_equal(first, slurp(out2));
     free(first);
+    nav_scene_release(a); /* a recorded reference's control points (docs/recorded-fit.md) */
+    nav_scene_release(b);
     ++n;
   }
   closedir(d);

@@ -191,6 +191,10 @@ bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_sc
   } else {
     const nav_status st = nav_scene_read_file_to_run(path, sc, collect, diags);
     ok = st == NAV_OK;
+    /* The callers free the scene with free(): it must own no heap data. A scene with heap data
+     * (a fitted recorded reference) names a file, which scan_file_fields refused above; the
+     * release makes that hold whatever the scan lets through. */
+    if (ok) nav_scene_release(sc);
     if (!ok && diags->n == 0) add_diag(diags, 0, 0, "", nav_status_str(st));
   }
   unlink(path);

@@ -113,8 +113,8 @@ typedef struct serve_diags {
  * Read and validate a submitted scene exactly as `navsim check` does (the library's reader, with
  * the checks for a scene that is about to run), after refusing the fields that name files (the
  * server reads no file a client names). The text is written to a private file under @p tmp_dir
- * for the reader. @p scene may be NULL. Returns true when valid; otherwise @p diags holds the
- * problems.
+ * for the reader. @p scene may be NULL; it owns no heap data (plain free() suffices). Returns true
+ * when valid; otherwise @p diags holds the problems.
  */
 bool serve_scene_check(const char *text, size_t len, const char *tmp_dir, nav_scene *scene,
                        serve_diags *diags);

@@ -39,7 +39,9 @@ NAV_API void nav_diag_format(const nav_diag *d, char *buf, size_t size);
 /**
  * Read and validate a scene file.
  * @param[in]  path    file to read
- * @param[out] out     the scene; written only on NAV_OK
+ * @param[out] out     the scene; written only on NAV_OK. It then owns the control points of a
+ *                     recorded reference: release it with nav_scene_release() when done
+ *                     (nav_scene.h; nothing to free for other trajectories, but always safe)
  * @param[in]  report  receives each diagnostic (may be NULL)
  * @param[in]  user    passed to @p report
  * @return NAV_OK; NAV_ERR_IO if the file cannot be read; NAV_ERR_PARSE if it is not a valid

@@ -7,6 +7,11 @@
  * nav_scene_validate() performs the cross-field checks that do not depend on the file format,
  * so `navsim check`, the editor panels and the core report the same messages.
  *
+ * One part lives on the heap: the control points of a fitted recorded reference
+ * (trajectory.recorded). A scene that a reader or nav_track_fit() filled owns them; release it
+ * with nav_scene_release(), deep-copy it with nav_scene_copy(); a plain struct copy is a
+ * borrowed view (docs/recorded-fit.md, "Ownership of the control points").
+ *
  * Field paths used in validation messages are the YAML paths of the scene file, e.g.
  * "trajectory.parametric.C_hz[2]", so navcore_io can attach file:line:col to them.
  */
@@ -296,11 +301,11 @@ typedef struct nav_traj_segments {
 /* ==== BEGIN recorded reference (owned by the recorded-trajectory work; nav_track.h) ==== */
 /**
  * Most B-spline control points of a recorded trajectory: knot_rate_hz x span_s + 5 must fit.
- * The fitted model lives in the scene by value (56 bytes per control point, about 70 KB here),
- * so the scene stays plain data under its 512 KB budget: 300 s at 4 Hz, 965 s at 1.3 Hz,
- * 30 min at 0.7 Hz.
+ * The control points live on the heap (nav_traj_recorded.ctrl_ned_m), not in the scene value;
+ * this cap only bounds the memory a scene file can ask for (56 bytes per point, 224 MB here:
+ * a day at 46 Hz knots, a one-hour reference at 1000 Hz).
  */
-#define NAV_RECORDED_MAX_CTRL 1280
+#define NAV_RECORDED_MAX_CTRL 4000000
 /** Longest recorded-file path kept in the scene [bytes, with the NUL]. */
 #define NAV_RECORDED_PATH_MAX 1024
 
@@ -369,7 +374,8 @@ enum {
  *     quaternions (made sign-continuous).
  * Both are C4, so velocity, acceleration, angular rate and angular acceleration are analytic
  * and continuous. Scene time 0 is the first recorded sample in the window (file time t0_s).
- * The recorded samples themselves are not kept.
+ * The recorded samples themselves are not kept. The control points are on the heap, owned as
+ * described at ctrl_ned_m (docs/recorded-fit.md, "Ownership of the control points").
  */
 typedef struct nav_traj_recorded {
   /* ---- settings (scene file) */
@@ -388,9 +394,15 @@ typedef struct nav_traj_recorded {
   double ref_lon_rad;   /**< [rad] */
   double ref_h_m;       /**< ellipsoidal height [m] */
   double knot_dt_s;     /**< knot spacing [s] */
-  int count;            /**< control points used (knot intervals + 5); 0: not fitted */
-  nav_vec3 ctrl_ned_m[NAV_RECORDED_MAX_CTRL]; /**< position control points [m] */
-  nav_quat ctrl_q[NAV_RECORDED_MAX_CTRL];     /**< attitude control points (not unit) */
+  int count;            /**< control points (knot intervals + 5); 0: not fitted */
+  /** Position control points [m], @c count of them, on the heap. One allocation holds them and
+   *  ctrl_q; the nav_traj_recorded (and so the nav_scene) that nav_track_fit() or a reader
+   *  filled owns it: release it with nav_scene_release() / nav_traj_recorded_release(), copy
+   *  it with nav_scene_copy() / nav_traj_recorded_copy(). A plain struct copy (s2 = s1) is a
+   *  borrowed view, valid while the owner is alive and unchanged; it must not be released.
+   *  NULL when not fitted. */
+  nav_vec3 *ctrl_ned_m;
+  nav_quat *ctrl_q;     /**< attitude control points (not unit), @c count of them, same block */
   nav_recorded_fit_stats fit; /**< residuals against the samples of the fit */
 } nav_traj_recorded;
 /* ==== END recorded reference ==== */
@@ -586,6 +598,24 @@ typedef struct nav_scene {
 
 /** @return a scene with every field at its default (T3.1 parametric trajectory, flat Earth). */
 NAV_API nav_scene nav_scene_default(void);
+
+/**
+ * Free the heap data a scene owns (the control points of a fitted recorded reference,
+ * trajectory.recorded) and mark that model not fitted (count 0, pointers NULL). Every scene
+ * filled by a reader (nav_scene_read_file and friends), by nav_track_fit() or by
+ * nav_scene_copy() is released once when no longer needed; a plain struct copy of it is a
+ * borrowed view and is not. No-op on NULL and on a scene without heap data (every
+ * nav_scene_default() scene); releasing twice is safe.
+ */
+NAV_API void nav_scene_release(nav_scene *scene);
+
+/**
+ * Copy @p src into @p dst with heap data of its own (a deep copy of the recorded control
+ * points), so that @p dst outlives @p src. @p dst is overwritten without being released: release
+ * it first if it owned data. On failure @p dst is a copy without the recorded model (not fitted).
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL); NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_scene_copy(nav_scene *dst, const nav_scene *src);
 
 /**
  * Callback receiving one validation problem: @p path is the scene-file field path

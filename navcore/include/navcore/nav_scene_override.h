@@ -57,6 +57,8 @@ NAV_API NAV_NODISCARD nav_status nav_scene_doc_set(nav_scene_doc *doc, const cha
  * Diagnostics name the original file and its places (line and column in the file as given, not
  * in the edited text); a diagnostic about a value that nav_scene_doc_set put there (or a key it
  * added) has no place in the file: line and column 0, and its path names the overridden field.
+ * On NAV_OK @p out owns heap data as after nav_scene_read_string (release it with
+ * nav_scene_release() before reading into it again).
  * @return the statuses of nav_scene_read_string.
  */
 NAV_API NAV_NODISCARD nav_status nav_scene_doc_read(const nav_scene_doc *doc, nav_scene *out, nav_diag_fn report,

@@ -20,8 +20,10 @@
  * Position and attitude are C4: velocity, acceleration, angular rate and angular acceleration
  * are continuous, and the WGS-84 embedding of traj.c turns them into the ECEF state.
  *
- * The fit is defined by its control points, stored in the scene (nav_traj_recorded) with a cap
- * of NAV_RECORDED_MAX_CTRL: knot_rate_hz x span + 5 must not exceed it. The knot rate is the
+ * The fit is defined by its control points, on the heap and owned by the nav_traj_recorded that
+ * nav_track_fit() filled (nav_traj_recorded_release(), nav_traj_recorded_copy(); a scene's by
+ * nav_scene_release(), nav_scene_copy()); the trajectory object (nav_traj) keeps a copy of its
+ * own. knot_rate_hz x span + 5 must not exceed NAV_RECORDED_MAX_CTRL. The knot rate is the
  * bandwidth of the model: motion faster than about knot_rate_hz / 2 is smoothed away and shows
  * in the fit residuals.
  *
@@ -41,6 +43,8 @@
  *   s->trajectory.duration_s = s->trajectory.recorded.span_s;
  *   if (nav_track_set_scene_start(&s->trajectory.recorded, s, true) != NAV_OK) fail("");  // origin, attitude
  *   printf("fit: %.3f m RMS\n", s->trajectory.recorded.fit.pos_rms_m);
+ *   nav_scene_release(s);  // the control points
+ *   free(s);
  * @endcode
  */
 #ifndef NAV_TRACK_H
@@ -76,7 +80,11 @@ typedef struct nav_track_sample {
  * are not used (the caller selected the samples). Deterministic: the same samples and settings
  * give bit-identical control points. Allocates O(n + count) temporary memory.
  *
- * @param[in,out] rec      settings in, model out; left untouched on failure
+ * @param[in,out] rec      settings in, model out; left untouched on failure. On success it owns
+ *                         new control points (release them with nav_traj_recorded_release()).
+ *                         The ones it pointed to before are not freed (@p rec may be a plain copy
+ *                         of another record, to refit with other settings): release them first
+ *                         when @p rec owned them.
  * @param[in]     samples  @p n samples, times strictly increasing, all finite
  * @param[in]     n        at least 2
  * @param[out]    msg      on failure, what is wrong (naming the sample index and the limit);
@@ -132,6 +140,19 @@ NAV_API NAV_NODISCARD nav_status nav_track_set_scene_start(const nav_traj_record
  * @return the NAV_TRACK_WARN_* bits (0: none, or not fitted).
  */
 NAV_API unsigned nav_track_warnings(const nav_traj_recorded *rec, char *msg, size_t msg_size);
+
+/**
+ * Free the control points @p rec owns and mark it not fitted (count 0, pointers NULL); the
+ * settings and the fit statistics stay. No-op on NULL or an unfitted @p rec; safe twice.
+ */
+NAV_API void nav_traj_recorded_release(nav_traj_recorded *rec);
+
+/**
+ * @p dst = @p src with control points of its own (deep copy). @p dst is overwritten without
+ * being released. On failure @p dst is @p src without the model (count 0, pointers NULL).
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL); NAV_ERR_NO_MEMORY.
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_recorded_copy(nav_traj_recorded *dst, const nav_traj_recorded *src);
 
 /** Name of a format as written in scene files ("kf_gins_nav"). */
 NAV_API const char *nav_recorded_format_name(nav_recorded_format f);

@@ -6,6 +6,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_scene.h"
 #include "navcore/nav_sensors.h"
+#include "navcore/nav_track.h"
 
 nav_scene nav_scene_default(void) {
   nav_scene s;
@@ -346,7 +347,7 @@ static void check_recorded(checker *c, const nav_scene *s) {
     issue(c, "trajectory.recorded.end_s", "must be a finite number (got %g)", r->end_s);
   if ((r->window & NAV_RECORDED_HAS_START) && (r->window & NAV_RECORDED_HAS_END) && !(r->end_s > r->start_s))
     issue(c, "trajectory.recorded.end_s", "must be later than start_s (got %g s)", r->end_s);
-  if (r->count < 6 || r->count > NAV_RECORDED_MAX_CTRL) {
+  if (r->count < 6 || r->count > NAV_RECORDED_MAX_CTRL || r->ctrl_ned_m == NULL || r->ctrl_q == NULL) {
     issue(c, "trajectory.recorded.file", "no fitted samples (%g control points); load the file with navcore_io "
           "or fit samples with nav_track_fit", (double)r->count);
     return;
@@ -588,4 +589,17 @@ const char *nav_traj_type_name(nav_traj_type t) {
   case NAV_TRAJ_RECORDED: return "recorded";
   }
   return "unknown";
+}
+
+/* ------------------------------------------------------------------ ownership (nav_scene.h) */
+
+void nav_scene_release(nav_scene *scene) {
+  if (scene) nav_traj_recorded_release(&scene->trajectory.recorded);
+}
+
+nav_status nav_scene_copy(nav_scene *dst, const nav_scene *src) {
+  if (!dst || !src) return NAV_ERR_INVALID_ARG;
+  if (dst == src) return NAV_OK;
+  *dst = *src;
+  return nav_traj_recorded_copy(&dst->trajectory.recorded, &src->trajectory.recorded);
 }

@@ -82,7 +82,12 @@ nav_status nav_sim_create(const nav_scene *scene, nav_sim **out) {
   if (nav_scene_validate(scene, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
   nav_sim *s = calloc(1, sizeof *s);
   if (!s) return NAV_ERR_NO_MEMORY;
-  s->scene = *scene;
+  /* The simulation keeps a scene of its own (with its own copy of a recorded reference's
+   * control points): it does not depend on the caller's scene staying alive. */
+  if (nav_scene_copy(&s->scene, scene) != NAV_OK) {
+    free(s);
+    return NAV_ERR_NO_MEMORY;
+  }
   atomic_init(&s->cancel, false);
   *out = s;
   return NAV_OK;
@@ -93,6 +98,7 @@ void nav_sim_destroy(nav_sim *sim) {
   free(sim->finals);
   free(sim->envelope);
   free(sim->fixes);
+  nav_scene_release(&sim->scene);
   free(sim);
 }
 

@@ -165,7 +165,8 @@ static nav_vec3 ned_velocity(const nav_geo_kin *g) {
 }
 
 static bool fitted(const nav_traj_recorded *rec) {
-  return rec->count >= 6 && rec->count <= NAV_RECORDED_MAX_CTRL && rec->knot_dt_s > 0.0 &&
+  return rec->count >= 6 && rec->count <= NAV_RECORDED_MAX_CTRL && rec->ctrl_ned_m != NULL &&
+         rec->ctrl_q != NULL && rec->knot_dt_s > 0.0 &&
          isfinite(rec->knot_dt_s) && isfinite(rec->t0_s) && isfinite(rec->ref_lat_rad) &&
          isfinite(rec->ref_lon_rad) && isfinite(rec->ref_h_m) &&
          fabs(rec->ref_lat_rad) <= NAV_TRACK_MAX_ABS_LAT_RAD;
@@ -498,12 +499,27 @@ static nav_status check_inputs(const nav_traj_recorded *rec, const nav_track_sam
     const double max_rate = (double)(NAV_RECORDED_MAX_CTRL - 5) / span;
     const double unit = pow(10.0, floor(log10(max_rate)) - 3.0);
     set_msg(msg, msg_size,
-            "%.3f s at knot_rate_hz %g needs %.0f control points, more than the %d a scene holds; use "
+            "%.3f s at knot_rate_hz %g needs %.0f control points, more than the %d a recorded reference may "
+            "have; use "
             "knot_rate_hz <= %.4g or a shorter window (start_s, end_s)",
             span, rec->knot_rate_hz, intervals + 5.0, NAV_RECORDED_MAX_CTRL, floor(max_rate / unit) * unit);
     return NAV_ERR_OUT_OF_RANGE;
   }
   return NAV_OK;
+}
+
+/* One block for count position and count attitude control points (nav_scene.h, ctrl_ned_m): the
+ * positions first, the quaternions after them (both arrays of doubles, so aligned). Sets
+ * rec->ctrl_ned_m and rec->ctrl_q, or leaves them NULL and returns false. */
+static bool ctrl_alloc(nav_traj_recorded *rec, int count) {
+  rec->ctrl_ned_m = NULL;
+  rec->ctrl_q = NULL;
+  if (count <= 0 || count > NAV_RECORDED_MAX_CTRL) return false;
+  unsigned char *block = malloc((size_t)count * (sizeof(nav_vec3) + sizeof(nav_quat)));
+  if (!block) return false;
+  rec->ctrl_ned_m = (nav_vec3 *)(void *)block;
+  rec->ctrl_q = (nav_quat *)(void *)(block + (size_t)count * sizeof(nav_vec3));
+  return true;
 }
 
 nav_status nav_track_fit(nav_traj_recorded *rec, const nav_track_sample *s, size_t n, char *msg,
@@ -519,6 +535,8 @@ nav_status nav_track_fit(nav_traj_recorded *rec, const nav_track_sample *s, size
   work = malloc(sizeof *work);
   if (!work) return NAV_ERR_NO_MEMORY;
   *work = *rec;
+  work->ctrl_ned_m = NULL; /* rec's control points (if any) stay rec's */
+  work->ctrl_q = NULL;
   work->t0_s = s[0].t_s;
   work->span_s = s[n - 1].t_s - s[0].t_s;
   work->ref_lat_rad = s[0].pos.lat_rad;
@@ -529,6 +547,10 @@ nav_status nav_track_fit(nav_traj_recorded *rec, const nav_track_sample *s, size
   const int count = intervals + 5;
   work->count = count;
   const double dt = work->knot_dt_s;
+  if (!ctrl_alloc(work, count)) {
+    st = NAV_ERR_NO_MEMORY;
+    goto cleanup;
+  }
 
   ap = calloc((size_t)count * BAND, sizeof *ap);
   aq = calloc((size_t)count * BAND, sizeof *aq);
@@ -644,15 +666,49 @@ nav_status nav_track_fit(nav_traj_recorded *rec, const nav_track_sample *s, size
   }
   st = nav_track_residuals(work, s, n, &work->fit);
   if (st != NAV_OK) goto cleanup;
+  /* The model moves to rec. What rec pointed to before is not freed: rec may be a plain copy of
+   * another record's settings (nav_track.h). */
   *rec = *work;
+  work->ctrl_ned_m = NULL;
+  work->ctrl_q = NULL;
 
 cleanup:
   free(ap);
   free(aq);
   free(bp);
   free(bq);
+  if (work) nav_traj_recorded_release(work);
   free(work);
   return st;
+}
+
+/* ------------------------------------------------------------------ ownership */
+
+void nav_traj_recorded_release(nav_traj_recorded *rec) {
+  if (!rec) return;
+  free(rec->ctrl_ned_m); /* ctrl_q is in the same block (ctrl_alloc) */
+  rec->ctrl_ned_m = NULL;
+  rec->ctrl_q = NULL;
+  rec->count = 0;
+}
+
+nav_status nav_traj_recorded_copy(nav_traj_recorded *dst, const nav_traj_recorded *src) {
+  if (!dst || !src) return NAV_ERR_INVALID_ARG;
+  if (dst == src) return NAV_OK;
+  *dst = *src;
+  dst->ctrl_ned_m = NULL;
+  dst->ctrl_q = NULL;
+  if (src->ctrl_ned_m == NULL || src->ctrl_q == NULL || src->count <= 0) {
+    dst->count = 0;
+    return NAV_OK;
+  }
+  if (!ctrl_alloc(dst, src->count)) {
+    dst->count = 0;
+    return NAV_ERR_NO_MEMORY;
+  }
+  memcpy(dst->ctrl_ned_m, src->ctrl_ned_m, (size_t)src->count * sizeof *src->ctrl_ned_m);
+  memcpy(dst->ctrl_q, src->ctrl_q, (size_t)src->count * sizeof *src->ctrl_q);
+  return NAV_OK;
 }
 
 /* ------------------------------------------------------------------ trajectory model */
@@ -669,7 +725,9 @@ static nav_status rec_eval(void *self, double t_s, nav_geo_kin *out) {
 }
 
 static void rec_destroy(void *self) {
-  free(self);
+  rec_model *m = self;
+  nav_traj_recorded_release(&m->rec);
+  free(m);
 }
 
 nav_status nav_traj_recorded_create(const nav_scene *scene, double dt_s, nav_traj_model *out, char *msg,
@@ -685,7 +743,12 @@ nav_status nav_traj_recorded_create(const nav_scene *scene, double dt_s, nav_tra
   }
   rec_model *m = malloc(sizeof *m);
   if (!m) return NAV_ERR_NO_MEMORY;
-  m->rec = *rec;
+  /* The trajectory object owns a copy of the control points: it does not depend on the scene's
+   * lifetime. */
+  if (nav_traj_recorded_copy(&m->rec, rec) != NAV_OK) {
+    free(m);
+    return NAV_ERR_NO_MEMORY;
+  }
   scales(rec, &m->m_lat, &m->m_lon);
   memset(out, 0, sizeof *out);
   out->name = "recorded";
