@@ -755,7 +755,7 @@ static double cdf_abs_normal(double r, double s) {
  * the nodes of every cdf_radius call whose radius stays within 9 sigma (umax = pi/2). Computed
  * once per quantile with the same expressions as the nodes themselves, so the same values. */
 typedef struct radius_nodes {
-  double s[CDF_RADIUS_N + 1], c[CDF_RADIUS_N + 1];
+  double u[CDF_RADIUS_N + 1], s[CDF_RADIUS_N + 1], c[CDF_RADIUS_N + 1];
 } radius_nodes;
 
 static void radius_nodes_init(radius_nodes *t) {
@@ -763,6 +763,7 @@ static void radius_nodes_init(radius_nodes *t) {
   const double h = 2.0 * umax / CDF_RADIUS_N;
   for (int i = 0; i <= CDF_RADIUS_N; ++i) {
     const double u = -umax + h * i;
+    t->u[i] = u;
     t->s[i] = sin(u);
     t->c[i] = cos(u);
   }
@@ -775,7 +776,10 @@ static void radius_nodes_init(radius_nodes *t) {
 /* P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2) independent: with x = r sin(u),
  * P = int phi(r sin u / a) / a * erf(r cos u / (sqrt 2 b)) r cos u du over |r sin u| <= 9 a (a >= b),
  * composite Simpson on 256 intervals (smooth in u). Degenerate sigmas reduce to 1-D.
- * @p nodes: sin and cos of the nodes for umax = pi/2 (the same values the loop would compute). */
+ * @p nodes: sin and cos of the nodes for umax = pi/2 (the same values the loop would compute).
+ * The integrand depends on u through (sin u)^2 and cos u only, and sin is odd and cos even in
+ * round-to-nearest arithmetic: a node whose u is exactly minus that of its mirror node (n - i)
+ * has the same integrand value, taken from the mirror. The sum runs over the nodes in order. */
 static double cdf_radius(double r, double a, double b, const radius_nodes *nodes) {
   if (r <= 0.0) return 0.0;
   if (a < b) {
@@ -790,23 +794,30 @@ static double cdf_radius(double r, double a, double b, const radius_nodes *nodes
   const double umax = whole ? 0.5 * NAV_PI : asin(9.0 * a / r);
   const int n = CDF_RADIUS_N;
   const double h = 2.0 * umax / n;
-  double sum = 0.0;
+  double f[CDF_RADIUS_N + 1], us[CDF_RADIUS_N + 1];
   for (int i = 0; i <= n; ++i) {
+    const double u = whole ? nodes->u[i] : -umax + h * i;
+    us[i] = u;
+    if (2 * i > n && us[n - i] == -u) {
+      f[i] = f[n - i];
+      continue;
+    }
     double su, cu;
     if (whole) {
       su = nodes->s[i];
       cu = nodes->c[i];
     } else {
-      const double u = -umax + h * i;
       su = sin(u);
       cu = cos(u);
     }
     const double x = r * su, c = r * cu;
     const double e = c / (sqrt(2.0) * b);
     const double ef = e >= ERF_ONE_FROM ? 1.0 : erf(e);
-    const double f = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * ef * c;
-    sum += f * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
+    f[i] = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * ef * c;
   }
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i)
+    sum += f[i] * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
   return fmin(1.0, sum * h / 3.0);
 }
 
