@@ -826,11 +826,25 @@ typedef struct pred_point {
   bool radial; /* 2-D radius, else |1-D| */
 } pred_point;
 
-static double mixture_cdf(const pred_point *p, size_t n, double r, const radius_nodes *nodes) {
+/*
+ * Whether the mixture CDF at @p r, the mean of the points' CDFs summed in order, is >= @p q.
+ * Every point's CDF lies in [0, 1] (cdf_radius is clamped to 1, erf <= 1; a NaN point makes the
+ * mean NaN, i.e. "no"), so once the sum so far plus one for every point still to come stays
+ * below q n with room for the rounding of the remaining additions (relative 2^-53 per addition,
+ * bounded here by 1e-15 each), the answer is "no" whatever the remaining points give: the loop
+ * stops there. Otherwise the whole sum decides, as it always did.
+ */
+static bool mixture_cdf_at_least(const pred_point *p, size_t n, double r, double q, const radius_nodes *nodes) {
+  const double qn = q * (double)n * (1.0 - 1e-12);
   double s = 0.0;
-  for (size_t i = 0; i < n; ++i)
+  for (size_t i = 0; i < n; ++i) {
     s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b, nodes) : cdf_abs_normal(r, p[i].a);
-  return s / (double)n;
+    if ((i & 63u) == 63u) {
+      const double rest = (double)(n - 1 - i);
+      if ((s + rest) * (1.0 + 1e-15 * (rest + 2.0)) < qn) return false;
+    }
+  }
+  return s / (double)n >= q;
 }
 
 /* Smallest r with mixture CDF >= q (bisection to 1e-9 relative). */
@@ -844,7 +858,7 @@ static double mixture_quantile(const pred_point *p, size_t n, double q) {
   double lo = 0.0;
   for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
     const double mid = 0.5 * (lo + hi);
-    if (mixture_cdf(p, n, mid, &nodes) >= q) hi = mid;
+    if (mixture_cdf_at_least(p, n, mid, q, &nodes)) hi = mid;
     else lo = mid;
   }
   return hi;
