@@ -74,6 +74,8 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
   }
   r.wall_s = bench_now_s() - t0;
   r.maxrss_mb = (double)ru.ru_maxrss / 1024.0; /* ru_maxrss is in KiB on Linux */
+  r.cpu_s = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+            1e-6 * (double)ru.ru_stime.tv_usec;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.exited_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
   if (r.exit_code == 127) r.started = false;
@@ -456,4 +458,6 @@ void bench_cases2(bool full, const char *out_dir, bench_row *rows, int *n, int c
   bench_case_studio_preview(full, out_dir, rows, n, cap);
   if (!quiet) fprintf(stderr, "  bench: browser studio, scene to first picture...\n");
   bench_case_web_first_picture(full, out_dir, rows, n, cap);
+  if (!quiet) fprintf(stderr, "  bench: navsim estimate of the library scenes...\n");
+  bench_case_estimate_library(full, out_dir, rows, n, cap);
 }

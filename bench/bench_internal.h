@@ -43,6 +43,7 @@ typedef struct child_result {
   int exit_code;
   double wall_s;
   double maxrss_mb; /* of the child itself (wait4) */
+  double cpu_s;     /* user + system CPU seconds of the child itself (wait4) */
 } child_result;
 
 child_result bench_run_child(char *const argv[], const char *log_path, double timeout_s);
@@ -78,6 +79,9 @@ void bench_studio_target_md(FILE *md, const bench_row *rows, int n);
 /* The browser studio's scene to first picture (bench_web.c): its row, and its target line. */
 void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
 void bench_web_target_md(FILE *md, const bench_row *rows, int n);
+/* navsim estimate of every library scene (bench_estimate.c): its row, and its target line. */
+void bench_case_estimate_library(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
+void bench_estimate_target_md(FILE *md, const bench_row *rows, int n);
 
 /* Per-stage floating-point operation counts (bench_report.c). */
 typedef struct bench_flops {

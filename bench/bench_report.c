@@ -578,6 +578,7 @@ void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *
     target_line(md, "viewer, one-hour 200 Hz case (20 paths)", "reported", f ? BENCH_MET : BENCH_NOT_MEASURED, v);
     bench_studio_target_md(md, rows, n);
     bench_web_target_md(md, rows, n);
+    bench_estimate_target_md(md, rows, n);
   }
   {
     struct rusage self, kids;

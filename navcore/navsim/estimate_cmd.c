@@ -302,6 +302,11 @@ typedef struct est_stream {
   nav_cov_point cov_last;         /* covariance of the last epoch received */
   size_t show_i[N_SHOW];          /* first epoch at or after each read-out time; nt: none yet */
   nav_cov_point show_cov[N_SHOW]; /* its covariance */
+  /* Every covariance point, kept when the requirements are predicted from this very analysis
+   * (nav_req_predict_scene_uses_sim_covariance): nav_req_predict_scene would run it again. */
+  bool keep_points;
+  nav_cov_point *pts;
+  size_t npts, pts_cap;
 } est_stream;
 
 static bool flush_batch(est_stream *s) {
@@ -325,6 +330,19 @@ static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
     s->cov[s->nb] = *p;
     s->hmax = fmax(s->hmax, p->pos_h_sd_m);
     s->cov_last = *p;
+    if (s->keep_points) {
+      if (s->npts == s->pts_cap) {
+        const size_t nc = s->pts_cap ? 2 * s->pts_cap : 1024;
+        nav_cov_point *g = realloc(s->pts, nc * sizeof *g);
+        if (!g) {
+          s->st = NAV_ERR_NO_MEMORY;
+          return false;
+        }
+        s->pts = g;
+        s->pts_cap = nc;
+      }
+      s->pts[s->npts++] = *p;
+    }
   }
   for (size_t q = 0; q < N_SHOW; ++q)
     if (s->show_i[q] == s->c->nt && t >= k_show_s[q]) {
@@ -524,6 +542,7 @@ int navsim_estimate(int argc, char **argv) {
   if (sc.earth.model == NAV_EARTH_WGS84) {
     st = nav_sim_create(&sc, &sim);
     es.with_cov = true;
+    es.keep_points = sc.n_requirements > 0 && nav_req_predict_scene_uses_sim_covariance(&sc);
     if (st == NAV_OK) {
       const double tc = navsim_now_s();
       st = nav_sim_covariance(sim, stream_cov, &es);
@@ -574,8 +593,9 @@ int navsim_estimate(int argc, char **argv) {
     if (!pred) goto cleanup;
     /* The covariance analysis plus the truth's scale factors the filter does not estimate
        (nav_req_predict_scene, as navsim select predicts); nothing without a covariance analysis. */
-    st = have_cov ? nav_req_predict_scene(&sc, pred)
-                  : nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred);
+    st = !have_cov       ? nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred)
+         : es.keep_points ? nav_req_predict_scene_points(&sc, es.pts, es.npts, pred)
+                          : nav_req_predict_scene(&sc, pred);
     if (st != NAV_OK) {
       fprintf(stderr, "navsim estimate: predicting the requirements failed: %s\n", nav_status_str(st));
       goto cleanup;
@@ -704,5 +724,6 @@ cleanup:
   free(es.tbuf);
   free(es.abuf);
   nav_scene_release(&sc);
+  free(es.pts);
   return rc;
 }

@@ -638,6 +638,54 @@ static void test_predict_known(void **state) {
   assert_true(v[1].value > 1.959963984540054 * sigma && v[1].value < sigma * sqrt(2.0 * log(20.0)));
 }
 
+typedef struct pts_buf {
+  nav_cov_point p[4096];
+  size_t n;
+} pts_buf;
+
+static nav_callback_result keep_pt(void *user, const nav_cov_point *p) {
+  pts_buf *b = user;
+  if (b->n == sizeof b->p / sizeof b->p[0]) return NAV_STOP;
+  b->p[b->n++] = *p;
+  return NAV_CONTINUE;
+}
+
+/* nav_req_predict_scene_points with the points of nav_sim_covariance gives the verdicts of
+ * nav_req_predict_scene bit for bit (navsim estimate passes the points of its own analysis). */
+static void test_predict_scene_points(void **state) {
+  (void)state;
+  nav_scene *sc = malloc(sizeof *sc);
+  pts_buf *b = calloc(1, sizeof *b);
+  assert_non_null(sc);
+  assert_non_null(b);
+  assert_int_equal(nav_scene_read_file(NAV_SOURCE_DIR "/scenes/gyro-free-gnss-car.yaml", sc, NULL, NULL), NAV_OK);
+  assert_true(nav_req_predict_scene_uses_sim_covariance(sc));
+  assert_true(sc->n_requirements >= 2 && sc->n_requirements <= 8);
+  nav_sim *sim = NULL;
+  assert_int_equal(nav_sim_create(sc, &sim), NAV_OK);
+  assert_int_equal(nav_sim_covariance(sim, keep_pt, b), NAV_OK);
+  nav_sim_destroy(sim);
+  assert_true(b->n > 100 && b->n < sizeof b->p / sizeof b->p[0]);
+  nav_requirement_verdict a[8], c[8];
+  assert_int_equal(nav_req_predict_scene(sc, a), NAV_OK);
+  assert_int_equal(nav_req_predict_scene_points(sc, b->p, b->n, c), NAV_OK);
+  assert_memory_equal(a, c, (size_t)sc->n_requirements * sizeof a[0]);
+  int quantiles = 0;
+  for (int i = 0; i < sc->n_requirements; ++i)
+    if (a[i].statistic == NAV_REQ_CEP95) {
+      ++quantiles;
+      assert_true(a[i].evaluated && isfinite(a[i].value) && a[i].value > 0.0);
+    }
+  assert_int_equal(quantiles, 1);
+  /* A scheme whose prediction is not nav_sim_covariance's (ins_gnss: the budget's total filter). */
+  sc->navigation.scheme = NAV_SCHEME_INS_GNSS;
+  assert_false(nav_req_predict_scene_uses_sim_covariance(sc));
+  assert_int_equal(nav_req_predict_scene_points(sc, b->p, b->n, c), NAV_ERR_INVALID_ARG);
+  assert_false(nav_req_predict_scene_uses_sim_covariance(NULL));
+  free(b);
+  free(sc);
+}
+
 
 /* The outages of a scene as the simulation applies them: gnss.outages plus the segments with
  * gnss_visible: false (merged when they touch). */
@@ -693,6 +741,7 @@ int main(void) {
       cmocka_unit_test(test_scene_errors),
       cmocka_unit_test(test_scene_round_trip),
       cmocka_unit_test(test_scene_outages),
+      cmocka_unit_test(test_predict_scene_points),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

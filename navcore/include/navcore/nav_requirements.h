@@ -300,6 +300,21 @@ NAV_API NAV_NODISCARD nav_status nav_req_predict(const nav_requirement *reqs, in
  * @return NAV_OK; NAV_ERR_INVALID_ARG (flat Earth, gyro_free); the simulation's statuses.
  */
 NAV_API NAV_NODISCARD nav_status nav_req_predict_scene(const struct nav_scene *scene, nav_requirement_verdict *out);
+/**
+ * Whether nav_req_predict_scene's covariance analysis for @p scene is exactly nav_sim_covariance()
+ * of its scene (gyro_free_gnss, ins_gnss_tight: no consider states), so that a caller that already
+ * ran it can pass its points to nav_req_predict_scene_points() instead of running it again.
+ */
+NAV_API bool nav_req_predict_scene_uses_sim_covariance(const struct nav_scene *scene);
+/**
+ * nav_req_predict_scene with the points of nav_sim_covariance() for @p scene already computed
+ * (every point it gave, in order; only where nav_req_predict_scene_uses_sim_covariance()): the same
+ * checks, outages and verdicts as nav_req_predict_scene, without running the analysis again.
+ * @return as nav_req_predict_scene; NAV_ERR_INVALID_ARG for the other schemes.
+ */
+NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_points(const struct nav_scene *scene,
+                                                              const struct nav_cov_point *pts, size_t npts,
+                                                              nav_requirement_verdict *out);
 
 NAV_END_DECLS
 

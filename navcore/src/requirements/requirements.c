@@ -748,10 +748,39 @@ static double cdf_abs_normal(double r, double s) {
   return erf(r / (sqrt(2.0) * s));
 }
 
+/* Intervals of the Simpson rule of cdf_radius (even). */
+#define CDF_RADIUS_N 256
+
+/* sin and cos of the Simpson nodes over the whole half circle, u = -pi/2 + h i with h = pi/256:
+ * the nodes of every cdf_radius call whose radius stays within 9 sigma (umax = pi/2). Computed
+ * once per quantile with the same expressions as the nodes themselves, so the same values. */
+typedef struct radius_nodes {
+  double u[CDF_RADIUS_N + 1], s[CDF_RADIUS_N + 1], c[CDF_RADIUS_N + 1];
+} radius_nodes;
+
+static void radius_nodes_init(radius_nodes *t) {
+  const double umax = 0.5 * NAV_PI;
+  const double h = 2.0 * umax / CDF_RADIUS_N;
+  for (int i = 0; i <= CDF_RADIUS_N; ++i) {
+    const double u = -umax + h * i;
+    t->u[i] = u;
+    t->s[i] = sin(u);
+    t->c[i] = cos(u);
+  }
+}
+
+/* erf(x) for x >= 6 is 1 - erfc(x) with erfc(6) = 2.2e-17 below half the spacing of the doubles
+ * just under 1 (2^-54 = 5.6e-17): exactly 1.0 in every correctly or faithfully rounded erf. */
+#define ERF_ONE_FROM 6.0
+
 /* P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2) independent: with x = r sin(u),
  * P = int phi(r sin u / a) / a * erf(r cos u / (sqrt 2 b)) r cos u du over |r sin u| <= 9 a (a >= b),
- * composite Simpson on 256 intervals (smooth in u). Degenerate sigmas reduce to 1-D. */
-static double cdf_radius(double r, double a, double b) {
+ * composite Simpson on 256 intervals (smooth in u). Degenerate sigmas reduce to 1-D.
+ * @p nodes: sin and cos of the nodes for umax = pi/2 (the same values the loop would compute).
+ * The integrand depends on u through (sin u)^2 and cos u only, and sin is odd and cos even in
+ * round-to-nearest arithmetic: a node whose u is exactly minus that of its mirror node (n - i)
+ * has the same integrand value, taken from the mirror. The sum runs over the nodes in order. */
+static double cdf_radius(double r, double a, double b, const radius_nodes *nodes) {
   if (r <= 0.0) return 0.0;
   if (a < b) {
     const double t = a;
@@ -761,16 +790,34 @@ static double cdf_radius(double r, double a, double b) {
   if (!(a > 0.0)) return 1.0;
   if (!(b > 0.0) || b < 1e-9 * a) return cdf_abs_normal(r, a);
   /* |x| beyond 9 a carries < 1e-18: integrate u over [-U, U], r sin U = min(r, 9 a). */
-  const double umax = 9.0 * a < r ? asin(9.0 * a / r) : 0.5 * NAV_PI;
-  const int n = 256;
+  const bool whole = !(9.0 * a < r);
+  const double umax = whole ? 0.5 * NAV_PI : asin(9.0 * a / r);
+  const int n = CDF_RADIUS_N;
   const double h = 2.0 * umax / n;
-  double sum = 0.0;
+  double f[CDF_RADIUS_N + 1], us[CDF_RADIUS_N + 1];
   for (int i = 0; i <= n; ++i) {
-    const double u = -umax + h * i;
-    const double x = r * sin(u), c = r * cos(u);
-    const double f = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * erf(c / (sqrt(2.0) * b)) * c;
-    sum += f * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
+    const double u = whole ? nodes->u[i] : -umax + h * i;
+    us[i] = u;
+    if (2 * i > n && us[n - i] == -u) {
+      f[i] = f[n - i];
+      continue;
+    }
+    double su, cu;
+    if (whole) {
+      su = nodes->s[i];
+      cu = nodes->c[i];
+    } else {
+      su = sin(u);
+      cu = cos(u);
+    }
+    const double x = r * su, c = r * cu;
+    const double e = c / (sqrt(2.0) * b);
+    const double ef = e >= ERF_ONE_FROM ? 1.0 : erf(e);
+    f[i] = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * ef * c;
   }
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i)
+    sum += f[i] * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
   return fmin(1.0, sum * h / 3.0);
 }
 
@@ -779,10 +826,25 @@ typedef struct pred_point {
   bool radial; /* 2-D radius, else |1-D| */
 } pred_point;
 
-static double mixture_cdf(const pred_point *p, size_t n, double r) {
+/*
+ * Whether the mixture CDF at @p r, the mean of the points' CDFs summed in order, is >= @p q.
+ * Every point's CDF lies in [0, 1] (cdf_radius is clamped to 1, erf <= 1; a NaN point makes the
+ * mean NaN, i.e. "no"), so once the sum so far plus one for every point still to come stays
+ * below q n with room for the rounding of the remaining additions (relative 2^-53 per addition,
+ * bounded here by 1e-15 each), the answer is "no" whatever the remaining points give: the loop
+ * stops there. Otherwise the whole sum decides, as it always did.
+ */
+static bool mixture_cdf_at_least(const pred_point *p, size_t n, double r, double q, const radius_nodes *nodes) {
+  const double qn = q * (double)n * (1.0 - 1e-12);
   double s = 0.0;
-  for (size_t i = 0; i < n; ++i) s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b) : cdf_abs_normal(r, p[i].a);
-  return s / (double)n;
+  for (size_t i = 0; i < n; ++i) {
+    s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b, nodes) : cdf_abs_normal(r, p[i].a);
+    if ((i & 63u) == 63u) {
+      const double rest = (double)(n - 1 - i);
+      if ((s + rest) * (1.0 + 1e-15 * (rest + 2.0)) < qn) return false;
+    }
+  }
+  return s / (double)n >= q;
 }
 
 /* Smallest r with mixture CDF >= q (bisection to 1e-9 relative). */
@@ -790,11 +852,13 @@ static double mixture_quantile(const pred_point *p, size_t n, double q) {
   double hi = 0.0;
   for (size_t i = 0; i < n; ++i) hi = fmax(hi, p[i].radial ? hypot(p[i].a, p[i].b) : p[i].a);
   if (!(hi > 0.0)) return 0.0;
+  radius_nodes nodes;
+  radius_nodes_init(&nodes);
   hi *= 10.0; /* P(|x| > 10 sigma_max) < 1e-20 */
   double lo = 0.0;
   for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
     const double mid = 0.5 * (lo + hi);
-    if (mixture_cdf(p, n, mid) >= q) hi = mid;
+    if (mixture_cdf_at_least(p, n, mid, q, &nodes)) hi = mid;
     else lo = mid;
   }
   return hi;
@@ -943,19 +1007,43 @@ static nav_callback_result keep_point(void *user, const nav_budget_epoch *e) {
   return keep_cov_point(user, &q);
 }
 
-nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
+bool nav_req_predict_scene_uses_sim_covariance(const nav_scene *scene) {
+  return scene && (scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+                   scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT);
+}
+
+/* The checks of nav_req_predict_scene and the scene's outages (@p iv, @p ni). */
+static nav_status predict_scene_begin(const nav_scene *scene, nav_requirement_verdict *out, nav_req_interval *iv,
+                                      int *ni) {
   if (!scene || (scene->n_requirements > 0 && !out)) return NAV_ERR_INVALID_ARG;
   if (scene->earth.model != NAV_EARTH_WGS84 || scene->navigation.scheme == NAV_SCHEME_GYRO_FREE)
     return NAV_ERR_INVALID_ARG;
-  /* gyro_free_gnss and ins_gnss_tight: their filters' covariance analysis (nav_sim_covariance). */
-  const bool gfg = scene->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
-                   scene->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
-  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
-  int ni = 0;
+  *ni = 0;
   nav_status st = NAV_OK;
-  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || gfg) st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, &ni);
+  if (scene->navigation.scheme == NAV_SCHEME_INS_GNSS || nav_req_predict_scene_uses_sim_covariance(scene))
+    st = nav_req_scene_outages(scene, iv, NAV_REQ_MAX_OUTAGES, ni);
   if (st != NAV_OK) return st;
   if (nav_scene_validate(scene, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
+  return NAV_OK;
+}
+
+nav_status nav_req_predict_scene_points(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
+                                        nav_requirement_verdict *out) {
+  if (!nav_req_predict_scene_uses_sim_covariance(scene)) return NAV_ERR_INVALID_ARG;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  const nav_status st = predict_scene_begin(scene, out, iv, &ni);
+  if (st != NAV_OK) return st;
+  return nav_req_predict(scene->requirements, scene->n_requirements, pts, npts, iv, ni, out);
+}
+
+nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
+  /* gyro_free_gnss and ins_gnss_tight: their filters' covariance analysis (nav_sim_covariance). */
+  const bool gfg = nav_req_predict_scene_uses_sim_covariance(scene);
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  nav_status st = predict_scene_begin(scene, out, iv, &ni);
+  if (st != NAV_OK) return st;
   cov_buf b = {NULL, 0, 0, false};
   if (gfg) {
     /* gyro_free_gnss: its filter's covariance analysis (no consider states: the scheme refuses
