@@ -587,6 +587,10 @@ typedef struct nav_scene {
 /** @return a scene with every field at its default (T3.1 parametric trajectory, flat Earth). */
 NAV_API nav_scene nav_scene_default(void);
 
+/** Whether the loosely coupled scheme takes its fixes from the least-squares PVT of the simulated
+ *  raw measurements: scheme ins_gnss with gnss.enabled and gnss.constellation.fixes: pvt. Leaf. */
+NAV_API bool nav_scene_gnss_pvt_fixes(const nav_scene *scene);
+
 /**
  * Callback receiving one validation problem: @p path is the scene-file field path
  * ("imu.rate_hz"), @p message says what is wrong and what is expected. Both are valid only
