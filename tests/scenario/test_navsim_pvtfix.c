@@ -6,8 +6,9 @@
  * - navsim run (100 Monte Carlo runs) is bit-identical with 1 and 2 threads (mc_stats, mc_final);
  * - its 9-state NEES is inside the 95 % band of chi2(9 x 100) / 100 on >= 90 % of the epochs;
  * - the RMS over the runs of north, east and down position agrees with the filter's own mean
- *   reported sigma inside the 99 % band of chi2(100) at ten epochs, the canyon's end included
- *   (>= 28 of 30);
+ *   reported sigma and with the covariance analysis (navsim estimate, R from the geometry of the
+ *   satellites the reference sees) inside the 99 % band of chi2(100) at ten epochs, the canyon's
+ *   end included (>= 28 of 30 each);
  * - before the canyon the horizontal RMS is below the receiver's own sigma x RMS(HDOP) bound of a
  *   single fix (the filter averages the fixes: 3 m code noise, HDOP from gnss_dop.csv);
  * - `navsim schema` documents gnss.constellation.fixes.
@@ -145,19 +146,31 @@ static void loose_on_pvt_fixes(void **state) {
   const double times[10] = {10.0, 30.0, 45.0, 60.0, 80.0, 99.9, 110.0, 130.0, 150.0, 170.0};
   const char *rms[3] = {"pos_rms_n_m", "pos_rms_e_m", "pos_rms_d_m"};
   const char *sd[3] = {"pos_sd_reported_n_m", "pos_sd_reported_e_m", "pos_sd_reported_d_m"};
-  int inside = 0;
+  const char *cov_sd[3] = {"cov_pos_n_sd_m", "cov_pos_e_sd_m", "cov_pos_d_sd_m"};
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "estimate '%s' --out est", LOOSE);
+  if (r->code != 0) fail_msg("estimate: %d\n%s", r->code, r->err);
+  table est;
+  read_table(WORK "/est/estimate.csv", &est);
+  int inside = 0, inside_cov = 0;
   for (int i = 0; i < 10; ++i) {
-    const int rm = row_at(&mc, times[i]);
-    assert_true(rm >= 0);
-    double ratio[3];
+    const int rm = row_at(&mc, times[i]), re = row_at(&est, times[i]);
+    assert_true(rm >= 0 && re >= 0);
+    double ratio[3], rc[3];
     for (int c = 0; c < 3; ++c) {
       ratio[c] = at(&mc, rm, col(&mc, rms[c])) / at(&mc, rm, col(&mc, sd[c]));
+      rc[c] = at(&mc, rm, col(&mc, rms[c])) / at(&est, re, col(&est, cov_sd[c]));
       inside += ratio[c] > lo && ratio[c] < hi;
+      inside_cov += rc[c] > lo && rc[c] < hi;
     }
-    print_message("t = %6.1f s: RMS / filter sigma N %.3f E %.3f D %.3f\n", times[i], ratio[0], ratio[1], ratio[2]);
+    print_message("t = %6.1f s: RMS / filter sigma N %.3f E %.3f D %.3f; RMS / covariance analysis N %.3f E %.3f "
+                  "D %.3f\n",
+                  times[i], ratio[0], ratio[1], ratio[2], rc[0], rc[1], rc[2]);
   }
-  print_message("%d of 30 ratios in the 99 %% band [%.3f, %.3f]\n", inside, lo, hi);
+  print_message("%d (filter sigma) and %d (covariance analysis) of 30 ratios in the 99 %% band [%.3f, %.3f]\n",
+                inside, inside_cov, lo, hi);
   assert_true(inside >= 28);
+  assert_true(inside_cov >= 28);
+  free(est.v);
   /* Before the canyon the filtered horizontal error is below one fix's sigma HDOP (3 m code). */
   const int rb = row_at(&mc, 39.9), db = row_at(&dop, 39.9), re = row_at(&mc, 99.9);
   assert_true(rb >= 0 && db >= 0 && re >= 0);

@@ -319,6 +319,16 @@ typedef struct nav_gnss_pvt {
 NAV_API NAV_NODISCARD nav_status nav_gnss_pvt_solve(int n, const nav_gnss_pseudorange *pr, double t_rx_s,
                                                     nav_gnss_pvt *out);
 
+/**
+ * The north/east/down block of (G'G)^-1 for @p n lines of sight (azimuth/elevation, NED rows of
+ * nav_gnss_dop_compute()), with one clock column per system present (@p one_clock false: the
+ * position fix) or a single clock column (true: the velocity fix, whose unknown is the common
+ * drift). The fix's covariance is sigma^2 times it. Leaf.
+ * @return false (q_ned untouched) for a singular geometry or too few lines of sight.
+ */
+NAV_API bool nav_gnss_cofactor_ned(int n, const double *az_rad, const double *el_rad, const nav_gnss_system *sys,
+                                   bool one_clock, double q_ned[3][3]);
+
 /** One range rate: the satellite and the measured rate rr = rho_dot + c dt_r' + e [m/s]. */
 typedef struct nav_gnss_range_rate {
   const nav_gnss_orbit *sat;

@@ -278,3 +278,39 @@ nav_status nav_gnss_pvt_velocity(int n, const nav_gnss_range_rate *rr, double t_
   *out = o;
   return NAV_OK;
 }
+
+bool nav_gnss_cofactor_ned(int n, const double *az_rad, const double *el_rad, const nav_gnss_system *sys,
+                           bool one_clock, double q_ned[3][3]) {
+  if (!az_rad || !el_rad || !sys || !q_ned || n < 4 || n > NAV_GNSS_MAX_SATS) {
+    return false;
+  }
+  int col_of[NAV_GNSS_SYS_COUNT] = {-1, -1};
+  int nclk = 0;
+  for (int i = 0; i < n; ++i) {
+    if ((int)sys[i] < 0 || (int)sys[i] >= NAV_GNSS_SYS_COUNT) {
+      return false;
+    }
+    if (col_of[sys[i]] < 0) {
+      col_of[sys[i]] = one_clock ? 3 : 3 + nclk++;
+    }
+  }
+  const int m = one_clock ? 4 : 3 + nclk;
+  if (n < m) {
+    return false;
+  }
+  double h[NAV_GNSS_MAX_SATS][5];
+  for (int i = 0; i < n; ++i) {
+    memset(h[i], 0, sizeof h[i]);
+    h[i][0] = -cos(el_rad[i]) * cos(az_rad[i]);
+    h[i][1] = -cos(el_rad[i]) * sin(az_rad[i]);
+    h[i][2] = sin(el_rad[i]);
+    h[i][col_of[sys[i]]] = 1.0;
+  }
+  nav_vec3 d;
+  double q[3][3];
+  if (!axis_dop(n, (const double(*)[5])h, m, &d, q)) {
+    return false;
+  }
+  memcpy(q_ned, q, sizeof q);
+  return true;
+}
