@@ -578,7 +578,7 @@ static void scene_section_round_trip(void **state) {
   snprintf(yaml, sizeof yaml,
            "gnss:\n  constellation:\n    epoch: \"2007-12-01T06:30:15.5\"\n    gps: almanac\n"
            "    almanac: %s/gnss/yuma431_prn01-08.alm\n    glonass: nominal\n    glonass_node_lon_deg: 12.5\n"
-           "    elevation_mask_deg: 7.5\n    min_satellites_for_fix: 5\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
+           "    elevation_mask_deg: 7.5\n    min_satellites_for_fix: 5\n    fixes: pvt\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
            "    canyons:\n      - {t0_s: 1, t1_s: 2, height_m: 20, left_m: 5, right_m: 6}\n"
            "      - {t0_s: 3, t1_s: 4.5, height_m: 10, left_m: 3, right_m: 4}\n",
            NAV_TEST_DATA_DIR);
@@ -595,6 +595,7 @@ static void scene_section_round_trip(void **state) {
   assert_int_equal(c->almanac.n, 8);
   assert_int_equal(c->n_canyons, 2);
   assert_int_equal(c->min_satellites_for_fix, 5);
+  assert_int_equal(c->fixes, NAV_GNSS_FIXES_PVT);
   assert_near(c->mask.profile_el_rad[1], 20.25 * DEG, 1e-15);
   nav_gnss_constellation all;
   assert_int_equal(nav_gnss_constellation_build(c, &all), NAV_OK);
@@ -613,6 +614,20 @@ static void scene_section_round_trip(void **state) {
              log.d[0].path, log.d[0].message);
   }
   assert_config_same(&a->gnss.constellation, &b->gnss.constellation);
+  assert_int_equal(b->gnss.constellation.fixes, NAV_GNSS_FIXES_PVT);
+  /* fixes: model, the default, is not written (scenes written before the key stay the same) */
+  a->gnss.constellation.fixes = NAV_GNSS_FIXES_MODEL;
+  assert_int_equal(nav_scene_write_file(out, a), NAV_OK);
+  {
+    FILE *fw = fopen(out, "r");
+    assert_non_null(fw);
+    static char w[1 << 16];
+    const size_t nw = fread(w, 1, sizeof w - 1, fw);
+    w[nw] = '\0';
+    fclose(fw);
+    assert_non_null(strstr(w, "constellation"));
+    assert_null(strstr(w, "fixes:"));
+  }
   /* a scene without the section: disabled, nothing written */
   assert_int_equal(read_scene_with("", a, &log), NAV_OK);
   assert_false(a->gnss.constellation.enabled);
