@@ -27,6 +27,9 @@ static const nav_io_enum_value k_gps_sources[] = {
 static const nav_io_enum_value k_glo_sources[] = {
     {"off", NAV_GNSS_SOURCE_OFF}, {"nominal", NAV_GNSS_SOURCE_NOMINAL}, {NULL, 0}};
 
+static const nav_io_enum_value k_fix_sources[] = {
+    {"model", NAV_GNSS_FIXES_MODEL}, {"pvt", NAV_GNSS_FIXES_PVT}, {NULL, 0}};
+
 static bool same_bits(double a, double b) {
   return memcmp(&a, &b, sizeof a) == 0;
 }
@@ -304,6 +307,12 @@ static bool almanac_given(const nav_io_writer *w, const nav_io_field *f, const v
   return ((const nav_scene *)base)->gnss.constellation.almanac_file[0] != '\0';
 }
 
+/* fixes: written only when not the default, so scenes written before the key existed stay the same. */
+static bool fixes_given(const nav_io_writer *w, const nav_io_field *f, const void *base, const void *def) {
+  (void)w, (void)f, (void)def;
+  return ((const nav_scene *)base)->gnss.constellation.fixes != NAV_GNSS_FIXES_MODEL;
+}
+
 static void finish_constellation(nav_io_reader *r, const nav_io_node *map, void *base);
 
 static const nav_io_field k_constellation[] = {
@@ -360,6 +369,13 @@ static const nav_io_field k_constellation[] = {
      .min = 0.0,
      .max = NAV_GNSS_MAX_SATS,
      .comment = "receiver (gnss.enabled): no fix below this many visible satellites; 0: off"},
+    {.key = "fixes",
+     .doc = "ins_gnss fixes: model (receiver model noise) or pvt (least-squares PVT of the simulated "
+            "pseudoranges and range rates, sigma DOP x code_sd_m, no fix below 3 + systems satellites)",
+     .kind = NAV_IO_ENUM,
+     .offset = OFF(C(fixes)),
+     .enums = k_fix_sources,
+     .write_if = fixes_given},
     {.key = "code_sd_m",
      .doc = "ins_gnss_tight: white pseudorange noise (1 sigma)",
      .kind = NAV_IO_DOUBLE,

@@ -1,8 +1,9 @@
 /*
  * The tightly coupled INS/GNSS through the urban canyon (issue 22 "done when"):
  * scenes/urban-canyon-tight.yaml (3 GPS satellites in view for the 60 s canyon, t = 40..100 s)
- * with its 100 Monte Carlo runs, and scenes/urban-canyon.yaml (the loosely coupled filter, no fix
- * below four satellites) with 100 runs.
+ * with its 100 Monte Carlo runs, and scenes/urban-canyon.yaml (the loosely coupled filter on fixes
+ * from the least-squares PVT of the simulated pseudoranges, no fix below four satellites) with 100
+ * runs.
  * - navsim run of the tight scene is bit-identical with 1 and 2 threads (mc_stats, mc_final);
  * - its 9-state NEES (mc_stats.csv) is inside the 95 % band of chi2(9 x 100) / 100 on >= 90 % of
  *   the epochs;

@@ -578,7 +578,7 @@ static void scene_section_round_trip(void **state) {
   snprintf(yaml, sizeof yaml,
            "gnss:\n  constellation:\n    epoch: \"2007-12-01T06:30:15.5\"\n    gps: almanac\n"
            "    almanac: %s/gnss/yuma431_prn01-08.alm\n    glonass: nominal\n    glonass_node_lon_deg: 12.5\n"
-           "    elevation_mask_deg: 7.5\n    min_satellites_for_fix: 5\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
+           "    elevation_mask_deg: 7.5\n    min_satellites_for_fix: 5\n    fixes: pvt\n    sky_mask_deg: [[0, 5], [90, 20.25], [270, 3]]\n"
            "    canyons:\n      - {t0_s: 1, t1_s: 2, height_m: 20, left_m: 5, right_m: 6}\n"
            "      - {t0_s: 3, t1_s: 4.5, height_m: 10, left_m: 3, right_m: 4}\n",
            NAV_TEST_DATA_DIR);
@@ -595,6 +595,7 @@ static void scene_section_round_trip(void **state) {
   assert_int_equal(c->almanac.n, 8);
   assert_int_equal(c->n_canyons, 2);
   assert_int_equal(c->min_satellites_for_fix, 5);
+  assert_int_equal(c->fixes, NAV_GNSS_FIXES_PVT);
   assert_near(c->mask.profile_el_rad[1], 20.25 * DEG, 1e-15);
   nav_gnss_constellation all;
   assert_int_equal(nav_gnss_constellation_build(c, &all), NAV_OK);
@@ -613,6 +614,20 @@ static void scene_section_round_trip(void **state) {
              log.d[0].path, log.d[0].message);
   }
   assert_config_same(&a->gnss.constellation, &b->gnss.constellation);
+  assert_int_equal(b->gnss.constellation.fixes, NAV_GNSS_FIXES_PVT);
+  /* fixes: model, the default, is not written (scenes written before the key stay the same) */
+  a->gnss.constellation.fixes = NAV_GNSS_FIXES_MODEL;
+  assert_int_equal(nav_scene_write_file(out, a), NAV_OK);
+  {
+    FILE *fw = fopen(out, "r");
+    assert_non_null(fw);
+    static char w[1 << 16];
+    const size_t nw = fread(w, 1, sizeof w - 1, fw);
+    w[nw] = '\0';
+    fclose(fw);
+    assert_non_null(strstr(w, "constellation"));
+    assert_null(strstr(w, "fixes:"));
+  }
   /* a scene without the section: disabled, nothing written */
   assert_int_equal(read_scene_with("", a, &log), NAV_OK);
   assert_false(a->gnss.constellation.enabled);
@@ -777,6 +792,96 @@ static void pvt_error_follows_dop(void **state) {
   assert_true(fabs(sp - 1.0) <= band);
 }
 
+/* e' (s^2 Q)^-1 e for a 3 x 3 symmetric Q, row-major (adjugate inverse). */
+static double mahalanobis3(const double e[3], const double *q, double s2) {
+  const double a = q[0], b = q[1], c = q[2], d = q[4], f = q[5], g = q[8];
+  const double i00 = d * g - f * f, i01 = c * f - b * g, i02 = b * f - c * d;
+  const double i11 = a * g - c * c, i12 = b * c - a * f, i22 = a * d - b * b;
+  const double det = a * i00 + b * i01 + c * i02;
+  const double m = e[0] * (i00 * e[0] + i01 * e[1] + i02 * e[2]) + e[1] * (i01 * e[0] + i11 * e[1] + i12 * e[2]) +
+                   e[2] * (i02 * e[0] + i12 * e[1] + i22 * e[2]);
+  return m / (det * s2);
+}
+
+/* The per-axis DOP and NED cofactor block of the position fix, and the range-rate velocity fix
+ * (nav_gnss_pvt_velocity), against their errors: a receiver in Berlin moving at (10, -5, 0.3) m/s
+ * NED, GPS + GLONASS nominal (two clocks, one drift), 3 m code and 0.1 m/s range-rate noise, a
+ * 250 m clock bias and a 40 m/s drift, every minute of a day (N = 1440). The range rates are the
+ * central difference of the exact range (light time, Sagnac) over +-0.5 s with the receiver moved
+ * along its velocity, as the simulation makes them. Each mean of e_i^2 / (sigma^2 Q_ii) has
+ * standard deviation sqrt(2 / N) = 0.037 and the mean of e' (sigma^2 Q)^-1 e / 3 sqrt(2 / 3N);
+ * bands 1 +- 4 standard deviations. */
+static void pvt_axes_and_velocity_follow_dop(void **state) {
+  (void)state;
+  nav_gnss_constellation c = {0};
+  const double t0 = nav_gnss_gps_time_s(2026, 11, 26, 0, 0, 0.0);
+  assert_int_equal(nav_gnss_add_gps_nominal(&c, t0), NAV_OK);
+  assert_int_equal(nav_gnss_add_glonass_nominal(&c, t0, 0.3), NAV_OK);
+  const nav_geodetic rx = {52.52 * DEG, 13.405 * DEG, 35.0};
+  const nav_vec3 r_rx = nav_earth_geodetic_to_ecef(rx);
+  const nav_mat3 C_n_e = nav_earth_dcm_n_e(rx.lat_rad, rx.lon_rad);
+  const nav_vec3 v_n = {10.0, -5.0, 0.3};
+  const nav_vec3 v_e = nav_mat3_mul_vec(C_n_e, v_n);
+  nav_rng rng;
+  nav_rng_init(&rng, 2023, 0, 2);
+  const double sp = 3.0, sr = 0.1, clk = 250.0, drift = 40.0, h = 0.5;
+  const int N = 1440;
+  double pax[3] = {0}, vax[3] = {0}, pm = 0.0, vm = 0.0, dmax = 0.0;
+  for (int k = 0; k < N; ++k) {
+    const double t = t0 + 60.0 * k;
+    nav_gnss_pseudorange pr[NAV_GNSS_MAX_SATS];
+    nav_gnss_range_rate rr[NAV_GNSS_MAX_SATS];
+    int n = 0;
+    for (int i = 0; i < c.n; ++i) {
+      nav_vec3 rs;
+      const double rho = nav_gnss_geometric_range_m(&c.sats[i], t, r_rx, &rs);
+      double az, el;
+      nav_gnss_az_el(rx, rs, &az, &el);
+      if (el < 5.0 * DEG) {
+        continue;
+      }
+      const double rp = nav_gnss_geometric_range_m(&c.sats[i], t + h, nav_vec3_axpy(r_rx, h, v_e), NULL);
+      const double rm = nav_gnss_geometric_range_m(&c.sats[i], t - h, nav_vec3_axpy(r_rx, -h, v_e), NULL);
+      pr[n] = (nav_gnss_pseudorange){&c.sats[i], rho + clk + sp * nav_rng_gauss(&rng)};
+      rr[n] = (nav_gnss_range_rate){&c.sats[i], (rp - rm) / (2.0 * h) + drift + sr * nav_rng_gauss(&rng)};
+      ++n;
+    }
+    nav_gnss_pvt sol;
+    nav_gnss_pvt_vel vel;
+    assert_int_equal(nav_gnss_pvt_solve(n, pr, t + clk / NAV_GNSS_C_MPS, &sol), NAV_OK);
+    assert_int_equal(nav_gnss_pvt_velocity(n, rr, t + clk / NAV_GNSS_C_MPS, &sol, &vel), NAV_OK);
+    const nav_vec3 de = nav_mat3_tmul_vec(C_n_e, nav_vec3_sub(sol.r_e_m, r_rx));
+    const double ep[3] = {de.x, de.y, de.z};
+    const double ev[3] = {vel.v_n_mps.x - v_n.x, vel.v_n_mps.y - v_n.y, vel.v_n_mps.z - v_n.z};
+    for (int a = 0; a < 3; ++a) {
+      /* the per-axis DOP is the root of the cofactor diagonal; HDOP^2 = Q_NN + Q_EE */
+      assert_near(nav_vec3_get(sol.dop_ned, a), sqrt(sol.q_ned[a][a]), 1e-12);
+      pax[a] += ep[a] * ep[a] / (sp * sp * sol.q_ned[a][a]);
+      vax[a] += ev[a] * ev[a] / (sr * sr * vel.q_ned[a][a]);
+    }
+    assert_rel_near(sol.q_ned[0][0] + sol.q_ned[1][1], sol.dop.hdop * sol.dop.hdop, 1e-9);
+    pm += mahalanobis3(ep, &sol.q_ned[0][0], sp * sp) / 3.0;
+    vm += mahalanobis3(ev, &vel.q_ned[0][0], sr * sr) / 3.0;
+    dmax = fmax(dmax, fabs(vel.drift_mps - drift));
+  }
+  const double b1 = 4.0 * sqrt(2.0 / N), b3 = 4.0 * sqrt(2.0 / (3.0 * N));
+  for (int a = 0; a < 3; ++a) {
+    pax[a] /= N;
+    vax[a] /= N;
+  }
+  pm /= N;
+  vm /= N;
+  print_message("PVT over %d epochs: position e_i^2/(sigma^2 Q_ii) N %.3f E %.3f D %.3f, e'(s^2Q)^-1e/3 %.3f; "
+                "velocity N %.3f E %.3f D %.3f, %.3f (bands 1 +- %.3f, 1 +- %.3f); largest drift error %.3f m/s\n",
+                N, pax[0], pax[1], pax[2], pm, vax[0], vax[1], vax[2], vm, b1, b3, dmax);
+  for (int a = 0; a < 3; ++a) {
+    assert_true(fabs(pax[a] - 1.0) <= b1);
+    assert_true(fabs(vax[a] - 1.0) <= b1);
+  }
+  assert_true(fabs(pm - 1.0) <= b3);
+  assert_true(fabs(vm - 1.0) <= b3);
+}
+
 /* Our least-squares PVT against RTKLIB's single-point positioning (rnx2rtkp -p 0) on the same
  * RINEX 3 files: nominal GPS broadcast as ephemerides (e = 0: no relativistic clock term),
  * pseudoranges with 3 m noise and a 100 us receiver clock bias at a receiver in Berlin, 30 epochs a
@@ -900,6 +1005,7 @@ int main(void) {
       cmocka_unit_test(glonass_against_rtklib),
       cmocka_unit_test(pvt_noise_free),
       cmocka_unit_test(pvt_error_follows_dop),
+      cmocka_unit_test(pvt_axes_and_velocity_follow_dop),
       cmocka_unit_test(pvt_against_rtklib),
       cmocka_unit_test(scene_section_round_trip),
       cmocka_unit_test(scene_section_errors),

@@ -218,6 +218,12 @@ typedef struct nav_gnss_raw_config {
   double isb_sd_m;           /**< GLONASS - GPS inter-system bias, 1 sigma [m], > 0 (default 10) */
 } nav_gnss_raw_config;
 
+/** Where the loosely coupled scheme (ins_gnss) takes its fixes from when a constellation is set. */
+typedef enum nav_gnss_fix_source {
+  NAV_GNSS_FIXES_MODEL = 0, /**< the receiver model (white + Gauss-Markov position/velocity noise) */
+  NAV_GNSS_FIXES_PVT = 1    /**< least-squares PVT of the simulated pseudoranges and range rates */
+} nav_gnss_fix_source;
+
 /** The satellite constellation along a scene's trajectory (scene section gnss.constellation). */
 typedef struct nav_gnss_constellation_config {
   bool enabled;                 /**< the section is present */
@@ -233,8 +239,11 @@ typedef struct nav_gnss_constellation_config {
    *  fewer satellites are visible (outages added by the simulation); 0: fixes do not depend on
    *  the constellation. Default 4. */
   int min_satellites_for_fix;
-  /** Raw measurements of the tightly coupled scheme (ins_gnss_tight). */
+  /** Raw measurements of the tightly coupled scheme (ins_gnss_tight), and of the PVT fixes. */
   nav_gnss_raw_config raw;
+  /** ins_gnss: fixes from the receiver model (default) or the least-squares PVT of the raw
+   *  measurements (no fix below 3 + number of systems satellites). */
+  nav_gnss_fix_source fixes;
   /** ALMANAC: the YUMA file (navcore_io stores the resolved path) and its satellites (loaded by
    *  navcore_io when the scene is read). */
   char almanac_file[NAV_GNSS_ALMANAC_PATH_MAX];
@@ -293,6 +302,8 @@ typedef struct nav_gnss_pvt {
   int n_used;
   int iterations;
   nav_gnss_dop dop;           /**< DOP at the solution */
+  nav_vec3 dop_ned;           /**< per-axis DOP: sqrt of Q's north, east, down diagonal */
+  double q_ned[3][3];         /**< Q's north/east/down block (position covariance = code sigma^2 Q) */
   double residual_rms_m;      /**< RMS of the post-fit residuals [m] */
 } nav_gnss_pvt;
 
@@ -307,6 +318,40 @@ typedef struct nav_gnss_pvt {
  */
 NAV_API NAV_NODISCARD nav_status nav_gnss_pvt_solve(int n, const nav_gnss_pseudorange *pr, double t_rx_s,
                                                     nav_gnss_pvt *out);
+
+/**
+ * The north/east/down block of (G'G)^-1 for @p n lines of sight (azimuth/elevation, NED rows of
+ * nav_gnss_dop_compute()), with one clock column per system present (@p one_clock false: the
+ * position fix) or a single clock column (true: the velocity fix, whose unknown is the common
+ * drift). The fix's covariance is sigma^2 times it. Leaf.
+ * @return false (q_ned untouched) for a singular geometry or too few lines of sight.
+ */
+NAV_API bool nav_gnss_cofactor_ned(int n, const double *az_rad, const double *el_rad, const nav_gnss_system *sys,
+                                   bool one_clock, double q_ned[3][3]);
+
+/** One range rate: the satellite and the measured rate rr = rho_dot + c dt_r' + e [m/s]. */
+typedef struct nav_gnss_range_rate {
+  const nav_gnss_orbit *sat;
+  double rr_mps;
+} nav_gnss_range_rate;
+
+/** A least-squares velocity fix. */
+typedef struct nav_gnss_pvt_vel {
+  nav_vec3 v_n_mps;   /**< receiver velocity, NED at the position fix [m/s] */
+  double drift_mps;   /**< receiver clock drift c dt_r' [m/s] (one for all systems) */
+  nav_vec3 dop_ned;   /**< per-axis DOP of the velocity solution (sqrt of (H'H)^-1 diagonal) */
+  double q_ned[3][3]; /**< (H'H)^-1, velocity block (covariance = range-rate sigma^2 Q) */
+} nav_gnss_pvt_vel;
+
+/**
+ * Velocity from range rates at the position @p pos (from nav_gnss_pvt_solve() at the same
+ * @p t_rx_s), linear least squares: rr_i = u_i' (v_s,i - v) / (1 + u_i' v_s,i / c) + d, unknowns v
+ * (NED) and one clock drift d (the inter-system bias is constant, so both systems share the drift).
+ * Satellite velocities at the transmit time, rotated like the positions (Sagnac). Needs 4 rates.
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, n < 4, non-finite input); NAV_ERR_NUMERIC (singular).
+ */
+NAV_API NAV_NODISCARD nav_status nav_gnss_pvt_velocity(int n, const nav_gnss_range_rate *rr, double t_rx_s,
+                                                       const nav_gnss_pvt *pos, nav_gnss_pvt_vel *out);
 
 NAV_END_DECLS
 

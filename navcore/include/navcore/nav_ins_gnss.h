@@ -107,6 +107,19 @@ NAV_API NAV_NODISCARD nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_im
 NAV_API NAV_NODISCARD nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix);
 
 /**
+ * Apply one GNSS fix whose position (and velocity) errors are correlated between the axes, as a
+ * least-squares PVT's are: R is the given full covariance instead of fix->pos_sd_m /
+ * fix->vel_sd_mps (which are ignored). Otherwise as nav_ins_gnss_update().
+ * @param[in] pos_cov_ned_m2 3 x 3 position covariance, north/east/down, row-major [m^2]
+ * @param[in] vel_cov_ned_m2s2 3 x 3 velocity covariance [m^2/s^2]; used when fix->has_vel
+ * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL); NAV_ERR_NUMERIC (R or S not positive definite);
+ *         NAV_ERR_STATE (before the first step).
+ */
+NAV_API NAV_NODISCARD nav_status nav_ins_gnss_update_cov(nav_ins_gnss *x, const nav_ins_gnss_fix *fix,
+                                                         const double pos_cov_ned_m2[9],
+                                                         const double vel_cov_ned_m2s2[9]);
+
+/**
  * Tightly coupled update (docs/ins-gnss-tight.md): one scalar update per pseudorange and range
  * rate, in the order given (pseudorange before range rate of each satellite), each tested against
  * the gate first, then one closed-loop feedback of the INS errors. The filter must have the

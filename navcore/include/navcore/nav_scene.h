@@ -599,6 +599,10 @@ typedef struct nav_scene {
 /** @return a scene with every field at its default (T3.1 parametric trajectory, flat Earth). */
 NAV_API nav_scene nav_scene_default(void);
 
+/** Whether the loosely coupled scheme takes its fixes from the least-squares PVT of the simulated
+ *  raw measurements: scheme ins_gnss with gnss.enabled and gnss.constellation.fixes: pvt. Leaf. */
+NAV_API bool nav_scene_gnss_pvt_fixes(const nav_scene *scene);
+
 /**
  * Free the heap data a scene owns (the control points of a fitted recorded reference,
  * trajectory.recorded) and mark that model not fitted (count 0, pointers NULL). Every scene

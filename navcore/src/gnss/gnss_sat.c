@@ -391,6 +391,7 @@ nav_gnss_constellation_config nav_gnss_constellation_config_default(void) {
   c.glonass_node1_lon_rad = 0.0;
   c.mask.elevation_mask_rad = 10.0 * DEG;
   c.min_satellites_for_fix = 4;
+  c.fixes = NAV_GNSS_FIXES_MODEL;
   /* Low-quality TCXO of Brown and Hwang, 4th ed., Table 9.2 (h_0 = 2e-19 s, h_-2 = 2e-20 /s);
    * 3 m code and 0.1 m/s Doppler noise of a single-frequency consumer receiver. */
   c.raw.code_sd_m = 3.0;
@@ -453,6 +454,9 @@ nav_status nav_gnss_constellation_config_validate(const nav_gnss_constellation_c
   }
   if (cfg->min_satellites_for_fix < 0 || cfg->min_satellites_for_fix > NAV_GNSS_MAX_SATS) {
     report_issue(report, user, &n, "min_satellites_for_fix", "must be in [0, %d]", NAV_GNSS_MAX_SATS);
+  }
+  if (cfg->fixes != NAV_GNSS_FIXES_MODEL && cfg->fixes != NAV_GNSS_FIXES_PVT) {
+    report_issue(report, user, &n, "fixes", "must be pvt or model");
   }
   const struct {
     const char *key;

@@ -9,6 +9,7 @@
 #include "navcore/nav_earth.h"
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_sensors.h"
+#include "filter/filter_internal.h"
 #include "integration/ins_gnss_internal.h"
 
 static nav_filter_ins_state nominal_of(const nav_ins_gnss *x);
@@ -92,7 +93,8 @@ static nav_filter_config filter_config(const nav_scene *sc) {
   /* A time-correlated GNSS error gets its own GM states when tau >> update interval
    * (numerics.md 6.4 (a)); white R on correlated errors would make the filter overconfident. */
   const nav_gnss_model_config *gm = &sc->gnss.model;
-  if ((gm->terms & NAV_GNSS_TERM_POS_GM) && vmax(gm->pos_gm_sd_m) > 0.0 &&
+  /* PVT fixes (gnss.constellation.fixes: pvt) have white errors: no GM states. */
+  if (!nav_scene_gnss_pvt_fixes(sc) && (gm->terms & NAV_GNSS_TERM_POS_GM) && vmax(gm->pos_gm_sd_m) > 0.0 &&
       vmax(gm->pos_gm_tau_s) * gm->update_rate_hz > 10.0) {
     c.states |= NAV_FILTER_STATE_GNSS_POS_GM;
     c.gnss_pos_gm_sd_m = gm->pos_gm_sd_m;
@@ -282,6 +284,37 @@ nav_status nav_ins_gnss_update(nav_ins_gnss *x, const nav_ins_gnss_fix *fix) {
   if (st == NAV_OK && fix->has_vel) {
     const nav_vec3 z_vel = nav_filter_gnss_vel_residual(&n, l, fix->v_n_mps);
     st = nav_filter_update_gnss_vel(x->kf, &n, z_vel, &r_vel, l);
+  }
+  if (st != NAV_OK) {
+    snprintf(x->err, sizeof x->err, "GNSS update failed at t = %.6f s: %s", fix->t_s, nav_filter_last_error(x->kf));
+    return st;
+  }
+  return nav_ins_gnss_feedback(x, &v, fix->t_s);
+}
+
+nav_status nav_ins_gnss_update_cov(nav_ins_gnss *x, const nav_ins_gnss_fix *fix, const double pos_cov_ned_m2[9],
+                                   const double vel_cov_ned_m2s2[9]) {
+  if (!x || !fix || !pos_cov_ned_m2 || (fix->has_vel && !vel_cov_ned_m2s2)) return NAV_ERR_INVALID_ARG;
+  if (!x->have_step) {
+    snprintf(x->err, sizeof x->err, "a GNSS fix before the first IMU step (t = %.6f s)", fix->t_s);
+    return NAV_ERR_STATE;
+  }
+  nav_local_view v;
+  const nav_filter_nav n = nav_ins_gnss_epoch_nav(x, &v);
+  const nav_vec3 l = x->cfg.r_ba_b_m;
+  const nav_filter_layout lay = nav_filter_get_layout(x->kf);
+  double H[3 * NAV_FILTER_MAX_STATES];
+  /* The same measurement and Jacobian as nav_filter_update_gnss_pos/_vel (E6.3, E6.4); only R
+   * is full. */
+  const nav_vec3 zp = nav_filter_gnss_pos_residual(v.pos, n.C_b_n, l, fix->pos);
+  const double z_pos[3] = {zp.x, zp.y, zp.z};
+  nav_filter_build_H_pos(H, &lay, &n, l);
+  nav_status st = nav_filter_update_linear(x->kf, 3, H, z_pos, pos_cov_ned_m2);
+  if (st == NAV_OK && fix->has_vel) {
+    const nav_vec3 zv = nav_filter_gnss_vel_residual(&n, l, fix->v_n_mps);
+    const double z_vel[3] = {zv.x, zv.y, zv.z};
+    nav_filter_build_H_vel(H, &lay, &n, l);
+    st = nav_filter_update_linear(x->kf, 3, H, z_vel, vel_cov_ned_m2s2);
   }
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "GNSS update failed at t = %.6f s: %s", fix->t_s, nav_filter_last_error(x->kf));

@@ -8,6 +8,11 @@
 #include "navcore/nav_sensors.h"
 #include "navcore/nav_track.h"
 
+bool nav_scene_gnss_pvt_fixes(const nav_scene *sc) {
+  return sc && sc->navigation.scheme == NAV_SCHEME_INS_GNSS && sc->gnss.enabled && sc->gnss.constellation.enabled &&
+         sc->gnss.constellation.fixes == NAV_GNSS_FIXES_PVT;
+}
+
 nav_scene nav_scene_default(void) {
   nav_scene s;
   memset(&s, 0, sizeof s);

@@ -12,6 +12,7 @@
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
+#include "filter/filter_internal.h"
 #include "integration/ins_gnss_internal.h"
 #include "sim/sim_internal.h"
 
@@ -93,6 +94,52 @@ static nav_status tight_update(nav_filter *kf, const nav_scene *sc, const nav_gn
   return st;
 }
 
+/* ins_gnss with gnss.constellation.fixes: pvt: the PVT fix of the satellites visible from the
+ * reference with R = sigma^2 Q (the NED block of the least-squares cofactor, position with a clock
+ * per system, velocity with one drift), as the simulation's fixes (sim.c pvt_fix); no fix where
+ * the geometry has no solution (fewer than 3 + systems satellites). */
+static nav_status pvt_update(nav_filter *kf, const nav_scene *sc, const nav_gnss_constellation *sats,
+                             const nav_traj_state *ts, const nav_filter_nav *nv, nav_geodetic pos) {
+  const nav_gnss_constellation_config *cc = &sc->gnss.constellation;
+  const double t_gps = cc->epoch_gps_s + ts->t_s;
+  const double heading = atan2(nv->C_b_n.m[1][0], nv->C_b_n.m[0][0]);
+  const nav_gnss_sky_mask mask = nav_gnss_constellation_mask_at(cc, ts->t_s);
+  nav_gnss_sat_view views[NAV_GNSS_MAX_SATS];
+  nav_gnss_dop dop;
+  nav_status st = nav_gnss_visibility(sats, &mask, t_gps, pos, heading, views, &dop);
+  if (st != NAV_OK) return st;
+  double az[NAV_GNSS_MAX_SATS], el[NAV_GNSS_MAX_SATS];
+  nav_gnss_system sy[NAV_GNSS_MAX_SATS];
+  int m = 0;
+  for (int i = 0; i < sats->n; ++i) {
+    if (!views[i].visible) continue;
+    az[m] = views[i].az_rad;
+    el[m] = views[i].el_rad;
+    sy[m] = views[i].system;
+    ++m;
+  }
+  double qp[3][3], qv[3][3];
+  if (!nav_gnss_cofactor_ned(m, az, el, sy, false, qp)) return NAV_OK;
+  const bool vel = nav_gnss_cofactor_ned(m, az, el, sy, true, qv);
+  const double sp2 = cc->raw.code_sd_m * cc->raw.code_sd_m, sv2 = cc->raw.range_rate_sd_mps * cc->raw.range_rate_sd_mps;
+  double Rp[9], Rv[9];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      Rp[r * 3 + c] = sp2 * qp[r][c];
+      Rv[r * 3 + c] = vel ? sv2 * qv[r][c] : 0.0;
+    }
+  const nav_filter_layout lay = nav_filter_get_layout(kf);
+  double H[3 * NAV_FILTER_MAX_STATES];
+  const double z[3] = {0.0, 0.0, 0.0};
+  nav_filter_build_H_pos(H, &lay, nv, sc->gnss.model.r_ba_b_m);
+  st = nav_filter_update_linear(kf, 3, H, z, Rp);
+  if (st == NAV_OK && vel) {
+    nav_filter_build_H_vel(H, &lay, nv, sc->gnss.model.r_ba_b_m);
+    st = nav_filter_update_linear(kf, 3, H, z, Rv);
+  }
+  return st;
+}
+
 nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   if (!sim || !fn) return NAV_ERR_INVALID_ARG;
   const nav_scene *sc = nav_sim_scene(sim);
@@ -144,7 +191,8 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   /* ins_gnss_tight: the satellites the reference trajectory sees (as the simulation's receiver). */
   nav_gnss_constellation sats;
   sats.n = 0;
-  if (tight) {
+  const bool pvt = nav_scene_gnss_pvt_fixes(sc);
+  if (tight || pvt) {
     st = nav_gnss_constellation_build(&sc->gnss.constellation, &sats);
     if (st != NAV_OK) {
       nav_sim_set_error(sim, "gnss.constellation: cannot build the constellation");
@@ -178,6 +226,14 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
       if (t_fix < imu.t_s - 0.5 * dt || in_outage(g, t_fix)) continue;
       if (tight) {
         st = tight_update(cf.kf, sc, &sats, &fr, &ts, &nv, v.pos);
+        if (st != NAV_OK) {
+          nav_sim_set_error(sim, cf_error(&cf));
+          goto cleanup;
+        }
+        continue;
+      }
+      if (pvt) {
+        st = pvt_update(cf.kf, sc, &sats, &ts, &nv, v.pos);
         if (st != NAV_OK) {
           nav_sim_set_error(sim, cf_error(&cf));
           goto cleanup;

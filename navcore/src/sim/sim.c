@@ -308,6 +308,7 @@ nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_
 typedef struct aiding {
   nav_gnss_model *gnss;
   nav_sim_gnss_raw *raw; /* ins_gnss_tight: pseudoranges and range rates instead of fixes */
+  bool pvt;              /* ins_gnss with gnss.constellation.fixes: pvt: raw feeds a PVT fix */
   nav_ins_gnss *x;
   nav_sim_gyrofree *gf; /* gyro_free_gnss: the fixes go to the array INS's filter (borrowed) */
   int64_t next_epoch;
@@ -345,6 +346,48 @@ static nav_status recorded_fixes(job *j, aiding *a, const nav_imu_increment *imu
 }
 
 /*
+ * The receiver's own fix from an epoch's raw measurements (gnss.constellation.fixes: pvt): the
+ * least-squares position (nav_gnss_pvt_solve) and velocity (nav_gnss_pvt_velocity) with their
+ * covariances sigma^2 Q (Q the NED block of (H'H)^-1, sigma the code or range-rate noise), the
+ * filter's R. *have is false when the solver has no solution: fewer than 3 + systems satellites,
+ * a singular geometry or no convergence; position only when the velocity has no solution.
+ */
+static nav_status pvt_fix(const nav_ins_gnss_raw_epoch *ep, nav_ins_gnss_fix *f, double pos_cov[9],
+                          double vel_cov[9], bool *have) {
+  *have = false;
+  nav_gnss_pseudorange pr[NAV_GNSS_MAX_SATS];
+  nav_gnss_range_rate rr[NAV_GNSS_MAX_SATS];
+  int n = 0;
+  for (int i = 0; i < ep->n; ++i) {
+    if (!ep->sats[i].has_pr || !ep->sats[i].has_rr) continue;
+    pr[n] = (nav_gnss_pseudorange){ep->sats[i].sat, ep->sats[i].pr_m};
+    rr[n] = (nav_gnss_range_rate){ep->sats[i].sat, ep->sats[i].rr_mps};
+    ++n;
+  }
+  if (n < 4) return NAV_OK;
+  nav_gnss_pvt p;
+  nav_status st = nav_gnss_pvt_solve(n, pr, ep->t_gps_s, &p);
+  if (st == NAV_ERR_INVALID_ARG || st == NAV_ERR_NUMERIC || st == NAV_ERR_NOT_CONVERGED) return NAV_OK;
+  if (st != NAV_OK) return st;
+  if (!(isfinite(p.dop_ned.x) && isfinite(p.dop_ned.y) && isfinite(p.dop_ned.z))) return NAV_OK;
+  f->t_s = ep->t_s;
+  f->pos = nav_earth_ecef_to_geodetic(p.r_e_m);
+  f->pos_sd_m = nav_vec3_scale(p.dop_ned, ep->pr_sd_m);
+  nav_gnss_pvt_vel v;
+  f->has_vel = nav_gnss_pvt_velocity(n, rr, ep->t_gps_s, &p, &v) == NAV_OK;
+  f->v_n_mps = f->has_vel ? v.v_n_mps : (nav_vec3){0.0, 0.0, 0.0};
+  f->vel_sd_mps = f->has_vel ? nav_vec3_scale(v.dop_ned, ep->rr_sd_mps) : (nav_vec3){0.0, 0.0, 0.0};
+  const double sp2 = ep->pr_sd_m * ep->pr_sd_m, sv2 = ep->rr_sd_mps * ep->rr_sd_mps;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      pos_cov[r * 3 + c] = sp2 * p.q_ned[r][c];
+      vel_cov[r * 3 + c] = f->has_vel ? sv2 * v.q_ned[r][c] : 0.0;
+    }
+  *have = true;
+  return NAV_OK;
+}
+
+/*
  * GNSS epochs whose time of validity falls within half an IMU interval of t_k are processed at
  * t_k (numerics.md 6.5: the residual offset is below dt/2; with rates that divide the IMU rate
  * it is zero). Each fix is made by the receiver model from the truth at its own time of validity.
@@ -374,6 +417,22 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
       return st;
     }
     if (!has_fix) continue;
+    if (a->raw && a->pvt) {
+      /* Loosely coupled on the least-squares PVT of the same raw measurements. */
+      nav_ins_gnss_raw_epoch ep;
+      const nav_frame fr = nav_truth_frame(truth);
+      st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
+      nav_ins_gnss_fix f;
+      double pos_cov[9], vel_cov[9];
+      bool have = false;
+      if (st == NAV_OK) st = pvt_fix(&ep, &f, pos_cov, vel_cov, &have);
+      if (st == NAV_OK && have) st = nav_ins_gnss_update_cov(a->x, &f, pos_cov, vel_cov);
+      if (st != NAV_OK) {
+        job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(a->x));
+        return st;
+      }
+      continue;
+    }
     if (a->raw) {
       /* Tightly coupled: the receiver's epochs and outages, the satellites' raw measurements. */
       nav_ins_gnss_raw_epoch ep;
@@ -587,7 +646,8 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       xc.smoother = sm;
     }
     st = nav_ins_gnss_create(&xc, &s0, &aid_kf.x);
-    if (st == NAV_OK && tight) st = nav_sim_gnss_raw_create(sc, (uint64_t)run, j->ideal, &aid_kf.raw);
+    aid_kf.pvt = !tight && nav_scene_gnss_pvt_fixes(sc);
+    if (st == NAV_OK && (tight || aid_kf.pvt)) st = nav_sim_gnss_raw_create(sc, (uint64_t)run, j->ideal, &aid_kf.raw);
     if (st != NAV_OK) {
       job_error(j, "run %ld: INS/GNSS set-up: %s", run, nav_status_str(st));
       goto cleanup;
