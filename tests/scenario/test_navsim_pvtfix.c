@@ -124,6 +124,17 @@ static void loose_on_pvt_fixes(void **state) {
   char js[16384];
   nav_test_slurp(WORK "/t2/summary.json", js, sizeof js);
   nav_test_assert_matches(js, "\"runs\": 100");
+  /* No gnss.csv: its writer evaluates the receiver model, whose fixes the filter never saw. */
+  {
+    FILE *g = fopen(WORK "/t2/gnss.csv", "r");
+    if (g != NULL) {
+      fclose(g);
+      fail_msg("a fixes: pvt run wrote gnss.csv (the receiver model's fixes, not the PVT's)");
+    }
+    g = fopen(WORK "/t2/gnss_outages.csv", "r");
+    assert_non_null(g);
+    fclose(g);
+  }
   table mc, dop;
   read_table(WORK "/t2/mc_stats.csv", &mc);
   read_table(WORK "/t2/gnss_dop.csv", &dop);
