@@ -132,32 +132,47 @@ static void count_fixes(const char *path, double t0, double t1, int *inside, int
   free(g);
 }
 
+/* urban-canyon.yaml with its fixes from the receiver model (the scene takes them from the PVT,
+ * whose fixes gnss.csv does not list), and @p extra inserted before its elevation mask. */
+static void write_model_scene(const char *name, const char *extra) {
+  static const char pvt[] = "    fixes: pvt\n", model[] = "    fixes: model\n";
+  static const char mask[] = "    elevation_mask_deg: 10\n";
+  char *scene = nav_test_slurp_alloc(NAV_SOURCE_DIR "/scenes/urban-canyon.yaml");
+  assert_non_null(scene);
+  const size_t cap = strlen(scene) + strlen(extra) + 32;
+  char *a = malloc(cap), *b = malloc(cap);
+  assert_non_null(a);
+  assert_non_null(b);
+  /* a: the scene with "fixes: model" */
+  const char *f = strstr(scene, pvt);
+  assert_non_null(f);
+  snprintf(a, cap, "%.*s%s%s", (int)(f - scene), scene, model, f + strlen(pvt));
+  /* b: a with @p extra before the elevation mask */
+  const char *m = strstr(a, mask);
+  assert_non_null(m);
+  snprintf(b, cap, "%.*s%s%s", (int)(m - a), a, extra, m);
+  nav_test_write_file(WORK, name, b);
+  free(a);
+  free(b);
+  free(scene);
+}
+
 static void receiver_follows_visibility(void **state) {
   (void)state;
-  /* canyon_visibility_and_dop ran first: WORK/uc */
-  char *o = nav_test_slurp_alloc(WORK "/uc/gnss_outages.csv");
+  write_model_scene("model.yaml", "");
+  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run model.yaml --runs 1 --out ucm --quiet");
+  if (r->code != 0) fail_msg("navsim run failed (%d):\n%s", r->code, r->err);
+  char *o = nav_test_slurp_alloc(WORK "/ucm/gnss_outages.csv");
   assert_non_null(o);
   assert_string_equal(o, "t0_s,t1_s\n40,100\n");
   free(o);
   int inside = 0, total = 0;
-  count_fixes(WORK "/uc/gnss.csv", 40.0, 100.0, &inside, &total);
+  count_fixes(WORK "/ucm/gnss.csv", 40.0, 100.0, &inside, &total);
   assert_int_equal(inside, 0);
   const int with_canyon = total;
   /* min_satellites_for_fix: 0: the receiver ignores the constellation */
-  char *scene = nav_test_slurp_alloc(NAV_SOURCE_DIR "/scenes/urban-canyon.yaml");
-  assert_non_null(scene);
-  char *p = strstr(scene, "    elevation_mask_deg: 10\n");
-  assert_non_null(p);
-  const size_t at = (size_t)(p - scene);
-  char *text = malloc(strlen(scene) + 64);
-  assert_non_null(text);
-  memcpy(text, scene, at);
-  strcpy(text + at, "    min_satellites_for_fix: 0\n");
-  strcat(text, scene + at);
-  nav_test_write_file(WORK, "nomin.yaml", text);
-  free(text);
-  free(scene);
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run nomin.yaml --runs 1 --out nomin --quiet");
+  write_model_scene("nomin.yaml", "    min_satellites_for_fix: 0\n");
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run nomin.yaml --runs 1 --out nomin --quiet");
   if (r->code != 0) fail_msg("navsim run failed (%d):\n%s", r->code, r->err);
   o = nav_test_slurp_alloc(WORK "/nomin/gnss_outages.csv");
   assert_non_null(o);
