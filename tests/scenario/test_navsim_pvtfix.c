@@ -28,75 +28,10 @@
 
 #include "nav_test.h"
 #include "navsim_cli.h"
+#include "nav_test_table.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define LOOSE NAV_SOURCE_DIR "/scenes/urban-canyon.yaml"
-
-static double chi2_over_k(double k, double z) {
-  const double a = 2.0 / (9.0 * k);
-  const double c = 1.0 - a + z * sqrt(a);
-  return c * c * c;
-}
-
-/* A CSV table: the header's column names and the numeric rows (empty cells read as 0). */
-typedef struct table {
-  int ncol, nrow;
-  char names[64][48];
-  double *v; /* [nrow][ncol] */
-} table;
-
-static void read_table(const char *path, table *t) {
-  char *text = nav_test_slurp_alloc(path);
-  if (!text) fail_msg("cannot read %s", path);
-  memset(t, 0, sizeof *t);
-  char *line = strtok(text, "\n");
-  assert_non_null(line);
-  for (char *p = line; t->ncol < 64;) {
-    char *c = strchr(p, ',');
-    const size_t len = c ? (size_t)(c - p) : strlen(p);
-    snprintf(t->names[t->ncol], sizeof t->names[0], "%.*s", (int)(len < 47 ? len : 47), p);
-    t->ncol++;
-    if (!c) break;
-    p = c + 1;
-  }
-  size_t cap = 1024;
-  t->v = malloc(cap * (size_t)t->ncol * sizeof *t->v);
-  assert_non_null(t->v);
-  for (line = strtok(NULL, "\n"); line; line = strtok(NULL, "\n")) {
-    if ((size_t)t->nrow == cap) {
-      cap *= 2;
-      t->v = realloc(t->v, cap * (size_t)t->ncol * sizeof *t->v);
-      assert_non_null(t->v);
-    }
-    char *p = line;
-    for (int c = 0; c < t->ncol; ++c) {
-      char *end = NULL;
-      t->v[(size_t)t->nrow * (size_t)t->ncol + (size_t)c] = strtod(p, &end);
-      p = end && *end == ',' ? end + 1 : end;
-    }
-    t->nrow++;
-  }
-  free(text);
-}
-
-static int col(const table *t, const char *name) {
-  for (int c = 0; c < t->ncol; ++c)
-    if (!strcmp(t->names[c], name)) return c;
-  fail_msg("no column %s", name);
-  return -1;
-}
-
-static double at(const table *t, int row, int c) {
-  return t->v[(size_t)row * (size_t)t->ncol + (size_t)c];
-}
-
-/* Row whose t_s is @p t (to 1e-6 s), or -1. */
-static int row_at(const table *t, double time_s) {
-  const int c = col(t, "t_s");
-  for (int r = 0; r < t->nrow; ++r)
-    if (fabs(at(t, r, c) - time_s) < 1e-6) return r;
-  return -1;
-}
 
 static int setup(void **state) {
   (void)state;
@@ -135,17 +70,17 @@ static void loose_on_pvt_fixes(void **state) {
     assert_non_null(g);
     fclose(g);
   }
-  table mc, dop;
-  read_table(WORK "/t2/mc_stats.csv", &mc);
-  read_table(WORK "/t2/gnss_dop.csv", &dop);
+  nav_table mc, dop;
+  nav_table_read(WORK "/t2/mc_stats.csv", &mc);
+  nav_table_read(WORK "/t2/gnss_dop.csv", &dop);
   const double M = 100.0;
   /* NEES */
-  const int cn = col(&mc, "nees9_mean");
-  const double lo9 = 9.0 * chi2_over_k(9.0 * M, -1.96), hi9 = 9.0 * chi2_over_k(9.0 * M, 1.96);
+  const int cn = nav_table_col(&mc, "nees9_mean");
+  const double lo9 = 9.0 * nav_chi2_over_k(9.0 * M, -1.96), hi9 = 9.0 * nav_chi2_over_k(9.0 * M, 1.96);
   int in9 = 0;
   double mean9 = 0.0;
   for (int i = 0; i < mc.nrow; ++i) {
-    const double v = at(&mc, i, cn);
+    const double v = nav_table_at(&mc, i, cn);
     in9 += v > lo9 && v < hi9;
     mean9 += v;
   }
@@ -153,23 +88,23 @@ static void loose_on_pvt_fixes(void **state) {
                 mean9 / mc.nrow, in9, mc.nrow, 100.0 * in9 / mc.nrow, lo9, hi9);
   assert_true((double)in9 >= 0.9 * (double)mc.nrow);
   /* RMS over the runs against the filter's mean reported sigma. */
-  const double lo = sqrt(chi2_over_k(M, -2.5758)), hi = sqrt(chi2_over_k(M, 2.5758));
+  const double lo = sqrt(nav_chi2_over_k(M, -2.5758)), hi = sqrt(nav_chi2_over_k(M, 2.5758));
   const double times[10] = {10.0, 30.0, 45.0, 60.0, 80.0, 99.9, 110.0, 130.0, 150.0, 170.0};
   const char *rms[3] = {"pos_rms_n_m", "pos_rms_e_m", "pos_rms_d_m"};
   const char *sd[3] = {"pos_sd_reported_n_m", "pos_sd_reported_e_m", "pos_sd_reported_d_m"};
   const char *cov_sd[3] = {"cov_pos_n_sd_m", "cov_pos_e_sd_m", "cov_pos_d_sd_m"};
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "estimate '%s' --out est", LOOSE);
   if (r->code != 0) fail_msg("estimate: %d\n%s", r->code, r->err);
-  table est;
-  read_table(WORK "/est/estimate.csv", &est);
+  nav_table est;
+  nav_table_read(WORK "/est/estimate.csv", &est);
   int inside = 0, inside_cov = 0;
   for (int i = 0; i < 10; ++i) {
-    const int rm = row_at(&mc, times[i]), re = row_at(&est, times[i]);
+    const int rm = nav_table_row_at(&mc, times[i]), re = nav_table_row_at(&est, times[i]);
     assert_true(rm >= 0 && re >= 0);
     double ratio[3], rc[3];
     for (int c = 0; c < 3; ++c) {
-      ratio[c] = at(&mc, rm, col(&mc, rms[c])) / at(&mc, rm, col(&mc, sd[c]));
-      rc[c] = at(&mc, rm, col(&mc, rms[c])) / at(&est, re, col(&est, cov_sd[c]));
+      ratio[c] = nav_table_at(&mc, rm, nav_table_col(&mc, rms[c])) / nav_table_at(&mc, rm, nav_table_col(&mc, sd[c]));
+      rc[c] = nav_table_at(&mc, rm, nav_table_col(&mc, rms[c])) / nav_table_at(&est, re, nav_table_col(&est, cov_sd[c]));
       inside += ratio[c] > lo && ratio[c] < hi;
       inside_cov += rc[c] > lo && rc[c] < hi;
     }
@@ -183,12 +118,12 @@ static void loose_on_pvt_fixes(void **state) {
   assert_true(inside_cov >= 28);
   free(est.v);
   /* Before the canyon the filtered horizontal error is below one fix's sigma HDOP (3 m code). */
-  const int rb = row_at(&mc, 39.9), db = row_at(&dop, 39.9), re = row_at(&mc, 99.9);
+  const int rb = nav_table_row_at(&mc, 39.9), db = nav_table_row_at(&dop, 39.9), re = nav_table_row_at(&mc, 99.9);
   assert_true(rb >= 0 && db >= 0 && re >= 0);
-  const double h_before = at(&mc, rb, col(&mc, "pos_h_rms_m")), hdop = at(&dop, db, col(&dop, "hdop"));
+  const double h_before = nav_table_at(&mc, rb, nav_table_col(&mc, "pos_h_rms_m")), hdop = nav_table_at(&dop, db, nav_table_col(&dop, "hdop"));
   print_message("t = 39.9 s: horizontal RMS %.2f m, one fix's sigma HDOP %.2f m; canyon end (99.9 s): %.2f m RMS "
                 "(max %.2f m)\n",
-                h_before, 3.0 * hdop, at(&mc, re, col(&mc, "pos_h_rms_m")), at(&mc, re, col(&mc, "pos_h_max_m")));
+                h_before, 3.0 * hdop, nav_table_at(&mc, re, nav_table_col(&mc, "pos_h_rms_m")), nav_table_at(&mc, re, nav_table_col(&mc, "pos_h_max_m")));
   assert_true(hdop > 0.0 && h_before < 3.0 * hdop);
   free(mc.v);
   free(dop.v);

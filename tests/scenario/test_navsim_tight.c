@@ -27,74 +27,11 @@
 
 #include "nav_test.h"
 #include "navsim_cli.h"
+#include "nav_test_table.h"
 
 #define WORK NAV_TEST_WORK_DIR
 #define TIGHT NAV_SOURCE_DIR "/scenes/urban-canyon-tight.yaml"
 #define LOOSE NAV_SOURCE_DIR "/scenes/urban-canyon.yaml"
-
-static double chi2_over_k(double k, double z) {
-  const double a = 2.0 / (9.0 * k);
-  const double c = 1.0 - a + z * sqrt(a);
-  return c * c * c;
-}
-
-/* A CSV table: the header's column names and the numeric rows. */
-typedef struct table {
-  int ncol, nrow;
-  char names[64][48];
-  double *v; /* [nrow][ncol] */
-} table;
-
-static void read_table(const char *path, table *t) {
-  char *text = nav_test_slurp_alloc(path);
-  if (!text) fail_msg("cannot read %s", path);
-  memset(t, 0, sizeof *t);
-  char *line = strtok(text, "\n");
-  assert_non_null(line);
-  for (char *p = line; t->ncol < 64;) {
-    char *c = strchr(p, ',');
-    const size_t len = c ? (size_t)(c - p) : strlen(p);
-    snprintf(t->names[t->ncol], sizeof t->names[0], "%.*s", (int)(len < 47 ? len : 47), p);
-    t->ncol++;
-    if (!c) break;
-    p = c + 1;
-  }
-  size_t cap = 1024;
-  t->v = malloc(cap * (size_t)t->ncol * sizeof *t->v);
-  for (line = strtok(NULL, "\n"); line; line = strtok(NULL, "\n")) {
-    if ((size_t)t->nrow == cap) {
-      cap *= 2;
-      t->v = realloc(t->v, cap * (size_t)t->ncol * sizeof *t->v);
-    }
-    char *p = line;
-    for (int c = 0; c < t->ncol; ++c) {
-      char *end = NULL;
-      t->v[(size_t)t->nrow * (size_t)t->ncol + (size_t)c] = strtod(p, &end);
-      p = end && *end == ',' ? end + 1 : end;
-    }
-    t->nrow++;
-  }
-  free(text);
-}
-
-static int col(const table *t, const char *name) {
-  for (int c = 0; c < t->ncol; ++c)
-    if (!strcmp(t->names[c], name)) return c;
-  fail_msg("no column %s", name);
-  return -1;
-}
-
-static double at(const table *t, int row, int c) {
-  return t->v[(size_t)row * (size_t)t->ncol + (size_t)c];
-}
-
-/* Row whose t_s is @p t (to 1e-6 s), or -1. */
-static int row_at(const table *t, double time_s) {
-  const int c = col(t, "t_s");
-  for (int r = 0; r < t->nrow; ++r)
-    if (fabs(at(t, r, c) - time_s) < 1e-6) return r;
-  return -1;
-}
 
 static int setup(void **state) {
   (void)state;
@@ -102,18 +39,18 @@ static int setup(void **state) {
 }
 
 /* Ratios RMS / sigma of N, E, D at the ten epochs, counted inside the 99 % band of chi2(M). */
-static int ratios_inside(const table *mc, const table *ref, const char *const sd[3], const char *what,
+static int ratios_inside(const nav_table *mc, const nav_table *ref, const char *const sd[3], const char *what,
                          double M) {
-  const double lo = sqrt(chi2_over_k(M, -2.5758)), hi = sqrt(chi2_over_k(M, 2.5758));
+  const double lo = sqrt(nav_chi2_over_k(M, -2.5758)), hi = sqrt(nav_chi2_over_k(M, 2.5758));
   const double times[10] = {10.0, 30.0, 45.0, 60.0, 80.0, 99.9, 110.0, 130.0, 150.0, 170.0};
   const char *rms[3] = {"pos_rms_n_m", "pos_rms_e_m", "pos_rms_d_m"};
   int inside = 0;
   for (int i = 0; i < 10; ++i) {
-    const int rm = row_at(mc, times[i]), re = row_at(ref, times[i]);
+    const int rm = nav_table_row_at(mc, times[i]), re = nav_table_row_at(ref, times[i]);
     assert_true(rm >= 0 && re >= 0);
     double ratio[3];
     for (int c = 0; c < 3; ++c) {
-      ratio[c] = at(mc, rm, col(mc, rms[c])) / at(ref, re, col(ref, sd[c]));
+      ratio[c] = nav_table_at(mc, rm, nav_table_col(mc, rms[c])) / nav_table_at(ref, re, nav_table_col(ref, sd[c]));
       inside += ratio[c] > lo && ratio[c] < hi;
     }
     print_message("t = %6.1f s: RMS / %s N %.3f E %.3f D %.3f\n", times[i], what, ratio[0], ratio[1],
@@ -143,20 +80,20 @@ static void test_tight_canyon(void **state) {
     free(a);
     free(b);
   }
-  table est, mc;
-  read_table(WORK "/est/estimate.csv", &est);
-  read_table(WORK "/t2/mc_stats.csv", &mc);
+  nav_table est, mc;
+  nav_table_read(WORK "/est/estimate.csv", &est);
+  nav_table_read(WORK "/t2/mc_stats.csv", &mc);
   const double M = 100.0;
   char js[16384];
   nav_test_slurp(WORK "/t2/summary.json", js, sizeof js);
   nav_test_assert_matches(js, "\"runs\": 100");
   /* NEES */
-  const int cn = col(&mc, "nees9_mean");
-  const double lo9 = 9.0 * chi2_over_k(9.0 * M, -1.96), hi9 = 9.0 * chi2_over_k(9.0 * M, 1.96);
+  const int cn = nav_table_col(&mc, "nees9_mean");
+  const double lo9 = 9.0 * nav_chi2_over_k(9.0 * M, -1.96), hi9 = 9.0 * nav_chi2_over_k(9.0 * M, 1.96);
   int in9 = 0;
   double mean9 = 0.0;
   for (int i = 0; i < mc.nrow; ++i) {
-    const double v = at(&mc, i, cn);
+    const double v = nav_table_at(&mc, i, cn);
     in9 += v > lo9 && v < hi9;
     mean9 += v;
   }
@@ -171,16 +108,16 @@ static void test_tight_canyon(void **state) {
   /* Tight against loose at the canyon's end. */
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "run '%s' --runs 100 --threads 2 --quiet --out loose", LOOSE);
   if (r->code != 0) fail_msg("run loose: %d\n%s", r->code, r->err);
-  table lo;
-  read_table(WORK "/loose/mc_stats.csv", &lo);
-  const int rt = row_at(&mc, 99.9), rl = row_at(&lo, 99.9), rb = row_at(&lo, 39.9);
+  nav_table lo;
+  nav_table_read(WORK "/loose/mc_stats.csv", &lo);
+  const int rt = nav_table_row_at(&mc, 99.9), rl = nav_table_row_at(&lo, 99.9), rb = nav_table_row_at(&lo, 39.9);
   assert_true(rt >= 0 && rl >= 0 && rb >= 0);
-  const double h_t = at(&mc, rt, col(&mc, "pos_h_rms_m")), h_l = at(&lo, rl, col(&lo, "pos_h_rms_m"));
+  const double h_t = nav_table_at(&mc, rt, nav_table_col(&mc, "pos_h_rms_m")), h_l = nav_table_at(&lo, rl, nav_table_col(&lo, "pos_h_rms_m"));
   print_message(
       "canyon end (t = 99.9 s), horizontal RMS over 100 runs: tight %.2f m (max %.2f m), loose %.2f m "
       "(max %.2f m); before the canyon (39.9 s): tight %.2f m, loose %.2f m\n",
-      h_t, at(&mc, rt, col(&mc, "pos_h_max_m")), h_l, at(&lo, rl, col(&lo, "pos_h_max_m")),
-      at(&mc, row_at(&mc, 39.9), col(&mc, "pos_h_rms_m")), at(&lo, rb, col(&lo, "pos_h_rms_m")));
+      h_t, nav_table_at(&mc, rt, nav_table_col(&mc, "pos_h_max_m")), h_l, nav_table_at(&lo, rl, nav_table_col(&lo, "pos_h_max_m")),
+      nav_table_at(&mc, nav_table_row_at(&mc, 39.9), nav_table_col(&mc, "pos_h_rms_m")), nav_table_at(&lo, rb, nav_table_col(&lo, "pos_h_rms_m")));
   assert_true(h_t < h_l);
   free(est.v);
   free(mc.v);
