@@ -482,6 +482,19 @@ static void test_read_string_numbers_and_styles(void **state) {
   assert_near(s.output.rate_hz, 25.0, 0.0);
   s = read_ok("format_version: 1\n\"name\": 'single ''quoted'''\n");
   assert_string_equal(s.name, "single 'quoted'");
+  /* Runs of escaped quotes (libfyaml 0.7.12 gets these wrong; the reader decodes them itself). */
+  s = read_ok("format_version: 1\nname: 'ab''''cd'\n");
+  assert_string_equal(s.name, "ab''cd");
+  s = read_ok("format_version: 1\nname: ''''''''''''\n");
+  assert_string_equal(s.name, "'''''");
+  s = read_ok("format_version: 1\nname: ''\n");
+  assert_string_equal(s.name, "");
+  /* Line folding in a single-quoted scalar: one break is a space, two are a newline, white
+     space around breaks goes, the first line's leading and the last line's trailing stay. */
+  s = read_ok("format_version: 1\nname: ' a \t\n    b\r\n  c '\n");
+  assert_string_equal(s.name, " a b c ");
+  /* Two breaks (one of them a white-space line) fold to a newline, which a name refuses. */
+  expect_one("format_version: 1\nname: ' a\n\n   \n  c'\n", 2, 7, "name", "control characters (byte 0x0a)");
   s = read_ok("format_version: 1\nname: 123\n"); /* a plain scalar name is a string */
   assert_string_equal(s.name, "123");
   s = read_ok("format_version: 1\ntrajectory:\n  initial_attitude: {yaw_deg: -0.0}\n");
