@@ -31,14 +31,16 @@ export function decimate(arr, max) {
   return out;
 }
 
+// outages: [[t0, t1], ...] or [{span: [t0, t1], fill}, ...] (the fill of each span).
 function spansPlugin(outages, limits) {
   return {
     hooks: {
       drawClear: [(u) => {
         const ctx = u.ctx;
         ctx.save();
-        ctx.fillStyle = 'rgba(120,120,120,0.18)';
-        for (const [t0, t1] of outages) {
+        for (const o of outages) {
+          const [t0, t1] = Array.isArray(o) ? o : o.span;
+          ctx.fillStyle = (!Array.isArray(o) && o.fill) || 'rgba(120,120,120,0.18)';
           const x0 = u.valToPos(t0, 'x', true), x1 = u.valToPos(t1, 'x', true);
           ctx.fillRect(x0, u.bbox.top, Math.max(1, x1 - x0), u.bbox.height);
         }
@@ -52,7 +54,9 @@ function spansPlugin(outages, limits) {
         ctx.lineWidth = 2;
         ctx.font = `${12 * devicePixelRatio}px sans-serif`;
         ctx.fillStyle = '#c62828';
-        for (const lim of limits) {
+        // Labels of limits close to each other are set side by side, not over each other.
+        const placed = [];
+        for (const lim of [...limits].sort((a, b) => b.value - a.value)) {
           const y = u.valToPos(lim.value, 'y', true);
           if (!(y >= u.bbox.top && y <= u.bbox.top + u.bbox.height)) continue;
           ctx.beginPath();
@@ -60,7 +64,10 @@ function spansPlugin(outages, limits) {
           ctx.lineTo(u.bbox.left + u.bbox.width, y);
           ctx.stroke();
           const w = ctx.measureText(lim.label).width;
-          ctx.fillText(lim.label, u.bbox.left + u.bbox.width - w - 6, y - 4);
+          let right = u.bbox.left + u.bbox.width - 6;
+          for (const p of placed) if (Math.abs(p.y - y) < 15 * devicePixelRatio) right = Math.min(right, p.x - 16 * devicePixelRatio);
+          ctx.fillText(lim.label, right - w, y - 4);
+          placed.push({ x: right - w, y });
         }
         ctx.restore();
       }],
@@ -83,7 +90,7 @@ function chart(host, title, unitLabel, t, series, outages, limits, width) {
     plugins: [spansPlugin(outages, limits)],
     scales: { x: { time: false }, y: { range: (u, lo, hi) => [Math.min(lo, 0), Math.max(hi, maxY)] } },
     axes: [{ label: 't [s]' }, { label: unitLabel, size: 60, values: (u, ticks) => ticks.map((v) => +v.toPrecision(3)) }],
-    series: [{ label: 't [s]' }, ...series.map((s) => ({ label: s.label, stroke: s.color, width: s.width || 1.5, dash: s.dash, fill: s.fill, points: { show: false } }))],
+    series: [{ label: 't [s]' }, ...series.map((s) => ({ label: s.label, stroke: s.color, width: s.width || 1.5, dash: s.dash, fill: s.fill, spanGaps: !!s.spanGaps, points: { show: false } }))],
     bands: series.map((s, i) => (s.bandWith !== undefined ? { series: [i + 1, s.bandWith + 1], fill: s.bandFill } : null)).filter(Boolean),
   };
   return new uPlot(opts, [t, ...series.map((s) => s.data)], div);
@@ -127,4 +134,92 @@ export function drawCharts(host, files, outages, requirements, width) {
     { label: 'yaw error [deg]', data: d(err.yaw_err_deg), color: '#b3261e' },
   ], outages, [], width));
   return charts;
+}
+
+// A/B comparison: the same quantities of two runs on shared axes (each run's own time base,
+// joined onto the union of the two; a run's gaps are spanned). A solid blue, B dashed orange.
+// run: {label, errors, mc_stats, outages, requirements}. Monte Carlo RMS when the run has it,
+// else the first run's error (the label says which).
+export const compareStyle = {
+  A: { color: '#1f5fbf', dash: undefined, width: 2, span: 'rgba(31,95,191,0.13)' },
+  B: { color: '#e07b00', dash: [10, 5], width: 2, span: 'rgba(224,123,0,0.16)' },
+};
+export function drawCompareCharts(host, runs, width) {
+  host.textContent = '';
+  const max = 3000;
+  const quantities = [
+    ['Horizontal position error', 'error [m]', 'horizontal_position', (e, m) => (m && m.pos_h_rms_m ? [m.pos_h_rms_m, true] : [e.pos_err_h_m, false])],
+    ['Vertical position error', 'error [m]', 'vertical_position', (e, m) => (m && m.pos_rms_d_m ? [m.pos_rms_d_m, true] : [e.pos_err_v_m || e.pos_err_d_m, false])],
+    ['Velocity error', 'error [m/s]', 'velocity', (e, m) => (m && m.vel_rms_mps ? [m.vel_rms_mps, true] : [e.vel_err_mps, false])],
+    ['Attitude error', 'error [deg]', 'attitude', (e, m) => (m && m.att_rms_rad ? [m.att_rms_rad.map((v) => (v * 180) / Math.PI), true] : [e.att_err_rad.map((v) => (v * 180) / Math.PI), false])],
+  ];
+  // Outage spans: drawn once when both scenes have the same, else each in its run's tint.
+  const key = (o) => JSON.stringify(o || []);
+  const spans = key(runs.A.outages) === key(runs.B.outages) ? runs.A.outages.map((o) => ({ span: o }))
+    : ['A', 'B'].flatMap((k) => runs[k].outages.map((o) => ({ span: o, fill: compareStyle[k].span })));
+  const charts = [];
+  for (const [title, unit, metric, pick] of quantities) {
+    const tables = [], series = [];
+    for (const k of ['A', 'B']) {
+      const r = runs[k];
+      const mcOk = r.mc_stats && r.mc_stats.length === r.errors.length ? r.mc_stats : null;
+      const [y, rms] = pick(r.errors, mcOk);
+      if (!y) continue;
+      tables.push([decimate(r.errors.t_s, max), decimate(y, max)]);
+      const st = compareStyle[k];
+      series.push({ label: `${k} · ${rms ? `RMS over ${r.runs} runs` : 'run 1'} · ${r.label}`, color: st.color, dash: st.dash, width: st.width, spanGaps: true });
+    }
+    if (tables.length < 2) continue;
+    const data = uPlot.join(tables);
+    const limits = new Map();
+    for (const k of ['A', 'B'])
+      for (const r of runs[k].requirements || [])
+        if (r.metric === metric && Number.isFinite(r.limit)) {
+          const value = r.limit * (r.unit === 'cm' ? 0.01 : r.unit === 'mm' ? 0.001 : r.unit === 'km' ? 1000 : 1);
+          const label = `${r.id} ${r.statistic} ≤ ${r.limit} ${r.unit || ''}`;
+          limits.set(label, { value, label });
+        }
+    charts.push(chart(host, `${title}: A and B`, unit, data[0], series.map((s, i) => ({ ...s, data: data[i + 1] })), spans, [...limits.values()], width));
+  }
+  return charts;
+}
+
+// A chart as a picture, as the page shows it: its title, the plot and a legend of its series
+// (uPlot draws the plot on a canvas and the title and legend in HTML). PNG data URL.
+export function chartPng(u) {
+  const src = u.ctx.canvas;
+  const dpr = src.width / (u.width || src.width) || 1;
+  const labels = u.series.slice(1).map((s, i) => ({ s, i: i + 1 })).filter(({ s }) => s.show !== false);
+  const lineH = 18 * dpr, cols = Math.max(1, Math.floor(src.width / (300 * dpr)));
+  const legendH = Math.ceil(labels.length / cols) * lineH + 6 * dpr;
+  const titleH = 26 * dpr;
+  const out = document.createElement('canvas');
+  out.width = src.width;
+  out.height = titleH + src.height + legendH;
+  const ctx = out.getContext('2d');
+  ctx.fillStyle = '#fff';
+  ctx.fillRect(0, 0, out.width, out.height);
+  ctx.fillStyle = '#1b1f24';
+  ctx.font = `bold ${14 * dpr}px sans-serif`;
+  ctx.textAlign = 'center';
+  ctx.fillText(u.root.querySelector('.u-title')?.textContent || '', out.width / 2, 18 * dpr);
+  ctx.textAlign = 'left';
+  ctx.drawImage(src, 0, titleH);
+  ctx.font = `${12 * dpr}px sans-serif`;
+  const colW = src.width / cols;
+  labels.forEach(({ s, i }, j) => {
+    const x = (j % cols) * colW + 10 * dpr, y = titleH + src.height + Math.floor(j / cols) * lineH + 12 * dpr;
+    const stroke = typeof s.stroke === 'function' ? s.stroke(u, i) : s.stroke;
+    ctx.strokeStyle = stroke || '#000';
+    ctx.lineWidth = 2 * dpr;
+    ctx.setLineDash((s.dash || []).map((v) => v * dpr));
+    ctx.beginPath();
+    ctx.moveTo(x, y - 4 * dpr);
+    ctx.lineTo(x + 26 * dpr, y - 4 * dpr);
+    ctx.stroke();
+    ctx.setLineDash([]);
+    ctx.fillStyle = '#1b1f24';
+    ctx.fillText(String(s.label).slice(0, 60), x + 32 * dpr, y);
+  });
+  return out.toDataURL('image/png');
 }

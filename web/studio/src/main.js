@@ -6,7 +6,9 @@
 import YAML from 'yaml';
 import { renderNode, schemaAt, deref, newItem } from './form.js';
 import { StudioMap, lonLatToNed, nedToLonLat } from './map.js';
-import { drawCharts, parseCsv } from './charts.js';
+import { drawCharts, drawCompareCharts, chartPng, parseCsv } from './charts.js';
+import { sceneDiff, modelDiff, verdictRows, formatValue, fmtNum, verdictText, change } from './compare.js';
+import { buildReport } from './report.js';
 import { View3D } from './view3d.js';
 
 void nedToLonLat;
@@ -84,7 +86,7 @@ function changed(source, structure = false) {
   if (source !== 'form' || structure) renderForms();
   syncFlow();
   drawPreview();
-  history.replaceState(null, '', '#scene=' + b64(scene.text()));
+  updateUrl();
   if (source === 'load') return;
   clearTimeout(pendingCheck);
   $('estimate').dataset.state = 'pending';
@@ -438,23 +440,53 @@ async function cancelRun() {
   await api('DELETE', `api/runs/${currentRun.id}`);
 }
 
-const resultFiles = ['summary.json', 'nav.csv', 'truth.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'tracks.kml', 'report.html', 'results.zip'];
-async function loadResults(id, text, files) {
+const resultFiles = ['summary.json', 'nav.csv', 'truth.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'tracks.kml', 'results.zip'];
+// Finished runs fetched from the server, by id (the run shown, A and a few recent ones).
+const runCache = new Map();
+async function fetchRun(id, text, files) {
+  if (runCache.has(id)) return runCache.get(id);
   // Only the files the run has (the state lists them): no request ends in a 404.
   if (!files) {
     const s = await api('GET', `api/runs/${id}`);
-    files = s.ok && s.json && Array.isArray(s.json.files) ? s.json.files : [];
+    if (!s.ok || !s.json || s.json.state !== 'done') return null;
+    files = Array.isArray(s.json.files) ? s.json.files : [];
   }
   const get = async (name) => {
     if (!files.includes(name)) return null;
     const r = await fetch(`api/runs/${id}/files/${name}`);
     return r.ok ? r.text() : null;
   };
-  const [summaryText, truthT, navT, errT, mcT, gnssT] = await Promise.all(['summary.json', 'truth.csv', 'nav.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv'].map(get));
-  const summary = summaryText ? JSON.parse(summaryText) : null;
-  const truth = truthT && parseCsv(truthT), nav = navT && parseCsv(navT), errors = errT && parseCsv(errT);
-  const mc = mcT && parseCsv(mcT), gnss = gnssT && parseCsv(gnssT);
-  lastRun = { id, sceneText: text, summary, truth, nav, errors, mc, gnss };
+  const [summaryText, truthT, navT, errT, mcT, gnssT, sceneT] = await Promise.all(
+    ['summary.json', 'truth.csv', 'nav.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'scene.yaml'].map(get));
+  const sceneText = text ?? sceneT ?? '';
+  let summary = null;
+  try { summary = summaryText ? JSON.parse(summaryText) : null; } catch { summary = null; }
+  const run = {
+    id, files, sceneText, summary,
+    truth: truthT && parseCsv(truthT), nav: navT && parseCsv(navT), errors: errT && parseCsv(errT),
+    mc: mcT && parseCsv(mcT), gnss: gnssT && parseCsv(gnssT),
+  };
+  runCache.set(id, run);
+  // Keep the runs in view and the three most recent others.
+  const keep = new Set([id, pinnedA, lastRun && lastRun.id]);
+  const others = [...runCache.keys()].filter((k) => !keep.has(k));
+  for (const k of others.slice(0, Math.max(0, others.length - 3))) runCache.delete(k);
+  return run;
+}
+async function loadResults(id, text, files) {
+  const run = await fetchRun(id, text, files);
+  if (!run) { status(`run ${id.slice(0, 8)}… is no longer on the server`); return false; }
+  rememberRun(run);
+  showRun(run);
+  fillRunSelects();
+  updateUrl();
+  await updateCompare();
+  return true;
+}
+function showRun(run) {
+  const { id, summary, truth, nav, errors, mc, gnss } = run;
+  const text = run.sceneText;
+  lastRun = run;
   studio.lastRun = { id, summary };
   // Verdicts.
   const v = $('verdicts');
@@ -466,6 +498,7 @@ async function loadResults(id, text, files) {
     failed ? `FAIL: ${failed} of ${reqs.length} requirements not met (${summary.runs} runs)` : `PASS: all ${reqs.length} requirements met (${summary.runs} runs)`;
   h.className = failed ? 'fail' : reqs.length ? 'pass' : '';
   v.appendChild(h);
+  v.appendChild(Object.assign(document.createElement('p'), { className: 'hint', textContent: `run ${runLabel(run)} (id ${id})` }));
   if (reqs.length) v.appendChild(requirementTable(reqs, false));
   v.dataset.state = !summary ? 'missing' : reqs.length === 0 ? 'none' : failed ? 'fail' : 'pass';
   // Downloads.
@@ -474,10 +507,20 @@ async function loadResults(id, text, files) {
   const ul = document.createElement('ul');
   const sceneLink = document.createElement('a');
   sceneLink.href = URL.createObjectURL(new Blob([text], { type: 'application/yaml' }));
-  sceneLink.download = `${scene.get(['name']) || 'scene'}.yaml`;
+  sceneLink.download = `${sceneName(run)}.yaml`;
   sceneLink.textContent = 'scene YAML (reruns this result bit-identically)';
   ul.appendChild(Object.assign(document.createElement('li'), {})).appendChild(sceneLink);
-  for (const name of [...resultFiles, ...files.filter((f) => !resultFiles.includes(f))]) {
+  const rep = document.createElement('button');
+  rep.type = 'button';
+  rep.id = 'download-report';
+  rep.textContent = 'report.html';
+  const repLi = document.createElement('li');
+  repLi.append(rep, ' ', Object.assign(document.createElement('span'), { className: 'hint',
+    textContent: 'one self-contained page made here in the browser: set-up, verdicts, figures, the charts, map and 3D pictures, the comparison with A when one is shown, and the scene to rerun' }));
+  ul.appendChild(repLi);
+  rep.addEventListener('click', () => downloadReport().catch((err) => { status(`report failed: ${err.message}`); studio.errors.push(String(err)); }));
+  const files = run.files;
+  for (const name of [...resultFiles, ...files.filter((f) => !resultFiles.includes(f) && f !== 'scene.yaml')]) {
     if (!files.includes(name)) continue;
     const a = document.createElement('a');
     a.href = `api/runs/${id}/files/${name}`;
@@ -487,15 +530,15 @@ async function loadResults(id, text, files) {
   }
   dl.appendChild(ul);
   // Map: truth, estimate, fixes.
-  if (truth) mapView.setReference(truth.pos_n_m, truth.pos_e_m);
-  if (nav) mapView.setEstimate(nav.pos_n_m, nav.pos_e_m);
-  if (gnss && gnss.lon_deg) mapView.setFixes(gnss.lon_deg, gnss.lat_deg);
+  mapView.setReference(truth ? truth.pos_n_m : [], truth ? truth.pos_e_m : []);
+  mapView.setEstimate(nav && nav.pos_n_m, nav && nav.pos_e_m);
+  mapView.setFixes(gnss && gnss.lon_deg, gnss && gnss.lat_deg);
   mapView.setWaypoints([]);
   mapView.fit();
   // Charts and 3D.
   const outages = (parseYamlSafe(text).gnss || {}).outages || [];
   if (errors) {
-    studio.charts = drawCharts($('charts'), { errors, mc_stats: mc }, outages, reqs, Math.max(320, $('work').clientWidth - 40));
+    studio.charts = drawCharts($('charts'), { errors, mc_stats: mc }, outages, reqs, chartWidth());
   }
   if (truth) {
     if (!view3d) view3d = new View3D($('three'));
@@ -503,8 +546,247 @@ async function loadResults(id, text, files) {
     view3d.setData(truth, nav, sig);
     studio.view3d = view3d;
   }
-  $('view-results').hidden || null;
-  status(`run ${id.slice(0, 8)}… done`);
+  $('pin-a').disabled = false;
+  status(`run ${runLabel(run)} shown`);
+}
+const chartWidth = () => Math.max(320, $('work').clientWidth - 40);
+const sceneName = (run) => String(parseYamlSafe(run.sceneText).name || 'scene').replace(/[^A-Za-z0-9._-]+/g, '_');
+
+// ---------------------------------------------------------------- the session's runs, A/B
+// The finished runs of this browser (local storage, newest last, at most 12; each checked
+// against the server when the page starts) are offered as A and B. The pair compared is in the
+// URL fragment (#scene=...&a=ID&b=ID), so a reload or a link shows it again while the server
+// still has both runs.
+const RUNS_KEY = 'navsim-studio.runs';
+let sessionRuns = [];
+let pinnedA = null;
+function loadSessionRuns() {
+  try {
+    const j = JSON.parse(localStorage.getItem(RUNS_KEY) || '[]');
+    sessionRuns = Array.isArray(j) ? j.filter((r) => r && /^[0-9a-f]{32}$/.test(r.id) && typeof r.label === 'string') : [];
+  } catch { sessionRuns = []; }
+}
+function saveSessionRuns() {
+  try { localStorage.setItem(RUNS_KEY, JSON.stringify(sessionRuns.slice(-12))); } catch { /* storage off: this page only */ }
+}
+function describeRun(run) {
+  const sc = parseYamlSafe(run.sceneText);
+  const imu = (sc.imu && sc.imu.catalog) || 'typed-in IMU';
+  const scheme = (sc.navigation && sc.navigation.scheme) || (run.summary && run.summary.setup && run.summary.setup.scheme) || '';
+  const runs = run.summary ? run.summary.runs : (sc.simulation || {}).runs;
+  return `${sc.name || 'scene'} · ${imu} · ${scheme} · ${runs} runs`;
+}
+function rememberRun(run) {
+  let e = sessionRuns.find((r) => r.id === run.id);
+  if (!e) {
+    const n = sessionRuns.reduce((m, r) => Math.max(m, r.n || 0), 0) + 1;
+    e = { id: run.id, n, label: describeRun(run), at: new Date().toISOString().slice(11, 19) };
+    sessionRuns.push(e);
+    while (sessionRuns.length > 12) sessionRuns.shift();
+    saveSessionRuns();
+  }
+  run.entry = e;
+  fillRunSelects();
+}
+const runLabel = (run) => (run.entry ? `#${run.entry.n} ${run.entry.label}` : run.id.slice(0, 8));
+function fillRunSelects() {
+  $('pin-a').setAttribute('aria-pressed', String(!!(pinnedA && lastRun && pinnedA === lastRun.id)));
+  $('pin-a').textContent = pinnedA && lastRun && pinnedA === lastRun.id ? 'Pinned as A' : 'Pin result as A';
+  const opts = sessionRuns.map((r) => [r.id, `#${r.n} ${r.label} (${r.at} UTC)`]);
+  const fill = (sel, cur, none) => {
+    sel.textContent = '';
+    for (const [v, t] of [['', none], ...[...opts].reverse()]) sel.appendChild(Object.assign(document.createElement('option'), { value: v, textContent: t }));
+    sel.value = cur && opts.some(([v]) => v === cur) ? cur : '';
+  };
+  fill($('compare-a'), pinnedA, '(none: pin a run as A)');
+  fill($('compare-b'), lastRun && lastRun.id, '(no run shown)');
+}
+function updateUrl() {
+  let h = '#scene=' + b64(scene.text());
+  if (pinnedA) h += `&a=${pinnedA}`;
+  if (lastRun) h += `&b=${lastRun.id}`;
+  history.replaceState(null, '', h);
+}
+async function pinA(id) {
+  pinnedA = id || null;
+  fillRunSelects();
+  updateUrl();
+  if (pinnedA && (!lastRun || lastRun.id === pinnedA)) {
+    const e = sessionRuns.find((r) => r.id === pinnedA);
+    status(`run #${e ? e.n : '?'} pinned as A: change the scene (another IMU, say) and run B`);
+  }
+  await updateCompare();
+}
+let compareRuns = null;
+async function updateCompare() {
+  const host = $('compare');
+  const B = lastRun;
+  const A = pinnedA && B && pinnedA !== B.id ? await fetchRun(pinnedA) : null;
+  if (pinnedA && B && pinnedA !== B.id && !A) {
+    status('run A is no longer on the server');
+    sessionRuns = sessionRuns.filter((r) => r.id !== pinnedA);
+    saveSessionRuns();
+    pinnedA = null;
+    fillRunSelects();
+    updateUrl();
+  }
+  if (!A || !B) {
+    compareRuns = null;
+    host.dataset.state = 'none';
+    $('compare-body').innerHTML = '<p class="hint">Pin a finished run as A (the button next to Run), change the scene and run it: the run shown is B. Or pick any two of this browser\'s finished runs above.</p>';
+    mapView.setCompare(null);
+    if (view3d) view3d.setCompare(null);
+    $('map-legend-a').hidden = true;
+    $('three-legend-a').hidden = true;
+    return;
+  }
+  if (!A.entry) A.entry = sessionRuns.find((r) => r.id === A.id);
+  compareRuns = { A, B };
+  const body = $('compare-body');
+  body.textContent = '';
+  const head = document.createElement('p');
+  head.className = 'ab-head';
+  for (const [k, r] of [['A', A], ['B', B]]) {
+    const sp = document.createElement('span');
+    sp.className = `ab-${k}`;
+    sp.textContent = `${k}: ${runLabel(r)}`;
+    head.appendChild(sp);
+  }
+  body.appendChild(head);
+  // The scene keys that differ.
+  const sa = parseYamlSafe(A.sceneText), sb = parseYamlSafe(B.sceneText);
+  const diff = sceneDiff(sa, sb);
+  const h3 = (t) => Object.assign(document.createElement('h3'), { textContent: t });
+  body.appendChild(h3(diff.length ? `Set-up: ${diff.length} scene key${diff.length > 1 ? 's differ' : ' differs'}` : 'Set-up: the two scenes are the same'));
+  if (diff.length) body.appendChild(diffTable(diff, 'scene key', 'compare-diff'));
+  const md = modelDiff(A.summary, B.summary);
+  if (md.length) {
+    const d = document.createElement('details');
+    d.appendChild(Object.assign(document.createElement('summary'), { textContent: `The sensor models as simulated: ${md.length} term${md.length > 1 ? 's differ' : ' differs'}` }));
+    d.appendChild(diffTable(md, 'model term', 'compare-model-diff'));
+    body.appendChild(d);
+  }
+  body.appendChild(h3('Verdicts and figures'));
+  body.appendChild(verdictTable(verdictRows(A.summary, B.summary)));
+  body.appendChild(h3('Errors of A and B'));
+  const charts = document.createElement('div');
+  charts.id = 'compare-charts';
+  body.appendChild(charts);
+  const runOf = (r) => ({
+    label: `#${r.entry ? r.entry.n : '?'}`, runs: r.summary ? r.summary.runs : '?', errors: r.errors, mc_stats: r.mc,
+    outages: (parseYamlSafe(r.sceneText).gnss || {}).outages || [], requirements: (r.summary && r.summary.requirements) || [],
+  });
+  studio.compareCharts = A.errors && B.errors ? drawCompareCharts(charts, { A: runOf(A), B: runOf(B) }, chartWidth()) : [];
+  // Both paths on the map and in 3D: A's estimate (and A's reference when it is another).
+  const sameRef = A.truth && B.truth && A.truth.length === B.truth.length && A.truth.pos_n_m.every((v, i) => Math.abs(v - B.truth.pos_n_m[i]) < 1e-3 && Math.abs(A.truth.pos_e_m[i] - B.truth.pos_e_m[i]) < 1e-3);
+  mapView.setCompare(A.truth && !sameRef ? A.truth.pos_n_m : null, A.truth && !sameRef ? A.truth.pos_e_m : null, A.nav && A.nav.pos_n_m, A.nav && A.nav.pos_e_m);
+  $('map-legend-a').hidden = false;
+  $('three-legend-a').hidden = false;
+  if (view3d && A.truth && A.nav) view3d.setCompare(A.truth, A.nav);
+  host.dataset.state = 'ready';
+  studio.compare = { a: A.id, b: B.id, diff: diff.map((d) => d.path) };
+}
+function diffTable(diff, what, id) {
+  const t = document.createElement('table');
+  t.id = id;
+  t.innerHTML = `<thead><tr><th>${what}</th><th>A</th><th>B</th></tr></thead>`;
+  const tb = document.createElement('tbody');
+  for (const d of diff) {
+    const tr = document.createElement('tr');
+    for (const [txt, cls] of [[d.path, 'key'], [formatValue(d.a), 'ab-A'], [formatValue(d.b), 'ab-B']])
+      tr.appendChild(Object.assign(document.createElement('td'), { textContent: txt, className: cls }));
+    tb.appendChild(tr);
+  }
+  t.appendChild(tb);
+  return t;
+}
+function verdictTable(rows) {
+  const t = document.createElement('table');
+  t.id = 'compare-verdicts';
+  t.innerHTML = '<thead><tr><th>requirement or figure</th><th>statistic</th><th>limit</th><th>A</th><th>B</th><th>B vs A</th></tr></thead>';
+  const tb = document.createElement('tbody');
+  for (const r of rows) {
+    const tr = document.createElement('tr');
+    tr.className = `row-${r.kind}`;
+    const cell = (v, pass) => {
+      const td = document.createElement('td');
+      td.textContent = `${fmtNum(v)}${typeof v === 'number' && r.unit ? ' ' + r.unit : ''}`;
+      if (pass !== undefined && verdictText(pass)) {
+        td.append(' ', Object.assign(document.createElement('span'), { className: pass ? 'pass' : 'fail', textContent: verdictText(pass) }));
+      }
+      return td;
+    };
+    tr.appendChild(Object.assign(document.createElement('td'), { textContent: r.label, className: r.kind === 'outage' ? 'sub' : '' }));
+    tr.appendChild(Object.assign(document.createElement('td'), { textContent: r.statistic }));
+    tr.appendChild(Object.assign(document.createElement('td'), { textContent: r.limit !== undefined ? `${r.limit} ${r.unit}` : '' }));
+    tr.appendChild(cell(r.a, r.passA));
+    tr.appendChild(cell(r.b, r.passB));
+    tr.appendChild(Object.assign(document.createElement('td'), { textContent: r.label === 'Monte Carlo runs' ? '' : change(r.a, r.b) }));
+    tb.appendChild(tr);
+  }
+  t.appendChild(tb);
+  return t;
+}
+
+// ---------------------------------------------------------------- report.html
+// Made here in the browser from what the page shows: the server cannot draw (navsim report needs
+// an X server), the browser already has every picture.
+async function downloadReport() {
+  const run = lastRun;
+  if (!run) return;
+  status('making report.html …');
+  const pictures = { charts: [], compare: [] };
+  for (const u of studio.charts || []) pictures.charts.push(chartPng(u));
+  if (compareRuns && compareRuns.B === run) for (const u of studio.compareCharts || []) pictures.compare.push(chartPng(u));
+  pictures.map = await mapPicture();
+  if (view3d) { view3d.render(); pictures.three = view3d.renderer.domElement.toDataURL('image/png'); }
+  const html = buildReport({
+    run, sceneObj: parseYamlSafe(run.sceneText), label: runLabel(run), pictures, exaggeration: view3d ? view3d.exaggeration : null,
+    compare: compareRuns && compareRuns.B === run ? { A: compareRuns.A, labelA: runLabel(compareRuns.A), diff: sceneDiff(parseYamlSafe(compareRuns.A.sceneText), parseYamlSafe(run.sceneText)), modelDiff: modelDiff(compareRuns.A.summary, run.summary), rows: verdictRows(compareRuns.A.summary, run.summary) } : null,
+    made: new Date().toISOString().replace(/\.\d+Z$/, 'Z'),
+  });
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(new Blob([html], { type: 'text/html' }));
+  a.download = `${sceneName(run)}-${run.id.slice(0, 8)}-report.html`;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+  studio.reportBytes = html.length;
+  status(`report.html of run ${runLabel(run)}: ${(html.length / 1024).toFixed(0)} KiB`);
+}
+// The map as the page draws it (its layer canvases composed); a hidden map panel is laid out
+// off-screen for the picture and hidden again.
+async function mapPicture() {
+  const panel = $('view-map');
+  const hidden = panel.hidden;
+  if (hidden) { panel.classList.add('offscreen'); panel.hidden = false; mapView.map.updateSize(); mapView.fit(); }
+  try {
+    const rendered = mapView.whenRendered();
+    mapView.map.render();
+    await Promise.race([rendered, sleep(4000)]);
+    const size = mapView.map.getSize();
+    if (!size || !size[0] || !size[1]) return null;
+    const out = document.createElement('canvas');
+    out.width = size[0];
+    out.height = size[1];
+    const ctx = out.getContext('2d');
+    ctx.fillStyle = '#cfe0ef';
+    ctx.fillRect(0, 0, out.width, out.height);
+    for (const c of $('map').querySelectorAll('.ol-layer canvas, canvas.ol-layer')) {
+      if (!c.width) continue;
+      const op = c.parentNode.style.opacity || c.style.opacity;
+      ctx.globalAlpha = op === '' ? 1 : +op;
+      const m = (c.style.transform || '').match(/^matrix\(([^(]*)\)$/);
+      if (m) ctx.setTransform(...m[1].split(',').map(Number));
+      else ctx.setTransform(out.width / c.width, 0, 0, out.height / c.height, 0, 0);
+      ctx.drawImage(c, 0, 0);
+    }
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.globalAlpha = 1;
+    return out.toDataURL('image/png');
+  } finally {
+    if (hidden) { panel.hidden = true; panel.classList.remove('offscreen'); mapView.map.updateSize(); }
+  }
 }
 function parseYamlSafe(t) { try { return YAML.parse(t) || {}; } catch { return {}; } }
 
@@ -519,7 +801,8 @@ function selectTab(tab) {
   }
   if (tab.id === 'tab-3d' && view3d) view3d.resize();
   if (tab.id === 'tab-map') mapView.map.updateSize();
-  if (tab.id === 'tab-charts' && studio.charts) for (const c of studio.charts) c.setSize({ width: Math.max(320, $('work').clientWidth - 40), height: 220 });
+  if (tab.id === 'tab-charts' && studio.charts) for (const c of studio.charts) c.setSize({ width: chartWidth(), height: 220 });
+  if (tab.id === 'tab-compare' && studio.compareCharts) for (const c of studio.compareCharts) c.setSize({ width: chartWidth(), height: 220 });
 }
 tabs.forEach((t, i) => {
   t.tabIndex = t.getAttribute('aria-selected') === 'true' ? 0 : -1;
@@ -657,6 +940,12 @@ $('yaml').addEventListener('input', () => {
   changed('yaml', true);
 });
 $('run').addEventListener('click', startRun);
+$('pin-a').addEventListener('click', () => { if (lastRun) pinA(pinnedA === lastRun.id ? null : lastRun.id); });
+$('compare-a').addEventListener('change', () => pinA($('compare-a').value));
+$('compare-b').addEventListener('change', async () => {
+  const id = $('compare-b').value;
+  if (id && (!lastRun || id !== lastRun.id)) await loadResults(id);
+});
 $('cancel').addEventListener('click', cancelRun);
 $('runs').addEventListener('change', () => {
   const n = Math.round(+$('runs').value);
@@ -679,10 +968,35 @@ async function start() {
   const scenes = sl.ok ? arr(sl.json, 'scenes') : [];
   fillSelect($('library'), ['', ...scenes.map((s) => s.name)], '', Object.fromEntries([['', '(choose a scene)'], ...scenes.map((s) => [s.name, s.description ? `${s.name} — ${s.description.slice(0, 60)}` : s.name])]));
   const m = location.hash.match(/#scene=([A-Za-z0-9_-]+)/);
+  const runA = (location.hash.match(/[#&]a=([0-9a-f]{32})\b/) || [])[1];
+  const runB = (location.hash.match(/[#&]b=([0-9a-f]{32})\b/) || [])[1];
+  loadSessionRuns();
+  fillRunSelects();
   if (m) await loadText(unb64(m[1]), 'scene from the URL');
   else if (scenes.some((s) => s.name === 'urban-drive')) { $('library').value = 'urban-drive'; await loadLibrary('urban-drive'); }
   else if (scenes.length) { $('library').value = scenes[0].name; await loadLibrary(scenes[0].name); }
   document.body.dataset.ready = '1';
+  // The runs of the URL (the one shown and A), then the check of this browser's other runs.
+  if (runB) {
+    pinnedA = runA || null;
+    const ok = await loadResults(runB);
+    if (!ok) { pinnedA = null; updateUrl(); }
+  } else if (runA) await pinA(runA);
+  await checkSessionRuns();
+}
+// Runs this browser remembers that the server no longer has (expired) are dropped.
+async function checkSessionRuns() {
+  const known = new Set([pinnedA, lastRun && lastRun.id]);
+  const gone = [];
+  for (const r of sessionRuns.filter((x) => !known.has(x.id))) {
+    const s = await api('GET', `api/runs/${r.id}`);
+    if (s.status === 404 || (s.ok && s.json && s.json.state !== 'done')) gone.push(r.id);
+  }
+  if (gone.length) {
+    sessionRuns = sessionRuns.filter((r) => !gone.includes(r.id));
+    saveSessionRuns();
+    fillRunSelects();
+  }
 }
 window.addEventListener('error', (e) => studio.errors.push(String(e.message)));
 start().catch((err) => { status(`start failed: ${err.message}`); studio.errors.push(String(err)); });

@@ -70,6 +70,8 @@ export class StudioMap {
     this.gridSrc = new VectorSource();
     this.refSrc = new VectorSource();
     this.estSrc = new VectorSource();
+    this.refASrc = new VectorSource(); // A/B comparison: run A's reference (when it differs) and estimate
+    this.estASrc = new VectorSource();
     this.fixSrc = new VectorSource();
     this.wpSrc = new VectorSource();
     const line = (color, width, dash) => new Style({ stroke: new Stroke({ color, width, lineDash: dash }) });
@@ -81,7 +83,9 @@ export class StudioMap {
         this.relief, land, lakes, graticule,
         new VectorLayer({ source: this.gridSrc, maxResolution: 25, style: new Style({ stroke: new Stroke({ color: 'rgba(60,70,90,0.28)', width: 1 }) }) }),
         new VectorLayer({ source: this.fixSrc, style: new Style({ image: new CircleStyle({ radius: 2.2, fill: new Fill({ color: '#2a9d3a' }) }) }) }),
+        new VectorLayer({ source: this.refASrc, style: line('#8a8f98', 3, [2, 4]) }),
         new VectorLayer({ source: this.refSrc, style: line('#111', 3) }),
+        new VectorLayer({ source: this.estASrc, style: line('#1f5fbf', 2) }),
         new VectorLayer({ source: this.estSrc, style: line('#d1401f', 2, [6, 4]) }),
         new VectorLayer({
           source: this.wpSrc,
@@ -137,6 +141,13 @@ export class StudioMap {
   setEstimate(ns, es) {
     this.estSrc.clear();
     if (ns && ns.length > 1) this.estSrc.addFeature(new Feature(new LineString(this.lineFromNed(ns, es))));
+  }
+  // Run A of a comparison: its estimate, and its reference when the trajectories differ (null: none).
+  setCompare(refN, refE, estN, estE) {
+    this.refASrc.clear();
+    this.estASrc.clear();
+    if (refN && refN.length > 1) this.refASrc.addFeature(new Feature(new LineString(this.lineFromNed(refN, refE))));
+    if (estN && estN.length > 1) this.estASrc.addFeature(new Feature(new LineString(this.lineFromNed(estN, estE))));
   }
   setFixes(lons, lats) {
     this.fixSrc.clear();

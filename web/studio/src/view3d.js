@@ -90,6 +90,12 @@ export class View3D {
     this.data = { truth, nav, sigmaH };
     this.build();
   }
+  // A/B comparison: run A's estimate (blue, deviation from A's reference x the exaggeration) and
+  // A's reference (grey) when it is not the shown run's; null removes them.
+  setCompare(truthA, navA) {
+    this.compare = truthA && navA ? { truth: truthA, nav: navA } : null;
+    if (this.data) this.build(false);
+  }
   setExaggeration(k) {
     this.exaggeration = k;
     if (this.data) this.build(false);
@@ -113,10 +119,28 @@ export class View3D {
       }
       rad.push(sigmaH ? Math.max(0, k * sigmaH[i]) : 0);
     }
-    const box = new THREE.Box3().setFromPoints(ref);
+    const refA = [], estA = [];
+    let sameRef = true;
+    if (this.compare) {
+      const { truth: tA, nav: nA } = this.compare;
+      const stepA = Math.max(1, Math.ceil(tA.length / 3000));
+      if (tA.length !== n) sameRef = false;
+      for (let i = 0; i < tA.length; i += stepA) {
+        const r = toR(tA.pos_n_m[i], tA.pos_e_m[i], tA.pos_d_m[i]);
+        refA.push(r);
+        if (sameRef && Math.abs(tA.pos_n_m[i] - truth.pos_n_m[i]) + Math.abs(tA.pos_e_m[i] - truth.pos_e_m[i]) + Math.abs(tA.pos_d_m[i] - truth.pos_d_m[i]) > 1e-3) sameRef = false;
+        if (i < nA.length) {
+          const e = toR(nA.pos_n_m[i], nA.pos_e_m[i], nA.pos_d_m[i]);
+          estA.push(r.clone().add(e.sub(r).multiplyScalar(k)));
+        }
+      }
+    }
+    const box = new THREE.Box3().setFromPoints(sameRef ? ref : [...ref, ...refA]);
     const size = box.getSize(new THREE.Vector3()).length() || 10;
     this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(ref), new THREE.LineBasicMaterial({ color: 0x111111 })));
     if (est.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(est), new THREE.LineBasicMaterial({ color: 0xd1401f })));
+    if (!sameRef && refA.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(refA), new THREE.LineBasicMaterial({ color: 0x8a8f98 })));
+    if (estA.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(estA), new THREE.LineBasicMaterial({ color: 0x1f5fbf })));
     if (sigmaH && ref.length > 1) {
       const maxR = size * 0.08;
       const tube = new THREE.Mesh(tubeGeometry(ref, rad.map((r) => Math.min(r, maxR)), 12),
