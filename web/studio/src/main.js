@@ -406,9 +406,16 @@ async function startRun() {
     if (!currentRun || currentRun.id !== id || currentRun.finished) return;
     currentRun.finished = true;
     if (es) es.close(); // the stream would otherwise hold one of the client's stream slots
-    runState(state, state === 'done' ? 1 : undefined);
+    // "done" once the results are on the page (verdicts, charts, map, 3D and the comparison).
+    if (state === 'done') {
+      $('progress').value = 1;
+      $('cancel').disabled = true;
+      $('run-state').textContent = 'done, loading the results';
+      try { await loadResults(id, text, currentRun.files); } finally { runState(state, 1); }
+      return;
+    }
+    runState(state);
     if (state === 'failed' && currentRun.error) $('run-state').textContent = `failed: ${currentRun.error}`;
-    if (state === 'done') await loadResults(id, text, currentRun.files);
   };
   const onState = (j) => {
     if (!j || !j.state) return;
@@ -457,7 +464,7 @@ async function fetchRun(id, text, files) {
     return r.ok ? r.text() : null;
   };
   const [summaryText, truthT, navT, errT, mcT, gnssT, sceneT] = await Promise.all(
-    ['summary.json', 'truth.csv', 'nav.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', 'scene.yaml'].map(get));
+    ['summary.json', 'truth.csv', 'nav.csv', 'errors.csv', 'mc_stats.csv', 'gnss.csv', text === undefined ? 'scene.yaml' : ''].map(get));
   const sceneText = text ?? sceneT ?? '';
   let summary = null;
   try { summary = summaryText ? JSON.parse(summaryText) : null; } catch { summary = null; }
@@ -513,7 +520,7 @@ function showRun(run) {
   const rep = document.createElement('button');
   rep.type = 'button';
   rep.id = 'download-report';
-  rep.textContent = 'report.html';
+  rep.textContent = 'Download report.html';
   const repLi = document.createElement('li');
   repLi.append(rep, ' ', Object.assign(document.createElement('span'), { className: 'hint',
     textContent: 'one self-contained page made here in the browser: set-up, verdicts, figures, the charts, map and 3D pictures, the comparison with A when one is shown, and the scene to rerun' }));
