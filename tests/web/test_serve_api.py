@@ -196,6 +196,7 @@ st, _, j = srv.json("GET", f"/api/runs/{rid}")
 check(st == 200 and j["state"] == "done" and j["progress"] == 1 and j["runs"] == 3, f"GET run -> done ({j})")
 check({"summary.json", "truth.csv", "nav.csv", "errors.csv", "mc_stats.csv", "gnss.csv", "tracks.kml",
        "scene.yaml", "results.zip"} <= set(j["files"]), f"files listed {j['files']}")
+check("report.html" not in j["files"], "no report.html promised (the studio makes it in the browser)")
 st, hd, body = srv.request("GET", f"/api/runs/{rid}/files/summary.json")
 summ = json.loads(body)
 check(st == 200 and summ["runs"] == 3 and summ["scene"]["name"] == "car-figure-eight", "summary.json")
@@ -272,6 +273,7 @@ st, _, j = srv.json("GET", "/api/estimate")
 check(st == 405, f"GET /api/estimate -> 405 ({st})")
 st, _, j = srv.json("GET", "/api/limits")
 check(st == 200 and j["max_runs"] == 500 and "summary.json" in j["result_files"], f"GET /api/limits ({st})")
+check("report.html" not in j["result_files"], f"no report.html among the result files ({j['result_files']})")
 
 # ---------------------------------------------------------------- a second server on the same port
 r = subprocess.run([NAVSIM, "serve", "--port", str(srv.port), "--data-dir", srv.data + "-2"], capture_output=True,

@@ -537,8 +537,9 @@ function showRun(run) {
   }
   dl.appendChild(ul);
   // Map: truth, estimate, fixes.
-  mapView.setReference(truth ? truth.pos_n_m : [], truth ? truth.pos_e_m : []);
-  mapView.setEstimate(nav && nav.pos_n_m, nav && nav.pos_e_m);
+  const origin = runOrigin(run);
+  mapView.setReference(truth ? truth.pos_n_m : [], truth ? truth.pos_e_m : [], origin);
+  mapView.setEstimate(nav && nav.pos_n_m, nav && nav.pos_e_m, origin);
   mapView.setFixes(gnss && gnss.lon_deg, gnss && gnss.lat_deg);
   mapView.setWaypoints([]);
   mapView.fit();
@@ -555,6 +556,11 @@ function showRun(run) {
   }
   $('pin-a').disabled = false;
   status(`run ${runLabel(run)} shown`);
+}
+// The scene origin of a run's local NED coordinates (undefined: the edited scene's).
+function runOrigin(run) {
+  const o = (parseYamlSafe(run.sceneText).earth || {}).origin || {};
+  return Number.isFinite(o.lat_deg) && Number.isFinite(o.lon_deg) ? { lat: o.lat_deg, lon: o.lon_deg } : undefined;
 }
 const chartWidth = () => Math.max(320, $('work').clientWidth - 40);
 const sceneName = (run) => String(parseYamlSafe(run.sceneText).name || 'scene').replace(/[^A-Za-z0-9._-]+/g, '_');
@@ -685,8 +691,9 @@ async function updateCompare() {
   });
   studio.compareCharts = A.errors && B.errors ? drawCompareCharts(charts, { A: runOf(A), B: runOf(B) }, chartWidth()) : [];
   // Both paths on the map and in 3D: A's estimate (and A's reference when it is another).
-  const sameRef = A.truth && B.truth && A.truth.length === B.truth.length && A.truth.pos_n_m.every((v, i) => Math.abs(v - B.truth.pos_n_m[i]) < 1e-3 && Math.abs(A.truth.pos_e_m[i] - B.truth.pos_e_m[i]) < 1e-3);
-  mapView.setCompare(A.truth && !sameRef ? A.truth.pos_n_m : null, A.truth && !sameRef ? A.truth.pos_e_m : null, A.nav && A.nav.pos_n_m, A.nav && A.nav.pos_e_m);
+  const sameRef = A.truth && B.truth && same(runOrigin(A), runOrigin(B)) && A.truth.length === B.truth.length && A.truth.pos_n_m.every((v, i) => Math.abs(v - B.truth.pos_n_m[i]) < 1e-3 && Math.abs(A.truth.pos_e_m[i] - B.truth.pos_e_m[i]) < 1e-3);
+  const originA = runOrigin(A) || null;
+  mapView.setCompare(originA, A.truth && !sameRef ? A.truth.pos_n_m : null, A.truth && !sameRef ? A.truth.pos_e_m : null, A.nav && A.nav.pos_n_m, A.nav && A.nav.pos_e_m);
   $('map-legend-a').hidden = false;
   $('three-legend-a').hidden = false;
   if (view3d && A.truth && A.nav) view3d.setCompare(A.truth, A.nav);
@@ -795,6 +802,7 @@ async function mapPicture() {
     if (hidden) { panel.hidden = true; panel.classList.remove('offscreen'); mapView.map.updateSize(); }
   }
 }
+const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
 function parseYamlSafe(t) { try { return YAML.parse(t) || {}; } catch { return {}; } }
 
 // ---------------------------------------------------------------- tabs

@@ -129,25 +129,28 @@ export class StudioMap {
   centre() { return toLonLat(this.map.getView().getCenter()); }
   // Pixel of a local NED point (for tests and keyboard help).
   pixelOfNed(n, e) { return this.map.getPixelFromCoordinate(fromLonLat(nedToLonLat(this.origin, n, e))); }
-  lineFromNed(ns, es) {
+  lineFromNed(ns, es, origin = this.origin) {
     const pts = [];
-    for (let i = 0; i < ns.length; ++i) pts.push(fromLonLat(nedToLonLat(this.origin, ns[i], es[i])));
+    for (let i = 0; i < ns.length; ++i) pts.push(fromLonLat(nedToLonLat(origin, ns[i], es[i])));
     return pts;
   }
-  setReference(ns, es) {
+  // origin: of the NED coordinates (a run's own scene origin; default the scene's being edited).
+  setReference(ns, es, origin = this.origin) {
     this.refSrc.clear();
-    if (ns.length > 1) this.refSrc.addFeature(new Feature(new LineString(this.lineFromNed(ns, es))));
+    if (ns.length > 1) this.refSrc.addFeature(new Feature(new LineString(this.lineFromNed(ns, es, origin))));
   }
-  setEstimate(ns, es) {
+  setEstimate(ns, es, origin = this.origin) {
     this.estSrc.clear();
-    if (ns && ns.length > 1) this.estSrc.addFeature(new Feature(new LineString(this.lineFromNed(ns, es))));
+    if (ns && ns.length > 1) this.estSrc.addFeature(new Feature(new LineString(this.lineFromNed(ns, es, origin))));
   }
-  // Run A of a comparison: its estimate, and its reference when the trajectories differ (null: none).
-  setCompare(refN, refE, estN, estE) {
+  // Run A of a comparison: its estimate, and its reference when the trajectories differ (null:
+  // none); local NED about A's own scene origin {lat, lon} (null: the shown scene's).
+  setCompare(origin, refN, refE, estN, estE) {
     this.refASrc.clear();
     this.estASrc.clear();
-    if (refN && refN.length > 1) this.refASrc.addFeature(new Feature(new LineString(this.lineFromNed(refN, refE))));
-    if (estN && estN.length > 1) this.estASrc.addFeature(new Feature(new LineString(this.lineFromNed(estN, estE))));
+    const o = origin || this.origin;
+    if (refN && refN.length > 1) this.refASrc.addFeature(new Feature(new LineString(this.lineFromNed(refN, refE, o))));
+    if (estN && estN.length > 1) this.estASrc.addFeature(new Feature(new LineString(this.lineFromNed(estN, estE, o))));
   }
   setFixes(lons, lats) {
     this.fixSrc.clear();
