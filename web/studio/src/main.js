@@ -14,6 +14,7 @@ import { View3D } from './view3d.js';
 void nedToLonLat;
 const $ = (id) => document.getElementById(id);
 const studio = (window.__studio = { timings: {}, errors: [] });
+studio.sceneDiff = (a, b) => sceneDiff(YAML.parse(a), YAML.parse(b)); // for the tests
 
 // ---------------------------------------------------------------- API
 async function api(method, url, body, type = 'application/yaml') {
@@ -840,7 +841,9 @@ async function loadText(text, label) {
     status(`${label}: ${err.message}`);
     return false;
   }
-  lastRun = null;
+  lastRun = null; // the views keep the last run's results until the next run (or a pick as B)
+  $('pin-a').disabled = true;
+  fillRunSelects();
   drawnThisSession = 0;
   $('yaml').value = scene.text();
   const runs = scene.get(['simulation', 'runs']);

@@ -66,6 +66,14 @@ test('A/B: run A, pin it, another IMU, run B: diff, overlaid charts, verdicts si
       assert.ok(name.length > 3, `#${id} has a label (${name})`);
     }
     assert.equal(await page.$eval('#pin-a', (b) => b.disabled), true, 'nothing to pin before a run');
+    // The key-level difference: nested keys, keys on one side only, lists of mappings item by item
+    // when they have the same length, vectors and other lists whole.
+    const d = await page.evaluate(() => window.__studio.sceneDiff(
+      'a: {b: 1, c: [1, 2, 3]}\np: [{x: 1, y: 2}, {x: 3}]\nq: [[0, 1]]\nr: 5\n',
+      'a: {b: 1, c: [1, 2, 4], d: x}\np: [{x: 1, y: 3}, {x: 3}]\nq: [[0, 1], [2, 3]]\n'));
+    assert.deepEqual(d, [
+      { path: 'a.c', a: [1, 2, 3], b: [1, 2, 4] }, { path: 'a.d', b: 'x' }, { path: 'p[0].y', a: 2, b: 3 },
+      { path: 'q', a: [[0, 1]], b: [[0, 1], [2, 3]] }, { path: 'r', a: 5 }]);
 
     // A: urban-drive as it is (Xsens MTi-300), 5 runs.
     await page.$eval('#runs', (e) => { e.value = ''; });
