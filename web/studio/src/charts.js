@@ -66,6 +66,12 @@ function spansPlugin(outages, limits) {
           const w = ctx.measureText(lim.label).width;
           let right = u.bbox.left + u.bbox.width - 6;
           for (const p of placed) if (Math.abs(p.y - y) < 15 * devicePixelRatio) right = Math.min(right, p.x - 16 * devicePixelRatio);
+          ctx.save();
+          ctx.setLineDash([]);
+          ctx.strokeStyle = 'rgba(255,255,255,0.9)';
+          ctx.lineWidth = 3 * devicePixelRatio;
+          ctx.strokeText(lim.label, right - w, y - 4); // a halo: readable over the other lines
+          ctx.restore();
           ctx.fillText(lim.label, right - w, y - 4);
           placed.push({ x: right - w, y });
         }

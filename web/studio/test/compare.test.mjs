@@ -229,6 +229,13 @@ test('A/B: run A, pin it, another IMU, run B: diff, overlaid charts, verdicts si
     const swapped = await page.$$eval('#compare-diff tbody tr', (rs) => rs.map((r) => [...r.cells].map((c) => c.textContent)));
     assert.deepEqual(swapped, [['imu.catalog', imuB, imuA]]);
     await page.screenshot({ path: shotPath('AB5-after-reload-swapped.png'), fullPage: true });
+    // A tablet-sized window: the comparison fits without horizontal scrolling.
+    await page.setViewport({ width: 820, height: 1180 });
+    await page.evaluate(() => new Promise((res) => requestAnimationFrame(() => requestAnimationFrame(res))));
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    await page.$eval('#view-compare', (e) => e.scrollIntoView());
+    await page.screenshot({ path: shotPath('AB6-compare-tablet.png') });
+    assert.ok(overflow <= 0, `no horizontal scrolling at 820 px (${overflow} px too wide)`);
     assert.deepEqual(problems, []);
     assert.deepEqual(await page.evaluate(() => window.__studio.errors), []);
     await page.close();
