@@ -185,11 +185,17 @@ static nav_rinex_gps_eph gps_eph_at(const nav_gnss_orbit *o, double t_gps_s) {
   return nav_rinex_gps_eph_from_orbit(o, toe, 0);
 }
 
+/* The GLONASS tb nearest to t: on the UTC grid of NAVSIM_RINEX_GLO_STEP_S (t - leap a multiple). */
+static double glo_tb(double t_gps_s) {
+  const double leap = (double)nav_rinex_leap_seconds(t_gps_s);
+  return floor((t_gps_s - leap) / NAVSIM_RINEX_GLO_STEP_S + 0.5) * NAVSIM_RINEX_GLO_STEP_S + leap;
+}
+
 /* The satellite clock a RINEX user applies to this satellite at transmit time t [s]. */
 static double sat_clock_s(const nav_gnss_orbit *o, double t) {
   if (o->system == NAV_GNSS_SYS_GLONASS) {
-    const double tb = floor(t / NAVSIM_RINEX_GLO_STEP_S + 0.5) * NAVSIM_RINEX_GLO_STEP_S;
-    const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, tb, 0);
+    const double tb = glo_tb(t);
+    const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, tb, 0, 0.5 * NAVSIM_RINEX_GLO_STEP_S);
     return nav_rinex_glo_clock_s(&e, t);
   }
   const nav_rinex_gps_eph e = gps_eph_at(o, t);
@@ -319,12 +325,14 @@ nav_status navsim_rinex_end(navsim_rinex *x, char *msg, size_t cap) {
     const nav_gnss_orbit *o = &x->c.sats[i];
     const bool glo = o->system == NAV_GNSS_SYS_GLONASS;
     const double step = glo ? NAVSIM_RINEX_GLO_STEP_S : GPS_STEP_S;
-    const double t0 = floor(x->t_first_gps_s / step + 0.5) * step, t1 = floor(x->t_last_gps_s / step + 0.5) * step;
+    const double t0 = glo ? glo_tb(x->t_first_gps_s) : floor(x->t_first_gps_s / step + 0.5) * step;
+    const double t1 = glo ? glo_tb(x->t_last_gps_s) : floor(x->t_last_gps_s / step + 0.5) * step;
     const long nrec = lround((t1 - t0) / step) + 1;
     for (long rec = 0; rec < nrec && st == NAV_OK; ++rec) {
       const double t = t0 + (double)rec * step;
       if (glo) {
-        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, t, nav_rinex_glonass_nominal_channel(o->prn));
+        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, t, nav_rinex_glonass_nominal_channel(o->prn),
+                                                                 0.5 * NAVSIM_RINEX_GLO_STEP_S);
         st = nav_rinex_nav_write_glonass(x->f[F_NAV], &e, leap);
       } else {
         /* IODE distinguishes a satellite's records (readers drop repeated IODEs). */
