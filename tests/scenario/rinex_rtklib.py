@@ -144,16 +144,59 @@ def run_scene(navsim, work, scene, ideal, max_m, weights_differ):
             fail("%s: %.4f of the axis errors within 3 DOP x sigma (expected about 0.997)" % (scene, f3))
 
 
+def contract(navsim, work, scene):
+    """What needs no RTKLIB: refusals (exit 2, nothing written) and bit-identical files for any
+    thread count."""
+    bad = os.path.join(work, "no-constellation.yaml")
+    with open(scene) as f:
+        text = f.read()
+    # The same scene without its gnss.constellation section.
+    lines, skip = [], False
+    for line in text.splitlines():
+        if line.startswith("  constellation:"):
+            skip = True
+            continue
+        if skip and (line.startswith("    ") or not line.strip()):
+            continue
+        skip = False
+        lines.append(line)
+    with open(bad, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    out = os.path.join(work, "refused")
+    r = subprocess.run([navsim, "run", bad, "--export", "rinex", "--out", out, "-q"], capture_output=True, text=True)
+    if r.returncode != 2 or "gnss.constellation" not in r.stderr or os.path.exists(out):
+        fail("scene without gnss.constellation: exit %d, stderr %r, %s written" % (r.returncode, r.stderr,
+                                                                                   out if os.path.exists(out) else "nothing"))
+    r = subprocess.run([navsim, "run", scene, "--export", "rinexx", "--out", out, "-q"], capture_output=True, text=True)
+    if r.returncode != 2 or "expected kfgins or rinex" not in r.stderr or os.path.exists(out):
+        fail("--export rinexx: exit %d, stderr %r" % (r.returncode, r.stderr))
+    files = []
+    for threads in ("1", "2"):
+        d = os.path.join(work, "threads" + threads)
+        r = subprocess.run([navsim, "run", scene, "--runs", "2", "--threads", threads, "--export", "rinex",
+                            "--export", "kfgins", "--out", d, "--force", "-q"], capture_output=True, text=True)
+        if r.returncode != 0:
+            fail("navsim run --threads %s: exit %d: %s" % (threads, r.returncode, r.stderr))
+        rd = os.path.join(d, "rinex")
+        files.append({n: open(os.path.join(rd, n), "rb").read() for n in sorted(os.listdir(rd))})
+        if not os.path.isdir(os.path.join(d, "kfgins")):
+            fail("--export rinex --export kfgins: no kfgins/ in %s" % d)
+    if files[0] != files[1] or len(files[0]) != 3:
+        fail("rinex/ differs between 1 and 2 threads or lacks files: %s" % sorted(files[0]))
+    print("contract: refusals exit 2 with nothing written; rinex/ bit-identical for 1 and 2 threads")
+
+
 def main():
     if len(sys.argv) < 4:
         print(__doc__)
         return 2
+    navsim, work = sys.argv[1], sys.argv[2]
+    os.makedirs(work, exist_ok=True)
+    contract(navsim, work, [a for a in sys.argv[3:] if a.endswith(".yaml")][0])
     if shutil.which("rnx2rtkp") is None:
         print("SKIP: rnx2rtkp (Debian package rtklib) is not installed: the RINEX export is not "
               "checked against RTKLIB")
         return 77
-    navsim, work = sys.argv[1], sys.argv[2]
-    os.makedirs(work, exist_ok=True)
     ideal = False
     max_m = 0.01
     weights_differ = False
