@@ -271,6 +271,7 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
     assert_same_double(wa->points[i].speed_mps, wb->points[i].speed_mps);
     assert_same_double(wa->points[i].time_s, wb->points[i].time_s);
     assert_same_euler(wa->points[i].attitude, wb->points[i].attitude);
+    assert_same_double(wa->points[i].hold_s, wb->points[i].hold_s);
   }
 
   const nav_traj_segments *sa = &ta->segments, *sb = &tb->segments;
@@ -2039,6 +2040,8 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
     w->points[i].speed_mps = fabs(any_double(x));
     w->points[i].time_s = fabs(any_double(x));
     w->points[i].attitude = (nav_euler){any_double(x), any_double(x), any_double(x)};
+    /* From a value already drawn, so the random stream of the other fields is unchanged. */
+    w->points[i].hold_s = i % 2 ? fmin(w->points[i].time_s, 1e6) : 0.0;
   }
   nav_traj_segments *s = &t->segments;
   s->allow_unconverged = splitmix64(x) & 1;
