@@ -1254,11 +1254,13 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
     bool *slow = keep; /* scratch: keep[] is cleared by build_attempt */
     size_t lo = 0, hi = 0;
     for (size_t k = 0; k < n; ++k) {
-      while (lo + 1 < k && P[lo + 1].t_s <= P[k].t_s - 0.5) ++lo;
-      if (lo >= k && k > 0) lo = k - 1;
+      /* a: the first point at most 0.5 s before k (k - 1 at the least); b: the last at most
+         0.5 s after it (k + 1 at the least). */
+      while (lo < k && P[lo].t_s < P[k].t_s - 0.5) ++lo;
+      const size_t a = k == 0 ? 0 : (lo < k ? lo : k - 1);
       if (hi < k) hi = k;
       while (hi + 1 < n && (hi == k || P[hi + 1].t_s <= P[k].t_s + 0.5)) ++hi;
-      const size_t a = k > 0 ? lo : k, b = hi;
+      const size_t b = hi;
       const double d = nav_vec3_norm(nav_vec3_sub(r[b], r[a])), dt = P[b].t_s - P[a].t_s;
       slow[k] = a != b && (dt > 0.0 ? d < opt->stop_speed_mps * dt : d < 1e-3);
     }
@@ -1295,7 +1297,7 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
       const size_t j = (size_t)stop_to[i];
       const bool same = m > 0 && nav_vec3_norm(nav_vec3_sub(r[i], r[idx[m - 1]])) < 1e-3;
       if (!same) idx[m++] = i;
-      hold[m - 1] += track->points[j].t_s - track->points[idx[m - 1]].t_s - hold[m - 1];
+      hold[m - 1] = track->points[j].t_s - track->points[idx[m - 1]].t_s;
       i = j;
       continue;
     }
