@@ -5,11 +5,11 @@
  *    trapezoidal speed profile (1.5 m/s^2) and stops of known length inside (on a straight line
  *    and at a right-angle corner), at the start and at the end, and several at once (one where the
  *    path turns back). A corner stop shorter than the turn in place needs (4 s, where 90 deg take
- *    5.33 s within the default angular limits) is held just long enough for the turn, and said so. The imported
- *    scene has one stop per track stop (hold_start_s, hold_s, hold_end_s) with the track's
- *    durations (to 2 ms: the times have milliseconds), lasts as long as the track (to 0.1 %,
- *    each part between stops is timed to 1e-4), and its vehicle is at rest, at the stop's place,
- *    in the middle of each track stop (the parts between stops are timed like the track's);
+ *    5.33 s within the default angular limits) is held just long enough for the turn, and said so. The
+ * imported scene has one stop per track stop (hold_start_s, hold_s, hold_end_s) with the track's durations
+ * (to 2 ms: the times have milliseconds), lasts as long as the track (to 0.1 %, each part between stops is
+ * timed to 1e-4), and its vehicle is at rest, at the stop's place, in the middle of each track stop (the
+ * parts between stops are timed like the track's);
  *  - --stop-min 0 keeps no stop, --stop-min above a stop's length drops that stop; bad values
  *    are exit 2;
  *  - the shared ADIS16465 reference (../shared/data/kfgins-matlab-dataset2-adis16465/truth.nav,
@@ -60,7 +60,7 @@ typedef struct drive {
   sample *s;
   size_t n, cap;
   double stop_t0[16], stop_t1[16], stop_n[16], stop_e[16]; /* track stops: start, end, place */
-  bool stop_corner[16];                                     /* the path turns at the stop */
+  bool stop_corner[16];                                    /* the path turns at the stop */
   int stops;
 } drive;
 
@@ -101,7 +101,8 @@ static drive make_drive(const piece *p, int np) {
       d.stop_t0[d.stops] = t;
       d.stop_n[d.stops] = n;
       d.stop_e[d.stops] = e;
-      for (int k = 1; k <= (int)p[i].stop_s; ++k) push(&d, t + k, n, e);
+      for (int k = 1; k <= (int)p[i].stop_s; ++k)
+        push(&d, t + k, n, e);
       t += p[i].stop_s;
       d.stop_t1[d.stops++] = t;
       continue;
@@ -139,7 +140,8 @@ static void write_gpx(const drive *d, const char *name) {
   snprintf(path, sizeof path, "%s/%s", WORK, name);
   FILE *f = fopen(path, "w");
   assert_non_null(f);
-  fprintf(f, "<?xml version=\"1.0\"?>\n<gpx version=\"1.1\" creator=\"test\"><trk><name>stops</name><trkseg>\n");
+  fprintf(f,
+          "<?xml version=\"1.0\"?>\n<gpx version=\"1.1\" creator=\"test\"><trk><name>stops</name><trkseg>\n");
   for (size_t i = 0; i < d->n; ++i) {
     double lat, lon;
     char ts[64];
@@ -156,8 +158,10 @@ static void write_kml(const drive *d, const char *name) {
   snprintf(path, sizeof path, "%s/%s", WORK, name);
   FILE *f = fopen(path, "w");
   assert_non_null(f);
-  fprintf(f, "<?xml version=\"1.0\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\" "
-             "xmlns:gx=\"http://www.google.com/kml/ext/2.2\"><Document><Placemark><name>drive</name><gx:Track>\n");
+  fprintf(
+      f,
+      "<?xml version=\"1.0\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\" "
+      "xmlns:gx=\"http://www.google.com/kml/ext/2.2\"><Document><Placemark><name>drive</name><gx:Track>\n");
   for (size_t i = 0; i < d->n; ++i) {
     char ts[64];
     iso_time(d->s[i].t, ts, sizeof ts);
@@ -199,8 +203,9 @@ static void check_import(const drive *d, const char *file, const char *extra) {
   nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import %s --out %s %s", file, out, extra);
   if (r->code != 0) fail_msg("import %s: exit %d\n%s", file, r->code, r->err);
   print_message("%s", r->out);
-  nav_test_assert_matches(r->out, "^stops      [0-9]+ \\([0-9.]+ s at rest: speed below 0.2 m/s for at least 3 s\\); "
-                                  "duration [0-9.]+ s, the track's [0-9.]+ s$");
+  nav_test_assert_matches(r->out,
+                          "^stops      [0-9]+ \\([0-9.]+ s at rest: speed below 0.2 m/s for at least 3 s\\); "
+                          "duration [0-9.]+ s, the track's [0-9.]+ s$");
   nav_scene *s = read_scene(out);
   double hold[16];
   const int k = scene_stops(s, hold);
@@ -231,8 +236,10 @@ static void check_import(const drive *d, const char *file, const char *extra) {
     double lat, lon;
     to_latlon(d->stop_n[i], d->stop_e[i], &lat, &lon);
     const double dn = (v.pos.lat_rad * 180.0 / PI - lat) * PI / 180.0 * R_EARTH_M;
-    const double de = (v.pos.lon_rad * 180.0 / PI - lon) * PI / 180.0 * R_EARTH_M * cos(LAT0_DEG * PI / 180.0);
-    print_message("  mid-stop %d: speed %.3g m/s, %.3f m from the stop\n", i, nav_vec3_norm(v.v_n_mps), hypot(dn, de));
+    const double de =
+        (v.pos.lon_rad * 180.0 / PI - lon) * PI / 180.0 * R_EARTH_M * cos(LAT0_DEG * PI / 180.0);
+    print_message("  mid-stop %d: speed %.3g m/s, %.3f m from the stop\n", i, nav_vec3_norm(v.v_n_mps),
+                  hypot(dn, de));
     assert_true(nav_vec3_norm(v.v_n_mps) < 1e-9);
     assert_true(hypot(dn, de) < 0.1);
   }
@@ -271,8 +278,8 @@ static void test_ends(void **state) {
 /* Several: start, three inside (one where the path turns back), end. */
 static void test_several(void **state) {
   (void)state;
-  const piece p[] = {{5, 0, 0, 0},  {0, 250, 0, 10},   {8, 0, 0, 0},  {0, 250, 270, 10}, {30, 0, 0, 0},
-                     {0, 120, 90, 8}, {25, 0, 0, 0}, {0, 300, 180, 12}, {6, 0, 0, 0}};
+  const piece p[] = {{5, 0, 0, 0},    {0, 250, 0, 10}, {8, 0, 0, 0},      {0, 250, 270, 10}, {30, 0, 0, 0},
+                     {0, 120, 90, 8}, {25, 0, 0, 0},   {0, 300, 180, 12}, {6, 0, 0, 0}};
   drive d = make_drive(p, 9);
   write_gpx(&d, "several.gpx");
   check_import(&d, "several.gpx", "");
@@ -286,7 +293,8 @@ static void test_several(void **state) {
   double hold[16];
   assert_int_equal(scene_stops(s, hold), 0);
   free(s);
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "import several.gpx --out long.yaml --stop-min 10 --accept-distance");
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "import several.gpx --out long.yaml --stop-min 10 --accept-distance");
   if (r->code != 0) fail_msg("--stop-min 10: exit %d\n%s", r->code, r->err);
   s = read_scene("long.yaml");
   assert_int_equal(scene_stops(s, hold), 2);
@@ -310,15 +318,16 @@ static void test_adis16465(void **state) {
   if (!in) fail_msg("cannot read %s", ADIS);
   FILE *f = fopen(WORK "/adis.gpx", "w");
   assert_non_null(f);
-  fprintf(f, "<?xml version=\"1.0\"?>\n<gpx version=\"1.1\" creator=\"test\"><trk><name>adis</name><trkseg>\n");
+  fprintf(f,
+          "<?xml version=\"1.0\"?>\n<gpx version=\"1.1\" creator=\"test\"><trk><name>adis</name><trkseg>\n");
   double runs[16][2];
   int nruns = 0;
   double run_t0 = NAN, t_first = NAN, t_last = NAN, t_prev = NAN;
   char line[512];
   while (fgets(line, sizeof line, in)) {
     double wk, t, lat, lon, h, vn, ve, vd, ro, pi, ya;
-    if (sscanf(line, "%lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", &wk, &t, &lat, &lon, &h, &vn, &ve, &vd, &ro, &pi,
-               &ya) != 11)
+    if (sscanf(line, "%lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", &wk, &t, &lat, &lon, &h, &vn, &ve, &vd,
+               &ro, &pi, &ya) != 11)
       continue;
     if (isnan(t_first)) t_first = t;
     t_last = t;
@@ -336,7 +345,9 @@ static void test_adis16465(void **state) {
     /* Seconds of the week from 2020-01-01T00:00:00Z, microseconds kept. */
     const long long us = llround(t * 1e6);
     const long long s = us / 1000000;
-    fprintf(f, "<trkpt lat=\"%.10f\" lon=\"%.10f\"><ele>%.4f</ele><time>2020-01-%02lldT%02lld:%02lld:%02lld.%06lldZ</time></trkpt>\n",
+    fprintf(f,
+            "<trkpt lat=\"%.10f\" "
+            "lon=\"%.10f\"><ele>%.4f</ele><time>2020-01-%02lldT%02lld:%02lld:%02lld.%06lldZ</time></trkpt>\n",
             lat, lon, h, 1 + s / 86400, (s / 3600) % 24, (s / 60) % 60, s % 60, us % 1000000);
   }
   if (!isnan(run_t0) && t_prev - run_t0 >= 3.0 && nruns < 16) {
@@ -354,17 +365,19 @@ static void test_adis16465(void **state) {
   assert_near(runs[0][0], t_first, 0.0);
   assert_near(runs[1][1], t_last, 0.0);
 
-  nav_cli_result *r = nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "import adis.gpx --out adis.yaml --accept-distance");
+  nav_cli_result *r =
+      nav_test_run_cli(NAVSIM_EXE, WORK, NULL, "import adis.gpx --out adis.yaml --accept-distance");
   if (r->code != 0) fail_msg("import: exit %d\n%s", r->code, r->err);
   print_message("%s", r->out);
   nav_scene *s = read_scene("adis.yaml");
   const nav_traj_waypoints *W = &s->trajectory.waypoints;
   double hold[16];
   assert_int_equal(scene_stops(s, hold), 2);
-  print_message("hold_start_s %.3f s (reference %.3f s), hold_end_s %.3f s (reference %.3f s), duration %.3f s "
-                "(reference %.3f s)\n",
-                W->hold_start_s, runs[0][1] - runs[0][0], W->hold_end_s, runs[1][1] - runs[1][0],
-                s->trajectory.duration_s, t_last - t_first);
+  print_message(
+      "hold_start_s %.3f s (reference %.3f s), hold_end_s %.3f s (reference %.3f s), duration %.3f s "
+      "(reference %.3f s)\n",
+      W->hold_start_s, runs[0][1] - runs[0][0], W->hold_end_s, runs[1][1] - runs[1][0],
+      s->trajectory.duration_s, t_last - t_first);
   assert_near(W->hold_start_s, runs[0][1] - runs[0][0], 0.5);
   assert_near(W->hold_end_s, runs[1][1] - runs[1][0], 0.5);
   assert_near(s->trajectory.duration_s, t_last - t_first, 1e-3 * (t_last - t_first));
