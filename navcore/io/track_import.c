@@ -1027,12 +1027,14 @@ static nav_status time_sections(const nav_geotrack *track, const int *src_of, na
   const double t0 = track->points[0].t_s;
   for (int a = 0; a + 1 < W->count;) {
     int b = a + 1;
-    while (b + 1 < W->count && !(W->points[b].hold_s > 0.0)) ++b;
+    while (b + 1 < W->count && !(W->points[b].hold_s > 0.0))
+      ++b;
     const double dep = a == 0 ? t0 + W->hold_start_s : wp_track_time(track, src_of, a) + W->points[a].hold_s;
     const double target = wp_track_time(track, src_of, b) - dep;
     const int n = b - a + 1;
     bool any_speed = false;
-    for (int j = a; j <= b; ++j) any_speed = any_speed || W->points[j].speed_mps > 0.0;
+    for (int j = a; j <= b; ++j)
+      any_speed = any_speed || W->points[j].speed_mps > 0.0;
     double f = 1.0; /* the last scaling applied */
     int halvings = 0;
     for (int it = 0; it < 40 && target > 0.0 && any_speed; ++it) {
@@ -1047,13 +1049,15 @@ static nav_status time_sections(const nav_geotrack *track, const int *src_of, na
         memcpy(&W->points[a], saved, (size_t)n * sizeof *saved);
         if (it == 0 || ++halvings > 6) break;
         f = 1.0 + 0.5 * (f - 1.0);
-        for (int j = a; j <= b; ++j) W->points[j].speed_mps *= f;
+        for (int j = a; j <= b; ++j)
+          W->points[j].speed_mps *= f;
         continue;
       }
       if (fabs(info.duration_s - target) <= 1e-4 * target) break;
       f = info.duration_s / target;
       memcpy(saved, &W->points[a], (size_t)n * sizeof *saved);
-      for (int j = a; j <= b; ++j) W->points[j].speed_mps *= f;
+      for (int j = a; j <= b; ++j)
+        W->points[j].speed_mps *= f;
     }
     a = b;
   }
@@ -1066,20 +1070,22 @@ static nav_status time_sections(const nav_geotrack *track, const int *src_of, na
  * fit its legs is merged with its neighbour into the corner of their extended legs (or dropped
  * when there is no such corner) until the plan is feasible. */
 static nav_status build_attempt(const nav_geotrack *track, const nav_track_import_options *opt, bool timed,
-                                const nav_vec3 *r, const size_t *idx, const double *hold, size_t m, double tol,
-                                bool *keep, int *src_of, nav_scene *sc, nav_track_import_report *rep, char *msg,
-                                size_t msg_size) {
+                                const nav_vec3 *r, const size_t *idx, const double *hold, size_t m,
+                                double tol, bool *keep, int *src_of, nav_scene *sc,
+                                nav_track_import_report *rep, char *msg, size_t msg_size) {
   memset(keep, 0, m * sizeof *keep);
   nav_status st = NAV_OK;
   /* Stops are kept: the thinning runs on each part between them, and a part that keeps no
      interior point keeps its middle one, so that no leg between two stops needs cruise_mps. */
   for (size_t a = 0; a + 1 < m && st == NAV_OK;) {
     size_t b = a + 1;
-    while (b + 1 < m && !(hold[b] > 0.0)) ++b;
+    while (b + 1 < m && !(hold[b] > 0.0))
+      ++b;
     st = douglas_peucker(r, idx + a, b - a + 1, tol, keep + a);
     if (hold[a] > 0.0 && hold[b] > 0.0 && b > a + 1) {
       bool any = false;
-      for (size_t k = a + 1; k < b; ++k) any = any || keep[k];
+      for (size_t k = a + 1; k < b; ++k)
+        any = any || keep[k];
       if (!any) keep[(a + b) / 2] = true;
     }
     a = b;
@@ -1118,9 +1124,12 @@ static nav_status build_attempt(const nav_geotrack *track, const nav_track_impor
     if (timed && w > 0 && k + 1 < m && p->speed_mps < 0.5) p->speed_mps = 0.5;
     if (hold[k] > 0.0) {
       p->speed_mps = 0.0;
-      if (k == 0) W->hold_start_s = hold[k];
-      else if (k + 1 == m) W->hold_end_s = hold[k];
-      else p->hold_s = hold[k];
+      if (k == 0)
+        W->hold_start_s = hold[k];
+      else if (k + 1 == m)
+        W->hold_end_s = hold[k];
+      else
+        p->hold_s = hold[k];
     }
     src_of[w++] = (int)idx[k];
   }
@@ -1155,8 +1164,8 @@ static nav_status build_attempt(const nav_geotrack *track, const nav_track_impor
     int j = (lprev < lnext) ? bad - 1 : bad;
     if (j < 1) j = bad;
     if (j + 2 >= W->count) j = bad - 1;
-    const bool stop_in_pair = j >= 1 && j + 1 < W->count &&
-                              (W->points[j].hold_s > 0.0 || W->points[j + 1].hold_s > 0.0);
+    const bool stop_in_pair =
+        j >= 1 && j + 1 < W->count && (W->points[j].hold_s > 0.0 || W->points[j + 1].hold_s > 0.0);
     if (stop_in_pair || !merge_corner(W, src_of, j)) drop_waypoint(W, src_of, bad);
     rep->merged++;
     if (W->count < 2) break;
@@ -1208,12 +1217,13 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   rep->max_dev_point = -1;
   if (!track || !opt || !scene) return NAV_ERR_INVALID_ARG;
   rep->points_in = track->count;
-  if (!(opt->speed_mps > 0) || !isfinite(opt->speed_mps) || !(opt->tolerance_m >= 0) || !isfinite(opt->tolerance_m) ||
-      opt->max_merges < 0 || !(opt->stop_speed_mps >= 0) || !isfinite(opt->stop_speed_mps) ||
-      !(opt->stop_min_s >= 0) || !isfinite(opt->stop_min_s)) {
+  if (!(opt->speed_mps > 0) || !isfinite(opt->speed_mps) || !(opt->tolerance_m >= 0) ||
+      !isfinite(opt->tolerance_m) || opt->max_merges < 0 || !(opt->stop_speed_mps >= 0) ||
+      !isfinite(opt->stop_speed_mps) || !(opt->stop_min_s >= 0) || !isfinite(opt->stop_min_s)) {
     if (msg)
-      snprintf(msg, msg_size, "speed must be > 0, the tolerance >= 0, max_merges >= 0 and the stop threshold "
-                              "and minimum duration >= 0");
+      snprintf(msg, msg_size,
+               "speed must be > 0, the tolerance >= 0, max_merges >= 0 and the stop threshold "
+               "and minimum duration >= 0");
     return NAV_ERR_INVALID_ARG;
   }
   if (track->count < 2) {
@@ -1227,7 +1237,7 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   size_t *idx = malloc(n * sizeof *idx);
   bool *keep = calloc(n, sizeof *keep);
   int *src_of = malloc(n * sizeof *src_of);
-  double *hold = calloc(n, sizeof *hold); /* per distinct point: the stop that starts there [s] */
+  double *hold = calloc(n, sizeof *hold);      /* per distinct point: the stop that starts there [s] */
   long *stop_to = malloc(n * sizeof *stop_to); /* per track point: the last point of its stop, or -1 */
   nav_status st = NAV_OK;
   if (!sc || !r || !idx || !keep || !src_of || !hold || !stop_to) {
@@ -1248,7 +1258,8 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
      but a few cm/s over a second. A run is then widened by the neighbouring intervals whose own
      speed is below the threshold, so that at 1 Hz it starts at the arrival and ends at the
      departure rather than a point inside them. */
-  for (size_t i = 0; i < n; ++i) stop_to[i] = -1;
+  for (size_t i = 0; i < n; ++i)
+    stop_to[i] = -1;
   if (timed && opt->stop_min_s > 0.0) {
     const nav_geopoint *P = track->points;
     bool *slow = keep; /* scratch: keep[] is cleared by build_attempt */
@@ -1256,10 +1267,12 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
     for (size_t k = 0; k < n; ++k) {
       /* a: the first point at most 0.5 s before k (k - 1 at the least); b: the last at most
          0.5 s after it (k + 1 at the least). */
-      while (lo < k && P[lo].t_s < P[k].t_s - 0.5) ++lo;
+      while (lo < k && P[lo].t_s < P[k].t_s - 0.5)
+        ++lo;
       const size_t a = k == 0 ? 0 : (lo < k ? lo : k - 1);
       if (hi < k) hi = k;
-      while (hi + 1 < n && (hi == k || P[hi + 1].t_s <= P[k].t_s + 0.5)) ++hi;
+      while (hi + 1 < n && (hi == k || P[hi + 1].t_s <= P[k].t_s + 0.5))
+        ++hi;
       const size_t b = hi;
       const double d = nav_vec3_norm(nav_vec3_sub(r[b], r[a])), dt = P[b].t_s - P[a].t_s;
       slow[k] = a != b && (dt > 0.0 ? d < opt->stop_speed_mps * dt : d < 1e-3);
@@ -1271,7 +1284,8 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
         continue;
       }
       size_t j = i;
-      while (j + 1 < n && slow[j + 1]) ++j;
+      while (j + 1 < n && slow[j + 1])
+        ++j;
       const size_t next = j + 1;
       size_t a = i, b = j;
       while (a > floor_idx &&
@@ -1312,7 +1326,8 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
     st = NAV_ERR_INVALID_ARG;
     goto done;
   }
-  st = build_attempt(track, opt, timed, r, idx, hold, m, opt->tolerance_m, keep, src_of, sc, rep, msg, msg_size);
+  st = build_attempt(track, opt, timed, r, idx, hold, m, opt->tolerance_m, keep, src_of, sc, rep, msg,
+                     msg_size);
   if (st != NAV_OK) goto done;
   rep->max_dev_point = -1;
   st = flown_deviation(sc, r, n, &rep->max_dev_m, &rep->max_dev_point);

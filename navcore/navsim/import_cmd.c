@@ -26,7 +26,8 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_import =
     "usage: navsim import FILE --out SCENE.yaml [--speed M/S] [--name NAME] [--tolerance M] [--no-time]\n"
-    "                     [--no-merge] [--track NAME|INDEX] [--format gpx|kml|motion_def] [--template SCENE] [--aircraft]\n"
+    "                     [--no-merge] [--track NAME|INDEX] [--format gpx|kml|motion_def] [--template SCENE] "
+    "[--aircraft]\n"
     "                     [--accept-distance] [--stop-speed M/S] [--stop-min S]\n"
     "\n"
     "Turn a track into a scene trajectory and write a complete scene file:\n"
@@ -166,7 +167,8 @@ int navsim_import(int argc, char **argv) {
       accept_distance = true;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--speed") == 0 || strcmp(a, "--name") == 0 ||
                strcmp(a, "--tolerance") == 0 || strcmp(a, "--track") == 0 || strcmp(a, "--format") == 0 ||
-               strcmp(a, "--template") == 0 || strcmp(a, "--stop-speed") == 0 || strcmp(a, "--stop-min") == 0) {
+               strcmp(a, "--template") == 0 || strcmp(a, "--stop-speed") == 0 ||
+               strcmp(a, "--stop-min") == 0) {
       if (!navsim_need_value("import", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (strcmp(a, "--out") == 0) out = v;
@@ -372,7 +374,8 @@ int navsim_import(int argc, char **argv) {
            in, rep.points_in, rep.waypoints, opt.tolerance_m, rep.merged, rep.merged == 1 ? "" : "s", rep.length_m,
            rep.timed ? "speeds from the track's times" : "constant speed", rep.duration_s, rep.max_dev_m);
     if (rep.timed) {
-      printf("stops      %d (%.1f s at rest: speed below %g m/s for at least %g s); duration %.3f s, the track's "
+      printf("stops      %d (%.1f s at rest: speed below %g m/s for at least %g s); duration %.3f s, the "
+             "track's "
              "%.3f s\n",
              rep.stops, rep.stop_s, opt.stop_speed_mps, opt.stop_min_s, rep.duration_s, rep.track_duration_s);
       if (rep.stops_lengthened > 0)

@@ -890,7 +890,8 @@ int navsim_replay(int argc, char **argv) {
     if (n > 0 && (size_t)n < sizeof init_beside && is_regular_file(init_beside)) {
       init = init_beside;
       if (!quiet)
-        fprintf(stderr, "navsim replay: initial state from %s (beside --imu; --init none: from the reference)\n",
+        fprintf(stderr,
+                "navsim replay: initial state from %s (beside --imu; --init none: from the reference)\n",
                 init);
     }
   }

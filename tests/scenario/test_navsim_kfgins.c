@@ -341,8 +341,8 @@ static void replay_without_init(void **state) {
                                      SCENE));
   table d = load(WORK "/DI/nav.csv", NAV_COLS, true), r = load(WORK "/RI/nav.csv", NAV_COLS, true);
   nav_diff df = compare_nav(&d, &r);
-  print_message("--ideal, --init none: %zu epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n", df.epochs,
-                df.pos_m, df.vel_mps, df.att_rad);
+  print_message("--ideal, --init none: %zu epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n",
+                df.epochs, df.pos_m, df.vel_mps, df.att_rad);
   assert_int_equal(df.missing, 0);
   assert_true(df.pos_m <= 1e-3 && df.vel_mps <= 1e-3 && df.att_rad <= 1e-6);
   free(d.v);

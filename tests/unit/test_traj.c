@@ -1296,7 +1296,6 @@ static void test_closure_wgs84_long_drive(void **state) {
   free(s);
 }
 
-
 /* ------------------------------------------------------------------ stops (hold_s) */
 
 /* A car with three interior stops (hold_s): one on a straight line, one at a right-angle corner
@@ -1331,16 +1330,18 @@ static void test_waypoints_stops(void **state) {
     const nav_traj_waypoints *W = &s->trajectory.waypoints;
     if (modes[mi] == NAV_WP_ATT_EULER)
       for (int k = 0; k < W->count; ++k)
-        s->trajectory.waypoints.points[k].attitude = (nav_euler){0.02 * k, -0.01 * k, remainder(1.3 * k, NAV_TWO_PI)};
+        s->trajectory.waypoints.points[k].attitude =
+            (nav_euler){0.02 * k, -0.01 * k, remainder(1.3 * k, NAV_TWO_PI)};
     assert_int_equal(nav_scene_validate(s, NULL, NULL), NAV_OK);
     nav_traj_model m;
     create_model(s, &m);
     const mismatch mm = check_model(s, &m, 0.0937);
     double tw[NAV_MAX_WAYPOINTS];
     assert_int_equal(nav_traj_waypoints_times(m.self, tw, NAV_MAX_WAYPOINTS), (size_t)W->count);
-    print_message("stops, mode %d: %.3f s; arrivals %.3f %.3f %.3f s; worst |v-fd| %.2e, |a-fd| %.2e, |w-fd| %.2e, "
-                  "|dw-fd| %.2e\n",
-                  (int)modes[mi], m.duration_s, tw[2], tw[3], tw[5], mm.v, mm.a, mm.w, mm.dw);
+    print_message(
+        "stops, mode %d: %.3f s; arrivals %.3f %.3f %.3f s; worst |v-fd| %.2e, |a-fd| %.2e, |w-fd| %.2e, "
+        "|dw-fd| %.2e\n",
+        (int)modes[mi], m.duration_s, tw[2], tw[3], tw[5], mm.v, mm.a, mm.w, mm.dw);
     /* At rest on the waypoint for the whole hold, moving just outside it. */
     for (int i = 2; i <= 5; ++i) {
       const double hold = W->points[i].hold_s;
@@ -1375,7 +1376,8 @@ static void test_waypoints_stops(void **state) {
     /* Each second added to every hold adds exactly one second per stop. */
     nav_scene *s2 = car_with_stops(modes[mi]);
     if (modes[mi] == NAV_WP_ATT_EULER)
-      for (int k = 0; k < W->count; ++k) s2->trajectory.waypoints.points[k].attitude = W->points[k].attitude;
+      for (int k = 0; k < W->count; ++k)
+        s2->trajectory.waypoints.points[k].attitude = W->points[k].attitude;
     for (int i = 1; i + 1 < s2->trajectory.waypoints.count; ++i)
       if (s2->trajectory.waypoints.points[i].hold_s > 0.0) s2->trajectory.waypoints.points[i].hold_s += 1.0;
     nav_traj_script_info info;
@@ -1408,9 +1410,11 @@ static void test_waypoints_stops_timed(void **state) {
   create_model(s, &m);
   double tw[NAV_MAX_WAYPOINTS];
   assert_int_equal(nav_traj_waypoints_times(m.self, tw, NAV_MAX_WAYPOINTS), 4u);
-  for (int i = 0; i < 4; ++i) assert_near(tw[i], W->hold_start_s + W->points[i].time_s, 1e-6);
+  for (int i = 0; i < 4; ++i)
+    assert_near(tw[i], W->hold_start_s + W->points[i].time_s, 1e-6);
   assert_near(m.duration_s, 101.0, 1e-6);
-  for (double t = tw[2]; t <= tw[2] + 8.0; t += 0.05) assert_vec3_near(kin_at(&m, t).v_ned_mps, nav_vec3_zero(), 1e-12);
+  for (double t = tw[2]; t <= tw[2] + 8.0; t += 0.05)
+    assert_vec3_near(kin_at(&m, t).v_ned_mps, nav_vec3_zero(), 1e-12);
   m.destroy(m.self);
 
   /* Errors: a hold with a speed, a hold on the first waypoint, a hold too short to turn in place. */
@@ -1441,9 +1445,10 @@ static void test_closure_stops(void **state) {
     assert_int_equal(nav_motiondef_script_summary(s, &sum, msg, sizeof msg), NAV_OK);
     s->trajectory.duration_s = sum.duration_s;
     const closure c = run_closure(s, cfg, false);
-    print_message("flat closure, waypoints with 3 stops (mode %d), %.1f s at 100 Hz, high order: pos h %.2e m v "
-                  "%.2e m (max h %.2e), vel %.2e m/s, att %.2e rad\n",
-                  (int)modes[mi], sum.duration_s, c.pos_h_m, c.pos_v_m, c.max_pos_h_m, c.vel_mps, c.att_rad);
+    print_message(
+        "flat closure, waypoints with 3 stops (mode %d), %.1f s at 100 Hz, high order: pos h %.2e m v "
+        "%.2e m (max h %.2e), vel %.2e m/s, att %.2e rad\n",
+        (int)modes[mi], sum.duration_s, c.pos_h_m, c.pos_v_m, c.max_pos_h_m, c.vel_mps, c.att_rad);
     assert_true(c.pos_h_m < 1e-4 && c.pos_v_m < 1e-4 && c.vel_mps < 1e-5 && c.att_rad < 1e-7);
     free(s);
   }

@@ -284,8 +284,8 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
     }
   for (int i = 1; i + 1 < N; ++i)
     if (hold[i] > 0.0 && v[i] != 0.0) {
-      st = fail(&pl, i, "waypoint %d: hold_s %g s needs speed 0 at the waypoint (speed_mps is %g)", i, hold[i],
-                v[i]);
+      st = fail(&pl, i, "waypoint %d: hold_s %g s needs speed 0 at the waypoint (speed_mps is %g)", i,
+                hold[i], v[i]);
       goto cleanup;
     }
   if (W->hold_start_s > 0.0 && v[0] != 0.0) {
@@ -331,7 +331,8 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
         st = fail(&pl, i,
                   "waypoint %d: turning %.4g deg in place takes %.4g s within max_rate_rps %g, "
                   "max_ang_accel_rps2 %g and max_ang_jerk_rps3 %g, longer than hold_s %g s",
-                  i, t->beta * RAD2DEG, d, L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3, hold[i]);
+                  i, t->beta * RAD2DEG, d, L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3,
+                  hold[i]);
         goto cleanup;
       }
       continue;
