@@ -107,6 +107,9 @@ void DeleteWaypoint(SceneDocument *doc, int index) {
       w.points[0].speed_mps = 0.0;
       w.points[w.count - 1].speed_mps = 0.0;
       w.points[0].time_s = 0.0;
+      // A stop (hold_s) is for interior waypoints; the ends hold with hold_start_s / hold_end_s.
+      w.points[0].hold_s = 0.0;
+      w.points[w.count - 1].hold_s = 0.0;
     }
   });
 }

@@ -271,6 +271,15 @@ static const nav_io_field k_point[] = {
      .offset = WOFF(time_s),
      .scale = 1.0,
      .write_if = wp_time_written},
+    {.key = "hold_s",
+     .doc = "stationary time at an interior waypoint: the vehicle stops there (speed 0) this long and turns "
+            "in place within it",
+     .kind = NAV_IO_DOUBLE,
+     .flags = NONNEG | NAV_IO_MAX_LE,
+     .offset = WOFF(hold_s),
+     .scale = 1.0,
+     .max = NAV_SCENE_MAX_DURATION_S,
+     .write_if = if_changed},
     {.key = "attitude",
      .kind = NAV_IO_SECTION,
      .flags = NAV_IO_FLOW,
@@ -379,7 +388,7 @@ static bool same_point(const nav_waypoint *a, const nav_waypoint *b) {
   return same_vec3(a->r_ned_m, b->r_ned_m) && same_bits(a->speed_mps, b->speed_mps) &&
          same_bits(a->time_s, b->time_s) && same_bits(a->attitude.roll_rad, b->attitude.roll_rad) &&
          same_bits(a->attitude.pitch_rad, b->attitude.pitch_rad) &&
-         same_bits(a->attitude.yaw_rad, b->attitude.yaw_rad);
+         same_bits(a->attitude.yaw_rad, b->attitude.yaw_rad) && same_bits(a->hold_s, b->hold_s);
 }
 
 static bool same_points(const nav_io_field *f, const void *a, const void *b) {

@@ -833,6 +833,11 @@ nav_track_import_options nav_track_import_options_default(void) {
   o.use_time = true;
   o.attitude_mode = NAV_WP_ATT_GROUND;
   o.limits = d.trajectory.waypoints.limits;
+  /* A car at rest logged by a post-processed reference moves by well under 0.1 m/s; 0.2 m/s
+     also takes a receiver's jitter of a few centimetres per second at rest. 3 s separates a
+     stop from slowing down through a turn or a queue. */
+  o.stop_speed_mps = 0.2;
+  o.stop_min_s = 3.0;
   return o;
 }
 
@@ -881,12 +886,24 @@ static nav_status douglas_peucker(const nav_vec3 *r, const size_t *idx, size_t n
 }
 
 /* Speed of the track at distinct point k (index into idx): path length over time across the
- * neighbouring points (two on each side where there are). */
-static double track_speed(const nav_geotrack *track, const nav_vec3 *r, const size_t *idx, size_t m, size_t k) {
-  const size_t k0 = k >= 2 ? k - 2 : 0, k1 = k + 2 < m ? k + 2 : m - 1;
+ * neighbouring points (two on each side where there are), not across a stop (hold[q] > 0: a
+ * stop's entry may end the window, with its departure time). */
+static double track_speed(const nav_geotrack *track, const nav_vec3 *r, const size_t *idx, const double *hold,
+                          size_t m, size_t k) {
+  size_t k0 = k >= 2 ? k - 2 : 0, k1 = k + 2 < m ? k + 2 : m - 1;
+  for (size_t q = k; q > k0; --q)
+    if (hold[q - 1] > 0.0) {
+      k0 = q - 1;
+      break;
+    }
+  for (size_t q = k + 1; q <= k1; ++q)
+    if (hold[q] > 0.0) {
+      k1 = q;
+      break;
+    }
   double L = 0;
   for (size_t q = k0; q < k1; ++q) L += nav_vec3_norm(nav_vec3_sub(r[idx[q + 1]], r[idx[q]]));
-  const double T = track->points[idx[k1]].t_s - track->points[idx[k0]].t_s;
+  const double T = track->points[idx[k1]].t_s - (track->points[idx[k0]].t_s + hold[k0]);
   return T > 0 ? L / T : 0.0;
 }
 
@@ -980,14 +997,99 @@ static nav_status flown_deviation(const nav_scene *sc, const nav_vec3 *r, size_t
   return st;
 }
 
+/* Time of arrival at waypoint j on the track [s] (its track point's time). */
+static double wp_track_time(const nav_geotrack *track, const int *src_of, int j) {
+  return track->points[src_of[j]].t_s;
+}
+
+/*
+ * Each part of a timed track between two stops (and the track's ends) is independent of the
+ * others: it starts and ends at rest, or at the track's ends. Its speeds (those > 0) are scaled
+ * until its planned duration matches the track's time from the departure at its start to the
+ * arrival at its end (the fixed point of D(f) = target, by f <- f D / target, which converges
+ * fast because D is nearly proportional to 1/f; a scaling the limits cannot fly is undone and
+ * the part keeps its last feasible speeds). A part that is two stops with nothing between them
+ * (no interior point on the track) is flown at cruise_mps and not scaled.
+ */
+static nav_status time_sections(const nav_geotrack *track, const int *src_of, nav_scene *sc) {
+  nav_traj_waypoints *W = &sc->trajectory.waypoints;
+  nav_scene *part = malloc(sizeof *part);
+  nav_waypoint *saved = malloc((size_t)W->count * sizeof *saved);
+  if (!part || !saved) {
+    free(part);
+    free(saved);
+    return NAV_ERR_NO_MEMORY;
+  }
+  *part = *sc;
+  nav_traj_waypoints *P = &part->trajectory.waypoints;
+  P->hold_start_s = 0.0;
+  P->hold_end_s = 0.0;
+  const double t0 = track->points[0].t_s;
+  for (int a = 0; a + 1 < W->count;) {
+    int b = a + 1;
+    while (b + 1 < W->count && !(W->points[b].hold_s > 0.0))
+      ++b;
+    const double dep = a == 0 ? t0 + W->hold_start_s : wp_track_time(track, src_of, a) + W->points[a].hold_s;
+    const double target = wp_track_time(track, src_of, b) - dep;
+    const int n = b - a + 1;
+    bool any_speed = false;
+    for (int j = a; j <= b; ++j)
+      any_speed = any_speed || W->points[j].speed_mps > 0.0;
+    double f = 1.0; /* the last scaling applied */
+    int halvings = 0;
+    for (int it = 0; it < 40 && target > 0.0 && any_speed; ++it) {
+      memcpy(P->points, &W->points[a], (size_t)n * sizeof *P->points);
+      P->points[0].hold_s = 0.0;
+      P->points[n - 1].hold_s = 0.0;
+      P->count = n;
+      nav_traj_script_info info;
+      if (nav_traj_waypoints_plan_info(part, &info, NULL, NULL, 0) != NAV_OK) {
+        /* The last scaling cannot be flown: back to the speeds before it, and try half of it
+           (a few times; then the part keeps its last feasible speeds). */
+        memcpy(&W->points[a], saved, (size_t)n * sizeof *saved);
+        if (it == 0 || ++halvings > 6) break;
+        f = 1.0 + 0.5 * (f - 1.0);
+        for (int j = a; j <= b; ++j)
+          W->points[j].speed_mps *= f;
+        continue;
+      }
+      if (fabs(info.duration_s - target) <= 1e-4 * target) break;
+      f = info.duration_s / target;
+      memcpy(saved, &W->points[a], (size_t)n * sizeof *saved);
+      for (int j = a; j <= b; ++j)
+        W->points[j].speed_mps *= f;
+    }
+    a = b;
+  }
+  free(part);
+  free(saved);
+  return NAV_OK;
+}
+
 /* Thin with @p tol, build the waypoints into @p sc, and plan them; an interior turn that does not
  * fit its legs is merged with its neighbour into the corner of their extended legs (or dropped
  * when there is no such corner) until the plan is feasible. */
 static nav_status build_attempt(const nav_geotrack *track, const nav_track_import_options *opt, bool timed,
-                                const nav_vec3 *r, const size_t *idx, size_t m, double tol, bool *keep, int *src_of,
-                                nav_scene *sc, nav_track_import_report *rep, char *msg, size_t msg_size) {
+                                const nav_vec3 *r, const size_t *idx, const double *hold, size_t m,
+                                double tol, bool *keep, int *src_of, nav_scene *sc,
+                                nav_track_import_report *rep, char *msg, size_t msg_size) {
   memset(keep, 0, m * sizeof *keep);
-  nav_status st = douglas_peucker(r, idx, m, tol, keep);
+  nav_status st = NAV_OK;
+  /* Stops are kept: the thinning runs on each part between them, and a part that keeps no
+     interior point keeps its middle one, so that no leg between two stops needs cruise_mps. */
+  for (size_t a = 0; a + 1 < m && st == NAV_OK;) {
+    size_t b = a + 1;
+    while (b + 1 < m && !(hold[b] > 0.0))
+      ++b;
+    st = douglas_peucker(r, idx + a, b - a + 1, tol, keep + a);
+    if (hold[a] > 0.0 && hold[b] > 0.0 && b > a + 1) {
+      bool any = false;
+      for (size_t k = a + 1; k < b; ++k)
+        any = any || keep[k];
+      if (!any) keep[(a + b) / 2] = true;
+    }
+    a = b;
+  }
   if (st != NAV_OK) return st;
   int count = 0;
   for (size_t k = 0; k < m; ++k)
@@ -1016,9 +1118,19 @@ static nav_status build_attempt(const nav_geotrack *track, const nav_track_impor
     nav_waypoint *p = &W->points[w];
     memset(p, 0, sizeof *p);
     p->r_ned_m = r[idx[k]];
-    p->speed_mps = timed ? track_speed(track, r, idx, m, k) : opt->speed_mps;
-    /* A fly-by turn needs some speed: a stop inside the track is driven through slowly. */
+    p->speed_mps = timed ? track_speed(track, r, idx, hold, m, k) : opt->speed_mps;
+    /* A fly-by turn needs some speed: a slow part inside the track that is not a stop is
+       driven through slowly. */
     if (timed && w > 0 && k + 1 < m && p->speed_mps < 0.5) p->speed_mps = 0.5;
+    if (hold[k] > 0.0) {
+      p->speed_mps = 0.0;
+      if (k == 0)
+        W->hold_start_s = hold[k];
+      else if (k + 1 == m)
+        W->hold_end_s = hold[k];
+      else
+        p->hold_s = hold[k];
+    }
     src_of[w++] = (int)idx[k];
   }
   rep->merged = 0;
@@ -1035,13 +1147,26 @@ static nav_status build_attempt(const nav_geotrack *track, const nav_track_impor
       snprintf(first_msg, sizeof first_msg, "%s", pm);
     }
     if (bad < 1 || bad >= W->count - 1 || rep->merged >= opt->max_merges) break;
-    /* Merge the turn with the neighbour across its shorter leg. */
+    if (W->points[bad].hold_s > 0.0) {
+      /* A stop too short to turn in place there: held longer (the part after it is then timed
+         to arrive as the track does); a stop is never merged away. */
+      const char *need = strstr(pm, "in place takes ");
+      if (need == NULL || W->points[bad].hold_s > 1e6) break;
+      /* The planner's message gives the turn's duration (4 digits): a little more than that. */
+      const double need_s = strtod(need + strlen("in place takes "), NULL);
+      W->points[bad].hold_s = fmax(1.01 * W->points[bad].hold_s, 1.001 * need_s);
+      rep->stops_lengthened++;
+      continue;
+    }
+    /* Merge the turn with the neighbour across its shorter leg (never a stop). */
     const double lprev = nav_vec3_norm(nav_vec3_sub(W->points[bad].r_ned_m, W->points[bad - 1].r_ned_m));
     const double lnext = nav_vec3_norm(nav_vec3_sub(W->points[bad + 1].r_ned_m, W->points[bad].r_ned_m));
     int j = (lprev < lnext) ? bad - 1 : bad;
     if (j < 1) j = bad;
     if (j + 2 >= W->count) j = bad - 1;
-    if (!merge_corner(W, src_of, j)) drop_waypoint(W, src_of, bad);
+    const bool stop_in_pair =
+        j >= 1 && j + 1 < W->count && (W->points[j].hold_s > 0.0 || W->points[j + 1].hold_s > 0.0);
+    if (stop_in_pair || !merge_corner(W, src_of, j)) drop_waypoint(W, src_of, bad);
     rep->merged++;
     if (W->count < 2) break;
   }
@@ -1052,6 +1177,21 @@ static nav_status build_attempt(const nav_geotrack *track, const nav_track_impor
                rep->merged ? " (still infeasible after merging turns)" : "");
     return st;
   }
+  if (timed) {
+    st = time_sections(track, src_of, sc);
+    if (st == NAV_OK) st = nav_traj_waypoints_plan_info(sc, &info, NULL, pm, sizeof pm);
+    if (st != NAV_OK) {
+      if (msg) snprintf(msg, msg_size, "the waypoint trajectory is infeasible after timing it: %s", pm);
+      return st;
+    }
+  }
+  rep->stops = (W->hold_start_s > 0.0) + (W->hold_end_s > 0.0);
+  rep->stop_s = W->hold_start_s + W->hold_end_s;
+  for (int k = 0; k < W->count; ++k)
+    if (W->points[k].hold_s > 0.0) {
+      rep->stops++;
+      rep->stop_s += W->points[k].hold_s;
+    }
   for (int k = 1; k < W->count; ++k)
     rep->length_m += nav_vec3_norm(nav_vec3_sub(W->points[k].r_ned_m, W->points[k - 1].r_ned_m));
   sc->trajectory.duration_s = info.duration_s;
@@ -1077,9 +1217,13 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   rep->max_dev_point = -1;
   if (!track || !opt || !scene) return NAV_ERR_INVALID_ARG;
   rep->points_in = track->count;
-  if (!(opt->speed_mps > 0) || !isfinite(opt->speed_mps) || !(opt->tolerance_m >= 0) || !isfinite(opt->tolerance_m) ||
-      opt->max_merges < 0) {
-    if (msg) snprintf(msg, msg_size, "speed must be > 0, the tolerance >= 0 and max_merges >= 0");
+  if (!(opt->speed_mps > 0) || !isfinite(opt->speed_mps) || !(opt->tolerance_m >= 0) ||
+      !isfinite(opt->tolerance_m) || opt->max_merges < 0 || !(opt->stop_speed_mps >= 0) ||
+      !isfinite(opt->stop_speed_mps) || !(opt->stop_min_s >= 0) || !isfinite(opt->stop_min_s)) {
+    if (msg)
+      snprintf(msg, msg_size,
+               "speed must be > 0, the tolerance >= 0, max_merges >= 0 and the stop threshold "
+               "and minimum duration >= 0");
     return NAV_ERR_INVALID_ARG;
   }
   if (track->count < 2) {
@@ -1093,8 +1237,10 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   size_t *idx = malloc(n * sizeof *idx);
   bool *keep = calloc(n, sizeof *keep);
   int *src_of = malloc(n * sizeof *src_of);
+  double *hold = calloc(n, sizeof *hold);      /* per distinct point: the stop that starts there [s] */
+  long *stop_to = malloc(n * sizeof *stop_to); /* per track point: the last point of its stop, or -1 */
   nav_status st = NAV_OK;
-  if (!sc || !r || !idx || !keep || !src_of) {
+  if (!sc || !r || !idx || !keep || !src_of || !hold || !stop_to) {
     st = NAV_ERR_NO_MEMORY;
     goto done;
   }
@@ -1105,11 +1251,72 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
   sc->earth.origin_h_m = track->points[0].pos.h_m;
   const nav_frame fr = nav_frame_from_scene(sc);
   for (size_t i = 0; i < n; ++i) r[i] = nav_frame_geodetic_to_local(&fr, track->points[i].pos);
-  /* Drop repeated points (a vehicle at rest repeats its position); the true end is kept. */
+  if (timed) rep->track_duration_s = track->points[n - 1].t_s - track->points[0].t_s;
+  /* Stops of a timed track: runs of points whose speed is below stop_speed_mps, lasting at least
+     stop_min_s. A point's speed is its displacement over +-0.5 s (at least to its neighbours):
+     at 10 Hz a receiver's centimetres of jitter at rest are 0.2 m/s from one point to the next,
+     but a few cm/s over a second. A run is then widened by the neighbouring intervals whose own
+     speed is below the threshold, so that at 1 Hz it starts at the arrival and ends at the
+     departure rather than a point inside them. */
+  for (size_t i = 0; i < n; ++i)
+    stop_to[i] = -1;
+  if (timed && opt->stop_min_s > 0.0) {
+    const nav_geopoint *P = track->points;
+    bool *slow = keep; /* scratch: keep[] is cleared by build_attempt */
+    size_t lo = 0, hi = 0;
+    for (size_t k = 0; k < n; ++k) {
+      /* a: the first point at most 0.5 s before k (k - 1 at the least); b: the last at most
+         0.5 s after it (k + 1 at the least). */
+      while (lo < k && P[lo].t_s < P[k].t_s - 0.5)
+        ++lo;
+      const size_t a = k == 0 ? 0 : (lo < k ? lo : k - 1);
+      if (hi < k) hi = k;
+      while (hi + 1 < n && (hi == k || P[hi + 1].t_s <= P[k].t_s + 0.5))
+        ++hi;
+      const size_t b = hi;
+      const double d = nav_vec3_norm(nav_vec3_sub(r[b], r[a])), dt = P[b].t_s - P[a].t_s;
+      slow[k] = a != b && (dt > 0.0 ? d < opt->stop_speed_mps * dt : d < 1e-3);
+    }
+    size_t floor_idx = 0; /* a run is never widened back into the previous stop */
+    for (size_t i = 0; i < n;) {
+      if (!slow[i]) {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j + 1 < n && slow[j + 1])
+        ++j;
+      const size_t next = j + 1;
+      size_t a = i, b = j;
+      while (a > floor_idx &&
+             nav_vec3_norm(nav_vec3_sub(r[a], r[a - 1])) < opt->stop_speed_mps * (P[a].t_s - P[a - 1].t_s))
+        --a;
+      while (b + 1 < n &&
+             nav_vec3_norm(nav_vec3_sub(r[b + 1], r[b])) < opt->stop_speed_mps * (P[b + 1].t_s - P[b].t_s))
+        ++b;
+      if (b > a && P[b].t_s - P[a].t_s >= opt->stop_min_s) {
+        stop_to[a] = (long)b;
+        floor_idx = b;
+        i = b + 1;
+      } else {
+        i = next;
+      }
+    }
+  }
+  /* Drop repeated points (a vehicle at rest repeats its position); the true end is kept. A stop
+     is one point, its first, held for the stop's duration; its other points are at rest. */
   size_t m = 0;
   for (size_t i = 0; i < n; ++i) {
+    if (stop_to[i] >= 0) {
+      const size_t j = (size_t)stop_to[i];
+      const bool same = m > 0 && nav_vec3_norm(nav_vec3_sub(r[i], r[idx[m - 1]])) < 1e-3;
+      if (!same) idx[m++] = i;
+      hold[m - 1] = track->points[j].t_s - track->points[idx[m - 1]].t_s;
+      i = j;
+      continue;
+    }
     if (m > 0 && nav_vec3_norm(nav_vec3_sub(r[i], r[idx[m - 1]])) < 1e-3) {
-      if (i == n - 1) idx[m - 1] = i;
+      if (i == n - 1 && !(hold[m - 1] > 0.0)) idx[m - 1] = i;
       continue;
     }
     idx[m++] = i;
@@ -1119,7 +1326,8 @@ nav_status nav_geotrack_to_scene(const nav_geotrack *track, const nav_track_impo
     st = NAV_ERR_INVALID_ARG;
     goto done;
   }
-  st = build_attempt(track, opt, timed, r, idx, m, opt->tolerance_m, keep, src_of, sc, rep, msg, msg_size);
+  st = build_attempt(track, opt, timed, r, idx, hold, m, opt->tolerance_m, keep, src_of, sc, rep, msg,
+                     msg_size);
   if (st != NAV_OK) goto done;
   rep->max_dev_point = -1;
   st = flown_deviation(sc, r, n, &rep->max_dev_m, &rep->max_dev_point);
@@ -1134,5 +1342,7 @@ done:
   free(idx);
   free(keep);
   free(src_of);
+  free(hold);
+  free(stop_to);
   return st;
 }

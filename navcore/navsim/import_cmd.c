@@ -26,8 +26,9 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 static const char *k_usage_import =
     "usage: navsim import FILE --out SCENE.yaml [--speed M/S] [--name NAME] [--tolerance M] [--no-time]\n"
-    "                     [--no-merge] [--track NAME|INDEX] [--format gpx|kml|motion_def] [--template SCENE] [--aircraft]\n"
-    "                     [--accept-distance]\n"
+    "                     [--no-merge] [--track NAME|INDEX] [--format gpx|kml|motion_def] [--template SCENE] "
+    "[--aircraft]\n"
+    "                     [--accept-distance] [--stop-speed M/S] [--stop-min S]\n"
     "\n"
     "Turn a track into a scene trajectory and write a complete scene file:\n"
     "  GPX (.gpx)   <trk>/<trkseg>/<trkpt lat lon> with <ele> and <time> (or <rtept>)\n"
@@ -54,6 +55,11 @@ static const char *k_usage_import =
     "  --accept-distance  write the scene even when the flown path strays beyond --tolerance\n"
     "  --no-merge       report the first infeasible turn instead of merging turns\n"
     "  --no-time        ignore the track's times; fly it at --speed\n"
+    "  --stop-speed M/S, --stop-min S  stops of a timed track: where the speed between consecutive\n"
+    "                   points stays below --stop-speed (default 0.2 m/s) for at least --stop-min\n"
+    "                   (default 3 s; 0: no stops), the vehicle stops at the first of those points for\n"
+    "                   that long (hold_start_s, hold_s, hold_end_s); each part between stops is timed\n"
+    "                   to take the track's time, so the scene lasts as long as the track\n"
     "  --track NAME|INDEX  KML: the track (LineString / gx:Track) of the Placemark with this name, or\n"
     "                   the INDEX-th of the file (1-based); a file with several needs it (they are listed)\n"
     "  --format F       gpx, kml or motion_def (default: from the extension or content)\n"
@@ -161,7 +167,8 @@ int navsim_import(int argc, char **argv) {
       accept_distance = true;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--speed") == 0 || strcmp(a, "--name") == 0 ||
                strcmp(a, "--tolerance") == 0 || strcmp(a, "--track") == 0 || strcmp(a, "--format") == 0 ||
-               strcmp(a, "--template") == 0) {
+               strcmp(a, "--template") == 0 || strcmp(a, "--stop-speed") == 0 ||
+               strcmp(a, "--stop-min") == 0) {
       if (!navsim_need_value("import", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
       if (strcmp(a, "--out") == 0) out = v;
@@ -175,6 +182,16 @@ int navsim_import(int argc, char **argv) {
           return EXIT_INVALID;
         }
         speed_given = true;
+      } else if (strcmp(a, "--stop-speed") == 0) {
+        if (!navsim_parse_positive(v, &opt.stop_speed_mps, true) || opt.stop_speed_mps > 10.0) {
+          fprintf(stderr, "navsim import: --stop-speed: expected a speed in [0, 10] m/s, got \"%s\"\n", v);
+          return EXIT_INVALID;
+        }
+      } else if (strcmp(a, "--stop-min") == 0) {
+        if (!navsim_parse_positive(v, &opt.stop_min_s, true) || opt.stop_min_s > 1e6) {
+          fprintf(stderr, "navsim import: --stop-min: expected a duration in [0, 1e6] s, got \"%s\"\n", v);
+          return EXIT_INVALID;
+        }
       } else if (!navsim_parse_positive(v, &opt.tolerance_m, true) || opt.tolerance_m > 1e5) {
         fprintf(stderr, "navsim import: --tolerance: expected a distance in [0, 1e5] m, got \"%s\"\n", v);
         return EXIT_INVALID;
@@ -356,6 +373,16 @@ int navsim_import(int argc, char **argv) {
            "largest distance of a track point from the flown path %.2f m\n",
            in, rep.points_in, rep.waypoints, opt.tolerance_m, rep.merged, rep.merged == 1 ? "" : "s", rep.length_m,
            rep.timed ? "speeds from the track's times" : "constant speed", rep.duration_s, rep.max_dev_m);
+    if (rep.timed) {
+      printf("stops      %d (%.1f s at rest: speed below %g m/s for at least %g s); duration %.3f s, the "
+             "track's "
+             "%.3f s\n",
+             rep.stops, rep.stop_s, opt.stop_speed_mps, opt.stop_min_s, rep.duration_s, rep.track_duration_s);
+      if (rep.stops_lengthened > 0)
+        printf("note       %d stop%s held longer than on the track, to turn in place at a corner within the "
+               "limits\n",
+               rep.stops_lengthened, rep.stops_lengthened == 1 ? "" : "s");
+    }
   }
   /* Nothing is written, and no existing scene replaced, unless the scene is valid. */
   rc = validate_import(in, out, fmt == NAV_TRACK_FORMAT_MOTION_DEF ? NULL : &tr, sc);

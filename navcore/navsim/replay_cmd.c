@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -51,7 +52,9 @@ static const char *k_usage_replay =
     "  --init FILE     initial state: the first row of a .nav file (same format as --truth) at the\n"
     "                  initial epoch, instead of the reference row (the frame and the scoring still\n"
     "                  come from --truth); navsim run --export kfgins writes run 0's initial state,\n"
-    "                  drawn initial errors included, to kfgins/init.nav\n"
+    "                  drawn initial errors included, to kfgins/init.nav. Without --init, an\n"
+    "                  init.nav in the folder of --imu is used (a line on stderr says so);\n"
+    "                  --init none: start from the reference row even then\n"
     "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n";
 
 /* The rest of navsim replay --help (one literal would exceed what C compilers must support). */
@@ -668,6 +671,11 @@ static void print_tables(const replay_job *j, bool show_published) {
 
 /* ---------------------------------------------------------------- command */
 
+static bool is_regular_file(const char *path) {
+  struct stat sb;
+  return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
+}
+
 int navsim_replay(int argc, char **argv) {
   const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay", *init = NULL;
   bool quiet = false, peers_auto = true, smooth = false, force = false;
@@ -870,6 +878,23 @@ int navsim_replay(int argc, char **argv) {
     }
   }
 
+  char init_beside[4096]; /* init.nav in the folder of --imu (navsim run --export kfgins) */
+  if (init && strcmp(init, "none") == 0) {
+    init = NULL;
+  } else if (!init) {
+    /* An export's IMU.txt sits beside run 0's initial state: take it, so that the replay of an
+       export reproduces run 0 without being told (issue 18, Done when). Said on stderr, once. */
+    const char *slash = strrchr(imu, '/');
+    const int n = slash ? snprintf(init_beside, sizeof init_beside, "%.*s/init.nav", (int)(slash - imu), imu)
+                        : snprintf(init_beside, sizeof init_beside, "init.nav");
+    if (n > 0 && (size_t)n < sizeof init_beside && is_regular_file(init_beside)) {
+      init = init_beside;
+      if (!quiet)
+        fprintf(stderr,
+                "navsim replay: initial state from %s (beside --imu; --init none: from the reference)\n",
+                init);
+    }
+  }
   if (init) {
     /* The initial state of --init: the first row of a .nav file, checked like the reference. */
     nav_rec_reader *ir = NULL;

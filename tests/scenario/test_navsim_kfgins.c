@@ -8,10 +8,12 @@
  * an outage, fixes 1 s apart (the receiver's rate) elsewhere, a reference row at every IMU epoch.
  *
  * The initial state: run 0 starts from the reference plus drawn initial errors (urban-drive:
- * 2/2/4 m, 0.1 m/s, 0.5/0.5/3 deg 1-sigma), which the recorded files alone do not carry; replay
- * takes them from kfgins/init.nav (--init). Without --init the replay starts from the reference
- * row: with --ideal (perfect initial state) that reproduces run 0 too, without it the first rows
- * differ by the drawn error. Both are checked.
+ * 2/2/4 m, 0.1 m/s, 0.5/0.5/3 deg 1-sigma), which IMU.txt, GNSS.txt and truth.nav do not carry;
+ * replay takes them from kfgins/init.nav, named by --init or, without --init, found beside
+ * IMU.txt (and said on stderr). The Done-when commands are run literally (no --init, scenes/
+ * relative to the working folder through a link to the source tree's scenes/). With --init none
+ * the replay starts from the reference row: with --ideal (perfect initial state) that reproduces
+ * run 0 too, without it the first rows differ by the drawn error. All are checked.
  *
  * NAVSIM_EXE, NAV_TEST_WORK_DIR and NAV_SOURCE_DIR come from the compile definitions.
  */
@@ -27,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "nav_test.h"
 #include "navsim_cli.h"
@@ -193,18 +196,23 @@ static void run_ok(const char *what, nav_cli_result *r) {
 
 static int setup(void **state) {
   (void)state;
-  return nav_test_fresh_dir(WORK);
+  if (nav_test_fresh_dir(WORK) != 0) return -1;
+  /* The Done-when commands name scenes/urban-drive.yaml relative to the working folder. */
+  return symlink(NAV_SOURCE_DIR "/scenes", WORK "/scenes");
 }
 
-/* The Done-when of issue 18 (with --init: see the file comment). */
+/* The Done-when of issue 18, its two commands as written (init.nav found beside IMU.txt). */
 static void replay_reproduces_run0(void **state) {
   (void)state;
-  run_ok("run", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                  "run '%s' --runs 1 --export kfgins --out D --quiet", SCENE));
-  run_ok("replay", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                     "replay --imu D/kfgins/IMU.txt --gnss D/kfgins/GNSS.txt --truth "
-                                     "D/kfgins/truth.nav --init D/kfgins/init.nav --scene '%s' --out R --quiet",
-                                     SCENE));
+  run_ok("run", nav_test_run_cli(NAVSIM_EXE, WORK, NULL,
+                                 "run scenes/urban-drive.yaml --runs 1 --export kfgins --out D"));
+  nav_cli_result *rr = nav_test_run_cli(NAVSIM_EXE, WORK, NULL,
+                                        "replay --imu D/kfgins/IMU.txt --gnss D/kfgins/GNSS.txt --truth "
+                                        "D/kfgins/truth.nav --scene scenes/urban-drive.yaml --out R");
+  run_ok("replay", rr);
+  /* One line says where the initial state came from. */
+  nav_test_assert_matches(rr->err, "^navsim replay: initial state from D/kfgins/init.nav \\(beside --imu; "
+                                   "--init none: from the reference\\)$");
   table d = load(WORK "/D/nav.csv", NAV_COLS, true), r = load(WORK "/R/nav.csv", NAV_COLS, true);
   const nav_diff df = compare_nav(&d, &r);
   print_message("nav.csv: %zu epochs, %zu missing in the replay; largest difference %.3g m, %.3g m/s, %.3g rad\n",
@@ -259,6 +267,20 @@ static void replay_reproduces_run0(void **state) {
   free(js_r);
   free(d.v);
   free(r.v);
+
+  /* --init naming the same file gives the same nav.csv, byte for byte, and says nothing. */
+  rr = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                         "replay --imu D/kfgins/IMU.txt --gnss D/kfgins/GNSS.txt --truth D/kfgins/truth.nav "
+                         "--init D/kfgins/init.nav --scene '%s' --out RX",
+                         SCENE);
+  run_ok("replay --init", rr);
+  assert_null(strstr(rr->err, "initial state from"));
+  char *nav_r = nav_test_slurp_alloc(WORK "/R/nav.csv"), *nav_x = nav_test_slurp_alloc(WORK "/RX/nav.csv");
+  assert_non_null(nav_r);
+  assert_non_null(nav_x);
+  assert_string_equal(nav_r, nav_x);
+  free(nav_r);
+  free(nav_x);
 }
 
 /* The exported files themselves: rows at every IMU epoch, fixes at the receiver rate, outages out. */
@@ -307,33 +329,35 @@ static void exported_files(void **state) {
   free(ini.v);
 }
 
-/* The literal Done-when command (no --init): reproduces run 0 with a perfect initial state
- * (--ideal), and differs by the drawn initial error without it. */
+/* --init none (the reference row as the initial state): reproduces run 0 with a perfect initial
+ * state (--ideal), and differs by the drawn initial error without it. */
 static void replay_without_init(void **state) {
   (void)state;
   run_ok("run --ideal", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
                                           "run '%s' --ideal --export kfgins --out DI --quiet", SCENE));
   run_ok("replay", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
                                      "replay --imu DI/kfgins/IMU.txt --gnss DI/kfgins/GNSS.txt --truth "
-                                     "DI/kfgins/truth.nav --scene '%s' --out RI --quiet",
+                                     "DI/kfgins/truth.nav --init none --scene '%s' --out RI --quiet",
                                      SCENE));
   table d = load(WORK "/DI/nav.csv", NAV_COLS, true), r = load(WORK "/RI/nav.csv", NAV_COLS, true);
   nav_diff df = compare_nav(&d, &r);
-  print_message("--ideal, no --init: %zu epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n", df.epochs,
-                df.pos_m, df.vel_mps, df.att_rad);
+  print_message("--ideal, --init none: %zu epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n",
+                df.epochs, df.pos_m, df.vel_mps, df.att_rad);
   assert_int_equal(df.missing, 0);
   assert_true(df.pos_m <= 1e-3 && df.vel_mps <= 1e-3 && df.att_rad <= 1e-6);
   free(d.v);
   free(r.v);
 
-  run_ok("replay", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                     "replay --imu D/kfgins/IMU.txt --gnss D/kfgins/GNSS.txt --truth "
-                                     "D/kfgins/truth.nav --scene '%s' --out R0 --quiet",
-                                     SCENE));
+  nav_cli_result *rr = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                                         "replay --imu D/kfgins/IMU.txt --gnss D/kfgins/GNSS.txt --truth "
+                                         "D/kfgins/truth.nav --init none --scene '%s' --out R0",
+                                         SCENE);
+  run_ok("replay --init none", rr);
+  assert_null(strstr(rr->err, "initial state from"));
   d = load(WORK "/D/nav.csv", NAV_COLS, true);
   r = load(WORK "/R0/nav.csv", NAV_COLS, true);
   df = compare_nav(&d, &r);
-  print_message("drawn initial errors, no --init: largest difference %.3g m\n", df.pos_m);
+  print_message("drawn initial errors, --init none: largest difference %.3g m\n", df.pos_m);
   assert_true(df.pos_m > 0.1);
   free(d.v);
   free(r.v);

@@ -271,6 +271,7 @@ static void assert_scene_same(const nav_scene *a, const nav_scene *b) {
     assert_same_double(wa->points[i].speed_mps, wb->points[i].speed_mps);
     assert_same_double(wa->points[i].time_s, wb->points[i].time_s);
     assert_same_euler(wa->points[i].attitude, wb->points[i].attitude);
+    assert_same_double(wa->points[i].hold_s, wb->points[i].hold_s);
   }
 
   const nav_traj_segments *sa = &ta->segments, *sb = &tb->segments;
@@ -895,6 +896,60 @@ static void test_long_values_are_cut_in_messages(void **state) {
 
 /* Tolerance for a datasheet-unit conversion against a hand value: one or two roundings. */
 #define REL_CONV 4e-16
+
+/* hold_s: a stop at an interior waypoint, read, counted in the planned duration, checked. */
+static void test_waypoint_hold_s(void **state) {
+  (void)state;
+  static const char *const head = "format_version: 1\n"
+                                  "trajectory:\n"
+                                  "  type: waypoints\n"
+                                  "  waypoints:\n"
+                                  "    cruise_mps: 5\n"
+                                  "    points:\n";
+  char text[1024];
+  snprintf(text, sizeof text,
+           "%s"
+           "      - {ned_m: [0, 0, 0], speed_mps: 0}\n"
+           "      - {ned_m: [100, 0, 0], speed_mps: 0, hold_s: 12.5}\n"
+           "      - {ned_m: [100, 100, 0], speed_mps: 0}\n",
+           head);
+  nav_scene s = read_ok(text);
+  assert_near(s.trajectory.waypoints.points[1].hold_s, 12.5, 0.0);
+  assert_near(s.trajectory.waypoints.points[0].hold_s, 0.0, 0.0);
+  const double with_hold = s.trajectory.duration_s;
+  snprintf(text, sizeof text,
+           "%s"
+           "      - {ned_m: [0, 0, 0], speed_mps: 0}\n"
+           "      - {ned_m: [100, 0, 0], speed_mps: 0, hold_s: 20.5}\n"
+           "      - {ned_m: [100, 100, 0], speed_mps: 0}\n",
+           head);
+  s = read_ok(text);
+  assert_near(s.trajectory.duration_s - with_hold, 8.0, 1e-9);
+  /* Bounds from the table, and the ends. */
+  snprintf(text, sizeof text,
+           "%s"
+           "      - {ned_m: [0, 0, 0], speed_mps: 0}\n"
+           "      - {ned_m: [100, 0, 0], speed_mps: 0, hold_s: -1}\n"
+           "      - {ned_m: [100, 100, 0], speed_mps: 0}\n",
+           head);
+  expect_one(text, 8, 52, "trajectory.waypoints.points[1].hold_s", ">= 0"); /* at the value */
+  snprintf(text, sizeof text,
+           "%s"
+           "      - {ned_m: [0, 0, 0], speed_mps: 0, hold_s: 3}\n"
+           "      - {ned_m: [100, 0, 0], speed_mps: 0, hold_s: 2}\n"
+           "      - {ned_m: [100, 100, 0], speed_mps: 0}\n",
+           head);
+  diag_log log;
+  nav_scene bad;
+  assert_int_equal(read_text(text, &bad, &log), NAV_ERR_PARSE);
+  bool found = false;
+  for (int i = 0; i < log.n; ++i)
+    found = found || strstr(log.d[i].message, "hold_start_s") != NULL;
+  if (!found) {
+    print_log(&log);
+    fail_msg("no diagnostic names hold_start_s");
+  }
+}
 
 static void test_waypoints(void **state) {
   (void)state;
@@ -2039,6 +2094,8 @@ static void random_trajectories(uint64_t *x, nav_scene_trajectory *t) {
     w->points[i].speed_mps = fabs(any_double(x));
     w->points[i].time_s = fabs(any_double(x));
     w->points[i].attitude = (nav_euler){any_double(x), any_double(x), any_double(x)};
+    /* From a value already drawn, so the random stream of the other fields is unchanged. */
+    w->points[i].hold_s = i % 2 ? fmin(w->points[i].time_s, 1e6) : 0.0;
   }
   nav_traj_segments *s = &t->segments;
   s->allow_unconverged = splitmix64(x) & 1;
@@ -2331,6 +2388,7 @@ int main(void) {
       cmocka_unit_test(test_deep_nesting_and_size_limits),
       cmocka_unit_test(test_long_values_are_cut_in_messages),
       cmocka_unit_test(test_waypoints),
+      cmocka_unit_test(test_waypoint_hold_s),
       cmocka_unit_test(test_geodetic_waypoints_any_order),
       cmocka_unit_test(test_segment_kinds),
       cmocka_unit_test(test_test_motions),

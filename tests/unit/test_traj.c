@@ -1296,6 +1296,164 @@ static void test_closure_wgs84_long_drive(void **state) {
   free(s);
 }
 
+/* ------------------------------------------------------------------ stops (hold_s) */
+
+/* A car with three interior stops (hold_s): one on a straight line, one at a right-angle corner
+ * (turned in place during the hold) and one where the path reverses (turned in place by 180 deg),
+ * and a last leg between two stops (cruise_mps). */
+static nav_scene *car_with_stops(nav_wp_attitude_mode mode) {
+  nav_scene *s = new_scene();
+  s->trajectory.type = NAV_TRAJ_WAYPOINTS;
+  nav_traj_waypoints *w = &s->trajectory.waypoints;
+  w->attitude_mode = mode;
+  w->hold_start_s = 2.0;
+  w->hold_end_s = 3.0;
+  w->cruise_mps = 5.0;
+  add_wp(s, 0, 0, 0, 0);
+  add_wp(s, 100, 0, 0, 8);
+  add_wp(s, 200, 0, 0, 0); /* stop, straight on */
+  w->points[2].hold_s = 5.0;
+  add_wp(s, 300, 0, -2, 0); /* stop at a corner (and a slope before it) */
+  w->points[3].hold_s = 10.0;
+  add_wp(s, 300, 150, -2, 7);
+  add_wp(s, 300, 300, -2, 0); /* stop and turn back */
+  w->points[5].hold_s = 12.0;
+  add_wp(s, 300, 200, -2, 0);
+  return s;
+}
+
+static void test_waypoints_stops(void **state) {
+  (void)state;
+  const nav_wp_attitude_mode modes[3] = {NAV_WP_ATT_GROUND, NAV_WP_ATT_AIRCRAFT, NAV_WP_ATT_EULER};
+  for (int mi = 0; mi < 3; ++mi) {
+    nav_scene *s = car_with_stops(modes[mi]);
+    const nav_traj_waypoints *W = &s->trajectory.waypoints;
+    if (modes[mi] == NAV_WP_ATT_EULER)
+      for (int k = 0; k < W->count; ++k)
+        s->trajectory.waypoints.points[k].attitude =
+            (nav_euler){0.02 * k, -0.01 * k, remainder(1.3 * k, NAV_TWO_PI)};
+    assert_int_equal(nav_scene_validate(s, NULL, NULL), NAV_OK);
+    nav_traj_model m;
+    create_model(s, &m);
+    const mismatch mm = check_model(s, &m, 0.0937);
+    double tw[NAV_MAX_WAYPOINTS];
+    assert_int_equal(nav_traj_waypoints_times(m.self, tw, NAV_MAX_WAYPOINTS), (size_t)W->count);
+    print_message(
+        "stops, mode %d: %.3f s; arrivals %.3f %.3f %.3f s; worst |v-fd| %.2e, |a-fd| %.2e, |w-fd| %.2e, "
+        "|dw-fd| %.2e\n",
+        (int)modes[mi], m.duration_s, tw[2], tw[3], tw[5], mm.v, mm.a, mm.w, mm.dw);
+    /* At rest on the waypoint for the whole hold, moving just outside it. */
+    for (int i = 2; i <= 5; ++i) {
+      const double hold = W->points[i].hold_s;
+      if (!(hold > 0.0)) continue;
+      double att_change = 0.0;
+      const nav_local_kin k0 = kin_at(&m, tw[i]);
+      for (double t = tw[i]; t <= tw[i] + hold; t += 0.01) {
+        const nav_local_kin k = kin_at(&m, t);
+        assert_vec3_near(k.r_ned_m, W->points[i].r_ned_m, 1e-6);
+        assert_vec3_near(k.v_ned_mps, nav_vec3_zero(), 1e-12);
+        assert_vec3_near(k.a_ned_mps2, nav_vec3_zero(), 1e-12);
+        att_change = fmax(att_change, nav_quat_angle_between(k.q_b_n, k0.q_b_n));
+      }
+      assert_true(nav_vec3_norm(kin_at(&m, tw[i] - 0.5).v_ned_mps) > 1e-3);
+      assert_true(nav_vec3_norm(kin_at(&m, tw[i] + hold + 0.5).v_ned_mps) > 1e-3);
+      const nav_local_kin k1 = kin_at(&m, tw[i] + hold);
+      print_message("  stop %d: %.1f s at rest, attitude turned %.2f deg in place\n", i, hold,
+                    nav_quat_angle_between(k1.q_b_n, k0.q_b_n) / D2R);
+      if (modes[mi] == NAV_WP_ATT_GROUND) {
+        /* Arrives with the heading of the leg before, leaves with that of the leg after. */
+        const nav_vec3 a = nav_vec3_sub(W->points[i].r_ned_m, W->points[i - 1].r_ned_m);
+        const nav_vec3 b = nav_vec3_sub(W->points[i + 1].r_ned_m, W->points[i].r_ned_m);
+        const nav_euler e0 = nav_quat_to_euler(k0.q_b_n, NULL), e1 = nav_quat_to_euler(k1.q_b_n, NULL);
+        assert_near(remainder(e0.yaw_rad - atan2(a.y, a.x), NAV_TWO_PI), 0.0, 1e-9);
+        assert_near(remainder(e1.yaw_rad - atan2(b.y, b.x), NAV_TWO_PI), 0.0, 1e-9);
+      }
+      if (modes[mi] == NAV_WP_ATT_EULER) {
+        /* The attitude is held at the stop. */
+        assert_true(att_change < 1e-12);
+      }
+    }
+    /* Each second added to every hold adds exactly one second per stop. */
+    nav_scene *s2 = car_with_stops(modes[mi]);
+    if (modes[mi] == NAV_WP_ATT_EULER)
+      for (int k = 0; k < W->count; ++k)
+        s2->trajectory.waypoints.points[k].attitude = W->points[k].attitude;
+    for (int i = 1; i + 1 < s2->trajectory.waypoints.count; ++i)
+      if (s2->trajectory.waypoints.points[i].hold_s > 0.0) s2->trajectory.waypoints.points[i].hold_s += 1.0;
+    nav_traj_script_info info;
+    char msg[512];
+    assert_int_equal(nav_traj_waypoints_plan_info(s2, &info, NULL, msg, sizeof msg), NAV_OK);
+    assert_near(info.duration_s - m.duration_s, 3.0, 1e-9);
+    free(s2);
+    m.destroy(m.self);
+    free(s);
+  }
+}
+
+/* Timing time with a stop: time_s is the arrival, the next leg starts after hold_s. */
+static void test_waypoints_stops_timed(void **state) {
+  (void)state;
+  nav_scene *s = new_scene();
+  s->trajectory.type = NAV_TRAJ_WAYPOINTS;
+  nav_traj_waypoints *W = &s->trajectory.waypoints;
+  W->timing = NAV_WP_TIMING_TIME;
+  W->hold_start_s = 1.0;
+  add_wp(s, 0, 0, 0, 0);
+  add_wp(s, 150, 0, 0, 0);
+  add_wp(s, 150, 150, 0, 0);
+  add_wp(s, 300, 150, 0, 0);
+  W->points[1].time_s = 25.0;
+  W->points[2].time_s = 60.0; /* arrives at 60 s, leaves at 68 s */
+  W->points[2].hold_s = 8.0;
+  W->points[3].time_s = 100.0;
+  nav_traj_model m;
+  create_model(s, &m);
+  double tw[NAV_MAX_WAYPOINTS];
+  assert_int_equal(nav_traj_waypoints_times(m.self, tw, NAV_MAX_WAYPOINTS), 4u);
+  for (int i = 0; i < 4; ++i)
+    assert_near(tw[i], W->hold_start_s + W->points[i].time_s, 1e-6);
+  assert_near(m.duration_s, 101.0, 1e-6);
+  for (double t = tw[2]; t <= tw[2] + 8.0; t += 0.05)
+    assert_vec3_near(kin_at(&m, t).v_ned_mps, nav_vec3_zero(), 1e-12);
+  m.destroy(m.self);
+
+  /* Errors: a hold with a speed, a hold on the first waypoint, a hold too short to turn in place. */
+  W->timing = NAV_WP_TIMING_SPEED;
+  W->cruise_mps = 5.0;
+  W->points[1].speed_mps = 5.0;
+  W->points[2].speed_mps = 3.0;
+  expect_wp_error(s, 2, "waypoint 2: hold_s 8 s needs speed 0", NULL);
+  W->points[2].speed_mps = 0.0;
+  W->points[2].hold_s = 0.5;
+  expect_wp_error(s, 2, "turning 90 deg in place takes", "longer than hold_s 0.5 s");
+  W->points[2].hold_s = 8.0;
+  W->points[0].hold_s = 1.0;
+  expect_wp_error(s, 0, "hold_s is for interior waypoints", "hold_start_s");
+  free(s);
+}
+
+static void test_closure_stops(void **state) {
+  (void)state;
+  nav_ins_config cfg = nav_ins_config_default();
+  cfg.algorithm = NAV_MECH_HIGH_ORDER;
+  const nav_wp_attitude_mode modes[2] = {NAV_WP_ATT_GROUND, NAV_WP_ATT_AIRCRAFT};
+  for (int mi = 0; mi < 2; ++mi) {
+    nav_scene *s = car_with_stops(modes[mi]);
+    s->navigation.algorithm = NAV_MECH_HIGH_ORDER;
+    nav_script_summary sum;
+    char msg[256];
+    assert_int_equal(nav_motiondef_script_summary(s, &sum, msg, sizeof msg), NAV_OK);
+    s->trajectory.duration_s = sum.duration_s;
+    const closure c = run_closure(s, cfg, false);
+    print_message(
+        "flat closure, waypoints with 3 stops (mode %d), %.1f s at 100 Hz, high order: pos h %.2e m v "
+        "%.2e m (max h %.2e), vel %.2e m/s, att %.2e rad\n",
+        (int)modes[mi], sum.duration_s, c.pos_h_m, c.pos_v_m, c.max_pos_h_m, c.vel_mps, c.att_rad);
+    assert_true(c.pos_h_m < 1e-4 && c.pos_v_m < 1e-4 && c.vel_mps < 1e-5 && c.att_rad < 1e-7);
+    free(s);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_jets),
@@ -1316,6 +1474,9 @@ int main(void) {
       cmocka_unit_test(test_closure_flat),
       cmocka_unit_test(test_closure_flat_long_drive),
       cmocka_unit_test(test_closure_wgs84_long_drive),
+      cmocka_unit_test(test_waypoints_stops),
+      cmocka_unit_test(test_waypoints_stops_timed),
+      cmocka_unit_test(test_closure_stops),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

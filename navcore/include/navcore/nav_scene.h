@@ -193,6 +193,13 @@ typedef struct nav_waypoint {
   double time_s;      /**< timing time: time from the start of the motion (after hold_start_s) at which the
                            vehicle passes the waypoint (mid-turn); 0 at the first waypoint */
   nav_euler attitude; /**< attitude mode euler: attitude C_b_n at the waypoint */
+  /** Stationary time at an interior waypoint [s] (>= 0; 0: none). With hold_s > 0 the vehicle
+      stops at the waypoint (speed 0: timing speed needs speed_mps 0 there, timing time sets it)
+      and stays hold_s; time_s is then its arrival; where the path turns there, the vehicle turns
+      in place, centred in the hold (its duration within max_rate_rps, max_ang_accel_rps2,
+      max_ang_jerk_rps3 must fit in hold_s). The first and the last waypoint use hold_start_s
+      and hold_end_s instead. */
+  double hold_s;
 } nav_waypoint;
 
 /**

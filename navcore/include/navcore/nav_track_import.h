@@ -113,6 +113,14 @@ typedef struct nav_track_import_options {
   bool use_time;
   nav_wp_attitude_mode attitude_mode; /**< ground (default) or aircraft */
   nav_traj_limits limits;             /**< planner limits (default: those of nav_scene_default) */
+  /** Stops of a timed track (use_time): a run of consecutive points whose point-to-point speeds
+   *  are all below stop_speed_mps [m/s] (default 0.2) and that lasts at least stop_min_s [s]
+   *  (default 3) becomes a stop: a waypoint with speed 0 at the run's first point, held for the
+   *  run's duration (hold_start_s / hold_end_s at the ends of the track, hold_s inside). Each
+   *  part between stops is then timed to take the track's time (its speeds scaled), so the
+   *  planned duration follows the track's. stop_min_s 0: no stops are detected. */
+  double stop_speed_mps;
+  double stop_min_s;
 } nav_track_import_options;
 
 NAV_API nav_track_import_options nav_track_import_options_default(void);
@@ -129,6 +137,12 @@ typedef struct nav_track_import_report {
   long max_dev_point;  /**< index of the track point at max_dev_m (-1: none checked) */
   bool timed;          /**< the speeds came from the track's times */
   int bad_point;       /**< on an infeasible plan: index into the track's points, else -1 */
+  int stops;           /**< stops kept (timed tracks), the start and the end included */
+  double stop_s;       /**< their total duration [s] (holds of the trajectory) */
+  double track_duration_s; /**< timed tracks: last time minus first time [s], else 0 */
+  int stops_lengthened;    /**< stops held longer than on the track: too short to turn in place
+                                at a corner within the angular limits (the part after such a
+                                stop is timed to arrive when the track does) */
 } nav_track_import_report;
 
 /**

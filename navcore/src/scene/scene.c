@@ -240,6 +240,14 @@ static void check_waypoints(checker *c, const nav_traj_waypoints *w) {
     snprintf(p, sizeof p, "trajectory.waypoints.points[%d].time_s", i);
     if (!(q->time_s >= 0.0 && q->time_s <= NAV_SCENE_MAX_DURATION_S))
       issue(c, p, "must be within [0, 1e7] s (got %g)", q->time_s);
+    snprintf(p, sizeof p, "trajectory.waypoints.points[%d].hold_s", i);
+    if (!(q->hold_s >= 0.0 && q->hold_s <= NAV_SCENE_MAX_DURATION_S))
+      issue(c, p, "must be within [0, 1e7] s (got %g)", q->hold_s);
+    else if (q->hold_s > 0.0 && (i == 0 || i == w->count - 1))
+      issue(c, p,
+            i == 0 ? "is for interior waypoints; use trajectory.waypoints.hold_start_s (got %g s)"
+                   : "is for interior waypoints; use trajectory.waypoints.hold_end_s (got %g s)",
+            q->hold_s);
     snprintf(p, sizeof p, "trajectory.waypoints.points[%d].attitude.roll_deg", i);
     check_finite(c, p, q->attitude.roll_rad);
     snprintf(p, sizeof p, "trajectory.waypoints.points[%d].attitude.pitch_deg", i);

@@ -29,6 +29,17 @@
  * rises to the section's cruise_mps, cruises and stops again; a part too short for that reaches
  * the highest speed its length allows (the peak speed solved by bisection).
  *
+ * Stops. An interior waypoint with hold_s > 0 is a stop: the speed falls to 0 on the straight
+ * part before it (a rest-to-rest move ends at rest with its rate and acceleration 0), the
+ * vehicle stays there hold_s, and the speed rises again on the straight part after it; the two
+ * legs are planned as if the stop were the end of one trajectory and the start of another. No
+ * fly-by turn: where the path turns at a stop, the tangent turns at rest by the same rest-to-rest
+ * move of the turn angle as a fly-by turn (in the plane of the two legs; a reversal about the
+ * vertical, to the right), bounded by max_rate_rps, max_ang_accel_rps2 and max_ang_jerk_rps3
+ * only (no speed, so no lateral acceleration or jerk) and centred in the hold, which must be
+ * long enough for it. The velocity is 0 throughout, so position and velocity stay exact, and
+ * the attitude (from the tangent) and its rates are as smooth as in a fly-by turn.
+ *
  * Attitude: ground (heading and pitch of the tangent, roll 0), aircraft (the same plus the
  * coordinated bank atan(V psi_dot / g)), fixed, or per-waypoint Euler angles interpolated
  * between the waypoint times by single rate pulses (septic ramps up and down over half the
@@ -157,6 +168,7 @@ static straight_plan straight_with_cruise(double va, double c, double vb, double
 }
 
 typedef struct turn_plan {
+  bool in_place; /* at a stop (hold_s > 0): turned at rest during the hold, no fly-by */
   double beta, V, tan_len_m, radius_m, rate_cap;
   const char *cap_name;
   nav_kin_move mv;
@@ -168,7 +180,7 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
   const nav_traj_limits *L = &W->limits;
   wplan pl = {W, bad, msg, msg_size};
   nav_vec3 *u = NULL;
-  double *len = NULL, *v = NULL, *tt = NULL;
+  double *len = NULL, *v = NULL, *tt = NULL, *hold = NULL;
   turn_plan *tp = NULL;
   straight_plan *sp = NULL;
   nav_status st = NAV_OK;
@@ -197,10 +209,11 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
   len = calloc((size_t)N, sizeof *len);
   v = calloc((size_t)N, sizeof *v);
   tt = calloc((size_t)N, sizeof *tt);
+  hold = calloc((size_t)N, sizeof *hold);
   tp = calloc((size_t)N, sizeof *tp);
   sp = calloc((size_t)N, sizeof *sp);
   m->wp_time = calloc((size_t)N, sizeof *m->wp_time);
-  if (!u || !len || !v || !tt || !tp || !sp || !m->wp_time) {
+  if (!u || !len || !v || !tt || !hold || !tp || !sp || !m->wp_time) {
     st = NAV_ERR_NO_MEMORY;
     goto cleanup;
   }
@@ -209,10 +222,20 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
     const nav_waypoint *p = &W->points[i];
     if (!nav_vec3_isfinite(p->r_ned_m) || !isfinite(p->speed_mps) || !isfinite(p->time_s) ||
         !isfinite(p->attitude.roll_rad) || !isfinite(p->attitude.pitch_rad) ||
-        !isfinite(p->attitude.yaw_rad)) {
+        !isfinite(p->attitude.yaw_rad) || !isfinite(p->hold_s)) {
       st = fail(&pl, i, "waypoint %d: a field is not a finite number", i);
       goto cleanup;
     }
+    if (!(p->hold_s >= 0.0)) {
+      st = fail(&pl, i, "waypoint %d: hold_s must be >= 0 (got %g)", i, p->hold_s);
+      goto cleanup;
+    }
+    if (p->hold_s > 0.0 && (i == 0 || i == N - 1)) {
+      st = fail(&pl, i, "waypoint %d: hold_s is for interior waypoints; use trajectory.waypoints.%s", i,
+                i == 0 ? "hold_start_s" : "hold_end_s");
+      goto cleanup;
+    }
+    hold[i] = p->hold_s;
   }
   /* Legs. */
   for (int i = 0; i + 1 < N; ++i) {
@@ -252,11 +275,17 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
         goto cleanup;
       }
     for (int i = 1; i + 1 < N; ++i)
-      v[i] = 0.5 * (len[i - 1] / (tt[i] - tt[i - 1]) + len[i] / (tt[i + 1] - tt[i]));
+      v[i] = hold[i] > 0.0 ? 0.0 : 0.5 * (len[i - 1] / (tt[i] - tt[i - 1]) + len[i] / (tt[i + 1] - tt[i]));
   }
   for (int i = 0; i < N; ++i)
     if (!(v[i] >= 0.0)) {
       st = fail(&pl, i, "waypoint %d: speed_mps must be >= 0 (got %g)", i, v[i]);
+      goto cleanup;
+    }
+  for (int i = 1; i + 1 < N; ++i)
+    if (hold[i] > 0.0 && v[i] != 0.0) {
+      st = fail(&pl, i, "waypoint %d: hold_s %g s needs speed 0 at the waypoint (speed_mps is %g)", i,
+                hold[i], v[i]);
       goto cleanup;
     }
   if (W->hold_start_s > 0.0 && v[0] != 0.0) {
@@ -279,10 +308,34 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
       t->beta = 0.0;
       continue;
     }
-    if (t->beta > NAV_PI - 1e-6) {
+    if (t->beta > NAV_PI - 1e-6 && !(hold[i] > 0.0)) {
       st = fail(&pl, i, "waypoint %d: the path reverses direction (turn of %.6g deg); a fly-by turn cannot",
                 i, t->beta * RAD2DEG);
       goto cleanup;
+    }
+    if (hold[i] > 0.0) {
+      /* A stop: the tangent turns at rest, in the plane of the two legs (about the vertical for
+         a reversal, to the right), as a rest-to-rest move of the turn angle within the angular
+         limits, centred in the hold. */
+      t->in_place = true;
+      if (s > 1e-9) {
+        t->w = nav_vec3_scale(nav_vec3_axpy(u[i], -c, u[i - 1]), 1.0 / s);
+      } else {
+        const double h = hypot(u[i - 1].x, u[i - 1].y);
+        t->w = h > 1e-9 ? nav_vec3_make(-u[i - 1].y / h, u[i - 1].x / h, 0.0) : nav_vec3_make(1.0, 0.0, 0.0);
+      }
+      const nav_kin_lim lim = {L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3};
+      t->mv = nav_kin_plan_move(t->beta, &lim);
+      const double d = nav_kin_move_duration(&t->mv);
+      if (d > hold[i]) {
+        st = fail(&pl, i,
+                  "waypoint %d: turning %.4g deg in place takes %.4g s within max_rate_rps %g, "
+                  "max_ang_accel_rps2 %g and max_ang_jerk_rps3 %g, longer than hold_s %g s",
+                  i, t->beta * RAD2DEG, d, L->max_rate_rps, L->max_ang_accel_rps2, L->max_ang_jerk_rps3,
+                  hold[i]);
+        goto cleanup;
+      }
+      continue;
     }
     t->w = nav_vec3_scale(nav_vec3_axpy(u[i], -c, u[i - 1]), 1.0 / s);
     const double V = v[i];
@@ -382,8 +435,10 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
       q->time_s = t1 + q->cruise_s;
       q->feasible = true;
     } else {
-      const double target = tt[i + 1] - tt[i] - 0.5 * nav_kin_move_duration(&tp[i].mv) -
-                            0.5 * nav_kin_move_duration(&tp[i + 1].mv);
+      /* A stop's hold (and its turn in place) comes before the leg: time_s is its arrival. */
+      const double target = tt[i + 1] - tt[i] - hold[i] -
+                            (tp[i].in_place ? 0.0 : 0.5 * nav_kin_move_duration(&tp[i].mv)) -
+                            (tp[i + 1].in_place ? 0.0 : 0.5 * nav_kin_move_duration(&tp[i + 1].mv));
       const double va = v[i], vb = v[i + 1];
       /* Cruise speed c: the time decreases as c rises while the ramps fit. Scan, then bisect. */
       const double c_lo = 1e-2, c_hi = fmax(va, vb) + sqrt(L->max_accel_mps2 * s_use) +
@@ -429,8 +484,8 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
         goto cleanup;
       }
       if (!found) {
-        const double t_turns =
-            0.5 * nav_kin_move_duration(&tp[i].mv) + 0.5 * nav_kin_move_duration(&tp[i + 1].mv);
+        const double t_turns = (tp[i].in_place ? 0.0 : 0.5 * nav_kin_move_duration(&tp[i].mv)) +
+                               (tp[i + 1].in_place ? 0.0 : 0.5 * nav_kin_move_duration(&tp[i + 1].mv));
         st = fail(&pl, i + 1,
                   "waypoint %d: time_s %g s cannot be met: leg %d-%d takes at least %.4g s within "
                   "max_accel_mps2 %g and "
@@ -468,7 +523,20 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
     }
     t += q->time_s;
     if (st != NAV_OK) break;
-    if (i + 2 < N && tp[i + 1].beta > 0.0) {
+    if (i + 2 < N && hold[i + 1] > 0.0) {
+      /* A stop: at rest for hold_s, arriving at t; a turn in place centred in the hold. */
+      const turn_plan *tq = &tp[i + 1];
+      m->wp_time[i + 1] = t;
+      const double d = tq->beta > 0.0 ? nav_kin_move_duration(&tq->mv) : 0.0;
+      const double t_turn = t + 0.5 * (hold[i + 1] - d);
+      if (!(tq->beta > 0.0) || t_turn > t) st = add_piece(m, P_HOLD, t, u[i], z, 0.0);
+      if (st == NAV_OK && tq->beta > 0.0) {
+        const double b0 = nav_kin_channel_eval(&m->turn, t_turn).d[0];
+        st = add_piece(m, P_TURN, t_turn, u[i], tq->w, b0);
+        if (st == NAV_OK) st = nav_kin_channel_add_move(&m->turn, t_turn, &tq->mv);
+      }
+      t += hold[i + 1];
+    } else if (i + 2 < N && tp[i + 1].beta > 0.0) {
       const double b0 = nav_kin_channel_eval(&m->turn, t).d[0];
       st = add_piece(m, P_TURN, t, u[i], tp[i + 1].w, b0);
       if (st == NAV_OK) st = nav_kin_channel_add_move(&m->turn, t, &tp[i + 1].mv);
@@ -496,7 +564,9 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
       const nav_euler a = W->points[i].attitude, b = W->points[i + 1].attitude;
       const double d[3] = {remainder(b.roll_rad - a.roll_rad, NAV_TWO_PI), b.pitch_rad - a.pitch_rad,
                            remainder(b.yaw_rad - a.yaw_rad, NAV_TWO_PI)};
-      const double D = m->wp_time[i + 1] - m->wp_time[i], h = 0.5 * D;
+      /* From the departure: a stop holds its attitude. */
+      const double t_dep = m->wp_time[i] + (i > 0 ? hold[i] : 0.0);
+      const double D = m->wp_time[i + 1] - t_dep, h = 0.5 * D;
       for (int c = 0; c < 3 && st == NAV_OK; ++c) {
         if (d[c] == 0.0) continue;
         const nav_kin_move mv = {d[c], d[c] / h, h, 0.0};
@@ -516,7 +586,7 @@ static nav_status plan(const nav_scene *scene, wp_model *m, int *bad, char *msg,
                     i + 1, names[c], d[c] * RAD2DEG, i, D, lnames[over], need[over], lim[over]);
           break;
         }
-        st = nav_kin_channel_add_move(&m->eul[c], m->wp_time[i], &mv);
+        st = nav_kin_channel_add_move(&m->eul[c], t_dep, &mv);
       }
     }
     if (st != NAV_OK) goto cleanup;
@@ -526,6 +596,7 @@ cleanup:
   free(len);
   free(v);
   free(tt);
+  free(hold);
   free(tp);
   free(sp);
   return st;
