@@ -26,6 +26,7 @@
 #include <vtkSequencePass.h>
 #include <vtkTranslucentPass.h>
 #include <vtkCellArray.h>
+#include <vtkCoordinate.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGlyph3D.h>
 #include <vtkInteractorStyleTrackballCamera.h>
@@ -184,6 +185,20 @@ vtkStandardNewMacro(PathViewStyle)
 
 namespace {
 constexpr int kMultiSamples = 8;
+
+// One colour per kind of object in both views (the 3D view's result scene, libnavview, uses the
+// same: reference black, estimate red, envelope blue, outages pink). Bottom to top: outages,
+// plan, the translucent envelope, the previous result (grey, A/B), the estimate (preview thin,
+// Monte Carlo result wider).
+constexpr double kPlanRgb[3] = {0.08, 0.08, 0.10};
+constexpr double kEstimateRgb[3] = {0.84, 0.10, 0.11};
+constexpr double kEnvelopeRgb[3] = {0.35, 0.55, 0.95};
+constexpr double kOutageRgb[3] = {0.96, 0.50, 0.80};
+constexpr double kPreviousRgb[3] = {0.55, 0.55, 0.58};
+constexpr double kOverRgb[3] = {1.00, 0.55, 0.00}; // over a vehicle limit: orange, not the estimate's red
+// The outage band's depth pushed behind the paths (VTK coincident-topology units): a wide line
+// is nearer to the camera than a path a pixel beside it and would hide it.
+constexpr double kOutageDepthUnits = 50.0;
 
 vtkSmartPointer<vtkActor> MakeActor(vtkPolyData *pd, double r, double g, double b, double width) {
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
@@ -345,11 +360,15 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     ground_->GetProperty()->SetOpacity(0.55);
     renderer_->AddActor(ground_);
   }
-  path_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.10, 0.35, 0.85, 3.0);
-  over_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.05, 0.05, 5.0); // path over a vehicle limit
-  estimate_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 2.0);
-  result_ = MakeActor(vtkNew<vtkPolyData>(), 0.85, 0.10, 0.45, 2.0);
-  previous_ = MakeActor(vtkNew<vtkPolyData>(), 0.45, 0.45, 0.45, 1.5); // the result before (A/B)
+  // The plan wider than the estimate drawn on it: where they coincide the plan edges it in black.
+  path_actor_ = MakeActor(vtkNew<vtkPolyData>(), kPlanRgb[0], kPlanRgb[1], kPlanRgb[2], 4.0);
+  over_actor_ = MakeActor(vtkNew<vtkPolyData>(), kOverRgb[0], kOverRgb[1], kOverRgb[2], 5.0); // over a vehicle limit
+  estimate_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 1.6);
+  result_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 2.4);
+  previous_ = MakeActor(vtkNew<vtkPolyData>(), kPreviousRgb[0], kPreviousRgb[1], kPreviousRgb[2], 1.5); // A/B
+  outages_ = MakeActor(vtkNew<vtkPolyData>(), kOutageRgb[0], kOutageRgb[1], kOutageRgb[2], 9.0);
+  outages_->GetMapper()->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, kOutageDepthUnits);
+  vtkMapper::SetResolveCoincidentTopologyToPolygonOffset(); // the offset above needs it (VTK: off by default)
   handles_ = MakeActor(vtkNew<vtkPolyData>(), 0.98, 0.98, 0.98, 1.0);
   handles_->GetProperty()->LightingOn();
   handles_->GetProperty()->SetColor(0.15, 0.15, 0.15);
@@ -357,9 +376,10 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   selected_actor_->GetProperty()->LightingOn();
   bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
   bad_actor_->GetProperty()->LightingOn();
-  envelope_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 1.0);
-  envelope_->GetProperty()->SetOpacity(0.25);
-  renderer_->AddActor(envelope_); // first: under the paths
+  envelope_ = MakeActor(vtkNew<vtkPolyData>(), kEnvelopeRgb[0], kEnvelopeRgb[1], kEnvelopeRgb[2], 1.0);
+  envelope_->GetProperty()->SetOpacity(0.28);
+  renderer_->AddActor(outages_);
+  renderer_->AddActor(envelope_); // under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
     renderer_->AddActor(a);
   if (mode == Mode::ThreeD) {
@@ -421,6 +441,8 @@ bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const Nav
   if (!show) {
     scene_.reset();
     scene_stale_ = false;
+    UpdateLegend();
+    UpdateCaption();
     Render();
     return true;
   }
@@ -449,6 +471,8 @@ bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const Nav
     return false;
   }
   scene_->SetStale(scene_stale_);
+  UpdateLegend();
+  UpdateCaption(); // left of the scene's legend panel
   Render();
   return true;
 }
@@ -459,6 +483,7 @@ void PathView::SetSceneStale(bool stale) {
   // The live preview keeps following in the editor's own estimate and band, over the greyed run.
   for (auto &a : {estimate_, envelope_})
     a->SetVisibility(!scene_ || stale);
+  UpdateLegend();
   Render();
 }
 
@@ -671,6 +696,26 @@ void PathView::Rebuild() {
   QString msg;
   if (!SharedSamplePath(s, 1200, &path_, &msg)) path_ = PathSamples();
   SetPolyline(InputOf(path_actor_), path_.ned_m, 0.3);
+  // GNSS outages: the plan's samples inside each outage, a wide pink band under the paths.
+  outage_spans_ = 0;
+  {
+    auto pts = vtkSmartPointer<vtkPoints>::New();
+    auto lines = vtkSmartPointer<vtkCellArray>::New();
+    const nav_gnss_model_config &g = s.gnss.model;
+    for (size_t o = 0; s.gnss.enabled && o < g.outage_count; ++o) {
+      std::vector<vtkIdType> ids;
+      for (size_t i = 0; i < path_.Size(); ++i)
+        if (path_.t_s[i] >= g.outages[o].t0_s && path_.t_s[i] <= g.outages[o].t1_s)
+          ids.push_back(pts->InsertNextPoint(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], -path_.ned_m[3 * i + 2] + 0.1));
+      if (ids.size() < 2) continue;
+      lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+      ++outage_spans_;
+    }
+    vtkPolyData *pd = InputOf(outages_);
+    pd->SetPoints(pts);
+    pd->SetLines(lines);
+    pd->Modified();
+  }
   // Parts of the path over a vehicle limit (a motion-definition script may exceed them): red.
   unsigned over_bits = 0;
   double over_t0 = 0.0, over_t1 = 0.0;
@@ -835,6 +880,7 @@ void PathView::Rebuild() {
     if (need > 0.9 * grid_extent_) UpdateGrid(grid_cx_, grid_cy_, 2.0 * need);
   }
 
+  UpdateLegend();
   UpdateCaption();
   renderer_->ResetCameraClippingRange();
   if (doc_->IsLive() && live_render_delay_ms_ > 0) {
@@ -843,6 +889,64 @@ void PathView::Rebuild() {
     if (!render_timer_.isActive()) render_timer_.start(live_render_delay_ms_);
   } else {
     Render();
+  }
+}
+
+void PathView::UpdateLegend() {
+  // Top right, one line per kind of object drawn: a coloured bar and what it is. In 3D the result
+  // scene (libnavview) draws its own legend; this one stands in before a result is shown.
+  struct Entry {
+    const double *rgb;
+    QString text;
+  };
+  std::vector<Entry> e;
+  const bool own = mode_ == Mode::Map || !scene_;
+  auto drawn = [](vtkActor *a) { return a->GetVisibility() && InputOf(a)->GetNumberOfPoints() > 1; };
+  if (own) {
+    if (path_.Size() > 1) e.push_back({kPlanRgb, tr("plan (reference path)")});
+    if (InputOf(over_actor_)->GetNumberOfPoints() > 1) e.push_back({kOverRgb, tr("over a vehicle limit")});
+    if (outage_spans_ > 0) e.push_back({kOutageRgb, tr("GNSS outage")});
+    if (drawn(envelope_))
+      e.push_back({kEnvelopeRgb, envelope_preview_ ? tr("band: 3 sigma of the preview") : tr("band: 3 x RMS over the runs")});
+    if (drawn(previous_)) e.push_back({kPreviousRgb, tr("previous result")});
+    if (drawn(estimate_)) e.push_back({kEstimateRgb, tr("estimate (live preview)")});
+    if (drawn(result_)) e.push_back({kEstimateRgb, tr("estimate (Monte Carlo run 0)")});
+  }
+  legend_entries_.clear();
+  for (auto &a : legend_) renderer_->RemoveViewProp(a);
+  legend_.clear();
+  const int fs = 12, line_h = 18, right = 8, top = 8, sym_w = 30;
+  for (size_t i = 0; i < e.size(); ++i) {
+    legend_entries_ << e[i].text;
+    const double y = -(top + static_cast<double>(i) * line_h);
+    for (int k = 0; k < 2; ++k) {
+      auto t = vtkSmartPointer<vtkTextActor>::New();
+      vtkTextProperty *tp = t->GetTextProperty();
+      tp->SetFontSize(fs);
+      tp->SetJustificationToRight();
+      tp->SetVerticalJustificationToTop();
+      if (k == 0) {
+        // The swatch: blanks on the object's colour, a bar 22 px wide and 6 px high.
+        t->SetInput("      ");
+        tp->SetFontSize(5);
+        tp->SetBackgroundColor(e[i].rgb[0], e[i].rgb[1], e[i].rgb[2]);
+        tp->SetBackgroundOpacity(1.0);
+      } else {
+        t->SetInput(e[i].text.toUtf8().constData());
+        tp->SetColor(0.08, 0.08, 0.10);
+        tp->SetBackgroundColor(1.0, 1.0, 1.0);
+        tp->SetBackgroundOpacity(0.75);
+      }
+      // Pixels from the view's top-right corner.
+      vtkNew<vtkCoordinate> corner;
+      corner->SetCoordinateSystemToNormalizedViewport();
+      corner->SetValue(1.0, 1.0);
+      t->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+      t->GetPositionCoordinate()->SetReferenceCoordinate(corner);
+      t->GetPositionCoordinate()->SetValue(k == 0 ? -right : -(right + sym_w), k == 0 ? y - 5.0 : y);
+      renderer_->AddViewProp(t);
+      legend_.push_back(t);
+    }
   }
 }
 
@@ -869,7 +973,9 @@ void PathView::UpdateCaption() {
     hint = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type));
   else if (mode_ == Mode::Map && count < 4)
     hint = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)");
-  const int avail = std::max(120, width() - 16); // the caption sits 8 px from the left edge
+  // The caption sits 8 px from the left edge, left of the result scene's legend panel.
+  const double panel = scene_ ? scene_->LegendPanelFraction() : 0.0;
+  const int avail = std::max(120, static_cast<int>(width() * (1.0 - panel)) - 16);
   vtkTextRenderer *text_renderer = vtkTextRenderer::GetInstance();
   const int dpi = window_ ? window_->GetDPI() : 72;
   auto fits = [&](const QString &line) {
@@ -993,6 +1099,7 @@ void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
     // A new preview supersedes the drawn Monte Carlo estimate of an older scene.
     SetPolyline(InputOf(result_), std::vector<double>(), 0.0);
   }
+  UpdateLegend();
   Render();
 }
 
@@ -1027,10 +1134,8 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
   pd->SetPoints(pts);
   pd->SetStrips(strips);
   pd->Modified();
-  if (preview)
-    envelope_->GetProperty()->SetColor(0.95, 0.55, 0.05);
-  else
-    envelope_->GetProperty()->SetColor(0.85, 0.10, 0.45);
+  envelope_preview_ = preview;
+  UpdateLegend();
 }
 
 size_t PathView::EnvelopePointCount() { return static_cast<size_t>(InputOf(envelope_)->GetNumberOfPoints()); }

@@ -65,6 +65,11 @@ public:
   void SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview);
   /** Points of the drawn envelope band (2 per epoch; tests). */
   size_t EnvelopePointCount();
+  /** The legend's entries, top to bottom (the map always; the 3D view until a result scene with
+   *  its own legend is shown). */
+  QStringList LegendEntries() const { return legend_entries_; }
+  /** GNSS outages drawn as pink bands along the plan (tests). */
+  int OutageSpanCount() const { return outage_spans_; }
   /** 3D view: show @p result through libnavview's scene (NavSceneView, the scene of navview and
    *  `navsim render`): reference and estimate, attitude triads, vehicle, outages, error tube and
    *  ellipsoids, legend, read-out; the editor's own estimate and band are hidden meanwhile.
@@ -155,6 +160,7 @@ private:
   bool HeightUnder(int x, int y, double n, double e, double *up);
   void UpdateGrid(double cx, double cy, double extent);
   void UpdateCaption();
+  void UpdateLegend();
   void resizeEvent(QResizeEvent *e) override;
   void showEvent(QShowEvent *e) override;
 
@@ -171,6 +177,11 @@ private:
   vtkSmartPointer<PathViewStyle> style_;
   vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, over_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
   vtkSmartPointer<vtkActor> envelope_; // band around the estimate (SetEnvelope)
+  vtkSmartPointer<vtkActor> outages_;  // GNSS outages along the plan
+  int outage_spans_ = 0;
+  bool envelope_preview_ = true;
+  std::vector<vtkSmartPointer<vtkTextActor>> legend_;
+  QStringList legend_entries_;
   vtkSmartPointer<vtkActor> stems_;    // 3D view: drop lines of waypoints off the ground plane
   vtkSmartPointer<vtkTextActor> caption_, problem_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;

@@ -78,6 +78,22 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   const nav_traj_limits &L = pr.limits;
   const double lane_h = (bottom - top) / 3.0;
   const double r2d = 180.0 / M_PI;
+  // GNSS outages: pink spans (the 3D view's outage colour) under the curves, across the lanes.
+  outage_rects_.clear();
+  const nav_scene &sc = doc_->Scene();
+  if (sc.gnss.enabled) {
+    for (size_t i = 0; i < sc.gnss.model.outage_count; ++i) {
+      const double a = std::max(sc.gnss.model.outages[i].t0_s, t0), b = std::min(sc.gnss.model.outages[i].t1_s, t1);
+      if (!(b > a)) continue;
+      const QRectF span(X(a), top, X(b) - X(a), bottom - top);
+      p.fillRect(span, kOutageTint);
+      outage_rects_.push_back(span);
+      // Named under the time axis, where the span starts (no label over the curves).
+      p.setPen(QColor(170, 40, 120));
+      p.drawText(QRectF(span.left(), bottom + 1, std::max(span.width(), 40.0), 14), Qt::AlignLeft | Qt::AlignTop,
+                 tr("GNSS outage"));
+    }
+  }
   struct Lane {
     QString name, unit;
     const std::vector<double> *v;

@@ -8,13 +8,19 @@
 #ifndef NAVSTUDIO_PROFILE_CHART_H
 #define NAVSTUDIO_PROFILE_CHART_H
 
+#include <QColor>
+#include <QRectF>
 #include <QString>
+#include <QVector>
 #include <QTimer>
 #include <QWidget>
 
 #include "studio_scene.h"
 
 namespace studio {
+
+/** GNSS outage spans in the charts: the 3D view's outage pink over the chart's background. */
+const QColor kOutageTint(245, 200, 228);
 
 class ProfileChart : public QWidget {
   Q_OBJECT
@@ -27,6 +33,8 @@ public:
   QString Message();
   /** Largest |value| / limit over the path for acceleration, turn rate, lateral acceleration. */
   void Utilisation(double *accel, double *turn, double *lateral);
+  /** The GNSS outage spans drawn at the last paint (widget coordinates; tests). */
+  QVector<QRectF> OutageRects() const { return outage_rects_; }
 
 protected:
   void paintEvent(QPaintEvent *e) override;
@@ -37,6 +45,7 @@ private:
   PathSamples prof_;
   QString msg_;
   QTimer timer_;
+  QVector<QRectF> outage_rects_;
 };
 
 } // namespace studio
