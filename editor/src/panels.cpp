@@ -370,9 +370,18 @@ QWidget *ScenePanels::BuildGnss() {
   QStringList names;
   names << tr("(scene values)") << cat_->GnssNames();
   gnss_receiver_ = Combo("gnssReceiver", names);
-  form->addRow(tr("Receiver class"), gnss_receiver_);
+  // Receiver classes have long names ("standalone SPS typical (single-frequency code, open
+  // sky)"): the combo takes the panel's whole width under its label, each name also its tooltip.
+  for (int i = 0; i < gnss_receiver_->count(); ++i)
+    gnss_receiver_->setItemData(i, gnss_receiver_->itemText(i), Qt::ToolTipRole);
+  form->addRow(new QLabel(tr("Receiver class")));
+  form->addRow(gnss_receiver_);
   connect(gnss_receiver_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
-    if (i == 0) return;
+    if (i == 0) {
+      // "(scene values)": the receiver's values stay, as the scene's own (no catalog class).
+      doc_->Edit(tr("Receiver: scene values"), [](nav_scene &s) { s.gnss.catalog[0] = '\0'; });
+      return;
+    }
     const nav_catalog_gnss_entry *e = nav_catalog_gnss_at(cat_->Gnss(), static_cast<size_t>(i - 1));
     if (!e) return;
     const nav_catalog_gnss_entry entry = *e;

@@ -344,7 +344,12 @@ private slots:
     QVERIFY(h->isVisibleTo(w.get()) && v->isVisibleTo(w.get()));
     Shot(w.get(), "legible-08-receiver-catalog");
     // "(scene values)": the fields stay, and edit the scene's noise.
+    const nav_vec3 catalog_sd = w->Doc()->Scene().gnss.model.pos_gm_sd_m;
     Choose(rx, "(scene values)", Qt::MatchExactly);
+    QCOMPARE(rx->currentText(), QString("(scene values)"));
+    QCOMPARE(w->Doc()->Scene().gnss.catalog[0], '\0');
+    QCOMPARE(w->Doc()->Scene().gnss.model.pos_gm_sd_m.x, catalog_sd.x); // the values stay
+    QVERIFY(!h->text().isEmpty());
     TypeInto(h, "2.5");
     TypeInto(v, "4");
     const nav_gnss_model_config &g = w->Doc()->Scene().gnss.model;
@@ -373,10 +378,11 @@ private slots:
 
     QTemporaryDir tmp;
     QVERIFY(tmp.isValid());
-    const QString shot = tmp.filePath("window.png");
+    const QString shot = tmp.filePath("navstudio.png");
     QString seen;
     AnswerFileDialog(&seen, shot);
     w->findChild<QAction *>("actionScreenshot")->trigger();
+    qInfo("dialog opened in %s; status bar: %s", qPrintable(seen), qPrintable(w->statusBar()->currentMessage()));
     QVERIFY(QFileInfo(shot).size() > 1000);
     QCOMPARE(QFileInfo(seen).canonicalFilePath(), QFileInfo(docs).canonicalFilePath());
     const QString msg = w->statusBar()->currentMessage();
