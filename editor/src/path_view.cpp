@@ -187,13 +187,16 @@ namespace {
 constexpr int kMultiSamples = 8;
 
 // One colour per kind of object in both views (the 3D view's result scene, libnavview, uses the
-// same: reference black, estimate red, envelope blue, outages pink). Bottom to top: outages,
-// plan, the translucent envelope, the previous result (grey, A/B), the estimate (preview thin,
-// Monte Carlo result wider).
+// same: reference black, estimate red, envelope blue, outages pink). Bottom to top: the
+// envelope (an opaque light blue region), outages, plan, the previous result (grey, A/B), the
+// estimate (preview thin, Monte Carlo result wider).
 constexpr double kPlanRgb[3] = {0.08, 0.08, 0.10};
 constexpr double kEstimateRgb[3] = {0.84, 0.10, 0.11};
-constexpr double kEnvelopeRgb[3] = {0.35, 0.55, 0.95};
 constexpr double kOutageRgb[3] = {0.96, 0.50, 0.80};
+// The envelope's fill: libnavview's tube blue (0.35, 0.55, 0.95) at 28 % over the views' light
+// background, drawn opaque
+// (SetEnvelope: overlapping pieces of the band show as one region).
+constexpr double kEnvelopeFillRgb[3] = {0.80, 0.86, 0.97};
 constexpr double kPreviousRgb[3] = {0.55, 0.55, 0.58};
 constexpr double kOverRgb[3] = {1.00, 0.55, 0.00}; // over a vehicle limit: orange, not the estimate's red
 // The outage band's depth pushed behind the paths (VTK coincident-topology units): a wide line
@@ -376,8 +379,7 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   selected_actor_->GetProperty()->LightingOn();
   bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
   bad_actor_->GetProperty()->LightingOn();
-  envelope_ = MakeActor(vtkNew<vtkPolyData>(), kEnvelopeRgb[0], kEnvelopeRgb[1], kEnvelopeRgb[2], 1.0);
-  envelope_->GetProperty()->SetOpacity(0.28);
+  envelope_ = MakeActor(vtkNew<vtkPolyData>(), kEnvelopeFillRgb[0], kEnvelopeFillRgb[1], kEnvelopeFillRgb[2], 1.0);
   renderer_->AddActor(outages_);
   renderer_->AddActor(envelope_); // under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
@@ -907,7 +909,7 @@ void PathView::UpdateLegend() {
     if (InputOf(over_actor_)->GetNumberOfPoints() > 1) e.push_back({kOverRgb, tr("over a vehicle limit")});
     if (outage_spans_ > 0) e.push_back({kOutageRgb, tr("GNSS outage")});
     if (drawn(envelope_))
-      e.push_back({kEnvelopeRgb, envelope_preview_ ? tr("band: 3 sigma of the preview") : tr("band: 3 x RMS over the runs")});
+      e.push_back({kEnvelopeFillRgb, envelope_preview_ ? tr("band: 3 sigma of the preview") : tr("band: 3 x RMS over the runs")});
     if (drawn(previous_)) e.push_back({kPreviousRgb, tr("previous result")});
     if (drawn(estimate_)) e.push_back({kEstimateRgb, tr("estimate (live preview)")});
     if (drawn(result_)) e.push_back({kEstimateRgb, tr("estimate (Monte Carlo run 0)")});
@@ -1104,41 +1106,50 @@ void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
 }
 
 void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview) {
+  // The band is the region within half_width_m[i] of the estimate: the union of a disc at every
+  // epoch and a trapezoid along every leg between two epochs (each piece convex). A strip of
+  // offset points (the band before) folds over itself at a corner tighter than its half-width
+  // and, translucent, drew each fold darker. The union is drawn opaque in the band's colour as
+  // seen through (kEnvelopeFillRgb), under the outages and the paths, so overlapping pieces
+  // show as one clean region.
   vtkPolyData *pd = InputOf(envelope_);
   auto pts = vtkSmartPointer<vtkPoints>::New();
-  auto strips = vtkSmartPointer<vtkCellArray>::New();
+  auto polys = vtkSmartPointer<vtkCellArray>::New();
   const size_t n = std::min(ned.size() / 3, half_width_m.size());
-  // Just under the estimate: in the map 4 m up (the estimate is drawn 5 m up), in 3D at its height.
-  const double lift = mode_ == Mode::Map ? 4.0 : 0.003 * std::max(grid_extent_, 100.0);
-  if (n >= 2) {
-    strips->InsertNextCell(static_cast<vtkIdType>(2 * n));
-    for (size_t i = 0; i < n; ++i) {
-      // Horizontal normal of the path at i (central difference; ends one-sided).
-      const size_t a = i > 0 ? i - 1 : i, b = i + 1 < n ? i + 1 : i;
-      double dn = ned[3 * b] - ned[3 * a], de = ned[3 * b + 1] - ned[3 * a + 1];
-      const double len = std::hypot(dn, de);
-      if (len > 1e-9) {
-        dn /= len;
-        de /= len;
-      } else {
-        dn = 1.0;
-        de = 0.0;
+  // Under the plan (0.3 m up) and the outage band (0.1 m).
+  const double lift = mode_ == Mode::Map ? 0.05 : 0.02;
+  envelope_epochs_ = n >= 2 ? n : 0;
+  constexpr int kSides = 20;
+  auto width = [&](size_t i) { return std::isfinite(half_width_m[i]) ? std::max(half_width_m[i], 0.0) : 0.0; };
+  for (size_t i = 0; n >= 2 && i < n; ++i) {
+    const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
+    if (w > 0.0) {
+      vtkIdType ids[kSides];
+      for (int k = 0; k < kSides; ++k) {
+        const double a = 2.0 * M_PI * k / kSides;
+        ids[k] = pts->InsertNextPoint(x + w * std::cos(a), y + w * std::sin(a), z);
       }
-      const double w = std::isfinite(half_width_m[i]) ? half_width_m[i] : 0.0;
-      const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift;
-      // Normal (east, north) = (dn, -de) rotated from the tangent (de, dn).
-      strips->InsertCellPoint(pts->InsertNextPoint(x + w * dn, y - w * de, z));
-      strips->InsertCellPoint(pts->InsertNextPoint(x - w * dn, y + w * de, z));
+      polys->InsertNextCell(kSides, ids);
     }
+    if (i + 1 == n) break;
+    const double x1 = ned[3 * (i + 1) + 1], y1 = ned[3 * (i + 1)], z1 = -ned[3 * (i + 1) + 2] + lift, w1 = width(i + 1);
+    const double len = std::hypot(x1 - x, y1 - y);
+    if (!(len > 1e-9) || (w <= 0.0 && w1 <= 0.0)) continue;
+    // Unit normal (east, north) of the leg.
+    const double nx = -(y1 - y) / len, ny = (x1 - x) / len;
+    const vtkIdType q[4] = {pts->InsertNextPoint(x + w * nx, y + w * ny, z), pts->InsertNextPoint(x1 + w1 * nx, y1 + w1 * ny, z1),
+                            pts->InsertNextPoint(x1 - w1 * nx, y1 - w1 * ny, z1), pts->InsertNextPoint(x - w * nx, y - w * ny, z)};
+    polys->InsertNextCell(4, q);
   }
   pd->SetPoints(pts);
-  pd->SetStrips(strips);
+  pd->SetPolys(polys);
+  pd->SetStrips(vtkSmartPointer<vtkCellArray>::New());
   pd->Modified();
   envelope_preview_ = preview;
   UpdateLegend();
 }
 
-size_t PathView::EnvelopePointCount() { return static_cast<size_t>(InputOf(envelope_)->GetNumberOfPoints()); }
+size_t PathView::EnvelopePointCount() { return 2 * envelope_epochs_; }
 
 QString PathView::CaptionText() const { return QString::fromUtf8(caption_->GetInput()); }
 

@@ -12,6 +12,7 @@
 #include <QFileInfo>
 #include <QLabel>
 #include <QLineEdit>
+#include <QMouseEvent>
 #include <QListWidget>
 #include <QPushButton>
 #include <QStandardPaths>
@@ -28,6 +29,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "main_window.h"
 #include "navview/nav_view_result.h"
@@ -119,6 +121,18 @@ private slots:
     QVERIFY(sc->LegendCompact());
     QVERIFY(sc->LegendFontPx() >= 8);
     QVERIFY(sc->LegendText().find("estimate (run 0)") != std::string::npos);
+    // The map's legend names what it draws, in the colours of the 3D scene: plan black under the
+    // estimate red (the live preview's orange and the plan's blue are gone).
+    const QStringList map_legend = w->MapView()->LegendEntries();
+    qInfo("map legend: %s", qPrintable(map_legend.join(" | ")));
+    QVERIFY(map_legend.contains("plan (reference path)"));
+    QVERIFY(map_legend.contains("estimate (live preview)"));
+    const QImage map_img = w->MapView()->Grab();
+    const long red = CountColour(map_img, 214, 26, 28, 40), orange = CountColour(map_img, 242, 140, 13, 30),
+               blue = CountColour(map_img, 26, 89, 217, 30);
+    qInfo("map pixels: estimate red %ld, old preview orange %ld, old plan blue %ld", red, orange, blue);
+    QVERIFY(red > 100);
+    QVERIFY(orange == 0 && blue == 0);
     Shot(w.get(), "legible-01-legend-narrow");
     QVERIFY(w->View3D()->Grab().save(QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-01-view3d.png")));
 
@@ -226,6 +240,9 @@ private slots:
     QApplication::processEvents();
     const QVector<QRectF> spans = pc->OutageRects();
     QCOMPARE(spans.size(), 2);
+    // On the map too: a pink band along the plan for each, named in its legend.
+    QCOMPARE(w->MapView()->OutageSpanCount(), 2);
+    QVERIFY(w->MapView()->LegendEntries().contains("GNSS outage"));
     const QImage img = pc->grab().toImage();
     QVERIFY(img.save(QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-05-profile.png")));
     for (const QRectF &s : spans) {
@@ -247,6 +264,30 @@ private slots:
     const double px_per_s = spans[0].width() / 60.0;
     QVERIFY(std::fabs((spans[1].left() - spans[0].left()) / px_per_s - 180.0) < 3.0);
     QVERIFY(t1 > 390.0);
+
+    // A drag across the time axis adds an outage over the dragged span (one undo step).
+    const int undo = w->Doc()->UndoStack()->count();
+    const int xa = static_cast<int>(std::lround(pc->XAtTime(240.0))), xb = static_cast<int>(std::lround(pc->XAtTime(300.0)));
+    const int y = pc->height() / 2;
+    QTest::mousePress(pc, Qt::LeftButton, Qt::NoModifier, QPoint(xa, y));
+    for (int k = 1; k <= 6; ++k) {
+      QMouseEvent move(QEvent::MouseMove, QPointF(xa + (xb - xa) * k / 6.0, y), Qt::LeftButton, Qt::LeftButton, Qt::NoModifier);
+      QApplication::sendEvent(pc, &move);
+    }
+    QTest::mouseRelease(pc, Qt::LeftButton, Qt::NoModifier, QPoint(xb, y));
+    QCOMPARE(w->Doc()->UndoStack()->count(), undo + 1);
+    const nav_gnss_model_config &g = w->Doc()->Scene().gnss.model;
+    QCOMPARE(static_cast<int>(g.outage_count), 3);
+    const double s_per_px = 60.0 / (xb - xa);
+    qInfo("dragged outage %.1f-%.1f s (%.2f s per pixel)", g.outages[2].t0_s, g.outages[2].t1_s, s_per_px);
+    QVERIFY(std::fabs(g.outages[2].t0_s - 240.0) <= s_per_px + 0.05);
+    QVERIFY(std::fabs(g.outages[2].t1_s - 300.0) <= s_per_px + 0.05);
+    pc->repaint();
+    QCOMPARE(pc->OutageRects().size(), 3);
+    QVERIFY(pc->grab().save(QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-05-profile-dragged.png")));
+    // A click is no outage.
+    QTest::mouseClick(pc, Qt::LeftButton, Qt::NoModifier, QPoint(xa, y));
+    QCOMPARE(static_cast<int>(w->Doc()->Scene().gnss.model.outage_count), 3);
   }
 
   // F5 with fewer than two waypoints says why (status bar and the Issues tab), and no Issues
@@ -399,6 +440,44 @@ private slots:
     QCOMPARE(QFileInfo(seen).canonicalFilePath(), QFileInfo(tmp.path()).canonicalFilePath());
   }
 
+  // The error band at a corner sharper than its half-width is one clean region: one colour, no
+  // darker folds (a strip of offset points folded over itself there, translucent).
+  void band_clean_region() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    studio::PathView *map = w->MapView();
+    map->SetMapExtent(0.0, 0.0, 320.0);
+    // An L: east along n = 0, then a right-angle turn north; 80 m half-width, points every 5 m.
+    std::vector<double> ned, half;
+    for (double e = -220.0; e <= 0.0; e += 5.0) ned.insert(ned.end(), {0.0, e, 0.0});
+    for (double n = 5.0; n <= 220.0; n += 5.0) ned.insert(ned.end(), {n, 0.0, 0.0});
+    half.assign(ned.size() / 3, 80.0);
+    map->SetEnvelope(ned, half, false);
+    QCOMPARE(map->EnvelopePointCount(), 2 * half.size());
+    map->Render();
+    QTest::qWait(300);
+    const QImage img = map->Grab();
+    QVERIFY(img.save(QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-11-band-corner.png")));
+    // The band's pixels: bluish. One shade (the fill) but for antialiased edges.
+    long fill = 0, other = 0;
+    const QImage im = img.convertToFormat(QImage::Format_RGB32);
+    for (int y = 0; y < im.height(); ++y)
+      for (int x = 0; x < im.width(); ++x) {
+        const QRgb c = im.pixel(x, y);
+        const int r = qRed(c), g = qGreen(c), b = qBlue(c);
+        if (!(b > r + 15 && b >= g)) continue;
+        if (std::abs(r - 204) <= 4 && std::abs(g - 219) <= 4 && std::abs(b - 247) <= 4)
+          ++fill;
+        else if (r + g + b < 204 + 219 + 247 - 24)
+          ++other;
+      }
+    qInfo("band pixels: %ld of the fill colour, %ld darker (folds, lines through the band)", fill, other);
+    QVERIFY(fill > 5000);
+    QVERIFY2(other < fill / 100, "the band is not one clean region");
+  }
+
   // Undo after a run marks the results out of date (they stay, greyed) until the next run.
   void undo_marks_stale() {
     auto w = MakeWindow();
@@ -416,6 +495,13 @@ private slots:
     QVERIFY(tabs->tabText(1).contains("out of date"));
     QVERIFY(w->ResultsText().contains("Out of date"));
     Shot(w.get(), "legible-10-undo-stale");
+    // New drive: no estimate or band of the old drive is left in either view.
+    QVERIFY(w->MapView()->EnvelopePointCount() > 0);
+    QVERIFY(w->NewDrive());
+    for (studio::PathView *v : {w->MapView(), w->View3D()}) {
+      QCOMPARE(v->EnvelopePointCount(), size_t{0});
+      QVERIFY(!v->LegendEntries().join(" ").contains("estimate"));
+    }
   }
 };
 
