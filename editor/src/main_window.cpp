@@ -223,8 +223,9 @@ void MainWindow::BuildActions() {
   QAction *movie = act(tr("Export &movie..."), "actionMovie", QKeySequence(tr("Ctrl+Shift+M")));
   QAction *picture = act(tr("Export &picture..."), "actionPicture", QKeySequence(tr("Ctrl+Shift+I")));
   connect(movie, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export movie"), DialogPath("navstudio-playback.mp4"),
-                                                   tr("H.264 MP4 (*.mp4);;VP9 WebM (*.webm)"));
+    const QString p =
+        QFileDialog::getSaveFileName(this, tr("Export movie"), DialogPath("navstudio-playback.mp4"),
+                                     tr("H.264 MP4 (*.mp4);;VP9 WebM (*.webm)"));
     if (p.isEmpty()) return;
     MovieRequest req;
     bool ok = false;
@@ -250,8 +251,8 @@ void MainWindow::BuildActions() {
     const QString size = QInputDialog::getItem(this, tr("Export picture"), tr("Size:"),
                                                {"1920x1080", "1280x720", "2560x1440", "3840x2160"}, 0, true, &ok);
     if (!ok) return;
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export picture"), DialogPath("navstudio-" + which + ".png"),
-                                                   tr("PNG (*.png)"));
+    const QString p = QFileDialog::getSaveFileName(
+        this, tr("Export picture"), DialogPath("navstudio-" + which + ".png"), tr("PNG (*.png)"));
     if (p.isEmpty()) return;
     QString err;
     if (ExportPicture(p, which, size.section('x', 0, 0).toInt(), size.section('x', 1, 1).toInt(), &err))
@@ -262,19 +263,20 @@ void MainWindow::BuildActions() {
   QAction *quit = act(tr("&Quit"), "actionQuit", QKeySequence::Quit);
   connect(nw, &QAction::triggered, this, [this] { NewDrive(); });
   connect(open, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getOpenFileName(this, tr("Open scene"), OpenDialogDir(), tr("Scenes (*.yaml *.yml)"));
+    const QString p =
+        QFileDialog::getOpenFileName(this, tr("Open scene"), OpenDialogDir(), tr("Scenes (*.yaml *.yml)"));
     if (!p.isEmpty()) OpenFile(p);
   });
   connect(save, &QAction::triggered, this, [this] { Save(); });
   connect(saveas, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene as"),
-                                                 doc_.FilePath().isEmpty() ? DialogPath("drive.yaml") : doc_.FilePath(),
-                                                 tr("Scenes (*.yaml)"));
+    const QString p = QFileDialog::getSaveFileName(
+        this, tr("Save scene as"), doc_.FilePath().isEmpty() ? DialogPath("drive.yaml") : doc_.FilePath(),
+        tr("Scenes (*.yaml)"));
     if (!p.isEmpty()) SaveAs(p);
   });
   connect(shot, &QAction::triggered, this, [this] {
-    const QString p =
-        QFileDialog::getSaveFileName(this, tr("Export screenshot"), DialogPath("navstudio.png"), tr("PNG (*.png)"));
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export screenshot"), DialogPath("navstudio.png"),
+                                                   tr("PNG (*.png)"));
     if (p.isEmpty()) return;
     if (Screenshot().save(p))
       statusBar()->showMessage(tr("Screenshot written to %1").arg(p), 8000);
@@ -282,8 +284,8 @@ void MainWindow::BuildActions() {
       QMessageBox::warning(this, tr("Export screenshot"), tr("%1: cannot write the picture").arg(p));
   });
   connect(report, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export report"), DialogPath("navstudio-report.html"),
-                                                   tr("HTML (*.html)"));
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export report"),
+                                                   DialogPath("navstudio-report.html"), tr("HTML (*.html)"));
     if (p.isEmpty()) return;
     QString err;
     if (ExportReport(p, &err))
@@ -456,7 +458,8 @@ bool MainWindow::NewDrive() {
 
 bool MainWindow::Save() {
   if (doc_.FilePath().isEmpty()) {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene"), DialogPath("drive.yaml"), tr("Scenes (*.yaml)"));
+    const QString p =
+        QFileDialog::getSaveFileName(this, tr("Save scene"), DialogPath("drive.yaml"), tr("Scenes (*.yaml)"));
     if (p.isEmpty()) return false;
     return SaveAs(p);
   }
@@ -547,7 +550,9 @@ QString MainWindow::OpenDialogDir() const {
   return scenes.isEmpty() ? DialogDir() : scenes;
 }
 
-QString MainWindow::DialogPath(const QString &name) const { return QDir(DialogDir()).filePath(name); }
+QString MainWindow::DialogPath(const QString &name) const {
+  return QDir(DialogDir()).filePath(name);
+}
 
 QStringList MainWindow::RecentFiles() const { return QSettings().value("recentFiles").toStringList(); }
 
@@ -915,7 +920,8 @@ bool MainWindow::ExportReport(const QString &path, QString *error) {
   r.result = res && !res->preview ? res.get() : nullptr;
   r.images.push_back({tr("navstudio: map, 3D view and panels"), Screenshot()});
   if (chart_ && !chart_->Picture().isNull())
-    r.images.push_back({tr("errors against time (horizontal, vertical, velocity, attitude)"), chart_->Picture()});
+    r.images.push_back(
+        {tr("errors against time (horizontal, vertical, velocity, attitude)"), chart_->Picture()});
   return WriteStudioReport(path, r, error);
 }
 

@@ -153,7 +153,8 @@ void NumField::OnCommit() {
   if (!Parse(&v, &empty, &err)) return; // the message stays; nothing is committed
   // Leaving a field unchanged is no edit: a value shown rounded (a datasheet term at three
   // significant digits) keeps its full precision in the scene.
-  if (!empty && (!is_set_ || is_set_(doc_->Scene())) && SameNumber(edit_->text(), get_(doc_->Scene()), digits_))
+  if (!empty && (!is_set_ || is_set_(doc_->Scene())) &&
+      SameNumber(edit_->text(), get_(doc_->Scene()), digits_))
     return;
   if (empty) {
     doc_->Edit(tr("Switch off %1").arg(label_), [this](nav_scene &s) { clear_(s); });

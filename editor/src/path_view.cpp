@@ -365,7 +365,8 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   }
   // The plan wider than the estimate drawn on it: where they coincide the plan edges it in black.
   path_actor_ = MakeActor(vtkNew<vtkPolyData>(), kPlanRgb[0], kPlanRgb[1], kPlanRgb[2], 4.0);
-  over_actor_ = MakeActor(vtkNew<vtkPolyData>(), kOverRgb[0], kOverRgb[1], kOverRgb[2], 5.0); // over a vehicle limit
+  over_actor_ =
+      MakeActor(vtkNew<vtkPolyData>(), kOverRgb[0], kOverRgb[1], kOverRgb[2], 5.0); // over a vehicle limit
   estimate_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 1.6);
   result_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 2.4);
   previous_ = MakeActor(vtkNew<vtkPolyData>(), kPreviousRgb[0], kPreviousRgb[1], kPreviousRgb[2], 1.5); // A/B
@@ -379,7 +380,8 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   selected_actor_->GetProperty()->LightingOn();
   bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
   bad_actor_->GetProperty()->LightingOn();
-  envelope_ = MakeActor(vtkNew<vtkPolyData>(), kEnvelopeFillRgb[0], kEnvelopeFillRgb[1], kEnvelopeFillRgb[2], 1.0);
+  envelope_ =
+      MakeActor(vtkNew<vtkPolyData>(), kEnvelopeFillRgb[0], kEnvelopeFillRgb[1], kEnvelopeFillRgb[2], 1.0);
   renderer_->AddActor(outages_);
   renderer_->AddActor(envelope_); // under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
@@ -708,7 +710,8 @@ void PathView::Rebuild() {
       std::vector<vtkIdType> ids;
       for (size_t i = 0; i < path_.Size(); ++i)
         if (path_.t_s[i] >= g.outages[o].t0_s && path_.t_s[i] <= g.outages[o].t1_s)
-          ids.push_back(pts->InsertNextPoint(path_.ned_m[3 * i + 1], path_.ned_m[3 * i], -path_.ned_m[3 * i + 2] + 0.1));
+          ids.push_back(pts->InsertNextPoint(path_.ned_m[3 * i + 1], path_.ned_m[3 * i],
+                                             -path_.ned_m[3 * i + 2] + 0.1));
       if (ids.size() < 2) continue;
       lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
       ++outage_spans_;
@@ -909,13 +912,15 @@ void PathView::UpdateLegend() {
     if (InputOf(over_actor_)->GetNumberOfPoints() > 1) e.push_back({kOverRgb, tr("over a vehicle limit")});
     if (outage_spans_ > 0) e.push_back({kOutageRgb, tr("GNSS outage")});
     if (drawn(envelope_))
-      e.push_back({kEnvelopeFillRgb, envelope_preview_ ? tr("band: 3 sigma of the preview") : tr("band: 3 x RMS over the runs")});
+      e.push_back({kEnvelopeFillRgb, envelope_preview_ ? tr("band: 3 sigma of the preview")
+                                                       : tr("band: 3 x RMS over the runs")});
     if (drawn(previous_)) e.push_back({kPreviousRgb, tr("previous result")});
     if (drawn(estimate_)) e.push_back({kEstimateRgb, tr("estimate (live preview)")});
     if (drawn(result_)) e.push_back({kEstimateRgb, tr("estimate (Monte Carlo run 0)")});
   }
   legend_entries_.clear();
-  for (auto &a : legend_) renderer_->RemoveViewProp(a);
+  for (auto &a : legend_)
+    renderer_->RemoveViewProp(a);
   legend_.clear();
   const int fs = 12, line_h = 18, right = 8, top = 8, sym_w = 30;
   for (size_t i = 0; i < e.size(); ++i) {
@@ -1120,7 +1125,9 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
   const double lift = mode_ == Mode::Map ? 0.05 : 0.02;
   envelope_epochs_ = n >= 2 ? n : 0;
   constexpr int kSides = 20;
-  auto width = [&](size_t i) { return std::isfinite(half_width_m[i]) ? std::max(half_width_m[i], 0.0) : 0.0; };
+  auto width = [&](size_t i) {
+    return std::isfinite(half_width_m[i]) ? std::max(half_width_m[i], 0.0) : 0.0;
+  };
   for (size_t i = 0; n >= 2 && i < n; ++i) {
     const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
     if (w > 0.0) {
@@ -1132,13 +1139,16 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
       polys->InsertNextCell(kSides, ids);
     }
     if (i + 1 == n) break;
-    const double x1 = ned[3 * (i + 1) + 1], y1 = ned[3 * (i + 1)], z1 = -ned[3 * (i + 1) + 2] + lift, w1 = width(i + 1);
+    const double x1 = ned[3 * (i + 1) + 1], y1 = ned[3 * (i + 1)], z1 = -ned[3 * (i + 1) + 2] + lift,
+                 w1 = width(i + 1);
     const double len = std::hypot(x1 - x, y1 - y);
     if (!(len > 1e-9) || (w <= 0.0 && w1 <= 0.0)) continue;
     // Unit normal (east, north) of the leg.
     const double nx = -(y1 - y) / len, ny = (x1 - x) / len;
-    const vtkIdType q[4] = {pts->InsertNextPoint(x + w * nx, y + w * ny, z), pts->InsertNextPoint(x1 + w1 * nx, y1 + w1 * ny, z1),
-                            pts->InsertNextPoint(x1 - w1 * nx, y1 - w1 * ny, z1), pts->InsertNextPoint(x - w * nx, y - w * ny, z)};
+    const vtkIdType q[4] = {pts->InsertNextPoint(x + w * nx, y + w * ny, z),
+                            pts->InsertNextPoint(x1 + w1 * nx, y1 + w1 * ny, z1),
+                            pts->InsertNextPoint(x1 - w1 * nx, y1 - w1 * ny, z1),
+                            pts->InsertNextPoint(x - w * nx, y - w * ny, z)};
     polys->InsertNextCell(4, q);
   }
   pd->SetPoints(pts);
@@ -1149,7 +1159,9 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
   UpdateLegend();
 }
 
-size_t PathView::EnvelopePointCount() { return 2 * envelope_epochs_; }
+size_t PathView::EnvelopePointCount() {
+  return 2 * envelope_epochs_;
+}
 
 QString PathView::CaptionText() const { return QString::fromUtf8(caption_->GetInput()); }
 

@@ -63,7 +63,8 @@ std::shared_ptr<NavResult> ToNavResult(const SimResult &r, const nav_scene &scen
     e.pos_err_v_m.assign(r.err_v_m.begin(), r.err_v_m.begin() + static_cast<long>(n));
     e.att_err_rad.assign(r.att_err_rad.begin(), r.att_err_rad.begin() + static_cast<long>(n));
     e.euler_err_rad.assign(r.euler_err_rad.begin(), r.euler_err_rad.begin() + static_cast<long>(3 * n));
-    if (r.err_vel_mps.size() >= n) e.vel_err_mps.assign(r.err_vel_mps.begin(), r.err_vel_mps.begin() + static_cast<long>(n));
+    if (r.err_vel_mps.size() >= n)
+      e.vel_err_mps.assign(r.err_vel_mps.begin(), r.err_vel_mps.begin() + static_cast<long>(n));
   }
   // The Monte Carlo envelope (a preview's single run has the filter's sigma only).
   const size_t m = r.env_t_s.size();

@@ -139,15 +139,18 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   const nav_scene &sc = doc_->Scene();
   if (sc.gnss.enabled) {
     for (size_t i = 0; i < sc.gnss.model.outage_count; ++i) {
-      const double a = std::max(sc.gnss.model.outages[i].t0_s, t0), b = std::min(sc.gnss.model.outages[i].t1_s, t1);
+      const double a = std::max(sc.gnss.model.outages[i].t0_s, t0),
+                   b = std::min(sc.gnss.model.outages[i].t1_s, t1);
       if (!(b > a)) continue;
       const QRectF span(X(a), top, X(b) - X(a), bottom - top);
       p.fillRect(span, kOutageTint);
       outage_rects_.push_back(span);
       // Named inside the span's top edge.
       p.setPen(QColor(170, 40, 120));
-      p.drawText(QRectF(span.left() + 2, top + 1, std::max(span.width() - 2, 30.0), 14), Qt::AlignLeft | Qt::AlignTop,
-                 p.fontMetrics().elidedText(tr("GNSS outage"), Qt::ElideRight, static_cast<int>(span.width()) - 2));
+      p.drawText(
+          QRectF(span.left() + 2, top + 1, std::max(span.width() - 2, 30.0), 14),
+          Qt::AlignLeft | Qt::AlignTop,
+          p.fontMetrics().elidedText(tr("GNSS outage"), Qt::ElideRight, static_cast<int>(span.width()) - 2));
     }
   }
   struct Lane {
@@ -240,12 +243,14 @@ void ProfileChart::paintEvent(QPaintEvent *) {
     const double b = std::clamp(static_cast<double>(std::max(drag_x0_, drag_x1_)), left, right);
     p.fillRect(QRectF(a, top, b - a, bottom - top), QColor(230, 90, 170, 70));
   }
-  QString legend = tr("limits dashed (turn rate: also lateral acceleration / speed); drag across to add a GNSS outage");
+  QString legend =
+      tr("limits dashed (turn rate: also lateral acceleration / speed); drag across to add a GNSS outage");
   if (all) legend = tr("over the vehicle limits (red): %1").arg(OverLimitText(all));
   p.setPen(all ? QColor(200, 0, 0) : QColor(60, 60, 60));
   // Between the time labels, elided when the chart is narrow.
   p.drawText(QPointF(left + 60, height() - 4),
-             p.fontMetrics().elidedText(legend, Qt::ElideRight, static_cast<int>(std::max(40.0, right - 60 - (left + 60)))));
+             p.fontMetrics().elidedText(legend, Qt::ElideRight,
+                                        static_cast<int>(std::max(40.0, right - 60 - (left + 60)))));
 }
 
 } // namespace studio

@@ -65,7 +65,8 @@ long CountColour(const QImage &img, int r, int g, int b, int tol) {
   for (int y = 0; y < im.height(); ++y) {
     const QRgb *row = reinterpret_cast<const QRgb *>(im.constScanLine(y));
     for (int x = 0; x < im.width(); ++x)
-      if (std::abs(qRed(row[x]) - r) <= tol && std::abs(qGreen(row[x]) - g) <= tol && std::abs(qBlue(row[x]) - b) <= tol)
+      if (std::abs(qRed(row[x]) - r) <= tol && std::abs(qGreen(row[x]) - g) <= tol &&
+          std::abs(qBlue(row[x]) - b) <= tol)
         ++n;
   }
   return n;
@@ -108,16 +109,19 @@ private slots:
     QVERIFY(w);
     QVERIFY(w->NewDrive());
     w->SetLivePreview(true);
-    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
-    QVERIFY(WaitUntil([&] { return w->View3D()->Scene() != nullptr && w->View3D()->Scene()->IsBuilt(); }, 60000));
+    for (auto &p : kDrive)
+      ClickMap(w->MapView(), p[0], p[1]);
+    QVERIFY(
+        WaitUntil([&] { return w->View3D()->Scene() != nullptr && w->View3D()->Scene()->IsBuilt(); }, 60000));
     QTest::qWait(200);
     NavSceneView *sc = w->View3D()->Scene();
     const int vw = w->View3D()->width();
-    qInfo("3D view %d x %d px: legend %.1f %% of the width, font %d px, compact %d", vw, w->View3D()->height(),
-          100.0 * sc->LegendPanelFraction(), sc->LegendFontPx(), sc->LegendCompact());
+    qInfo("3D view %d x %d px: legend %.1f %% of the width, font %d px, compact %d", vw,
+          w->View3D()->height(), 100.0 * sc->LegendPanelFraction(), sc->LegendFontPx(), sc->LegendCompact());
     QVERIFY2(vw < 700, "the 3D view is expected narrow in the default layout");
     QVERIFY(sc->LegendPanelFraction() > 0.0);
-    QVERIFY2(sc->LegendPanelFraction() <= 0.26 + 1e-9, qPrintable(QString::number(sc->LegendPanelFraction())));
+    QVERIFY2(sc->LegendPanelFraction() <= 0.26 + 1e-9,
+             qPrintable(QString::number(sc->LegendPanelFraction())));
     QVERIFY(sc->LegendCompact());
     QVERIFY(sc->LegendFontPx() >= 8);
     QVERIFY(sc->LegendText().find("estimate (run 0)") != std::string::npos);
@@ -157,7 +161,8 @@ private slots:
   void estimate_over_outage() {
     auto with = std::make_shared<NavResult>();
     std::string err;
-    QVERIFY2(NavLoadResultDir(NAVSTUDIO_SOURCE_DIR "/viewer/tests/data/tiny-gnss", with.get(), &err), err.c_str());
+    QVERIFY2(NavLoadResultDir(NAVSTUDIO_SOURCE_DIR "/viewer/tests/data/tiny-gnss", with.get(), &err),
+             err.c_str());
     QVERIFY(!with->gnss.outage_t0_s.empty());
     auto without = std::make_shared<NavResult>(*with);
     without->gnss.outage_t0_s.clear();
@@ -186,7 +191,8 @@ private slots:
       NavSceneView v;
       v.SetResult(k == 0 ? with : without);
       v.SetOptions(o);
-      const QString png = QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-03-outage-%1.png").arg(k == 0 ? "band" : "none");
+      const QString png =
+          QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-03-outage-%1.png").arg(k == 0 ? "band" : "none");
       QVERIFY2(v.RenderPng(png.toStdString(), &err), err.c_str());
       QImage img(png);
       QVERIFY(!img.isNull());
@@ -217,7 +223,8 @@ private slots:
     QTest::qWait(300);
     const QImage pic = chart->Picture();
     QVERIFY2(!pic.isNull(), qPrintable(chart->Message()));
-    qInfo("Errors tab picture %d x %d (viewport %d px wide)", pic.width(), pic.height(), chart->viewport()->width());
+    qInfo("Errors tab picture %d x %d (viewport %d px wide)", pic.width(), pic.height(),
+          chart->viewport()->width());
     QVERIFY(pic.height() >= studio::kMinChartHeightPx);
     QVERIFY(std::abs(pic.width() - chart->viewport()->width()) <= 2 || pic.width() == 320);
     QVERIFY(pic.save(QStringLiteral(NAVSTUDIO_TEST_OUT_DIR "/legible-04-errors-tab.png")));
@@ -252,7 +259,8 @@ private slots:
         for (int x = static_cast<int>(s.left()) + 2; x < static_cast<int>(s.right()) - 2; x += 3) {
           const QColor c = img.pixelColor(x, y);
           ++all;
-          if (std::abs(c.red() - studio::kOutageTint.red()) <= 4 && std::abs(c.green() - studio::kOutageTint.green()) <= 4 &&
+          if (std::abs(c.red() - studio::kOutageTint.red()) <= 4 &&
+              std::abs(c.green() - studio::kOutageTint.green()) <= 4 &&
               std::abs(c.blue() - studio::kOutageTint.blue()) <= 4)
             ++tinted;
         }
@@ -267,11 +275,13 @@ private slots:
 
     // A drag across the time axis adds an outage over the dragged span (one undo step).
     const int undo = w->Doc()->UndoStack()->count();
-    const int xa = static_cast<int>(std::lround(pc->XAtTime(240.0))), xb = static_cast<int>(std::lround(pc->XAtTime(300.0)));
+    const int xa = static_cast<int>(std::lround(pc->XAtTime(240.0))),
+              xb = static_cast<int>(std::lround(pc->XAtTime(300.0)));
     const int y = pc->height() / 2;
     QTest::mousePress(pc, Qt::LeftButton, Qt::NoModifier, QPoint(xa, y));
     for (int k = 1; k <= 6; ++k) {
-      QMouseEvent move(QEvent::MouseMove, QPointF(xa + (xb - xa) * k / 6.0, y), Qt::LeftButton, Qt::LeftButton, Qt::NoModifier);
+      QMouseEvent move(QEvent::MouseMove, QPointF(xa + (xb - xa) * k / 6.0, y), Qt::LeftButton,
+                       Qt::LeftButton, Qt::NoModifier);
       QApplication::sendEvent(pc, &move);
     }
     QTest::mouseRelease(pc, Qt::LeftButton, Qt::NoModifier, QPoint(xb, y));
@@ -336,15 +346,16 @@ private slots:
     w->Panels()->setCurrentIndex(1);
     QApplication::processEvents();
     int checked = 0;
-    for (const char *name : {"imu.gyro.arw", "imu.gyro.bias_gm_sigma", "imu.gyro.bias_turn_on", "imu.accel.vrw",
-                             "imu.accel.bias_gm_sigma"}) {
+    for (const char *name : {"imu.gyro.arw", "imu.gyro.bias_gm_sigma", "imu.gyro.bias_turn_on",
+                             "imu.accel.vrw", "imu.accel.bias_gm_sigma"}) {
       auto *e = w->findChild<QLineEdit *>(name);
       QVERIFY2(e, name);
       const QString t = e->text();
       if (t.isEmpty()) continue;
       QString digits = t;
       digits.remove('-').remove('.');
-      while (digits.startsWith('0')) digits.remove(0, 1);
+      while (digits.startsWith('0'))
+        digits.remove(0, 1);
       qInfo("%s = %s", name, qPrintable(t));
       QVERIFY2(!t.contains('e') && digits.size() <= 3, qPrintable(QString("%1 = %2").arg(name, t)));
       ++checked;
@@ -423,7 +434,8 @@ private slots:
     QString seen;
     AnswerFileDialog(&seen, shot);
     w->findChild<QAction *>("actionScreenshot")->trigger();
-    qInfo("dialog opened in %s; status bar: %s", qPrintable(seen), qPrintable(w->statusBar()->currentMessage()));
+    qInfo("dialog opened in %s; status bar: %s", qPrintable(seen),
+          qPrintable(w->statusBar()->currentMessage()));
     QVERIFY(QFileInfo(shot).size() > 1000);
     QCOMPARE(QFileInfo(seen).canonicalFilePath(), QFileInfo(docs).canonicalFilePath());
     const QString msg = w->statusBar()->currentMessage();
@@ -451,8 +463,10 @@ private slots:
     map->SetMapExtent(0.0, 0.0, 320.0);
     // An L: east along n = 0, then a right-angle turn north; 80 m half-width, points every 5 m.
     std::vector<double> ned, half;
-    for (double e = -220.0; e <= 0.0; e += 5.0) ned.insert(ned.end(), {0.0, e, 0.0});
-    for (double n = 5.0; n <= 220.0; n += 5.0) ned.insert(ned.end(), {n, 0.0, 0.0});
+    for (double e = -220.0; e <= 0.0; e += 5.0)
+      ned.insert(ned.end(), {0.0, e, 0.0});
+    for (double n = 5.0; n <= 220.0; n += 5.0)
+      ned.insert(ned.end(), {n, 0.0, 0.0});
     half.assign(ned.size() / 3, 80.0);
     map->SetEnvelope(ned, half, false);
     QCOMPARE(map->EnvelopePointCount(), 2 * half.size());
@@ -484,7 +498,8 @@ private slots:
     QVERIFY(w);
     w->SetLivePreview(false);
     QVERIFY(w->NewDrive());
-    for (auto &p : kDrive) ClickMap(w->MapView(), p[0], p[1]);
+    for (auto &p : kDrive)
+      ClickMap(w->MapView(), p[0], p[1]);
     TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "2");
     QVERIFY(RunAndWait(w.get(), 300000));
     QVERIFY(!w->ResultsStale());

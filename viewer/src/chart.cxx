@@ -190,8 +190,8 @@ void FillChart(vtkChartXY *chart, const std::string &title, const std::string &y
 
 // The y range of a panel: every finite value of the series and the band, with a margin above
 // (and below when negative values occur).
-void PanelRange(const std::vector<Series> &series, const std::vector<double> *lo, const std::vector<double> *hi,
-                double *y_lo, double *y_hi) {
+void PanelRange(const std::vector<Series> &series, const std::vector<double> *lo,
+                const std::vector<double> *hi, double *y_lo, double *y_hi) {
   double mn = 0.0, mx = 0.0;
   auto take = [&](const std::vector<double> &v) {
     for (double x : v)
@@ -375,8 +375,8 @@ bool BuildErrorChart(const NavResult &result, const NavChartOptions &opt, vtkCon
             mc ? &v_hi : nullptr, band, outages, lo, hi, opt, font);
   if (vel) {
     PanelRange(ss, vel_band ? &zero : nullptr, vel_band ? &s_hi : nullptr, &lo, &hi);
-    FillChart(charts[next++], "velocity error", "velocity [m/s]", false, e.t_s, ss, vel_band ? &zero : nullptr,
-              vel_band ? &s_hi : nullptr, band, outages, lo, hi, opt, font);
+    FillChart(charts[next++], "velocity error", "velocity [m/s]", false, e.t_s, ss,
+              vel_band ? &zero : nullptr, vel_band ? &s_hi : nullptr, band, outages, lo, hi, opt, font);
   }
   const bool att_band = mc && !env.att_rms_rad.empty();
   PanelRange(as, att_band ? &a_lo : nullptr, att_band ? &a_hi : nullptr, &lo, &hi);
@@ -409,8 +409,8 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opt,
   return NavWriteWindowPng(view->GetRenderWindow(), path, error);
 }
 
-bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &opt, std::vector<unsigned char> *rgb,
-                            std::string *error) {
+bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &opt,
+                            std::vector<unsigned char> *rgb, std::string *error) {
   vtkNew<vtkContextView> view;
   if (!BuildErrorChart(result, opt, view, error)) return false;
   const int w = opt.width_px, h = opt.height_px;

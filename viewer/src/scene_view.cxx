@@ -1034,7 +1034,7 @@ void NavSceneViewImpl::AddPanel() {
       tube_text += buf;
     }
     std::snprintf(buf, sizeof buf, "%g%s tube\n\u2264 %s", Options.envelope_k,
-                  src == NavEnvelopeSource::MonteCarlo ? "\u00d7 RMS"
+                  src == NavEnvelopeSource::MonteCarlo  ? "\u00d7 RMS"
                   : src == NavEnvelopeSource::RunErrors ? "\u00d7 error"
                                                         : "\u03c3",
                   rbuf);
@@ -1061,10 +1061,12 @@ void NavSceneViewImpl::AddPanel() {
   if (Options.show_vehicle) {
     const NavVehicleKind vk = Model.vehicle;
     e.push_back({Sym::Box,
-                 vk == NavVehicleKind::Aircraft ? "aircraft at t (reference)"
-                                                : (vk == NavVehicleKind::Car ? "car at t (reference)" : "vehicle at t (reference)"),
+                 vk == NavVehicleKind::Aircraft
+                     ? "aircraft at t (reference)"
+                     : (vk == NavVehicleKind::Car ? "car at t (reference)" : "vehicle at t (reference)"),
                  kVehicleColor, 0.0,
-                 vk == NavVehicleKind::Aircraft ? "aircraft at t" : (vk == NavVehicleKind::Car ? "car at t" : "vehicle at t")});
+                 vk == NavVehicleKind::Aircraft ? "aircraft at t"
+                                                : (vk == NavVehicleKind::Car ? "car at t" : "vehicle at t")});
     e.push_back({Sym::Dot, "estimated position at t", kEstColor, 0.0, "estimate at t"});
   }
 
@@ -1099,7 +1101,8 @@ void NavSceneViewImpl::AddPanel() {
   LegendCompact = panel_px > max_px;
   if (LegendCompact) {
     const int fs_full = fs;
-    fs = std::max(kLegendMinFontPx, std::min(fs_full, static_cast<int>(std::lround(Options.width_px / 46.0))));
+    fs =
+        std::max(kLegendMinFontPx, std::min(fs_full, static_cast<int>(std::lround(Options.width_px / 46.0))));
     panel_px = measure(true, fs);
     if (panel_px > max_px && fs > kLegendMinFontPx) {
       // Text width grows with the font size: one proportional step down.
@@ -1190,14 +1193,14 @@ void NavSceneViewImpl::AddPanel() {
   const double legend_bottom_px = y_cursor + 0.5 * fs;
 
   if (!LegendCompact) {
-  Info = vtkSmartPointer<vtkTextActor>::New();
-  StyleText(Info->GetTextProperty(), FontSize(0.75));
-  Info->GetTextProperty()->SetColor(0.35, 0.35, 0.4);
-  Info->GetTextProperty()->SetLineSpacing(1.05);
-  Info->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  Info->GetPositionCoordinate()->SetValue(pad / panel_w, 0.015);
-  Info->SetInput("");
-  Panel->AddViewProp(Info);
+    Info = vtkSmartPointer<vtkTextActor>::New();
+    StyleText(Info->GetTextProperty(), FontSize(0.75));
+    Info->GetTextProperty()->SetColor(0.35, 0.35, 0.4);
+    Info->GetTextProperty()->SetLineSpacing(1.05);
+    Info->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    Info->GetPositionCoordinate()->SetValue(pad / panel_w, 0.015);
+    Info->SetInput("");
+    Panel->AddViewProp(Info);
   }
 
   // Scalar bar of the error colouring below the legend.

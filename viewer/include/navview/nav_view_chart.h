@@ -42,8 +42,8 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opti
  * navstudio's Errors tab, shows it without a file).
  * @return false with a message as NavRenderErrorChartPng.
  */
-bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &options, std::vector<unsigned char> *rgb,
-                            std::string *error);
+bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &options,
+                            std::vector<unsigned char> *rgb, std::string *error);
 
 /**
  * Simulated sensor errors of run 0 (imu_errors.csv; the paper's Fig. 2): gyro errors [deg/h] and
