@@ -372,7 +372,12 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   previous_ = MakeActor(vtkNew<vtkPolyData>(), kPreviousRgb[0], kPreviousRgb[1], kPreviousRgb[2], 1.5); // A/B
   outages_ = MakeActor(vtkNew<vtkPolyData>(), kOutageRgb[0], kOutageRgb[1], kOutageRgb[2], 9.0);
   outages_->GetMapper()->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, kOutageDepthUnits);
-  vtkMapper::SetResolveCoincidentTopologyToPolygonOffset(); // the offset above needs it (VTK: off by default)
+  // The offset above needs VTK's coincident-topology resolution (off by default; process-wide):
+  // on, with zero global offsets, so that only the band's applies (as libnavview sets it).
+  vtkMapper::SetResolveCoincidentTopologyToPolygonOffset();
+  vtkMapper::SetResolveCoincidentTopologyPolygonOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyLineOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyPointOffsetParameter(0.0);
   handles_ = MakeActor(vtkNew<vtkPolyData>(), 0.98, 0.98, 0.98, 1.0);
   handles_->GetProperty()->LightingOn();
   handles_->GetProperty()->SetColor(0.15, 0.15, 0.15);
@@ -898,6 +903,7 @@ void PathView::Rebuild() {
 }
 
 void PathView::UpdateLegend() {
+  // Rebuilt only when what it lists changes (each text actor is rasterized when first drawn).
   // Top right, one line per kind of object drawn: a coloured bar and what it is. In 3D the result
   // scene (libnavview) draws its own legend; this one stands in before a result is shown.
   struct Entry {
@@ -918,6 +924,10 @@ void PathView::UpdateLegend() {
     if (drawn(estimate_)) e.push_back({kEstimateRgb, tr("estimate (live preview)")});
     if (drawn(result_)) e.push_back({kEstimateRgb, tr("estimate (Monte Carlo run 0)")});
   }
+  QStringList texts;
+  for (const Entry &x : e)
+    texts << x.text;
+  if (texts == legend_entries_ && legend_.size() == 2 * e.size()) return;
   legend_entries_.clear();
   for (auto &a : legend_)
     renderer_->RemoveViewProp(a);
@@ -1105,6 +1115,10 @@ void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
   if (preview) {
     // A new preview supersedes the drawn Monte Carlo estimate of an older scene.
     SetPolyline(InputOf(result_), std::vector<double>(), 0.0);
+  } else if (!ned.empty()) {
+    // The Monte Carlo result's run 0 is the scene's estimate now: one red estimate line, not the
+    // preview's beside it (the next edit's preview replaces it again).
+    SetPolyline(InputOf(estimate_), std::vector<double>(), 0.0);
   }
   UpdateLegend();
   Render();
@@ -1128,28 +1142,65 @@ void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<dou
   auto width = [&](size_t i) {
     return std::isfinite(half_width_m[i]) ? std::max(half_width_m[i], 0.0) : 0.0;
   };
-  for (size_t i = 0; n >= 2 && i < n; ++i) {
+  // Straight stretches of nearly constant width become one trapezoid (a live preview's band has
+  // about 2000 epochs: a piece per epoch cost about 10 ms of CPU per edit). A disc is needed only
+  // where the band turns (it fills the wedge between two trapezoids) and at the ends.
+  auto heading = [&](size_t a, size_t b) {
+    return std::atan2(ned[3 * b + 1] - ned[3 * a + 1], ned[3 * b] - ned[3 * a]);
+  };
+  constexpr double kTurnRad = 1.0 * M_PI / 180.0, kWidthChange = 0.02;
+  auto disc = [&](size_t i) {
     const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
-    if (w > 0.0) {
-      vtkIdType ids[kSides];
-      for (int k = 0; k < kSides; ++k) {
-        const double a = 2.0 * M_PI * k / kSides;
-        ids[k] = pts->InsertNextPoint(x + w * std::cos(a), y + w * std::sin(a), z);
-      }
-      polys->InsertNextCell(kSides, ids);
+    if (!(w > 0.0)) return;
+    vtkIdType ids[kSides];
+    for (int k = 0; k < kSides; ++k) {
+      const double a = 2.0 * M_PI * k / kSides;
+      ids[k] = pts->InsertNextPoint(x + w * std::cos(a), y + w * std::sin(a), z);
     }
-    if (i + 1 == n) break;
-    const double x1 = ned[3 * (i + 1) + 1], y1 = ned[3 * (i + 1)], z1 = -ned[3 * (i + 1) + 2] + lift,
-                 w1 = width(i + 1);
+    polys->InsertNextCell(kSides, ids);
+  };
+  auto trapezoid = [&](size_t i, size_t j) {
+    const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
+    const double x1 = ned[3 * j + 1], y1 = ned[3 * j], z1 = -ned[3 * j + 2] + lift, w1 = width(j);
     const double len = std::hypot(x1 - x, y1 - y);
-    if (!(len > 1e-9) || (w <= 0.0 && w1 <= 0.0)) continue;
-    // Unit normal (east, north) of the leg.
+    if (!(len > 1e-9) || (w <= 0.0 && w1 <= 0.0)) return;
+    // Unit normal (east, north) of the stretch.
     const double nx = -(y1 - y) / len, ny = (x1 - x) / len;
     const vtkIdType q[4] = {pts->InsertNextPoint(x + w * nx, y + w * ny, z),
                             pts->InsertNextPoint(x1 + w1 * nx, y1 + w1 * ny, z1),
                             pts->InsertNextPoint(x1 - w1 * nx, y1 - w1 * ny, z1),
                             pts->InsertNextPoint(x - w * nx, y - w * ny, z)};
     polys->InsertNextCell(4, q);
+  };
+  if (n >= 2) {
+    disc(0);
+    size_t a = 0;
+    double prev_dir = NAN;
+    while (a + 1 < n) {
+      // Skip repeated points (a vehicle at rest): no direction.
+      size_t b = a + 1;
+      while (b + 1 < n && std::hypot(ned[3 * b] - ned[3 * a], ned[3 * b + 1] - ned[3 * a + 1]) < 1e-9)
+        ++b;
+      const double dir = heading(a, b);
+      const double wa = width(a);
+      while (b + 1 < n) {
+        const size_t c = b + 1;
+        if (std::hypot(ned[3 * c] - ned[3 * b], ned[3 * c + 1] - ned[3 * b + 1]) < 1e-9) {
+          b = c;
+          continue;
+        }
+        if (std::fabs(std::remainder(heading(b, c) - dir, 2.0 * M_PI)) > kTurnRad ||
+            std::fabs(width(c) - wa) > kWidthChange * std::max(wa, 1e-9))
+          break;
+        b = c;
+      }
+      if (std::isfinite(prev_dir) && std::fabs(std::remainder(dir - prev_dir, 2.0 * M_PI)) > kTurnRad)
+        disc(a);
+      trapezoid(a, b);
+      prev_dir = dir;
+      a = b;
+    }
+    disc(n - 1);
   }
   pd->SetPoints(pts);
   pd->SetPolys(polys);

@@ -496,13 +496,19 @@ private slots:
   void undo_marks_stale() {
     auto w = MakeWindow();
     QVERIFY(w);
-    w->SetLivePreview(false);
+    w->SetLivePreview(true);
     QVERIFY(w->NewDrive());
     for (auto &p : kDrive)
       ClickMap(w->MapView(), p[0], p[1]);
     TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "2");
+    QVERIFY(WaitUntil([&] { return w->LastPreview() && !w->PreviewWorker()->IsBusy(); }, 60000));
+    QVERIFY(w->MapView()->LegendEntries().contains("estimate (live preview)"));
     QVERIFY(RunAndWait(w.get(), 300000));
     QVERIFY(!w->ResultsStale());
+    // One estimate in the map: the run's, the preview's gone.
+    const QStringList legend = w->MapView()->LegendEntries();
+    QVERIFY(legend.contains("estimate (Monte Carlo run 0)"));
+    QVERIFY(!legend.contains("estimate (live preview)"));
     w->findChild<QAction *>("actionUndo")->trigger(); // the runs edit
     QVERIFY(w->ResultsStale());
     auto *tabs = w->findChild<QTabWidget *>("bottomTabs");

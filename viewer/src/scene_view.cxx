@@ -414,9 +414,13 @@ double NavSceneViewImpl::MetresPerPixel() const {
 
 bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_camera) {
   // The outage band's depth offset (AddGnss) needs VTK's coincident-topology resolution, which
-  // is off by default (a process-wide setting; its defaults move lines 4 units and points 8
-  // units towards the camera and leave polygons where they are).
+  // is off by default. It is a process-wide setting: its global offsets are set to zero, so that
+  // only the band's own offset applies and every other actor is drawn as before (an offset makes
+  // the fragment shader write its depth, which costs llvmpipe time on every line).
   vtkMapper::SetResolveCoincidentTopologyToPolygonOffset();
+  vtkMapper::SetResolveCoincidentTopologyPolygonOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyLineOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyPointOffsetParameter(0.0);
   if (!Result) {
     *error = "no result set";
     return false;
