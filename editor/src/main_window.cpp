@@ -214,7 +214,7 @@ void MainWindow::BuildActions() {
   QAction *saveas = act(tr("Save &as..."), "actionSaveAs", QKeySequence::SaveAs);
   QAction *import = act(tr("&Import track..."), "actionImportTrack", QKeySequence(tr("Ctrl+I")));
   connect(import, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getOpenFileName(this, tr("Import track"), QString(),
+    const QString p = QFileDialog::getOpenFileName(this, tr("Import track"), DialogDir(),
                                                    tr("Tracks (*.gpx *.kml *.csv);;All files (*)"));
     if (!p.isEmpty()) ImportTrack(p);
   });
@@ -223,8 +223,9 @@ void MainWindow::BuildActions() {
   QAction *movie = act(tr("Export &movie..."), "actionMovie", QKeySequence(tr("Ctrl+Shift+M")));
   QAction *picture = act(tr("Export &picture..."), "actionPicture", QKeySequence(tr("Ctrl+Shift+I")));
   connect(movie, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export movie"), "navstudio-playback.mp4",
-                                                   tr("H.264 MP4 (*.mp4);;VP9 WebM (*.webm)"));
+    const QString p =
+        QFileDialog::getSaveFileName(this, tr("Export movie"), DialogPath("navstudio-playback.mp4"),
+                                     tr("H.264 MP4 (*.mp4);;VP9 WebM (*.webm)"));
     if (p.isEmpty()) return;
     MovieRequest req;
     bool ok = false;
@@ -250,8 +251,8 @@ void MainWindow::BuildActions() {
     const QString size = QInputDialog::getItem(this, tr("Export picture"), tr("Size:"),
                                                {"1920x1080", "1280x720", "2560x1440", "3840x2160"}, 0, true, &ok);
     if (!ok) return;
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export picture"), "navstudio-" + which + ".png",
-                                                   tr("PNG (*.png)"));
+    const QString p = QFileDialog::getSaveFileName(
+        this, tr("Export picture"), DialogPath("navstudio-" + which + ".png"), tr("PNG (*.png)"));
     if (p.isEmpty()) return;
     QString err;
     if (ExportPicture(p, which, size.section('x', 0, 0).toInt(), size.section('x', 1, 1).toInt(), &err))
@@ -262,21 +263,29 @@ void MainWindow::BuildActions() {
   QAction *quit = act(tr("&Quit"), "actionQuit", QKeySequence::Quit);
   connect(nw, &QAction::triggered, this, [this] { NewDrive(); });
   connect(open, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getOpenFileName(this, tr("Open scene"), ScenesDir(), tr("Scenes (*.yaml *.yml)"));
+    const QString p =
+        QFileDialog::getOpenFileName(this, tr("Open scene"), OpenDialogDir(), tr("Scenes (*.yaml *.yml)"));
     if (!p.isEmpty()) OpenFile(p);
   });
   connect(save, &QAction::triggered, this, [this] { Save(); });
   connect(saveas, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene as"), doc_.FilePath(), tr("Scenes (*.yaml)"));
+    const QString p = QFileDialog::getSaveFileName(
+        this, tr("Save scene as"), doc_.FilePath().isEmpty() ? DialogPath("drive.yaml") : doc_.FilePath(),
+        tr("Scenes (*.yaml)"));
     if (!p.isEmpty()) SaveAs(p);
   });
   connect(shot, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export screenshot"), "navstudio.png", tr("PNG (*.png)"));
-    if (!p.isEmpty()) Screenshot().save(p);
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export screenshot"), DialogPath("navstudio.png"),
+                                                   tr("PNG (*.png)"));
+    if (p.isEmpty()) return;
+    if (Screenshot().save(p))
+      statusBar()->showMessage(tr("Screenshot written to %1").arg(p), 8000);
+    else
+      QMessageBox::warning(this, tr("Export screenshot"), tr("%1: cannot write the picture").arg(p));
   });
   connect(report, &QAction::triggered, this, [this] {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Export report"), "navstudio-report.html",
-                                                   tr("HTML (*.html)"));
+    const QString p = QFileDialog::getSaveFileName(this, tr("Export report"),
+                                                   DialogPath("navstudio-report.html"), tr("HTML (*.html)"));
     if (p.isEmpty()) return;
     QString err;
     if (ExportReport(p, &err))
@@ -326,7 +335,8 @@ void MainWindow::BuildActions() {
   sim->addActions({run_act_, cancel_act_, preview_act_});
   QAction *trade = act(tr("Speed against &error..."), "actionTradeoff", QKeySequence());
   connect(trade, &QAction::triggered, this, [this] {
-    const QString base = doc_.FilePath().isEmpty() ? QString("tradeoff") : doc_.FilePath().section('.', 0, -2);
+    const QString base =
+        doc_.FilePath().isEmpty() ? DialogPath("tradeoff") : doc_.FilePath().section('.', 0, -2);
     const QString p = QFileDialog::getSaveFileName(this, tr("navsim tradeoff into the new directory"),
                                                    base + "-tradeoff");
     if (p.isEmpty()) return;
@@ -448,7 +458,8 @@ bool MainWindow::NewDrive() {
 
 bool MainWindow::Save() {
   if (doc_.FilePath().isEmpty()) {
-    const QString p = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Scenes (*.yaml)"));
+    const QString p =
+        QFileDialog::getSaveFileName(this, tr("Save scene"), DialogPath("drive.yaml"), tr("Scenes (*.yaml)"));
     if (p.isEmpty()) return false;
     return SaveAs(p);
   }
@@ -524,6 +535,23 @@ bool MainWindow::CheckRecovery() {
   view3d_->ResetCamera();
   status_->setText(tr("Recovered the autosave"));
   return true;
+}
+
+QString MainWindow::DialogDir() const {
+  if (!doc_.FilePath().isEmpty()) return QFileInfo(doc_.FilePath()).absolutePath();
+  const QString docs = QStandardPaths::writableLocation(QStandardPaths::DocumentsLocation);
+  if (!docs.isEmpty() && QFileInfo(docs).isDir()) return docs;
+  return QDir::homePath();
+}
+
+QString MainWindow::OpenDialogDir() const {
+  if (!doc_.FilePath().isEmpty()) return DialogDir();
+  const QString scenes = ScenesDir();
+  return scenes.isEmpty() ? DialogDir() : scenes;
+}
+
+QString MainWindow::DialogPath(const QString &name) const {
+  return QDir(DialogDir()).filePath(name);
 }
 
 QStringList MainWindow::RecentFiles() const { return QSettings().value("recentFiles").toStringList(); }
@@ -865,7 +893,7 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
   results_stale_ = false;
   results_->setHtml(h);
   bottom_tabs_->setCurrentWidget(results_);
-  chart_->SetResult(r);
+  chart_->SetResult(r, ToNavResult(*r, doc_.Scene()));
   panels_->SetVerdicts(r->verdicts);
   SetEnvelopes(*r, false);
   map_->SetEstimate(r->nav_ned, false);
@@ -891,7 +919,9 @@ bool MainWindow::ExportReport(const QString &path, QString *error) {
   const std::shared_ptr<const SimResult> res = last_result_;
   r.result = res && !res->preview ? res.get() : nullptr;
   r.images.push_back({tr("navstudio: map, 3D view and panels"), Screenshot()});
-  if (chart_) r.images.push_back({tr("horizontal error against time"), chart_->grab().toImage()});
+  if (chart_ && !chart_->Picture().isNull())
+    r.images.push_back(
+        {tr("errors against time (horizontal, vertical, velocity, attitude)"), chart_->Picture()});
   return WriteStudioReport(path, r, error);
 }
 
@@ -956,7 +986,7 @@ void MainWindow::ClearResults() {
     v->SetEstimate({}, true);
     v->SetEnvelope({}, {}, true);
   }
-  chart_->SetResult(nullptr);
+  chart_->SetResult(nullptr, nullptr);
   chart_->setEnabled(true);
   panels_->SetVerdicts({});
   bottom_tabs_->setTabText(bottom_tabs_->indexOf(results_), tr("Results"));

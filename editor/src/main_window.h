@@ -136,6 +136,13 @@ public:
    *  larger than a 1280 x 1024 screen) and centres it; used when navstudio is opened by a user. */
   void FitToScreen();
   QStringList RecentFiles() const;
+  /** Where the save and export dialogs open: the scene's folder, else the user's documents
+   *  folder (else home), never the working directory the program was started in. */
+  QString DialogDir() const;
+  /** Where File > Open starts: the scene's folder, else the shipped scenes. */
+  QString OpenDialogDir() const;
+  /** @p name in DialogDir(). */
+  QString DialogPath(const QString &name) const;
 
 signals:
   /** A Monte Carlo result or a preview has been drawn. */

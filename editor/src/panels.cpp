@@ -27,15 +27,19 @@ namespace studio {
 namespace {
 const char *kErrorStyle = "QLineEdit { border: 2px solid #d03030; background: #fff0f0; }";
 
-QString Num(double v) {
+// @p digits significant digits, but every digit before the decimal point (no exponent for a
+// whole number of up to 15 digits: "3000", not "3e+03").
+QString Num(double v, int digits = 10) {
   if (!std::isfinite(v)) return QString::number(v);
-  return QString::number(v, 'g', 10);
+  const double a = std::fabs(v);
+  const int whole = a >= 1.0 ? static_cast<int>(std::floor(std::log10(a))) + 1 : 0;
+  return QString::number(v, 'g', std::min(15, std::max(digits, whole)));
 }
 
-bool SameNumber(const QString &text, double v) {
+bool SameNumber(const QString &text, double v, int digits = 10) {
   bool ok = false;
   const double t = text.trimmed().toDouble(&ok);
-  return ok && (t == v || Num(t) == Num(v));
+  return ok && (t == v || Num(t, digits) == Num(v, digits));
 }
 
 QComboBox *Combo(const QString &name, const QStringList &items) {
@@ -137,11 +141,21 @@ void NumField::OnEdited() {
   ShowIssues(Validate(cand));
 }
 
+void NumField::SetSignificantDigits(int digits) {
+  digits_ = digits;
+  Refresh();
+}
+
 void NumField::OnCommit() {
   double v = 0.0;
   bool empty = false;
   QString err;
   if (!Parse(&v, &empty, &err)) return; // the message stays; nothing is committed
+  // Leaving a field unchanged is no edit: a value shown rounded (a datasheet term at three
+  // significant digits) keeps its full precision in the scene.
+  if (!empty && (!is_set_ || is_set_(doc_->Scene())) &&
+      SameNumber(edit_->text(), get_(doc_->Scene()), digits_))
+    return;
   if (empty) {
     doc_->Edit(tr("Switch off %1").arg(label_), [this](nav_scene &s) { clear_(s); });
   } else {
@@ -156,7 +170,7 @@ void NumField::Refresh() {
     return;
   }
   const double v = get_(s);
-  if (!SameNumber(edit_->text(), v)) edit_->setText(Num(v));
+  if (!SameNumber(edit_->text(), v, digits_)) edit_->setText(Num(v, digits_));
 }
 
 /* ---------------------------------------------------------------- panels */
@@ -339,6 +353,8 @@ QWidget *ScenePanels::BuildImu() {
         });
     f->SetOptional([t](const nav_scene &s) { return ((t.gyro ? s.imu.model.gyro.terms : s.imu.model.accel.terms) & t.bit) != 0; },
                    [bits, t](nav_scene &s) { bits(s) &= ~t.bit; });
+    // A datasheet figure converted to the field's unit ("16.19789203 deg/h") at datasheet precision.
+    f->SetSignificantDigits(3);
   }
   return w;
 }
@@ -355,9 +371,18 @@ QWidget *ScenePanels::BuildGnss() {
   QStringList names;
   names << tr("(scene values)") << cat_->GnssNames();
   gnss_receiver_ = Combo("gnssReceiver", names);
-  form->addRow(tr("Receiver class"), gnss_receiver_);
+  // Receiver classes have long names ("standalone SPS typical (single-frequency code, open
+  // sky)"): the combo takes the panel's whole width under its label, each name also its tooltip.
+  for (int i = 0; i < gnss_receiver_->count(); ++i)
+    gnss_receiver_->setItemData(i, gnss_receiver_->itemText(i), Qt::ToolTipRole);
+  form->addRow(new QLabel(tr("Receiver class")));
+  form->addRow(gnss_receiver_);
   connect(gnss_receiver_, QOverload<int>::of(&QComboBox::activated), this, [this](int i) {
-    if (i == 0) return;
+    if (i == 0) {
+      // "(scene values)": the receiver's values stay, as the scene's own (no catalog class).
+      doc_->Edit(tr("Receiver: scene values"), [](nav_scene &s) { s.gnss.catalog[0] = '\0'; });
+      return;
+    }
     const nav_catalog_gnss_entry *e = nav_catalog_gnss_at(cat_->Gnss(), static_cast<size_t>(i - 1));
     if (!e) return;
     const nav_catalog_gnss_entry entry = *e;
@@ -381,6 +406,55 @@ QWidget *ScenePanels::BuildGnss() {
       form, tr("Latency"), "gnss.latency_s", "gnss.latency",
       [](const nav_scene &s) { return s.gnss.model.latency_s; },
       [](nav_scene &s, double v) { s.gnss.model.latency_s = v; });
+  // The receiver's noise (the catalog class's values, or the scene's own for "(scene values)"):
+  // horizontal components (N and E) and vertical (D) of each term; empty = term off.
+  struct Noise {
+    QString label;
+    const char *key;
+    QString path;
+    unsigned bit;
+    nav_vec3 nav_gnss_model_config::*v;
+    int axes; // 0: N and E, 1: D, 2: all three
+  };
+  const std::vector<Noise> noise = {
+      {tr("Position σ horizontal"), "gnss.position_sigma_m", "gnss.position_sigma", NAV_GNSS_TERM_POS_GM,
+       &nav_gnss_model_config::pos_gm_sd_m, 0},
+      {tr("Position σ vertical"), "gnss.position_sigma_m", "gnss.position_sigma", NAV_GNSS_TERM_POS_GM,
+       &nav_gnss_model_config::pos_gm_sd_m, 1},
+      {tr("Position correlation time"), "gnss.position_corr_time_s", "gnss.position_corr_time",
+       NAV_GNSS_TERM_POS_GM, &nav_gnss_model_config::pos_gm_tau_s, 2},
+      {tr("White position σ horizontal"), "gnss.position_white_sigma_m", "gnss.position_white_sigma",
+       NAV_GNSS_TERM_POS_WHITE, &nav_gnss_model_config::pos_white_sd_m, 0},
+      {tr("White position σ vertical"), "gnss.position_white_sigma_m", "gnss.position_white_sigma",
+       NAV_GNSS_TERM_POS_WHITE, &nav_gnss_model_config::pos_white_sd_m, 1},
+      {tr("Velocity σ"), "gnss.velocity_sigma_mps", "gnss.velocity_sigma", NAV_GNSS_TERM_VEL_WHITE,
+       &nav_gnss_model_config::vel_sd_mps, 2},
+  };
+  for (const Noise &n : noise) {
+    NumField *f = AddKey(
+        form, n.label, n.key, n.path,
+        [n](const nav_scene &s) {
+          const nav_vec3 &v = s.gnss.model.*(n.v);
+          return n.axes == 1 ? v.z : v.x;
+        },
+        [n](nav_scene &s, double x) {
+          nav_vec3 &v = s.gnss.model.*(n.v);
+          if (n.axes != 1) v.x = v.y = x;
+          if (n.axes != 0) v.z = x;
+          if (!(s.gnss.model.terms & n.bit)) {
+            // A term switched on from one field: the other axes get the same value (a
+            // correlation time of 0 is white noise, valid).
+            if (n.axes == 0) v.z = x;
+            if (n.axes == 1) v.x = v.y = x;
+            s.gnss.model.terms |= n.bit;
+          }
+        });
+    // Two fields per key (horizontal, vertical): each its own name.
+    if (n.axes != 2) f->Edit()->setObjectName(n.path + (n.axes == 0 ? ".horizontal" : ".vertical"));
+    f->SetOptional([n](const nav_scene &s) { return (s.gnss.model.terms & n.bit) != 0; },
+                   [n](nav_scene &s) { s.gnss.model.terms &= ~n.bit; });
+    f->SetSignificantDigits(3);
+  }
   const char *axes[3] = {"x (forward)", "y (right)", "z (down)"};
   for (int k = 0; k < 3; ++k) {
     AddKey(

@@ -41,6 +41,9 @@ public:
   /** Add the scene table's description, range and default of @p key to the tooltip. */
   void SetHelp(const QString &key, const QString &help);
   void Refresh();
+  /** Show the value with @p digits significant digits (whole numbers keep every digit); the scene
+   *  keeps the full value until the user types another (default 10). */
+  void SetSignificantDigits(int digits);
   QLineEdit *Edit() { return edit_; }
   QString Label() const { return label_; }
   QString Path() const { return path_; }
@@ -60,6 +63,7 @@ private:
   std::function<void(nav_scene &)> clear_;
   QLineEdit *edit_;
   QLabel *msg_;
+  int digits_ = 10;
 };
 
 class ScenePanels : public QTabWidget {

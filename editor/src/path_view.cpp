@@ -26,6 +26,7 @@
 #include <vtkSequencePass.h>
 #include <vtkTranslucentPass.h>
 #include <vtkCellArray.h>
+#include <vtkCoordinate.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGlyph3D.h>
 #include <vtkInteractorStyleTrackballCamera.h>
@@ -188,6 +189,23 @@ vtkStandardNewMacro(PathViewStyle)
 namespace {
 constexpr int kMultiSamples = 8;
 
+// One colour per kind of object in both views (the 3D view's result scene, libnavview, uses the
+// same: reference black, estimate red, envelope blue, outages pink). Bottom to top: the
+// envelope (an opaque light blue region), outages, plan, the previous result (grey, A/B), the
+// estimate (preview thin, Monte Carlo result wider).
+constexpr double kPlanRgb[3] = {0.08, 0.08, 0.10};
+constexpr double kEstimateRgb[3] = {0.84, 0.10, 0.11};
+constexpr double kOutageRgb[3] = {0.96, 0.50, 0.80};
+// The envelope's fill: libnavview's tube blue (0.35, 0.55, 0.95) at 28 % over the views' light
+// background, drawn opaque
+// (SetEnvelope: overlapping pieces of the band show as one region).
+constexpr double kEnvelopeFillRgb[3] = {0.80, 0.86, 0.97};
+constexpr double kPreviousRgb[3] = {0.55, 0.55, 0.58};
+constexpr double kOverRgb[3] = {1.00, 0.55, 0.00}; // over a vehicle limit: orange, not the estimate's red
+// The outage band's depth pushed behind the paths (VTK coincident-topology units): a wide line
+// is nearer to the camera than a path a pixel beside it and would hide it.
+constexpr double kOutageDepthUnits = 50.0;
+
 vtkSmartPointer<vtkActor> MakeActor(vtkPolyData *pd, double r, double g, double b, double width) {
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
   mapper->SetInputData(pd);
@@ -348,11 +366,21 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     ground_->GetProperty()->SetOpacity(0.55);
     renderer_->AddActor(ground_);
   }
-  path_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.10, 0.35, 0.85, 3.0);
-  over_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.05, 0.05, 5.0); // path over a vehicle limit
-  estimate_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 2.0);
-  result_ = MakeActor(vtkNew<vtkPolyData>(), 0.85, 0.10, 0.45, 2.0);
-  previous_ = MakeActor(vtkNew<vtkPolyData>(), 0.45, 0.45, 0.45, 1.5); // the result before (A/B)
+  // The plan wider than the estimate drawn on it: where they coincide the plan edges it in black.
+  path_actor_ = MakeActor(vtkNew<vtkPolyData>(), kPlanRgb[0], kPlanRgb[1], kPlanRgb[2], 4.0);
+  over_actor_ =
+      MakeActor(vtkNew<vtkPolyData>(), kOverRgb[0], kOverRgb[1], kOverRgb[2], 5.0); // over a vehicle limit
+  estimate_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 1.6);
+  result_ = MakeActor(vtkNew<vtkPolyData>(), kEstimateRgb[0], kEstimateRgb[1], kEstimateRgb[2], 2.4);
+  previous_ = MakeActor(vtkNew<vtkPolyData>(), kPreviousRgb[0], kPreviousRgb[1], kPreviousRgb[2], 1.5); // A/B
+  outages_ = MakeActor(vtkNew<vtkPolyData>(), kOutageRgb[0], kOutageRgb[1], kOutageRgb[2], 9.0);
+  outages_->GetMapper()->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, kOutageDepthUnits);
+  // The offset above needs VTK's coincident-topology resolution (off by default; process-wide):
+  // on, with zero global offsets, so that only the band's applies (as libnavview sets it).
+  vtkMapper::SetResolveCoincidentTopologyToPolygonOffset();
+  vtkMapper::SetResolveCoincidentTopologyPolygonOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyLineOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyPointOffsetParameter(0.0);
   handles_ = MakeActor(vtkNew<vtkPolyData>(), 0.98, 0.98, 0.98, 1.0);
   handles_->GetProperty()->LightingOn();
   handles_->GetProperty()->SetColor(0.15, 0.15, 0.15);
@@ -360,9 +388,10 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
   selected_actor_->GetProperty()->LightingOn();
   bad_actor_ = MakeActor(vtkNew<vtkPolyData>(), 0.90, 0.10, 0.10, 1.0); // infeasible waypoints
   bad_actor_->GetProperty()->LightingOn();
-  envelope_ = MakeActor(vtkNew<vtkPolyData>(), 0.95, 0.55, 0.05, 1.0);
-  envelope_->GetProperty()->SetOpacity(0.25);
-  renderer_->AddActor(envelope_); // first: under the paths
+  envelope_ =
+      MakeActor(vtkNew<vtkPolyData>(), kEnvelopeFillRgb[0], kEnvelopeFillRgb[1], kEnvelopeFillRgb[2], 1.0);
+  renderer_->AddActor(outages_);
+  renderer_->AddActor(envelope_); // under the paths
   for (auto &a : {previous_, path_actor_, over_actor_, estimate_, result_, handles_, selected_actor_, bad_actor_})
     renderer_->AddActor(a);
   if (mode == Mode::ThreeD) {
@@ -424,6 +453,8 @@ bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const Nav
   if (!show) {
     scene_.reset();
     scene_stale_ = false;
+    UpdateLegend();
+    UpdateCaption();
     Render();
     return true;
   }
@@ -452,6 +483,8 @@ bool PathView::SetSceneResult(std::shared_ptr<const NavResult> result, const Nav
     return false;
   }
   scene_->SetStale(scene_stale_);
+  UpdateLegend();
+  UpdateCaption(); // left of the scene's legend panel
   Render();
   return true;
 }
@@ -462,6 +495,7 @@ void PathView::SetSceneStale(bool stale) {
   // The live preview keeps following in the editor's own estimate and band, over the greyed run.
   for (auto &a : {estimate_, envelope_})
     a->SetVisibility(!scene_ || stale);
+  UpdateLegend();
   Render();
 }
 
@@ -674,6 +708,27 @@ void PathView::Rebuild() {
   QString msg;
   if (!SharedSamplePath(s, 1200, &path_, &msg)) path_ = PathSamples();
   SetPolyline(InputOf(path_actor_), path_.ned_m, 0.3);
+  // GNSS outages: the plan's samples inside each outage, a wide pink band under the paths.
+  outage_spans_ = 0;
+  {
+    auto pts = vtkSmartPointer<vtkPoints>::New();
+    auto lines = vtkSmartPointer<vtkCellArray>::New();
+    const nav_gnss_model_config &g = s.gnss.model;
+    for (size_t o = 0; s.gnss.enabled && o < g.outage_count; ++o) {
+      std::vector<vtkIdType> ids;
+      for (size_t i = 0; i < path_.Size(); ++i)
+        if (path_.t_s[i] >= g.outages[o].t0_s && path_.t_s[i] <= g.outages[o].t1_s)
+          ids.push_back(pts->InsertNextPoint(path_.ned_m[3 * i + 1], path_.ned_m[3 * i],
+                                             -path_.ned_m[3 * i + 2] + 0.1));
+      if (ids.size() < 2) continue;
+      lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+      ++outage_spans_;
+    }
+    vtkPolyData *pd = InputOf(outages_);
+    pd->SetPoints(pts);
+    pd->SetLines(lines);
+    pd->Modified();
+  }
   // Parts of the path over a vehicle limit (a motion-definition script may exceed them): red.
   unsigned over_bits = 0;
   double over_t0 = 0.0, over_t1 = 0.0;
@@ -838,6 +893,7 @@ void PathView::Rebuild() {
     if (need > 0.9 * grid_extent_) UpdateGrid(grid_cx_, grid_cy_, 2.0 * need);
   }
 
+  UpdateLegend();
   UpdateCaption();
   renderer_->ResetCameraClippingRange();
   if (doc_->IsLive() && live_render_delay_ms_ > 0) {
@@ -846,6 +902,71 @@ void PathView::Rebuild() {
     if (!render_timer_.isActive()) render_timer_.start(live_render_delay_ms_);
   } else {
     Render();
+  }
+}
+
+void PathView::UpdateLegend() {
+  // Rebuilt only when what it lists changes (each text actor is rasterized when first drawn).
+  // Top right, one line per kind of object drawn: a coloured bar and what it is. In 3D the result
+  // scene (libnavview) draws its own legend; this one stands in before a result is shown.
+  struct Entry {
+    const double *rgb;
+    QString text;
+  };
+  std::vector<Entry> e;
+  const bool own = mode_ == Mode::Map || !scene_;
+  auto drawn = [](vtkActor *a) { return a->GetVisibility() && InputOf(a)->GetNumberOfPoints() > 1; };
+  if (own) {
+    if (path_.Size() > 1) e.push_back({kPlanRgb, tr("plan (reference path)")});
+    if (InputOf(over_actor_)->GetNumberOfPoints() > 1) e.push_back({kOverRgb, tr("over a vehicle limit")});
+    if (outage_spans_ > 0) e.push_back({kOutageRgb, tr("GNSS outage")});
+    if (drawn(envelope_))
+      e.push_back({kEnvelopeFillRgb, envelope_preview_ ? tr("band: 3 sigma of the preview")
+                                                       : tr("band: 3 x RMS over the runs")});
+    if (drawn(previous_)) e.push_back({kPreviousRgb, tr("previous result")});
+    if (drawn(estimate_)) e.push_back({kEstimateRgb, tr("estimate (live preview)")});
+    if (drawn(result_)) e.push_back({kEstimateRgb, tr("estimate (Monte Carlo run 0)")});
+  }
+  QStringList texts;
+  for (const Entry &x : e)
+    texts << x.text;
+  if (texts == legend_entries_ && legend_.size() == 2 * e.size()) return;
+  legend_entries_.clear();
+  for (auto &a : legend_)
+    renderer_->RemoveViewProp(a);
+  legend_.clear();
+  const int fs = 12, line_h = 18, right = 8, top = 8, sym_w = 30;
+  for (size_t i = 0; i < e.size(); ++i) {
+    legend_entries_ << e[i].text;
+    const double y = -(top + static_cast<double>(i) * line_h);
+    for (int k = 0; k < 2; ++k) {
+      auto t = vtkSmartPointer<vtkTextActor>::New();
+      vtkTextProperty *tp = t->GetTextProperty();
+      tp->SetFontSize(fs);
+      tp->SetJustificationToRight();
+      tp->SetVerticalJustificationToTop();
+      if (k == 0) {
+        // The swatch: blanks on the object's colour, a bar 22 px wide and 6 px high.
+        t->SetInput("      ");
+        tp->SetFontSize(5);
+        tp->SetBackgroundColor(e[i].rgb[0], e[i].rgb[1], e[i].rgb[2]);
+        tp->SetBackgroundOpacity(1.0);
+      } else {
+        t->SetInput(e[i].text.toUtf8().constData());
+        tp->SetColor(0.08, 0.08, 0.10);
+        tp->SetBackgroundColor(1.0, 1.0, 1.0);
+        tp->SetBackgroundOpacity(0.75);
+      }
+      // Pixels from the view's top-right corner.
+      vtkNew<vtkCoordinate> corner;
+      corner->SetCoordinateSystemToNormalizedViewport();
+      corner->SetValue(1.0, 1.0);
+      t->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+      t->GetPositionCoordinate()->SetReferenceCoordinate(corner);
+      t->GetPositionCoordinate()->SetValue(k == 0 ? -right : -(right + sym_w), k == 0 ? y - 5.0 : y);
+      renderer_->AddViewProp(t);
+      legend_.push_back(t);
+    }
   }
 }
 
@@ -872,7 +993,9 @@ void PathView::UpdateCaption() {
     hint = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type));
   else if (mode_ == Mode::Map && count < 4)
     hint = tr("Click to add a waypoint, drag one to move it (Ctrl+click inserts, Delete removes)");
-  const int avail = std::max(120, width() - 16); // the caption sits 8 px from the left edge
+  // The caption sits 8 px from the left edge, left of the result scene's legend panel.
+  const double panel = scene_ ? scene_->LegendPanelFraction() : 0.0;
+  const int avail = std::max(120, static_cast<int>(width() * (1.0 - panel)) - 16);
   vtkTextRenderer *text_renderer = vtkTextRenderer::GetInstance();
   const int dpi = window_ ? window_->GetDPI() : 72;
   auto fits = [&](const QString &line) {
@@ -995,48 +1118,104 @@ void PathView::SetEstimate(const std::vector<double> &ned, bool preview) {
   if (preview) {
     // A new preview supersedes the drawn Monte Carlo estimate of an older scene.
     SetPolyline(InputOf(result_), std::vector<double>(), 0.0);
+  } else if (!ned.empty()) {
+    // The Monte Carlo result's run 0 is the scene's estimate now: one red estimate line, not the
+    // preview's beside it (the next edit's preview replaces it again).
+    SetPolyline(InputOf(estimate_), std::vector<double>(), 0.0);
   }
+  UpdateLegend();
   Render();
 }
 
 void PathView::SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview) {
+  // The band is the region within half_width_m[i] of the estimate: the union of a disc at every
+  // epoch and a trapezoid along every leg between two epochs (each piece convex). A strip of
+  // offset points (the band before) folds over itself at a corner tighter than its half-width
+  // and, translucent, drew each fold darker. The union is drawn opaque in the band's colour as
+  // seen through (kEnvelopeFillRgb), under the outages and the paths, so overlapping pieces
+  // show as one clean region.
   vtkPolyData *pd = InputOf(envelope_);
   auto pts = vtkSmartPointer<vtkPoints>::New();
-  auto strips = vtkSmartPointer<vtkCellArray>::New();
+  auto polys = vtkSmartPointer<vtkCellArray>::New();
   const size_t n = std::min(ned.size() / 3, half_width_m.size());
-  // Just under the estimate: in the map 4 m up (the estimate is drawn 5 m up), in 3D at its height.
-  const double lift = mode_ == Mode::Map ? 4.0 : 0.003 * std::max(grid_extent_, 100.0);
-  if (n >= 2) {
-    strips->InsertNextCell(static_cast<vtkIdType>(2 * n));
-    for (size_t i = 0; i < n; ++i) {
-      // Horizontal normal of the path at i (central difference; ends one-sided).
-      const size_t a = i > 0 ? i - 1 : i, b = i + 1 < n ? i + 1 : i;
-      double dn = ned[3 * b] - ned[3 * a], de = ned[3 * b + 1] - ned[3 * a + 1];
-      const double len = std::hypot(dn, de);
-      if (len > 1e-9) {
-        dn /= len;
-        de /= len;
-      } else {
-        dn = 1.0;
-        de = 0.0;
-      }
-      const double w = std::isfinite(half_width_m[i]) ? half_width_m[i] : 0.0;
-      const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift;
-      // Normal (east, north) = (dn, -de) rotated from the tangent (de, dn).
-      strips->InsertCellPoint(pts->InsertNextPoint(x + w * dn, y - w * de, z));
-      strips->InsertCellPoint(pts->InsertNextPoint(x - w * dn, y + w * de, z));
+  // Under the plan (0.3 m up) and the outage band (0.1 m).
+  const double lift = mode_ == Mode::Map ? 0.05 : 0.02;
+  envelope_epochs_ = n >= 2 ? n : 0;
+  constexpr int kSides = 20;
+  auto width = [&](size_t i) {
+    return std::isfinite(half_width_m[i]) ? std::max(half_width_m[i], 0.0) : 0.0;
+  };
+  // Straight stretches of nearly constant width become one trapezoid (a live preview's band has
+  // about 2000 epochs: a piece per epoch cost about 10 ms of CPU per edit). A disc is needed only
+  // where the band turns (it fills the wedge between two trapezoids) and at the ends.
+  auto heading = [&](size_t a, size_t b) {
+    return std::atan2(ned[3 * b + 1] - ned[3 * a + 1], ned[3 * b] - ned[3 * a]);
+  };
+  constexpr double kTurnRad = 1.0 * M_PI / 180.0, kWidthChange = 0.02;
+  auto disc = [&](size_t i) {
+    const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
+    if (!(w > 0.0)) return;
+    vtkIdType ids[kSides];
+    for (int k = 0; k < kSides; ++k) {
+      const double a = 2.0 * M_PI * k / kSides;
+      ids[k] = pts->InsertNextPoint(x + w * std::cos(a), y + w * std::sin(a), z);
     }
+    polys->InsertNextCell(kSides, ids);
+  };
+  auto trapezoid = [&](size_t i, size_t j) {
+    const double x = ned[3 * i + 1], y = ned[3 * i], z = -ned[3 * i + 2] + lift, w = width(i);
+    const double x1 = ned[3 * j + 1], y1 = ned[3 * j], z1 = -ned[3 * j + 2] + lift, w1 = width(j);
+    const double len = std::hypot(x1 - x, y1 - y);
+    if (!(len > 1e-9) || (w <= 0.0 && w1 <= 0.0)) return;
+    // Unit normal (east, north) of the stretch.
+    const double nx = -(y1 - y) / len, ny = (x1 - x) / len;
+    const vtkIdType q[4] = {pts->InsertNextPoint(x + w * nx, y + w * ny, z),
+                            pts->InsertNextPoint(x1 + w1 * nx, y1 + w1 * ny, z1),
+                            pts->InsertNextPoint(x1 - w1 * nx, y1 - w1 * ny, z1),
+                            pts->InsertNextPoint(x - w * nx, y - w * ny, z)};
+    polys->InsertNextCell(4, q);
+  };
+  if (n >= 2) {
+    disc(0);
+    size_t a = 0;
+    double prev_dir = NAN;
+    while (a + 1 < n) {
+      // Skip repeated points (a vehicle at rest): no direction.
+      size_t b = a + 1;
+      while (b + 1 < n && std::hypot(ned[3 * b] - ned[3 * a], ned[3 * b + 1] - ned[3 * a + 1]) < 1e-9)
+        ++b;
+      const double dir = heading(a, b);
+      const double wa = width(a);
+      while (b + 1 < n) {
+        const size_t c = b + 1;
+        if (std::hypot(ned[3 * c] - ned[3 * b], ned[3 * c + 1] - ned[3 * b + 1]) < 1e-9) {
+          b = c;
+          continue;
+        }
+        if (std::fabs(std::remainder(heading(b, c) - dir, 2.0 * M_PI)) > kTurnRad ||
+            std::fabs(width(c) - wa) > kWidthChange * std::max(wa, 1e-9))
+          break;
+        b = c;
+      }
+      if (std::isfinite(prev_dir) && std::fabs(std::remainder(dir - prev_dir, 2.0 * M_PI)) > kTurnRad)
+        disc(a);
+      trapezoid(a, b);
+      prev_dir = dir;
+      a = b;
+    }
+    disc(n - 1);
   }
   pd->SetPoints(pts);
-  pd->SetStrips(strips);
+  pd->SetPolys(polys);
+  pd->SetStrips(vtkSmartPointer<vtkCellArray>::New());
   pd->Modified();
-  if (preview)
-    envelope_->GetProperty()->SetColor(0.95, 0.55, 0.05);
-  else
-    envelope_->GetProperty()->SetColor(0.85, 0.10, 0.45);
+  envelope_preview_ = preview;
+  UpdateLegend();
 }
 
-size_t PathView::EnvelopePointCount() { return static_cast<size_t>(InputOf(envelope_)->GetNumberOfPoints()); }
+size_t PathView::EnvelopePointCount() {
+  return 2 * envelope_epochs_;
+}
 
 QString PathView::CaptionText() const { return QString::fromUtf8(caption_->GetInput()); }
 

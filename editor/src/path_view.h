@@ -59,12 +59,18 @@ public:
    *  colour, else the Monte Carlo result's (the one it replaces stays drawn in grey for A/B
    *  comparison). Empty clears it. */
   void SetEstimate(const std::vector<double> &ned, bool preview);
-  /** Error envelope around the estimate: a horizontal band of half-width @p half_width_m[i] about
-   *  the points @p ned (3 per point, local NED); translucent orange for a preview (k x the filter's
-   *  reported sigma), magenta for a Monte Carlo result (k x the RMS over runs). Empty clears it. */
+  /** Error envelope around the estimate: the region within @p half_width_m[i] of the points
+   *  @p ned (3 per point, local NED), drawn as one light blue region under the paths (k x the
+   *  filter's reported sigma for a preview, k x the RMS over runs for a Monte Carlo result; the
+   *  legend says which). Empty clears it. */
   void SetEnvelope(const std::vector<double> &ned, const std::vector<double> &half_width_m, bool preview);
-  /** Points of the drawn envelope band (2 per epoch; tests). */
+  /** Two per epoch of the drawn envelope band (its two edges; tests). */
   size_t EnvelopePointCount();
+  /** The legend's entries, top to bottom (the map always; the 3D view until a result scene with
+   *  its own legend is shown). */
+  QStringList LegendEntries() const { return legend_entries_; }
+  /** GNSS outages drawn as pink bands along the plan (tests). */
+  int OutageSpanCount() const { return outage_spans_; }
   /** 3D view: show @p result through libnavview's scene (NavSceneView, the scene of navview and
    *  `navsim render`): reference and estimate, attitude triads, vehicle, outages, error tube and
    *  ellipsoids, legend, read-out; the editor's own estimate and band are hidden meanwhile.
@@ -155,6 +161,7 @@ private:
   bool HeightUnder(int x, int y, double n, double e, double *up);
   void UpdateGrid(double cx, double cy, double extent);
   void UpdateCaption();
+  void UpdateLegend();
   void resizeEvent(QResizeEvent *e) override;
   void showEvent(QShowEvent *e) override;
 
@@ -171,6 +178,12 @@ private:
   vtkSmartPointer<PathViewStyle> style_;
   vtkSmartPointer<vtkActor> grid_, ground_, path_actor_, over_actor_, handles_, selected_actor_, estimate_, result_, previous_, bad_actor_;
   vtkSmartPointer<vtkActor> envelope_; // band around the estimate (SetEnvelope)
+  vtkSmartPointer<vtkActor> outages_;  // GNSS outages along the plan
+  int outage_spans_ = 0;
+  size_t envelope_epochs_ = 0;
+  bool envelope_preview_ = true;
+  std::vector<vtkSmartPointer<vtkTextActor>> legend_;
+  QStringList legend_entries_;
   vtkSmartPointer<vtkActor> stems_;    // 3D view: drop lines of waypoints off the ground plane
   vtkSmartPointer<vtkTextActor> caption_, problem_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;

@@ -63,6 +63,8 @@ std::shared_ptr<NavResult> ToNavResult(const SimResult &r, const nav_scene &scen
     e.pos_err_v_m.assign(r.err_v_m.begin(), r.err_v_m.begin() + static_cast<long>(n));
     e.att_err_rad.assign(r.att_err_rad.begin(), r.att_err_rad.begin() + static_cast<long>(n));
     e.euler_err_rad.assign(r.euler_err_rad.begin(), r.euler_err_rad.begin() + static_cast<long>(3 * n));
+    if (r.err_vel_mps.size() >= n)
+      e.vel_err_mps.assign(r.err_vel_mps.begin(), r.err_vel_mps.begin() + static_cast<long>(n));
   }
   // The Monte Carlo envelope (a preview's single run has the filter's sigma only).
   const size_t m = r.env_t_s.size();
@@ -72,6 +74,7 @@ std::shared_ptr<NavResult> ToNavResult(const SimResult &r, const nav_scene &scen
     v.pos_rms_ned_m = r.env_rms_ned_m;
     v.pos_h_rms_m = r.env_h_rms_m;
     if (r.env_att_rms_rad.size() == m) v.att_rms_rad = r.env_att_rms_rad;
+    if (r.env_vel_rms_mps.size() == m) v.vel_rms_mps = r.env_vel_rms_mps;
     if (r.env_sd_ned_m.size() == 3 * m) v.pos_sd_reported_ned_m = r.env_sd_ned_m;
   } else if (r.preview && m > 0 && r.env_sd_ned_m.size() == 3 * m && r.env_h_rms_m.size() == m &&
              r.env_rms_ned_m.size() == 3 * m) {
@@ -84,6 +87,19 @@ std::shared_ptr<NavResult> ToNavResult(const SimResult &r, const nav_scene &scen
   for (const nav_gnss_outage &o : r.outages) {
     out->gnss.outage_t0_s.push_back(o.t0_s);
     out->gnss.outage_t1_s.push_back(o.t1_s);
+  }
+  // The requirement verdicts (limits on the error charts), as summary.json carries them.
+  for (const nav_requirement_verdict &v : r.verdicts) {
+    NavRequirementVerdict x;
+    x.id = v.id;
+    x.metric = nav_req_metric_name(v.metric);
+    x.statistic = nav_req_statistic_name(v.statistic);
+    x.unit = nav_req_unit_name(v.unit);
+    x.limit = v.limit;
+    x.value = v.value;
+    x.limit_si = v.limit * nav_req_unit_to_si(v.unit);
+    x.pass = v.pass;
+    out->requirements.push_back(x);
   }
   return out;
 }

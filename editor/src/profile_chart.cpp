@@ -1,5 +1,6 @@
 #include "profile_chart.h"
 
+#include <QMouseEvent>
 #include <QPainter>
 #include <QPainterPath>
 
@@ -10,6 +11,61 @@ namespace studio {
 
 namespace {
 constexpr int kProfilePoints = 500;
+// The plot's horizontal extent in the widget [px]: left of it the lane labels.
+constexpr double kPlotLeftPx = 150.0, kPlotRightMarginPx = 12.0;
+// A drag shorter than this adds no outage (a click) [px].
+constexpr int kMinOutageDragPx = 4;
+} // namespace
+
+double ProfileChart::XAtTime(double t) {
+  const PathSamples &pr = Profile();
+  if (pr.Size() < 2) return NAN;
+  const double t0 = pr.t_s.front(), t1 = std::max(pr.t_s.back(), t0 + 1e-9);
+  return kPlotLeftPx + (t - t0) / (t1 - t0) * (width() - kPlotRightMarginPx - kPlotLeftPx);
+}
+
+double ProfileChart::TimeAtX(double x) {
+  const PathSamples &pr = Profile();
+  if (pr.Size() < 2) return NAN;
+  const double t0 = pr.t_s.front(), t1 = std::max(pr.t_s.back(), t0 + 1e-9);
+  const double f = (x - kPlotLeftPx) / (width() - kPlotRightMarginPx - kPlotLeftPx);
+  return t0 + std::clamp(f, 0.0, 1.0) * (t1 - t0);
+}
+
+void ProfileChart::mousePressEvent(QMouseEvent *e) {
+  if (e->button() != Qt::LeftButton || Profile().Size() < 2 || e->pos().x() < kPlotLeftPx) {
+    QWidget::mousePressEvent(e);
+    return;
+  }
+  drag_x0_ = drag_x1_ = e->pos().x();
+  dragging_ = true;
+  update();
+}
+
+void ProfileChart::mouseMoveEvent(QMouseEvent *e) {
+  if (!dragging_) return;
+  drag_x1_ = e->pos().x();
+  update();
+}
+
+void ProfileChart::mouseReleaseEvent(QMouseEvent *e) {
+  if (!dragging_) return;
+  dragging_ = false;
+  drag_x1_ = e->pos().x();
+  update();
+  if (std::abs(drag_x1_ - drag_x0_) < kMinOutageDragPx) return;
+  // The span dragged over the time axis becomes a GNSS outage (one undo step), at 0.1 s.
+  double a = TimeAtX(std::min(drag_x0_, drag_x1_)), b = TimeAtX(std::max(drag_x0_, drag_x1_));
+  a = std::round(a * 10.0) / 10.0;
+  b = std::round(b * 10.0) / 10.0;
+  if (!(b > a)) return;
+  doc_->Edit(tr("Add GNSS outage %1-%2 s").arg(a).arg(b), [a, b](nav_scene &s) {
+    nav_gnss_model_config &g = s.gnss.model;
+    if (g.outage_count >= NAV_GNSS_MAX_OUTAGES) return;
+    g.outages[g.outage_count].t0_s = a;
+    g.outages[g.outage_count].t1_s = b;
+    ++g.outage_count;
+  });
 }
 
 ProfileChart::ProfileChart(SceneDocument *doc, QWidget *parent) : QWidget(parent), doc_(doc) {
@@ -60,7 +116,7 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   QFont f = p.font();
   f.setPointSizeF(8.5);
   p.setFont(f);
-  const double left = 150, right = width() - 12.0, top = 6, bottom = height() - 18.0;
+  const double left = kPlotLeftPx, right = width() - kPlotRightMarginPx, top = 6, bottom = height() - 18.0;
   const PathSamples &pr = prof_;
   if (pr.Size() < 2) {
     // A drive still being drawn (fewer than two waypoints) is not an error: grey, and what to do.
@@ -78,6 +134,25 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   const nav_traj_limits &L = pr.limits;
   const double lane_h = (bottom - top) / 3.0;
   const double r2d = 180.0 / M_PI;
+  // GNSS outages: pink spans (the 3D view's outage colour) under the curves, across the lanes.
+  outage_rects_.clear();
+  const nav_scene &sc = doc_->Scene();
+  if (sc.gnss.enabled) {
+    for (size_t i = 0; i < sc.gnss.model.outage_count; ++i) {
+      const double a = std::max(sc.gnss.model.outages[i].t0_s, t0),
+                   b = std::min(sc.gnss.model.outages[i].t1_s, t1);
+      if (!(b > a)) continue;
+      const QRectF span(X(a), top, X(b) - X(a), bottom - top);
+      p.fillRect(span, kOutageTint);
+      outage_rects_.push_back(span);
+      // Named inside the span's top edge.
+      p.setPen(QColor(170, 40, 120));
+      p.drawText(
+          QRectF(span.left() + 2, top + 1, std::max(span.width() - 2, 30.0), 14),
+          Qt::AlignLeft | Qt::AlignTop,
+          p.fontMetrics().elidedText(tr("GNSS outage"), Qt::ElideRight, static_cast<int>(span.width()) - 2));
+    }
+  }
   struct Lane {
     QString name, unit;
     const std::vector<double> *v;
@@ -162,10 +237,20 @@ void ProfileChart::paintEvent(QPaintEvent *) {
   p.drawText(QPointF(right - 50, height() - 4), QString::number(t1, 'f', 0) + " s");
   unsigned all = 0;
   for (unsigned char b : pr.over) all |= b;
-  QString legend = tr("limits dashed (turn rate: also lateral acceleration / speed)");
+  if (dragging_) {
+    // The outage being dragged out.
+    const double a = std::clamp(static_cast<double>(std::min(drag_x0_, drag_x1_)), left, right);
+    const double b = std::clamp(static_cast<double>(std::max(drag_x0_, drag_x1_)), left, right);
+    p.fillRect(QRectF(a, top, b - a, bottom - top), QColor(230, 90, 170, 70));
+  }
+  QString legend =
+      tr("limits dashed (turn rate: also lateral acceleration / speed); drag across to add a GNSS outage");
   if (all) legend = tr("over the vehicle limits (red): %1").arg(OverLimitText(all));
   p.setPen(all ? QColor(200, 0, 0) : QColor(60, 60, 60));
-  p.drawText(QPointF(left + 60, height() - 4), legend);
+  // Between the time labels, elided when the chart is narrow.
+  p.drawText(QPointF(left + 60, height() - 4),
+             p.fontMetrics().elidedText(legend, Qt::ElideRight,
+                                        static_cast<int>(std::max(40.0, right - 60 - (left + 60)))));
 }
 
 } // namespace studio

@@ -47,6 +47,7 @@ nav_callback_result OnRecord(void *user, const nav_sim_record *r) {
   o->err_ned_m.insert(o->err_ned_m.end(), {r->err->pos_err_n_m.x, r->err->pos_err_n_m.y, r->err->pos_err_n_m.z});
   o->err_v_m.push_back(r->err->pos_err_v_m);
   o->att_err_rad.push_back(r->err->att_err_rad);
+  o->err_vel_mps.push_back(r->err->vel_err_mps);
   o->euler_err_rad.insert(o->euler_err_rad.end(), {r->err->euler_err.roll_rad, r->err->euler_err.pitch_rad, r->err->euler_err.yaw_rad});
   return c->cancel->load() ? NAV_STOP : NAV_CONTINUE;
 }
@@ -179,6 +180,7 @@ void SimWorker::RunJob(SimWorker *self, Job *job, SimResult *out) {
       out->env_h_rms_m.push_back(env[i].pos_h_rms_m);
       out->env_rms_ned_m.insert(out->env_rms_ned_m.end(), {env[i].pos_rms_n_m.x, env[i].pos_rms_n_m.y, env[i].pos_rms_n_m.z});
       out->env_att_rms_rad.push_back(env[i].att_rms_rad);
+      out->env_vel_rms_mps.push_back(env[i].vel_rms_mps);
       if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS || scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
           scene.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
         out->env_sd_h_m.push_back(std::hypot(env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y));

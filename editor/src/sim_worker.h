@@ -43,9 +43,11 @@ struct SimResult {
   std::vector<double> err_ned_m;   /**< 3 per epoch: position error N/E/D of run 0 [m] */
   std::vector<double> err_v_m;     /**< vertical error of run 0 [m] */
   std::vector<double> att_err_rad; /**< attitude error angle of run 0 [rad] */
+  std::vector<double> err_vel_mps; /**< |velocity error| of run 0 [m/s] */
   std::vector<double> euler_err_rad; /**< 3 per epoch: roll/pitch/yaw error of run 0 [rad] */
   std::vector<double> env_rms_ned_m; /**< 3 per envelope epoch: RMS over runs of N/E/D error [m] */
   std::vector<double> env_att_rms_rad; /**< RMS over runs of the attitude error [rad] */
+  std::vector<double> env_vel_rms_mps; /**< RMS over runs of |velocity error| [m/s] */
   std::vector<double> env_sd_ned_m;  /**< 3 per envelope epoch: filter's reported sigma N/E/D [m] */
   std::vector<double> env_t_s;    /**< Monte Carlo envelope epochs */
   std::vector<double> env_h_rms_m; /**< RMS over runs of the horizontal error [m] */

@@ -30,7 +30,13 @@ namespace studio {
 struct Issue {
   QString path;
   QString message;
-  QString Text() const { return path.isEmpty() ? message : path + ": " + message; }
+  /** "path: message"; a message that already starts with its path or a field under it
+   *  (navcore's planner messages do: "trajectory.waypoints[2]: ...") is not prefixed again. */
+  QString Text() const {
+    const bool own = !path.isEmpty() && message.startsWith(path) && message.size() > path.size() &&
+                     QStringLiteral(":[.").contains(message.at(path.size()));
+    return path.isEmpty() || own ? message : path + ": " + message;
+  }
 };
 
 /** The reference path sampled for drawing: local N/E/D about the scene origin [m]. */

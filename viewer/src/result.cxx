@@ -117,6 +117,12 @@ bool LoadErrors(const std::string &path, NavErrorSeries *out, std::string *error
     e.pos_err_v_m[r] = t.At(r, c[5]);
     e.att_err_rad[r] = t.At(r, c[6]);
   }
+  const int vel = t.Column("vel_err_mps");
+  if (vel >= 0) {
+    e.vel_err_mps.resize(n);
+    for (size_t r = 0; r < n; ++r)
+      e.vel_err_mps[r] = t.At(r, vel);
+  }
   *out = std::move(e);
   return true;
 }
@@ -142,6 +148,12 @@ bool LoadEnvelope(const std::string &path, NavEnvelope *out, std::string *error)
       e.pos_rms_ned_m[3 * r + static_cast<size_t>(k)] = t.At(r, c[1 + k]);
     e.pos_h_rms_m[r] = t.At(r, c[4]);
     if (att >= 0) e.att_rms_rad[r] = t.At(r, att);
+  }
+  const int vel = t.Column("vel_rms_mps");
+  if (vel >= 0) {
+    e.vel_rms_mps.resize(n);
+    for (size_t r = 0; r < n; ++r)
+      e.vel_rms_mps[r] = t.At(r, vel);
   }
   const int sd = t.Column("pos_sd_reported_n_m");
   if (sd >= 0 && t.Column("pos_sd_reported_e_m") == sd + 1 && t.Column("pos_sd_reported_d_m") == sd + 2) {

@@ -238,6 +238,15 @@ bool NavSceneView::VehiclePosition(double xyz_r[3]) const {
 }
 
 std::string NavSceneView::LegendText() const { return Impl->Legend; }
+double NavSceneView::LegendPanelFraction() const {
+  return Impl->PanelFraction;
+}
+bool NavSceneView::LegendCompact() const {
+  return Impl->LegendCompact;
+}
+int NavSceneView::LegendFontPx() const {
+  return Impl->LegendFontPx;
+}
 
 double NavSceneView::EnvelopeFloorM() const { return 0.5 * Impl->Options.min_envelope_px * Impl->ScaleMpp; }
 

@@ -64,6 +64,10 @@ const double kTriadRefGrey[3] = {0.42, 0.42, 0.46};
 const double kTextColor[3] = {0.05, 0.05, 0.08};
 const double kGnssColor[3] = {0.10, 0.62, 0.20};
 const double kOutageColor[3] = {0.96, 0.50, 0.80}; // pink: the vehicle is orange
+// The outage band's depth offset behind the paths (AddGnss): 50 units = 8e-4 of the depth range,
+// more than the depth between the band and a path a few pixels away at any scene scale, far
+// less than the scene's depth.
+constexpr double kOutageDepthUnits = 50.0;
 const double kEllipsoidColor[3] = {0.45, 0.25, 0.80};
 
 // Perceptually ordered colour map for the error magnitude (viridis control points).
@@ -409,6 +413,14 @@ double NavSceneViewImpl::MetresPerPixel() const {
 }
 
 bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_camera) {
+  // The outage band's depth offset (AddGnss) needs VTK's coincident-topology resolution, which
+  // is off by default. It is a process-wide setting: its global offsets are set to zero, so that
+  // only the band's own offset applies and every other actor is drawn as before (an offset makes
+  // the fragment shader write its depth, which costs llvmpipe time on every line).
+  vtkMapper::SetResolveCoincidentTopologyToPolygonOffset();
+  vtkMapper::SetResolveCoincidentTopologyPolygonOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyLineOffsetParameters(0.0, 0.0);
+  vtkMapper::SetResolveCoincidentTopologyPointOffsetParameter(0.0);
   if (!Result) {
     *error = "no result set";
     return false;
@@ -460,6 +472,8 @@ bool NavSceneViewImpl::BuildScene(bool offscreen, std::string *error, bool keep_
 
   // The side panel (legend, scalar bar, notes) takes its width from its text.
   PanelFraction = 0.0;
+  LegendCompact = false;
+  LegendFontPx = 0;
   if (Options.show_text) AddPanel();
   Renderer->SetViewport(0.0, 0.0, 1.0 - PanelFraction, 1.0);
   if (Under) Under->SetViewport(0.0, 0.0, 1.0 - PanelFraction, 1.0);
@@ -639,10 +653,14 @@ void NavSceneViewImpl::AddEnvelope() {
 }
 
 void NavSceneViewImpl::AddGnss() {
-  // Outages: a wide pink band under the reference path.
+  // Outages: a wide pink band under the paths. A 9 px line along the reference is nearer to the
+  // camera than the estimate beside it wherever the estimate lies behind the reference, and hid
+  // it there: its depth is pushed back (kOutageDepthUnits, in VTK's coincident-topology units of
+  // 1.6e-5 of the depth range) so that every path, the estimate above all, is drawn over it.
   for (const NavPolyline &seg : Model.outage_segments) {
     if (seg.Size() < 2) continue;
     auto a = LineActor(MakePolyline(seg.xyz_r), kOutageColor, 9.0); // opaque: see AddPaths
+    a->GetMapper()->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, kOutageDepthUnits);
     Renderer->AddActor(a);
   }
   // Fixes: small green spheres (points rendered as spheres keep their pixel size at any zoom).
@@ -972,22 +990,23 @@ void NavSceneViewImpl::AddPanel() {
     std::string text;
     const double *rgb;
     double width;
+    std::string compact; /**< short form for a narrow view (empty: the text itself) */
   };
   const bool colour = Options.color_by_error && Result->errors.Size() > 0;
   std::vector<Entry> e;
-  e.push_back({Sym::Line, "reference", kRefColor, 3.0});
+  e.push_back({Sym::Line, "reference", kRefColor, 3.0, ""});
   e.push_back({Sym::Line, colour ? "estimate (run 0),\ncolour = horizontal error" : "estimate (run 0)",
-               kEstColor, 2.0});
+               kEstColor, 2.0, colour ? "estimate,\ncolour = error" : "estimate"});
   if (!Result->extra_runs.empty())
-    e.push_back({Sym::Line, std::to_string(Result->extra_runs.size()) + " further runs", kRunColor, 1.5});
+    e.push_back({Sym::Line, std::to_string(Result->extra_runs.size()) + " further runs", kRunColor, 1.5, ""});
   // The tube label is known once the model has its envelope; recompute the source here.
   const NavEnvelopeSource src = NavResolveEnvelopeSource(*Result, Options.envelope_source);
   char buf[160];
   if (Options.show_gnss && Result->gnss.Size() > 0)
-    e.push_back({Sym::Dot, "GNSS fixes (run 0)", kGnssColor, 0.0});
+    e.push_back({Sym::Dot, "GNSS fixes (run 0)", kGnssColor, 0.0, "GNSS fixes"});
   if (Options.show_gnss && !Result->gnss.outage_t0_s.empty()) {
     std::snprintf(buf, sizeof buf, "GNSS outage (%zu)", Result->gnss.outage_t0_s.size());
-    e.push_back({Sym::Line, buf, kOutageColor, 7.0});
+    e.push_back({Sym::Line, buf, kOutageColor, 7.0, "GNSS outage"});
   }
   if (src != NavEnvelopeSource::None && Options.envelope_k > 0.0) {
     // The largest radius tells why a tube may be invisible (an ideal run has micrometres).
@@ -1018,50 +1037,86 @@ void NavSceneViewImpl::AddPanel() {
       std::snprintf(buf, sizeof buf, "\ndrawn at least %g px wide", Options.min_envelope_px);
       tube_text += buf;
     }
-    e.push_back({Sym::Box, tube_text, kTubeColor, 0.0});
+    std::snprintf(buf, sizeof buf, "%g%s tube\n\u2264 %s", Options.envelope_k,
+                  src == NavEnvelopeSource::MonteCarlo  ? "\u00d7 RMS"
+                  : src == NavEnvelopeSource::RunErrors ? "\u00d7 error"
+                                                        : "\u03c3",
+                  rbuf);
+    e.push_back({Sym::Box, tube_text, kTubeColor, 0.0, buf});
     const size_t n_ell = NavEllipsoidTimes(*Result, Options).size();
     if (n_ell > 0) {
       std::snprintf(buf, sizeof buf, "ellipsoids: %g\u03c3 N/E/D\n(%s), at %zu epochs%s", Options.envelope_k,
                     NavEnvelopeSourceName(src), n_ell,
                     Options.ellipsoid_times_s.empty() && !Result->gnss.outage_t0_s.empty() ? "\nincl. outage ends"
                                                                                          : "");
-      e.push_back({Sym::Box, buf, kEllipsoidColor, 0.0});
+      const std::string full = buf;
+      std::snprintf(buf, sizeof buf, "%g\u03c3 ellipsoids", Options.envelope_k);
+      e.push_back({Sym::Box, full, kEllipsoidColor, 0.0, buf});
     }
   }
   if (Options.show_triads) {
-    e.push_back({Sym::Arrow, "reference attitude", kTriadRefGrey, 2.0});
+    e.push_back({Sym::Arrow, "reference attitude", kTriadRefGrey, 2.0, "ref. attitude"});
     std::snprintf(buf, sizeof buf, "estimated attitude,\nerror \u00d7%g (x red, y green,\nz blue)",
                   Options.att_exaggeration);
-    e.push_back({Sym::Triad, buf, kTriadRGB[0], 2.0});
+    const std::string full = buf;
+    std::snprintf(buf, sizeof buf, "est. attitude,\nerror \u00d7%g", Options.att_exaggeration);
+    e.push_back({Sym::Triad, full, kTriadRGB[0], 2.0, buf});
   }
   if (Options.show_vehicle) {
     const NavVehicleKind vk = Model.vehicle;
     e.push_back({Sym::Box,
-                 vk == NavVehicleKind::Aircraft ? "aircraft at t (reference)"
-                                                : (vk == NavVehicleKind::Car ? "car at t (reference)" : "vehicle at t (reference)"),
-                 kVehicleColor, 0.0});
-    e.push_back({Sym::Dot, "estimated position at t", kEstColor, 0.0});
+                 vk == NavVehicleKind::Aircraft
+                     ? "aircraft at t (reference)"
+                     : (vk == NavVehicleKind::Car ? "car at t (reference)" : "vehicle at t (reference)"),
+                 kVehicleColor, 0.0,
+                 vk == NavVehicleKind::Aircraft ? "aircraft at t"
+                                                : (vk == NavVehicleKind::Car ? "car at t" : "vehicle at t")});
+    e.push_back({Sym::Dot, "estimated position at t", kEstColor, 0.0, "estimate at t"});
   }
 
-  const int fs = FontSize(0.82);
-  const double line_h = 1.3 * fs, row_pad = 0.45 * fs, pad = 0.9 * fs, sym_w = 2.4 * fs, gap = 0.6 * fs;
-  double text_w = 0.0;
-  std::vector<vtkSmartPointer<vtkTextActor>> texts;
+  // The panel takes what its text needs, at most kLegendMaxFraction of the window's width. A
+  // narrow view (navstudio's 3D view beside the map, about 440 px) would give the full entries
+  // about 40 %: there the legend draws each entry's short form in a font scaled with the view's
+  // width (at least kLegendMinFontPx) and leaves the notes out.
   Legend.clear();
-  for (const Entry &x : e) {
+  for (const Entry &x : e)
     Legend += x.text + "\n";
-    auto t = vtkSmartPointer<vtkTextActor>::New();
-    t->SetInput(x.text.c_str());
-    StyleText(t->GetTextProperty(), fs);
-    t->GetTextProperty()->SetVerticalJustificationToTop();
-    t->GetTextProperty()->SetLineSpacing(1.05);
-    double sz[2] = {0.0, 0.0};
-    t->GetSize(Panel, sz);
-    text_w = std::max(text_w, sz[0]);
-    texts.push_back(t);
+  std::vector<vtkSmartPointer<vtkTextActor>> texts;
+  auto measure = [&](bool short_form, int size) {
+    texts.clear();
+    double w = 0.0;
+    for (const Entry &x : e) {
+      auto t = vtkSmartPointer<vtkTextActor>::New();
+      t->SetInput((short_form && !x.compact.empty() ? x.compact : x.text).c_str());
+      StyleText(t->GetTextProperty(), size);
+      t->GetTextProperty()->SetVerticalJustificationToTop();
+      t->GetTextProperty()->SetLineSpacing(1.05);
+      double sz[2] = {0.0, 0.0};
+      t->GetSize(Panel, sz);
+      w = std::max(w, sz[0]);
+      texts.push_back(t);
+    }
+    // pad + symbol + gap + text + pad
+    return (0.9 + 2.4 + 0.6 + 0.9) * size + w;
+  };
+  int fs = FontSize(0.82);
+  const double max_px = kLegendMaxFraction * Options.width_px;
+  double panel_px = measure(false, fs);
+  LegendCompact = panel_px > max_px;
+  if (LegendCompact) {
+    const int fs_full = fs;
+    fs =
+        std::max(kLegendMinFontPx, std::min(fs_full, static_cast<int>(std::lround(Options.width_px / 46.0))));
+    panel_px = measure(true, fs);
+    if (panel_px > max_px && fs > kLegendMinFontPx) {
+      // Text width grows with the font size: one proportional step down.
+      fs = std::max(kLegendMinFontPx, static_cast<int>(std::floor(fs * max_px / panel_px)));
+      panel_px = measure(true, fs);
+    }
   }
-  const double panel_px = pad + sym_w + gap + text_w + pad;
-  PanelFraction = std::min(0.42, panel_px / Options.width_px);
+  const double line_h = 1.3 * fs, row_pad = 0.45 * fs, pad = 0.9 * fs, sym_w = 2.4 * fs, gap = 0.6 * fs;
+  PanelFraction = std::min(kLegendMaxFraction, panel_px / Options.width_px);
+  LegendFontPx = fs;
   const double panel_w = PanelFraction * Options.width_px;
 
   // Entries from the top; geometry in pixels relative to the panel's top-left corner.
@@ -1086,8 +1141,8 @@ void NavSceneViewImpl::AddPanel() {
     // Symbol centred on the entry's first text line.
     const double y_top = y_cursor;
     const double yc = -(y_top + 0.5 * line_h);
-    y_cursor +=
-        line_h * static_cast<double>(1 + std::count(e[i].text.begin(), e[i].text.end(), '\n')) + row_pad;
+    const std::string &drawn = LegendCompact && !e[i].compact.empty() ? e[i].compact : e[i].text;
+    y_cursor += line_h * static_cast<double>(1 + std::count(drawn.begin(), drawn.end(), '\n')) + row_pad;
     const double x0 = pad, x1 = pad + sym_w;
     vtkNew<vtkPoints> pts;
     vtkNew<vtkCellArray> cells;
@@ -1141,14 +1196,16 @@ void NavSceneViewImpl::AddPanel() {
   }
   const double legend_bottom_px = y_cursor + 0.5 * fs;
 
-  Info = vtkSmartPointer<vtkTextActor>::New();
-  StyleText(Info->GetTextProperty(), FontSize(0.75));
-  Info->GetTextProperty()->SetColor(0.35, 0.35, 0.4);
-  Info->GetTextProperty()->SetLineSpacing(1.05);
-  Info->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  Info->GetPositionCoordinate()->SetValue(pad / panel_w, 0.015);
-  Info->SetInput("");
-  Panel->AddViewProp(Info);
+  if (!LegendCompact) {
+    Info = vtkSmartPointer<vtkTextActor>::New();
+    StyleText(Info->GetTextProperty(), FontSize(0.75));
+    Info->GetTextProperty()->SetColor(0.35, 0.35, 0.4);
+    Info->GetTextProperty()->SetLineSpacing(1.05);
+    Info->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    Info->GetPositionCoordinate()->SetValue(pad / panel_w, 0.015);
+    Info->SetInput("");
+    Panel->AddViewProp(Info);
+  }
 
   // Scalar bar of the error colouring below the legend.
   if (colour && Result->errors.Size() > 0) {
@@ -1157,7 +1214,7 @@ void NavSceneViewImpl::AddPanel() {
     // The bar's own title is centred over the bar and runs out of the panel: a text actor
     // aligned with the legend instead, and the labels to the right of the bar.
     auto title = vtkSmartPointer<vtkTextActor>::New();
-    title->SetInput("horizontal error [m]");
+    title->SetInput(LegendCompact ? "error [m]" : "horizontal error [m]");
     StyleText(title->GetTextProperty(), fs);
     title->GetTextProperty()->SetVerticalJustificationToTop();
     title->GetPositionCoordinate()->SetCoordinateSystemToViewport();
@@ -1177,7 +1234,7 @@ void NavSceneViewImpl::AddPanel() {
     const double h = Options.height_px;
     const double y_top = 1.0 - (legend_bottom_px + 2.2 * fs) / h;
     // Keep clear of the notes at the bottom of the panel (four or five lines).
-    const double notes_h = (5.6 * 1.3 * FontSize(0.75)) / h + 0.02;
+    const double notes_h = LegendCompact ? 0.02 : (5.6 * 1.3 * FontSize(0.75)) / h + 0.02;
     const double bar_h = std::max(0.12, std::min(0.45, y_top - notes_h));
     ScalarBar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     ScalarBar->GetPositionCoordinate()->SetValue(pad / panel_w, y_top - bar_h);

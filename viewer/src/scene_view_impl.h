@@ -26,6 +26,11 @@ class vtkRenderer;
 class vtkScalarBarActor;
 class vtkTextActor;
 
+/** The legend panel takes at most this fraction of the window's width. */
+constexpr double kLegendMaxFraction = 0.26;
+/** The smallest legend font of a narrow view [px]. */
+constexpr int kLegendMinFontPx = 8;
+
 class NavSceneViewImpl {
 public:
   std::shared_ptr<const NavResult> Result;
@@ -40,6 +45,8 @@ public:
   vtkSmartPointer<vtkRenderer> Renderer; /**< the 3D scene */
   vtkSmartPointer<vtkRenderer> Panel;    /**< legend, scalar bar and notes on the right (with text) */
   double PanelFraction = 0.0;            /**< width of the panel / window width */
+  bool LegendCompact = false;            /**< the legend draws its entries' short forms (AddPanel) */
+  int LegendFontPx = 0;                  /**< the legend's font size [px] */
   vtkSmartPointer<vtkActor> Vehicle;
   vtkSmartPointer<vtkActor> EstimateMarker;
   vtkSmartPointer<vtkActor> EstimateActor; /**< the estimated path (pick target) */

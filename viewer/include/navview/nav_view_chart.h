@@ -2,14 +2,19 @@
  * @file nav_view_chart.h
  * @brief Error-versus-time charts (vtkChartXY in a vtkContextView) written as PNG.
  *
- * Three stacked panels: horizontal position error, vertical position error and attitude error
- * (roll, pitch, yaw), each of run 0, with the Monte Carlo k-RMS band when mc_stats.csv is
- * present. Axis titles carry units in brackets; labels use DejaVu Sans. Needs an X server.
+ * Stacked panels: horizontal position error, vertical position error, velocity error (when
+ * errors.csv has vel_err_mps) and attitude error (roll, pitch, yaw), each of run 0, with the
+ * Monte Carlo k-RMS band when mc_stats.csv is present, the filter's and the covariance analysis's
+ * k-sigma curves when present, the requirement limits (PASS grey, FAIL red, the limits of one
+ * panel in different dash patterns) and the GNSS outages shaded; each panel's legend stands right
+ * of its plot, off the data. Axis titles carry units in brackets; labels use DejaVu Sans. Needs an
+ * X server.
  */
 #ifndef NAV_VIEW_CHART_H
 #define NAV_VIEW_CHART_H
 
 #include <string>
+#include <vector>
 
 #include "navview/nav_view_result.h"
 
@@ -30,6 +35,15 @@ struct NavChartOptions {
  */
 bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &options, const std::string &path,
                             std::string *error);
+
+/**
+ * The picture NavRenderErrorChartPng writes, as pixels: @p rgb gets options.width_px x
+ * options.height_px pixels of 3 bytes (R, G, B), rows from the top (a program's own window,
+ * navstudio's Errors tab, shows it without a file).
+ * @return false with a message as NavRenderErrorChartPng.
+ */
+bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &options,
+                            std::vector<unsigned char> *rgb, std::string *error);
 
 /**
  * Simulated sensor errors of run 0 (imu_errors.csv; the paper's Fig. 2): gyro errors [deg/h] and

@@ -125,6 +125,8 @@ struct NavErrorSeries {
   std::vector<double> pos_err_v_m;   /**< vertical error magnitude [m] */
   std::vector<double> att_err_rad;   /**< attitude error angle [rad] */
   std::vector<double> euler_err_rad; /**< 3 per epoch: roll, pitch, yaw error [rad] */
+  /** |velocity error| [m/s]; empty when errors.csv has no vel_err_mps column */
+  std::vector<double> vel_err_mps;
   size_t Size() const { return t_s.size(); }
 };
 
@@ -134,6 +136,7 @@ struct NavEnvelope {
   std::vector<double> pos_rms_ned_m; /**< 3 per epoch: RMS over runs of the N, E, D errors [m] */
   std::vector<double> pos_h_rms_m;   /**< RMS over runs of the horizontal error [m] */
   std::vector<double> att_rms_rad;   /**< RMS over runs of the attitude error [rad]; may be empty */
+  std::vector<double> vel_rms_mps;   /**< RMS over runs of |velocity error| [m/s]; may be empty */
   /** 3 per epoch: mean over runs of the filter's reported position sigma N/E/D [m]; empty when
    *  the column is absent or all zero (free INS). */
   std::vector<double> pos_sd_reported_ned_m;

@@ -130,8 +130,16 @@ public:
   bool NowTriad(double xyz_r[3], double q_b_r[4]) const;
   /** Position of the vehicle glyph (frame r). */
   bool VehiclePosition(double xyz_r[3]) const;
-  /** Legend entries' text, top to bottom, one entry per line group (tests). */
+  /** Legend entries' text, top to bottom, one entry per line group (tests); a narrow view draws
+   *  each entry's short form (LegendCompact). */
   std::string LegendText() const;
+  /** Width of the legend panel / the window's width (0 without text; at most 0.26: a narrow view
+   *  draws the short forms in a smaller font instead of a wider panel). */
+  double LegendPanelFraction() const;
+  /** The legend draws its entries' short forms (a narrow view). */
+  bool LegendCompact() const;
+  /** The legend's font size [px]. */
+  int LegendFontPx() const;
   /** Mark the scene out of date (its result no longer matches the edited scene): every drawn
    *  object faded towards grey and the title says "OUT OF DATE"; false restores it. */
   void SetStale(bool stale);
