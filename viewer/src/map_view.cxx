@@ -768,7 +768,11 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
     leg->GetTextProperty()->SetJustificationToRight();
     TextSize(leg->GetTextProperty(), lt, &w, &h);
     leg->GetTextProperty()->SetJustificationToLeft();
-    add_text(leg, 0.985 * W - w, 0.015 * H, NavMapLabel::Legend, lt, w, h);
+    // Bottom right; raised above the scale bar when a narrow map puts the two side by side.
+    double leg_y = 0.015 * H;
+    for (const Box &o : taken)
+      if (o.Hits({0.985 * W - w, leg_y, 0.985 * W, leg_y + h})) leg_y = o.y1 + 4;
+    add_text(leg, 0.985 * W - w, leg_y, NavMapLabel::Legend, lt, w, h);
 
     // Graticule (or grid) labels: longitudes below the title, latitudes at the right edge; one
     // that would touch an earlier text is left out.
