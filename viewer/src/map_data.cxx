@@ -380,6 +380,25 @@ bool NavMapLoadLayers(const std::string &dir, NavShoreRes res, double lat0, doub
         rings = std::make_shared<const std::vector<NavMapRing>>(CloseBin(*segs, shore->node_levels[static_cast<size_t>(b)]));
         shore->rings[b] = rings;
       }
+      {
+        auto segs = BinSegs(shore, b, error);
+        if (!segs) return false;
+        for (const Seg &sg : *segs) {
+          if (sg.level == 6 || sg.uv.size() < 4) continue;
+          NavMapLine l;
+          l.level = MapLevel(sg.level);
+          l.lonlat.resize(sg.uv.size() + (sg.entry == kClosed ? 2 : 0));
+          for (size_t i = 0; i + 1 < sg.uv.size(); i += 2) {
+            l.lonlat[i] = lon_sw + bs * sg.uv[i];
+            l.lonlat[i + 1] = lat_sw + bs * sg.uv[i + 1];
+          }
+          if (sg.entry == kClosed) { // close the ring's outline
+            l.lonlat[sg.uv.size()] = l.lonlat[0];
+            l.lonlat[sg.uv.size() + 1] = l.lonlat[1];
+          }
+          out->shores.push_back(std::move(l));
+        }
+      }
       for (const NavMapRing &r : *rings) {
         NavMapRing g;
         g.level = r.level;

@@ -546,6 +546,9 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
     // River classes: 0 double-lined, 1-4 permanent (major to minor), 5-10 intermittent, canals.
     const int river_max = m_px < 60.0 ? 5 : m_px < 600.0 ? 3 : m_px < 3000.0 ? 2 : 1;
     const double c_river[3] = {0.36, 0.58, 0.84}, c_border[3] = {0.52, 0.30, 0.50}, c_state[3] = {0.66, 0.55, 0.64};
+    // Shores: a thin line a shade darker than the water hides the fill's pixel steps.
+    const double c_shore[3] = {0.45, 0.60, 0.75};
+    ren->AddActor(Lines(world_lines(layers.shores, 4, 1), c_shore, 1.0f, -1.7));
     ren->AddActor(Lines(world_lines(layers.rivers, river_max, 0), c_river, m_px < 60.0 ? 1.6f : 1.1f, -1.6));
     if (m_px < 3000.0) ren->AddActor(Lines(world_lines(layers.borders, 2, 2), c_state, 0.9f, -1.5));
     ren->AddActor(Lines(world_lines(layers.borders, 1, 1), c_border, 1.6f, -1.4));

@@ -49,6 +49,9 @@ struct NavMapLayers {
    *  true level). */
   std::vector<NavMapRing> rings;
   std::vector<NavMapLine> rivers, borders;
+  /** The shoreline segments themselves (no bin edges), level as for rings: to draw the coasts
+   *  and lake shores as smooth lines over the filled areas. */
+  std::vector<NavMapLine> shores;
   NavShoreRes res = NavShoreRes::Crude;
   /** Bins read (for tests and the speed report). */
   int bins = 0;
