@@ -321,7 +321,70 @@ std::vector<NavMapRing> CloseBin(const std::vector<Seg> &segs, short corners) {
   return rings;
 }
 
+/** Even-odd scanline fill of one ring (display pixels, origin bottom left) into an RGB image:
+ *  a pixel is painted when its centre is inside. Rings sharing an edge (neighbouring bins) paint
+ *  each pixel once. */
+void FillRing(std::vector<unsigned char> *img, int w, int h, const std::vector<double> &xy, const unsigned char rgb[3],
+              std::vector<std::pair<int, float>> *scratch) {
+  const size_t n = xy.size() / 2;
+  if (n < 3) return;
+  double ymin = INFINITY, ymax = -INFINITY, xmin = INFINITY, xmax = -INFINITY;
+  for (size_t i = 0; i < n; ++i) {
+    xmin = std::min(xmin, xy[2 * i]);
+    xmax = std::max(xmax, xy[2 * i]);
+    ymin = std::min(ymin, xy[2 * i + 1]);
+    ymax = std::max(ymax, xy[2 * i + 1]);
+  }
+  if (xmax < 0 || ymax < 0 || xmin > w || ymin > h) return;
+  auto &cross = *scratch;
+  cross.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const double x0 = xy[2 * i], y0 = xy[2 * i + 1];
+    const double x1 = xy[2 * ((i + 1) % n)], y1 = xy[2 * ((i + 1) % n) + 1];
+    if (y0 == y1) continue;
+    const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
+    // Rows whose centre j + 0.5 lies in [ylo, yhi).
+    const int j0 = std::max(0, static_cast<int>(std::ceil(ylo - 0.5))), j1 = std::min(h - 1, static_cast<int>(std::ceil(yhi - 0.5)) - 1);
+    for (int j = j0; j <= j1; ++j) {
+      const double yc = j + 0.5;
+      cross.push_back({j, static_cast<float>(x0 + (yc - y0) * (x1 - x0) / (y1 - y0))});
+    }
+  }
+  std::sort(cross.begin(), cross.end());
+  for (size_t k = 0; k + 1 < cross.size(); k += 2) {
+    if (cross[k].first != cross[k + 1].first) { // an odd count on a row (degenerate): resync
+      --k;
+      continue;
+    }
+    const int j = cross[k].first;
+    const int i0 = std::max(0, static_cast<int>(std::ceil(cross[k].second - 0.5)));
+    const int i1 = std::min(w - 1, static_cast<int>(std::ceil(cross[k + 1].second - 0.5)) - 1);
+    unsigned char *row = img->data() + 3 * static_cast<size_t>(j) * static_cast<size_t>(w);
+    for (int i = i0; i <= i1; ++i) {
+      row[3 * i] = rgb[0];
+      row[3 * i + 1] = rgb[1];
+      row[3 * i + 2] = rgb[2];
+    }
+  }
+}
+
 } // namespace
+
+void NavMapPaintAreas(const NavMapLayers &layers, const NavMapToPixel &to_pixel, int w, int h,
+                      std::vector<unsigned char> *rgb) {
+  rgb->resize(3 * static_cast<size_t>(w) * static_cast<size_t>(h));
+  for (size_t i = 0; i < rgb->size(); i += 3)
+    std::memcpy(&(*rgb)[i], kNavMapWaterRgb, 3);
+  std::vector<double> xy;
+  std::vector<std::pair<int, float>> scratch;
+  for (const NavMapRing &r : layers.rings) {
+    xy.resize(r.lonlat.size());
+    bool ok = true;
+    for (size_t i = 0; ok && i + 1 < r.lonlat.size(); i += 2)
+      ok = to_pixel(r.lonlat[i + 1], r.lonlat[i], &xy[i], &xy[i + 1]);
+    if (ok) FillRing(rgb, w, h, xy, r.level % 2 ? kNavMapLandRgb : kNavMapWaterRgb, &scratch);
+  }
+}
 
 char NavShoreResLetter(NavShoreRes r) {
   static const char letters[] = {'c', 'l', 'i', 'h', 'f'};

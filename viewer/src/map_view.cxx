@@ -264,56 +264,9 @@ namespace {
 
 // Map colours (RGB 0..1): the sea and lakes one blue, land a light sand, so the two differ in
 // every channel that a pixel test reads (blue minus red: about +60 on water, -20 on land).
-const double kSea[3] = {0.667, 0.800, 0.910};
-const double kLand[3] = {0.950, 0.933, 0.870};
+const double kSea[3] = {kNavMapWaterRgb[0] / 255.0, kNavMapWaterRgb[1] / 255.0, kNavMapWaterRgb[2] / 255.0};
+const double kLand[3] = {kNavMapLandRgb[0] / 255.0, kNavMapLandRgb[1] / 255.0, kNavMapLandRgb[2] / 255.0};
 const double kNoData[3] = {0.900, 0.900, 0.900};
-
-/** Even-odd scanline fill of one ring (display pixels, origin bottom left) into an RGB image:
- *  a pixel is painted when its centre is inside. Rings sharing an edge (neighbouring bins) paint
- *  each pixel once. */
-void FillRing(std::vector<unsigned char> *img, int w, int h, const std::vector<double> &xy, const unsigned char rgb[3],
-              std::vector<std::pair<int, float>> *scratch) {
-  const size_t n = xy.size() / 2;
-  if (n < 3) return;
-  double ymin = INFINITY, ymax = -INFINITY, xmin = INFINITY, xmax = -INFINITY;
-  for (size_t i = 0; i < n; ++i) {
-    xmin = std::min(xmin, xy[2 * i]);
-    xmax = std::max(xmax, xy[2 * i]);
-    ymin = std::min(ymin, xy[2 * i + 1]);
-    ymax = std::max(ymax, xy[2 * i + 1]);
-  }
-  if (xmax < 0 || ymax < 0 || xmin > w || ymin > h) return;
-  auto &cross = *scratch;
-  cross.clear();
-  for (size_t i = 0; i < n; ++i) {
-    const double x0 = xy[2 * i], y0 = xy[2 * i + 1];
-    const double x1 = xy[2 * ((i + 1) % n)], y1 = xy[2 * ((i + 1) % n) + 1];
-    if (y0 == y1) continue;
-    const double ylo = std::min(y0, y1), yhi = std::max(y0, y1);
-    // Rows whose centre j + 0.5 lies in [ylo, yhi).
-    const int j0 = std::max(0, static_cast<int>(std::ceil(ylo - 0.5))), j1 = std::min(h - 1, static_cast<int>(std::ceil(yhi - 0.5)) - 1);
-    for (int j = j0; j <= j1; ++j) {
-      const double yc = j + 0.5;
-      cross.push_back({j, static_cast<float>(x0 + (yc - y0) * (x1 - x0) / (y1 - y0))});
-    }
-  }
-  std::sort(cross.begin(), cross.end());
-  for (size_t k = 0; k + 1 < cross.size(); k += 2) {
-    if (cross[k].first != cross[k + 1].first) { // an odd count on a row (degenerate): resync
-      --k;
-      continue;
-    }
-    const int j = cross[k].first;
-    const int i0 = std::max(0, static_cast<int>(std::ceil(cross[k].second - 0.5)));
-    const int i1 = std::min(w - 1, static_cast<int>(std::ceil(cross[k + 1].second - 0.5)) - 1);
-    unsigned char *row = img->data() + 3 * static_cast<size_t>(j) * static_cast<size_t>(w);
-    for (int i = i0; i <= i1; ++i) {
-      row[3 * i] = rgb[0];
-      row[3 * i + 1] = rgb[1];
-      row[3 * i + 2] = rgb[2];
-    }
-  }
-}
 
 struct Box {
   double x0, y0, x1, y1;
@@ -479,30 +432,19 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
   // Beyond this angular distance from the centre a ring is not drawn: the projection stretches
   // rings near the antipode around the whole disc (the view's corners reach at most ~141 deg).
   const double c_draw = std::min(kPi - 0.05, c_max + 10.0 * kD2R);
-  auto project_px = [&](const std::vector<double> &lonlat, std::vector<double> *xy) {
-    xy->resize(lonlat.size());
-    for (size_t i = 0; i + 1 < lonlat.size(); i += 2) {
-      const double la = lonlat[i + 1] * kD2R, lo = lonlat[i] * kD2R;
-      if (pr.Dist(la, lo) > c_draw) return false;
-      double x, y;
-      pr.Fwd(la, lo, &x, &y);
-      to_px(x, y, &(*xy)[i], &(*xy)[i + 1]);
-    }
-    return true;
-  };
   if (have_shore) {
     info.shore_res = NavShoreResLetter(layers.res);
     info.bins = layers.bins;
-    const unsigned char land[3] = {static_cast<unsigned char>(std::lround(255 * kLand[0])),
-                                   static_cast<unsigned char>(std::lround(255 * kLand[1])),
-                                   static_cast<unsigned char>(std::lround(255 * kLand[2]))};
-    const unsigned char water[3] = {static_cast<unsigned char>(std::lround(255 * kSea[0])),
-                                    static_cast<unsigned char>(std::lround(255 * kSea[1])),
-                                    static_cast<unsigned char>(std::lround(255 * kSea[2]))};
-    std::vector<double> xy;
-    std::vector<std::pair<int, float>> scratch;
-    for (const NavMapRing &r : layers.rings)
-      if (project_px(r.lonlat, &xy)) FillRing(&img, W, H, xy, r.level % 2 ? land : water, &scratch);
+    NavMapPaintAreas(layers,
+                     [&](double lat_deg, double lon_deg, double *px, double *py) {
+                       const double la = lat_deg * kD2R, lo = lon_deg * kD2R;
+                       if (pr.Dist(la, lo) > c_draw) return false;
+                       double x, y;
+                       pr.Fwd(la, lo, &x, &y);
+                       to_px(x, y, px, py);
+                       return true;
+                     },
+                     W, H, &img);
   } else {
     info.notes.push_back(derr);
   }

@@ -14,6 +14,7 @@
 #ifndef NAV_MAP_DATA_H
 #define NAV_MAP_DATA_H
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,21 @@ struct NavMapLayers {
  *  binned format; missing river or border files only leave those layers empty. */
 bool NavMapLoadLayers(const std::string &dir, NavShoreRes res, double lat0, double lat1, double lon0, double lon1,
                       NavMapLayers *out, std::string *error);
+
+/** The map's fill colours (RGB): sea and lakes, land. */
+constexpr unsigned char kNavMapWaterRgb[3] = {170, 204, 232};
+constexpr unsigned char kNavMapLandRgb[3] = {242, 238, 222};
+
+/** Maps latitude, longitude [deg] to display pixels (x right, y up, origin at the bottom-left
+ *  corner of the image); false: the point is not drawn (a ring with such a point is skipped). */
+using NavMapToPixel = std::function<bool(double lat_deg, double lon_deg, double *px, double *py)>;
+
+/** Paint the areas of @p layers into @p rgb (@p w x @p h x 3 bytes, row 0 at the bottom): sea
+ *  first, then each ring in order, land for odd levels and water for even ones (even-odd scan-line
+ *  fill of pixel centres: neighbouring bins share their edges, so they leave no seams). The one
+ *  fill of navview's map and navstudio's map view. */
+void NavMapPaintAreas(const NavMapLayers &layers, const NavMapToPixel &to_pixel, int w, int h,
+                      std::vector<unsigned char> *rgb);
 
 /** The GSHHG directory: $NAVVIEW_GSHHG_DIR, else /usr/share/gmt-gshhg. */
 std::string NavMapGshhgDir();
