@@ -57,7 +57,7 @@ nav_ensure_node() {
   fi
   local sudo=()
   [ "$(id -u)" -ne 0 ] && sudo=(sudo)
-  nav_log "installing node and npm (browser studio)"
+  nav_log "installing node and npm (browser studio, map place names)"
   DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -q --no-install-recommends nodejs npm >/dev/null ||
     nav_log "node/npm not installed: the browser studio (NAV_BUILD_WEB) is left out"
 }

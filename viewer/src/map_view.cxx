@@ -200,7 +200,10 @@ std::string FormatDeg(double v, bool lat, double step) {
   int dec = 0;
   while (dec < 6 && std::fabs(step * std::pow(10.0, dec) - std::round(step * std::pow(10.0, dec))) > 1e-6)
     ++dec;
-  std::snprintf(buf, sizeof buf, "%.*f\u00b0%c", dec, a, hemi);
+  if (a == 0.0 || (!lat && std::fabs(a - 180.0) < 1e-9)) // the equator, prime and 180th meridians
+    std::snprintf(buf, sizeof buf, "%.*f\u00b0", dec, a);
+  else
+    std::snprintf(buf, sizeof buf, "%.*f\u00b0%c", dec, a, hemi);
   return buf;
 }
 
