@@ -658,6 +658,16 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
     info.labels.push_back(l);
     taken.push_back({px, py, px + w, py + h});
   };
+  size_t placed = 0;
+  const std::string places_path = opt.places_file.empty() ? NavMapPlacesFile() : opt.places_file;
+  const std::vector<NavPlace> *places = nullptr;
+  if (opt.show_places && opt.show_text) {
+    std::string perr;
+    if (places_path.empty())
+      info.notes.push_back("no gazetteer (places.tsv not built: node and npm needed)");
+    else if (!NavMapLoadPlaces(places_path, &places, &perr))
+      info.notes.push_back(perr);
+  }
   const double sb = NiceLength(span_x / 5.0);
   {
     const double bpx = 0.04 * W, bpy = 0.06 * H, tick = 0.012 * H;
@@ -708,6 +718,8 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
       lt += std::string("\nGSHHG 2.3.7 (") + NavShoreResLetter(layers.res) +
             ") land, lakes, WDBII rivers and borders";
     }
+    // GeoNames asks for credit (CC BY 4.0).
+    if (places) lt += "\nplace names: GeoNames (CC BY 4.0)";
     for (const std::string &n : info.notes)
       lt += "\n" + n;
     auto leg = Text(lt, font - 2, tc);
@@ -758,16 +770,6 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
 
   // Place names: the most populous places in view first, each with a dot, its name right of the
   // dot (else left, above, below), never over another text; at most one label per ~30 000 px^2.
-  size_t placed = 0;
-  const std::string places_path = opt.places_file.empty() ? NavMapPlacesFile() : opt.places_file;
-  const std::vector<NavPlace> *places = nullptr;
-  if (opt.show_places && opt.show_text) {
-    std::string perr;
-    if (places_path.empty())
-      info.notes.push_back("no gazetteer (places.tsv not built: node and npm needed)");
-    else if (!NavMapLoadPlaces(places_path, &places, &perr))
-      info.notes.push_back(perr);
-  }
   if (places) {
     const size_t max_labels = std::clamp<size_t>(static_cast<size_t>(W) * H / 30000, 3, 40);
     const double c_place[3] = {0.10, 0.10, 0.14};
@@ -841,17 +843,6 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
       a->GetProperty()->LightingOff();
       ren->AddActor(a);
     }
-  }
-  if (places && opt.show_text) {
-    // GeoNames asks for credit (CC BY 4.0): on the map, in the corner under the legend's text.
-    auto c = Text("places: GeoNames (CC BY 4.0)", std::max(8, font - 5), gc);
-    double w, h;
-    TextSize(c->GetTextProperty(), "places: GeoNames (CC BY 4.0)", &w, &h);
-    bool clash = false;
-    const Box b{0.985 * W - w, 2, 0.985 * W, 2 + h};
-    for (const Box &o : taken)
-      clash = clash || o.Hits(b);
-    if (!clash) add_text(c, b.x0, b.y0, NavMapLabel::Legend, "places: GeoNames (CC BY 4.0)", w, h);
   }
   info.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
   if (info_out) *info_out = std::move(info);
