@@ -4,6 +4,7 @@
 // another text or the scale bar, and the interactive map rebuilding as it zooms about the
 // pointer. The PNGs stay in Testing/Temporary (geomap_*.png) to be looked at.
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -269,6 +270,33 @@ void test_polar_route(void **) {
     CheckSurface(im, info, p);
 }
 
+// Without the GSHHG files the map says so (the file it looked for) and paints neither land nor
+// sea: a neutral grey, so that nothing looks like sea that may be land.
+void test_missing_data(void **) {
+  const NavResult r = Track("no-data", {45.0703, 7.6869, 45.0625, 7.6781});
+  NavMapOptions o;
+  o.width_px = 320;
+  o.height_px = 200;
+  o.span_km = 30.0;
+  o.multisamples = 0;
+  o.data_dir = "/nonexistent-gshhg";
+  o.places_file = "/nonexistent-places.tsv";
+  NavMapInfo info;
+  std::string err;
+  const std::string png = OutDir() + "/geomap_missing_data.png";
+  if (!NavRenderMapPng(r, o, png, &err, &info)) fail_msg("%s", err.c_str());
+  assert_int_equal(info.shore_res, 0);
+  std::string notes;
+  for (const std::string &n : info.notes)
+    notes += n + "\n";
+  std::printf("notes:\n%s", notes.c_str());
+  assert_non_null(std::strstr(notes.c_str(), "/nonexistent-gshhg/binned_GSHHS_f.nc: error: no such file"));
+  assert_non_null(std::strstr(notes.c_str(), "/nonexistent-places.tsv: error: cannot open the gazetteer"));
+  const Image im = ReadPng(png);
+  const unsigned char *c = im.At(160, 100);
+  assert_true(std::abs(c[0] - c[2]) < 8);
+}
+
 // navview's interactive map: the wheel zooms about the pointer (the point under it stays), and
 // the map is rebuilt for each view: its "km across", scale bar and labels follow. Also times a
 // rebuild at each scale from the globe to a street (layers, render) at 1280x800.
@@ -328,7 +356,7 @@ int main(void) {
       cmocka_unit_test(test_san_francisco_50km), cmocka_unit_test(test_san_francisco_5km),
       cmocka_unit_test(test_turin_30km),         cmocka_unit_test(test_berlin_500km),
       cmocka_unit_test(test_berlin_50km_lakes),  cmocka_unit_test(test_polar_route),
-      cmocka_unit_test(test_interactive_rebuilds),
+      cmocka_unit_test(test_missing_data),       cmocka_unit_test(test_interactive_rebuilds),
   };
   return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
