@@ -19,6 +19,7 @@ NAV_PACKAGES=(
   dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
   rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions and of the RINEX export (issue 22)
   python3-yaml python3-jsonschema   # scenes against `navsim schema` (issue 18, test_navsim_schema)
+  libnetcdf-dev gmt-gshhg-high gmt-gshhg-full # map land/water, rivers, borders (GSHHG binned netCDF)
   ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
 )
 
@@ -56,7 +57,7 @@ nav_ensure_node() {
   fi
   local sudo=()
   [ "$(id -u)" -ne 0 ] && sudo=(sudo)
-  nav_log "installing node and npm (browser studio)"
+  nav_log "installing node and npm (browser studio, map place names)"
   DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -q --no-install-recommends nodejs npm >/dev/null ||
     nav_log "node/npm not installed: the browser studio (NAV_BUILD_WEB) is left out"
 }

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sys/stat.h>
 
+#include "navview/nav_map_data.h"
 #include "navview/nav_view_map.h"
 
 extern "C" {
@@ -130,7 +131,8 @@ std::string MapDataDir() {
   return nav_paths_map_data_dir(dir, sizeof dir) ? std::string(dir) : std::string();
 }
 
-void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out) {
+void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
+                        int w_px, int h_px) {
   *out = MapBackground();
   const nav_frame fr = nav_frame_from_scene(&s);
   // The lat/lon box of the rectangle (its boundary and inside, sampled), longitudes relative to the
@@ -153,7 +155,47 @@ void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, dou
   const Projector proj(s, x0, y0, x1, y1);
   const double span = std::max(x1 - x0, y1 - y0);
 
-  if (span > kCoastSpanM) {
+  // Land and water from GSHHG, painted into an image of the rectangle (one pixel per screen pixel).
+  NavMapLayers layers;
+  bool gshhg = false;
+  if (w_px > 0 && h_px > 0) {
+    std::string err;
+    const bool all_lon = dlo1 - dlo0 > 300.0;
+    gshhg = NavMapLoadLayers(NavMapGshhgDir(), NavShoreResForScale((x1 - x0) / w_px), la0, la1,
+                             all_lon ? lonc - 180.0 : lonc + dlo0, all_lon ? lonc + 180.0 : lonc + dlo1, &layers, &err);
+    if (!gshhg) {
+      out->note = QString::fromStdString(err);
+    } else {
+      // Rings far beyond the rectangle are skipped: the local frame folds the far side of the
+      // Earth back onto the view (its "down" grows as 1 - cos of the arc from the origin).
+      const double arc_max = std::min(M_PI, 0.75 * std::hypot(std::max(std::fabs(x0), std::fabs(x1)),
+                                                               std::max(std::fabs(y0), std::fabs(y1))) / 6371e3 +
+                                                    10.0 * kD2R);
+      const double down_max = 6371e3 * (1.0 - std::cos(arc_max)) + 1.0;
+      NavMapPaintAreas(layers,
+                       [&](double lat, double lon, double *px, double *py) {
+                         const nav_vec3 r = nav_frame_geodetic_to_local(&fr, nav_geodetic{lat * kD2R, lon * kD2R, 0.0});
+                         if (r.z > down_max) return false;
+                         *px = (r.y - x0) / (x1 - x0) * w_px;
+                         *py = (r.x - y0) / (y1 - y0) * h_px;
+                         return true;
+                       },
+                       w_px, h_px, &out->land_rgb);
+      out->land_w = w_px;
+      out->land_h = h_px;
+      out->shore_res = NavShoreResLetter(layers.res);
+    }
+  }
+  if (gshhg && span > kCoastSpanM) {
+    const double m_px = (x1 - x0) / w_px;
+    const int river_max = m_px < 60.0 ? 5 : m_px < 600.0 ? 3 : m_px < 3000.0 ? 2 : 1;
+    for (const NavMapLine &l : layers.shores)
+      proj.Add(l.lonlat.data(), l.lonlat.size() / 2, &out->coast);
+    for (const NavMapLine &l : layers.rivers)
+      if (l.level <= river_max) proj.Add(l.lonlat.data(), l.lonlat.size() / 2, &out->rivers);
+    for (const NavMapLine &l : layers.borders)
+      if (l.level <= 2) proj.Add(l.lonlat.data(), l.lonlat.size() / 2, &out->borders);
+  } else if (span > kCoastSpanM) {
     const Shapes &sh = CoastShapes();
     out->note = sh.note;
     for (const Part &p : sh.parts) {

@@ -1,5 +1,6 @@
 /*
- * navstudio: the offline background of the map view: GSHHS coastlines and lakes (read through
+ * navstudio: the offline background of the map view: land and water filled from GSHHG (libnavview's
+ * map data), or else GSHHS coastlines and lakes (read through
  * libnavview's shapefile reader from Debian's python-cartopy-data) and a lat/lon graticule with
  * labels, both in the view's local frame (x = East, y = North, metres from the scene origin).
  * Plain data; PathView turns it into VTK actors. GUI thread only.
@@ -26,6 +27,12 @@ struct MapLabel {
 
 struct MapBackground {
   std::vector<std::vector<double>> coast;     /**< polylines, x/y pairs [m] */
+  std::vector<std::vector<double>> rivers, borders; /**< GSHHG WDBII polylines, x/y pairs [m] */
+  /** Land and water of the rectangle painted by libnavview (NavMapPaintAreas): land_w x land_h
+   *  RGB pixels, row 0 at the bottom; empty when no pixel size was given or GSHHG is missing. */
+  std::vector<unsigned char> land_rgb;
+  int land_w = 0, land_h = 0;
+  char shore_res = 0; /**< GSHHG resolution letter of the fill, 0: none */
   std::vector<std::vector<double>> graticule; /**< polylines, x/y pairs [m] */
   std::vector<MapLabel> labels;
   double lat_step_deg = 0.0, lon_step_deg = 0.0;
@@ -41,8 +48,12 @@ constexpr double kCoastSpanM = 15e3;
 std::string MapDataDir();
 
 /** Coastlines (when the rectangle is wider than kCoastSpanM) and the graticule with labels for
- *  the local rectangle [x0, x1] x [y0, y1] (East, North [m]) of the scene @p s. */
-void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out);
+ *  the local rectangle [x0, x1] x [y0, y1] (East, North [m]) of the scene @p s. With a pixel size
+ *  (@p w_px, @p h_px > 0) also land and water at every scale, from GSHHG at the resolution of the
+ *  scale (navview's map data, nav_map_data.h), and rivers and borders above kCoastSpanM; the
+ *  coastlines then come from GSHHG too (python-cartopy-data only when GSHHG is missing). */
+void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
+                        int w_px = 0, int h_px = 0);
 
 } // namespace studio
 

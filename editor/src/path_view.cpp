@@ -31,7 +31,10 @@
 #include <vtkGlyph3D.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkObjectFactory.h>
+#include <vtkImageData.h>
 #include <vtkPlaneSource.h>
+#include <vtkPointData.h>
+#include <vtkTexture.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
@@ -346,9 +349,28 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
 
   if (mode == Mode::Map) {
     // Offline background: coastlines and lakes, the graticule (above street scale).
-    coast_ = MakeActor(vtkNew<vtkPolyData>(), 0.30, 0.36, 0.45, 1.4);
+    coast_ = MakeActor(vtkNew<vtkPolyData>(), 0.45, 0.60, 0.75, 1.2);
     graticule_ = MakeActor(vtkNew<vtkPolyData>(), 0.62, 0.66, 0.72, 1.0);
+    rivers_ = MakeActor(vtkNew<vtkPolyData>(), 0.36, 0.58, 0.84, 1.1);
+    borders_ = MakeActor(vtkNew<vtkPolyData>(), 0.52, 0.30, 0.50, 1.4);
+    // Land and water under everything: an image of the view on a quad (UpdateBackground).
+    land_plane_ = vtkSmartPointer<vtkPlaneSource>::New();
+    land_image_ = vtkSmartPointer<vtkImageData>::New();
+    auto tex = vtkSmartPointer<vtkTexture>::New();
+    tex->SetInputData(land_image_);
+    tex->InterpolateOff();
+    tex->SetColorModeToDirectScalars();
+    auto lm = vtkSmartPointer<vtkPolyDataMapper>::New();
+    lm->SetInputConnection(land_plane_->GetOutputPort());
+    land_ = vtkSmartPointer<vtkActor>::New();
+    land_->SetMapper(lm);
+    land_->SetTexture(tex);
+    land_->GetProperty()->LightingOff();
+    land_->SetVisibility(0);
+    renderer_->AddActor(land_);
     renderer_->AddActor(graticule_);
+    renderer_->AddActor(rivers_);
+    renderer_->AddActor(borders_);
     renderer_->AddActor(coast_);
   }
   grid_ = MakeActor(vtkNew<vtkPolyData>(), 0.70, 0.74, 0.70, 1.0);
@@ -1052,6 +1074,18 @@ QStringList PathView::GraticuleLabels() const {
   return l;
 }
 
+long PathView::LandColourAt(double e, double n) const {
+  if (!land_ || !land_->GetVisibility()) return -1;
+  int d[3];
+  land_image_->GetDimensions(d);
+  const double *o = land_plane_->GetOrigin(), *p1 = land_plane_->GetPoint1(), *p2 = land_plane_->GetPoint2();
+  const int x = static_cast<int>(std::floor((e - o[0]) / (p1[0] - o[0]) * d[0]));
+  const int y = static_cast<int>(std::floor((n - o[1]) / (p2[1] - o[1]) * d[1]));
+  if (x < 0 || y < 0 || x >= d[0] || y >= d[1]) return -1;
+  const auto *p = static_cast<const unsigned char *>(land_image_->GetScalarPointer(x, y, 0));
+  return (long(p[0]) << 16) | (long(p[1]) << 8) | long(p[2]);
+}
+
 bool PathView::MetricGridShown() const { return grid_->GetVisibility() != 0; }
 
 void PathView::UpdateBackground() {
@@ -1068,8 +1102,27 @@ void PathView::UpdateBackground() {
   const double half_h = key[2], half_w = half_h * w / h, cx = f[0], cy = f[1];
   const double span = 2.0 * std::max(half_w, half_h);
   MapBackground bg;
-  BuildMapBackground(doc_->Scene(), cx - half_w, cy - half_h, cx + half_w, cy + half_h, &bg);
+  BuildMapBackground(doc_->Scene(), cx - half_w, cy - half_h, cx + half_w, cy + half_h, &bg, static_cast<int>(w),
+                     static_cast<int>(h));
   coast_count_ = SetXyPolylines(InputOf(coast_), bg.coast, -0.06);
+  SetXyPolylines(InputOf(rivers_), bg.rivers, -0.065);
+  SetXyPolylines(InputOf(borders_), bg.borders, -0.062);
+  land_res_ = bg.shore_res;
+  if (!bg.land_rgb.empty()) {
+    land_image_->SetDimensions(bg.land_w, bg.land_h, 1);
+    auto px = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    px->SetNumberOfComponents(3);
+    px->SetNumberOfTuples(static_cast<vtkIdType>(bg.land_w) * bg.land_h);
+    std::memcpy(px->GetPointer(0), bg.land_rgb.data(), bg.land_rgb.size());
+    land_image_->GetPointData()->SetScalars(px);
+    land_image_->Modified();
+    land_plane_->SetOrigin(cx - half_w, cy - half_h, -0.08);
+    land_plane_->SetPoint1(cx + half_w, cy - half_h, -0.08);
+    land_plane_->SetPoint2(cx - half_w, cy + half_h, -0.08);
+    land_->SetVisibility(1);
+  } else {
+    land_->SetVisibility(0);
+  }
   graticule_count_ = SetXyPolylines(InputOf(graticule_), bg.graticule, -0.04);
   graticule_step_deg_ = std::min(bg.lat_step_deg, bg.lon_step_deg);
   bg_note_ = bg.note;

@@ -34,6 +34,8 @@ class QImage;
 class QWindow;
 class QVTKOpenGLStereoWidget;
 class vtkActor;
+class vtkImageData;
+class vtkPlaneSource;
 class vtkBillboardTextActor3D;
 class vtkGenericOpenGLRenderWindow;
 class vtkPolyData;
@@ -124,6 +126,11 @@ public:
   /** Map background (tests): coastline and graticule polylines drawn, graticule labels, and
    *  whether the local metric grid is shown (street scale). */
   size_t CoastlineCount() const { return coast_count_; }
+  /** GSHHG resolution letter of the land/water fill now shown (c l i h f), 0 when none. */
+  char LandResolution() const { return land_res_; }
+  /** The land/water fill's colour at local East/North (@p e, @p n) [m] as 0xRRGGBB; -1 when no
+   *  fill is shown or the point is outside the view. */
+  long LandColourAt(double e, double n) const;
   size_t GraticuleCount() const { return graticule_count_; }
   QStringList GraticuleLabels() const;
   bool MetricGridShown() const;
@@ -197,7 +204,12 @@ private:
   std::unique_ptr<nav_scene> drag_before_;
   QTimer rebuild_timer_;
   // Map background (coastlines, graticule and its labels), rebuilt when the view moves.
-  vtkSmartPointer<vtkActor> coast_, graticule_;
+  vtkSmartPointer<vtkActor> coast_, graticule_, rivers_, borders_;
+  /** Land and water (GSHHG through libnavview), a textured quad covering the view. */
+  vtkSmartPointer<vtkActor> land_;
+  vtkSmartPointer<vtkPlaneSource> land_plane_;
+  vtkSmartPointer<vtkImageData> land_image_;
+  char land_res_ = 0;
   std::vector<vtkSmartPointer<vtkTextActor>> geo_labels_;
   QTimer bg_timer_;
   double bg_key_[5] = {0, 0, 0, 0, 0};

@@ -1117,12 +1117,22 @@ private slots:
     double ned[3];
     studio::GeodeticToLocal(s, 54.0, 13.4, 0.0, ned); // on the Baltic coast (Greifswald)
     QVERIFY(ned[0] > 100e3 && ned[0] < 250e3);
+    // Land and water filled from GSHHG (issue 19): Berlin is land, the Baltic north of Usedom and
+    // the Mueritz lake are water.
+    QVERIFY(map->LandResolution() != 0);
+    const long land = 0xf2eede, water = 0xaaccE8;
+    QCOMPARE(map->LandColourAt(0.0, 0.0), land);
+    studio::GeodeticToLocal(s, 54.2, 14.25, 0.0, ned);
+    QCOMPARE(map->LandColourAt(ned[1], ned[0]), water);
+    studio::GeodeticToLocal(s, 53.43, 12.69, 0.0, ned);
+    QCOMPARE(map->LandColourAt(ned[1], ned[0]), water);
     Shot(w.get(), "map-02-regional");
     // Continental scale, then back to street scale: the grid returns, the graticule goes.
     map->SetMapExtent(0.0, 0.0, 2000e3);
     QVERIFY(map->CoastlineCount() > 10);
     Shot(w.get(), "map-03-continental");
     map->SetMapExtent(0.0, 0.0, 400.0);
+    QCOMPARE(map->LandColourAt(0.0, 0.0), land); // the fill at street scale too
     QVERIFY(map->MetricGridShown());
     QCOMPARE(map->GraticuleCount(), size_t(0));
     QCOMPARE(map->CoastlineCount(), size_t(0));

@@ -5,7 +5,7 @@
 #include "map_interactive_internal.h"
 
 #include "navview_internal.h"
-#include "navcore/nav_paths.h"
+#include "navview/nav_map_data.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,14 +15,17 @@
 #include <cstring>
 #include <fstream>
 #include <sys/stat.h>
+#include <chrono>
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkTextRenderer.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkPointData.h>
 #include <vtkNew.h>
-#include <vtkPNGReader.h>
 #include <vtkPlaneSource.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -40,10 +43,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kD2R = kPi / 180.0;
 constexpr double kR = 6371008.8; // mean Earth radius [m]: map scale only
 
-bool Exists(const std::string &p) {
-  struct stat st;
-  return stat(p.c_str(), &st) == 0;
-}
 
 uint32_t Be32(const unsigned char *p) {
   return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
@@ -83,6 +82,24 @@ struct Projection {
     *x = kR * k * cl * sdl;
     *y = kR * k * (cos0 * sl - sin0 * cl * cdl);
     return c <= kMaxC;
+  }
+  /** Angular distance of a point from the centre [rad]. */
+  double Dist(double lat, double lon) const {
+    return std::acos(std::clamp(sin0 * std::sin(lat) + cos0 * std::cos(lat) * std::cos(lon - lon0), -1.0, 1.0));
+  }
+  /** The inverse: lat/lon [rad] of (x, y) [m]; false beyond the antipode. */
+  bool Inv(double x, double y, double *lat, double *lon) const {
+    const double rho = std::hypot(x, y), c = rho / kR;
+    if (rho < 1e-9) {
+      *lat = lat0;
+      *lon = lon0;
+      return true;
+    }
+    if (c > kPi) return false;
+    const double sc = std::sin(c), cc = std::cos(c);
+    *lat = std::asin(std::clamp(cc * sin0 + y * sc * cos0 / rho, -1.0, 1.0));
+    *lon = lon0 + std::atan2(x * sc, rho * cos0 * cc - y * sin0 * sc);
+    return true;
   }
 };
 
@@ -183,7 +200,10 @@ std::string FormatDeg(double v, bool lat, double step) {
   int dec = 0;
   while (dec < 6 && std::fabs(step * std::pow(10.0, dec) - std::round(step * std::pow(10.0, dec))) > 1e-6)
     ++dec;
-  std::snprintf(buf, sizeof buf, "%.*f\u00b0%c", dec, a, hemi);
+  if (a == 0.0 || (!lat && std::fabs(a - 180.0) < 1e-9)) // the equator, prime and 180th meridians
+    std::snprintf(buf, sizeof buf, "%.*f\u00b0", dec, a);
+  else
+    std::snprintf(buf, sizeof buf, "%.*f\u00b0%c", dec, a, hemi);
   return buf;
 }
 
@@ -243,8 +263,44 @@ bool NavReadShapefile(const std::string &path, std::vector<std::vector<double>> 
   return true;
 }
 
-bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer *ren, NavMapExtent *extent,
-                 std::string *error) {
+namespace {
+
+// Map colours (RGB 0..1): the sea and lakes one blue, land a light sand, so the two differ in
+// every channel that a pixel test reads (blue minus red: about +60 on water, -20 on land).
+const double kSea[3] = {kNavMapWaterRgb[0] / 255.0, kNavMapWaterRgb[1] / 255.0, kNavMapWaterRgb[2] / 255.0};
+const double kLand[3] = {kNavMapLandRgb[0] / 255.0, kNavMapLandRgb[1] / 255.0, kNavMapLandRgb[2] / 255.0};
+const double kNoData[3] = {0.900, 0.900, 0.900};
+
+struct Box {
+  double x0, y0, x1, y1;
+  bool Hits(const Box &o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
+/** Text extent [px] with the label's property (left/bottom justified). */
+void TextSize(vtkTextProperty *tp, const std::string &s, double *w, double *h) {
+  int bb[4] = {0, 0, 0, 0};
+  vtkTextRenderer *tr = vtkTextRenderer::GetInstance();
+  if (tr && tr->GetBoundingBox(tp, s, bb, 72)) {
+    *w = bb[1] - bb[0] + 1;
+    *h = bb[3] - bb[2] + 1;
+  } else { // no renderer: a generous estimate
+    *w = 0.62 * tp->GetFontSize() * static_cast<double>(s.size());
+    *h = 1.25 * tp->GetFontSize();
+  }
+}
+
+} // namespace
+
+void NavMapInfo::PixelOf(double lat_deg, double lon_deg, double *px, double *py) const {
+  Projection pr;
+  pr.Init(proj_lat_deg * kD2R, proj_lon_deg * kD2R);
+  double x, y;
+  pr.Fwd(lat_deg * kD2R, lon_deg * kD2R, &x, &y);
+  *px = (x - (view_x_m - 0.5 * span_x_m)) / span_x_m * width_px;
+  *py = (y - (view_y_m - 0.5 * span_y_m)) / span_y_m * height_px;
+}
+
+bool NavMapFit(const NavResult &result, const NavMapOptions &opt, NavMapFrame *frame, std::string *error) {
   const NavTrack &ref = result.truth;
   if (!ref.HasGeodetic() || ref.Size() == 0) {
     *error = (result.dir.empty() ? std::string("result") : result.dir) +
@@ -255,7 +311,6 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
     *error = "map size out of range (64..8192 pixels)";
     return false;
   }
-
   // Centre: the mean direction of the tracks (no seam at the date line or the poles); extent:
   // the tracks projected about it.
   Projection pr;
@@ -276,109 +331,176 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
       y1 = std::max(y1, y);
     }
   const double aspect = static_cast<double>(opt.width_px) / opt.height_px;
-  // Fit about the centre (the view is centred on it), symmetric extents.
   const double half_w = std::max(std::fabs(x0), std::fabs(x1)), half_h = std::max(std::fabs(y0), std::fabs(y1));
   double span_x = opt.span_km > 0.0 ? opt.span_km * 1e3 : std::max(200.0, 2.3 * std::max(half_w, half_h * aspect));
-  span_x = std::min(span_x, 2.0 * kMaxC * kR);
-  const double span_y = span_x / aspect;
-  // Angular radius of the view (half diagonal) and the lat/lon range it covers.
-  const double view_c = std::min(0.5 * std::hypot(span_x, span_y) / kR, kMaxC);
-  const double lat_lo = std::max(-0.5 * kPi, pr.lat0 - view_c), lat_hi = std::min(0.5 * kPi, pr.lat0 + view_c);
-  const bool pole = lat_hi >= 0.5 * kPi - 1e-9 || lat_lo <= -0.5 * kPi + 1e-9;
-  const double dlon = pole ? kPi : std::min(kPi, std::asin(std::min(1.0, std::sin(view_c) / std::max(std::cos(pr.lat0 + (pr.lat0 > 0 ? view_c : -view_c)), 1e-6))));
-  const double lon_lo = pr.lon0 - dlon, lon_hi = pr.lon0 + dlon;
-  const double span_deg_y = (lat_hi - lat_lo) / kD2R, span_deg_x = 2.0 * dlon / kD2R;
+  frame->lat0_rad = pr.lat0;
+  frame->lon0_rad = pr.lon0;
+  frame->fit_span_x_m = std::min(span_x, NavMapMaxSpanM());
+  frame->track_box_m[0] = x0;
+  frame->track_box_m[1] = y0;
+  frame->track_box_m[2] = x1;
+  frame->track_box_m[3] = y1;
+  return true;
+}
 
+double NavMapMaxSpanM() { return 2.0 * kMaxC * kR; }
+
+bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const NavMapFrame &frame, double cx, double cy,
+                     double span_x, vtkRenderer *ren, NavMapInfo *info_out, std::string *error) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const NavTrack &ref = result.truth;
+  if (!std::isfinite(cx) || !std::isfinite(cy) || !(span_x > 0.0) || !std::isfinite(span_x)) {
+    *error = "map view: centre and width must be finite, width > 0";
+    return false;
+  }
+  NavMapInfo info;
+  const int W = opt.width_px, H = opt.height_px;
+  span_x = std::clamp(span_x, 1.0, NavMapMaxSpanM());
+  const double span_y = span_x * H / W;
+  const double left = cx - 0.5 * span_x, bottom = cy - 0.5 * span_y;
+  const double m_px = span_x / W;
+  info.width_px = W;
+  info.height_px = H;
+  info.span_x_m = span_x;
+  info.span_y_m = span_y;
+  info.proj_lat_deg = frame.lat0_rad / kD2R;
+  info.proj_lon_deg = frame.lon0_rad / kD2R;
+  info.view_x_m = cx;
+  info.view_y_m = cy;
+  Projection pr;
+  pr.Init(frame.lat0_rad, frame.lon0_rad);
+  auto to_px = [&](double x, double y, double *px, double *py) {
+    *px = (x - left) / m_px;
+    *py = (y - bottom) / m_px;
+  };
+  auto to_world = [&](double px, double py, double *x, double *y) {
+    *x = left + px * m_px;
+    *y = bottom + py * m_px;
+  };
+  ren->RemoveAllViewProps();
+
+  // The view's latitude/longitude box: the inverse projection of its border, widened to every
+  // longitude when a pole is inside or the view reaches far from the centre.
+  double lat_lo = INFINITY, lat_hi = -INFINITY, dlon_lo = INFINITY, dlon_hi = -INFINITY, c_max = 0.0;
+  for (int k = 0; k < 4 * 32; ++k) {
+    const double f = (k % 32) / 32.0;
+    const int side = k / 32;
+    const double x = side == 0 ? left + f * span_x : side == 1 ? left + span_x : side == 2 ? left + span_x - f * span_x : left;
+    const double y = side == 0 ? bottom : side == 1 ? bottom + f * span_y : side == 2 ? bottom + span_y : bottom + span_y - f * span_y;
+    double la, lo;
+    if (!pr.Inv(x, y, &la, &lo)) continue;
+    c_max = std::max(c_max, std::hypot(x, y) / kR);
+    lat_lo = std::min(lat_lo, la);
+    lat_hi = std::max(lat_hi, la);
+    const double d = std::remainder(lo - pr.lon0, 2 * kPi);
+    dlon_lo = std::min(dlon_lo, d);
+    dlon_hi = std::max(dlon_hi, d);
+  }
+  bool all_lon = c_max > 80.0 * kD2R;
+  for (double pole : {0.5 * kPi, -0.5 * kPi}) {
+    double x, y;
+    pr.Fwd(pole, 0.0, &x, &y);
+    if (x >= left && x <= left + span_x && y >= bottom && y <= bottom + span_y) {
+      all_lon = true;
+      (pole > 0 ? lat_hi : lat_lo) = pole;
+    }
+  }
+  if (all_lon) {
+    lat_lo = std::max(-0.5 * kPi, std::min(lat_lo, pr.lat0 - c_max));
+    lat_hi = std::min(0.5 * kPi, std::max(lat_hi, pr.lat0 + c_max));
+    dlon_lo = -kPi;
+    dlon_hi = kPi;
+  }
+  const double lon_lo = pr.lon0 + dlon_lo, lon_hi = pr.lon0 + dlon_hi;
+  const double span_deg_y = (lat_hi - lat_lo) / kD2R, span_deg_x = (lon_hi - lon_lo) / kD2R;
+  const bool pole = all_lon;
+
+  // Land and water: GSHHG areas painted level by level into an image of the view.
   const bool street = span_x < 20e3;
-  ren->SetBackground(street ? 0.97 : 0.86, street ? 0.97 : 0.91, street ? 0.95 : 0.96); // sea tint when zoomed out
-  std::vector<std::string> notes;
-
-  char data_dir[4096];
-  const std::string data = !opt.data_dir.empty() ? opt.data_dir
-                           : nav_paths_map_data_dir(data_dir, sizeof data_dir) ? std::string(data_dir)
-                                                                              : std::string();
-  // Shaded relief (0.5 deg per pixel): useful from a few hundred km across.
-  const std::string relief = data + "/raster/natural_earth/50-natural-earth-1-downsampled.png";
-  if (span_x > 250e3) {
-    if (Exists(relief)) {
-      vtkNew<vtkPNGReader> rd;
-      rd->SetFileName(relief.c_str());
-      vtkNew<vtkTexture> tex;
-      tex->SetInputConnection(rd->GetOutputPort());
-      tex->InterpolateOn();
-      // The raster is plate carree (-180..180, -90..90): a lon/lat mesh carries its texture
-      // coordinates through the projection. Cells of about a degree over the visible range.
-      const double cell = std::max(0.25, std::min(2.0, span_deg_y / 60.0)) * kD2R;
-      const int nlat = std::max(2, static_cast<int>(std::ceil((lat_hi - lat_lo) / cell)));
-      const int nlon = std::max(2, static_cast<int>(std::ceil((lon_hi - lon_lo) / cell)));
-      vtkNew<vtkPoints> mp;
-      vtkNew<vtkFloatArray> tc;
-      tc->SetNumberOfComponents(2);
-      tc->SetName("tcoords");
-      std::vector<char> on(static_cast<size_t>((nlat + 1) * (nlon + 1)));
-      for (int i = 0; i <= nlat; ++i)
-        for (int j = 0; j <= nlon; ++j) {
-          const double la = lat_lo + (lat_hi - lat_lo) * i / nlat, lo = lon_lo + (lon_hi - lon_lo) * j / nlon;
-          double x, y;
-          on[static_cast<size_t>(i * (nlon + 1) + j)] = pr.Fwd(la, lo, &x, &y) ? 1 : 0;
-          mp->InsertNextPoint(x, y, -2.0);
-          double u = (lo / kD2R + 180.0) / 360.0;
-          u -= std::floor(u);
-          if (j > 0 && u < 1e-9) u = 1.0; // the cell ending at the date line
-          tc->InsertNextTuple2(u, (la / kD2R + 90.0) / 180.0);
-        }
-      vtkNew<vtkCellArray> quads;
-      for (int i = 0; i < nlat; ++i)
-        for (int j = 0; j < nlon; ++j) {
-          const vtkIdType a0 = i * (nlon + 1) + j, a1 = a0 + 1, a2 = a0 + nlon + 2, a3 = a0 + nlon + 1;
-          if (!on[static_cast<size_t>(a0)] || !on[static_cast<size_t>(a1)] || !on[static_cast<size_t>(a2)] ||
-              !on[static_cast<size_t>(a3)])
-            continue;
-          // A cell whose texture wraps (crosses the date line between its corners) is skipped.
-          double ua[2], ub[2];
-          tc->GetTuple(a0, ua);
-          tc->GetTuple(a1, ub);
-          if (ub[0] < ua[0]) continue;
-          const vtkIdType ids[4] = {a0, a1, a2, a3};
-          quads->InsertNextCell(4, ids);
-        }
-      vtkNew<vtkPolyData> mesh;
-      mesh->SetPoints(mp);
-      mesh->SetPolys(quads);
-      mesh->GetPointData()->SetTCoords(tc);
-      vtkNew<vtkPolyDataMapper> m;
-      m->SetInputData(mesh);
-      vtkNew<vtkActor> a;
-      a->SetMapper(m);
-      a->SetTexture(tex);
-      a->GetProperty()->LightingOff();
-      a->GetProperty()->SetOpacity(0.9);
-      ren->AddActor(a);
-    } else {
-      notes.push_back("no relief raster (" + relief + ")");
-    }
+  std::vector<unsigned char> img(3 * static_cast<size_t>(W) * static_cast<size_t>(H));
+  const std::string gshhg = opt.data_dir.empty() ? NavMapGshhgDir() : opt.data_dir;
+  NavMapLayers layers;
+  std::string derr;
+  const NavShoreRes res = NavShoreResForScale(m_px);
+  const bool have_shore = NavMapLoadLayers(gshhg, res, lat_lo / kD2R, lat_hi / kD2R, lon_lo / kD2R,
+                                           all_lon ? lon_lo / kD2R + 360.0 : lon_hi / kD2R, &layers, &derr);
+  {
+    const double *bg = have_shore ? kSea : kNoData;
+    const unsigned char c0[3] = {static_cast<unsigned char>(std::lround(255 * bg[0])),
+                                 static_cast<unsigned char>(std::lround(255 * bg[1])),
+                                 static_cast<unsigned char>(std::lround(255 * bg[2]))};
+    for (size_t i = 0; i < img.size(); i += 3)
+      std::memcpy(&img[i], c0, 3);
   }
-  // Coastlines (GSHHS crude, about 25 km): down to regional scale; they thin out below.
-  const std::string coast = data + "/shapefiles/gshhs/c/GSHHS_c_L1.shp";
-  const std::string lakes = data + "/shapefiles/gshhs/l/GSHHS_l_L2.shp";
-  if (span_x > 15e3) {
-    for (const std::string &f : {coast, lakes}) {
-      std::vector<std::vector<double>> parts;
-      std::string e2;
-      if (!Exists(f) || !NavReadShapefile(f, &parts, &e2)) {
-        notes.push_back("no coastline data (" + f + ")");
-        continue;
-      }
-      std::vector<std::vector<double>> split;
-      for (const auto &pl : parts)
-        AddProjected(pr, pl, 0.25 * kPi * kR, &split, 1.5 * span_x / opt.width_px);
-      const double c[3] = {0.30, 0.36, 0.45};
-      ren->AddActor(Lines(split, c, f == coast ? 1.3f : 0.8f, -1.0));
+  // Beyond this angular distance from the centre a ring is not drawn: the projection stretches
+  // rings near the antipode around the whole disc (the view's corners reach at most ~141 deg).
+  const double c_draw = std::min(kPi - 0.05, c_max + 10.0 * kD2R);
+  if (have_shore) {
+    info.shore_res = NavShoreResLetter(layers.res);
+    info.bins = layers.bins;
+    NavMapPaintAreas(layers,
+                     [&](double lat_deg, double lon_deg, double *px, double *py) {
+                       const double la = lat_deg * kD2R, lo = lon_deg * kD2R;
+                       if (pr.Dist(la, lo) > c_draw) return false;
+                       double x, y;
+                       pr.Fwd(la, lo, &x, &y);
+                       to_px(x, y, px, py);
+                       return true;
+                     },
+                     W, H, &img);
+  } else {
+    info.notes.push_back(derr);
+  }
+  {
+    vtkNew<vtkImageData> im;
+    im->SetDimensions(W, H, 1);
+    vtkNew<vtkUnsignedCharArray> px;
+    px->SetNumberOfComponents(3);
+    px->SetNumberOfTuples(static_cast<vtkIdType>(W) * H);
+    std::memcpy(px->GetPointer(0), img.data(), img.size());
+    im->GetPointData()->SetScalars(px);
+    vtkNew<vtkTexture> tex;
+    tex->SetInputData(im);
+    tex->InterpolateOff();
+    tex->SetColorModeToDirectScalars();
+    vtkNew<vtkPlaneSource> plane;
+    plane->SetOrigin(left, bottom, -2.0);
+    plane->SetPoint1(left + span_x, bottom, -2.0);
+    plane->SetPoint2(left, bottom + span_y, -2.0);
+    vtkNew<vtkPolyDataMapper> m;
+    m->SetInputConnection(plane->GetOutputPort());
+    vtkNew<vtkActor> a;
+    a->SetMapper(m);
+    a->SetTexture(tex);
+    a->GetProperty()->LightingOff();
+    ren->AddActor(a);
+  }
+  ren->SetBackground(have_shore ? kSea[0] : kNoData[0], have_shore ? kSea[1] : kNoData[1],
+                     have_shore ? kSea[2] : kNoData[2]);
+
+  // Shorelines, rivers and borders as lines over the fill.
+  auto world_lines = [&](const std::vector<NavMapLine> &ls, int max_level, int min_level) {
+    std::vector<std::vector<double>> out;
+    for (const NavMapLine &l : ls) {
+      if (l.level > max_level || l.level < min_level) continue;
+      AddProjected(pr, l.lonlat, 0.25 * kPi * kR, &out, 0.8 * m_px);
     }
+    return out;
+  };
+  if (have_shore) {
+    // River classes: 0 double-lined, 1-4 permanent (major to minor), 5-10 intermittent, canals.
+    const int river_max = m_px < 60.0 ? 5 : m_px < 600.0 ? 3 : m_px < 3000.0 ? 2 : 1;
+    const double c_river[3] = {0.36, 0.58, 0.84}, c_border[3] = {0.52, 0.30, 0.50}, c_state[3] = {0.66, 0.55, 0.64};
+    // Shores: a thin line a shade darker than the water hides the fill's pixel steps.
+    const double c_shore[3] = {0.45, 0.60, 0.75};
+    ren->AddActor(Lines(world_lines(layers.shores, 4, 1), c_shore, 1.0f, -1.7));
+    ren->AddActor(Lines(world_lines(layers.rivers, river_max, 0), c_river, m_px < 60.0 ? 1.6f : 1.1f, -1.6));
+    if (m_px < 3000.0) ren->AddActor(Lines(world_lines(layers.borders, 2, 2), c_state, 0.9f, -1.5));
+    ren->AddActor(Lines(world_lines(layers.borders, 1, 1), c_border, 1.6f, -1.4));
   }
 
-  const int font = std::max(10, static_cast<int>(std::lround(opt.height_px / 48.0)));
-  const double tc[3] = {0.05, 0.05, 0.08}, gc[3] = {0.45, 0.47, 0.52};
+  const int font = std::max(10, static_cast<int>(std::lround(H / 48.0)));
+  const double tc[3] = {0.05, 0.05, 0.08}, gc[3] = {0.38, 0.40, 0.46};
   // Graticule, or a local metric grid at street scale.
   std::vector<std::vector<double>> grid;
   std::vector<std::pair<std::string, double>> xlabels, ylabels; // text, position in m
@@ -392,15 +514,14 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
       double best = -INFINITY;
       for (const auto &pl : lines)
         for (size_t i = 0; i + 1 < pl.size(); i += 2) {
-          const double x = pl[i], y = pl[i + 1];
+          const double x = pl[i] - cx, y = pl[i + 1] - cy;
           if (std::fabs(x) > 0.5 * span_x || std::fabs(y) > 0.5 * span_y) continue;
           const double key = right ? x : y;
           if (key > best) {
             best = key;
-            *pos = right ? y : x;
+            *pos = right ? pl[i + 1] : pl[i];
           }
         }
-      // Only lines that reach the edge get a label there (not those ending at a pole inside).
       return std::isfinite(best) && best > (right ? 0.3 * span_x : 0.3 * span_y);
     };
     for (double la = std::ceil(lat_a / lat_step) * lat_step; la <= lat_b + 1e-9; la += lat_step) {
@@ -409,7 +530,7 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
       for (int i = 0; i <= 720; ++i)
         ll.insert(ll.end(), {lon_a + (lon_b - lon_a) * i / 720.0, la});
       std::vector<std::vector<double>> lines;
-      AddProjected(pr, ll, 0.25 * kPi * kR, &lines, 1.5 * span_x / opt.width_px);
+      AddProjected(pr, ll, 0.25 * kPi * kR, &lines, 1.5 * m_px);
       double pos = 0.0;
       if (label_at(lines, true, &pos)) ylabels.push_back({FormatDeg(la, true, lat_step), pos});
       grid.insert(grid.end(), lines.begin(), lines.end());
@@ -420,38 +541,34 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
       for (int i = 0; i <= 720; ++i)
         ll.insert(ll.end(), {lo, std::clamp(lat_a + (lat_b - lat_a) * i / 720.0, -90.0, 90.0)});
       std::vector<std::vector<double>> lines;
-      AddProjected(pr, ll, 0.25 * kPi * kR, &lines, 1.5 * span_x / opt.width_px);
-      double wl = lo;
-      while (wl > 180)
-        wl -= 360;
-      while (wl <= -180)
-        wl += 360;
+      AddProjected(pr, ll, 0.25 * kPi * kR, &lines, 1.5 * m_px);
+      double wl = std::remainder(lo, 360.0);
+      if (wl <= -180.0) wl += 360.0;
       double pos = 0.0;
       if (label_at(lines, false, &pos)) xlabels.push_back({FormatDeg(wl, false, lon_step), pos});
       grid.insert(grid.end(), lines.begin(), lines.end());
     }
   } else {
     const double s = NiceLength(span_x / 6.0);
-    for (double x = std::ceil(-span_x / s) * s; x <= span_x; x += s)
-      grid.push_back({x, -span_y, x, span_y});
-    for (double y = std::ceil(-span_y / s) * s; y <= span_y; y += s)
-      grid.push_back({-span_x, y, span_x, y});
+    for (double x = std::floor(left / s) * s; x <= left + span_x; x += s)
+      grid.push_back({x, bottom, x, bottom + span_y});
+    for (double y = std::floor(bottom / s) * s; y <= bottom + span_y; y += s)
+      grid.push_back({left, y, left + span_x, y});
     char buf[64];
-    for (double x = std::ceil(-0.5 * span_x / s) * s; x <= 0.5 * span_x; x += s) {
+    for (double x = std::ceil(left / s) * s; x <= left + span_x; x += s) {
       std::snprintf(buf, sizeof buf, "%+g m E", x);
       xlabels.push_back({buf, x});
     }
-    for (double y = std::ceil(-0.5 * span_y / s) * s; y <= 0.5 * span_y; y += s) {
+    for (double y = std::ceil(bottom / s) * s; y <= bottom + span_y; y += s) {
       std::snprintf(buf, sizeof buf, "%+g m N", y);
       ylabels.push_back({buf, y});
     }
   }
-  ren->AddActor(Lines(grid, gc, 1.0f, -0.5, 0.55));
+  ren->AddActor(Lines(grid, gc, 1.0f, -0.5, 0.5));
 
-  // Tracks.
-  // Tracks thinned to about half a pixel between vertices: with multisampling, llvmpipe drew
+  // Tracks, thinned to about half a pixel between vertices: with multisampling, llvmpipe drew
   // almost nothing of 18 000 sub-pixel segments (the ship scene at 20 km across).
-  const double track_step = 0.5 * span_x / opt.width_px;
+  const double track_step = 0.5 * m_px;
   auto track_lines = [&](const NavTrack &t) {
     std::vector<double> ll;
     ll.reserve(2 * t.Size());
@@ -463,7 +580,6 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
   };
   const double c_ref[3] = {0.08, 0.08, 0.10}, c_est[3] = {0.84, 0.10, 0.11}, c_gnss[3] = {0.10, 0.62, 0.20},
                c_out[3] = {0.96, 0.50, 0.80};
-  // Outages: the reference inside each outage interval, wide and pink, under the tracks.
   std::vector<std::vector<double>> outs;
   for (size_t o = 0; o < result.gnss.outage_t0_s.size(); ++o) {
     std::vector<double> pl;
@@ -482,9 +598,8 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
   if (result.gnss.Size() > 0 && opt.show_gnss) {
     vtkNew<vtkPoints> pts;
     vtkNew<vtkCellArray> verts;
-    // Display thinning as in the 3D view: at least three dot diameters between drawn fixes.
-    const double dot_px = std::max(4.0, opt.height_px / 150.0);
-    const double gap = 3.0 * dot_px * span_x / opt.width_px;
+    const double dot_px = std::max(4.0, H / 150.0);
+    const double gap = 3.0 * dot_px * m_px;
     double lx = INFINITY, ly = INFINITY;
     for (size_t i = 0; i < result.gnss.Size(); ++i) {
       double x, y;
@@ -511,19 +626,235 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
     ren->AddActor(a);
   }
   // When the whole drive is smaller than a few pixels, a ring marks where it is.
-  const double px_m = span_x / opt.width_px;
-  if (std::max(x1 - x0, y1 - y0) < 8.0 * px_m) {
-    std::vector<double> ring;
-    double cx, cy;
-    cx = 0.5 * (x0 + x1);
-    cy = 0.5 * (y0 + y1);
-    for (int i = 0; i <= 48; ++i) {
-      ring.push_back(cx + 9.0 * px_m * std::cos(2 * kPi * i / 48.0));
-      ring.push_back(cy + 9.0 * px_m * std::sin(2 * kPi * i / 48.0));
+  {
+    const double *tb = frame.track_box_m;
+    if (std::max(tb[2] - tb[0], tb[3] - tb[1]) < 8.0 * m_px) {
+      std::vector<double> ring;
+      const double rx = 0.5 * (tb[0] + tb[2]), ry = 0.5 * (tb[1] + tb[3]);
+      for (int i = 0; i <= 48; ++i) {
+        ring.push_back(rx + 9.0 * m_px * std::cos(2 * kPi * i / 48.0));
+        ring.push_back(ry + 9.0 * m_px * std::sin(2 * kPi * i / 48.0));
+      }
+      ren->AddActor(Lines({ring}, c_est, 2.5f, 0.8));
     }
-    ren->AddActor(Lines({ring}, c_est, 2.5f, 0.8));
   }
 
+  // Scale bar: a nice length about a fifth of the width, bottom left.
+  std::vector<Box> taken; // display boxes of every text and the scale bar: nothing overlaps them
+  auto add_text = [&](vtkTextActor *t, double px, double py, NavMapLabel::Kind kind, const std::string &s, double w,
+                      double h) {
+    double x, y;
+    to_world(px, py, &x, &y);
+    t->GetPositionCoordinate()->SetCoordinateSystemToWorld();
+    t->GetPositionCoordinate()->SetValue(x, y, 1.0);
+    ren->AddViewProp(t);
+    NavMapLabel l;
+    l.kind = kind;
+    l.text = s;
+    l.x0 = px;
+    l.y0 = py;
+    l.x1 = px + w;
+    l.y1 = py + h;
+    info.labels.push_back(l);
+    taken.push_back({px, py, px + w, py + h});
+  };
+  size_t placed = 0;
+  const std::string places_path = opt.places_file.empty() ? NavMapPlacesFile() : opt.places_file;
+  const std::vector<NavPlace> *places = nullptr;
+  if (opt.show_places && opt.show_text) {
+    std::string perr;
+    if (places_path.empty())
+      info.notes.push_back("no gazetteer (places.tsv not built: node and npm needed)");
+    else if (!NavMapLoadPlaces(places_path, &places, &perr))
+      info.notes.push_back(perr);
+  }
+  const double sb = NiceLength(span_x / 5.0);
+  {
+    const double bpx = 0.04 * W, bpy = 0.06 * H, tick = 0.012 * H;
+    double bx, by;
+    to_world(bpx, bpy, &bx, &by);
+    ren->AddActor(Lines({{bx, by, bx + sb, by}, {bx, by - tick * m_px, bx, by + tick * m_px},
+                         {bx + sb, by - tick * m_px, bx + sb, by + tick * m_px}},
+                        tc, 3.0f, 1.0));
+    taken.push_back({bpx - 4, bpy - tick - 4, bpx + sb / m_px + 4, bpy + tick + 2});
+    if (opt.show_text) {
+      char buf[64];
+      if (sb >= 1000.0)
+        std::snprintf(buf, sizeof buf, "%g km", sb / 1000.0);
+      else
+        std::snprintf(buf, sizeof buf, "%g m", sb);
+      auto t = Text(buf, font, tc);
+      double w, h;
+      TextSize(t->GetTextProperty(), buf, &w, &h);
+      add_text(t, bpx + 0.5 * sb / m_px - 0.5 * w, bpy + tick + 2, NavMapLabel::ScaleBar, buf, w, h);
+    }
+  }
+  if (opt.show_text) {
+    char buf[512];
+    {
+      double clat = pr.lat0, clon = pr.lon0;
+      pr.Inv(cx, cy, &clat, &clon);
+      clon = std::remainder(clon, 2 * kPi);
+      char km[32];
+      std::snprintf(km, sizeof km, span_x >= 1e7 ? "%.0f" : "%.4g", span_x / 1e3);
+      std::snprintf(buf, sizeof buf, "%s \u2013 map, %s km across, centre %.5f\u00b0%c %.5f\u00b0%c\n%s",
+                    result.scene_name.c_str(), km, std::fabs(clat / kD2R), clat >= 0 ? 'N' : 'S',
+                    std::fabs(clon / kD2R), clon >= 0 ? 'E' : 'W',
+                    street ? "local metric grid (m from the projection centre)" : "azimuthal equidistant, graticule");
+    }
+    auto title = Text(buf, font, tc);
+    title->GetTextProperty()->SetBold(true);
+    title->GetTextProperty()->SetBackgroundColor(1, 1, 1);
+    title->GetTextProperty()->SetBackgroundOpacity(0.75);
+    double w, h;
+    TextSize(title->GetTextProperty(), buf, &w, &h);
+    add_text(title, 0.012 * W, H - 0.012 * H - h, NavMapLabel::Title, buf, w, h);
+    const double title_y0 = H - 0.012 * H - h;
+
+    std::string lt = "black: reference   red: estimate (run 0)";
+    if (result.gnss.Size() > 0) lt += "   green dots: GNSS fixes";
+    if (!result.gnss.outage_t0_s.empty()) lt += "   pink: GNSS outage";
+    if (have_shore) {
+      lt += std::string("\nGSHHG 2.3.7 (") + NavShoreResLetter(layers.res) +
+            ") land, lakes, WDBII rivers and borders";
+    }
+    // GeoNames asks for credit (CC BY 4.0).
+    if (places) lt += "\nplace names: GeoNames (CC BY 4.0)";
+    for (const std::string &n : info.notes)
+      lt += "\n" + n;
+    auto leg = Text(lt, font - 2, tc);
+    leg->GetTextProperty()->SetBackgroundColor(1, 1, 1);
+    leg->GetTextProperty()->SetBackgroundOpacity(0.75);
+    leg->GetTextProperty()->SetJustificationToRight();
+    TextSize(leg->GetTextProperty(), lt, &w, &h);
+    leg->GetTextProperty()->SetJustificationToLeft();
+    // Bottom right; raised above the scale bar when a narrow map puts the two side by side.
+    double leg_y = 0.015 * H;
+    for (const Box &o : taken)
+      if (o.Hits({0.985 * W - w, leg_y, 0.985 * W, leg_y + h})) leg_y = o.y1 + 4;
+    add_text(leg, 0.985 * W - w, leg_y, NavMapLabel::Legend, lt, w, h);
+
+    // Graticule (or grid) labels: longitudes below the title, latitudes at the right edge; one
+    // that would touch an earlier text is left out.
+    for (const auto &l : xlabels) {
+      auto t = Text(l.first, font - 3, gc);
+      t->GetTextProperty()->SetBackgroundColor(kLand[0], kLand[1], kLand[2]);
+      t->GetTextProperty()->SetBackgroundOpacity(0.6);
+      TextSize(t->GetTextProperty(), l.first, &w, &h);
+      double px, py;
+      to_px(l.second, 0.0, &px, &py);
+      const Box b{px - 0.5 * w, title_y0 - 4 - h, px + 0.5 * w, title_y0 - 4};
+      if (b.x0 < 2 || b.x1 > W - 2) continue;
+      bool clash = false;
+      for (const Box &o : taken)
+        clash = clash || o.Hits({b.x0 - 6, b.y0, b.x1 + 6, b.y1});
+      if (clash) continue;
+      add_text(t, b.x0, b.y0, NavMapLabel::Graticule, l.first, w, h);
+    }
+    for (const auto &l : ylabels) {
+      auto t = Text(l.first, font - 3, gc);
+      t->GetTextProperty()->SetBackgroundColor(kLand[0], kLand[1], kLand[2]);
+      t->GetTextProperty()->SetBackgroundOpacity(0.6);
+      TextSize(t->GetTextProperty(), l.first, &w, &h);
+      double px, py;
+      to_px(0.0, l.second, &px, &py);
+      const Box b{0.992 * W - w, py - 0.5 * h, 0.992 * W, py + 0.5 * h};
+      if (b.y0 < 2 || b.y1 > H - 2) continue;
+      bool clash = false;
+      for (const Box &o : taken)
+        clash = clash || o.Hits({b.x0, b.y0 - 3, b.x1, b.y1 + 3});
+      if (clash) continue;
+      add_text(t, b.x0, b.y0, NavMapLabel::Graticule, l.first, w, h);
+    }
+  }
+
+  // Place names: the most populous places in view first, each with a dot, its name right of the
+  // dot (else left, above, below), never over another text; at most one label per ~30 000 px^2.
+  if (places) {
+    const size_t max_labels = std::clamp<size_t>(static_cast<size_t>(W) * H / 30000, 3, 40);
+    const double c_place[3] = {0.10, 0.10, 0.14};
+    std::vector<double> dots;
+    std::vector<Box> dot_boxes;
+    size_t looked = 0;
+    for (const NavPlace &p : *places) {
+      if (placed >= max_labels || looked > 20000) break;
+      const double la = p.lat_deg * kD2R, lo = p.lon_deg * kD2R;
+      if (la < lat_lo || la > lat_hi) continue;
+      if (!all_lon) {
+        const double d = std::remainder(lo - pr.lon0, 2 * kPi);
+        if (d < dlon_lo || d > dlon_hi) continue;
+      }
+      double x, y;
+      if (!pr.Fwd(la, lo, &x, &y)) continue;
+      double px, py;
+      to_px(x, y, &px, &py);
+      if (px < 4 || py < 4 || px > W - 4 || py > H - 4) continue;
+      ++looked;
+      const int size = p.population >= 1000000 ? font : p.population >= 100000 ? font - 1 : font - 2;
+      auto t = Text(p.name, size, c_place);
+      t->GetTextProperty()->SetBold(p.capital || p.population >= 1000000);
+      t->GetTextProperty()->SetBackgroundColor(kLand[0], kLand[1], kLand[2]);
+      t->GetTextProperty()->SetBackgroundOpacity(0.55);
+      double w, h;
+      TextSize(t->GetTextProperty(), p.name, &w, &h);
+      const Box dot{px - 3, py - 3, px + 3, py + 3};
+      const Box cand[4] = {{px + 5, py - 0.5 * h, px + 5 + w, py + 0.5 * h},
+                           {px - 5 - w, py - 0.5 * h, px - 5, py + 0.5 * h},
+                           {px - 0.5 * w, py + 4, px + 0.5 * w, py + 4 + h},
+                           {px - 0.5 * w, py - 4 - h, px + 0.5 * w, py - 4}};
+      bool dot_free = true;
+      for (const Box &o : taken)
+        dot_free = dot_free && !o.Hits(dot);
+      if (!dot_free) continue;
+      for (const Box &b : cand) {
+        if (b.x0 < 2 || b.y0 < 2 || b.x1 > W - 2 || b.y1 > H - 2) continue;
+        const Box pad{b.x0 - 3, b.y0 - 2, b.x1 + 3, b.y1 + 2};
+        bool clash = false;
+        for (const Box &o : taken)
+          clash = clash || o.Hits(pad);
+        for (const Box &o : dot_boxes)
+          clash = clash || o.Hits(pad);
+        if (clash) continue;
+        add_text(t, b.x0, b.y0, NavMapLabel::Place, p.name, w, h);
+        // Place labels first in the list (the documented order): move this one forward.
+        std::rotate(info.labels.begin() + static_cast<std::ptrdiff_t>(placed), info.labels.end() - 1, info.labels.end());
+        dots.insert(dots.end(), {x, y});
+        dot_boxes.push_back(dot);
+        ++placed;
+        break;
+      }
+    }
+    if (!dots.empty()) {
+      vtkNew<vtkPoints> pts;
+      vtkNew<vtkCellArray> verts;
+      for (size_t i = 0; i + 1 < dots.size(); i += 2) {
+        const vtkIdType id = pts->InsertNextPoint(dots[i], dots[i + 1], 0.9);
+        verts->InsertNextCell(1, &id);
+      }
+      vtkNew<vtkPolyData> pd;
+      pd->SetPoints(pts);
+      pd->SetVerts(verts);
+      vtkNew<vtkPolyDataMapper> m;
+      m->SetInputData(pd);
+      vtkNew<vtkActor> a;
+      a->SetMapper(m);
+      a->GetProperty()->SetColor(c_place[0], c_place[1], c_place[2]);
+      a->GetProperty()->SetPointSize(5.0f);
+      a->GetProperty()->LightingOff();
+      ren->AddActor(a);
+    }
+  }
+  info.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+  if (info_out) *info_out = std::move(info);
+  return true;
+}
+
+bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer *ren, NavMapExtent *extent,
+                 std::string *error, NavMapFrame *frame_out, NavMapInfo *info) {
+  NavMapFrame frame;
+  if (!NavMapFit(result, opt, &frame, error)) return false;
+  const double span_x = frame.fit_span_x_m, span_y = span_x * opt.height_px / opt.width_px;
+  if (!NavBuildMapView(result, opt, frame, 0.0, 0.0, span_x, ren, info, error)) return false;
   // Camera: plan view, parallel projection, north up.
   vtkCamera *cam = ren->GetActiveCamera();
   cam->ParallelProjectionOn();
@@ -532,98 +863,16 @@ bool NavBuildMap(const NavResult &result, const NavMapOptions &opt, vtkRenderer 
   cam->SetViewUp(0, 1, 0);
   cam->SetParallelScale(0.5 * span_y);
   cam->SetClippingRange(1.0, 40.0 * span_x + 1000.0);
-
-  // Scale bar: a nice length about a fifth of the width, bottom left.
-  const double sb = NiceLength(span_x / 5.0);
-  {
-    const double bx = -0.5 * span_x + 0.04 * span_x, by = -0.5 * span_y + 0.06 * span_y;
-    const double tick = 0.012 * span_y;
-    ren->AddActor(Lines({{bx, by, bx + sb, by}, {bx, by - tick, bx, by + tick}, {bx + sb, by - tick, bx + sb, by + tick}},
-                        tc, 3.0f, 1.0));
-    if (opt.show_text) {
-      char buf[64];
-      if (sb >= 1000.0)
-        std::snprintf(buf, sizeof buf, "%g km", sb / 1000.0);
-      else
-        std::snprintf(buf, sizeof buf, "%g m", sb);
-      auto t = Text(buf, font, tc);
-      t->GetTextProperty()->SetJustificationToCentered();
-      t->GetPositionCoordinate()->SetCoordinateSystemToWorld();
-      t->GetPositionCoordinate()->SetValue(bx + 0.5 * sb, by + 1.5 * tick, 1.0);
-      ren->AddViewProp(t);
-    }
-  }
-  if (opt.show_text) {
-    // Drop labels that would overlap an earlier one (meridians meet at a pole, parallels around
-    // it have their rightmost points side by side).
-    auto dedupe = [&](std::vector<std::pair<std::string, double>> *v, double min_gap) {
-      std::vector<std::pair<std::string, double>> keep;
-      for (const auto &l : *v) {
-        bool clash = false;
-        for (const auto &k : keep)
-          clash = clash || std::fabs(k.second - l.second) < min_gap;
-        if (!clash) keep.push_back(l);
-      }
-      *v = keep;
-    };
-    dedupe(&xlabels, 5.0 * font * span_x / opt.width_px);
-    dedupe(&ylabels, 1.3 * font * span_y / opt.height_px);
-    for (const auto &l : xlabels) {
-      if (std::fabs(l.second) > 0.47 * span_x) continue;
-      auto t = Text(l.first, font - 3, gc);
-      t->GetTextProperty()->SetJustificationToCentered();
-      t->GetTextProperty()->SetVerticalJustificationToTop();
-      t->GetPositionCoordinate()->SetCoordinateSystemToWorld();
-      // Below the title band (two lines at the top left).
-      t->GetPositionCoordinate()->SetValue(l.second, 0.5 * span_y - (3.0 * font + 4.0) * span_y / opt.height_px, 1.0);
-      ren->AddViewProp(t);
-    }
-    for (const auto &l : ylabels) {
-      if (std::fabs(l.second) > 0.45 * span_y) continue;
-      auto t = Text(l.first, font - 3, gc);
-      t->GetTextProperty()->SetJustificationToRight();
-      t->GetTextProperty()->SetVerticalJustificationToCentered();
-      t->GetPositionCoordinate()->SetCoordinateSystemToWorld();
-      t->GetPositionCoordinate()->SetValue(0.5 * span_x - 0.008 * span_x, l.second, 1.0);
-      ren->AddViewProp(t);
-    }
-    char buf[512];
-    std::snprintf(buf, sizeof buf, "%s \u2013 map, %.4g km across, centre %.5f\u00b0%c %.5f\u00b0%c%s%s",
-                  result.scene_name.c_str(), span_x / 1e3, std::fabs(pr.lat0 / kD2R), pr.lat0 >= 0 ? 'N' : 'S',
-                  std::fabs(pr.lon0 / kD2R), pr.lon0 >= 0 ? 'E' : 'W',
-                  street ? "\nlocal metric grid about the centre" : "",
-                  street ? "" : "\nazimuthal equidistant about the centre");
-    auto title = Text(buf, font, tc);
-    title->GetTextProperty()->SetBold(true);
-    title->GetTextProperty()->SetVerticalJustificationToTop();
-    title->GetTextProperty()->SetBackgroundColor(1, 1, 1);
-    title->GetTextProperty()->SetBackgroundOpacity(0.75);
-    title->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-    title->GetPositionCoordinate()->SetValue(0.012, 0.985);
-    ren->AddViewProp(title);
-    auto leg = Text("", font - 2, tc);
-    std::string lt = "black: reference   red: estimate (run 0)";
-    if (result.gnss.Size() > 0) lt += "   green dots: GNSS fixes";
-    if (!result.gnss.outage_t0_s.empty()) lt += "   pink: GNSS outage";
-    lt += span_x > 250e3 ? "\nbackground: Natural Earth relief, GSHHS coastlines" : "";
-    for (const std::string &n : notes)
-      lt += "\n" + n;
-    leg->SetInput(lt.c_str());
-    leg->GetTextProperty()->SetBackgroundColor(1, 1, 1);
-    leg->GetTextProperty()->SetBackgroundOpacity(0.75);
-    leg->GetTextProperty()->SetJustificationToRight();
-    leg->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-    leg->GetPositionCoordinate()->SetValue(0.985, 0.015);
-    ren->AddViewProp(leg);
-  }
   if (extent) {
     extent->span_x_m = span_x;
     extent->span_y_m = span_y;
   }
+  if (frame_out) *frame_out = frame;
   return true;
 }
 
-bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const std::string &path, std::string *error) {
+bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const std::string &path, std::string *error,
+                     NavMapInfo *info) {
   if (!NavCheckDisplay(error)) return false;
   vtkNew<vtkRenderWindow> win;
   NavAttachDisplay(win);
@@ -632,7 +881,7 @@ bool NavRenderMapPng(const NavResult &result, const NavMapOptions &opt, const st
   win->SetMultiSamples(opt.multisamples);
   vtkNew<vtkRenderer> ren;
   win->AddRenderer(ren);
-  if (!NavBuildMap(result, opt, ren, nullptr, error)) {
+  if (!NavBuildMap(result, opt, ren, nullptr, error, nullptr, info)) {
     win->Finalize();
     return false;
   }

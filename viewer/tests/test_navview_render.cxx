@@ -119,7 +119,7 @@ int main(int argc, char **argv) {
     // Street scale: fitted to the 120 m figure eight, local metric grid, outage band, fixes.
     ok = NavRenderMapPng(*result, mo, actual, &err);
   } else if (name == "map_region") {
-    // 600 km around Munich: relief raster and GSHHS coastlines (python-cartopy-data), graticule.
+    // 600 km around Munich: GSHHG land and lakes (high resolution), rivers and borders, graticule.
     mo.span_km = 600.0;
     ok = NavRenderMapPng(*result, mo, actual, &err);
   } else {

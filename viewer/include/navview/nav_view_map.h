@@ -1,12 +1,14 @@
 /**
  * @file nav_view_map.h
  * @brief Geodetic map view: reference, estimated and GNSS tracks in latitude/longitude over an
- *        offline background (Natural Earth shaded relief and GSHHS coastlines from Debian's
- *        python-cartopy-data), with a graticule and a scale bar; below about 20 km across, a
- *        local metric grid replaces the graticule (the background thins out at street scale).
+ *        offline map: land and water filled from GSHHG shorelines (lakes, islands in lakes) at a
+ *        resolution chosen by the scale, WDBII rivers and borders, place names from a GeoNames
+ *        gazetteer chosen by population, a graticule (below about 20 km across a local metric
+ *        grid) and a scale bar; no label overlaps another (nav_map_data.h, docs/map-data.md).
  *
- * Projection: equirectangular about the view centre (x = R cos(lat0) dlon, y = R dlat, metres),
- * which is what a lat/lon plot with a 1:cos(lat0) aspect shows. No VTK types here.
+ * Projection: azimuthal equidistant about the projection centre (x east, y north, metres):
+ * distances and directions from the centre are true, and a view over a pole or across the date
+ * line has no seam. No VTK types here.
  */
 #ifndef NAV_VIEW_MAP_H
 #define NAV_VIEW_MAP_H
@@ -27,10 +29,35 @@ struct NavMapOptions {
   bool show_text = true;
   /** GNSS fixes and outage highlighting (gnss.csv, gnss_outages.csv). */
   bool show_gnss = true;
-  /** Directory of the cartopy data (shapefiles/, raster/); empty: $NAVVIEW_MAP_DATA, else
-   *  /usr/share/cartopy/data. Missing files leave the background blank with a note. */
+  /** Directory of the GSHHG binned files (binned_GSHHS_f.nc ...); empty: NavMapGshhgDir()
+   *  ($NAVVIEW_GSHHG_DIR, else /usr/share/gmt-gshhg). Missing files leave the sea tint with a note. */
   std::string data_dir;
+  /** Gazetteer (places.tsv); empty: NavMapPlacesFile(). None: no place names, with a note. */
+  std::string places_file;
+  bool show_places = true;
   int multisamples = 8;
+};
+
+/** A text placed on the map, as a box in display pixels (origin bottom left). */
+struct NavMapLabel {
+  enum Kind { Place, Graticule, ScaleBar, Title, Legend } kind = Place;
+  std::string text;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/** What a map build drew: for tests, the interactive title and the speed report. */
+struct NavMapInfo {
+  int width_px = 0, height_px = 0;
+  double span_x_m = 0.0, span_y_m = 0.0; /**< width and height shown [m] */
+  double proj_lat_deg = 0.0, proj_lon_deg = 0.0; /**< projection centre */
+  double view_x_m = 0.0, view_y_m = 0.0;         /**< view centre in the projection [m] */
+  char shore_res = 0;                            /**< GSHHG resolution letter (c l i h f), 0: none */
+  int bins = 0;                                  /**< GSHHG bins read */
+  std::vector<NavMapLabel> labels;               /**< every text placed, place names first */
+  std::vector<std::string> notes;                /**< missing data */
+  double build_ms = 0.0;                         /**< time to build the layers (no render) */
+  /** Display pixel (origin bottom left, may lie outside the view) of @p lat_deg, @p lon_deg. */
+  void PixelOf(double lat_deg, double lon_deg, double *px, double *py) const;
 };
 
 /** Graticule step [deg] (1-2-5 x 10^k, or 10/15/30) for a view @p span_deg across: 3 to 8 lines. */
@@ -38,7 +65,7 @@ double NavGraticuleStepDeg(double span_deg);
 
 /** Render the map of @p result to the PNG @p path. Needs an X server. */
 bool NavRenderMapPng(const NavResult &result, const NavMapOptions &options, const std::string &path,
-                     std::string *error);
+                     std::string *error, NavMapInfo *info = nullptr);
 
 /** Open the map of @p result in an interactive window (drag = pan, wheel or +/- = zoom, r = reset,
  *  q = quit) and run its event loop until it is closed. Needs an X server. */
