@@ -1,0 +1,1077 @@
+/*
+ * RINEX 3 observation and navigation readers, and the raw-measurement source of a tightly
+ * coupled replay (nav_rinex_read.h). Column numbers in comments are the 1-based columns of the
+ * RINEX 3.04 format tables (A1-A11).
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <locale.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "navcore/nav_rinex_read.h"
+
+/* ---------------------------------------------------------------- lines */
+
+/* A line source over a FILE or memory; one line at a time into buf (no line end, NUL-terminated). */
+typedef struct lines {
+  FILE *f;
+  const char *mem;
+  size_t mem_len, mem_pos;
+  long file_size, consumed;
+  char buf[NAV_RINEX_MAX_LINE + 2];
+  size_t n;
+  long line; /* 1-based number of the line in buf */
+  bool eof;
+  nav_diag diag;
+  nav_status failed;
+  locale_t c_numeric;
+} lines;
+
+static void diag_set(nav_diag *d, const char *file, int line, int col, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void diag_set(nav_diag *d, const char *file, int line, int col, const char *fmt, ...) {
+  if (!d) return;
+  char name[sizeof d->file];
+  snprintf(name, sizeof name, "%s", file ? file : "");
+  memset(d, 0, sizeof *d);
+  memcpy(d->file, name, sizeof d->file);
+  d->line = line;
+  d->col = line > 0 ? (col > 0 ? col : 1) : 0;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(d->message, sizeof d->message, fmt, ap);
+  va_end(ap);
+}
+
+static nav_status lfail(lines *L, nav_status st, int col, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static nav_status lfail(lines *L, nav_status st, int col, const char *fmt, ...) {
+  char msg[sizeof L->diag.message];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  diag_set(&L->diag, L->diag.file, (int)L->line, col, "%s", msg);
+  L->failed = st;
+  return st;
+}
+
+static nav_status lines_init(lines *L, const char *path, const char *text, size_t len, const char *name,
+                             nav_diag *diag) {
+  memset(L, 0, sizeof *L);
+  snprintf(L->diag.file, sizeof L->diag.file, "%s", name ? name : "");
+  L->c_numeric = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+  if (L->c_numeric == (locale_t)0) return NAV_ERR_NO_MEMORY;
+  if (path) {
+    L->f = fopen(path, "rb");
+    if (!L->f) {
+      diag_set(diag, path, 0, 0, "cannot open the file for reading");
+      return NAV_ERR_IO;
+    }
+    if (fseek(L->f, 0, SEEK_END) == 0) L->file_size = ftell(L->f);
+    if (fseek(L->f, 0, SEEK_SET) != 0) L->file_size = 0;
+  } else {
+    L->mem = text;
+    L->mem_len = len;
+    L->file_size = (long)len;
+  }
+  return NAV_OK;
+}
+
+static void lines_close(lines *L) {
+  if (L->f) fclose(L->f);
+  L->f = NULL;
+  if (L->c_numeric != (locale_t)0) freelocale(L->c_numeric);
+  L->c_numeric = (locale_t)0;
+}
+
+static int lgetc(lines *L) {
+  if (L->f) return getc(L->f);
+  if (L->mem_pos >= L->mem_len) return EOF;
+  return (unsigned char)L->mem[L->mem_pos++];
+}
+
+/* Next line into L->buf; *got false at the end of the input. CR-LF and a last line without a
+ * line end are accepted; a NUL byte or a line longer than NAV_RINEX_MAX_LINE is an error. */
+static nav_status next_line(lines *L, bool *got) {
+  *got = false;
+  if (L->failed != NAV_OK) return L->failed;
+  if (L->eof) return NAV_OK;
+  size_t n = 0;
+  int c = lgetc(L);
+  if (c == EOF) {
+    L->eof = true;
+    if (L->f && ferror(L->f)) {
+      ++L->line;
+      return lfail(L, NAV_ERR_IO, 1, "read error");
+    }
+    return NAV_OK;
+  }
+  ++L->line;
+  for (; c != EOF && c != '\n'; c = lgetc(L)) {
+    L->consumed++;
+    if (c == '\0') return lfail(L, NAV_ERR_PARSE, (int)n + 1, "a NUL byte; expected a text file");
+    if (n >= NAV_RINEX_MAX_LINE)
+      return lfail(L, NAV_ERR_PARSE, NAV_RINEX_MAX_LINE + 1,
+                   "line longer than %d bytes; expected RINEX records (80 columns, longer only for "
+                   "observation records)",
+                   NAV_RINEX_MAX_LINE);
+    L->buf[n++] = (char)c;
+  }
+  if (c == '\n') L->consumed++;
+  if (c == EOF) {
+    L->eof = true;
+    if (L->f && ferror(L->f)) return lfail(L, NAV_ERR_IO, 1, "read error");
+  }
+  if (n > 0 && L->buf[n - 1] == '\r') --n;
+  L->buf[n] = '\0';
+  L->n = n;
+  *got = true;
+  return NAV_OK;
+}
+
+/* Columns [col, col + w) (1-based) of the line, blank-padded beyond its end, into dst. */
+static void field(const lines *L, int col, int w, char *dst) {
+  for (int i = 0; i < w; ++i) {
+    const size_t k = (size_t)(col - 1 + i);
+    dst[i] = k < L->n ? L->buf[k] : ' ';
+  }
+  dst[w] = '\0';
+}
+
+static bool all_blank(const char *s) {
+  for (; *s; ++s)
+    if (*s != ' ') return false;
+  return true;
+}
+
+/* Printable copy of a field for messages. */
+static void shown(const char *s, char *dst, size_t cap) {
+  size_t j = 0;
+  for (; *s && j + 1 < cap; ++s) dst[j++] = ((unsigned char)*s < 0x20 || (unsigned char)*s >= 0x7f) ? '?' : *s;
+  dst[j] = '\0';
+}
+
+/* A number in columns [col, col + w): Fortran F, E or D form, blanks around it. *blank set when
+ * the field is empty (then *v = 0). */
+static nav_status num(lines *L, int col, int w, const char *what, double *v, bool *blank) {
+  char f[64], s[64];
+  if (w > 60) w = 60;
+  field(L, col, w, f);
+  *v = 0.0;
+  if (blank) *blank = false;
+  if (all_blank(f)) {
+    if (blank) {
+      *blank = true;
+      return NAV_OK;
+    }
+    return lfail(L, NAV_ERR_PARSE, col, "%s: blank; expected a number in columns %d-%d", what, col, col + w - 1);
+  }
+  int a = 0, b = w;
+  while (f[a] == ' ') ++a;
+  while (b > a && f[b - 1] == ' ') --b;
+  int k = 0;
+  bool ok = true;
+  for (int i = a; i < b; ++i) {
+    char c = f[i];
+    if (c == 'D' || c == 'd') c = 'E';
+    if (!((c >= '0' && c <= '9') || c == '.' || c == '+' || c == '-' || c == 'E' || c == 'e')) ok = false;
+    s[k++] = c;
+  }
+  s[k] = '\0';
+  char *end = NULL;
+  double x = NAN;
+  if (ok) {
+    /* uselocale is per thread: "C" numbers whatever the process locale. */
+    const locale_t old = uselocale(L->c_numeric);
+    x = strtod(s, &end);
+    uselocale(old);
+  }
+  if (!ok || end != s + k || !isfinite(x)) {
+    char sh[64];
+    shown(f + a, sh, sizeof sh);
+    sh[b - a < (int)sizeof sh ? b - a : (int)sizeof sh - 1] = '\0';
+    return lfail(L, NAV_ERR_PARSE, col + a, "%s: \"%s\" is not a number; expected a finite number in columns %d-%d",
+                 what, sh, col, col + w - 1);
+  }
+  *v = x;
+  return NAV_OK;
+}
+
+/* An integer field in [lo, hi]. */
+static nav_status inum(lines *L, int col, int w, const char *what, int lo, int hi, int *v) {
+  double x = 0.0;
+  nav_status st = num(L, col, w, what, &x, NULL);
+  if (st != NAV_OK) return st;
+  if (x != floor(x) || x < lo || x > hi)
+    return lfail(L, NAV_ERR_PARSE, col, "%s: %.17g; expected an integer in [%d, %d] in columns %d-%d", what, x, lo,
+                 hi, col, col + w - 1);
+  *v = (int)x;
+  return NAV_OK;
+}
+
+/* The header label of the line (columns 61-80, trailing blanks dropped). */
+static void label_of(const lines *L, char *dst) {
+  field(L, 61, 20, dst);
+  for (int i = 19; i >= 0 && dst[i] == ' '; --i) dst[i] = '\0';
+}
+
+/* Civil epoch "yyyy mm dd hh mm ss.s" fields to GPS time, checked. cols: year, month, day, hour,
+ * minute (integer fields) and second (real). */
+static nav_status epoch_fields(lines *L, const int col[6], const int w[6], double *t_gps) {
+  static const char *const names[6] = {"year", "month", "day", "hour", "minute", "second"};
+  static const int lo[5] = {1980, 1, 1, 0, 0}, hi[5] = {2200, 12, 31, 23, 59};
+  int v[5];
+  for (int i = 0; i < 5; ++i) {
+    nav_status st = inum(L, col[i], w[i], names[i], lo[i], hi[i], &v[i]);
+    if (st != NAV_OK) return st;
+  }
+  double sec = 0.0;
+  nav_status st = num(L, col[5], w[5], "second", &sec, NULL);
+  if (st != NAV_OK) return st;
+  if (!(sec >= 0.0 && sec < 61.0))
+    return lfail(L, NAV_ERR_PARSE, col[5], "second: %.17g; expected 0 <= second < 61", sec);
+  static const int mdays[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (v[2] > mdays[v[1] - 1])
+    return lfail(L, NAV_ERR_PARSE, col[2], "day: %d; month %d has at most %d days", v[2], v[1], mdays[v[1] - 1]);
+  *t_gps = nav_gnss_gps_time_s(v[0], v[1], v[2], v[3], v[4], sec);
+  return NAV_OK;
+}
+
+/* The version line (first line of both file kinds): F9.2 version, file type at column 21,
+ * system at column 41. */
+static nav_status version_line(lines *L, char want_type, double *version, char *system) {
+  bool got = false;
+  nav_status st = next_line(L, &got);
+  if (st != NAV_OK) return st;
+  if (!got) {
+    L->line = 1;
+    return lfail(L, NAV_ERR_PARSE, 1, "empty file; expected a RINEX 3 header starting with RINEX VERSION / TYPE");
+  }
+  char lab[21];
+  label_of(L, lab);
+  if (strcmp(lab, "RINEX VERSION / TYPE") != 0)
+    return lfail(L, NAV_ERR_PARSE, 61, "first line: label \"%s\"; expected RINEX VERSION / TYPE in columns 61-80",
+                 lab);
+  st = num(L, 1, 9, "RINEX version", version, NULL);
+  if (st != NAV_OK) return st;
+  if (!(*version >= 3.0 && *version < 4.0))
+    return lfail(L, NAV_ERR_PARSE, 1, "RINEX version %.2f; expected 3.00 to 3.05 (RINEX 3)", *version);
+  char t[2];
+  field(L, 21, 1, t);
+  if (t[0] != want_type)
+    return lfail(L, NAV_ERR_PARSE, 21, "file type '%c'; expected '%c' (%s file) in column 21", t[0] == ' ' ? '?' : t[0],
+                 want_type, want_type == 'O' ? "observation" : "navigation");
+  field(L, 41, 1, t);
+  *system = t[0] == ' ' ? 'G' : t[0];
+  return NAV_OK;
+}
+
+static int sys_index(char c) {
+  return c == 'G' ? NAV_GNSS_SYS_GPS : c == 'R' ? NAV_GNSS_SYS_GLONASS : -1;
+}
+
+static bool known_sys(char c) {
+  return c == 'G' || c == 'R' || c == 'E' || c == 'C' || c == 'J' || c == 'I' || c == 'S';
+}
+
+/* ---------------------------------------------------------------- observation files */
+
+struct nav_rinex_obs_reader {
+  lines L;
+  nav_rinex_obs_header h;
+  double t_prev;
+  bool have_prev;
+  long events;
+};
+
+static nav_status obs_header(nav_rinex_obs_reader *r) {
+  lines *L = &r->L;
+  nav_rinex_obs_header *h = &r->h;
+  memset(h, 0, sizeof *h);
+  for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) h->idx_c1c[s] = h->idx_d1c[s] = h->idx_s1c[s] = -1;
+  nav_status st = version_line(L, 'O', &h->version, &h->system);
+  if (st != NAV_OK) return st;
+  int pending_sys = -2, pending_left = 0; /* SYS / # / OBS TYPES continuation */
+  int glo_left = -1;                      /* GLONASS SLOT / FRQ # entries still expected */
+  char time_sys[4] = "";
+  for (;;) {
+    bool got = false;
+    st = next_line(L, &got);
+    if (st != NAV_OK) return st;
+    if (!got) {
+      ++L->line;
+      return lfail(L, NAV_ERR_PARSE, 1, "end of file inside the header; expected END OF HEADER");
+    }
+    char lab[21];
+    label_of(L, lab);
+    if (strcmp(lab, "END OF HEADER") == 0) break;
+    if (strcmp(lab, "SYS / # / OBS TYPES") == 0) {
+      char c[2];
+      field(L, 1, 1, c);
+      int idx = 0, count = 0;
+      if (c[0] == ' ') {
+        if (pending_left <= 0)
+          return lfail(L, NAV_ERR_PARSE, 1,
+                       "SYS / # / OBS TYPES continuation line without a preceding record; expected a "
+                       "system letter (G, R, E, C, J, I, S) in column 1");
+        idx = pending_sys;
+        count = pending_left;
+      } else {
+        if (pending_left > 0)
+          return lfail(L, NAV_ERR_PARSE, 1,
+                       "%d observation type(s) of the previous system still missing; expected a continuation "
+                       "line (blank column 1)",
+                       pending_left);
+        if (!known_sys(c[0]))
+          return lfail(L, NAV_ERR_PARSE, 1, "satellite system '%c'; expected G, R, E, C, J, I or S",
+                       (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+        st = inum(L, 4, 3, "number of observation types", 1, 999, &count);
+        if (st != NAV_OK) return st;
+        idx = sys_index(c[0]);
+        if (idx < 0) {
+          h->skipped_systems++;
+          idx = -1;
+        } else {
+          if (h->n_types[idx] > 0)
+            return lfail(L, NAV_ERR_PARSE, 1, "second SYS / # / OBS TYPES record of system %c; expected one", c[0]);
+          if (count > NAV_RINEX_MAX_TYPES)
+            return lfail(L, NAV_ERR_PARSE, 4, "%d observation types; at most %d are supported", count,
+                         NAV_RINEX_MAX_TYPES);
+        }
+      }
+      const int on_line = count < 13 ? count : 13;
+      for (int k = 0; k < on_line; ++k) {
+        char t[4];
+        field(L, 8 + 4 * k, 3, t);
+        if (t[0] < 'A' || t[0] > 'Z' || t[1] < '0' || t[1] > '9' || t[2] == ' ')
+          return lfail(L, NAV_ERR_PARSE, 8 + 4 * k,
+                       "observation type \"%c%c%c\"; expected a RINEX 3 type such as C1C (type, band, attribute)",
+                       (unsigned char)t[0] < 0x20 ? '?' : t[0], (unsigned char)t[1] < 0x20 ? '?' : t[1],
+                       (unsigned char)t[2] < 0x20 ? '?' : t[2]);
+        if (idx >= 0) {
+          const int j = h->n_types[idx]++;
+          memcpy(h->types[idx][j], t, 4);
+          if (strcmp(t, "C1C") == 0) h->idx_c1c[idx] = j;
+          if (strcmp(t, "D1C") == 0) h->idx_d1c[idx] = j;
+          if (strcmp(t, "S1C") == 0) h->idx_s1c[idx] = j;
+        }
+      }
+      pending_sys = idx;
+      pending_left = count - on_line;
+      continue;
+    }
+    if (pending_left > 0)
+      return lfail(L, NAV_ERR_PARSE, 61,
+                   "label \"%s\" while %d observation type(s) are still missing; expected a SYS / # / OBS TYPES "
+                   "continuation line",
+                   lab, pending_left);
+    if (strcmp(lab, "MARKER NAME") == 0) {
+      field(L, 1, 60, h->marker);
+      for (int i = 59; i >= 0 && h->marker[i] == ' '; --i) h->marker[i] = '\0';
+    } else if (strcmp(lab, "APPROX POSITION XYZ") == 0) {
+      double x[3];
+      for (int i = 0; i < 3; ++i) {
+        st = num(L, 1 + 14 * i, 14, "approximate position", &x[i], NULL);
+        if (st != NAV_OK) return st;
+      }
+      h->has_approx_pos = true;
+      h->approx_pos_e_m = nav_vec3_make(x[0], x[1], x[2]);
+    } else if (strcmp(lab, "ANTENNA: DELTA H/E/N") == 0) {
+      double x[3];
+      for (int i = 0; i < 3; ++i) {
+        st = num(L, 1 + 14 * i, 14, "antenna delta", &x[i], NULL);
+        if (st != NAV_OK) return st;
+      }
+      h->antenna_hen_m = nav_vec3_make(x[0], x[1], x[2]);
+    } else if (strcmp(lab, "INTERVAL") == 0) {
+      st = num(L, 1, 10, "interval", &h->interval_s, NULL);
+      if (st != NAV_OK) return st;
+      if (!(h->interval_s > 0.0)) return lfail(L, NAV_ERR_PARSE, 1, "interval %.17g s; expected > 0", h->interval_s);
+      h->has_interval = true;
+    } else if (strcmp(lab, "TIME OF FIRST OBS") == 0) {
+      static const int col[6] = {1, 7, 13, 19, 25, 31}, w[6] = {6, 6, 6, 6, 6, 13};
+      st = epoch_fields(L, col, w, &h->t_first_gps_s);
+      if (st != NAV_OK) return st;
+      field(L, 49, 3, time_sys);
+      h->has_first = true;
+      if (!(all_blank(time_sys) || strcmp(time_sys, "GPS") == 0))
+        return lfail(L, NAV_ERR_PARSE, 49,
+                     "time system \"%s\"; only GPS time is supported (expected GPS, or blank in a GPS file)",
+                     time_sys);
+      if (all_blank(time_sys) && h->system != 'G')
+        return lfail(L, NAV_ERR_PARSE, 49,
+                     "blank time system in a file of system %c; expected GPS in columns 49-51 (only GPS time is "
+                     "supported)",
+                     h->system);
+    } else if (strcmp(lab, "GLONASS SLOT / FRQ #") == 0) {
+      int n = 0;
+      if (glo_left < 0) {
+        st = inum(L, 1, 3, "number of GLONASS satellites", 0, 99, &n);
+        if (st != NAV_OK) return st;
+        glo_left = n;
+      } else {
+        char c[4];
+        field(L, 1, 3, c);
+        if (!all_blank(c))
+          return lfail(L, NAV_ERR_PARSE, 1, "second GLONASS SLOT / FRQ # record; expected a continuation line "
+                                            "(blank columns 1-3)");
+      }
+      for (int k = 0; k < 8 && glo_left > 0; ++k, --glo_left) {
+        char c[4];
+        field(L, 5 + 7 * k, 3, c);
+        int slot = 0, fk = 0;
+        if (c[0] != 'R')
+          return lfail(L, NAV_ERR_PARSE, 5 + 7 * k, "GLONASS SLOT / FRQ #: \"%c\"; expected R and the slot (Rnn)",
+                       (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+        st = inum(L, 6 + 7 * k, 2, "GLONASS slot", 1, 24, &slot);
+        if (st == NAV_OK) st = inum(L, 9 + 7 * k, 2, "GLONASS frequency number", -7, 13, &fk);
+        if (st != NAV_OK) return st;
+        h->glo_has_k[slot] = true;
+        h->glo_k[slot] = fk;
+      }
+    }
+    /* Other labels are not needed for the replay. */
+  }
+  if (pending_left > 0)
+    return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d observation type(s) are missing", pending_left);
+  if (h->n_types[0] == 0 && h->n_types[1] == 0 && h->skipped_systems == 0)
+    return lfail(L, NAV_ERR_PARSE, 1, "the header has no SYS / # / OBS TYPES record; expected one per system");
+  if (!h->has_first && h->system != 'G')
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "no TIME OF FIRST OBS in a file of system %c; expected it with time system GPS", h->system);
+  return NAV_OK;
+}
+
+static nav_status obs_open(const char *path, const char *text, size_t len, const char *name,
+                           nav_rinex_obs_reader **out, nav_diag *diag) {
+  if (!out || (!path && !text && len > 0)) return NAV_ERR_INVALID_ARG;
+  nav_rinex_obs_reader *r = calloc(1, sizeof *r);
+  if (!r) return NAV_ERR_NO_MEMORY;
+  nav_status st = lines_init(&r->L, path, text, len, name, diag);
+  if (st == NAV_OK) {
+    st = obs_header(r);
+    if (st != NAV_OK && diag) *diag = r->L.diag;
+  }
+  if (st != NAV_OK) {
+    lines_close(&r->L);
+    free(r);
+    return st;
+  }
+  r->L.failed = NAV_OK;
+  *out = r;
+  return NAV_OK;
+}
+
+nav_status nav_rinex_obs_open(const char *path, nav_rinex_obs_reader **out, nav_diag *diag) {
+  if (!path) return NAV_ERR_INVALID_ARG;
+  return obs_open(path, NULL, 0, path, out, diag);
+}
+
+nav_status nav_rinex_obs_open_memory(const char *text, size_t len, const char *display_name,
+                                     nav_rinex_obs_reader **out, nav_diag *diag) {
+  return obs_open(NULL, text ? text : "", text ? len : 0, display_name ? display_name : "memory", out, diag);
+}
+
+void nav_rinex_obs_destroy(nav_rinex_obs_reader *r) {
+  if (!r) return;
+  lines_close(&r->L);
+  free(r);
+}
+
+const nav_rinex_obs_header *nav_rinex_obs_get_header(const nav_rinex_obs_reader *r) { return r ? &r->h : NULL; }
+const nav_diag *nav_rinex_obs_diag(const nav_rinex_obs_reader *r) { return r ? &r->L.diag : NULL; }
+long nav_rinex_obs_events(const nav_rinex_obs_reader *r) { return r ? r->events : 0; }
+double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r) {
+  if (!r || r->L.file_size <= 0) return 1.0;
+  const double f = (double)r->L.consumed / (double)r->L.file_size;
+  return f > 1.0 ? 1.0 : f;
+}
+
+/* One observation record line of an epoch: satellite in columns 1-3, then 16 columns per type
+ * (F14.3, LLI, signal strength). */
+static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep) {
+  lines *L = &r->L;
+  char c[4];
+  field(L, 1, 3, c);
+  if (c[0] == '>')
+    return lfail(L, NAV_ERR_PARSE, 1, "an epoch record where a satellite's observations were expected (the "
+                                      "previous epoch announced more satellites)");
+  if (!known_sys(c[0]))
+    return lfail(L, NAV_ERR_PARSE, 1, "satellite system '%c'; expected G, R, E, C, J, I or S and a number (e.g. G05)",
+                 (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+  int prn = 0;
+  nav_status st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
+  if (st != NAV_OK) return st;
+  const int s = sys_index(c[0]);
+  if (s < 0) {
+    ep->skipped++;
+    return NAV_OK;
+  }
+  if (r->h.n_types[s] == 0)
+    return lfail(L, NAV_ERR_PARSE, 1, "satellite %s of a system without SYS / # / OBS TYPES in the header", c);
+  if (s == NAV_GNSS_SYS_GLONASS && prn > 24)
+    return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
+  if (s == NAV_GNSS_SYS_GPS && prn > 32) return lfail(L, NAV_ERR_PARSE, 2, "GPS PRN %d; expected 1..32", prn);
+  for (int k = 0; k < ep->n; ++k)
+    if ((int)ep->sats[k].system == s && ep->sats[k].prn == prn)
+      return lfail(L, NAV_ERR_PARSE, 1, "satellite %s twice in one epoch; expected each once", c);
+  if (ep->n >= NAV_RINEX_MAX_EPOCH_SATS)
+    return lfail(L, NAV_ERR_PARSE, 1, "more than %d GPS and GLONASS satellites in one epoch",
+                 NAV_RINEX_MAX_EPOCH_SATS);
+  nav_rinex_obs_sat *o = &ep->sats[ep->n];
+  memset(o, 0, sizeof *o);
+  o->system = (nav_gnss_system)s;
+  o->prn = prn;
+  const int want[3] = {r->h.idx_c1c[s], r->h.idx_d1c[s], r->h.idx_s1c[s]};
+  static const char *const names[3] = {"C1C pseudorange", "D1C Doppler", "S1C signal strength"};
+  bool *has[3] = {&o->has_c1c, &o->has_d1c, &o->has_s1c};
+  double *val[3] = {&o->c1c_m, &o->d1c_hz, &o->s1c_dbhz};
+  for (int i = 0; i < 3; ++i) {
+    if (want[i] < 0) continue;
+    bool blank = false;
+    st = num(L, 4 + 16 * want[i], 14, names[i], val[i], &blank);
+    if (st != NAV_OK) return st;
+    *has[i] = !blank;
+  }
+  if (o->has_c1c && !(o->c1c_m > 1.0e6 && o->c1c_m < 1.0e8))
+    return lfail(L, NAV_ERR_PARSE, 4 + 16 * want[0],
+                 "C1C pseudorange %.3f m; expected 1e6 to 1e8 m (a satellite range plus a receiver clock bias)",
+                 o->c1c_m);
+  if (o->has_d1c && !(fabs(o->d1c_hz) < 1.0e6))
+    return lfail(L, NAV_ERR_PARSE, 4 + 16 * want[1], "D1C Doppler %.3f Hz; expected |D| < 1e6 Hz", o->d1c_hz);
+  ep->n++;
+  return NAV_OK;
+}
+
+nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out, bool *got) {
+  if (!r || !out || !got) return NAV_ERR_INVALID_ARG;
+  *got = false;
+  lines *L = &r->L;
+  if (L->failed != NAV_OK) return L->failed;
+  for (;;) {
+    bool have = false;
+    nav_status st = next_line(L, &have);
+    if (st != NAV_OK) return st;
+    if (!have) return NAV_OK;
+    if (L->n == 0) continue; /* a blank line between records */
+    if (L->buf[0] != '>')
+      return lfail(L, NAV_ERR_PARSE, 1, "expected an epoch record starting with '>' (RINEX 3 observation data)");
+    /* '>' yyyy mm dd hh mm ss.sssssss  flag numsat  (reserved)  rx clock offset:
+     * A1,1X,I4,4(1X,I2),F11.7,2X,I1,I3,6X,F15.12 */
+    int flag = 0, nsat = 0;
+    st = inum(L, 32, 1, "epoch flag", 0, 6, &flag);
+    if (st == NAV_OK) st = inum(L, 33, 3, "number of satellites", 0, 999, &nsat);
+    if (st != NAV_OK) return st;
+    if (flag >= 2 && flag <= 5) {
+      /* Events: nsat special records follow (header lines or nothing). */
+      r->events++;
+      for (int k = 0; k < nsat; ++k) {
+        st = next_line(L, &have);
+        if (st != NAV_OK) return st;
+        if (!have) {
+          ++L->line;
+          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside an event record (flag %d announced %d lines)", flag,
+                       nsat);
+        }
+      }
+      continue;
+    }
+    static const int col[6] = {3, 8, 11, 14, 17, 19}, w[6] = {4, 2, 2, 2, 2, 11};
+    double t = 0.0;
+    st = epoch_fields(L, col, w, &t);
+    if (st != NAV_OK) return st;
+    nav_rinex_obs_epoch *ep = out;
+    const long epoch_line = L->line;
+    double clk = 0.0;
+    bool clk_blank = true;
+    st = num(L, 42, 15, "receiver clock offset", &clk, &clk_blank);
+    if (st != NAV_OK) return st;
+    if (flag == 6) r->events++;
+    if (flag <= 1) {
+      if (r->have_prev && t < r->t_prev)
+        return lfail(L, NAV_ERR_PARSE, 3, "epoch %.7f s GPS is before the previous epoch (%.7f s); expected "
+                                          "epochs in time order",
+                     t, r->t_prev);
+      ep->t_gps_s = t;
+      ep->flag = flag;
+      ep->has_rx_clock = !clk_blank;
+      ep->rx_clock_s = clk;
+      ep->n = 0;
+      ep->skipped = 0;
+      ep->line = epoch_line;
+    }
+    nav_rinex_obs_epoch scratch;
+    nav_rinex_obs_epoch *dst = flag <= 1 ? ep : &scratch;
+    if (flag == 6) {
+      scratch.n = 0;
+      scratch.skipped = 0;
+    }
+    for (int k = 0; k < nsat; ++k) {
+      st = next_line(L, &have);
+      if (st != NAV_OK) return st;
+      if (!have) {
+        ++L->line;
+        return lfail(L, NAV_ERR_PARSE, 1,
+                     "end of file inside the epoch record of line %ld, which announced %d satellites; got %d",
+                     epoch_line, nsat, k);
+      }
+      st = obs_sat_line(r, dst);
+      if (st != NAV_OK) return st;
+    }
+    if (flag == 6) continue;
+    r->t_prev = t;
+    r->have_prev = true;
+    *got = true;
+    return NAV_OK;
+  }
+}
+
+/* ---------------------------------------------------------------- navigation files */
+
+/* The broadcast-orbit fields of a record line: 4 x D19.12 starting at column 5. */
+static nav_status orbit_line(lines *L, int which, double v[4], int n_required) {
+  bool got = false;
+  nav_status st = next_line(L, &got);
+  if (st != NAV_OK) return st;
+  if (!got) {
+    ++L->line;
+    return lfail(L, NAV_ERR_PARSE, 1, "end of file inside a navigation record; expected BROADCAST ORBIT - %d", which);
+  }
+  char buf[48];
+  for (int i = 0; i < 4; ++i) {
+    snprintf(buf, sizeof buf, "BROADCAST ORBIT - %d, field %d", which, i + 1);
+    bool blank = false;
+    st = num(L, 5 + 19 * i, 19, buf, &v[i], &blank);
+    if (st != NAV_OK) return st;
+    if (blank && i < n_required)
+      return lfail(L, NAV_ERR_PARSE, 5 + 19 * i, "%s: blank; expected a number in columns %d-%d", buf, 5 + 19 * i,
+                   23 + 19 * i);
+  }
+  return NAV_OK;
+}
+
+static nav_status nav_grow(lines *L, void **arr, size_t *cap, size_t n, size_t size) {
+  if (n < *cap) return NAV_OK;
+  size_t nc = *cap ? 2 * *cap : 64;
+  if (nc > NAV_RINEX_MAX_EPHEMERIDES) nc = NAV_RINEX_MAX_EPHEMERIDES;
+  if (n >= nc)
+    return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
+                 NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
+  void *p = realloc(*arr, nc * size);
+  if (!p) return lfail(L, NAV_ERR_NO_MEMORY, 1, "out of memory");
+  *arr = p;
+  *cap = nc;
+  return NAV_OK;
+}
+
+static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
+  char system = 'G';
+  nav_status st = version_line(L, 'N', &nv->version, &system);
+  if (st != NAV_OK) return st;
+  nv->leap_s = 18;
+  for (;;) {
+    bool got = false;
+    st = next_line(L, &got);
+    if (st != NAV_OK) return st;
+    if (!got) {
+      ++L->line;
+      return lfail(L, NAV_ERR_PARSE, 1, "end of file inside the header; expected END OF HEADER");
+    }
+    char lab[21];
+    label_of(L, lab);
+    if (strcmp(lab, "END OF HEADER") == 0) break;
+    if (strcmp(lab, "LEAP SECONDS") == 0) {
+      st = inum(L, 1, 6, "leap seconds", 0, 99, &nv->leap_s);
+      if (st != NAV_OK) return st;
+      nv->has_leap = true;
+    }
+  }
+  size_t cap_g = 0, cap_r = 0;
+  const size_t max_total = NAV_RINEX_MAX_EPHEMERIDES;
+  for (;;) {
+    bool got = false;
+    st = next_line(L, &got);
+    if (st != NAV_OK) return st;
+    if (!got) break;
+    if (L->n == 0) continue;
+    char c[4];
+    field(L, 1, 3, c);
+    const long line0 = L->line;
+    int prn = 0;
+    if (!known_sys(c[0]))
+      return lfail(L, NAV_ERR_PARSE, 1,
+                   "satellite system '%c'; expected the first line of a navigation record (G, R, E, C, J, I or S "
+                   "and the satellite number)",
+                   (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+    st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
+    if (st != NAV_OK) return st;
+    if (nv->n_gps + nv->n_glo >= max_total)
+      return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
+                   NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
+    static const int col[6] = {5, 10, 13, 16, 19, 22}, w[6] = {4, 2, 2, 2, 2, 2};
+    if (c[0] != 'G' && c[0] != 'R') {
+      /* Other systems: 8 lines (Galileo, BeiDou, QZSS, IRNSS), 4 (SBAS). */
+      const int more = c[0] == 'S' ? 3 : 7;
+      for (int k = 0; k < more; ++k) {
+        st = next_line(L, &got);
+        if (st != NAV_OK) return st;
+        if (!got) {
+          ++L->line;
+          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside the %c%02d navigation record of line %ld", c[0], prn,
+                       line0);
+        }
+      }
+      nv->skipped++;
+      continue;
+    }
+    double t_rec = 0.0, clk[3];
+    st = epoch_fields(L, col, w, &t_rec);
+    for (int i = 0; i < 3 && st == NAV_OK; ++i) {
+      static const char *const nm[2][3] = {{"SV clock bias af0", "SV clock drift af1", "SV clock drift rate af2"},
+                                           {"-TauN", "+GammaN", "message frame time"}};
+      st = num(L, 24 + 19 * i, 19, nm[c[0] == 'R'][i], &clk[i], NULL);
+    }
+    if (st != NAV_OK) return st;
+    if (c[0] == 'G') {
+      if (prn > 32) return lfail(L, NAV_ERR_PARSE, 2, "GPS PRN %d; expected 1..32", prn);
+      double o[7][4];
+      for (int k = 0; k < 7 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], k < 6 ? 4 : 1);
+      if (st != NAV_OK) return st;
+      st = nav_grow(L, (void **)&nv->gps, &cap_g, nv->n_gps, sizeof *nv->gps);
+      if (st != NAV_OK) return st;
+      nav_rinex_gps_eph *e = &nv->gps[nv->n_gps];
+      memset(e, 0, sizeof *e);
+      e->prn = prn;
+      e->line = line0;
+      e->toc_gps_s = t_rec;
+      e->af0_s = clk[0];
+      e->af1_sps = clk[1];
+      e->af2_sps2 = clk[2];
+      e->iode = o[0][0];
+      e->crs_m = o[0][1];
+      e->delta_n_rps = o[0][2];
+      e->m0_rad = o[0][3];
+      e->cuc_rad = o[1][0];
+      e->e = o[1][1];
+      e->cus_rad = o[1][2];
+      e->sqrt_a_sqrtm = o[1][3];
+      e->toe_sow_s = o[2][0];
+      e->cic_rad = o[2][1];
+      e->omega0_rad = o[2][2];
+      e->cis_rad = o[2][3];
+      e->i0_rad = o[3][0];
+      e->crc_m = o[3][1];
+      e->w_rad = o[3][2];
+      e->omega_dot_rps = o[3][3];
+      e->idot_rps = o[4][0];
+      e->accuracy_m = o[5][0];
+      e->health = (int)o[5][1];
+      e->tgd_s = o[5][2];
+      e->iodc = o[5][3];
+      /* Line-relative checks: the line of each field is the record's first line + k. */
+      const long last = L->line;
+      if (!(e->e >= 0.0 && e->e < 1.0)) {
+        L->line = line0 + 2;
+        st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.17g; expected 0 <= e < 1", e->e);
+      } else if (!(e->sqrt_a_sqrtm > 1000.0 && e->sqrt_a_sqrtm < 10000.0)) {
+        L->line = line0 + 2;
+        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.17g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)",
+                   e->sqrt_a_sqrtm);
+      } else if (!(e->toe_sow_s >= 0.0 && e->toe_sow_s < NAV_GNSS_WEEK_S)) {
+        L->line = line0 + 3;
+        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.17g s; expected seconds of the GPS week, 0 <= toe < 604800",
+                   e->toe_sow_s);
+      } else if (!(o[4][2] == floor(o[4][2]) && o[4][2] >= 0.0 && o[4][2] < 1.0e5)) {
+        L->line = line0 + 5;
+        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.17g; expected a non-negative integer (continuous week number)",
+                   o[4][2]);
+      } else if (!(o[5][1] == floor(o[5][1]) && o[5][1] >= 0.0 && o[5][1] < 64.0)) {
+        L->line = line0 + 6;
+        st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.17g; expected an integer 0..63", o[5][1]);
+      }
+      if (st != NAV_OK) return st;
+      L->line = last;
+      e->week = (int)o[4][2];
+      /* The week of toe; toc and toe normally share it, but a toe near the week's start may
+       * belong to the next week of toc (IS-GPS-200N 20.3.4.3): take the week that puts toe
+       * closest to toc. */
+      double toe = (double)e->week * NAV_GNSS_WEEK_S + e->toe_sow_s;
+      if (toe - e->toc_gps_s > 0.5 * NAV_GNSS_WEEK_S) toe -= NAV_GNSS_WEEK_S;
+      if (e->toc_gps_s - toe > 0.5 * NAV_GNSS_WEEK_S) toe += NAV_GNSS_WEEK_S;
+      e->toe_gps_s = toe;
+      nv->n_gps++;
+    } else {
+      if (prn > 24) return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
+      double o[4][4];
+      for (int k = 0; k < 3 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], 4);
+      if (st == NAV_OK && nv->version >= 3.045) st = orbit_line(L, 4, o[3], 0);
+      if (st != NAV_OK) return st;
+      st = nav_grow(L, (void **)&nv->glo, &cap_r, nv->n_glo, sizeof *nv->glo);
+      if (st != NAV_OK) return st;
+      nav_rinex_glo_eph *e = &nv->glo[nv->n_glo];
+      memset(e, 0, sizeof *e);
+      e->slot = prn;
+      e->line = line0;
+      /* The record's epoch is UTC (RINEX 3.04 Table A10): GPS = UTC + leap seconds. */
+      e->tb_gps_s = t_rec + (double)nv->leap_s;
+      e->tau_n_s = -clk[0];
+      e->gamma_n = clk[1];
+      e->tk_s = clk[2];
+      /* km, km/s, km/s^2 in the file. */
+      e->r_m = nav_vec3_make(1e3 * o[0][0], 1e3 * o[1][0], 1e3 * o[2][0]);
+      e->v_mps = nav_vec3_make(1e3 * o[0][1], 1e3 * o[1][1], 1e3 * o[2][1]);
+      e->a_mps2 = nav_vec3_make(1e3 * o[0][2], 1e3 * o[1][2], 1e3 * o[2][2]);
+      e->health = (int)o[0][3];
+      e->age_days = o[2][3];
+      const long last = L->line;
+      if (!(o[1][3] == floor(o[1][3]) && o[1][3] >= -7.0 && o[1][3] <= 13.0)) {
+        L->line = line0 + 2;
+        st = lfail(L, NAV_ERR_PARSE, 62, "frequency number %.17g; expected an integer -7..13", o[1][3]);
+      } else if (!(nav_vec3_norm(e->r_m) > 1.0e7 && nav_vec3_norm(e->r_m) < 1.0e8)) {
+        L->line = line0 + 1;
+        st = lfail(L, NAV_ERR_PARSE, 5, "satellite position of %.6g km from the Earth's centre; expected 10 000 "
+                                        "to 100 000 km (a GLONASS orbit: 25 500 km)",
+                   1e-3 * nav_vec3_norm(e->r_m));
+      }
+      if (st != NAV_OK) return st;
+      L->line = last;
+      e->freq_k = (int)o[1][3];
+      nv->n_glo++;
+    }
+  }
+  return NAV_OK;
+}
+
+static nav_status nav_read(const char *path, const char *text, size_t len, const char *name, nav_rinex_nav **out,
+                           nav_diag *diag) {
+  if (!out) return NAV_ERR_INVALID_ARG;
+  lines *L = malloc(sizeof *L);
+  nav_rinex_nav *nv = calloc(1, sizeof *nv);
+  nav_status st = (L && nv) ? NAV_OK : NAV_ERR_NO_MEMORY;
+  if (st == NAV_OK) st = lines_init(L, path, text, len, name, diag);
+  if (st == NAV_OK) {
+    st = nav_parse(L, nv);
+    if (st != NAV_OK && diag) *diag = L->diag;
+  }
+  if (L) lines_close(L);
+  free(L);
+  if (st != NAV_OK) {
+    nav_rinex_nav_destroy(nv);
+    return st;
+  }
+  *out = nv;
+  return NAV_OK;
+}
+
+nav_status nav_rinex_nav_read(const char *path, nav_rinex_nav **out, nav_diag *diag) {
+  if (!path) return NAV_ERR_INVALID_ARG;
+  return nav_read(path, NULL, 0, path, out, diag);
+}
+
+nav_status nav_rinex_nav_read_memory(const char *text, size_t len, const char *display_name, nav_rinex_nav **out,
+                                     nav_diag *diag) {
+  return nav_read(NULL, text ? text : "", text ? len : 0, display_name ? display_name : "memory", out, diag);
+}
+
+void nav_rinex_nav_destroy(nav_rinex_nav *n) {
+  if (!n) return;
+  free(n->gps);
+  free(n->glo);
+  free(n);
+}
+
+nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmonics) {
+  nav_gnss_orbit o;
+  memset(&o, 0, sizeof o);
+  o.system = NAV_GNSS_SYS_GPS;
+  o.prn = e->prn;
+  o.health = e->health;
+  o.toe_s = e->toe_gps_s;
+  o.sqrt_a_sqrtm = e->sqrt_a_sqrtm;
+  o.e = e->e;
+  o.i0_rad = e->i0_rad;
+  o.idot_rps = e->idot_rps;
+  o.omega0_rad = e->omega0_rad;
+  o.omega_dot_rps = e->omega_dot_rps;
+  o.w_rad = e->w_rad;
+  o.m0_rad = e->m0_rad;
+  o.delta_n_rps = e->delta_n_rps;
+  o.af0_s = e->af0_s;
+  o.af1_sps = e->af1_sps;
+  if (has_harmonics)
+    *has_harmonics = e->crs_m != 0.0 || e->crc_m != 0.0 || e->cus_rad != 0.0 || e->cuc_rad != 0.0 ||
+                     e->cis_rad != 0.0 || e->cic_rad != 0.0;
+  return o;
+}
+
+double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s) {
+  /* IS-GPS-200N 20.3.3.3.3.1 and 20.3.3.3.3.2: dt_sv = af0 + af1 dt + af2 dt^2 + dt_r - T_GD,
+   * dt_r = F e sqrt(A) sin E_k, F = -2 sqrt(mu) / c^2. */
+  const double dt = t_gps_s - e->toc_gps_s;
+  const double A = e->sqrt_a_sqrtm * e->sqrt_a_sqrtm;
+  const double n = sqrt(NAV_GPS_MU_M3PS2 / (A * A * A)) + e->delta_n_rps;
+  const double Mk = e->m0_rad + n * (t_gps_s - e->toe_gps_s);
+  double E = Mk;
+  for (int it = 0; it < 30; ++it) {
+    const double dE = (Mk - E + e->e * sin(E)) / (1.0 - e->e * cos(E));
+    E += dE;
+    if (fabs(dE) < 1e-15) break;
+  }
+  const double F = -4.442807633e-10; /* s/m^0.5, IS-GPS-200N 20.3.3.3.3.1 */
+  return e->af0_s + e->af1_sps * dt + e->af2_sps2 * dt * dt + F * e->e * e->sqrt_a_sqrtm * sin(E) - e->tgd_s;
+}
+
+/* ---------------------------------------------------------------- replay source */
+
+struct nav_rinex_source {
+  nav_rinex_source_config cfg;
+  char obs_name[512];
+  nav_rinex_obs_reader *obs;
+  nav_rinex_nav *nav;
+  nav_rinex_obs_epoch ep;
+  nav_gnss_orbit orbits[NAV_RINEX_MAX_EPOCH_SATS];
+  nav_ins_gnss_sat_meas meas[NAV_RINEX_MAX_EPOCH_SATS];
+  nav_rinex_source_counts counts;
+  char nav_name[512];
+};
+
+nav_rinex_source_config nav_rinex_source_config_default(void) {
+  nav_rinex_source_config c;
+  memset(&c, 0, sizeof c);
+  c.pr_sd_m = 3.0;
+  c.rr_sd_mps = 0.1;
+  c.max_eph_age_s = 7200.0;
+  c.use_doppler = true;
+  return c;
+}
+
+nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex_source **out, nav_diag *diag) {
+  if (!cfg || !out) return NAV_ERR_INVALID_ARG;
+  const char *bad = NULL;
+  if (!cfg->obs_path || !cfg->nav_path) bad = "an observation file and a navigation file are both required";
+  else if (!(cfg->pr_sd_m > 0.0 && isfinite(cfg->pr_sd_m))) bad = "the pseudorange sigma must be finite and > 0";
+  else if (!(cfg->rr_sd_mps > 0.0 && isfinite(cfg->rr_sd_mps))) bad = "the range-rate sigma must be finite and > 0";
+  else if (!(cfg->max_eph_age_s > 0.0 && isfinite(cfg->max_eph_age_s))) bad = "the ephemeris age must be > 0";
+  else if (!isfinite(cfg->t0_gps_s)) bad = "the GPS time of t = 0 must be finite";
+  if (bad) {
+    diag_set(diag, "replay", 0, 0, "%s", bad);
+    return NAV_ERR_INVALID_ARG;
+  }
+  nav_rinex_source *s = calloc(1, sizeof *s);
+  if (!s) return NAV_ERR_NO_MEMORY;
+  s->cfg = *cfg;
+  snprintf(s->nav_name, sizeof s->nav_name, "%s", cfg->nav_path);
+  snprintf(s->obs_name, sizeof s->obs_name, "%s", cfg->obs_path);
+  s->cfg.nav_path = s->nav_name;
+  s->cfg.obs_path = s->obs_name;
+  nav_status st = nav_rinex_nav_read(cfg->nav_path, &s->nav, diag);
+  if (st == NAV_OK) st = nav_rinex_obs_open(cfg->obs_path, &s->obs, diag);
+  if (st == NAV_OK && s->nav->n_gps == 0) {
+    diag_set(diag, cfg->nav_path, 0, 0, "no GPS navigation record; the replay needs GPS LNAV ephemerides");
+    st = NAV_ERR_PARSE;
+  }
+  if (st != NAV_OK) {
+    nav_rinex_source_destroy(s);
+    return st;
+  }
+  *out = s;
+  return NAV_OK;
+}
+
+void nav_rinex_source_destroy(nav_rinex_source *s) {
+  if (!s) return;
+  nav_rinex_obs_destroy(s->obs);
+  nav_rinex_nav_destroy(s->nav);
+  free(s);
+}
+
+nav_rinex_source_counts nav_rinex_source_get_counts(const nav_rinex_source *s) {
+  nav_rinex_source_counts c;
+  memset(&c, 0, sizeof c);
+  if (!s) return c;
+  c = s->counts;
+  c.events = nav_rinex_obs_events(s->obs);
+  return c;
+}
+
+double nav_rinex_source_fraction(const nav_rinex_source *s) { return s ? nav_rinex_obs_fraction(s->obs) : 1.0; }
+
+/* The GPS ephemeris of @p prn with toe nearest to @p t (ties: the later record), or NULL. */
+static const nav_rinex_gps_eph *gps_eph_for(const nav_rinex_nav *nv, int prn, double t) {
+  const nav_rinex_gps_eph *best = NULL;
+  for (size_t i = 0; i < nv->n_gps; ++i) {
+    const nav_rinex_gps_eph *e = &nv->gps[i];
+    if (e->prn != prn) continue;
+    if (!best || fabs(e->toe_gps_s - t) <= fabs(best->toe_gps_s - t)) best = e;
+  }
+  return best;
+}
+
+nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag) {
+  if (!s || !ep || !got) return NAV_ERR_INVALID_ARG;
+  *got = false;
+  bool have = false;
+  nav_status st = nav_rinex_obs_next(s->obs, &s->ep, &have);
+  if (st != NAV_OK) {
+    if (diag) *diag = *nav_rinex_obs_diag(s->obs);
+    return st;
+  }
+  if (!have) return NAV_OK;
+  const double t = s->ep.t_gps_s;
+  int m = 0;
+  s->counts.other_systems += s->ep.skipped;
+  for (int i = 0; i < s->ep.n; ++i) {
+    const nav_rinex_obs_sat *o = &s->ep.sats[i];
+    if (o->system == NAV_GNSS_SYS_GLONASS) {
+      s->counts.glonass_skipped++;
+      continue;
+    }
+    if (!o->has_c1c) {
+      s->counts.no_code++;
+      continue;
+    }
+    const nav_rinex_gps_eph *e = gps_eph_for(s->nav, o->prn, t);
+    if (!e || fabs(e->toe_gps_s - t) > s->cfg.max_eph_age_s) {
+      s->counts.no_ephemeris++;
+      continue;
+    }
+    if (e->health != 0) {
+      s->counts.unhealthy++;
+      continue;
+    }
+    bool harm = false;
+    s->orbits[m] = nav_rinex_gps_orbit(e, &harm);
+    if (harm) {
+      diag_set(diag, s->cfg.nav_path, (int)e->line, 1,
+               "G%02d: the ephemeris has harmonic corrections (C_rs ... C_is not all zero), which the replay's "
+               "orbit model (nav_gnss_orbit, almanac form) does not hold yet; expected zero corrections as navsim "
+               "writes them",
+               e->prn);
+      return NAV_ERR_PARSE;
+    }
+    /* The satellite clock correction of the transmit time (t - P/c), applied to the code. */
+    const double dt_sv = nav_rinex_gps_clock_s(e, t - o->c1c_m / NAV_GNSS_C_MPS);
+    nav_ins_gnss_sat_meas *x = &s->meas[m];
+    x->sat = &s->orbits[m];
+    x->has_pr = true;
+    x->pr_m = o->c1c_m + NAV_GNSS_C_MPS * dt_sv;
+    /* Range rate = -lambda D (D positive for an approaching satellite), with the satellite clock
+     * drift af1 removed as the code's bias is. */
+    x->has_rr = s->cfg.use_doppler && o->has_d1c;
+    x->rr_mps = x->has_rr ? -(NAV_GNSS_C_MPS / NAV_GPS_L1_HZ) * o->d1c_hz + NAV_GNSS_C_MPS * e->af1_sps : 0.0;
+    ++m;
+  }
+  s->counts.epochs++;
+  s->counts.sats_used += m;
+  ep->t_gps_s = t;
+  ep->t_s = t - s->cfg.t0_gps_s;
+  ep->n = m;
+  ep->sats = s->meas;
+  ep->pr_sd_m = s->cfg.pr_sd_m;
+  ep->rr_sd_mps = s->cfg.rr_sd_mps;
+  *got = true;
+  return NAV_OK;
+}
