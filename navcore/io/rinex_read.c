@@ -282,20 +282,31 @@ static bool known_sys(char c) {
 struct nav_rinex_obs_reader {
   lines L;
   nav_rinex_obs_header h;
+  nav_rinex_obs_info info;
+  /* Per system: the file's type count and, per file type, its kept index or -1. */
+  int n_file[NAV_GNSS_SYS_COUNT];
+  int keep[NAV_GNSS_SYS_COUNT][NAV_RINEX_MAX_FILE_TYPES];
   double t_prev;
   bool have_prev;
   long events;
 };
 
+/* The types the replay and its users need; the others are skipped. */
+static bool kept_type(const char *t) {
+  return strcmp(t, "C1C") == 0 || strcmp(t, "L1C") == 0 || strcmp(t, "D1C") == 0 || strcmp(t, "S1C") == 0;
+}
+
 static nav_status obs_header(nav_rinex_obs_reader *r) {
   lines *L = &r->L;
   nav_rinex_obs_header *h = &r->h;
+  nav_rinex_obs_info *in = &r->info;
   memset(h, 0, sizeof *h);
-  for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) h->idx_c1c[s] = h->idx_d1c[s] = h->idx_s1c[s] = -1;
-  nav_status st = version_line(L, 'O', &h->version, &h->system);
+  memset(in, 0, sizeof *in);
+  nav_status st = version_line(L, 'O', &in->version, &in->system);
   if (st != NAV_OK) return st;
   int pending_sys = -2, pending_left = 0; /* SYS / # / OBS TYPES continuation */
   int glo_left = -1;                      /* GLONASS SLOT / FRQ # entries still expected */
+  bool any_types = false;
   char time_sys[4] = "";
   for (;;) {
     bool got = false;
@@ -327,36 +338,39 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
                        pending_left);
         if (!known_sys(c[0]))
           return lfail(L, NAV_ERR_PARSE, 1, "satellite system '%c'; expected G, R, E, C, J, I or S",
-                       (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+                       (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
         st = inum(L, 4, 3, "number of observation types", 1, 999, &count);
         if (st != NAV_OK) return st;
+        any_types = true;
         idx = sys_index(c[0]);
         if (idx < 0) {
-          h->skipped_systems++;
-          idx = -1;
+          in->skipped_systems++;
         } else {
-          if (h->n_types[idx] > 0)
+          if (r->n_file[idx] > 0)
             return lfail(L, NAV_ERR_PARSE, 1, "second SYS / # / OBS TYPES record of system %c; expected one", c[0]);
-          if (count > NAV_RINEX_MAX_TYPES)
+          if (count > NAV_RINEX_MAX_FILE_TYPES)
             return lfail(L, NAV_ERR_PARSE, 4, "%d observation types; at most %d are supported", count,
-                         NAV_RINEX_MAX_TYPES);
+                         NAV_RINEX_MAX_FILE_TYPES);
         }
       }
       const int on_line = count < 13 ? count : 13;
       for (int k = 0; k < on_line; ++k) {
         char t[4];
         field(L, 8 + 4 * k, 3, t);
-        if (t[0] < 'A' || t[0] > 'Z' || t[1] < '0' || t[1] > '9' || t[2] == ' ')
+        if (t[0] < 'A' || t[0] > 'Z' || t[1] < '0' || t[1] > '9' || t[2] == ' ' || (unsigned char)t[2] < 0x20 ||
+            (unsigned char)t[2] >= 0x7f) {
+          char sh[8];
+          shown(t, sh, sizeof sh);
           return lfail(L, NAV_ERR_PARSE, 8 + 4 * k,
-                       "observation type \"%c%c%c\"; expected a RINEX 3 type such as C1C (type, band, attribute)",
-                       (unsigned char)t[0] < 0x20 ? '?' : t[0], (unsigned char)t[1] < 0x20 ? '?' : t[1],
-                       (unsigned char)t[2] < 0x20 ? '?' : t[2]);
+                       "observation type \"%s\"; expected a RINEX 3 type such as C1C (type, band, attribute)", sh);
+        }
         if (idx >= 0) {
-          const int j = h->n_types[idx]++;
-          memcpy(h->types[idx][j], t, 4);
-          if (strcmp(t, "C1C") == 0) h->idx_c1c[idx] = j;
-          if (strcmp(t, "D1C") == 0) h->idx_d1c[idx] = j;
-          if (strcmp(t, "S1C") == 0) h->idx_s1c[idx] = j;
+          const int j = r->n_file[idx]++;
+          r->keep[idx][j] = -1;
+          if (kept_type(t) && h->n_types[idx] < NAV_RINEX_MAX_OBS_TYPES) {
+            r->keep[idx][j] = h->n_types[idx];
+            memcpy(h->types[idx][h->n_types[idx]++], t, 4);
+          }
         }
       }
       pending_sys = idx;
@@ -369,15 +383,14 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
                    "continuation line",
                    lab, pending_left);
     if (strcmp(lab, "MARKER NAME") == 0) {
-      field(L, 1, 60, h->marker);
-      for (int i = 59; i >= 0 && h->marker[i] == ' '; --i) h->marker[i] = '\0';
+      field(L, 1, 60, h->marker_name);
+      for (int i = 59; i >= 0 && h->marker_name[i] == ' '; --i) h->marker_name[i] = '\0';
     } else if (strcmp(lab, "APPROX POSITION XYZ") == 0) {
       double x[3];
       for (int i = 0; i < 3; ++i) {
         st = num(L, 1 + 14 * i, 14, "approximate position", &x[i], NULL);
         if (st != NAV_OK) return st;
       }
-      h->has_approx_pos = true;
       h->approx_pos_e_m = nav_vec3_make(x[0], x[1], x[2]);
     } else if (strcmp(lab, "ANTENNA: DELTA H/E/N") == 0) {
       double x[3];
@@ -385,31 +398,36 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
         st = num(L, 1 + 14 * i, 14, "antenna delta", &x[i], NULL);
         if (st != NAV_OK) return st;
       }
-      h->antenna_hen_m = nav_vec3_make(x[0], x[1], x[2]);
+      h->antenna_delta_hen_m = nav_vec3_make(x[0], x[1], x[2]);
     } else if (strcmp(lab, "INTERVAL") == 0) {
       st = num(L, 1, 10, "interval", &h->interval_s, NULL);
       if (st != NAV_OK) return st;
       if (!(h->interval_s > 0.0)) return lfail(L, NAV_ERR_PARSE, 1, "interval %.17g s; expected > 0", h->interval_s);
-      h->has_interval = true;
+    } else if (strcmp(lab, "LEAP SECONDS") == 0) {
+      st = inum(L, 1, 6, "leap seconds", 0, 99, &h->leap_seconds);
+      if (st != NAV_OK) return st;
+      in->has_leap = true;
     } else if (strcmp(lab, "TIME OF FIRST OBS") == 0) {
       static const int col[6] = {1, 7, 13, 19, 25, 31}, w[6] = {6, 6, 6, 6, 6, 13};
       st = epoch_fields(L, col, w, &h->t_first_gps_s);
       if (st != NAV_OK) return st;
       field(L, 49, 3, time_sys);
-      h->has_first = true;
-      if (!(all_blank(time_sys) || strcmp(time_sys, "GPS") == 0))
+      in->has_first = true;
+      if (!(all_blank(time_sys) || strcmp(time_sys, "GPS") == 0)) {
+        char sh[8];
+        shown(time_sys, sh, sizeof sh);
         return lfail(L, NAV_ERR_PARSE, 49,
-                     "time system \"%s\"; only GPS time is supported (expected GPS, or blank in a GPS file)",
-                     time_sys);
-      if (all_blank(time_sys) && h->system != 'G')
+                     "time system \"%s\"; only GPS time is supported (expected GPS, or blank in a GPS file)", sh);
+      }
+      if (all_blank(time_sys) && in->system != 'G')
         return lfail(L, NAV_ERR_PARSE, 49,
                      "blank time system in a file of system %c; expected GPS in columns 49-51 (only GPS time is "
                      "supported)",
-                     h->system);
+                     in->system);
     } else if (strcmp(lab, "GLONASS SLOT / FRQ #") == 0) {
       int n = 0;
       if (glo_left < 0) {
-        st = inum(L, 1, 3, "number of GLONASS satellites", 0, 99, &n);
+        st = inum(L, 1, 3, "number of GLONASS satellites", 0, NAV_RINEX_MAX_GLO_SLOTS, &n);
         if (st != NAV_OK) return st;
         glo_left = n;
       } else {
@@ -424,24 +442,28 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
         field(L, 5 + 7 * k, 3, c);
         int slot = 0, fk = 0;
         if (c[0] != 'R')
-          return lfail(L, NAV_ERR_PARSE, 5 + 7 * k, "GLONASS SLOT / FRQ #: \"%c\"; expected R and the slot (Rnn)",
-                       (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+          return lfail(L, NAV_ERR_PARSE, 5 + 7 * k, "GLONASS SLOT / FRQ #: '%c'; expected R and the slot (Rnn)",
+                       (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
         st = inum(L, 6 + 7 * k, 2, "GLONASS slot", 1, 24, &slot);
         if (st == NAV_OK) st = inum(L, 9 + 7 * k, 2, "GLONASS frequency number", -7, 13, &fk);
         if (st != NAV_OK) return st;
-        h->glo_has_k[slot] = true;
-        h->glo_k[slot] = fk;
+        h->glo_slot[h->n_glo] = slot;
+        h->glo_channel[h->n_glo] = fk;
+        h->n_glo++;
       }
     }
     /* Other labels are not needed for the replay. */
   }
   if (pending_left > 0)
     return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d observation type(s) are missing", pending_left);
-  if (h->n_types[0] == 0 && h->n_types[1] == 0 && h->skipped_systems == 0)
+  if (glo_left > 0)
+    return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d GLONASS SLOT / FRQ # entries are missing", glo_left);
+  if (!any_types)
     return lfail(L, NAV_ERR_PARSE, 1, "the header has no SYS / # / OBS TYPES record; expected one per system");
-  if (!h->has_first && h->system != 'G')
+  if (!in->has_first && in->system != 'G')
     return lfail(L, NAV_ERR_PARSE, 1,
-                 "no TIME OF FIRST OBS in a file of system %c; expected it with time system GPS", h->system);
+                 "no TIME OF FIRST OBS in a file of system %c; expected it with time system GPS", in->system);
+  for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) in->file_types[s] = r->n_file[s];
   return NAV_OK;
 }
 
@@ -482,6 +504,14 @@ void nav_rinex_obs_destroy(nav_rinex_obs_reader *r) {
 }
 
 const nav_rinex_obs_header *nav_rinex_obs_get_header(const nav_rinex_obs_reader *r) { return r ? &r->h : NULL; }
+const nav_rinex_obs_info *nav_rinex_obs_get_info(const nav_rinex_obs_reader *r) { return r ? &r->info : NULL; }
+
+int nav_rinex_obs_type_index(const nav_rinex_obs_header *h, nav_gnss_system sys, const char *type) {
+  if (!h || !type || (int)sys < 0 || (int)sys >= NAV_GNSS_SYS_COUNT) return -1;
+  for (int k = 0; k < h->n_types[sys] && k < NAV_RINEX_MAX_OBS_TYPES; ++k)
+    if (strcmp(h->types[sys][k], type) == 0) return k;
+  return -1;
+}
 const nav_diag *nav_rinex_obs_diag(const nav_rinex_obs_reader *r) { return r ? &r->L.diag : NULL; }
 long nav_rinex_obs_events(const nav_rinex_obs_reader *r) { return r ? r->events : 0; }
 double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r) {
@@ -492,7 +522,7 @@ double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r) {
 
 /* One observation record line of an epoch: satellite in columns 1-3, then 16 columns per type
  * (F14.3, LLI, signal strength). */
-static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep) {
+static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep, int *skipped) {
   lines *L = &r->L;
   char c[4];
   field(L, 1, 3, c);
@@ -501,23 +531,23 @@ static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep)
                                       "previous epoch announced more satellites)");
   if (!known_sys(c[0]))
     return lfail(L, NAV_ERR_PARSE, 1, "satellite system '%c'; expected G, R, E, C, J, I or S and a number (e.g. G05)",
-                 (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+                 (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
   int prn = 0;
   nav_status st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
   if (st != NAV_OK) return st;
   const int s = sys_index(c[0]);
   if (s < 0) {
-    ep->skipped++;
+    ++*skipped;
     return NAV_OK;
   }
-  if (r->h.n_types[s] == 0)
-    return lfail(L, NAV_ERR_PARSE, 1, "satellite %s of a system without SYS / # / OBS TYPES in the header", c);
-  if (s == NAV_GNSS_SYS_GLONASS && prn > 24)
-    return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
+  if (r->n_file[s] == 0)
+    return lfail(L, NAV_ERR_PARSE, 1, "satellite %c%02d of a system without SYS / # / OBS TYPES in the header", c[0],
+                 prn);
+  if (s == NAV_GNSS_SYS_GLONASS && prn > 24) return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
   if (s == NAV_GNSS_SYS_GPS && prn > 32) return lfail(L, NAV_ERR_PARSE, 2, "GPS PRN %d; expected 1..32", prn);
   for (int k = 0; k < ep->n; ++k)
     if ((int)ep->sats[k].system == s && ep->sats[k].prn == prn)
-      return lfail(L, NAV_ERR_PARSE, 1, "satellite %s twice in one epoch; expected each once", c);
+      return lfail(L, NAV_ERR_PARSE, 1, "satellite %c%02d twice in one epoch; expected each once", c[0], prn);
   if (ep->n >= NAV_RINEX_MAX_EPOCH_SATS)
     return lfail(L, NAV_ERR_PARSE, 1, "more than %d GPS and GLONASS satellites in one epoch",
                  NAV_RINEX_MAX_EPOCH_SATS);
@@ -525,28 +555,32 @@ static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep)
   memset(o, 0, sizeof *o);
   o->system = (nav_gnss_system)s;
   o->prn = prn;
-  const int want[3] = {r->h.idx_c1c[s], r->h.idx_d1c[s], r->h.idx_s1c[s]};
-  static const char *const names[3] = {"C1C pseudorange", "D1C Doppler", "S1C signal strength"};
-  bool *has[3] = {&o->has_c1c, &o->has_d1c, &o->has_s1c};
-  double *val[3] = {&o->c1c_m, &o->d1c_hz, &o->s1c_dbhz};
-  for (int i = 0; i < 3; ++i) {
-    if (want[i] < 0) continue;
+  for (int j = 0; j < r->n_file[s]; ++j) {
+    const int k = r->keep[s][j];
+    if (k < 0) continue;
+    const char *t = r->h.types[s][k];
+    char what[32];
+    snprintf(what, sizeof what, "%s of %c%02d", t, c[0], prn);
+    const int col = 4 + 16 * j;
     bool blank = false;
-    st = num(L, 4 + 16 * want[i], 14, names[i], val[i], &blank);
+    st = num(L, col, 14, what, &o->value[k], &blank);
     if (st != NAV_OK) return st;
-    *has[i] = !blank;
+    o->has[k] = !blank;
+    if (blank) continue;
+    const double v = o->value[k];
+    if (t[0] == 'C' && !(v > 1.0e6 && v < 1.0e8))
+      return lfail(L, NAV_ERR_PARSE, col,
+                   "%s: pseudorange %.3f m; expected 1e6 to 1e8 m (a satellite range plus a receiver clock bias)",
+                   what, v);
+    if (t[0] == 'D' && !(fabs(v) < 1.0e6))
+      return lfail(L, NAV_ERR_PARSE, col, "%s: Doppler %.3f Hz; expected |D| < 1e6 Hz", what, v);
   }
-  if (o->has_c1c && !(o->c1c_m > 1.0e6 && o->c1c_m < 1.0e8))
-    return lfail(L, NAV_ERR_PARSE, 4 + 16 * want[0],
-                 "C1C pseudorange %.3f m; expected 1e6 to 1e8 m (a satellite range plus a receiver clock bias)",
-                 o->c1c_m);
-  if (o->has_d1c && !(fabs(o->d1c_hz) < 1.0e6))
-    return lfail(L, NAV_ERR_PARSE, 4 + 16 * want[1], "D1C Doppler %.3f Hz; expected |D| < 1e6 Hz", o->d1c_hz);
   ep->n++;
   return NAV_OK;
 }
 
-nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out, bool *got) {
+nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out, nav_rinex_epoch_info *info,
+                              bool *got) {
   if (!r || !out || !got) return NAV_ERR_INVALID_ARG;
   *got = false;
   lines *L = &r->L;
@@ -583,45 +617,47 @@ nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out,
     double t = 0.0;
     st = epoch_fields(L, col, w, &t);
     if (st != NAV_OK) return st;
-    nav_rinex_obs_epoch *ep = out;
     const long epoch_line = L->line;
     double clk = 0.0;
     bool clk_blank = true;
     st = num(L, 42, 15, "receiver clock offset", &clk, &clk_blank);
     if (st != NAV_OK) return st;
     if (flag == 6) r->events++;
-    if (flag <= 1) {
-      if (r->have_prev && t < r->t_prev)
-        return lfail(L, NAV_ERR_PARSE, 3, "epoch %.7f s GPS is before the previous epoch (%.7f s); expected "
-                                          "epochs in time order",
-                     t, r->t_prev);
-      ep->t_gps_s = t;
-      ep->flag = flag;
-      ep->has_rx_clock = !clk_blank;
-      ep->rx_clock_s = clk;
-      ep->n = 0;
-      ep->skipped = 0;
-      ep->line = epoch_line;
-    }
-    nav_rinex_obs_epoch scratch;
-    nav_rinex_obs_epoch *dst = flag <= 1 ? ep : &scratch;
+    if (flag <= 1 && r->have_prev && t < r->t_prev)
+      return lfail(L, NAV_ERR_PARSE, 3, "epoch %.7f s GPS is before the previous epoch (%.7f s); expected epochs in "
+                                        "time order",
+                   t, r->t_prev);
+    /* A cycle-slip record's satellites are read (and checked) into a scratch epoch. */
+    nav_rinex_obs_epoch *dst = out;
+    nav_rinex_obs_epoch *scratch = NULL;
     if (flag == 6) {
-      scratch.n = 0;
-      scratch.skipped = 0;
+      scratch = malloc(sizeof *scratch);
+      if (!scratch) return lfail(L, NAV_ERR_NO_MEMORY, 1, "out of memory");
+      dst = scratch;
     }
-    for (int k = 0; k < nsat; ++k) {
+    dst->n = 0;
+    int skipped = 0;
+    for (int k = 0; k < nsat && st == NAV_OK; ++k) {
       st = next_line(L, &have);
-      if (st != NAV_OK) return st;
-      if (!have) {
+      if (st == NAV_OK && !have) {
         ++L->line;
-        return lfail(L, NAV_ERR_PARSE, 1,
-                     "end of file inside the epoch record of line %ld, which announced %d satellites; got %d",
-                     epoch_line, nsat, k);
+        st = lfail(L, NAV_ERR_PARSE, 1,
+                   "end of file inside the epoch record of line %ld, which announced %d satellites; got %d",
+                   epoch_line, nsat, k);
       }
-      st = obs_sat_line(r, dst);
-      if (st != NAV_OK) return st;
+      if (st == NAV_OK) st = obs_sat_line(r, dst, &skipped);
     }
+    free(scratch);
+    if (st != NAV_OK) return st;
     if (flag == 6) continue;
+    out->t_gps_s = t;
+    if (info) {
+      info->flag = flag;
+      info->has_rx_clock = !clk_blank;
+      info->rx_clock_s = clk;
+      info->skipped = skipped;
+      info->line = epoch_line;
+    }
     r->t_prev = t;
     r->have_prev = true;
     *got = true;
@@ -653,25 +689,30 @@ static nav_status orbit_line(lines *L, int which, double v[4], int n_required) {
   return NAV_OK;
 }
 
-static nav_status nav_grow(lines *L, void **arr, size_t *cap, size_t n, size_t size) {
+/* Room for record n in an array of records and its parallel array of lines. */
+static nav_status nav_grow(lines *L, void **arr, long **line_arr, size_t *cap, size_t n, size_t size) {
   if (n < *cap) return NAV_OK;
   size_t nc = *cap ? 2 * *cap : 64;
   if (nc > NAV_RINEX_MAX_EPHEMERIDES) nc = NAV_RINEX_MAX_EPHEMERIDES;
-  if (n >= nc)
-    return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
-                 NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
   void *p = realloc(*arr, nc * size);
   if (!p) return lfail(L, NAV_ERR_NO_MEMORY, 1, "out of memory");
   *arr = p;
+  long *q = realloc(*line_arr, nc * sizeof *q);
+  if (!q) return lfail(L, NAV_ERR_NO_MEMORY, 1, "out of memory");
+  *line_arr = q;
   *cap = nc;
   return NAV_OK;
 }
+
+/* GPS - UTC [s] for GLONASS record epochs without a LEAP SECONDS record: 18 s, the value since
+ * 2017-01-01 (IERS Bulletin C 52). */
+enum { LEAP_DEFAULT_S = 18 };
 
 static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
   char system = 'G';
   nav_status st = version_line(L, 'N', &nv->version, &system);
   if (st != NAV_OK) return st;
-  nv->leap_s = 18;
+  nv->leap_s = LEAP_DEFAULT_S;
   for (;;) {
     bool got = false;
     st = next_line(L, &got);
@@ -690,7 +731,6 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
     }
   }
   size_t cap_g = 0, cap_r = 0;
-  const size_t max_total = NAV_RINEX_MAX_EPHEMERIDES;
   for (;;) {
     bool got = false;
     st = next_line(L, &got);
@@ -705,13 +745,9 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       return lfail(L, NAV_ERR_PARSE, 1,
                    "satellite system '%c'; expected the first line of a navigation record (G, R, E, C, J, I or S "
                    "and the satellite number)",
-                   (unsigned char)c[0] < 0x20 ? '?' : c[0]);
+                   (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
     st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
     if (st != NAV_OK) return st;
-    if (nv->n_gps + nv->n_glo >= max_total)
-      return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
-                   NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
-    static const int col[6] = {5, 10, 13, 16, 19, 22}, w[6] = {4, 2, 2, 2, 2, 2};
     if (c[0] != 'G' && c[0] != 'R') {
       /* Other systems: 8 lines (Galileo, BeiDou, QZSS, IRNSS), 4 (SBAS). */
       const int more = c[0] == 'S' ? 3 : 7;
@@ -727,11 +763,16 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       nv->skipped++;
       continue;
     }
+    if (nv->n_gps + nv->n_glo >= NAV_RINEX_MAX_EPHEMERIDES)
+      return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
+                   NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
+    static const int col[6] = {5, 10, 13, 16, 19, 22}, w[6] = {4, 2, 2, 2, 2, 2};
     double t_rec = 0.0, clk[3];
     st = epoch_fields(L, col, w, &t_rec);
     for (int i = 0; i < 3 && st == NAV_OK; ++i) {
       static const char *const nm[2][3] = {{"SV clock bias af0", "SV clock drift af1", "SV clock drift rate af2"},
-                                           {"-TauN", "+GammaN", "message frame time"}};
+                                           {"SV clock bias -TauN", "relative frequency bias +GammaN",
+                                            "message frame time"}};
       st = num(L, 24 + 19 * i, 19, nm[c[0] == 'R'][i], &clk[i], NULL);
     }
     if (st != NAV_OK) return st;
@@ -740,17 +781,39 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       double o[7][4];
       for (int k = 0; k < 7 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], k < 6 ? 4 : 1);
       if (st != NAV_OK) return st;
-      st = nav_grow(L, (void **)&nv->gps, &cap_g, nv->n_gps, sizeof *nv->gps);
+      /* Field checks; the line of each is the record's first line + the orbit line number. */
+      const long last = L->line;
+      const double week = o[4][2];
+      if (!(o[1][1] >= 0.0 && o[1][1] < 1.0)) {
+        L->line = line0 + 2;
+        st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.17g; expected 0 <= e < 1", o[1][1]);
+      } else if (!(o[1][3] > 1000.0 && o[1][3] < 10000.0)) {
+        L->line = line0 + 2;
+        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.17g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)", o[1][3]);
+      } else if (!(o[2][0] >= 0.0 && o[2][0] < NAV_GNSS_WEEK_S)) {
+        L->line = line0 + 3;
+        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.17g s; expected seconds of the GPS week, 0 <= toe < 604800", o[2][0]);
+      } else if (!(week == floor(week) && week >= 0.0 && week < 1.0e5)) {
+        L->line = line0 + 5;
+        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.17g; expected a non-negative integer (continuous week number)",
+                   week);
+      } else if (!(o[5][1] == floor(o[5][1]) && o[5][1] >= 0.0 && o[5][1] < 64.0)) {
+        L->line = line0 + 6;
+        st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.17g; expected an integer 0..63", o[5][1]);
+      }
+      if (st != NAV_OK) return st;
+      L->line = last;
+      st = nav_grow(L, (void **)&nv->gps, &nv->gps_line, &cap_g, nv->n_gps, sizeof *nv->gps);
       if (st != NAV_OK) return st;
       nav_rinex_gps_eph *e = &nv->gps[nv->n_gps];
       memset(e, 0, sizeof *e);
+      nv->gps_line[nv->n_gps] = line0;
       e->prn = prn;
-      e->line = line0;
       e->toc_gps_s = t_rec;
       e->af0_s = clk[0];
       e->af1_sps = clk[1];
       e->af2_sps2 = clk[2];
-      e->iode = o[0][0];
+      e->iode = (int)fmax(-1.0, fmin(1023.0, o[0][0]));
       e->crs_m = o[0][1];
       e->delta_n_rps = o[0][2];
       e->m0_rad = o[0][3];
@@ -758,7 +821,6 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       e->e = o[1][1];
       e->cus_rad = o[1][2];
       e->sqrt_a_sqrtm = o[1][3];
-      e->toe_sow_s = o[2][0];
       e->cic_rad = o[2][1];
       e->omega0_rad = o[2][2];
       e->cis_rad = o[2][3];
@@ -767,41 +829,20 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       e->w_rad = o[3][2];
       e->omega_dot_rps = o[3][3];
       e->idot_rps = o[4][0];
-      e->accuracy_m = o[5][0];
+      e->l2_codes = (int)fmax(0.0, fmin(3.0, o[4][1]));
+      e->l2p_flag = (int)fmax(0.0, fmin(1.0, o[4][3]));
+      e->sv_accuracy_m = o[5][0];
       e->health = (int)o[5][1];
       e->tgd_s = o[5][2];
-      e->iodc = o[5][3];
-      /* Line-relative checks: the line of each field is the record's first line + k. */
-      const long last = L->line;
-      if (!(e->e >= 0.0 && e->e < 1.0)) {
-        L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.17g; expected 0 <= e < 1", e->e);
-      } else if (!(e->sqrt_a_sqrtm > 1000.0 && e->sqrt_a_sqrtm < 10000.0)) {
-        L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.17g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)",
-                   e->sqrt_a_sqrtm);
-      } else if (!(e->toe_sow_s >= 0.0 && e->toe_sow_s < NAV_GNSS_WEEK_S)) {
-        L->line = line0 + 3;
-        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.17g s; expected seconds of the GPS week, 0 <= toe < 604800",
-                   e->toe_sow_s);
-      } else if (!(o[4][2] == floor(o[4][2]) && o[4][2] >= 0.0 && o[4][2] < 1.0e5)) {
-        L->line = line0 + 5;
-        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.17g; expected a non-negative integer (continuous week number)",
-                   o[4][2]);
-      } else if (!(o[5][1] == floor(o[5][1]) && o[5][1] >= 0.0 && o[5][1] < 64.0)) {
-        L->line = line0 + 6;
-        st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.17g; expected an integer 0..63", o[5][1]);
-      }
-      if (st != NAV_OK) return st;
-      L->line = last;
-      e->week = (int)o[4][2];
-      /* The week of toe; toc and toe normally share it, but a toe near the week's start may
-       * belong to the next week of toc (IS-GPS-200N 20.3.4.3): take the week that puts toe
-       * closest to toc. */
-      double toe = (double)e->week * NAV_GNSS_WEEK_S + e->toe_sow_s;
+      e->iodc = (int)fmax(-1.0, fmin(1023.0, o[5][3]));
+      /* The week of toe; a toe near the week's start may belong to the week after toc's
+       * (IS-GPS-200N 20.3.4.3): take the week that puts toe closest to toc. */
+      double toe = week * NAV_GNSS_WEEK_S + o[2][0];
       if (toe - e->toc_gps_s > 0.5 * NAV_GNSS_WEEK_S) toe -= NAV_GNSS_WEEK_S;
       if (e->toc_gps_s - toe > 0.5 * NAV_GNSS_WEEK_S) toe += NAV_GNSS_WEEK_S;
       e->toe_gps_s = toe;
+      e->t_tx_gps_s = week * NAV_GNSS_WEEK_S + o[6][0];
+      e->fit_interval_h = o[6][1];
       nv->n_gps++;
     } else {
       if (prn > 24) return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
@@ -809,36 +850,42 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       for (int k = 0; k < 3 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], 4);
       if (st == NAV_OK && nv->version >= 3.045) st = orbit_line(L, 4, o[3], 0);
       if (st != NAV_OK) return st;
-      st = nav_grow(L, (void **)&nv->glo, &cap_r, nv->n_glo, sizeof *nv->glo);
-      if (st != NAV_OK) return st;
-      nav_rinex_glo_eph *e = &nv->glo[nv->n_glo];
-      memset(e, 0, sizeof *e);
-      e->slot = prn;
-      e->line = line0;
-      /* The record's epoch is UTC (RINEX 3.04 Table A10): GPS = UTC + leap seconds. */
-      e->tb_gps_s = t_rec + (double)nv->leap_s;
-      e->tau_n_s = -clk[0];
-      e->gamma_n = clk[1];
-      e->tk_s = clk[2];
-      /* km, km/s, km/s^2 in the file. */
-      e->r_m = nav_vec3_make(1e3 * o[0][0], 1e3 * o[1][0], 1e3 * o[2][0]);
-      e->v_mps = nav_vec3_make(1e3 * o[0][1], 1e3 * o[1][1], 1e3 * o[2][1]);
-      e->a_mps2 = nav_vec3_make(1e3 * o[0][2], 1e3 * o[1][2], 1e3 * o[2][2]);
-      e->health = (int)o[0][3];
-      e->age_days = o[2][3];
       const long last = L->line;
+      const nav_vec3 r_m = nav_vec3_make(1e3 * o[0][0], 1e3 * o[1][0], 1e3 * o[2][0]);
       if (!(o[1][3] == floor(o[1][3]) && o[1][3] >= -7.0 && o[1][3] <= 13.0)) {
         L->line = line0 + 2;
         st = lfail(L, NAV_ERR_PARSE, 62, "frequency number %.17g; expected an integer -7..13", o[1][3]);
-      } else if (!(nav_vec3_norm(e->r_m) > 1.0e7 && nav_vec3_norm(e->r_m) < 1.0e8)) {
+      } else if (!(nav_vec3_norm(r_m) > 1.0e7 && nav_vec3_norm(r_m) < 1.0e8)) {
         L->line = line0 + 1;
-        st = lfail(L, NAV_ERR_PARSE, 5, "satellite position of %.6g km from the Earth's centre; expected 10 000 "
-                                        "to 100 000 km (a GLONASS orbit: 25 500 km)",
-                   1e-3 * nav_vec3_norm(e->r_m));
+        st = lfail(L, NAV_ERR_PARSE, 5,
+                   "satellite position %.6g km from the Earth's centre; expected 10 000 to 100 000 km (a GLONASS "
+                   "orbit: 25 500 km; the file's unit is km)",
+                   1e-3 * nav_vec3_norm(r_m));
+      } else if (!(o[0][3] == floor(o[0][3]) && o[0][3] >= 0.0 && o[0][3] < 16.0)) {
+        L->line = line0 + 1;
+        st = lfail(L, NAV_ERR_PARSE, 62, "health %.17g; expected an integer (0 = healthy)", o[0][3]);
       }
       if (st != NAV_OK) return st;
       L->line = last;
-      e->freq_k = (int)o[1][3];
+      st = nav_grow(L, (void **)&nv->glo, &nv->glo_line, &cap_r, nv->n_glo, sizeof *nv->glo);
+      if (st != NAV_OK) return st;
+      nav_rinex_glo_eph *e = &nv->glo[nv->n_glo];
+      memset(e, 0, sizeof *e);
+      nv->glo_line[nv->n_glo] = line0;
+      e->slot = prn;
+      /* The record's epoch is UTC (RINEX 3.04 Table A11): GPS = UTC + leap seconds. */
+      e->tb_gps_s = t_rec + (double)nv->leap_s;
+      e->clock_bias_s = clk[0];
+      e->gamma_n = clk[1];
+      /* tk: seconds of the UTC week of the record. */
+      e->tk_gps_s = floor(t_rec / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S + clk[2] + (double)nv->leap_s;
+      /* km, km/s, km/s^2 in the file. */
+      e->r_e_m = r_m;
+      e->v_e_mps = nav_vec3_make(1e3 * o[0][1], 1e3 * o[1][1], 1e3 * o[2][1]);
+      e->a_e_mps2 = nav_vec3_make(1e3 * o[0][2], 1e3 * o[1][2], 1e3 * o[2][2]);
+      e->health = (int)o[0][3];
+      e->channel = (int)o[1][3];
+      e->age_d = (int)fmax(0.0, fmin(99.0, o[2][3]));
       nv->n_glo++;
     }
   }
@@ -879,7 +926,9 @@ nav_status nav_rinex_nav_read_memory(const char *text, size_t len, const char *d
 void nav_rinex_nav_destroy(nav_rinex_nav *n) {
   if (!n) return;
   free(n->gps);
+  free(n->gps_line);
   free(n->glo);
+  free(n->glo_line);
   free(n);
 }
 
@@ -907,7 +956,9 @@ nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmoni
   return o;
 }
 
-double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s) {
+/* Satellite clock offset dt_sv [s] of a GPS ephemeris at GPS time t (the L1 C/A user's, T_GD
+ * subtracted). */
+static double gps_sat_clock_s(const nav_rinex_gps_eph *e, double t_gps_s) {
   /* IS-GPS-200N 20.3.3.3.3.1 and 20.3.3.3.3.2: dt_sv = af0 + af1 dt + af2 dt^2 + dt_r - T_GD,
    * dt_r = F e sqrt(A) sin E_k, F = -2 sqrt(mu) / c^2. */
   const double dt = t_gps_s - e->toc_gps_s;
@@ -932,6 +983,7 @@ struct nav_rinex_source {
   nav_rinex_obs_reader *obs;
   nav_rinex_nav *nav;
   nav_rinex_obs_epoch ep;
+  int i_c1c[NAV_GNSS_SYS_COUNT], i_d1c[NAV_GNSS_SYS_COUNT]; /* kept-type indices, or -1 */
   nav_gnss_orbit orbits[NAV_RINEX_MAX_EPOCH_SATS];
   nav_ins_gnss_sat_meas meas[NAV_RINEX_MAX_EPOCH_SATS];
   nav_rinex_source_counts counts;
@@ -969,6 +1021,19 @@ nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex
   s->cfg.obs_path = s->obs_name;
   nav_status st = nav_rinex_nav_read(cfg->nav_path, &s->nav, diag);
   if (st == NAV_OK) st = nav_rinex_obs_open(cfg->obs_path, &s->obs, diag);
+  if (st == NAV_OK) {
+    const nav_rinex_obs_header *h = nav_rinex_obs_get_header(s->obs);
+    for (int k = 0; k < NAV_GNSS_SYS_COUNT; ++k) {
+      s->i_c1c[k] = nav_rinex_obs_type_index(h, (nav_gnss_system)k, "C1C");
+      s->i_d1c[k] = nav_rinex_obs_type_index(h, (nav_gnss_system)k, "D1C");
+    }
+    if (s->i_c1c[NAV_GNSS_SYS_GPS] < 0) {
+      diag_set(diag, cfg->obs_path, 1, 1,
+               "no C1C observation type for GPS in the header; the replay needs GPS L1 C/A pseudoranges "
+               "(SYS / # / OBS TYPES of G with C1C)");
+      st = NAV_ERR_PARSE;
+    }
+  }
   if (st == NAV_OK && s->nav->n_gps == 0) {
     diag_set(diag, cfg->nav_path, 0, 0, "no GPS navigation record; the replay needs GPS LNAV ephemerides");
     st = NAV_ERR_PARSE;
@@ -1014,25 +1079,28 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
   if (!s || !ep || !got) return NAV_ERR_INVALID_ARG;
   *got = false;
   bool have = false;
-  nav_status st = nav_rinex_obs_next(s->obs, &s->ep, &have);
+  nav_rinex_epoch_info info;
+  nav_status st = nav_rinex_obs_next(s->obs, &s->ep, &info, &have);
   if (st != NAV_OK) {
     if (diag) *diag = *nav_rinex_obs_diag(s->obs);
     return st;
   }
   if (!have) return NAV_OK;
   const double t = s->ep.t_gps_s;
+  const int ic = s->i_c1c[NAV_GNSS_SYS_GPS], id = s->i_d1c[NAV_GNSS_SYS_GPS];
   int m = 0;
-  s->counts.other_systems += s->ep.skipped;
+  s->counts.other_systems += info.skipped;
   for (int i = 0; i < s->ep.n; ++i) {
     const nav_rinex_obs_sat *o = &s->ep.sats[i];
     if (o->system == NAV_GNSS_SYS_GLONASS) {
       s->counts.glonass_skipped++;
       continue;
     }
-    if (!o->has_c1c) {
+    if (!o->has[ic]) {
       s->counts.no_code++;
       continue;
     }
+    const double c1c = o->value[ic];
     const nav_rinex_gps_eph *e = gps_eph_for(s->nav, o->prn, t);
     if (!e || fabs(e->toe_gps_s - t) > s->cfg.max_eph_age_s) {
       s->counts.no_ephemeris++;
@@ -1045,23 +1113,25 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
     bool harm = false;
     s->orbits[m] = nav_rinex_gps_orbit(e, &harm);
     if (harm) {
-      diag_set(diag, s->cfg.nav_path, (int)e->line, 1,
+      diag_set(diag, s->cfg.nav_path, (int)s->nav->gps_line[e - s->nav->gps], 1,
                "G%02d: the ephemeris has harmonic corrections (C_rs ... C_is not all zero), which the replay's "
                "orbit model (nav_gnss_orbit, almanac form) does not hold yet; expected zero corrections as navsim "
                "writes them",
                e->prn);
       return NAV_ERR_PARSE;
     }
-    /* The satellite clock correction of the transmit time (t - P/c), applied to the code. */
-    const double dt_sv = nav_rinex_gps_clock_s(e, t - o->c1c_m / NAV_GNSS_C_MPS);
+    /* The satellite clock at the transmit time t - P/c, applied to the code; its rate (central
+     * difference over +-1 s: af1, af2 and the relativistic term) to the range rate. */
+    const double t_tx = t - c1c / NAV_GNSS_C_MPS;
+    const double dt_sv = gps_sat_clock_s(e, t_tx);
+    const double dt_sv_rate = 0.5 * (gps_sat_clock_s(e, t_tx + 1.0) - gps_sat_clock_s(e, t_tx - 1.0));
     nav_ins_gnss_sat_meas *x = &s->meas[m];
     x->sat = &s->orbits[m];
     x->has_pr = true;
-    x->pr_m = o->c1c_m + NAV_GNSS_C_MPS * dt_sv;
-    /* Range rate = -lambda D (D positive for an approaching satellite), with the satellite clock
-     * drift af1 removed as the code's bias is. */
-    x->has_rr = s->cfg.use_doppler && o->has_d1c;
-    x->rr_mps = x->has_rr ? -(NAV_GNSS_C_MPS / NAV_GPS_L1_HZ) * o->d1c_hz + NAV_GNSS_C_MPS * e->af1_sps : 0.0;
+    x->pr_m = c1c + NAV_GNSS_C_MPS * dt_sv;
+    /* Range rate = -lambda D (D positive for an approaching satellite). */
+    x->has_rr = s->cfg.use_doppler && id >= 0 && o->has[id];
+    x->rr_mps = x->has_rr ? -(NAV_GNSS_C_MPS / NAV_RINEX_GPS_L1_HZ) * o->value[id] + NAV_GNSS_C_MPS * dt_sv_rate : 0.0;
     ++m;
   }
   s->counts.epochs++;

@@ -1001,7 +1001,7 @@ int navsim_replay(int argc, char **argv) {
       bool got = false;
       rs = e1 ? nav_rinex_obs_open(rinex_obs, &orr, &d) : NAV_ERR_NO_MEMORY;
       if (rs == NAV_OK) {
-        rs = nav_rinex_obs_next(orr, e1, &got);
+        rs = nav_rinex_obs_next(orr, e1, NULL, &got);
         if (rs != NAV_OK) d = *nav_rinex_obs_diag(orr);
       }
       if (rs == NAV_OK && got) t0_gps = floor(e1->t_gps_s / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S;

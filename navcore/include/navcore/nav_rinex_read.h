@@ -18,11 +18,14 @@
  * Navigation files: GPS LNAV records (8 lines: SV / EPOCH / SV CLK and 7 BROADCAST ORBIT lines)
  * and GLONASS records (4 lines, 5 in version 3.05); records of other systems are skipped and
  * counted. GLONASS record epochs are UTC; they are turned into GPS time with LEAP SECONDS of the
- * header (18 s if the header has none: the value since 2017-01-01).
+ * header (nav_rinex_leap_seconds() of the epoch if the header has none).
+ *
+ * The records are the structures of nav_rinex.h, shared with the writer (navsim run --export
+ * rinex).
  *
  * Errors: any problem is one nav_diag "FILE:LINE:COL: error: what is wrong and what is
  * expected" with COL the 1-based column of the offending field; NAV_ERR_PARSE. Limits: lines of
- * at most NAV_RINEX_MAX_LINE bytes, NAV_RINEX_MAX_TYPES observation types per system,
+ * at most NAV_RINEX_MAX_LINE bytes, NAV_RINEX_MAX_FILE_TYPES observation types per system,
  * NAV_RINEX_MAX_EPOCH_SATS GPS + GLONASS satellites per epoch, NAV_RINEX_MAX_EPHEMERIDES
  * navigation records. The observation reader streams (memory does not grow with the file); the
  * navigation reader keeps every GPS and GLONASS record.
@@ -40,76 +43,43 @@
 #include "nav_ins_gnss.h"
 #include "nav_io.h"
 #include "nav_math.h"
+#include "nav_rinex.h"
 #include "nav_status.h"
 
 NAV_BEGIN_DECLS
 
 /** Longest accepted line in bytes, line end excluded (an epoch line of 64 types is 1027). */
 #define NAV_RINEX_MAX_LINE 2048
-/** Most observation types of one system. */
-#define NAV_RINEX_MAX_TYPES 64
-/** Most GPS + GLONASS satellites kept from one epoch record. */
-#define NAV_RINEX_MAX_EPOCH_SATS NAV_GNSS_MAX_SATS
+/** Most observation types of one system in a file read (the types kept are at most
+ *  NAV_RINEX_MAX_OBS_TYPES: C1C, L1C, D1C, S1C). */
+#define NAV_RINEX_MAX_FILE_TYPES 64
 /** Most GPS + GLONASS navigation records of one file (a week of 32 GPS satellites every 2 h and
  *  24 GLONASS satellites every 30 min is 11 000). */
 #define NAV_RINEX_MAX_EPHEMERIDES 100000
-/** GPS L1 carrier frequency [Hz] (IS-GPS-200N 3.3.1.1). */
-#define NAV_GPS_L1_HZ 1575.42e6
-/** GLONASS L1 FDMA carrier frequency of channel k: 1602 MHz + k 0.5625 MHz (ICD GLONASS 5.1,
- *  3.3.1.4). */
-#define NAV_GLO_L1_BASE_HZ 1602.0e6
-#define NAV_GLO_L1_STEP_HZ 0.5625e6
 
 /* ================================================================ observation files */
 
-/** What an observation file's header says (the part the reader uses). */
-typedef struct nav_rinex_obs_header {
-  double version;            /**< e.g. 3.04 */
-  char system;               /**< satellite system of the file: 'G', 'R', 'M' (mixed), ... */
-  char marker[61];           /**< MARKER NAME ("" if none) */
-  bool has_approx_pos;       /**< APPROX POSITION XYZ given */
-  nav_vec3 approx_pos_e_m;   /**< APPROX POSITION XYZ, ECEF [m] */
-  nav_vec3 antenna_hen_m;    /**< ANTENNA: DELTA H/E/N [m] (0 if none) */
-  bool has_interval;         /**< INTERVAL given */
-  double interval_s;         /**< INTERVAL [s] */
-  bool has_first;            /**< TIME OF FIRST OBS given */
-  double t_first_gps_s;      /**< TIME OF FIRST OBS, GPS seconds since the GPS epoch */
-  /** Observation types of GPS ([0]) and GLONASS ([1]) in file order ("C1C", ...); n_types 0 if
-   *  the file has none for the system. */
-  int n_types[NAV_GNSS_SYS_COUNT];
-  char types[NAV_GNSS_SYS_COUNT][NAV_RINEX_MAX_TYPES][4];
-  /** Index of C1C, D1C, S1C in types[sys], or -1. */
-  int idx_c1c[NAV_GNSS_SYS_COUNT], idx_d1c[NAV_GNSS_SYS_COUNT], idx_s1c[NAV_GNSS_SYS_COUNT];
-  /** GLONASS SLOT / FRQ #: frequency channel k of slot s (1..24) in glo_k[s], valid where
-   *  glo_has_k[s]. */
-  bool glo_has_k[25];
-  int glo_k[25];
-  int skipped_systems;       /**< SYS / # / OBS TYPES records of systems other than G and R */
-} nav_rinex_obs_header;
+/**
+ * What the reader found in an observation file beyond nav_rinex_obs_header (which lists, per
+ * system, only the kept types: C1C, L1C, D1C and S1C where the file has them, in file order).
+ */
+typedef struct nav_rinex_obs_info {
+  double version;        /**< e.g. 3.04 */
+  char system;           /**< satellite system of the file: 'G', 'R', 'M' (mixed), ... */
+  bool has_first;        /**< TIME OF FIRST OBS given (else t_first_gps_s is 0) */
+  bool has_leap;         /**< LEAP SECONDS given */
+  int file_types[NAV_GNSS_SYS_COUNT];    /**< types the file lists for GPS, GLONASS */
+  int skipped_systems;   /**< SYS / # / OBS TYPES records of systems other than G and R */
+} nav_rinex_obs_info;
 
-/** One satellite of an epoch: the kept observations (C1C, D1C, S1C). */
-typedef struct nav_rinex_obs_sat {
-  nav_gnss_system system;
-  int prn;            /**< GPS PRN or GLONASS slot */
-  bool has_c1c;       /**< C1C present (blank fields are absent) */
-  double c1c_m;       /**< code pseudorange on L1 C/A [m] */
-  bool has_d1c;
-  double d1c_hz;      /**< Doppler on L1 C/A [Hz] (positive for an approaching satellite) */
-  bool has_s1c;
-  double s1c_dbhz;    /**< signal strength [dB-Hz] */
-} nav_rinex_obs_sat;
-
-/** One epoch record with flag 0 (OK) or 1 (power failure since the previous epoch). */
-typedef struct nav_rinex_obs_epoch {
-  double t_gps_s;        /**< epoch, GPS seconds since the GPS epoch (receiver time as written) */
-  int flag;              /**< 0 or 1 */
+/** What an epoch record said besides its observations. */
+typedef struct nav_rinex_epoch_info {
+  int flag;              /**< 0 (OK) or 1 (power failure since the previous epoch) */
   bool has_rx_clock;     /**< the receiver clock offset field is given */
   double rx_clock_s;     /**< receiver clock offset [s] (0 if not given) */
-  int n;                 /**< GPS and GLONASS satellites kept */
-  nav_rinex_obs_sat sats[NAV_RINEX_MAX_EPOCH_SATS];
   int skipped;           /**< satellites of other systems in the record */
   long line;             /**< line of the epoch's '>' record */
-} nav_rinex_obs_epoch;
+} nav_rinex_epoch_info;
 
 typedef struct nav_rinex_obs_reader nav_rinex_obs_reader;
 
@@ -130,19 +100,28 @@ NAV_API NAV_NODISCARD nav_status nav_rinex_obs_open_memory(const char *text, siz
 /** Close and free; accepts NULL. */
 NAV_API void nav_rinex_obs_destroy(nav_rinex_obs_reader *r);
 
-/** The header (borrowed, valid until destroy). */
+/** The header with the kept types (borrowed, valid until destroy). */
 NAV_API const nav_rinex_obs_header *nav_rinex_obs_get_header(const nav_rinex_obs_reader *r);
 
+/** The rest of the header (borrowed, valid until destroy). */
+NAV_API const nav_rinex_obs_info *nav_rinex_obs_get_info(const nav_rinex_obs_reader *r);
+
 /**
- * Next epoch with flag 0 or 1. Event records (flags 2-5) and cycle-slip records (flag 6) are
- * skipped with their special records and counted (nav_rinex_obs_events()). Epochs must not go
- * back in time.
- * @param[out] out the epoch, written only when @p got is set
- * @param[out] got false at the end of the file
+ * Next epoch with flag 0 or 1, GPS and GLONASS satellites only, values in the order of the kept
+ * types of nav_rinex_obs_get_header(). Event records (flags 2-5) and cycle-slip records (flag 6)
+ * are skipped with their special records and counted (nav_rinex_obs_events()). Epochs must not
+ * go back in time.
+ * @param[out] out  the epoch, written only when @p got is set
+ * @param[out] info flag, receiver clock, skipped satellites, line (may be NULL)
+ * @param[out] got  false at the end of the file
  * @return NAV_OK; NAV_ERR_PARSE (see nav_rinex_obs_diag()); NAV_ERR_IO. After an error every
  *         further call returns the same status.
  */
-NAV_API NAV_NODISCARD nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out, bool *got);
+NAV_API NAV_NODISCARD nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out,
+                                                    nav_rinex_epoch_info *info, bool *got);
+
+/** Index of observation type @p type ("C1C") among the kept types of system @p sys, or -1. */
+NAV_API int nav_rinex_obs_type_index(const nav_rinex_obs_header *h, nav_gnss_system sys, const char *type);
 
 /** The last error ("" if none); borrowed until the next call or destroy. */
 NAV_API const nav_diag *nav_rinex_obs_diag(const nav_rinex_obs_reader *r);
@@ -155,49 +134,17 @@ NAV_API double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r);
 
 /* ================================================================ navigation files */
 
-/** A GPS LNAV broadcast ephemeris (RINEX 3.04 Table A6), in SI units with times made continuous. */
-typedef struct nav_rinex_gps_eph {
-  int prn;
-  double toc_gps_s;                          /**< clock reference time, GPS s since the GPS epoch */
-  double af0_s, af1_sps, af2_sps2;           /**< satellite clock polynomial */
-  double iode;
-  double crs_m, delta_n_rps, m0_rad;
-  double cuc_rad, e, cus_rad, sqrt_a_sqrtm;
-  double toe_sow_s;                          /**< toe, seconds of the GPS week */
-  double cic_rad, omega0_rad, cis_rad;
-  double i0_rad, crc_m, w_rad, omega_dot_rps;
-  double idot_rps;
-  int week;                                  /**< GPS week of toe (continuous, not mod 1024) */
-  double toe_gps_s;                          /**< 604800 week + toe_sow_s */
-  double accuracy_m;
-  int health;
-  double tgd_s;
-  double iodc;
-  long line;                                 /**< line of the record's first line */
-} nav_rinex_gps_eph;
-
-/** A GLONASS ephemeris (RINEX 3.04 Table A10): state vector at tb in PZ-90 [m, m/s, m/s^2]. */
-typedef struct nav_rinex_glo_eph {
-  int slot;
-  double tb_gps_s;     /**< epoch of the state (the record's UTC epoch made GPS time) */
-  double tau_n_s;      /**< -TauN as written is negated back: clock correction tau_n [s] */
-  double gamma_n;      /**< relative frequency bias gamma_n */
-  double tk_s;         /**< message frame time (seconds of the UTC week), as written */
-  nav_vec3 r_m, v_mps, a_mps2; /**< PZ-90 position, velocity, lunisolar acceleration */
-  int health;          /**< 0 = healthy */
-  int freq_k;          /**< frequency channel -7..13 */
-  double age_days;
-  long line;
-} nav_rinex_glo_eph;
-
-/** The GPS and GLONASS records of a navigation file, in file order. */
+/** The GPS and GLONASS records of a navigation file, in file order (nav_rinex.h structures). */
 typedef struct nav_rinex_nav {
   double version;
   bool has_leap;
-  int leap_s;          /**< GPS - UTC [s] used for GLONASS epochs */
+  int leap_s;          /**< LEAP SECONDS (GPS - UTC) [s] used for GLONASS epochs; without the
+                        *   record, nav_rinex_leap_seconds() of each record's epoch */
   size_t n_gps, n_glo;
   nav_rinex_gps_eph *gps;
+  long *gps_line;      /**< line of each GPS record's first line */
   nav_rinex_glo_eph *glo;
+  long *glo_line;
   long skipped;        /**< records of other systems */
 } nav_rinex_nav;
 
@@ -224,13 +171,6 @@ NAV_API void nav_rinex_nav_destroy(nav_rinex_nav *n);
  * (may be NULL) tells whether any is non-zero (the replay refuses such ephemerides).
  */
 NAV_API nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmonics);
-
-/**
- * Satellite clock correction dt_sv [s] of a GPS ephemeris at GPS time @p t_gps_s (IS-GPS-200N
- * 20.3.3.3.3.1: af0 + af1 (t - toc) + af2 (t - toc)^2 + F e sqrt(A) sin E_k, minus T_GD for the
- * L1 C/A user). The corrected pseudorange is P + c dt_sv. Leaf maths.
- */
-NAV_API double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s);
 
 /* ================================================================ replay source */
 
