@@ -206,7 +206,7 @@ static nav_status inum(lines *L, int col, int w, const char *what, int lo, int h
   nav_status st = num(L, col, w, what, &x, NULL);
   if (st != NAV_OK) return st;
   if (x != floor(x) || x < lo || x > hi)
-    return lfail(L, NAV_ERR_PARSE, col, "%s: %.17g; expected an integer in [%d, %d] in columns %d-%d", what, x, lo,
+    return lfail(L, NAV_ERR_PARSE, col, "%s: %.12g; expected an integer in [%d, %d] in columns %d-%d", what, x, lo,
                  hi, col, col + w - 1);
   *v = (int)x;
   return NAV_OK;
@@ -232,7 +232,7 @@ static nav_status epoch_fields(lines *L, const int col[6], const int w[6], doubl
   nav_status st = num(L, col[5], w[5], "second", &sec, NULL);
   if (st != NAV_OK) return st;
   if (!(sec >= 0.0 && sec < 61.0))
-    return lfail(L, NAV_ERR_PARSE, col[5], "second: %.17g; expected 0 <= second < 61", sec);
+    return lfail(L, NAV_ERR_PARSE, col[5], "second: %.12g; expected 0 <= second < 61", sec);
   static const int mdays[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
   if (v[2] > mdays[v[1] - 1])
     return lfail(L, NAV_ERR_PARSE, col[2], "day: %d; month %d has at most %d days", v[2], v[1], mdays[v[1] - 1]);
@@ -402,7 +402,7 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
     } else if (strcmp(lab, "INTERVAL") == 0) {
       st = num(L, 1, 10, "interval", &h->interval_s, NULL);
       if (st != NAV_OK) return st;
-      if (!(h->interval_s > 0.0)) return lfail(L, NAV_ERR_PARSE, 1, "interval %.17g s; expected > 0", h->interval_s);
+      if (!(h->interval_s > 0.0)) return lfail(L, NAV_ERR_PARSE, 1, "interval %.12g s; expected > 0", h->interval_s);
     } else if (strcmp(lab, "LEAP SECONDS") == 0) {
       st = inum(L, 1, 6, "leap seconds", 0, 99, &h->leap_seconds);
       if (st != NAV_OK) return st;
@@ -786,20 +786,20 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       const double week = o[4][2];
       if (!(o[1][1] >= 0.0 && o[1][1] < 1.0)) {
         L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.17g; expected 0 <= e < 1", o[1][1]);
+        st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.12g; expected 0 <= e < 1", o[1][1]);
       } else if (!(o[1][3] > 1000.0 && o[1][3] < 10000.0)) {
         L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.17g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)", o[1][3]);
+        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.12g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)", o[1][3]);
       } else if (!(o[2][0] >= 0.0 && o[2][0] < NAV_GNSS_WEEK_S)) {
         L->line = line0 + 3;
-        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.17g s; expected seconds of the GPS week, 0 <= toe < 604800", o[2][0]);
+        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.12g s; expected seconds of the GPS week, 0 <= toe < 604800", o[2][0]);
       } else if (!(week == floor(week) && week >= 0.0 && week < 1.0e5)) {
         L->line = line0 + 5;
-        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.17g; expected a non-negative integer (continuous week number)",
+        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.12g; expected a non-negative integer (continuous week number)",
                    week);
       } else if (!(o[5][1] == floor(o[5][1]) && o[5][1] >= 0.0 && o[5][1] < 64.0)) {
         L->line = line0 + 6;
-        st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.17g; expected an integer 0..63", o[5][1]);
+        st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.12g; expected an integer 0..63", o[5][1]);
       }
       if (st != NAV_OK) return st;
       L->line = last;
@@ -854,7 +854,7 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       const nav_vec3 r_m = nav_vec3_make(1e3 * o[0][0], 1e3 * o[1][0], 1e3 * o[2][0]);
       if (!(o[1][3] == floor(o[1][3]) && o[1][3] >= -7.0 && o[1][3] <= 13.0)) {
         L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 62, "frequency number %.17g; expected an integer -7..13", o[1][3]);
+        st = lfail(L, NAV_ERR_PARSE, 62, "frequency number %.12g; expected an integer -7..13", o[1][3]);
       } else if (!(nav_vec3_norm(r_m) > 1.0e7 && nav_vec3_norm(r_m) < 1.0e8)) {
         L->line = line0 + 1;
         st = lfail(L, NAV_ERR_PARSE, 5,
@@ -863,7 +863,7 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
                    1e-3 * nav_vec3_norm(r_m));
       } else if (!(o[0][3] == floor(o[0][3]) && o[0][3] >= 0.0 && o[0][3] < 16.0)) {
         L->line = line0 + 1;
-        st = lfail(L, NAV_ERR_PARSE, 62, "health %.17g; expected an integer (0 = healthy)", o[0][3]);
+        st = lfail(L, NAV_ERR_PARSE, 62, "health %.12g; expected an integer (0 = healthy)", o[0][3]);
       }
       if (st != NAV_OK) return st;
       L->line = last;
