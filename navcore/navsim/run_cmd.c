@@ -24,6 +24,7 @@
 #include "import_cmd.h"
 #include "interrupt.h"
 #include "kfgins_out.h"
+#include "rinex_out.h"
 #include "select_cmd.h"
 #include "replay_cmd.h"
 #include "report_cmd.h"
@@ -39,7 +40,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2, EXIT_REQUIREMENT = 3 };
 
 static const char *k_usage_run =
     "usage: navsim run SCENE [--out DIR] [--force] [--seed N] [--runs N] [--threads N] [--ideal] [--quiet]\n"
-    "                  [--kml] [--strict] [--allow-large] [--export kfgins] [--progress-fd N]\n"
+    "                  [--kml] [--strict] [--allow-large] [--export kfgins|rinex] [--progress-fd N]\n"
     "\n"
     "Run the scene's pipeline (reference trajectory -> ideal IMU increments -> strapdown\n"
     "navigation -> errors against the reference) and write into DIR:\n"
@@ -94,6 +95,11 @@ static const char *k_usage_run_tail =
     "                navsim replay --imu DIR/kfgins/IMU.txt --gnss DIR/kfgins/GNSS.txt\n"
     "                --truth DIR/kfgins/truth.nav --init DIR/kfgins/init.nav --scene SCENE\n"
     "                reproduces run 0's nav.csv (10 Hz output epochs)\n"
+    "  --export rinex  also write run 0's raw GNSS data (scenes with gnss.constellation) as RINEX\n"
+    "                3.04 into DIR/rinex/: NAME.obs (C1C pseudorange, D1C Doppler of the satellites\n"
+    "                in view at every receiver epoch), NAME.nav (GPS LNAV and GLONASS records of the\n"
+    "                simulated orbits) and pvt.csv (our least-squares PVT of the same epochs beside\n"
+    "                the reference antenna); docs/rinex.md. --export may be repeated\n"
     "  --progress-fd N  also write the progress as lines \"progress F\" (F the fraction of the job\n"
     "                done, 0 to 1, at most about ten lines a second and a last one at 1) to the\n"
     "                open file descriptor N, for a program that runs navsim (navsim serve)\n"
@@ -123,6 +129,8 @@ typedef struct run_out {
   char kfgins_msg[256];      /* what the kfgins export reported on failure */
   int progress_fd;           /* --progress-fd, or -1 */
   double t_last_fd;          /* wall clock of the last line written there */
+  navsim_rinex *rinex;       /* --export rinex, or NULL */
+  char rinex_msg[256];       /* what the rinex export reported on failure */
 } run_out;
 
 static const char *k_imu_errors_header =
@@ -166,6 +174,13 @@ static nav_callback_result on_record(void *user, const nav_sim_record *r) {
   }
   if (o->kfgins) {
     const nav_status st = navsim_kfgins_record(o->kfgins, r, o->kfgins_msg, sizeof o->kfgins_msg);
+    if (st != NAV_OK) {
+      o->st = st;
+      return NAV_STOP;
+    }
+  }
+  if (o->rinex) {
+    const nav_status st = navsim_rinex_record(o->rinex, r, o->rinex_msg, sizeof o->rinex_msg);
     if (st != NAV_OK) {
       o->st = st;
       return NAV_STOP;
@@ -234,7 +249,7 @@ static nav_callback_result on_progress(void *user, const nav_progress *p) {
 int navsim_run(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool ideal = false, quiet = false, have_seed = false, kml = false, strict = false, force = false,
-       allow_large = false, export_kfgins = false;
+       allow_large = false, export_kfgins = false, export_rinex = false;
   uint64_t seed = 0, runs = 0, threads = 0;
   int progress_fd = -1;
   for (int i = 0; i < argc; ++i) {
@@ -276,11 +291,15 @@ int navsim_run(int argc, char **argv) {
     } else if (strcmp(a, "--export") == 0) {
       if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
-      if (strcmp(v, "kfgins") != 0) {
-        fprintf(stderr, "navsim run: --export: expected kfgins (the only export format), got \"%s\"\n", v);
+      /* One format per --export; the option may be repeated. */
+      if (strcmp(v, "kfgins") == 0) {
+        export_kfgins = true;
+      } else if (strcmp(v, "rinex") == 0) {
+        export_rinex = true;
+      } else {
+        fprintf(stderr, "navsim run: --export: expected kfgins or rinex, got \"%s\"\n", v);
         return EXIT_INVALID;
       }
-      export_kfgins = true;
     } else if (strcmp(a, "--out") == 0 || strcmp(a, "--seed") == 0) {
       if (!navsim_need_value("run", argc, i, a)) return EXIT_INVALID;
       const char *v = argv[++i];
@@ -313,6 +332,11 @@ int navsim_run(int argc, char **argv) {
   if (runs > 0) scene.simulation.runs = (long)runs;
   if (export_kfgins && navsim_kfgins_unsupported(&scene)) {
     fprintf(stderr, "%s: error: --export kfgins: %s\n", scene_path, navsim_kfgins_unsupported(&scene));
+    nav_scene_release(&scene);
+    return EXIT_INVALID;
+  }
+  if (export_rinex && navsim_rinex_unsupported(&scene)) {
+    fprintf(stderr, "%s: error: --export rinex: %s\n", scene_path, navsim_rinex_unsupported(&scene));
     nav_scene_release(&scene);
     return EXIT_INVALID;
   }
@@ -356,7 +380,7 @@ int navsim_run(int argc, char **argv) {
   nav_req_evaluator *req_ev = NULL; /* requirements of the scene (nav_requirements.h) */
   nav_requirement_verdict *verdicts = NULL;
   run_out o = {{NULL, NULL, NULL}, NAV_OK, quiet || !isatty(STDERR_FILENO), 0.0, navsim_now_s(),
-               scene.simulation.runs, NULL, NULL, NULL, NULL, NULL, "", progress_fd, 0.0};
+               scene.simulation.runs, NULL, NULL, NULL, NULL, NULL, "", progress_fd, 0.0, NULL, ""};
   static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
   nav_status st = nav_sim_create(&scene, &sim);
   if (st != NAV_OK) {
@@ -429,6 +453,15 @@ int navsim_run(int argc, char **argv) {
     }
   }
 
+  if (export_rinex) {
+    st = navsim_rinex_begin(&scene, ideal, rd, &o.rinex, o.rinex_msg, sizeof o.rinex_msg);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: --export rinex: %s\n", o.rinex_msg[0] ? o.rinex_msg : nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+
   if (scene.navigation.smoother && navsim_run_smooth_begin(rd, &o.smooth) != NAV_OK) {
     fprintf(stderr, "navsim run: cannot write nav_smoothed.csv / smoothed_errors.csv in \"%s\"\n", out_dir);
     rc = EXIT_FAIL;
@@ -464,6 +497,7 @@ int navsim_run(int argc, char **argv) {
   }
   if (st != NAV_OK || o.st != NAV_OK) {
     if (o.st != NAV_OK && o.kfgins_msg[0]) fprintf(stderr, "navsim run: --export kfgins: %s\n", o.kfgins_msg);
+    else if (o.st != NAV_OK && o.rinex_msg[0]) fprintf(stderr, "navsim run: --export rinex: %s\n", o.rinex_msg);
     else if (o.st != NAV_OK) fprintf(stderr, "navsim run: writing results failed: %s\n", nav_status_str(o.st));
     else fprintf(stderr, "navsim run: %s: %s\n", scene_path, nav_sim_last_error(sim));
     rc = EXIT_FAIL;
@@ -508,6 +542,15 @@ int navsim_run(int argc, char **argv) {
     o.kfgins = NULL;
     if (st != NAV_OK) {
       fprintf(stderr, "navsim run: --export kfgins: %s\n", o.kfgins_msg[0] ? o.kfgins_msg : nav_status_str(st));
+      rc = EXIT_FAIL;
+      goto cleanup;
+    }
+  }
+  if (o.rinex) {
+    st = navsim_rinex_end(o.rinex, o.rinex_msg, sizeof o.rinex_msg);
+    o.rinex = NULL;
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim run: --export rinex: %s\n", o.rinex_msg[0] ? o.rinex_msg : nav_status_str(st));
       rc = EXIT_FAIL;
       goto cleanup;
     }
@@ -630,6 +673,7 @@ cleanup:
   (void)navsim_gnss_out_end(o.gnss);
   (void)navsim_gnss_sat_out_end(o.gsat);
   navsim_kfgins_destroy(o.kfgins);
+  navsim_rinex_destroy(o.rinex);
   navsim_run_smooth_abort(o.smooth);
   nav_resultdir_abort(rd);
   if (committed) navsim_interrupt_detach(); /* the results are complete: a late signal is absorbed */

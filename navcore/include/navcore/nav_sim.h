@@ -234,6 +234,27 @@ NAV_API const char *nav_sim_last_error(const nav_sim *sim);
 NAV_API NAV_NODISCARD nav_status nav_sim_gnss_config(const nav_scene *sc, double dt_s, nav_gnss_model_config *out,
                                                      char *msg, size_t msg_size);
 
+/** Pseudoranges and range rates of the visible satellites (gnss.constellation), the receiver of
+ *  the tightly coupled scheme and of the PVT fixes (docs/ins-gnss-tight.md section 2). Public so
+ *  that exports (navsim run --export rinex) regenerate run @p run's raw data exactly. */
+typedef struct nav_sim_gnss_raw nav_sim_gnss_raw;
+
+/** Run @p run's receiver: constellation of the scene, initial clock and inter-system bias drawn
+ *  from the run's streams (none when @p ideal: then no clock and no noise either).
+ *  @return NAV_OK; NAV_ERR_INVALID_ARG; NAV_ERR_NO_MEMORY; as nav_gnss_constellation_build(). */
+NAV_API NAV_NODISCARD nav_status nav_sim_gnss_raw_create(const nav_scene *sc, uint64_t run, bool ideal,
+                                                         nav_sim_gnss_raw **out);
+/** Accepts NULL. */
+NAV_API void nav_sim_gnss_raw_destroy(nav_sim_gnss_raw *g);
+/** The measurements at the true state @p ts (frame @p fr, time ts->t_s, increasing between calls;
+ *  the simulation calls it at every receiver epoch that has a fix, in time order, and so must a
+ *  caller that wants the run's very draws); @p ep points into @p g's buffers until the next call.
+ *  @return NAV_OK; NAV_ERR_INVALID_ARG. */
+NAV_API NAV_NODISCARD nav_status nav_sim_gnss_raw_measure(nav_sim_gnss_raw *g, const nav_frame *fr,
+                                                          const nav_traj_state *ts, nav_ins_gnss_raw_epoch *ep);
+/** The true receiver clock (bias c dt_r [m], drift [m/s]) at the last measurement. */
+NAV_API void nav_sim_gnss_raw_clock(const nav_sim_gnss_raw *g, double *bias_m, double *drift_mps);
+
 NAV_END_DECLS
 
 #endif /* NAV_SIM_H */

@@ -68,20 +68,6 @@ nav_status nav_sim_gnss_visibility_outages(const nav_scene *sc, double dt_s, nav
                                            size_t msg_size);
 /* nav_sim_gnss_config: public, navcore/nav_sim.h. */
 
-/* ------------------------------------------------------------------ raw GNSS (sim_gnss_raw.c) */
-
-/** Pseudoranges and range rates of the visible satellites for the tightly coupled scheme. */
-typedef struct nav_sim_gnss_raw nav_sim_gnss_raw;
-
-/** Run @p run's receiver: constellation of the scene, initial clock and inter-system bias drawn
- *  (none when @p ideal: then no clock and no noise either). */
-nav_status nav_sim_gnss_raw_create(const nav_scene *sc, uint64_t run, bool ideal, nav_sim_gnss_raw **out);
-void nav_sim_gnss_raw_destroy(nav_sim_gnss_raw *g);
-/** The measurements at the true state @p ts (F = ECEF, time ts->t_s, increasing between calls);
- *  @p ep points into @p g's buffers until the next call. */
-nav_status nav_sim_gnss_raw_measure(nav_sim_gnss_raw *g, const nav_frame *fr, const nav_traj_state *ts,
-                                    nav_ins_gnss_raw_epoch *ep);
-/** The true receiver clock at the last measurement. */
-void nav_sim_gnss_raw_clock(const nav_sim_gnss_raw *g, double *bias_m, double *drift_mps);
+/* Raw GNSS measurements (sim_gnss_raw.c): public, navcore/nav_sim.h (nav_sim_gnss_raw_*). */
 
 #endif /* NAV_SIM_INTERNAL_H */
