@@ -704,15 +704,10 @@ static nav_status nav_grow(lines *L, void **arr, long **line_arr, size_t *cap, s
   return NAV_OK;
 }
 
-/* GPS - UTC [s] for GLONASS record epochs without a LEAP SECONDS record: 18 s, the value since
- * 2017-01-01 (IERS Bulletin C 52). */
-enum { LEAP_DEFAULT_S = 18 };
-
 static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
   char system = 'G';
   nav_status st = version_line(L, 'N', &nv->version, &system);
   if (st != NAV_OK) return st;
-  nv->leap_s = LEAP_DEFAULT_S;
   for (;;) {
     bool got = false;
     st = next_line(L, &got);
@@ -874,11 +869,12 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
       nv->glo_line[nv->n_glo] = line0;
       e->slot = prn;
       /* The record's epoch is UTC (RINEX 3.04 Table A11): GPS = UTC + leap seconds. */
-      e->tb_gps_s = t_rec + (double)nv->leap_s;
+      const int leap = nv->has_leap ? nv->leap_s : nav_rinex_leap_seconds(t_rec);
+      e->tb_gps_s = t_rec + (double)leap;
       e->clock_bias_s = clk[0];
       e->gamma_n = clk[1];
       /* tk: seconds of the UTC week of the record. */
-      e->tk_gps_s = floor(t_rec / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S + clk[2] + (double)nv->leap_s;
+      e->tk_gps_s = floor(t_rec / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S + clk[2] + (double)leap;
       /* km, km/s, km/s^2 in the file. */
       e->r_e_m = r_m;
       e->v_e_mps = nav_vec3_make(1e3 * o[0][1], 1e3 * o[1][1], 1e3 * o[2][1]);
@@ -954,25 +950,6 @@ nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmoni
     *has_harmonics = e->crs_m != 0.0 || e->crc_m != 0.0 || e->cus_rad != 0.0 || e->cuc_rad != 0.0 ||
                      e->cis_rad != 0.0 || e->cic_rad != 0.0;
   return o;
-}
-
-/* Satellite clock offset dt_sv [s] of a GPS ephemeris at GPS time t (the L1 C/A user's, T_GD
- * subtracted). */
-static double gps_sat_clock_s(const nav_rinex_gps_eph *e, double t_gps_s) {
-  /* IS-GPS-200N 20.3.3.3.3.1 and 20.3.3.3.3.2: dt_sv = af0 + af1 dt + af2 dt^2 + dt_r - T_GD,
-   * dt_r = F e sqrt(A) sin E_k, F = -2 sqrt(mu) / c^2. */
-  const double dt = t_gps_s - e->toc_gps_s;
-  const double A = e->sqrt_a_sqrtm * e->sqrt_a_sqrtm;
-  const double n = sqrt(NAV_GPS_MU_M3PS2 / (A * A * A)) + e->delta_n_rps;
-  const double Mk = e->m0_rad + n * (t_gps_s - e->toe_gps_s);
-  double E = Mk;
-  for (int it = 0; it < 30; ++it) {
-    const double dE = (Mk - E + e->e * sin(E)) / (1.0 - e->e * cos(E));
-    E += dE;
-    if (fabs(dE) < 1e-15) break;
-  }
-  const double F = -4.442807633e-10; /* s/m^0.5, IS-GPS-200N 20.3.3.3.3.1 */
-  return e->af0_s + e->af1_sps * dt + e->af2_sps2 * dt * dt + F * e->e * e->sqrt_a_sqrtm * sin(E) - e->tgd_s;
 }
 
 /* ---------------------------------------------------------------- replay source */
@@ -1123,8 +1100,8 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
     /* The satellite clock at the transmit time t - P/c, applied to the code; its rate (central
      * difference over +-1 s: af1, af2 and the relativistic term) to the range rate. */
     const double t_tx = t - c1c / NAV_GNSS_C_MPS;
-    const double dt_sv = gps_sat_clock_s(e, t_tx);
-    const double dt_sv_rate = 0.5 * (gps_sat_clock_s(e, t_tx + 1.0) - gps_sat_clock_s(e, t_tx - 1.0));
+    const double dt_sv = nav_rinex_gps_clock_s(e, t_tx, true);
+    const double dt_sv_rate = 0.5 * (nav_rinex_gps_clock_s(e, t_tx + 1.0, true) - nav_rinex_gps_clock_s(e, t_tx - 1.0, true));
     nav_ins_gnss_sat_meas *x = &s->meas[m];
     x->sat = &s->orbits[m];
     x->has_pr = true;

@@ -138,8 +138,8 @@ NAV_API double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r);
 typedef struct nav_rinex_nav {
   double version;
   bool has_leap;
-  int leap_s;          /**< LEAP SECONDS (GPS - UTC) [s] used for GLONASS epochs; without the
-                        *   record, nav_rinex_leap_seconds() of each record's epoch */
+  int leap_s;          /**< LEAP SECONDS (GPS - UTC) [s] used for GLONASS epochs (valid when
+                        *   has_leap; without it, nav_rinex_leap_seconds() of each record's epoch) */
   size_t n_gps, n_glo;
   nav_rinex_gps_eph *gps;
   long *gps_line;      /**< line of each GPS record's first line */
@@ -218,8 +218,10 @@ NAV_API void nav_rinex_source_destroy(nav_rinex_source *s);
 /**
  * Next observation epoch as the tightly coupled update takes it (nav_ins_gnss_update_raw()):
  * t_s = t_gps - t0_gps_s; per GPS satellite with C1C and a usable ephemeris (the nearest toe
- * within max_eph_age_s, healthy), its orbit, P = C1C + c dt_sv (satellite clock corrected), and
- * the range rate -lambda_L1 D1C when D1C is present. The epoch and the orbits it points to are
+ * within max_eph_age_s, healthy), its orbit, P = C1C + c dt_sv (dt_sv of nav_rinex_gps_clock_s()
+ * with T_GD, at the transmit time t - C1C / c), and the range rate -lambda_L1 D1C + c dt_sv'
+ * (the clock's rate by a central difference over +-1 s) when D1C is present. GLONASS
+ * satellites are skipped and counted. The epoch and the orbits it points to are
  * borrowed until the next call.
  * @return NAV_OK (got false at the end); NAV_ERR_PARSE with FILE:LINE:COL in @p diag (also for
  *         a GPS ephemeris with harmonic corrections, which nav_gnss_orbit cannot hold).
