@@ -17,7 +17,7 @@ NAV_PACKAGES=(
   python-cartopy-data gmt-gshhg-low # offline map background (coastlines, borders)
   help2man man-db bsdextrautils     # man pages from --help; tests render them (man, col)
   dpkg-dev file lintian             # cpack -G DEB (dpkg-shlibdeps, file) and its lintian test
-  rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions (issue 22)
+  rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions and of the RINEX export (issue 22)
   python3-yaml python3-jsonschema   # scenes against `navsim schema` (issue 18, test_navsim_schema)
   ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
 )

@@ -14,7 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include "cli_util.h"
 #include "navcore/nav_earth.h"
@@ -151,10 +150,6 @@ nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir 
   snprintf(h->marker_name, sizeof h->marker_name, "%.60s", nm);
   snprintf(h->program, sizeof h->program, "navsim");
   snprintf(h->run_by, sizeof h->run_by, "navsim run");
-  const time_t now = time(NULL);
-  struct tm tmv;
-  if (gmtime_r(&now, &tmv)) strftime(x->date, sizeof x->date, "%Y%m%d %H%M%S UTC", &tmv);
-  snprintf(h->date, sizeof h->date, "%s", x->date);
   snprintf(h->receiver_type, sizeof h->receiver_type, "navsim simulation");
   snprintf(h->antenna_type, sizeof h->antenna_type, "NONE");
   const nav_gnss_constellation_config *cc = &sc->gnss.constellation;
@@ -185,11 +180,17 @@ static nav_rinex_gps_eph gps_eph_at(const nav_gnss_orbit *o, double t_gps_s) {
   return nav_rinex_gps_eph_from_orbit(o, toe, 0);
 }
 
+/* The GLONASS tb nearest to t: on the UTC grid of NAVSIM_RINEX_GLO_STEP_S (t - leap a multiple). */
+static double glo_tb(double t_gps_s) {
+  const double leap = (double)nav_rinex_leap_seconds(t_gps_s);
+  return floor((t_gps_s - leap) / NAVSIM_RINEX_GLO_STEP_S + 0.5) * NAVSIM_RINEX_GLO_STEP_S + leap;
+}
+
 /* The satellite clock a RINEX user applies to this satellite at transmit time t [s]. */
 static double sat_clock_s(const nav_gnss_orbit *o, double t) {
   if (o->system == NAV_GNSS_SYS_GLONASS) {
-    const double tb = floor(t / NAVSIM_RINEX_GLO_STEP_S + 0.5) * NAVSIM_RINEX_GLO_STEP_S;
-    const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, tb, 0);
+    const double tb = glo_tb(t);
+    const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, tb, 0, 0.0); /* the clock only */
     return nav_rinex_glo_clock_s(&e, t);
   }
   const nav_rinex_gps_eph e = gps_eph_at(o, t);
@@ -210,6 +211,14 @@ static nav_status write_epoch(navsim_rinex *x, const nav_traj_state *ts, char *m
       nav_vec3_add(nav_earth_geodetic_to_ecef(v.pos), nav_mat3_mul_vec(C_b_e, x->scene->gnss.model.r_ba_b_m));
   if (ep.n == 0) return NAV_OK;
   if (!x->header_done) {
+    /* The creation date field holds the first epoch (UTC), not the wall clock: the same scene and
+     * seed give bit-identical files. */
+    const nav_rinex_date d = nav_rinex_date_from_gps(floor(ep.t_gps_s) - nav_rinex_leap_seconds(ep.t_gps_s));
+    char tmp[64];
+    snprintf(tmp, sizeof tmp, "%04d%02d%02d %02d%02d%02d UTC", d.year, d.month, d.day, d.hour, d.minute,
+             (int)d.second);
+    snprintf(x->date, sizeof x->date, "%.20s", tmp);
+    snprintf(x->hdr.date, sizeof x->hdr.date, "%s", x->date);
     x->hdr.t_first_gps_s = ep.t_gps_s;
     x->hdr.approx_pos_e_m = r_ea_e;
     x->hdr.leap_seconds = nav_rinex_leap_seconds(ep.t_gps_s);
@@ -319,12 +328,14 @@ nav_status navsim_rinex_end(navsim_rinex *x, char *msg, size_t cap) {
     const nav_gnss_orbit *o = &x->c.sats[i];
     const bool glo = o->system == NAV_GNSS_SYS_GLONASS;
     const double step = glo ? NAVSIM_RINEX_GLO_STEP_S : GPS_STEP_S;
-    const double t0 = floor(x->t_first_gps_s / step + 0.5) * step, t1 = floor(x->t_last_gps_s / step + 0.5) * step;
+    const double t0 = glo ? glo_tb(x->t_first_gps_s) : floor(x->t_first_gps_s / step + 0.5) * step;
+    const double t1 = glo ? glo_tb(x->t_last_gps_s) : floor(x->t_last_gps_s / step + 0.5) * step;
     const long nrec = lround((t1 - t0) / step) + 1;
     for (long rec = 0; rec < nrec && st == NAV_OK; ++rec) {
       const double t = t0 + (double)rec * step;
       if (glo) {
-        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, t, nav_rinex_glonass_nominal_channel(o->prn));
+        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, t, nav_rinex_glonass_nominal_channel(o->prn),
+                                                                 0.5 * NAVSIM_RINEX_GLO_STEP_S);
         st = nav_rinex_nav_write_glonass(x->f[F_NAV], &e, leap);
       } else {
         /* IODE distinguishes a satellite's records (readers drop repeated IODEs). */

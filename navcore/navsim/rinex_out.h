@@ -6,7 +6,7 @@
  *   NAME.obs  observation file: C1C (pseudorange [m]) and D1C (Doppler [Hz]) of the satellites in
  *             view at every receiver epoch outside the receiver's outages, GPS time tags
  *   NAME.nav  navigation file: GPS LNAV records every 2 h and GLONASS records every
- *             NAVSIM_RINEX_GLO_STEP_S seconds spanning the observations
+ *             15 min of UTC (NAVSIM_RINEX_GLO_STEP_S) spanning the observations
  *   pvt.csv   our own least-squares PVT of the same epochs (nav_gnss_pvt_solve) beside the
  *             reference antenna position, for comparisons with other solvers (rnx2rtkp):
  *             t_s, t_gps_s, n_sats, x_m, y_m, z_m (PVT, ECEF), ref_x_m, ref_y_m, ref_z_m,
@@ -25,8 +25,10 @@
 #include "navcore/nav_scene.h"
 #include "navcore/nav_sim.h"
 
-/** Spacing of the GLONASS records (tb) [s]: docs/rinex.md measures the orbit agreement. */
-#define NAVSIM_RINEX_GLO_STEP_S 300.0
+/** Spacing of the GLONASS records [s]: tb on the 15 min grid of UTC, as the GLONASS navigation
+ *  message has it (RTKLIB rounds a record's epoch to that grid). docs/rinex.md measures the orbit
+ *  agreement this leaves. */
+#define NAVSIM_RINEX_GLO_STEP_S 900.0
 
 typedef struct navsim_rinex navsim_rinex;
 

@@ -168,9 +168,12 @@ NAV_API double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s,
  * nav_gnss_orbit_state(), and as acceleration term the difference between the orbit's true ECEF
  * acceleration and the ICD GLONASS (Ed. 5.1, A.3.1.2) force model (central body, J2, rotating
  * frame) at that state, so that a receiver integrating the ICD equations from tb follows the
- * orbit closely for short intervals (docs/rinex.md measures how closely).
+ * orbit closely for short intervals. With @p half_span_s = T > 0 the velocity is tilted so that
+ * the linear drift of that difference is balanced over [tb - T, tb + T] (the record then serves
+ * that interval best). docs/rinex.md measures the agreement.
  */
-NAV_API nav_rinex_glo_eph nav_rinex_glo_eph_from_orbit(const nav_gnss_orbit *o, double tb_gps_s, int channel);
+NAV_API nav_rinex_glo_eph nav_rinex_glo_eph_from_orbit(const nav_gnss_orbit *o, double tb_gps_s, int channel,
+                                                       double half_span_s);
 
 /** The GLONASS satellite clock offset [s] at @p t_gps_s: clock_bias_s + gamma_n (t - tb). */
 NAV_API double nav_rinex_glo_clock_s(const nav_rinex_glo_eph *e, double t_gps_s);
