@@ -973,6 +973,7 @@ nav_rinex_source_config nav_rinex_source_config_default(void) {
   c.pr_sd_m = 3.0;
   c.rr_sd_mps = 0.1;
   c.max_eph_age_s = 7200.0;
+  c.max_glo_age_s = 1800.0;
   c.use_doppler = true;
   return c;
 }
@@ -983,7 +984,9 @@ nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex
   if (!cfg->obs_path || !cfg->nav_path) bad = "an observation file and a navigation file are both required";
   else if (!(cfg->pr_sd_m > 0.0 && isfinite(cfg->pr_sd_m))) bad = "the pseudorange sigma must be finite and > 0";
   else if (!(cfg->rr_sd_mps > 0.0 && isfinite(cfg->rr_sd_mps))) bad = "the range-rate sigma must be finite and > 0";
-  else if (!(cfg->max_eph_age_s > 0.0 && isfinite(cfg->max_eph_age_s))) bad = "the ephemeris age must be > 0";
+  else if (!(cfg->max_eph_age_s > 0.0 && isfinite(cfg->max_eph_age_s)) ||
+           !(cfg->max_glo_age_s > 0.0 && cfg->max_glo_age_s <= 86400.0))
+    bad = "the ephemeris ages must be > 0 (GLONASS: at most one day)";
   else if (!isfinite(cfg->t0_gps_s)) bad = "the GPS time of t = 0 must be finite";
   if (bad) {
     diag_set(diag, "replay", 0, 0, "%s", bad);
@@ -1004,15 +1007,16 @@ nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex
       s->i_c1c[k] = nav_rinex_obs_type_index(h, (nav_gnss_system)k, "C1C");
       s->i_d1c[k] = nav_rinex_obs_type_index(h, (nav_gnss_system)k, "D1C");
     }
-    if (s->i_c1c[NAV_GNSS_SYS_GPS] < 0) {
+    if (s->i_c1c[NAV_GNSS_SYS_GPS] < 0 && s->i_c1c[NAV_GNSS_SYS_GLONASS] < 0) {
       diag_set(diag, cfg->obs_path, 1, 1,
-               "no C1C observation type for GPS in the header; the replay needs GPS L1 C/A pseudoranges "
-               "(SYS / # / OBS TYPES of G with C1C)");
+               "no C1C observation type for GPS or GLONASS in the header; the replay needs L1 C/A "
+               "pseudoranges (SYS / # / OBS TYPES with C1C)");
       st = NAV_ERR_PARSE;
     }
   }
-  if (st == NAV_OK && s->nav->n_gps == 0) {
-    diag_set(diag, cfg->nav_path, 0, 0, "no GPS navigation record; the replay needs GPS LNAV ephemerides");
+  if (st == NAV_OK && s->nav->n_gps == 0 && s->nav->n_glo == 0) {
+    diag_set(diag, cfg->nav_path, 0, 0,
+             "no GPS or GLONASS navigation record; the replay needs the satellites' ephemerides");
     st = NAV_ERR_PARSE;
   }
   if (st != NAV_OK) {
@@ -1052,6 +1056,105 @@ static const nav_rinex_gps_eph *gps_eph_for(const nav_rinex_nav *nv, int prn, do
   return best;
 }
 
+/* The GLONASS record of @p slot with tb nearest to @p t, or NULL. */
+static const nav_rinex_glo_eph *glo_eph_for(const nav_rinex_nav *nv, int slot, double t) {
+  const nav_rinex_glo_eph *best = NULL;
+  for (size_t i = 0; i < nv->n_glo; ++i) {
+    const nav_rinex_glo_eph *e = &nv->glo[i];
+    if (e->slot != slot) continue;
+    if (!best || fabs(e->tb_gps_s - t) <= fabs(best->tb_gps_s - t)) best = e;
+  }
+  return best;
+}
+
+/* Derivative of the GLONASS state [r, v] (PZ-90, rotating) under the ICD force model (ICD
+ * GLONASS Edition 5.1, 2008, A.3.1.2: central body, J2 zonal term, centrifugal and Coriolis
+ * terms) plus the record's constant luni-solar acceleration. */
+static void glo_deriv(const double x[6], nav_vec3 acc, double dx[6]) {
+  const double mu = 398600.4418e9, ae = 6378136.0, J2 = 1082625.75e-9, w = 7.292115e-5;
+  const double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2], r = sqrt(r2), r3 = r2 * r;
+  const double k = 1.5 * J2 * mu * ae * ae / (r3 * r2); /* 3/2 J2 mu ae^2 / r^5 */
+  const double z2 = x[2] * x[2] / r2;
+  dx[0] = x[3];
+  dx[1] = x[4];
+  dx[2] = x[5];
+  dx[3] = (-mu / r3 - k * (1.0 - 5.0 * z2)) * x[0] + w * w * x[0] + 2.0 * w * x[4] + acc.x;
+  dx[4] = (-mu / r3 - k * (1.0 - 5.0 * z2)) * x[1] + w * w * x[1] - 2.0 * w * x[3] + acc.y;
+  dx[5] = (-mu / r3 - k * (3.0 - 5.0 * z2)) * x[2] + acc.z;
+}
+
+/* The satellite's ECEF state at @p t from its record: fourth-order Runge-Kutta from tb in steps
+ * of at most 60 s (ICD GLONASS A.3.1.2 recommends RK4; RTKLIB uses 60 s). */
+static void glo_state(const nav_rinex_glo_eph *e, double t, nav_vec3 *r, nav_vec3 *v) {
+  double x[6] = {e->r_e_m.x, e->r_e_m.y, e->r_e_m.z, e->v_e_mps.x, e->v_e_mps.y, e->v_e_mps.z};
+  const double span = t - e->tb_gps_s;
+  const int n = (int)ceil(fabs(span) / 60.0);
+  const double h = n > 0 ? span / n : 0.0;
+  for (int s = 0; s < n; ++s) {
+    double k1[6], k2[6], k3[6], k4[6], y[6];
+    glo_deriv(x, e->a_e_mps2, k1);
+    for (int i = 0; i < 6; ++i) y[i] = x[i] + 0.5 * h * k1[i];
+    glo_deriv(y, e->a_e_mps2, k2);
+    for (int i = 0; i < 6; ++i) y[i] = x[i] + 0.5 * h * k2[i];
+    glo_deriv(y, e->a_e_mps2, k3);
+    for (int i = 0; i < 6; ++i) y[i] = x[i] + h * k3[i];
+    glo_deriv(y, e->a_e_mps2, k4);
+    for (int i = 0; i < 6; ++i) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+  }
+  *r = nav_vec3_make(x[0], x[1], x[2]);
+  *v = nav_vec3_make(x[3], x[4], x[5]);
+}
+
+/*
+ * The osculating orbit at @p t of an ECEF state, in the form nav_gnss_orbit_state() propagates
+ * (toe = t, no rates): the filter evaluates a satellite within a few tenths of a second of the
+ * epoch (light time, range rate), where the two-body motion and the ICD integration differ by
+ * far less than a millimetre. Classical elements from position and inertial velocity (Vallado,
+ * Fundamentals of Astrodynamics and Applications, 4th ed., algorithm 9 "RV2COE"), with the
+ * constants the propagator uses (IS-GPS-200N mu and omega_e) so that it returns the state at t.
+ */
+static bool osculating_orbit(nav_vec3 r, nav_vec3 v_e, double t, int slot, nav_gnss_orbit *o) {
+  const double mu = NAV_GPS_MU_M3PS2, we = NAV_GPS_OMEGA_E_RPS;
+  /* Inertial velocity in the frame aligned with ECEF at t: v_i = v_e + omega_e x r. */
+  const nav_vec3 v = nav_vec3_add(v_e, nav_vec3_make(-we * r.y, we * r.x, 0.0));
+  const nav_vec3 h = nav_vec3_cross(r, v);
+  const double rn = nav_vec3_norm(r), hn = nav_vec3_norm(h), v2 = nav_vec3_dot(v, v);
+  const double a = 1.0 / (2.0 / rn - v2 / mu);
+  if (!(a > 0.0) || !(hn > 0.0)) return false;
+  const double inc = acos(h.z / hn);
+  const double node = atan2(h.x, -h.y); /* longitude of the ascending node at t */
+  /* Eccentric anomaly from r and r.v (e cos E = 1 - r/a, e sin E = r.v / sqrt(mu a)). */
+  const double ecE = 1.0 - rn / a, esE = nav_vec3_dot(r, v) / sqrt(mu * a);
+  const double e = hypot(ecE, esE);
+  if (!(e < 1.0)) return false;
+  const double E = atan2(esE, ecE);
+  const double M = E - esE;
+  const double nu = atan2(sqrt(1.0 - e * e) * sin(E), cos(E) - e);
+  /* Argument of latitude: the angle from the node line to r in the orbit plane. */
+  const double cO = cos(node), sO = sin(node);
+  const double u = atan2(r.z / sin(inc), r.x * cO + r.y * sO);
+  memset(o, 0, sizeof *o);
+  o->system = NAV_GNSS_SYS_GLONASS;
+  o->prn = slot;
+  o->toe_s = t;
+  o->sqrt_a_sqrtm = sqrt(a);
+  o->e = e;
+  o->i0_rad = inc;
+  o->m0_rad = M;
+  o->w_rad = u - nu;
+  /* Omega_k = Omega_0 - omega_e toe_sow at t_k = 0 (nav_gnss_orbit_state). */
+  const double toe_sow = t - floor(t / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S;
+  o->omega0_rad = node + we * toe_sow;
+  return true;
+}
+
+/* GLONASS frequency channel of @p slot: the observation header's SLOT / FRQ #, else the record's. */
+static int glo_channel(const nav_rinex_obs_header *h, const nav_rinex_glo_eph *e) {
+  for (int i = 0; i < h->n_glo && i < NAV_RINEX_MAX_GLO_SLOTS; ++i)
+    if (h->glo_slot[i] == e->slot) return h->glo_channel[i];
+  return e->channel;
+}
+
 nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag) {
   if (!s || !ep || !got) return NAV_ERR_INVALID_ARG;
   *got = false;
@@ -1064,20 +1167,51 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
   }
   if (!have) return NAV_OK;
   const double t = s->ep.t_gps_s;
-  const int ic = s->i_c1c[NAV_GNSS_SYS_GPS], id = s->i_d1c[NAV_GNSS_SYS_GPS];
+  const nav_rinex_obs_header *hdr = nav_rinex_obs_get_header(s->obs);
   int m = 0;
   s->counts.other_systems += info.skipped;
   for (int i = 0; i < s->ep.n; ++i) {
     const nav_rinex_obs_sat *o = &s->ep.sats[i];
-    if (o->system == NAV_GNSS_SYS_GLONASS) {
-      s->counts.glonass_skipped++;
-      continue;
-    }
-    if (!o->has[ic]) {
+    const int sys = (int)o->system;
+    const int ic = s->i_c1c[sys], id = s->i_d1c[sys];
+    if (ic < 0 || !o->has[ic]) {
       s->counts.no_code++;
       continue;
     }
     const double c1c = o->value[ic];
+    const double t_tx = t - c1c / NAV_GNSS_C_MPS;
+    if (o->system == NAV_GNSS_SYS_GLONASS) {
+      const nav_rinex_glo_eph *g = glo_eph_for(s->nav, o->prn, t);
+      if (!g || fabs(g->tb_gps_s - t) > s->cfg.max_glo_age_s) {
+        s->counts.no_ephemeris++;
+        continue;
+      }
+      if (g->health != 0) {
+        s->counts.unhealthy++;
+        continue;
+      }
+      nav_vec3 r, v;
+      glo_state(g, t, &r, &v);
+      if (!osculating_orbit(r, v, t, o->prn, &s->orbits[m])) {
+        diag_set(diag, s->cfg.nav_path, (int)s->nav->glo_line[g - s->nav->glo], 1,
+                 "R%02d: the record's state does not give a closed orbit at t = %.3f s GPS; expected a "
+                 "satellite state vector in km, km/s",
+                 g->slot, t);
+        return NAV_ERR_PARSE;
+      }
+      /* Satellite clock -TauN + GammaN (t - tb) (nav_rinex_glo_clock_s), its rate GammaN. */
+      const double dt_sv = nav_rinex_glo_clock_s(g, t_tx);
+      const double lambda = NAV_GNSS_C_MPS / nav_rinex_l1_hz(NAV_GNSS_SYS_GLONASS, glo_channel(hdr, g));
+      nav_ins_gnss_sat_meas *x = &s->meas[m];
+      x->sat = &s->orbits[m];
+      x->has_pr = true;
+      x->pr_m = c1c + NAV_GNSS_C_MPS * dt_sv;
+      x->has_rr = s->cfg.use_doppler && id >= 0 && o->has[id];
+      x->rr_mps = x->has_rr ? -lambda * o->value[id] + NAV_GNSS_C_MPS * g->gamma_n : 0.0;
+      ++m;
+      s->counts.glonass_used++;
+      continue;
+    }
     const nav_rinex_gps_eph *e = gps_eph_for(s->nav, o->prn, t);
     if (!e || fabs(e->toe_gps_s - t) > s->cfg.max_eph_age_s) {
       s->counts.no_ephemeris++;
@@ -1099,7 +1233,6 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
     }
     /* The satellite clock at the transmit time t - P/c, applied to the code; its rate (central
      * difference over +-1 s: af1, af2 and the relativistic term) to the range rate. */
-    const double t_tx = t - c1c / NAV_GNSS_C_MPS;
     const double dt_sv = nav_rinex_gps_clock_s(e, t_tx, true);
     const double dt_sv_rate = 0.5 * (nav_rinex_gps_clock_s(e, t_tx + 1.0, true) - nav_rinex_gps_clock_s(e, t_tx - 1.0, true));
     nav_ins_gnss_sat_meas *x = &s->meas[m];

@@ -55,12 +55,13 @@ static const char *k_usage_replay =
     "                  come from --truth); navsim run --export kfgins writes run 0's initial state,\n"
     "                  drawn initial errors included, to kfgins/init.nav\n"
     "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n"
-    "  --rinex-obs FILE  tightly coupled replay: RINEX 3 observation file whose GPS C1C pseudoranges\n"
-    "                  and D1C Dopplers update the filter (nav_ins_gnss_update_raw) instead of --gnss\n"
+    "  --rinex-obs FILE  tightly coupled replay: RINEX 3 observation file whose GPS and GLONASS C1C\n"
+    "                  pseudoranges and D1C Dopplers update the filter (nav_ins_gnss_update_raw) instead of --gnss\n"
     "                  fixes; needs --rinex-nav and --scene (whose filter is made the tight scheme's,\n"
     "                  with its gnss.constellation code_sd_m, range_rate_sd_mps and receiver clock)\n"
-    "  --rinex-nav FILE  RINEX 3 navigation file: the GPS LNAV ephemerides of the satellites (orbits\n"
-    "                  and clocks propagated by the constellation code of the simulation)\n"
+    "  --rinex-nav FILE  RINEX 3 navigation file: GPS LNAV ephemerides (orbits and clocks propagated\n"
+    "                  by the constellation code of the simulation) and GLONASS records (integrated\n"
+    "                  with the ICD force model)\n"
     "  --t0-gps S      GPS time of the IMU files' t = 0, seconds since 1980-01-06 (default: the\n"
     "                  scene's gnss.constellation epoch, which is what navsim run --export writes;\n"
     "                  without one the start of the GPS week of the first observation, i.e. the IMU\n"
@@ -495,9 +496,9 @@ static nav_status write_summary(const char *path, const replay_job *j) {
     json_number(f, j->t0_gps_s);
     fprintf(f,
             ", \"epochs\": %ld, \"satellite_measurements\": %ld, \"skipped_no_ephemeris\": %ld, "
-            "\"skipped_unhealthy\": %ld, \"skipped_glonass\": %ld, \"skipped_no_c1c\": %ld, "
+            "\"skipped_unhealthy\": %ld, \"glonass_measurements\": %ld, \"skipped_no_c1c\": %ld, "
             "\"skipped_other_systems\": %ld, \"event_records\": %ld},\n",
-            c->epochs, c->sats_used, c->no_ephemeris, c->unhealthy, c->glonass_skipped, c->no_code,
+            c->epochs, c->sats_used, c->no_ephemeris, c->unhealthy, c->glonass_used, c->no_code,
             c->other_systems, c->events);
   }
   json_stats(f, 1, "errors", &s->stats, false);
@@ -596,10 +597,10 @@ static void print_tables(const replay_job *j, bool show_published) {
   printf("\n");
   if (j->rinex_obs) {
     const nav_rinex_source_counts *c = &j->rinex;
-    printf("raw gnss   %ld epochs read, %ld applied (%ld satellite measurements); skipped: %ld without "
-           "ephemeris, %ld unhealthy, %ld GLONASS (not replayed yet), %ld without C1C, %ld of other systems\n",
-           c->epochs, s->gnss_applied, c->sats_used, c->no_ephemeris, c->unhealthy, c->glonass_skipped,
-           c->no_code, c->other_systems);
+    printf("raw gnss   %ld epochs read, %ld applied (%ld satellite measurements, %ld GLONASS); skipped: %ld "
+           "without ephemeris, %ld unhealthy, %ld without C1C, %ld of other systems\n",
+           c->epochs, s->gnss_applied, c->sats_used, c->glonass_used, c->no_ephemeris, c->unhealthy, c->no_code,
+           c->other_systems);
   } else if (!s->free_ins)
     printf("gnss       %ld fixes applied, %ld dropped (outages), %ld before the start, %ld unmatched; %ld "
            "gap%s\n",

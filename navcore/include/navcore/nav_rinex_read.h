@@ -188,10 +188,14 @@ typedef struct nav_rinex_source_config {
   double rr_sd_mps;      /**< range-rate sigma for the filter [m/s] (> 0) */
   /** Largest |t - toe| of a usable GPS ephemeris [s]; default 7200 (the 4 h fit interval). */
   double max_eph_age_s;
+  /** Largest |t - tb| of a usable GLONASS record [s], at most 86400; default 1800 (records come
+   *  every 30 min, navsim writes them every 15 min). */
+  double max_glo_age_s;
   bool use_doppler;      /**< use D1C as range rate; default true */
 } nav_rinex_source_config;
 
-/** Defaults: no paths, t0 0, sigmas 3 m and 0.1 m/s, ephemeris age 7200 s, Doppler on. */
+/** Defaults: no paths, t0 0, sigmas 3 m and 0.1 m/s, ephemeris ages 7200 s (GPS) and 1800 s
+ *  (GLONASS), Doppler on. */
 NAV_API nav_rinex_source_config nav_rinex_source_config_default(void);
 
 /** What a source did so far. */
@@ -200,7 +204,7 @@ typedef struct nav_rinex_source_counts {
   long sats_used;         /**< satellite measurements returned */
   long no_ephemeris;      /**< satellites without a usable ephemeris (skipped) */
   long unhealthy;         /**< satellites whose ephemeris is unhealthy (skipped) */
-  long glonass_skipped;   /**< GLONASS satellites (not replayed yet: skipped) */
+  long glonass_used;      /**< GLONASS satellite measurements among sats_used */
   long no_code;           /**< satellites without C1C (skipped) */
   long events;            /**< event records skipped by the observation reader */
   long other_systems;     /**< satellites of other systems */
@@ -220,8 +224,12 @@ NAV_API void nav_rinex_source_destroy(nav_rinex_source *s);
  * t_s = t_gps - t0_gps_s; per GPS satellite with C1C and a usable ephemeris (the nearest toe
  * within max_eph_age_s, healthy), its orbit, P = C1C + c dt_sv (dt_sv of nav_rinex_gps_clock_s()
  * with T_GD, at the transmit time t - C1C / c), and the range rate -lambda_L1 D1C + c dt_sv'
- * (the clock's rate by a central difference over +-1 s) when D1C is present. GLONASS
- * satellites are skipped and counted. The epoch and the orbits it points to are
+ * (the clock's rate by a central difference over +-1 s) when D1C is present. Per GLONASS
+ * satellite with C1C and a healthy record within max_glo_age_s of t (nearest tb): the record's
+ * state integrated to t with the ICD force model (RK4, steps of at most 60 s) and expressed as
+ * the osculating orbit at t (nav_gnss_orbit, toe = t), P = C1C + c dt_sv
+ * (nav_rinex_glo_clock_s()), range rate -lambda_k D1C + c GammaN with the channel k of the
+ * header's GLONASS SLOT / FRQ # (else the record's). The epoch and the orbits it points to are
  * borrowed until the next call.
  * @return NAV_OK (got false at the end); NAV_ERR_PARSE with FILE:LINE:COL in @p diag (also for
  *         a GPS ephemeris with harmonic corrections, which nav_gnss_orbit cannot hold).
