@@ -946,6 +946,12 @@ nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmoni
   o.delta_n_rps = e->delta_n_rps;
   o.af0_s = e->af0_s;
   o.af1_sps = e->af1_sps;
+  o.cuc_rad = e->cuc_rad;
+  o.cus_rad = e->cus_rad;
+  o.crc_m = e->crc_m;
+  o.crs_m = e->crs_m;
+  o.cic_rad = e->cic_rad;
+  o.cis_rad = e->cis_rad;
   if (has_harmonics)
     *has_harmonics = e->crs_m != 0.0 || e->crc_m != 0.0 || e->cus_rad != 0.0 || e->cuc_rad != 0.0 ||
                      e->cis_rad != 0.0 || e->cic_rad != 0.0;
@@ -1221,16 +1227,7 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
       s->counts.unhealthy++;
       continue;
     }
-    bool harm = false;
-    s->orbits[m] = nav_rinex_gps_orbit(e, &harm);
-    if (harm) {
-      diag_set(diag, s->cfg.nav_path, (int)s->nav->gps_line[e - s->nav->gps], 1,
-               "G%02d: the ephemeris has harmonic corrections (C_rs ... C_is not all zero), which the replay's "
-               "orbit model (nav_gnss_orbit, almanac form) does not hold yet; expected zero corrections as navsim "
-               "writes them",
-               e->prn);
-      return NAV_ERR_PARSE;
-    }
+    s->orbits[m] = nav_rinex_gps_orbit(e, NULL);
     /* The satellite clock at the transmit time t - P/c, applied to the code; its rate (central
      * difference over +-1 s: af1, af2 and the relativistic term) to the range rate. */
     const double dt_sv = nav_rinex_gps_clock_s(e, t_tx, true);

@@ -456,34 +456,60 @@ static void test_source(void **state) {
   assert_non_null(strstr(d.message, "pseudorange sigma"));
 }
 
-/* An ephemeris with harmonic corrections is refused where it is used, at its record's line. */
-static void test_source_harmonics(void **state) {
+/*
+ * Harmonic corrections (every real broadcast record has them): read into the orbit and applied
+ * by nav_gnss_orbit_state() (IS-GPS-200N Table 20-IV). With C_rs alone the radius changes by
+ * C_rs sin 2 phi; with all six, the velocity equations must be the derivative of the positions
+ * (fourth-order central difference, h = 0.5 s: truncation and rounding below 1e-7 m/s; a
+ * second-order one would leave r_ddd h^2 / 6 = 3e-6 m/s).
+ */
+static void test_harmonic_corrections(void **state) {
   (void)state;
   size_t len = 0;
   char *text = edited(SMALL_NAV, "     0.170000000000D+02 0.000000000000D+00",
                       "     0.170000000000D+02 0.150000000000D+02", &len);
-  char path[] = "/tmp/test_rinex_read_XXXXXX";
-  const int fd = mkstemp(path);
-  assert_true(fd >= 0);
-  FILE *f = fdopen(fd, "wb");
-  assert_non_null(f);
-  fwrite(text, 1, len, f);
-  fclose(f);
-  free(text);
-  nav_rinex_source_config c = nav_rinex_source_config_default();
-  c.obs_path = SMALL_OBS;
-  c.nav_path = path;
-  nav_rinex_source *s = NULL;
+  nav_rinex_nav *nv = NULL;
   nav_diag d;
   memset(&d, 0, sizeof d);
-  assert_int_equal(nav_rinex_source_create(&c, &s, &d), NAV_OK);
-  nav_ins_gnss_raw_epoch ep;
-  bool got = false;
-  assert_int_equal(nav_rinex_source_next(s, &ep, &got, &d), NAV_ERR_PARSE);
-  assert_int_equal(d.line, 5);
-  assert_non_null(strstr(d.message, "G05: the ephemeris has harmonic corrections"));
-  nav_rinex_source_destroy(s);
-  remove(path);
+  assert_int_equal(nav_rinex_nav_read_memory(text, len, "harm.nav", &nv, &d), NAV_OK);
+  free(text);
+  bool harm = false;
+  const nav_gnss_orbit with = nav_rinex_gps_orbit(&nv->gps[0], &harm);
+  assert_true(harm);
+  assert_near(with.crs_m, 15.0, 0.0);
+  nav_gnss_orbit without = with;
+  without.crs_m = 0.0;
+  const double t = with.toe_s + 1234.5;
+  nav_vec3 r1, r0;
+  nav_gnss_orbit_state(&with, t, &r1, NULL);
+  nav_gnss_orbit_state(&without, t, &r0, NULL);
+  /* phi = nu + w at t from the uncorrected orbit's own elements. */
+  const double A = with.sqrt_a_sqrtm * with.sqrt_a_sqrtm;
+  const double n = sqrt(NAV_GPS_MU_M3PS2 / (A * A * A)) + with.delta_n_rps;
+  const double M = with.m0_rad + n * (t - with.toe_s);
+  double E = M;
+  for (int i = 0; i < 60; ++i) E = M + with.e * sin(E);
+  const double nu = atan2(sqrt(1.0 - with.e * with.e) * sin(E), cos(E) - with.e);
+  assert_near(nav_vec3_norm(r1) - nav_vec3_norm(r0), 15.0 * sin(2.0 * (nu + with.w_rad)), 1e-6);
+  /* All six: velocity against the derivative of the positions. */
+  nav_gnss_orbit all = with;
+  all.cuc_rad = 3e-6;
+  all.cus_rad = -5e-6;
+  all.crc_m = 200.0;
+  all.cic_rad = 1e-7;
+  all.cis_rad = -2e-7;
+  for (int k = 0; k < 5; ++k) {
+    const double tk = all.toe_s - 7200.0 + 3600.0 * k;
+    nav_vec3 v, r[4];
+    static const double hs[4] = {-1.0, -0.5, 0.5, 1.0}; /* exact offsets of an integer time */
+    nav_gnss_orbit_state(&all, tk, NULL, &v);
+    for (int i = 0; i < 4; ++i) nav_gnss_orbit_state(&all, tk + hs[i], &r[i], NULL);
+    /* Fourth-order central difference, h = 0.5 s: [8 (r(h) - r(-h)) - (r(2h) - r(-2h))] / (12 h). */
+    const nav_vec3 d1 = nav_vec3_sub(r[2], r[1]), d2 = nav_vec3_sub(r[3], r[0]);
+    const nav_vec3 fd = nav_vec3_scale(nav_vec3_sub(nav_vec3_scale(d1, 8.0), d2), 1.0 / 6.0);
+    assert_vec3_near(v, fd, 1e-6);
+  }
+  nav_rinex_nav_destroy(nv);
 }
 
 /*
@@ -599,7 +625,7 @@ int main(void) {
       cmocka_unit_test(test_errors),
       cmocka_unit_test(test_binary_and_long_lines),
       cmocka_unit_test(test_source),
-      cmocka_unit_test(test_source_harmonics),
+      cmocka_unit_test(test_harmonic_corrections),
       cmocka_unit_test(test_source_glonass_round_trip),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

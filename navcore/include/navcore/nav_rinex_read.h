@@ -166,9 +166,9 @@ NAV_API void nav_rinex_nav_destroy(nav_rinex_nav *n);
 
 /**
  * The orbit of a GPS ephemeris in the form the constellation code propagates
- * (nav_gnss_orbit_state()): Keplerian elements at toe, toe_s = toe_gps_s, satellite clock af0/af1
- * copied. The harmonic corrections (C_rs ... C_is) are not part of nav_gnss_orbit: @p has_harmonics
- * (may be NULL) tells whether any is non-zero (the replay refuses such ephemerides).
+ * (nav_gnss_orbit_state()): Keplerian elements at toe, toe_s = toe_gps_s, the harmonic
+ * corrections, satellite clock af0/af1 copied. @p has_harmonics (may be NULL) tells whether any
+ * harmonic correction is non-zero (always for real broadcast records, never for navsim's).
  */
 NAV_API nav_gnss_orbit nav_rinex_gps_orbit(const nav_rinex_gps_eph *e, bool *has_harmonics);
 
@@ -232,7 +232,7 @@ NAV_API void nav_rinex_source_destroy(nav_rinex_source *s);
  * header's GLONASS SLOT / FRQ # (else the record's). The epoch and the orbits it points to are
  * borrowed until the next call.
  * @return NAV_OK (got false at the end); NAV_ERR_PARSE with FILE:LINE:COL in @p diag (also for
- *         a GPS ephemeris with harmonic corrections, which nav_gnss_orbit cannot hold).
+ *         a GLONASS record whose state gives no closed orbit).
  */
 NAV_API NAV_NODISCARD nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep, bool *got,
                                                        nav_diag *diag);
