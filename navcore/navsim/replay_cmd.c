@@ -1127,6 +1127,11 @@ int navsim_replay(int argc, char **argv) {
                 "may be incomplete\n",
                 paths[i], cut[i]);
   }
+  if (rinex_obs && sum.gnss_applied == 0)
+    fprintf(stderr,
+            "%s: warning: no observation epoch fell on the IMU's time span %.3f .. %.3f s (IMU time = GPS time - "
+            "%.17g s, see --t0-gps); the replay ran without GNSS\n",
+            rinex_obs, sum.t_first_s, sum.t_last_s, t0_gps);
   for (int i = 0; i < 3; ++i) {
     const bool bad = ferror(o.f[i]) != 0;
     const int cl = fclose(o.f[i]);

@@ -230,6 +230,14 @@ static void refusals(void **state) {
                         base);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--t0-gps: expected GPS seconds");
+  /* A scene without gnss.constellation: t = 0 is the GPS week's start, the observations (GPS
+   * seconds of week about 374400) fall after the IMU data (0 .. 178 s) and the replay says so. */
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --scene '%s/scenes/urban-drive.yaml' --out W", base,
+                        NAV_SOURCE_DIR);
+  assert_int_equal(r->code, 0);
+  nav_test_assert_matches(r->err, "warning: no observation epoch fell on the IMU's time span 0.000 .. 177.880 s "
+                                  "\\(IMU time = GPS time - 1479340800 s");
   /* Files swapped: the navigation file where the observations belong. */
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s --rinex-obs " NAVF " --rinex-nav " OBS " --scene '%s' --out X",
                         base, SCENE);
