@@ -15,10 +15,10 @@
 static void civil_from_days(long z, int *y, int *m, int *d) {
   z += 719468; /* days from 0000-03-01 to 1970-01-01 */
   const long era = (z >= 0 ? z : z - 146096) / 146097;
-  const long doe = z - era * 146097;                                   /* [0, 146096] */
+  const long doe = z - era * 146097;                                      /* [0, 146096] */
   const long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365; /* [0, 399] */
-  const long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);             /* [0, 365] */
-  const long mp = (5 * doy + 2) / 153;                                  /* March = 0 */
+  const long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);               /* [0, 365] */
+  const long mp = (5 * doy + 2) / 153;                                    /* March = 0 */
   *d = (int)(doy - (153 * mp + 2) / 5 + 1);
   *m = (int)(mp < 10 ? mp + 3 : mp - 9);
   *y = (int)(yoe + era * 400 + (*m <= 2 ? 1 : 0));
@@ -40,9 +40,10 @@ nav_rinex_date nav_rinex_date_from_gps(double t_s) {
 
 int nav_rinex_leap_seconds(double t_gps_s) {
   /* Dates (UTC, 00:00) from which GPS - UTC grew by one second: IERS Bulletin C. */
-  static const int dates[][3] = {{1981, 7, 1}, {1982, 7, 1}, {1983, 7, 1}, {1985, 7, 1}, {1988, 1, 1}, {1990, 1, 1},
-                                 {1991, 1, 1}, {1992, 7, 1}, {1993, 7, 1}, {1994, 7, 1}, {1996, 1, 1}, {1997, 7, 1},
-                                 {1999, 1, 1}, {2006, 1, 1}, {2009, 1, 1}, {2012, 7, 1}, {2015, 7, 1}, {2017, 1, 1}};
+  static const int dates[][3] = {{1981, 7, 1}, {1982, 7, 1}, {1983, 7, 1}, {1985, 7, 1}, {1988, 1, 1},
+                                 {1990, 1, 1}, {1991, 1, 1}, {1992, 7, 1}, {1993, 7, 1}, {1994, 7, 1},
+                                 {1996, 1, 1}, {1997, 7, 1}, {1999, 1, 1}, {2006, 1, 1}, {2009, 1, 1},
+                                 {2012, 7, 1}, {2015, 7, 1}, {2017, 1, 1}};
   int leap = 0;
   for (size_t i = 0; i < sizeof dates / sizeof dates[0]; ++i) {
     /* The UTC date read on the GPS scale plus the GPS - UTC in force from it. */
@@ -83,8 +84,8 @@ nav_rinex_gps_eph nav_rinex_gps_eph_from_orbit(const nav_gnss_orbit *o, double t
   const double weeks = floor(toe_gps_s / NAV_GNSS_WEEK_S) - floor(o->toe_s / NAV_GNSS_WEEK_S);
   e.m0_rad = remainder(o->m0_rad + n * dt, 2.0 * NAV_PI);
   e.i0_rad = o->i0_rad + o->idot_rps * dt;
-  e.omega0_rad =
-      remainder(o->omega0_rad + o->omega_dot_rps * dt - NAV_GPS_OMEGA_E_RPS * NAV_GNSS_WEEK_S * weeks, 2.0 * NAV_PI);
+  e.omega0_rad = remainder(
+      o->omega0_rad + o->omega_dot_rps * dt - NAV_GPS_OMEGA_E_RPS * NAV_GNSS_WEEK_S * weeks, 2.0 * NAV_PI);
   e.toe_gps_s = toe_gps_s;
   e.toc_gps_s = toe_gps_s;
   e.af0_s = o->af0_s + o->af1_sps * dt;
@@ -173,7 +174,8 @@ nav_rinex_glo_eph nav_rinex_glo_eph_from_orbit(const nav_gnss_orbit *o, double t
   e.a_e_mps2 = force_gap(o, tb_gps_s);
   if (half_span_s > 0.0) {
     const double h = 60.0;
-    const nav_vec3 g1 = nav_vec3_scale(nav_vec3_sub(force_gap(o, tb_gps_s + h), force_gap(o, tb_gps_s - h)), 0.5 / h);
+    const nav_vec3 g1 =
+        nav_vec3_scale(nav_vec3_sub(force_gap(o, tb_gps_s + h), force_gap(o, tb_gps_s - h)), 0.5 / h);
     e.v_e_mps = nav_vec3_axpy(e.v_e_mps, 0.1 * half_span_s * half_span_s, g1);
   }
   return e;
@@ -193,7 +195,8 @@ typedef struct out {
 #if defined(__GNUC__)
 __attribute__((format(printf, 2, 3)))
 #endif
-static void put(out *o, const char *fmt, ...) {
+static void
+put(out *o, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   if (vfprintf(o->f, fmt, ap) < 0) o->ok = false;
@@ -250,9 +253,12 @@ nav_status nav_rinex_obs_write_header(FILE *f, const nav_rinex_obs_header *h) {
   for (int i = 0; i < h->n_glo; ++i)
     if (h->glo_slot[i] < 1 || h->glo_slot[i] > 99 || h->glo_channel[i] < -7 || h->glo_channel[i] > 13)
       return NAV_ERR_INVALID_ARG;
-  if (fabs(h->approx_pos_e_m.x) >= 1e8 || fabs(h->approx_pos_e_m.y) >= 1e8 || fabs(h->approx_pos_e_m.z) >= 1e8)
+  if (fabs(h->approx_pos_e_m.x) >= 1e8 || fabs(h->approx_pos_e_m.y) >= 1e8 ||
+      fabs(h->approx_pos_e_m.z) >= 1e8)
     return NAV_ERR_OUT_OF_RANGE;
-  const char only = h->n_types[NAV_GNSS_SYS_GLONASS] == 0 ? 'G' : h->n_types[NAV_GNSS_SYS_GPS] == 0 ? 'R' : 'M';
+  const char only = h->n_types[NAV_GNSS_SYS_GLONASS] == 0 ? 'G'
+                    : h->n_types[NAV_GNSS_SYS_GPS] == 0   ? 'R'
+                                                          : 'M';
   out o = {f, true};
   char line[128];
   snprintf(line, sizeof line, "%9.2f%11s%-20s%c", 3.04, "", "OBSERVATION DATA", only);
@@ -267,7 +273,8 @@ nav_status nav_rinex_obs_write_header(FILE *f, const nav_rinex_obs_header *h) {
   hline(&o, line, "REC # / TYPE / VERS");
   snprintf(line, sizeof line, "%-20s%-20.20s", "0", h->antenna_type);
   hline(&o, line, "ANT # / TYPE");
-  snprintf(line, sizeof line, "%14.4f%14.4f%14.4f", h->approx_pos_e_m.x, h->approx_pos_e_m.y, h->approx_pos_e_m.z);
+  snprintf(line, sizeof line, "%14.4f%14.4f%14.4f", h->approx_pos_e_m.x, h->approx_pos_e_m.y,
+           h->approx_pos_e_m.z);
   hline(&o, line, "APPROX POSITION XYZ");
   snprintf(line, sizeof line, "%14.4f%14.4f%14.4f", h->antenna_delta_hen_m.x, h->antenna_delta_hen_m.y,
            h->antenna_delta_hen_m.z);
@@ -276,7 +283,8 @@ nav_status nav_rinex_obs_write_header(FILE *f, const nav_rinex_obs_header *h) {
     if (h->n_types[s] == 0) continue;
     /* A1, 2X, I3, 13(1X, A3); more than 13 types continue on 6X lines (at most 8 here). */
     int len = snprintf(line, sizeof line, "%c  %3d", sys_char((nav_gnss_system)s), h->n_types[s]);
-    for (int k = 0; k < h->n_types[s]; ++k) len += snprintf(line + len, sizeof line - (size_t)len, " %s", h->types[s][k]);
+    for (int k = 0; k < h->n_types[s]; ++k)
+      len += snprintf(line + len, sizeof line - (size_t)len, " %s", h->types[s][k]);
     hline(&o, line, "SYS / # / OBS TYPES");
   }
   if (h->interval_s > 0.0) {
@@ -284,8 +292,8 @@ nav_status nav_rinex_obs_write_header(FILE *f, const nav_rinex_obs_header *h) {
     hline(&o, line, "INTERVAL");
   }
   const nav_rinex_date d = date_rounded(h->t_first_gps_s);
-  snprintf(line, sizeof line, "%6d%6d%6d%6d%6d%13.7f%5s%3s", d.year, d.month, d.day, d.hour, d.minute, d.second, "",
-           "GPS");
+  snprintf(line, sizeof line, "%6d%6d%6d%6d%6d%13.7f%5s%3s", d.year, d.month, d.day, d.hour, d.minute,
+           d.second, "", "GPS");
   hline(&o, line, "TIME OF FIRST OBS");
   /* Carrier phases carry no quarter-cycle shifts here: one record per system with no type. */
   for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) {
@@ -299,7 +307,8 @@ nav_status nav_rinex_obs_write_header(FILE *f, const nav_rinex_obs_header *h) {
     do {
       int len = i == 0 ? snprintf(line, sizeof line, "%3d ", h->n_glo) : snprintf(line, sizeof line, "    ");
       for (int k = 0; k < 8 && i < h->n_glo; ++k, ++i)
-        len += snprintf(line + len, sizeof line - (size_t)len, "R%02d %2d ", h->glo_slot[i], h->glo_channel[i]);
+        len +=
+            snprintf(line + len, sizeof line - (size_t)len, "R%02d %2d ", h->glo_slot[i], h->glo_channel[i]);
       hline(&o, line, "GLONASS SLOT / FRQ #");
     } while (i < h->n_glo);
     hline(&o, " C1C    0.000 C1P    0.000 C2C    0.000 C2P    0.000", "GLONASS COD/PHS/BIS");
@@ -327,17 +336,21 @@ nav_status nav_rinex_obs_write_epoch(FILE *f, const nav_rinex_obs_header *h, con
   out o = {f, true};
   const nav_rinex_date d = date_rounded(ep->t_gps_s);
   /* A1, 1X, I4, 4(1X, I2.2), F11.7, 2X, I1, I3 */
-  put(&o, "> %4d %02d %02d %02d %02d%11.7f  %d%3d\n", d.year, d.month, d.day, d.hour, d.minute, d.second, 0, ep->n);
+  put(&o, "> %4d %02d %02d %02d %02d%11.7f  %d%3d\n", d.year, d.month, d.day, d.hour, d.minute, d.second, 0,
+      ep->n);
   char line[16 * NAV_RINEX_MAX_OBS_TYPES + 8];
   for (int i = 0; i < ep->n; ++i) {
     const nav_rinex_obs_sat *s = &ep->sats[i];
     int len = snprintf(line, sizeof line, "%c%02d", sys_char(s->system), s->prn);
     for (int k = 0; k < h->n_types[s->system]; ++k) {
       /* F14.3, then the loss-of-lock and signal-strength flags (blank: unknown). */
-      if (s->has[k]) len += snprintf(line + len, sizeof line - (size_t)len, "%14.3f  ", s->value[k]);
-      else len += snprintf(line + len, sizeof line - (size_t)len, "%16s", "");
+      if (s->has[k])
+        len += snprintf(line + len, sizeof line - (size_t)len, "%14.3f  ", s->value[k]);
+      else
+        len += snprintf(line + len, sizeof line - (size_t)len, "%16s", "");
     }
-    while (len > 3 && line[len - 1] == ' ') line[--len] = '\0'; /* no trailing blanks */
+    while (len > 3 && line[len - 1] == ' ')
+      line[--len] = '\0'; /* no trailing blanks */
     put(&o, "%s\n", line);
   }
   return o.ok ? NAV_OK : NAV_ERR_IO;
@@ -380,10 +393,14 @@ static bool all_finite(const double *v, int n) {
 
 nav_status nav_rinex_nav_write_gps(FILE *f, const nav_rinex_gps_eph *e) {
   if (!f || !e || e->prn < 1 || e->prn > 99) return NAV_ERR_INVALID_ARG;
-  const double v[] = {e->toc_gps_s, e->af0_s,     e->af1_sps,  e->af2_sps2,      e->crs_m,    e->delta_n_rps,
-                      e->m0_rad,    e->cuc_rad,   e->e,        e->cus_rad,       e->sqrt_a_sqrtm, e->toe_gps_s,
-                      e->cic_rad,   e->omega0_rad, e->cis_rad, e->i0_rad,        e->crc_m,    e->w_rad,
-                      e->omega_dot_rps, e->idot_rps, e->sv_accuracy_m, e->tgd_s, e->t_tx_gps_s, e->fit_interval_h};
+  const double v[] = {e->toc_gps_s,     e->af0_s,        e->af1_sps,
+                      e->af2_sps2,      e->crs_m,        e->delta_n_rps,
+                      e->m0_rad,        e->cuc_rad,      e->e,
+                      e->cus_rad,       e->sqrt_a_sqrtm, e->toe_gps_s,
+                      e->cic_rad,       e->omega0_rad,   e->cis_rad,
+                      e->i0_rad,        e->crc_m,        e->w_rad,
+                      e->omega_dot_rps, e->idot_rps,     e->sv_accuracy_m,
+                      e->tgd_s,         e->t_tx_gps_s,   e->fit_interval_h};
   if (!all_finite(v, (int)(sizeof v / sizeof v[0])) || e->toc_gps_s < 0.0) return NAV_ERR_INVALID_ARG;
   out o = {f, true};
   const double toc = floor(e->toc_gps_s + 0.5); /* the epoch line has whole seconds */
@@ -413,9 +430,9 @@ nav_status nav_rinex_nav_write_glonass(FILE *f, const nav_rinex_glo_eph *e, int 
   if (!f || !e || e->slot < 1 || e->slot > 99 || leap_seconds < 0 || leap_seconds > 99 || e->channel < -7 ||
       e->channel > 13)
     return NAV_ERR_INVALID_ARG;
-  const double v[] = {e->tb_gps_s, e->clock_bias_s, e->gamma_n, e->tk_gps_s, e->r_e_m.x, e->r_e_m.y,
-                      e->r_e_m.z,  e->v_e_mps.x,    e->v_e_mps.y, e->v_e_mps.z, e->a_e_mps2.x, e->a_e_mps2.y,
-                      e->a_e_mps2.z};
+  const double v[] = {e->tb_gps_s,   e->clock_bias_s, e->gamma_n,   e->tk_gps_s,  e->r_e_m.x,
+                      e->r_e_m.y,    e->r_e_m.z,      e->v_e_mps.x, e->v_e_mps.y, e->v_e_mps.z,
+                      e->a_e_mps2.x, e->a_e_mps2.y,   e->a_e_mps2.z};
   if (!all_finite(v, (int)(sizeof v / sizeof v[0])) || e->tb_gps_s < 0.0) return NAV_ERR_INVALID_ARG;
   out o = {f, true};
   /* The epoch (tb) and the message frame time are UTC in a GLONASS record (RINEX 3.04 A11). */

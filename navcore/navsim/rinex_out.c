@@ -37,8 +37,8 @@ struct navsim_rinex {
   FILE *f[F_COUNT];
   nav_truth *truth;
   nav_frame frame;
-  nav_gnss_model *gnss;    /* run 0's receiver epochs and outages */
-  nav_sim_gnss_raw *raw;   /* run 0's raw measurements */
+  nav_gnss_model *gnss;  /* run 0's receiver epochs and outages */
+  nav_sim_gnss_raw *raw; /* run 0's raw measurements */
   nav_gnss_constellation c;
   double dt_s;
   int64_t next_epoch;
@@ -63,7 +63,8 @@ const char *navsim_rinex_unsupported(const nav_scene *sc) {
   if (!sc->gnss.constellation.enabled)
     return "the rinex export writes the simulated pseudoranges of gnss.constellation; this scene has no "
            "gnss.constellation section";
-  if (!sc->gnss.enabled) return "the rinex export needs a gnss receiver (gnss.enabled) for its epochs and outages";
+  if (!sc->gnss.enabled)
+    return "the rinex export needs a gnss receiver (gnss.enabled) for its epochs and outages";
   if (sc->earth.model != NAV_EARTH_WGS84) return "the rinex export needs earth.model wgs84";
   if (sc->gnss.file[0] != '\0')
     return "the rinex export writes simulated raw data; this scene's fixes come from gnss.file";
@@ -81,8 +82,8 @@ void navsim_rinex_destroy(navsim_rinex *x) {
   free(x);
 }
 
-nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir *rd, navsim_rinex **out, char *msg,
-                              size_t msg_cap) {
+nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir *rd, navsim_rinex **out,
+                              char *msg, size_t msg_cap) {
   *out = NULL;
   const char *why = navsim_rinex_unsupported(scene);
   if (why) {
@@ -130,8 +131,10 @@ nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir 
     goto fail;
   }
   for (int i = 0; i < F_COUNT; ++i) {
-    if (i == F_PVT) snprintf(rel, sizeof rel, "rinex/pvt.csv");
-    else snprintf(rel, sizeof rel, "rinex/%s.%s", nm, i == F_OBS ? "obs" : "nav");
+    if (i == F_PVT)
+      snprintf(rel, sizeof rel, "rinex/pvt.csv");
+    else
+      snprintf(rel, sizeof rel, "rinex/%s.%s", nm, i == F_OBS ? "obs" : "nav");
     const char *p = nav_resultdir_file(rd, rel);
     x->f[i] = p ? fopen(p, "w") : NULL;
     if (!x->f[i]) {
@@ -140,7 +143,8 @@ nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir 
       goto fail;
     }
   }
-  if (fputs("t_s,t_gps_s,n_sats,x_m,y_m,z_m,ref_x_m,ref_y_m,ref_z_m,sd_n_m,sd_e_m,sd_d_m,pdop\n", x->f[F_PVT]) < 0) {
+  if (fputs("t_s,t_gps_s,n_sats,x_m,y_m,z_m,ref_x_m,ref_y_m,ref_z_m,sd_n_m,sd_e_m,sd_d_m,pdop\n",
+            x->f[F_PVT]) < 0) {
     st = NAV_ERR_IO;
     goto fail;
   }
@@ -154,7 +158,8 @@ nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir 
   snprintf(h->antenna_type, sizeof h->antenna_type, "NONE");
   const nav_gnss_constellation_config *cc = &sc->gnss.constellation;
   for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) {
-    const bool on = s == NAV_GNSS_SYS_GPS ? cc->gps != NAV_GNSS_SOURCE_OFF : cc->glonass != NAV_GNSS_SOURCE_OFF;
+    const bool on =
+        s == NAV_GNSS_SYS_GPS ? cc->gps != NAV_GNSS_SOURCE_OFF : cc->glonass != NAV_GNSS_SOURCE_OFF;
     if (!on) continue;
     h->n_types[s] = 2;
     snprintf(h->types[s][0], 4, "C1C");
@@ -206,7 +211,8 @@ static nav_status write_epoch(navsim_rinex *x, const nav_traj_state *ts, char *m
   }
   /* The reference antenna: r_a = r_b + C_b_e l (as the receiver measures it). */
   const nav_local_view v = nav_frame_view(&x->frame, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f);
-  const nav_mat3 C_b_e = nav_mat3_mul(nav_earth_dcm_n_e(v.pos.lat_rad, v.pos.lon_rad), nav_quat_to_dcm(v.q_b_n));
+  const nav_mat3 C_b_e =
+      nav_mat3_mul(nav_earth_dcm_n_e(v.pos.lat_rad, v.pos.lon_rad), nav_quat_to_dcm(v.q_b_n));
   const nav_vec3 r_ea_e =
       nav_vec3_add(nav_earth_geodetic_to_ecef(v.pos), nav_mat3_mul_vec(C_b_e, x->scene->gnss.model.r_ba_b_m));
   if (ep.n == 0) return NAV_OK;
@@ -270,9 +276,9 @@ static nav_status write_epoch(navsim_rinex *x, const nav_traj_state *ts, char *m
   st = nav_gnss_pvt_solve(npr, pr, ep.t_gps_s, &p);
   if (st != NAV_OK) return NAV_OK; /* no solution at this epoch: no row */
   const nav_vec3 sd = nav_vec3_scale(p.dop_ned, ep.pr_sd_m);
-  if (fprintf(x->f[F_PVT], "%.6f,%.6f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", ep.t_s, ep.t_gps_s,
-              p.n_used, p.r_e_m.x, p.r_e_m.y, p.r_e_m.z, r_ea_e.x, r_ea_e.y, r_ea_e.z, sd.x, sd.y, sd.z,
-              p.dop.pdop) < 0)
+  if (fprintf(x->f[F_PVT], "%.6f,%.6f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", ep.t_s,
+              ep.t_gps_s, p.n_used, p.r_e_m.x, p.r_e_m.y, p.r_e_m.z, r_ea_e.x, r_ea_e.y, r_ea_e.z, sd.x, sd.y,
+              sd.z, p.dop.pdop) < 0)
     return NAV_ERR_IO;
   return NAV_OK;
 }
@@ -334,8 +340,8 @@ nav_status navsim_rinex_end(navsim_rinex *x, char *msg, size_t cap) {
     for (long rec = 0; rec < nrec && st == NAV_OK; ++rec) {
       const double t = t0 + (double)rec * step;
       if (glo) {
-        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(o, t, nav_rinex_glonass_nominal_channel(o->prn),
-                                                                 0.5 * NAVSIM_RINEX_GLO_STEP_S);
+        const nav_rinex_glo_eph e = nav_rinex_glo_eph_from_orbit(
+            o, t, nav_rinex_glonass_nominal_channel(o->prn), 0.5 * NAVSIM_RINEX_GLO_STEP_S);
         st = nav_rinex_nav_write_glonass(x->f[F_NAV], &e, leap);
       } else {
         /* IODE distinguishes a satellite's records (readers drop repeated IODEs). */

@@ -36,8 +36,8 @@ typedef struct navsim_rinex navsim_rinex;
 const char *navsim_rinex_unsupported(const nav_scene *scene);
 
 /* Create rinex/ in @p rd and open its files. @p msg (may be NULL) says what failed. */
-nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir *rd, navsim_rinex **out, char *msg,
-                              size_t msg_cap);
+nav_status navsim_rinex_begin(const nav_scene *scene, bool ideal, nav_resultdir *rd, navsim_rinex **out,
+                              char *msg, size_t msg_cap);
 
 /* Called with every output record (other runs' records are ignored): writes the receiver epochs
  * up to the record's time. */

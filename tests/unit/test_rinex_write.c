@@ -76,7 +76,8 @@ static void test_calendar_and_leap_seconds(void **state) {
   /* Antipodal GLONASS slots share a channel. */
   for (int s = 1; s <= 24; ++s) {
     const int plane_pos = (s - 1) % 8;
-    if (plane_pos < 4) assert_int_equal(nav_rinex_glonass_nominal_channel(s), nav_rinex_glonass_nominal_channel(s + 4));
+    if (plane_pos < 4)
+      assert_int_equal(nav_rinex_glonass_nominal_channel(s), nav_rinex_glonass_nominal_channel(s + 4));
   }
   assert_int_equal(nav_rinex_glonass_nominal_channel(25), 0);
   assert_near(nav_rinex_l1_hz(NAV_GNSS_SYS_GLONASS, -7), 1598.0625e6, 1e-3);
@@ -121,9 +122,10 @@ static void test_obs_header_and_epoch_columns(void **state) {
   /* Every header line: 60 columns of content, the label from column 61, at most 80 columns. */
   char line[256];
   int k = 0, end = -1;
-  const char *labels[] = {"RINEX VERSION / TYPE", "PGM / RUN BY / DATE", "MARKER NAME", "APPROX POSITION XYZ",
-                          "SYS / # / OBS TYPES", "TIME OF FIRST OBS", "GLONASS SLOT / FRQ #", "LEAP SECONDS",
-                          "INTERVAL", "GLONASS COD/PHS/BIS"};
+  const char *labels[] = {"RINEX VERSION / TYPE", "PGM / RUN BY / DATE", "MARKER NAME",
+                          "APPROX POSITION XYZ",  "SYS / # / OBS TYPES", "TIME OF FIRST OBS",
+                          "GLONASS SLOT / FRQ #", "LEAP SECONDS",        "INTERVAL",
+                          "GLONASS COD/PHS/BIS"};
   int seen[sizeof labels / sizeof labels[0]] = {0};
   for (;; ++k) {
     line_of(text, k, line, sizeof line);
@@ -136,7 +138,8 @@ static void test_obs_header_and_epoch_columns(void **state) {
       break;
     }
   }
-  for (size_t i = 0; i < sizeof labels / sizeof labels[0]; ++i) assert_true(seen[i] >= 1);
+  for (size_t i = 0; i < sizeof labels / sizeof labels[0]; ++i)
+    assert_true(seen[i] >= 1);
   line_of(text, 0, line, sizeof line);
   assert_memory_equal(line, "     3.04", 9); /* F9.2 */
   assert_int_equal(line[20], 'O');
@@ -260,7 +263,8 @@ static void test_gps_record_reproduces_orbit(void **state) {
     lo = rel < lo ? rel : lo;
     hi = rel > hi ? rel : hi;
   }
-  assert_near(hi, 2.0 * sqrt(NAV_GPS_MU_M3PS2) / (NAV_GNSS_C_MPS * NAV_GNSS_C_MPS) * o.e * o.sqrt_a_sqrtm, 2e-10);
+  assert_near(hi, 2.0 * sqrt(NAV_GPS_MU_M3PS2) / (NAV_GNSS_C_MPS * NAV_GNSS_C_MPS) * o.e * o.sqrt_a_sqrtm,
+              2e-10);
   assert_near(lo, -hi, 2e-10);
 }
 
@@ -281,9 +285,11 @@ static void test_nav_records_columns(void **state) {
   char *text = sink_close(&s);
   char line[256];
   line_of(text, 0, line, sizeof line);
-  assert_string_equal(line, "     3.04           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE");
+  assert_string_equal(line,
+                      "     3.04           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE");
   line_of(text, 3, line, sizeof line);
-  assert_string_equal(line, "                                                            END OF HEADER       "); /* A20 */
+  assert_string_equal(
+      line, "                                                            END OF HEADER       "); /* A20 */
   /* GPS: toe + 2 h is in week 2447, at 01:15:12 on Sunday (602112 + 7200 - 604800 = 4512 s). */
   line_of(text, 4, line, sizeof line);
   assert_int_equal((int)strlen(line), 23 + 3 * 19);
@@ -335,8 +341,10 @@ static void test_nav_records_columns(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_calendar_and_leap_seconds), cmocka_unit_test(test_obs_header_and_epoch_columns),
-      cmocka_unit_test(test_obs_bad_input),             cmocka_unit_test(test_gps_record_reproduces_orbit),
+      cmocka_unit_test(test_calendar_and_leap_seconds),
+      cmocka_unit_test(test_obs_header_and_epoch_columns),
+      cmocka_unit_test(test_obs_bad_input),
+      cmocka_unit_test(test_gps_record_reproduces_orbit),
       cmocka_unit_test(test_nav_records_columns),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -68,21 +68,21 @@ NAV_API int nav_rinex_glonass_nominal_channel(int slot);
 
 /** Observation-file header (RINEX 3.04 Table A2), the records navsim uses. */
 typedef struct nav_rinex_obs_header {
-  char marker_name[61];             /**< MARKER NAME */
-  char program[21];                 /**< PGM / RUN BY / DATE: program */
-  char run_by[21];                  /**< PGM / RUN BY / DATE: run by */
-  char date[21];                    /**< PGM / RUN BY / DATE: creation date "yyyymmdd hhmmss UTC" */
-  char receiver_type[21];           /**< REC # / TYPE / VERS: type */
-  char antenna_type[21];            /**< ANT # / TYPE: type */
-  nav_vec3 approx_pos_e_m;          /**< APPROX POSITION XYZ, ECEF [m] */
-  nav_vec3 antenna_delta_hen_m;     /**< ANTENNA: DELTA H/E/N [m] */
+  char marker_name[61];         /**< MARKER NAME */
+  char program[21];             /**< PGM / RUN BY / DATE: program */
+  char run_by[21];              /**< PGM / RUN BY / DATE: run by */
+  char date[21];                /**< PGM / RUN BY / DATE: creation date "yyyymmdd hhmmss UTC" */
+  char receiver_type[21];       /**< REC # / TYPE / VERS: type */
+  char antenna_type[21];        /**< ANT # / TYPE: type */
+  nav_vec3 approx_pos_e_m;      /**< APPROX POSITION XYZ, ECEF [m] */
+  nav_vec3 antenna_delta_hen_m; /**< ANTENNA: DELTA H/E/N [m] */
   /** SYS / # / OBS TYPES per system (index nav_gnss_system): n_types[s] = 0 leaves the system
    *  out; types are three-character codes ("C1C", "L1C", "D1C", "S1C"). */
   int n_types[NAV_GNSS_SYS_COUNT];
   char types[NAV_GNSS_SYS_COUNT][NAV_RINEX_MAX_OBS_TYPES][4];
-  double interval_s;                /**< INTERVAL [s]; <= 0: record omitted */
-  double t_first_gps_s;             /**< TIME OF FIRST OBS (GPS time scale) */
-  int leap_seconds;                 /**< LEAP SECONDS (GPS - UTC) [s] */
+  double interval_s;    /**< INTERVAL [s]; <= 0: record omitted */
+  double t_first_gps_s; /**< TIME OF FIRST OBS (GPS time scale) */
+  int leap_seconds;     /**< LEAP SECONDS (GPS - UTC) [s] */
   /** GLONASS SLOT / FRQ #: slot (1..24) and frequency channel (-7..6) of every GLONASS
    *  satellite in the file. */
   int n_glo;
@@ -93,9 +93,9 @@ typedef struct nav_rinex_obs_header {
 /** One satellite's observations at an epoch, in the order of its system's header types. */
 typedef struct nav_rinex_obs_sat {
   nav_gnss_system system;
-  int prn;                                /**< GPS PRN / GLONASS slot */
-  bool has[NAV_RINEX_MAX_OBS_TYPES];      /**< false: blank field */
-  double value[NAV_RINEX_MAX_OBS_TYPES];  /**< C [m], L [cycles], D [Hz], S [dB-Hz] */
+  int prn;                               /**< GPS PRN / GLONASS slot */
+  bool has[NAV_RINEX_MAX_OBS_TYPES];     /**< false: blank field */
+  double value[NAV_RINEX_MAX_OBS_TYPES]; /**< C [m], L [cycles], D [Hz], S [dB-Hz] */
 } nav_rinex_obs_sat;
 
 /** One observation epoch (RINEX 3.04 Table A3, epoch flag 0). */
@@ -110,12 +110,12 @@ typedef struct nav_rinex_obs_epoch {
 /** GPS LNAV broadcast ephemeris (RINEX 3.04 Table A8; IS-GPS-200N Table 20-III). */
 typedef struct nav_rinex_gps_eph {
   int prn;
-  double toc_gps_s;       /**< clock reference time (record epoch; whole seconds) */
+  double toc_gps_s; /**< clock reference time (record epoch; whole seconds) */
   double af0_s, af1_sps, af2_sps2;
   int iode;
   double crs_m, delta_n_rps, m0_rad;
   double cuc_rad, e, cus_rad, sqrt_a_sqrtm;
-  double toe_gps_s;       /**< ephemeris reference time (file: seconds of week + week) */
+  double toe_gps_s; /**< ephemeris reference time (file: seconds of week + week) */
   double cic_rad, omega0_rad, cis_rad;
   double i0_rad, crc_m, w_rad, omega_dot_rps;
   double idot_rps;
@@ -124,23 +124,23 @@ typedef struct nav_rinex_gps_eph {
   int health;
   double tgd_s;
   int iodc;
-  double t_tx_gps_s;      /**< transmission time of message */
+  double t_tx_gps_s; /**< transmission time of message */
   double fit_interval_h;
 } nav_rinex_gps_eph;
 
 /** GLONASS ephemeris: the satellite's PZ-90 state at tb (RINEX 3.04 Table A11). */
 typedef struct nav_rinex_glo_eph {
   int slot;
-  double tb_gps_s;        /**< reference time tb on the GPS scale (the file holds it as UTC) */
-  double clock_bias_s;    /**< SV clock bias -TauN [s] (satellite time minus system time) */
-  double gamma_n;         /**< relative frequency bias GammaN */
-  double tk_gps_s;        /**< message frame time on the GPS scale (file: seconds of UTC week) */
-  nav_vec3 r_e_m;         /**< position at tb [m] */
-  nav_vec3 v_e_mps;       /**< velocity at tb [m/s] */
-  nav_vec3 a_e_mps2;      /**< the luni-solar acceleration term at tb [m/s^2] */
+  double tb_gps_s;     /**< reference time tb on the GPS scale (the file holds it as UTC) */
+  double clock_bias_s; /**< SV clock bias -TauN [s] (satellite time minus system time) */
+  double gamma_n;      /**< relative frequency bias GammaN */
+  double tk_gps_s;     /**< message frame time on the GPS scale (file: seconds of UTC week) */
+  nav_vec3 r_e_m;      /**< position at tb [m] */
+  nav_vec3 v_e_mps;    /**< velocity at tb [m/s] */
+  nav_vec3 a_e_mps2;   /**< the luni-solar acceleration term at tb [m/s^2] */
   int health;
-  int channel;            /**< frequency number -7..13 */
-  int age_d;              /**< age of operation information [days] */
+  int channel; /**< frequency number -7..13 */
+  int age_d;   /**< age of operation information [days] */
 } nav_rinex_glo_eph;
 
 /** Navigation-file header (RINEX 3.04 Table A5), the records navsim writes. */
@@ -208,7 +208,8 @@ NAV_API NAV_NODISCARD nav_status nav_rinex_nav_write_gps(FILE *f, const nav_rine
 
 /** Write a GLONASS record (epoch line in UTC with @p leap_seconds, three broadcast-orbit lines
  *  in km, km/s, km/s^2). @return as nav_rinex_nav_write_gps(). */
-NAV_API NAV_NODISCARD nav_status nav_rinex_nav_write_glonass(FILE *f, const nav_rinex_glo_eph *e, int leap_seconds);
+NAV_API NAV_NODISCARD nav_status nav_rinex_nav_write_glonass(FILE *f, const nav_rinex_glo_eph *e,
+                                                             int leap_seconds);
 
 NAV_END_DECLS
 
