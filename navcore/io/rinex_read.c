@@ -46,7 +46,8 @@ static void diag_set(nav_diag *d, const char *file, int line, int col, const cha
   va_end(ap);
 }
 
-static nav_status lfail(lines *L, nav_status st, int col, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static nav_status lfail(lines *L, nav_status st, int col, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 static nav_status lfail(lines *L, nav_status st, int col, const char *fmt, ...) {
   char msg[sizeof L->diag.message];
   va_list ap;
@@ -150,7 +151,8 @@ static bool all_blank(const char *s) {
 /* Printable copy of a field for messages. */
 static void shown(const char *s, char *dst, size_t cap) {
   size_t j = 0;
-  for (; *s && j + 1 < cap; ++s) dst[j++] = ((unsigned char)*s < 0x20 || (unsigned char)*s >= 0x7f) ? '?' : *s;
+  for (; *s && j + 1 < cap; ++s)
+    dst[j++] = ((unsigned char)*s < 0x20 || (unsigned char)*s >= 0x7f) ? '?' : *s;
   dst[j] = '\0';
 }
 
@@ -167,11 +169,14 @@ static nav_status num(lines *L, int col, int w, const char *what, double *v, boo
       *blank = true;
       return NAV_OK;
     }
-    return lfail(L, NAV_ERR_PARSE, col, "%s: blank; expected a number in columns %d-%d", what, col, col + w - 1);
+    return lfail(L, NAV_ERR_PARSE, col, "%s: blank; expected a number in columns %d-%d", what, col,
+                 col + w - 1);
   }
   int a = 0, b = w;
-  while (f[a] == ' ') ++a;
-  while (b > a && f[b - 1] == ' ') --b;
+  while (f[a] == ' ')
+    ++a;
+  while (b > a && f[b - 1] == ' ')
+    --b;
   int k = 0;
   bool ok = true;
   for (int i = a; i < b; ++i) {
@@ -193,8 +198,9 @@ static nav_status num(lines *L, int col, int w, const char *what, double *v, boo
     char sh[64];
     shown(f + a, sh, sizeof sh);
     sh[b - a < (int)sizeof sh ? b - a : (int)sizeof sh - 1] = '\0';
-    return lfail(L, NAV_ERR_PARSE, col + a, "%s: \"%s\" is not a number; expected a finite number in columns %d-%d",
-                 what, sh, col, col + w - 1);
+    return lfail(L, NAV_ERR_PARSE, col + a,
+                 "%s: \"%s\" is not a number; expected a finite number in columns %d-%d", what, sh, col,
+                 col + w - 1);
   }
   *v = x;
   return NAV_OK;
@@ -206,8 +212,8 @@ static nav_status inum(lines *L, int col, int w, const char *what, int lo, int h
   nav_status st = num(L, col, w, what, &x, NULL);
   if (st != NAV_OK) return st;
   if (x != floor(x) || x < lo || x > hi)
-    return lfail(L, NAV_ERR_PARSE, col, "%s: %.12g; expected an integer in [%d, %d] in columns %d-%d", what, x, lo,
-                 hi, col, col + w - 1);
+    return lfail(L, NAV_ERR_PARSE, col, "%s: %.12g; expected an integer in [%d, %d] in columns %d-%d", what,
+                 x, lo, hi, col, col + w - 1);
   *v = (int)x;
   return NAV_OK;
 }
@@ -215,7 +221,8 @@ static nav_status inum(lines *L, int col, int w, const char *what, int lo, int h
 /* The header label of the line (columns 61-80, trailing blanks dropped). */
 static void label_of(const lines *L, char *dst) {
   field(L, 61, 20, dst);
-  for (int i = 19; i >= 0 && dst[i] == ' '; --i) dst[i] = '\0';
+  for (int i = 19; i >= 0 && dst[i] == ' '; --i)
+    dst[i] = '\0';
 }
 
 /* Civil epoch "yyyy mm dd hh mm ss.s" fields to GPS time, checked. cols: year, month, day, hour,
@@ -235,7 +242,8 @@ static nav_status epoch_fields(lines *L, const int col[6], const int w[6], doubl
     return lfail(L, NAV_ERR_PARSE, col[5], "second: %.12g; expected 0 <= second < 61", sec);
   static const int mdays[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
   if (v[2] > mdays[v[1] - 1])
-    return lfail(L, NAV_ERR_PARSE, col[2], "day: %d; month %d has at most %d days", v[2], v[1], mdays[v[1] - 1]);
+    return lfail(L, NAV_ERR_PARSE, col[2], "day: %d; month %d has at most %d days", v[2], v[1],
+                 mdays[v[1] - 1]);
   *t_gps = nav_gnss_gps_time_s(v[0], v[1], v[2], v[3], v[4], sec);
   return NAV_OK;
 }
@@ -248,13 +256,14 @@ static nav_status version_line(lines *L, char want_type, double *version, char *
   if (st != NAV_OK) return st;
   if (!got) {
     L->line = 1;
-    return lfail(L, NAV_ERR_PARSE, 1, "empty file; expected a RINEX 3 header starting with RINEX VERSION / TYPE");
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "empty file; expected a RINEX 3 header starting with RINEX VERSION / TYPE");
   }
   char lab[21];
   label_of(L, lab);
   if (strcmp(lab, "RINEX VERSION / TYPE") != 0)
-    return lfail(L, NAV_ERR_PARSE, 61, "first line: label \"%s\"; expected RINEX VERSION / TYPE in columns 61-80",
-                 lab);
+    return lfail(L, NAV_ERR_PARSE, 61,
+                 "first line: label \"%s\"; expected RINEX VERSION / TYPE in columns 61-80", lab);
   st = num(L, 1, 9, "RINEX version", version, NULL);
   if (st != NAV_OK) return st;
   if (!(*version >= 3.0 && *version < 4.0))
@@ -262,8 +271,8 @@ static nav_status version_line(lines *L, char want_type, double *version, char *
   char t[2];
   field(L, 21, 1, t);
   if (t[0] != want_type)
-    return lfail(L, NAV_ERR_PARSE, 21, "file type '%c'; expected '%c' (%s file) in column 21", t[0] == ' ' ? '?' : t[0],
-                 want_type, want_type == 'O' ? "observation" : "navigation");
+    return lfail(L, NAV_ERR_PARSE, 21, "file type '%c'; expected '%c' (%s file) in column 21",
+                 t[0] == ' ' ? '?' : t[0], want_type, want_type == 'O' ? "observation" : "navigation");
   field(L, 41, 1, t);
   *system = t[0] == ' ' ? 'G' : t[0];
   return NAV_OK;
@@ -347,7 +356,8 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
           in->skipped_systems++;
         } else {
           if (r->n_file[idx] > 0)
-            return lfail(L, NAV_ERR_PARSE, 1, "second SYS / # / OBS TYPES record of system %c; expected one", c[0]);
+            return lfail(L, NAV_ERR_PARSE, 1, "second SYS / # / OBS TYPES record of system %c; expected one",
+                         c[0]);
           if (count > NAV_RINEX_MAX_FILE_TYPES)
             return lfail(L, NAV_ERR_PARSE, 4, "%d observation types; at most %d are supported", count,
                          NAV_RINEX_MAX_FILE_TYPES);
@@ -357,12 +367,13 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
       for (int k = 0; k < on_line; ++k) {
         char t[4];
         field(L, 8 + 4 * k, 3, t);
-        if (t[0] < 'A' || t[0] > 'Z' || t[1] < '0' || t[1] > '9' || t[2] == ' ' || (unsigned char)t[2] < 0x20 ||
-            (unsigned char)t[2] >= 0x7f) {
+        if (t[0] < 'A' || t[0] > 'Z' || t[1] < '0' || t[1] > '9' || t[2] == ' ' ||
+            (unsigned char)t[2] < 0x20 || (unsigned char)t[2] >= 0x7f) {
           char sh[8];
           shown(t, sh, sizeof sh);
           return lfail(L, NAV_ERR_PARSE, 8 + 4 * k,
-                       "observation type \"%s\"; expected a RINEX 3 type such as C1C (type, band, attribute)", sh);
+                       "observation type \"%s\"; expected a RINEX 3 type such as C1C (type, band, attribute)",
+                       sh);
         }
         if (idx >= 0) {
           const int j = r->n_file[idx]++;
@@ -378,13 +389,15 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
       continue;
     }
     if (pending_left > 0)
-      return lfail(L, NAV_ERR_PARSE, 61,
-                   "label \"%s\" while %d observation type(s) are still missing; expected a SYS / # / OBS TYPES "
-                   "continuation line",
-                   lab, pending_left);
+      return lfail(
+          L, NAV_ERR_PARSE, 61,
+          "label \"%s\" while %d observation type(s) are still missing; expected a SYS / # / OBS TYPES "
+          "continuation line",
+          lab, pending_left);
     if (strcmp(lab, "MARKER NAME") == 0) {
       field(L, 1, 60, h->marker_name);
-      for (int i = 59; i >= 0 && h->marker_name[i] == ' '; --i) h->marker_name[i] = '\0';
+      for (int i = 59; i >= 0 && h->marker_name[i] == ' '; --i)
+        h->marker_name[i] = '\0';
     } else if (strcmp(lab, "APPROX POSITION XYZ") == 0) {
       double x[3];
       for (int i = 0; i < 3; ++i) {
@@ -402,7 +415,8 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
     } else if (strcmp(lab, "INTERVAL") == 0) {
       st = num(L, 1, 10, "interval", &h->interval_s, NULL);
       if (st != NAV_OK) return st;
-      if (!(h->interval_s > 0.0)) return lfail(L, NAV_ERR_PARSE, 1, "interval %.12g s; expected > 0", h->interval_s);
+      if (!(h->interval_s > 0.0))
+        return lfail(L, NAV_ERR_PARSE, 1, "interval %.12g s; expected > 0", h->interval_s);
     } else if (strcmp(lab, "LEAP SECONDS") == 0) {
       st = inum(L, 1, 6, "leap seconds", 0, 99, &h->leap_seconds);
       if (st != NAV_OK) return st;
@@ -417,13 +431,15 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
         char sh[8];
         shown(time_sys, sh, sizeof sh);
         return lfail(L, NAV_ERR_PARSE, 49,
-                     "time system \"%s\"; only GPS time is supported (expected GPS, or blank in a GPS file)", sh);
+                     "time system \"%s\"; only GPS time is supported (expected GPS, or blank in a GPS file)",
+                     sh);
       }
       if (all_blank(time_sys) && in->system != 'G')
-        return lfail(L, NAV_ERR_PARSE, 49,
-                     "blank time system in a file of system %c; expected GPS in columns 49-51 (only GPS time is "
-                     "supported)",
-                     in->system);
+        return lfail(
+            L, NAV_ERR_PARSE, 49,
+            "blank time system in a file of system %c; expected GPS in columns 49-51 (only GPS time is "
+            "supported)",
+            in->system);
     } else if (strcmp(lab, "GLONASS SLOT / FRQ #") == 0) {
       int n = 0;
       if (glo_left < 0) {
@@ -434,15 +450,17 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
         char c[4];
         field(L, 1, 3, c);
         if (!all_blank(c))
-          return lfail(L, NAV_ERR_PARSE, 1, "second GLONASS SLOT / FRQ # record; expected a continuation line "
-                                            "(blank columns 1-3)");
+          return lfail(L, NAV_ERR_PARSE, 1,
+                       "second GLONASS SLOT / FRQ # record; expected a continuation line "
+                       "(blank columns 1-3)");
       }
       for (int k = 0; k < 8 && glo_left > 0; ++k, --glo_left) {
         char c[4];
         field(L, 5 + 7 * k, 3, c);
         int slot = 0, fk = 0;
         if (c[0] != 'R')
-          return lfail(L, NAV_ERR_PARSE, 5 + 7 * k, "GLONASS SLOT / FRQ #: '%c'; expected R and the slot (Rnn)",
+          return lfail(L, NAV_ERR_PARSE, 5 + 7 * k,
+                       "GLONASS SLOT / FRQ #: '%c'; expected R and the slot (Rnn)",
                        (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
         st = inum(L, 6 + 7 * k, 2, "GLONASS slot", 1, 24, &slot);
         if (st == NAV_OK) st = inum(L, 9 + 7 * k, 2, "GLONASS frequency number", -7, 13, &fk);
@@ -457,13 +475,16 @@ static nav_status obs_header(nav_rinex_obs_reader *r) {
   if (pending_left > 0)
     return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d observation type(s) are missing", pending_left);
   if (glo_left > 0)
-    return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d GLONASS SLOT / FRQ # entries are missing", glo_left);
+    return lfail(L, NAV_ERR_PARSE, 1, "END OF HEADER while %d GLONASS SLOT / FRQ # entries are missing",
+                 glo_left);
   if (!any_types)
-    return lfail(L, NAV_ERR_PARSE, 1, "the header has no SYS / # / OBS TYPES record; expected one per system");
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "the header has no SYS / # / OBS TYPES record; expected one per system");
   if (!in->has_first && in->system != 'G')
     return lfail(L, NAV_ERR_PARSE, 1,
                  "no TIME OF FIRST OBS in a file of system %c; expected it with time system GPS", in->system);
-  for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s) in->file_types[s] = r->n_file[s];
+  for (int s = 0; s < NAV_GNSS_SYS_COUNT; ++s)
+    in->file_types[s] = r->n_file[s];
   return NAV_OK;
 }
 
@@ -503,8 +524,12 @@ void nav_rinex_obs_destroy(nav_rinex_obs_reader *r) {
   free(r);
 }
 
-const nav_rinex_obs_header *nav_rinex_obs_get_header(const nav_rinex_obs_reader *r) { return r ? &r->h : NULL; }
-const nav_rinex_obs_info *nav_rinex_obs_get_info(const nav_rinex_obs_reader *r) { return r ? &r->info : NULL; }
+const nav_rinex_obs_header *nav_rinex_obs_get_header(const nav_rinex_obs_reader *r) {
+  return r ? &r->h : NULL;
+}
+const nav_rinex_obs_info *nav_rinex_obs_get_info(const nav_rinex_obs_reader *r) {
+  return r ? &r->info : NULL;
+}
 
 int nav_rinex_obs_type_index(const nav_rinex_obs_header *h, nav_gnss_system sys, const char *type) {
   if (!h || !type || (int)sys < 0 || (int)sys >= NAV_GNSS_SYS_COUNT) return -1;
@@ -512,8 +537,12 @@ int nav_rinex_obs_type_index(const nav_rinex_obs_header *h, nav_gnss_system sys,
     if (strcmp(h->types[sys][k], type) == 0) return k;
   return -1;
 }
-const nav_diag *nav_rinex_obs_diag(const nav_rinex_obs_reader *r) { return r ? &r->L.diag : NULL; }
-long nav_rinex_obs_events(const nav_rinex_obs_reader *r) { return r ? r->events : 0; }
+const nav_diag *nav_rinex_obs_diag(const nav_rinex_obs_reader *r) {
+  return r ? &r->L.diag : NULL;
+}
+long nav_rinex_obs_events(const nav_rinex_obs_reader *r) {
+  return r ? r->events : 0;
+}
 double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r) {
   if (!r || r->L.file_size <= 0) return 1.0;
   const double f = (double)r->L.consumed / (double)r->L.file_size;
@@ -527,10 +556,12 @@ static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep,
   char c[4];
   field(L, 1, 3, c);
   if (c[0] == '>')
-    return lfail(L, NAV_ERR_PARSE, 1, "an epoch record where a satellite's observations were expected (the "
-                                      "previous epoch announced more satellites)");
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "an epoch record where a satellite's observations were expected (the "
+                 "previous epoch announced more satellites)");
   if (!known_sys(c[0]))
-    return lfail(L, NAV_ERR_PARSE, 1, "satellite system '%c'; expected G, R, E, C, J, I or S and a number (e.g. G05)",
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "satellite system '%c'; expected G, R, E, C, J, I or S and a number (e.g. G05)",
                  (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
   int prn = 0;
   nav_status st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
@@ -541,9 +572,10 @@ static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep,
     return NAV_OK;
   }
   if (r->n_file[s] == 0)
-    return lfail(L, NAV_ERR_PARSE, 1, "satellite %c%02d of a system without SYS / # / OBS TYPES in the header", c[0],
-                 prn);
-  if (s == NAV_GNSS_SYS_GLONASS && prn > 24) return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
+    return lfail(L, NAV_ERR_PARSE, 1,
+                 "satellite %c%02d of a system without SYS / # / OBS TYPES in the header", c[0], prn);
+  if (s == NAV_GNSS_SYS_GLONASS && prn > 24)
+    return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
   if (s == NAV_GNSS_SYS_GPS && prn > 32) return lfail(L, NAV_ERR_PARSE, 2, "GPS PRN %d; expected 1..32", prn);
   for (int k = 0; k < ep->n; ++k)
     if ((int)ep->sats[k].system == s && ep->sats[k].prn == prn)
@@ -569,9 +601,10 @@ static nav_status obs_sat_line(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *ep,
     if (blank) continue;
     const double v = o->value[k];
     if (t[0] == 'C' && !(v > 1.0e6 && v < 1.0e8))
-      return lfail(L, NAV_ERR_PARSE, col,
-                   "%s: pseudorange %.3f m; expected 1e6 to 1e8 m (a satellite range plus a receiver clock bias)",
-                   what, v);
+      return lfail(
+          L, NAV_ERR_PARSE, col,
+          "%s: pseudorange %.3f m; expected 1e6 to 1e8 m (a satellite range plus a receiver clock bias)",
+          what, v);
     if (t[0] == 'D' && !(fabs(v) < 1.0e6))
       return lfail(L, NAV_ERR_PARSE, col, "%s: Doppler %.3f Hz; expected |D| < 1e6 Hz", what, v);
   }
@@ -592,7 +625,8 @@ nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out,
     if (!have) return NAV_OK;
     if (L->n == 0) continue; /* a blank line between records */
     if (L->buf[0] != '>')
-      return lfail(L, NAV_ERR_PARSE, 1, "expected an epoch record starting with '>' (RINEX 3 observation data)");
+      return lfail(L, NAV_ERR_PARSE, 1,
+                   "expected an epoch record starting with '>' (RINEX 3 observation data)");
     /* '>' yyyy mm dd hh mm ss.sssssss  flag numsat  (reserved)  rx clock offset:
      * A1,1X,I4,4(1X,I2),F11.7,2X,I1,I3,6X,F15.12 */
     int flag = 0, nsat = 0;
@@ -607,8 +641,8 @@ nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out,
         if (st != NAV_OK) return st;
         if (!have) {
           ++L->line;
-          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside an event record (flag %d announced %d lines)", flag,
-                       nsat);
+          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside an event record (flag %d announced %d lines)",
+                       flag, nsat);
         }
       }
       continue;
@@ -624,8 +658,9 @@ nav_status nav_rinex_obs_next(nav_rinex_obs_reader *r, nav_rinex_obs_epoch *out,
     if (st != NAV_OK) return st;
     if (flag == 6) r->events++;
     if (flag <= 1 && r->have_prev && t < r->t_prev)
-      return lfail(L, NAV_ERR_PARSE, 3, "epoch %.7f s GPS is before the previous epoch (%.7f s); expected epochs in "
-                                        "time order",
+      return lfail(L, NAV_ERR_PARSE, 3,
+                   "epoch %.7f s GPS is before the previous epoch (%.7f s); expected epochs in "
+                   "time order",
                    t, r->t_prev);
     /* A cycle-slip record's satellites are read (and checked) into a scratch epoch. */
     nav_rinex_obs_epoch *dst = out;
@@ -674,7 +709,8 @@ static nav_status orbit_line(lines *L, int which, double v[4], int n_required) {
   if (st != NAV_OK) return st;
   if (!got) {
     ++L->line;
-    return lfail(L, NAV_ERR_PARSE, 1, "end of file inside a navigation record; expected BROADCAST ORBIT - %d", which);
+    return lfail(L, NAV_ERR_PARSE, 1, "end of file inside a navigation record; expected BROADCAST ORBIT - %d",
+                 which);
   }
   char buf[48];
   for (int i = 0; i < 4; ++i) {
@@ -683,8 +719,8 @@ static nav_status orbit_line(lines *L, int which, double v[4], int n_required) {
     st = num(L, 5 + 19 * i, 19, buf, &v[i], &blank);
     if (st != NAV_OK) return st;
     if (blank && i < n_required)
-      return lfail(L, NAV_ERR_PARSE, 5 + 19 * i, "%s: blank; expected a number in columns %d-%d", buf, 5 + 19 * i,
-                   23 + 19 * i);
+      return lfail(L, NAV_ERR_PARSE, 5 + 19 * i, "%s: blank; expected a number in columns %d-%d", buf,
+                   5 + 19 * i, 23 + 19 * i);
   }
   return NAV_OK;
 }
@@ -737,10 +773,11 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
     const long line0 = L->line;
     int prn = 0;
     if (!known_sys(c[0]))
-      return lfail(L, NAV_ERR_PARSE, 1,
-                   "satellite system '%c'; expected the first line of a navigation record (G, R, E, C, J, I or S "
-                   "and the satellite number)",
-                   (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
+      return lfail(
+          L, NAV_ERR_PARSE, 1,
+          "satellite system '%c'; expected the first line of a navigation record (G, R, E, C, J, I or S "
+          "and the satellite number)",
+          (unsigned char)c[0] < 0x20 || (unsigned char)c[0] >= 0x7f ? '?' : c[0]);
     st = inum(L, 2, 2, "satellite number", 1, 99, &prn);
     if (st != NAV_OK) return st;
     if (c[0] != 'G' && c[0] != 'R') {
@@ -751,30 +788,32 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
         if (st != NAV_OK) return st;
         if (!got) {
           ++L->line;
-          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside the %c%02d navigation record of line %ld", c[0], prn,
-                       line0);
+          return lfail(L, NAV_ERR_PARSE, 1, "end of file inside the %c%02d navigation record of line %ld",
+                       c[0], prn, line0);
         }
       }
       nv->skipped++;
       continue;
     }
     if (nv->n_gps + nv->n_glo >= NAV_RINEX_MAX_EPHEMERIDES)
-      return lfail(L, NAV_ERR_OUT_OF_RANGE, 1, "more than %d GPS and GLONASS navigation records; the limit is %d",
+      return lfail(L, NAV_ERR_OUT_OF_RANGE, 1,
+                   "more than %d GPS and GLONASS navigation records; the limit is %d",
                    NAV_RINEX_MAX_EPHEMERIDES, NAV_RINEX_MAX_EPHEMERIDES);
     static const int col[6] = {5, 10, 13, 16, 19, 22}, w[6] = {4, 2, 2, 2, 2, 2};
     double t_rec = 0.0, clk[3];
     st = epoch_fields(L, col, w, &t_rec);
     for (int i = 0; i < 3 && st == NAV_OK; ++i) {
-      static const char *const nm[2][3] = {{"SV clock bias af0", "SV clock drift af1", "SV clock drift rate af2"},
-                                           {"SV clock bias -TauN", "relative frequency bias +GammaN",
-                                            "message frame time"}};
+      static const char *const nm[2][3] = {
+          {"SV clock bias af0", "SV clock drift af1", "SV clock drift rate af2"},
+          {"SV clock bias -TauN", "relative frequency bias +GammaN", "message frame time"}};
       st = num(L, 24 + 19 * i, 19, nm[c[0] == 'R'][i], &clk[i], NULL);
     }
     if (st != NAV_OK) return st;
     if (c[0] == 'G') {
       if (prn > 32) return lfail(L, NAV_ERR_PARSE, 2, "GPS PRN %d; expected 1..32", prn);
       double o[7][4];
-      for (int k = 0; k < 7 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], k < 6 ? 4 : 1);
+      for (int k = 0; k < 7 && st == NAV_OK; ++k)
+        st = orbit_line(L, k + 1, o[k], k < 6 ? 4 : 1);
       if (st != NAV_OK) return st;
       /* Field checks; the line of each is the record's first line + the orbit line number. */
       const long last = L->line;
@@ -784,14 +823,16 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
         st = lfail(L, NAV_ERR_PARSE, 24, "eccentricity %.12g; expected 0 <= e < 1", o[1][1]);
       } else if (!(o[1][3] > 1000.0 && o[1][3] < 10000.0)) {
         L->line = line0 + 2;
-        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.12g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)", o[1][3]);
+        st = lfail(L, NAV_ERR_PARSE, 62, "sqrt(A) %.12g m^0.5; expected 1000 to 10000 (a GPS orbit: 5153.7)",
+                   o[1][3]);
       } else if (!(o[2][0] >= 0.0 && o[2][0] < NAV_GNSS_WEEK_S)) {
         L->line = line0 + 3;
-        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.12g s; expected seconds of the GPS week, 0 <= toe < 604800", o[2][0]);
+        st = lfail(L, NAV_ERR_PARSE, 5, "toe %.12g s; expected seconds of the GPS week, 0 <= toe < 604800",
+                   o[2][0]);
       } else if (!(week == floor(week) && week >= 0.0 && week < 1.0e5)) {
         L->line = line0 + 5;
-        st = lfail(L, NAV_ERR_PARSE, 43, "GPS week %.12g; expected a non-negative integer (continuous week number)",
-                   week);
+        st = lfail(L, NAV_ERR_PARSE, 43,
+                   "GPS week %.12g; expected a non-negative integer (continuous week number)", week);
       } else if (!(o[5][1] == floor(o[5][1]) && o[5][1] >= 0.0 && o[5][1] < 64.0)) {
         L->line = line0 + 6;
         st = lfail(L, NAV_ERR_PARSE, 24, "SV health %.12g; expected an integer 0..63", o[5][1]);
@@ -842,7 +883,8 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
     } else {
       if (prn > 24) return lfail(L, NAV_ERR_PARSE, 2, "GLONASS slot %d; expected 1..24", prn);
       double o[4][4];
-      for (int k = 0; k < 3 && st == NAV_OK; ++k) st = orbit_line(L, k + 1, o[k], 4);
+      for (int k = 0; k < 3 && st == NAV_OK; ++k)
+        st = orbit_line(L, k + 1, o[k], 4);
       if (st == NAV_OK && nv->version >= 3.045) st = orbit_line(L, 4, o[3], 0);
       if (st != NAV_OK) return st;
       const long last = L->line;
@@ -852,10 +894,11 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
         st = lfail(L, NAV_ERR_PARSE, 62, "frequency number %.12g; expected an integer -7..13", o[1][3]);
       } else if (!(nav_vec3_norm(r_m) > 1.0e7 && nav_vec3_norm(r_m) < 1.0e8)) {
         L->line = line0 + 1;
-        st = lfail(L, NAV_ERR_PARSE, 5,
-                   "satellite position %.6g km from the Earth's centre; expected 10 000 to 100 000 km (a GLONASS "
-                   "orbit: 25 500 km; the file's unit is km)",
-                   1e-3 * nav_vec3_norm(r_m));
+        st = lfail(
+            L, NAV_ERR_PARSE, 5,
+            "satellite position %.6g km from the Earth's centre; expected 10 000 to 100 000 km (a GLONASS "
+            "orbit: 25 500 km; the file's unit is km)",
+            1e-3 * nav_vec3_norm(r_m));
       } else if (!(o[0][3] == floor(o[0][3]) && o[0][3] >= 0.0 && o[0][3] < 16.0)) {
         L->line = line0 + 1;
         st = lfail(L, NAV_ERR_PARSE, 62, "health %.12g; expected an integer (0 = healthy)", o[0][3]);
@@ -888,8 +931,8 @@ static nav_status nav_parse(lines *L, nav_rinex_nav *nv) {
   return NAV_OK;
 }
 
-static nav_status nav_read(const char *path, const char *text, size_t len, const char *name, nav_rinex_nav **out,
-                           nav_diag *diag) {
+static nav_status nav_read(const char *path, const char *text, size_t len, const char *name,
+                           nav_rinex_nav **out, nav_diag *diag) {
   if (!out) return NAV_ERR_INVALID_ARG;
   lines *L = malloc(sizeof *L);
   nav_rinex_nav *nv = calloc(1, sizeof *nv);
@@ -914,8 +957,8 @@ nav_status nav_rinex_nav_read(const char *path, nav_rinex_nav **out, nav_diag *d
   return nav_read(path, NULL, 0, path, out, diag);
 }
 
-nav_status nav_rinex_nav_read_memory(const char *text, size_t len, const char *display_name, nav_rinex_nav **out,
-                                     nav_diag *diag) {
+nav_status nav_rinex_nav_read_memory(const char *text, size_t len, const char *display_name,
+                                     nav_rinex_nav **out, nav_diag *diag) {
   return nav_read(NULL, text ? text : "", text ? len : 0, display_name ? display_name : "memory", out, diag);
 }
 
@@ -984,16 +1027,21 @@ nav_rinex_source_config nav_rinex_source_config_default(void) {
   return c;
 }
 
-nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex_source **out, nav_diag *diag) {
+nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex_source **out,
+                                   nav_diag *diag) {
   if (!cfg || !out) return NAV_ERR_INVALID_ARG;
   const char *bad = NULL;
-  if (!cfg->obs_path || !cfg->nav_path) bad = "an observation file and a navigation file are both required";
-  else if (!(cfg->pr_sd_m > 0.0 && isfinite(cfg->pr_sd_m))) bad = "the pseudorange sigma must be finite and > 0";
-  else if (!(cfg->rr_sd_mps > 0.0 && isfinite(cfg->rr_sd_mps))) bad = "the range-rate sigma must be finite and > 0";
+  if (!cfg->obs_path || !cfg->nav_path)
+    bad = "an observation file and a navigation file are both required";
+  else if (!(cfg->pr_sd_m > 0.0 && isfinite(cfg->pr_sd_m)))
+    bad = "the pseudorange sigma must be finite and > 0";
+  else if (!(cfg->rr_sd_mps > 0.0 && isfinite(cfg->rr_sd_mps)))
+    bad = "the range-rate sigma must be finite and > 0";
   else if (!(cfg->max_eph_age_s > 0.0 && isfinite(cfg->max_eph_age_s)) ||
            !(cfg->max_glo_age_s > 0.0 && cfg->max_glo_age_s <= 86400.0))
     bad = "the ephemeris ages must be > 0 (GLONASS: at most one day)";
-  else if (!isfinite(cfg->t0_gps_s)) bad = "the GPS time of t = 0 must be finite";
+  else if (!isfinite(cfg->t0_gps_s))
+    bad = "the GPS time of t = 0 must be finite";
   if (bad) {
     diag_set(diag, "replay", 0, 0, "%s", bad);
     return NAV_ERR_INVALID_ARG;
@@ -1049,7 +1097,9 @@ nav_rinex_source_counts nav_rinex_source_get_counts(const nav_rinex_source *s) {
   return c;
 }
 
-double nav_rinex_source_fraction(const nav_rinex_source *s) { return s ? nav_rinex_obs_fraction(s->obs) : 1.0; }
+double nav_rinex_source_fraction(const nav_rinex_source *s) {
+  return s ? nav_rinex_obs_fraction(s->obs) : 1.0;
+}
 
 /* The GPS ephemeris of @p prn with toe nearest to @p t (ties: the later record), or NULL. */
 static const nav_rinex_gps_eph *gps_eph_for(const nav_rinex_nav *nv, int prn, double t) {
@@ -1099,13 +1149,17 @@ static void glo_state(const nav_rinex_glo_eph *e, double t, nav_vec3 *r, nav_vec
   for (int s = 0; s < n; ++s) {
     double k1[6], k2[6], k3[6], k4[6], y[6];
     glo_deriv(x, e->a_e_mps2, k1);
-    for (int i = 0; i < 6; ++i) y[i] = x[i] + 0.5 * h * k1[i];
+    for (int i = 0; i < 6; ++i)
+      y[i] = x[i] + 0.5 * h * k1[i];
     glo_deriv(y, e->a_e_mps2, k2);
-    for (int i = 0; i < 6; ++i) y[i] = x[i] + 0.5 * h * k2[i];
+    for (int i = 0; i < 6; ++i)
+      y[i] = x[i] + 0.5 * h * k2[i];
     glo_deriv(y, e->a_e_mps2, k3);
-    for (int i = 0; i < 6; ++i) y[i] = x[i] + h * k3[i];
+    for (int i = 0; i < 6; ++i)
+      y[i] = x[i] + h * k3[i];
     glo_deriv(y, e->a_e_mps2, k4);
-    for (int i = 0; i < 6; ++i) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    for (int i = 0; i < 6; ++i)
+      x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
   }
   *r = nav_vec3_make(x[0], x[1], x[2]);
   *v = nav_vec3_make(x[3], x[4], x[5]);
@@ -1231,14 +1285,17 @@ nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep
     /* The satellite clock at the transmit time t - P/c, applied to the code; its rate (central
      * difference over +-1 s: af1, af2 and the relativistic term) to the range rate. */
     const double dt_sv = nav_rinex_gps_clock_s(e, t_tx, true);
-    const double dt_sv_rate = 0.5 * (nav_rinex_gps_clock_s(e, t_tx + 1.0, true) - nav_rinex_gps_clock_s(e, t_tx - 1.0, true));
+    const double dt_sv_rate =
+        0.5 * (nav_rinex_gps_clock_s(e, t_tx + 1.0, true) - nav_rinex_gps_clock_s(e, t_tx - 1.0, true));
     nav_ins_gnss_sat_meas *x = &s->meas[m];
     x->sat = &s->orbits[m];
     x->has_pr = true;
     x->pr_m = c1c + NAV_GNSS_C_MPS * dt_sv;
     /* Range rate = -lambda D (D positive for an approaching satellite). */
     x->has_rr = s->cfg.use_doppler && id >= 0 && o->has[id];
-    x->rr_mps = x->has_rr ? -(NAV_GNSS_C_MPS / NAV_RINEX_GPS_L1_HZ) * o->value[id] + NAV_GNSS_C_MPS * dt_sv_rate : 0.0;
+    x->rr_mps = x->has_rr
+                    ? -(NAV_GNSS_C_MPS / NAV_RINEX_GPS_L1_HZ) * o->value[id] + NAV_GNSS_C_MPS * dt_sv_rate
+                    : 0.0;
     ++m;
   }
   s->counts.epochs++;

@@ -49,8 +49,8 @@ static void run_ok(const char *what, nav_cli_result *r) {
 static int setup(void **state) {
   (void)state;
   if (nav_test_fresh_dir(WORK) != 0) return -1;
-  nav_cli_result *r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                        "run '%s' --runs 1 --export kfgins --export rinex --out D --quiet", SCENE);
+  nav_cli_result *r = nav_test_run_clif(
+      NAVSIM_EXE, WORK, NULL, "run '%s' --runs 1 --export kfgins --export rinex --out D --quiet", SCENE);
   if (r->code != 0) {
     fprintf(stderr, "run: exit %d\n%s", r->code, r->err);
     return -1;
@@ -82,9 +82,9 @@ static nav_diff compare_nav(const nav_table *a, const nav_table *b) {
                                    nav_table_at(b, j, nav_table_col(b, pos[k]))));
       d.vel_mps = fmax(d.vel_mps, fabs(nav_table_at(a, i, nav_table_col(a, vel[k])) -
                                        nav_table_at(b, j, nav_table_col(b, vel[k]))));
-      double e = fmod(fabs(nav_table_at(a, i, nav_table_col(a, att[k])) -
-                           nav_table_at(b, j, nav_table_col(b, att[k]))),
-                      360.0);
+      double e = fmod(
+          fabs(nav_table_at(a, i, nav_table_col(a, att[k])) - nav_table_at(b, j, nav_table_col(b, att[k]))),
+          360.0);
       if (e > 180.0) e = 360.0 - e;
       d.att_rad = fmax(d.att_rad, e * PI / 180.0);
     }
@@ -109,11 +109,12 @@ static double stats_value(const char *json, const char *key, const char *stat) {
 
 static void replay_reproduces_run0(void **state) {
   (void)state;
-  run_ok("replay", nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                                     "replay --imu D/kfgins/IMU.txt --rinex-obs " OBS " --rinex-nav " NAVF
-                                     " --truth D/kfgins/truth.nav --init D/kfgins/init.nav --scene '%s' --out R "
-                                     "--quiet",
-                                     SCENE));
+  run_ok("replay",
+         nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                           "replay --imu D/kfgins/IMU.txt --rinex-obs " OBS " --rinex-nav " NAVF
+                           " --truth D/kfgins/truth.nav --init D/kfgins/init.nav --scene '%s' --out R "
+                           "--quiet",
+                           SCENE));
   nav_table d, r;
   nav_table_read(WORK "/D/nav.csv", &d);
   nav_table_read(WORK "/R/nav.csv", &r);
@@ -129,12 +130,14 @@ static void replay_reproduces_run0(void **state) {
   assert_true(df.att_rad <= 1e-4);
 
   /* summary.json: run's "stats" keys and figures; the raw-measurement counts. */
-  char *js_d = nav_test_slurp_alloc(WORK "/D/summary.json"), *js_r = nav_test_slurp_alloc(WORK "/R/summary.json");
+  char *js_d = nav_test_slurp_alloc(WORK "/D/summary.json"),
+       *js_r = nav_test_slurp_alloc(WORK "/R/summary.json");
   assert_non_null(js_d);
   assert_non_null(js_r);
   assert_true(stats_value(js_d, "epochs", NULL) == stats_value(js_r, "epochs", NULL));
   assert_true(stats_value(js_d, "stride", NULL) == stats_value(js_r, "stride", NULL));
-  static const char *const metric[5] = {"pos_err_h_m", "pos_err_v_m", "vel_err_mps", "att_err_rad", "yaw_err_rad"};
+  static const char *const metric[5] = {"pos_err_h_m", "pos_err_v_m", "vel_err_mps", "att_err_rad",
+                                        "yaw_err_rad"};
   static const char *const stat[3] = {"rms", "max", "p95"};
   for (int m = 0; m < 5; ++m)
     for (int s = 0; s < 3; ++s) {
@@ -182,17 +185,20 @@ static void replay_gps_glonass(void **state) {
   nav_cli_result *res = nav_test_run_clif(
       NAVSIM_EXE, WORK, NULL,
       "replay --imu G/kfgins/IMU.txt --rinex-obs G/rinex/urban-canyon-tight-glonass.obs --rinex-nav "
-      "G/rinex/urban-canyon-tight-glonass.nav --truth G/kfgins/truth.nav --init G/kfgins/init.nav --scene '%s' "
+      "G/rinex/urban-canyon-tight-glonass.nav --truth G/kfgins/truth.nav --init G/kfgins/init.nav --scene "
+      "'%s' "
       "--out GR",
       scene);
   run_ok("replay", res);
-  nav_test_assert_matches(res->out, "raw gnss +177 epochs read, 177 applied \\([0-9]+ satellite measurements, [1-9][0-9]+ GLONASS\\)");
+  nav_test_assert_matches(
+      res->out,
+      "raw gnss +177 epochs read, 177 applied \\([0-9]+ satellite measurements, [1-9][0-9]+ GLONASS\\)");
   nav_table d, r;
   nav_table_read(WORK "/G/nav.csv", &d);
   nav_table_read(WORK "/GR/nav.csv", &r);
   const nav_diff df = compare_nav(&r, &d);
-  print_message("GPS + GLONASS nav.csv: %d epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n", df.epochs,
-                df.pos_m, df.vel_mps, df.att_rad);
+  print_message("GPS + GLONASS nav.csv: %d epochs; largest difference %.3g m, %.3g m/s, %.3g rad\n",
+                df.epochs, df.pos_m, df.vel_mps, df.att_rad);
   assert_int_equal(df.missing, 0);
   assert_true(df.epochs >= 1779);
   assert_true(df.pos_m <= 0.2);
@@ -215,7 +221,8 @@ static void refusals(void **state) {
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--rinex-obs and --rinex-nav go together");
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --gnss D/kfgins/GNSS.txt --scene '%s' --out X",
+                        "%s --rinex-obs " OBS " --rinex-nav " NAVF
+                        " --gnss D/kfgins/GNSS.txt --scene '%s' --out X",
                         base, SCENE);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--rinex-obs and --gnss are exclusive");
@@ -223,24 +230,27 @@ static void refusals(void **state) {
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--rinex-obs needs --scene");
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --scene '%s' --smooth --out X", base, SCENE);
+                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --scene '%s' --smooth --out X", base,
+                        SCENE);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--smooth is not supported with --rinex-obs");
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s --rinex-obs " OBS " --rinex-nav " NAVF " --t0-gps x --out X",
-                        base);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --t0-gps x --out X", base);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "--t0-gps: expected GPS seconds");
   /* A scene without gnss.constellation: t = 0 is the GPS week's start, the observations (GPS
    * seconds of week about 374400) fall after the IMU data (0 .. 178 s) and the replay says so. */
   r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
-                        "%s --rinex-obs " OBS " --rinex-nav " NAVF " --scene '%s/scenes/urban-drive.yaml' --out W", base,
-                        NAV_SOURCE_DIR);
+                        "%s --rinex-obs " OBS " --rinex-nav " NAVF
+                        " --scene '%s/scenes/urban-drive.yaml' --out W",
+                        base, NAV_SOURCE_DIR);
   assert_int_equal(r->code, 0);
-  nav_test_assert_matches(r->err, "warning: no observation epoch fell on the IMU's time span 0.000 .. 177.880 s "
-                                  "\\(IMU time = GPS time - 1479340800 s");
+  nav_test_assert_matches(r->err,
+                          "warning: no observation epoch fell on the IMU's time span 0.000 .. 177.880 s "
+                          "\\(IMU time = GPS time - 1479340800 s");
   /* Files swapped: the navigation file where the observations belong. */
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s --rinex-obs " NAVF " --rinex-nav " OBS " --scene '%s' --out X",
-                        base, SCENE);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "%s --rinex-obs " NAVF " --rinex-nav " OBS " --scene '%s' --out X", base, SCENE);
   assert_int_equal(r->code, 2);
   nav_test_assert_matches(r->err, "urban-canyon-tight.(nav|obs):1:21: error: file type");
   /* A malformed observation deep in the file: reported before any result is written. */
@@ -256,8 +266,8 @@ static void refusals(void **state) {
     if (*q == '\n') ++line;
   nav_test_write_file(WORK, "bad.obs", obs);
   free(obs);
-  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL, "%s --rinex-obs bad.obs --rinex-nav " NAVF " --scene '%s' --out X",
-                        base, SCENE);
+  r = nav_test_run_clif(NAVSIM_EXE, WORK, NULL,
+                        "%s --rinex-obs bad.obs --rinex-nav " NAVF " --scene '%s' --out X", base, SCENE);
   assert_int_equal(r->code, 2);
   char want[128];
   snprintf(want, sizeof want, "^bad.obs:%ld:[0-9]+: error: C1C of G[0-9][0-9]: \".*\" is not a number", line);

@@ -170,13 +170,13 @@ static void test_nav_good(void **state) {
 
 /* One bad input: the file name, line, column and a part of the message. */
 typedef struct bad_case {
-  const char *what;      /* for the failure message */
-  bool obs;              /* observation (true) or navigation file */
-  const char *find;      /* text of the good file to replace ... */
-  const char *replace;   /* ... with this */
+  const char *what;    /* for the failure message */
+  bool obs;            /* observation (true) or navigation file */
+  const char *find;    /* text of the good file to replace ... */
+  const char *replace; /* ... with this */
   nav_status status;
   int line, col;
-  const char *message;   /* expected part of the message */
+  const char *message; /* expected part of the message */
 } bad_case;
 
 /* The good file with the first occurrence of find replaced. */
@@ -202,11 +202,12 @@ static const bad_case k_bad[] = {
     {"empty", true, NULL, NULL, NAV_ERR_PARSE, 1, 1, "empty file"},
     {"no version label", true, "RINEX VERSION / TYPE", "RINEX VERSION      ", NAV_ERR_PARSE, 1, 61,
      "expected RINEX VERSION / TYPE"},
-    {"version 2", true, "     3.04           O", "     2.11           O", NAV_ERR_PARSE, 1, 1, "expected 3.00 to 3.05"},
+    {"version 2", true, "     3.04           O", "     2.11           O", NAV_ERR_PARSE, 1, 1,
+     "expected 3.00 to 3.05"},
     {"version not a number", true, "     3.04           O", "     3.x4           O", NAV_ERR_PARSE, 1, 6,
      "\"3.x4\" is not a number"},
-    {"navigation file as observations", true, "     3.04           O", "     3.04           N", NAV_ERR_PARSE, 1, 21,
-     "expected 'O' (observation file)"},
+    {"navigation file as observations", true, "     3.04           O", "     3.04           N", NAV_ERR_PARSE,
+     1, 21, "expected 'O' (observation file)"},
     {"bad system", true, "E    2 C1C D1C ", "X    2 C1C D1C ", NAV_ERR_PARSE, 9, 1, "satellite system 'X'"},
     {"bad type count", true, "G    5 C1C", "G    x C1C", NAV_ERR_PARSE, 6, 6, "number of observation types"},
     {"bad type", true, "G    5 C1C L1C", "G    5 C1C 1LC", NAV_ERR_PARSE, 6, 12, "observation type \"1LC\""},
@@ -214,7 +215,8 @@ static const bad_case k_bad[] = {
      "still missing; expected a continuation line"},
     {"continuation without record", true, "E    2 C1C D1C ", "       C1C D1C ", NAV_ERR_PARSE, 9, 1,
      "continuation line without a preceding record"},
-    {"another label inside the types", true, "       L2P                                                  SYS",
+    {"another label inside the types", true,
+     "       L2P                                                  SYS",
      "                                                            MAR", NAV_ERR_PARSE, 8, 61,
      "still missing; expected a SYS / # / OBS TYPES continuation line"},
     {"time system", true, "    GPS         TIME", "    GLO         TIME", NAV_ERR_PARSE, 11, 49,
@@ -227,7 +229,8 @@ static const bad_case k_bad[] = {
      "expected R and the slot"},
     {"GLONASS channel", true, "  2 R01  1 R05 -4", "  2 R01  1 R05 -9", NAV_ERR_PARSE, 13, 16,
      "GLONASS frequency number"},
-    {"no END OF HEADER", true, "END OF HEADER", "END OF HEADEX", NAV_ERR_PARSE, 0, 1, "expected END OF HEADER"},
+    {"no END OF HEADER", true, "END OF HEADER", "END OF HEADEX", NAV_ERR_PARSE, 0, 1,
+     "expected END OF HEADER"},
     {"epoch marker", true, "> 2026 11 26 08 00  0.0000000  0  4", "< 2026 11 26 08 00  0.0000000  0  4",
      NAV_ERR_PARSE, 15, 1, "expected an epoch record starting with '>'"},
     {"epoch flag", true, "> 2026 11 26 08 00  0.0000000  0  4", "> 2026 11 26 08 00  0.0000000  7  4",
@@ -236,12 +239,14 @@ static const bad_case k_bad[] = {
      NAV_ERR_PARSE, 15, 19, "expected 0 <= second < 61"},
     {"epoch hour", true, "> 2026 11 26 08 00  0.0000000  0  4", "> 2026 11 26 24 00  0.0000000  0  4",
      NAV_ERR_PARSE, 15, 14, "hour: 24"},
-    {"receiver clock", true, "0.000000123456", "0.0000001x3456", NAV_ERR_PARSE, 15, 43, "receiver clock offset"},
-    {"epochs out of order", true, "> 2026 11 26 08 00  1.0000000  0  2", "> 2026 11 26 07 59 59.0000000  0  2",
-     NAV_ERR_PARSE, 23, 3, "expected epochs in time order"},
+    {"receiver clock", true, "0.000000123456", "0.0000001x3456", NAV_ERR_PARSE, 15, 43,
+     "receiver clock offset"},
+    {"epochs out of order", true, "> 2026 11 26 08 00  1.0000000  0  2",
+     "> 2026 11 26 07 59 59.0000000  0  2", NAV_ERR_PARSE, 23, 3, "expected epochs in time order"},
     {"satellite system", true, "G12  22345678.901", "X12  22345678.901", NAV_ERR_PARSE, 17, 1,
      "satellite system 'X'"},
-    {"satellite number", true, "G12  22345678.901", "G1x  22345678.901", NAV_ERR_PARSE, 17, 2, "satellite number"},
+    {"satellite number", true, "G12  22345678.901", "G1x  22345678.901", NAV_ERR_PARSE, 17, 2,
+     "satellite number"},
     {"GPS PRN 40", true, "G12  22345678.901", "G40  22345678.901", NAV_ERR_PARSE, 17, 2, "GPS PRN 40"},
     {"satellite twice", true, "G12  22345678.901", "G05  22345678.901", NAV_ERR_PARSE, 17, 1,
      "G05 twice in one epoch"},
@@ -250,10 +255,11 @@ static const bad_case k_bad[] = {
     {"pseudorange too short", true, "G12  22345678.901", "G12       678.901", NAV_ERR_PARSE, 17, 4,
      "pseudorange 678.901 m; expected 1e6 to 1e8 m"},
     {"Doppler too large", true, "2345.678", "2345678.", NAV_ERR_PARSE, 17, 36, "expected |D| < 1e6 Hz"},
-    {"too few satellite lines", true, "> 2026 11 26 08 00  2.0000000  1  1", "> 2026 11 26 08 00  2.0000000  1  3",
-     NAV_ERR_PARSE, 31, 1, "announced 3 satellites; got 1"},
-    {"epoch inside an epoch", true, "> 2026 11 26 08 00  1.0000000  0  2", "> 2026 11 26 08 00  1.0000000  0  4",
-     NAV_ERR_PARSE, 26, 1, "an epoch record where a satellite's observations were expected"},
+    {"too few satellite lines", true, "> 2026 11 26 08 00  2.0000000  1  1",
+     "> 2026 11 26 08 00  2.0000000  1  3", NAV_ERR_PARSE, 31, 1, "announced 3 satellites; got 1"},
+    {"epoch inside an epoch", true, "> 2026 11 26 08 00  1.0000000  0  2",
+     "> 2026 11 26 08 00  1.0000000  0  4", NAV_ERR_PARSE, 26, 1,
+     "an epoch record where a satellite's observations were expected"},
     {"event record cut", true, "> 2026 11 26 08 00  1.0000000  4  2\nANTENNA CHANGED",
      "> 2026 11 26 08 00  1.0000000  4 99\nANTENNA CHANGED", NAV_ERR_PARSE, 31, 1, "inside an event record"},
     {"GLONASS system without types", true, "R   14 C1C L1C D1C S1C C1P L1P D1P S1P C2C L2C D2C S2C C2P",
@@ -279,19 +285,22 @@ static const bad_case k_bad[] = {
      "BROADCAST ORBIT - 1, field 3: blank"},
     {"nav: eccentricity", false, "0.100000000000D-01", "0.100000000000D+01", NAV_ERR_PARSE, 7, 24,
      "eccentricity 1; expected 0 <= e < 1"},
-    {"nav: sqrt(A)", false, "0.515370000000D+04", "0.515370000000D+02", NAV_ERR_PARSE, 7, 62, "sqrt(A) 51.537"},
-    {"nav: toe", false, "     0.374400000000D+06 0.000000000000D+00-0.2", "     0.704400000000D+06 0.000000000000D+00-0.2",
-     NAV_ERR_PARSE, 8, 5, "toe 704400 s"},
-    {"nav: week", false, "0.244600000000D+04", "0.244650000000D+04", NAV_ERR_PARSE, 10, 43, "GPS week 2446.5"},
+    {"nav: sqrt(A)", false, "0.515370000000D+04", "0.515370000000D+02", NAV_ERR_PARSE, 7, 62,
+     "sqrt(A) 51.537"},
+    {"nav: toe", false, "     0.374400000000D+06 0.000000000000D+00-0.2",
+     "     0.704400000000D+06 0.000000000000D+00-0.2", NAV_ERR_PARSE, 8, 5, "toe 704400 s"},
+    {"nav: week", false, "0.244600000000D+04", "0.244650000000D+04", NAV_ERR_PARSE, 10, 43,
+     "GPS week 2446.5"},
     {"nav: health", false, "     0.200000000000D+01 0.000000000000D+00-0.5",
      "     0.200000000000D+01 0.650000000000D+02-0.5", NAV_ERR_PARSE, 11, 24, "SV health 65"},
-    {"nav: GLONASS channel", false, "0.200000000000D+05-0.100000000000D+01 0.000000000000D+00 0.100000000000D+01",
+    {"nav: GLONASS channel", false,
+     "0.200000000000D+05-0.100000000000D+01 0.000000000000D+00 0.100000000000D+01",
      "0.200000000000D+05-0.100000000000D+01 0.000000000000D+00 0.150000000000D+02", NAV_ERR_PARSE, 15, 62,
      "frequency number 15"},
     {"nav: GLONASS position in m", false, "     0.100000000000D+05 0.15", "     0.100000000000D+08 0.15",
      NAV_ERR_PARSE, 14, 5, "the file's unit is km"},
-    {"nav: GLONASS slot 25", false, "R01 2026 11 26 07 45 00", "R25 2026 11 26 07 45 00", NAV_ERR_PARSE, 13, 2,
-     "GLONASS slot 25"},
+    {"nav: GLONASS slot 25", false, "R01 2026 11 26 07 45 00", "R25 2026 11 26 07 45 00", NAV_ERR_PARSE, 13,
+     2, "GLONASS slot 25"},
     {"nav: record cut", false, "     0.381400000000D+06\n", "", NAV_ERR_PARSE, 32, 1,
      "end of file inside a navigation record; expected BROADCAST ORBIT - 7"},
 };
@@ -299,8 +308,10 @@ static const bad_case k_bad[] = {
 static void check_bad(const bad_case *c) {
   size_t len = 0;
   char *text = NULL;
-  if (c->find) text = edited(c->obs ? SMALL_OBS : SMALL_NAV, c->find, c->replace, &len);
-  else text = calloc(1, 1);
+  if (c->find)
+    text = edited(c->obs ? SMALL_OBS : SMALL_NAV, c->find, c->replace, &len);
+  else
+    text = calloc(1, 1);
   nav_diag d;
   memset(&d, 0, sizeof d);
   nav_status st = NAV_OK;
@@ -310,7 +321,8 @@ static void check_bad(const bad_case *c) {
     if (st == NAV_OK) {
       nav_rinex_obs_epoch *ep = malloc(sizeof *ep);
       bool got = true;
-      while (st == NAV_OK && got) st = nav_rinex_obs_next(r, ep, NULL, &got);
+      while (st == NAV_OK && got)
+        st = nav_rinex_obs_next(r, ep, NULL, &got);
       if (st != NAV_OK) d = *nav_rinex_obs_diag(r);
       /* After an error every call returns it again. */
       if (st != NAV_OK) assert_int_equal(nav_rinex_obs_next(r, ep, NULL, &got), st);
@@ -323,7 +335,8 @@ static void check_bad(const bad_case *c) {
     nav_rinex_nav_destroy(nv);
   }
   free(text);
-  if (st != c->status) fail_msg("%s: status %d, expected %d (%s)", c->what, (int)st, (int)c->status, d.message);
+  if (st != c->status)
+    fail_msg("%s: status %d, expected %d (%s)", c->what, (int)st, (int)c->status, d.message);
   if (c->line > 0 && (d.line != c->line || d.col != c->col))
     fail_msg("%s: at %d:%d, expected %d:%d (%s)", c->what, d.line, d.col, c->line, c->col, d.message);
   if (c->message && !strstr(d.message, c->message))
@@ -404,7 +417,8 @@ static void test_source(void **state) {
   const double dt = -P / c_mps;
   const double A = 5153.7 * 5153.7, n = sqrt(NAV_GPS_MU_M3PS2 / (A * A * A)) + 4.5e-9;
   double E = 1.25 + n * dt;
-  for (int i = 0; i < 50; ++i) E = 1.25 + n * dt + 0.01 * sin(E);
+  for (int i = 0; i < 50; ++i)
+    E = 1.25 + n * dt + 0.01 * sin(E);
   const double dt_sv = 1e-5 + 2e-12 * dt - 4.442807633e-10 * 0.01 * 5153.7 * sin(E) + 5e-9;
   assert_near(ep.sats[0].pr_m, P + c_mps * dt_sv, 1e-6);
   /* Range rate -lambda D plus c times the clock rate: af1 and the relativistic term's rate
@@ -488,7 +502,8 @@ static void test_harmonic_corrections(void **state) {
   const double n = sqrt(NAV_GPS_MU_M3PS2 / (A * A * A)) + with.delta_n_rps;
   const double M = with.m0_rad + n * (t - with.toe_s);
   double E = M;
-  for (int i = 0; i < 60; ++i) E = M + with.e * sin(E);
+  for (int i = 0; i < 60; ++i)
+    E = M + with.e * sin(E);
   const double nu = atan2(sqrt(1.0 - with.e * with.e) * sin(E), cos(E) - with.e);
   assert_near(nav_vec3_norm(r1) - nav_vec3_norm(r0), 15.0 * sin(2.0 * (nu + with.w_rad)), 1e-6);
   /* All six: velocity against the derivative of the positions. */
@@ -503,7 +518,8 @@ static void test_harmonic_corrections(void **state) {
     nav_vec3 v, r[4];
     static const double hs[4] = {-1.0, -0.5, 0.5, 1.0}; /* exact offsets of an integer time */
     nav_gnss_orbit_state(&all, tk, NULL, &v);
-    for (int i = 0; i < 4; ++i) nav_gnss_orbit_state(&all, tk + hs[i], &r[i], NULL);
+    for (int i = 0; i < 4; ++i)
+      nav_gnss_orbit_state(&all, tk + hs[i], &r[i], NULL);
     /* Fourth-order central difference, h = 0.5 s: [8 (r(h) - r(-h)) - (r(2h) - r(-2h))] / (12 h). */
     const nav_vec3 d1 = nav_vec3_sub(r[2], r[1]), d2 = nav_vec3_sub(r[3], r[0]);
     const nav_vec3 fd = nav_vec3_scale(nav_vec3_sub(nav_vec3_scale(d1, 8.0), d2), 1.0 / 6.0);
@@ -529,7 +545,8 @@ static void glonass_round_trip(double half_span_s) {
   const double tb = nav_gnss_gps_time_s(2026, 11, 26, 8, 0, 0.0) - 18.0 + 900.0; /* 08:15 UTC */
   assert_int_equal(nav_gnss_add_glonass_nominal(&con, tb, 0.3), NAV_OK);
   const nav_gnss_orbit *truth = &con.sats[3];
-  const nav_rinex_glo_eph rec = nav_rinex_glo_eph_from_orbit(truth, tb, nav_rinex_glonass_nominal_channel(truth->prn), half_span_s);
+  const nav_rinex_glo_eph rec =
+      nav_rinex_glo_eph_from_orbit(truth, tb, nav_rinex_glonass_nominal_channel(truth->prn), half_span_s);
   char nav_path[] = "/tmp/test_rinex_read_nav_XXXXXX", obs_path[] = "/tmp/test_rinex_read_obs_XXXXXX";
   int fd = mkstemp(nav_path);
   assert_true(fd >= 0);
@@ -573,7 +590,8 @@ static void glonass_round_trip(double half_span_s) {
   nav_rinex_source *s = NULL;
   nav_diag d;
   memset(&d, 0, sizeof d);
-  if (nav_rinex_source_create(&c, &s, &d) != NAV_OK) fail_msg("%s:%d:%d: %s", d.file, d.line, d.col, d.message);
+  if (nav_rinex_source_create(&c, &s, &d) != NAV_OK)
+    fail_msg("%s:%d:%d: %s", d.file, d.line, d.col, d.message);
   for (int k = 0; k < 3; ++k) {
     nav_ins_gnss_raw_epoch ep;
     bool got = false;
@@ -586,9 +604,11 @@ static void glonass_round_trip(double half_span_s) {
       nav_vec3 r_rep, v_rep, r_sim, v_sim;
       nav_gnss_orbit_state(ep.sats[0].sat, t, &r_rep, &v_rep);
       nav_gnss_orbit_state(truth, t, &r_sim, &v_sim);
-      const double dr = nav_vec3_norm(nav_vec3_sub(r_rep, r_sim)), dv = nav_vec3_norm(nav_vec3_sub(v_rep, v_sim));
-      print_message("  R%02d, record span %3.0f s, at tb + %6.2f s: replay orbit - simulated orbit %.3g m, %.3g m/s\n",
-                    truth->prn, half_span_s, t - tb, dr, dv);
+      const double dr = nav_vec3_norm(nav_vec3_sub(r_rep, r_sim)),
+                   dv = nav_vec3_norm(nav_vec3_sub(v_rep, v_sim));
+      print_message(
+          "  R%02d, record span %3.0f s, at tb + %6.2f s: replay orbit - simulated orbit %.3g m, %.3g m/s\n",
+          truth->prn, half_span_s, t - tb, dr, dv);
       if (k == 0) {
         /* The record's own state, 12 significant digits in km: 1e-5 m, 1e-9 m/s; with a span
          * the record's velocity is tilted by design (docs/rinex.md 4). 0.07 s away the two-body

@@ -64,21 +64,21 @@ NAV_BEGIN_DECLS
  * system, only the kept types: C1C, L1C, D1C and S1C where the file has them, in file order).
  */
 typedef struct nav_rinex_obs_info {
-  double version;        /**< e.g. 3.04 */
-  char system;           /**< satellite system of the file: 'G', 'R', 'M' (mixed), ... */
-  bool has_first;        /**< TIME OF FIRST OBS given (else t_first_gps_s is 0) */
-  bool has_leap;         /**< LEAP SECONDS given */
-  int file_types[NAV_GNSS_SYS_COUNT];    /**< types the file lists for GPS, GLONASS */
-  int skipped_systems;   /**< SYS / # / OBS TYPES records of systems other than G and R */
+  double version;                     /**< e.g. 3.04 */
+  char system;                        /**< satellite system of the file: 'G', 'R', 'M' (mixed), ... */
+  bool has_first;                     /**< TIME OF FIRST OBS given (else t_first_gps_s is 0) */
+  bool has_leap;                      /**< LEAP SECONDS given */
+  int file_types[NAV_GNSS_SYS_COUNT]; /**< types the file lists for GPS, GLONASS */
+  int skipped_systems;                /**< SYS / # / OBS TYPES records of systems other than G and R */
 } nav_rinex_obs_info;
 
 /** What an epoch record said besides its observations. */
 typedef struct nav_rinex_epoch_info {
-  int flag;              /**< 0 (OK) or 1 (power failure since the previous epoch) */
-  bool has_rx_clock;     /**< the receiver clock offset field is given */
-  double rx_clock_s;     /**< receiver clock offset [s] (0 if not given) */
-  int skipped;           /**< satellites of other systems in the record */
-  long line;             /**< line of the epoch's '>' record */
+  int flag;          /**< 0 (OK) or 1 (power failure since the previous epoch) */
+  bool has_rx_clock; /**< the receiver clock offset field is given */
+  double rx_clock_s; /**< receiver clock offset [s] (0 if not given) */
+  int skipped;       /**< satellites of other systems in the record */
+  long line;         /**< line of the epoch's '>' record */
 } nav_rinex_epoch_info;
 
 typedef struct nav_rinex_obs_reader nav_rinex_obs_reader;
@@ -90,11 +90,13 @@ typedef struct nav_rinex_obs_reader nav_rinex_obs_reader;
  * @return NAV_OK; NAV_ERR_IO (cannot open or read); NAV_ERR_PARSE (header); NAV_ERR_INVALID_ARG
  *         (NULL); NAV_ERR_NO_MEMORY.
  */
-NAV_API NAV_NODISCARD nav_status nav_rinex_obs_open(const char *path, nav_rinex_obs_reader **out, nav_diag *diag);
+NAV_API NAV_NODISCARD nav_status nav_rinex_obs_open(const char *path, nav_rinex_obs_reader **out,
+                                                    nav_diag *diag);
 
 /** As nav_rinex_obs_open(), over @p len bytes of memory (not copied: @p text must outlive the
  *  reader); @p display_name is the FILE of diagnostics. */
-NAV_API NAV_NODISCARD nav_status nav_rinex_obs_open_memory(const char *text, size_t len, const char *display_name,
+NAV_API NAV_NODISCARD nav_status nav_rinex_obs_open_memory(const char *text, size_t len,
+                                                           const char *display_name,
                                                            nav_rinex_obs_reader **out, nav_diag *diag);
 
 /** Close and free; accepts NULL. */
@@ -138,14 +140,14 @@ NAV_API double nav_rinex_obs_fraction(const nav_rinex_obs_reader *r);
 typedef struct nav_rinex_nav {
   double version;
   bool has_leap;
-  int leap_s;          /**< LEAP SECONDS (GPS - UTC) [s] used for GLONASS epochs (valid when
-                        *   has_leap; without it, nav_rinex_leap_seconds() of each record's epoch) */
+  int leap_s; /**< LEAP SECONDS (GPS - UTC) [s] used for GLONASS epochs (valid when
+               *   has_leap; without it, nav_rinex_leap_seconds() of each record's epoch) */
   size_t n_gps, n_glo;
   nav_rinex_gps_eph *gps;
-  long *gps_line;      /**< line of each GPS record's first line */
+  long *gps_line; /**< line of each GPS record's first line */
   nav_rinex_glo_eph *glo;
   long *glo_line;
-  long skipped;        /**< records of other systems */
+  long skipped; /**< records of other systems */
 } nav_rinex_nav;
 
 /**
@@ -158,8 +160,9 @@ typedef struct nav_rinex_nav {
 NAV_API NAV_NODISCARD nav_status nav_rinex_nav_read(const char *path, nav_rinex_nav **out, nav_diag *diag);
 
 /** As nav_rinex_nav_read(), over memory. */
-NAV_API NAV_NODISCARD nav_status nav_rinex_nav_read_memory(const char *text, size_t len, const char *display_name,
-                                                           nav_rinex_nav **out, nav_diag *diag);
+NAV_API NAV_NODISCARD nav_status nav_rinex_nav_read_memory(const char *text, size_t len,
+                                                           const char *display_name, nav_rinex_nav **out,
+                                                           nav_diag *diag);
 
 /** Free; accepts NULL. */
 NAV_API void nav_rinex_nav_destroy(nav_rinex_nav *n);
@@ -180,18 +183,18 @@ typedef struct nav_rinex_source nav_rinex_source;
 
 /** Settings of a nav_rinex_source. */
 typedef struct nav_rinex_source_config {
-  const char *obs_path;  /**< observation file (required) */
-  const char *nav_path;  /**< navigation file (required) */
+  const char *obs_path; /**< observation file (required) */
+  const char *nav_path; /**< navigation file (required) */
   /** GPS time of the IMU's time 0: t_imu = t_gps - t0_gps_s. */
   double t0_gps_s;
-  double pr_sd_m;        /**< pseudorange sigma for the filter [m] (> 0) */
-  double rr_sd_mps;      /**< range-rate sigma for the filter [m/s] (> 0) */
+  double pr_sd_m;   /**< pseudorange sigma for the filter [m] (> 0) */
+  double rr_sd_mps; /**< range-rate sigma for the filter [m/s] (> 0) */
   /** Largest |t - toe| of a usable GPS ephemeris [s]; default 7200 (the 4 h fit interval). */
   double max_eph_age_s;
   /** Largest |t - tb| of a usable GLONASS record [s], at most 86400; default 1800 (records come
    *  every 30 min, navsim writes them every 15 min). */
   double max_glo_age_s;
-  bool use_doppler;      /**< use D1C as range rate; default true */
+  bool use_doppler; /**< use D1C as range rate; default true */
 } nav_rinex_source_config;
 
 /** Defaults: no paths, t0 0, sigmas 3 m and 0.1 m/s, ephemeris ages 7200 s (GPS) and 1800 s
@@ -200,14 +203,14 @@ NAV_API nav_rinex_source_config nav_rinex_source_config_default(void);
 
 /** What a source did so far. */
 typedef struct nav_rinex_source_counts {
-  long epochs;            /**< epochs returned */
-  long sats_used;         /**< satellite measurements returned */
-  long no_ephemeris;      /**< satellites without a usable ephemeris (skipped) */
-  long unhealthy;         /**< satellites whose ephemeris is unhealthy (skipped) */
-  long glonass_used;      /**< GLONASS satellite measurements among sats_used */
-  long no_code;           /**< satellites without C1C (skipped) */
-  long events;            /**< event records skipped by the observation reader */
-  long other_systems;     /**< satellites of other systems */
+  long epochs;        /**< epochs returned */
+  long sats_used;     /**< satellite measurements returned */
+  long no_ephemeris;  /**< satellites without a usable ephemeris (skipped) */
+  long unhealthy;     /**< satellites whose ephemeris is unhealthy (skipped) */
+  long glonass_used;  /**< GLONASS satellite measurements among sats_used */
+  long no_code;       /**< satellites without C1C (skipped) */
+  long events;        /**< event records skipped by the observation reader */
+  long other_systems; /**< satellites of other systems */
 } nav_rinex_source_counts;
 
 /**
@@ -215,8 +218,8 @@ typedef struct nav_rinex_source_counts {
  * @return NAV_OK; the statuses of nav_rinex_obs_open() and nav_rinex_nav_read();
  *         NAV_ERR_INVALID_ARG (settings: message in @p diag).
  */
-NAV_API NAV_NODISCARD nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg, nav_rinex_source **out,
-                                                         nav_diag *diag);
+NAV_API NAV_NODISCARD nav_status nav_rinex_source_create(const nav_rinex_source_config *cfg,
+                                                         nav_rinex_source **out, nav_diag *diag);
 NAV_API void nav_rinex_source_destroy(nav_rinex_source *s);
 
 /**
@@ -234,8 +237,8 @@ NAV_API void nav_rinex_source_destroy(nav_rinex_source *s);
  * @return NAV_OK (got false at the end); NAV_ERR_PARSE with FILE:LINE:COL in @p diag (also for
  *         a GLONASS record whose state gives no closed orbit).
  */
-NAV_API NAV_NODISCARD nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep, bool *got,
-                                                       nav_diag *diag);
+NAV_API NAV_NODISCARD nav_status nav_rinex_source_next(nav_rinex_source *s, nav_ins_gnss_raw_epoch *ep,
+                                                       bool *got, nav_diag *diag);
 
 /** Counts so far. */
 NAV_API nav_rinex_source_counts nav_rinex_source_get_counts(const nav_rinex_source *s);
