@@ -113,7 +113,7 @@ NAV_API const nav_rinex_obs_info *nav_rinex_obs_get_info(const nav_rinex_obs_rea
  * types of nav_rinex_obs_get_header(). Event records (flags 2-5) and cycle-slip records (flag 6)
  * are skipped with their special records and counted (nav_rinex_obs_events()). Epochs must not
  * go back in time.
- * @param[out] out  the epoch, written only when @p got is set
+ * @param[out] out  the epoch when @p got is set (unspecified after an error)
  * @param[out] info flag, receiver clock, skipped satellites, line (may be NULL)
  * @param[out] got  false at the end of the file
  * @return NAV_OK; NAV_ERR_PARSE (see nav_rinex_obs_diag()); NAV_ERR_IO. After an error every
