@@ -66,10 +66,13 @@ static nav_status lines_init(lines *L, const char *path, const char *text, size_
   L->c_numeric = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
   if (L->c_numeric == (locale_t)0) return NAV_ERR_NO_MEMORY;
   if (path) {
-    L->f = fopen(path, "rb");
-    if (!L->f) {
-      diag_set(diag, path, 0, 0, "cannot open the file for reading");
-      return NAV_ERR_IO;
+    /* The readers' one way to open an input (nav_io.h): a FIFO, device or directory is refused at
+     * once instead of blocking or reading forever. */
+    char why[320];
+    const nav_status st = nav_io_fopen_regular(path, &L->f, why, sizeof why);
+    if (st != NAV_OK) {
+      diag_set(diag, path, 0, 0, "%s", why);
+      return st;
     }
     if (fseek(L->f, 0, SEEK_END) == 0) L->file_size = ftell(L->f);
     if (fseek(L->f, 0, SEEK_SET) != 0) L->file_size = 0;

@@ -383,6 +383,9 @@ static void test_binary_and_long_lines(void **state) {
   free(big);
   assert_int_equal(nav_rinex_obs_open("/nonexistent/x.obs", &r, &d), NAV_ERR_IO);
   assert_non_null(strstr(d.message, "cannot open"));
+  /* A directory (and likewise a FIFO) is refused at once, not read. */
+  assert_int_equal(nav_rinex_nav_read(RINEX_DIR, &nv, &d), NAV_ERR_PARSE);
+  assert_non_null(strstr(d.message, "it is a directory, not a regular file"));
 }
 
 static void test_source(void **state) {
