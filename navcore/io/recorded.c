@@ -813,6 +813,7 @@ typedef struct replay {
   bool ref_have;
   nav_ins_gnss_fix fix;
   bool fix_have;
+  nav_ins_gnss_raw_epoch raw; /* cfg->raw: the next raw epoch */
   nav_replay_summary *sum;
   nav_diag *diag;
 } replay;
@@ -830,6 +831,20 @@ static nav_status ref_next(replay *p) {
 }
 
 static nav_status fix_next(replay *p) {
+  if (p->cfg->raw) {
+    /* A raw epoch stands for a fix: only its time is read by the loop (p->fix.t_s). */
+    const nav_status st = p->cfg->raw(p->cfg->raw_user, &p->raw, &p->fix_have, p->diag);
+    if (st != NAV_OK) return st;
+    if (p->fix_have) {
+      if (!isfinite(p->raw.t_s)) {
+        diag_set(p->diag, "replay", 0, 0, "", "a raw GNSS epoch with a non-finite time");
+        return NAV_ERR_PARSE;
+      }
+      p->fix.t_s = p->raw.t_s;
+      p->sum->gnss_records++;
+    }
+    return NAV_OK;
+  }
   const nav_status st = nav_rec_read_gnss(p->gnss, &p->fix, &p->fix_have);
   if (st != NAV_OK) return reader_failed(p, p->gnss, st);
   if (p->fix_have) {
@@ -865,6 +880,11 @@ static nav_status check_config(const nav_replay_config *c, nav_diag *diag) {
     bad = "the end time must be after the start time";
   else if (c->outage_count > NAV_GNSS_MAX_OUTAGES)
     bad = "too many outages";
+  else if (c->raw && c->gnss_path)
+    bad = "raw measurements and a GNSS fix file are exclusive";
+  else if (c->raw && !(c->nav.filter.states & NAV_FILTER_STATE_RX_CLOCK))
+    bad = "raw measurements need the filter's receiver-clock states (the tightly coupled scheme, "
+          "navigation.scheme ins_gnss_tight)";
   for (size_t i = 0; !bad && i < c->outage_count; ++i)
     if (!(isfinite(c->outages[i].t0_s) && isfinite(c->outages[i].t1_s) &&
           c->outages[i].t1_s > c->outages[i].t0_s))
@@ -962,14 +982,15 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   p.sum = sum;
   p.diag = diag;
   nav_side nav = {NULL, NULL};
-  sum->free_ins = cfg->gnss_path == NULL;
+  sum->free_ins = cfg->gnss_path == NULL && cfg->raw == NULL;
+  const bool aided = !sum->free_ins;
 
   st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
   if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
   if (st != NAV_OK) goto cleanup;
   st = ref_next(&p);
-  if (st == NAV_OK && p.gnss) st = fix_next(&p);
+  if (st == NAV_OK && aided) st = fix_next(&p);
   if (st != NAV_OK) goto cleanup;
 
   /* 1. The initial epoch: the first IMU epoch in the window with a reference row. */
@@ -1026,7 +1047,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   s0.r_fb_f_m = is0.r_fb_f_m;
   s0.v_fb_f_mps = is0.v_fb_f_mps;
   s0.q_b_f = is0.q_b_f;
-  if (p.gnss)
+  if (aided)
     st = nav_ins_gnss_create(&cfg->nav, &s0, &nav.x);
   else
     st = nav_ins_create(&cfg->nav.ins, &s0, &nav.ins);
@@ -1090,7 +1111,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
 
     /* GNSS fixes of this epoch: time of validity within dt/2 (numerics.md 6.5). */
     bool updated = false;
-    while (p.gnss && p.fix_have && p.fix.t_s <= t + 0.5 * dt) {
+    while (aided && p.fix_have && p.fix.t_s <= t + 0.5 * dt) {
       if (p.fix.t_s <= t - 0.5 * dt) {
         if (p.fix.t_s <= t_first + 0.5 * dt)
           sum->gnss_before_start++;
@@ -1118,7 +1139,10 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
           if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
           sum->gap_count++;
         }
-        st = nav_ins_gnss_update(nav.x, &p.fix);
+        if (cfg->raw)
+          st = nav_ins_gnss_update_raw(nav.x, &p.raw, NULL);
+        else
+          st = nav_ins_gnss_update(nav.x, &p.fix);
         if (st != NAV_OK) {
           nav_fail(diag, st, "GNSS update failed", nav_ins_gnss_last_error(nav.x));
           goto cleanup;
@@ -1165,7 +1189,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     }
   }
   /* A gap still open at the end of the run. */
-  if (p.gnss && have_fix && have_spacing && sum->t_last_s - last_fix_t > cfg->gap_factor * min_spacing) {
+  if (aided && have_fix && have_spacing && sum->t_last_s - last_fix_t > cfg->gap_factor * min_spacing) {
     nav_replay_gap g;
     memset(&g, 0, sizeof g);
     g.t0_s = last_fix_t;

@@ -50,8 +50,11 @@ static void set_msg(char *msg, size_t cap, const char *fmt, ...) {
 }
 
 const char *navsim_kfgins_unsupported(const nav_scene *sc) {
-  if (sc->navigation.scheme != NAV_SCHEME_INS_GNSS)
-    return "the kfgins export needs navigation.scheme ins_gnss (KF-GINS is an INS/GNSS filter)";
+  /* ins_gnss_tight: IMU.txt, truth.nav and init.nav are what navsim replay --rinex-obs takes
+   * beside the RINEX export; GNSS.txt then holds the receiver model's fixes at the receiver
+   * epochs, which the tight filter did not use (docs/kfgins-export.md). */
+  if (sc->navigation.scheme != NAV_SCHEME_INS_GNSS && sc->navigation.scheme != NAV_SCHEME_INS_GNSS_TIGHT)
+    return "the kfgins export needs navigation.scheme ins_gnss or ins_gnss_tight (KF-GINS is an INS/GNSS filter)";
   if (sc->earth.model != NAV_EARTH_WGS84)
     return "the kfgins export needs earth.model wgs84 (the KF-GINS formats are geodetic on WGS-84)";
   if (sc->gnss.file[0] != '\0')

@@ -20,6 +20,7 @@
 
 #include "navcore/nav_io.h"
 #include "navcore/nav_recorded.h"
+#include "navcore/nav_rinex_read.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_version.h"
 #include "smooth_out.h"
@@ -31,6 +32,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 static const char *k_usage_replay =
     "usage: navsim replay --imu FILE --truth FILE [--gnss FILE] [--scene SCENE] [--init FILE] [--start T]\n"
     "                     [--end T] [--outage T0:T1]... [--peer NAME=FILE]... [--out DIR]\n"
+    "                     [--rinex-obs FILE --rinex-nav FILE [--t0-gps S]]\n"
     "                     [--force] [--peers auto|none] [--cov-decimation N] [--smooth] [--quiet]\n"
     "\n"
     "Run our navigation on recorded data and score it against a reference:\n"
@@ -55,7 +57,20 @@ static const char *k_usage_replay =
     "                  drawn initial errors included, to kfgins/init.nav. Without --init, an\n"
     "                  init.nav in the folder of --imu is used (a line on stderr says so);\n"
     "                  --init none: start from the reference row even then\n"
-    "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n";
+    "  --start T, --end T  process only IMU epochs in [T_start, T_end] (file time base, s)\n"
+    "  --rinex-obs FILE  tightly coupled replay: RINEX 3 observation file whose GPS and GLONASS C1C\n"
+    "                  pseudoranges and D1C Dopplers update the filter instead of --gnss fixes;\n"
+    "                  needs --rinex-nav and --scene (whose filter is made the tight scheme's, with\n"
+    "                  its gnss.constellation code_sd_m, range_rate_sd_mps and receiver clock);\n"
+    "                  docs/rinex.md section 8. navsim run --export kfgins --export rinex writes\n"
+    "                  files that replay run 0 (IMU.txt, truth.nav, init.nav and rinex/NAME.obs/.nav)\n"
+    "  --rinex-nav FILE  RINEX 3 navigation file: GPS LNAV ephemerides (orbits and clocks propagated\n"
+    "                  by the constellation code of the simulation) and GLONASS records (integrated\n"
+    "                  with the ICD force model)\n"
+    "  --t0-gps S      GPS time of the IMU files' t = 0, seconds since 1980-01-06 (default: the\n"
+    "                  scene's gnss.constellation epoch, which is what navsim run --export writes;\n"
+    "                  without one the start of the GPS week of the first observation, i.e. the IMU\n"
+    "                  time is GPS seconds of week as in KF-GINS data)\n";
 
 /* The rest of navsim replay --help (one literal would exceed what C compilers must support). */
 static const char *k_usage_replay_tail =
@@ -366,6 +381,9 @@ typedef struct peer_arg {
 
 typedef struct replay_job {
   const char *imu, *gnss, *truth, *config;
+  const char *rinex_obs, *rinex_nav; /* tightly coupled replay, else NULL */
+  double t0_gps_s;
+  nav_rinex_source_counts rinex;
   const nav_replay_config *rc;
   const nav_replay_summary *sum;
   data_case dcase;
@@ -393,6 +411,12 @@ static nav_status write_summary(const char *path, const replay_job *j) {
     nav_json_write_string(f, j->gnss);
   else
     fputs("null", f);
+  if (j->rinex_obs) {
+    fputs(", \"rinex_obs\": ", f);
+    nav_json_write_string(f, j->rinex_obs);
+    fputs(", \"rinex_nav\": ", f);
+    nav_json_write_string(f, j->rinex_nav);
+  }
   fputs(", \"truth\": ", f);
   nav_json_write_string(f, j->truth);
   fputs(", \"config\": ", f);
@@ -400,7 +424,8 @@ static nav_status write_summary(const char *path, const replay_job *j) {
     nav_json_write_string(f, j->config);
   else
     fputs("null", f);
-  fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"case\": ", s->free_ins ? "free_ins" : "ins_gnss");
+  fprintf(f, "},\n  \"scheme\": \"%s\",\n  \"case\": ",
+          s->free_ins ? "free_ins" : j->rinex_obs ? "ins_gnss_tight" : "ins_gnss");
   nav_json_write_string(f, k_case_names[j->dcase]);
   fprintf(f, ",\n  \"dataset\": %s,\n", j->long_drive ? "\"gnss-ins-sim long_drive\"" : "null");
   fprintf(
@@ -470,6 +495,17 @@ static nav_status write_summary(const char *path, const replay_job *j) {
   fputs(", \"realtime_factor\": ", f);
   json_number(f, j->wall_s > 0.0 ? (s->t_last_s - s->t_first_s) / j->wall_s : 0.0);
   fputs("},\n", f);
+  if (j->rinex_obs) {
+    const nav_rinex_source_counts *c = &j->rinex;
+    fputs("  \"raw_gnss\": {\"t0_gps_s\": ", f);
+    json_number(f, j->t0_gps_s);
+    fprintf(f,
+            ", \"epochs\": %ld, \"satellite_measurements\": %ld, \"skipped_no_ephemeris\": %ld, "
+            "\"skipped_unhealthy\": %ld, \"glonass_measurements\": %ld, \"skipped_no_c1c\": %ld, "
+            "\"skipped_other_systems\": %ld, \"event_records\": %ld},\n",
+            c->epochs, c->sats_used, c->no_ephemeris, c->unhealthy, c->glonass_used, c->no_code,
+            c->other_systems, c->events);
+  }
   json_stats(f, 1, "errors", &s->stats, false);
   json_stats(f, 1, "errors_at_output_epochs", &s->stats_output, false);
   json_run_stats(f, j->rstats);
@@ -554,13 +590,23 @@ static void print_cell(double v) {
 
 static void print_tables(const replay_job *j, bool show_published) {
   const nav_replay_summary *s = j->sum;
-  printf("replay     %s%s%s vs %s (%s)\n", j->imu, j->gnss ? " + " : " (free INS)", j->gnss ? j->gnss : "",
-         j->truth, j->config ? j->config : "default filter settings");
+  if (j->rinex_obs)
+    printf("replay     %s + %s + %s (tightly coupled) vs %s (%s)\n", j->imu, j->rinex_obs, j->rinex_nav, j->truth,
+           j->config ? j->config : "default filter settings");
+  else
+    printf("replay     %s%s%s vs %s (%s)\n", j->imu, j->gnss ? " + " : " (free INS)", j->gnss ? j->gnss : "",
+           j->truth, j->config ? j->config : "default filter settings");
   printf("epochs     %ld IMU steps, %.3f .. %.3f s; %ld scored against the reference", s->imu_steps,
          s->t_first_s, s->t_last_s, s->stats.epochs);
   if (s->ref_unmatched > 0) printf(" (%ld reference rows between IMU epochs not scored)", s->ref_unmatched);
   printf("\n");
-  if (!s->free_ins)
+  if (j->rinex_obs) {
+    const nav_rinex_source_counts *c = &j->rinex;
+    printf("raw gnss   %ld epochs read, %ld applied (%ld satellite measurements, %ld GLONASS); skipped: %ld "
+           "without ephemeris, %ld unhealthy, %ld without C1C, %ld of other systems\n",
+           c->epochs, s->gnss_applied, c->sats_used, c->glonass_used, c->no_ephemeris, c->unhealthy, c->no_code,
+           c->other_systems);
+  } else if (!s->free_ins)
     printf("gnss       %ld fixes applied, %ld dropped (outages), %ld before the start, %ld unmatched; %ld "
            "gap%s\n",
            s->gnss_applied, s->gnss_dropped, s->gnss_before_start, s->gnss_unmatched, s->gap_count,
@@ -676,8 +722,18 @@ static bool is_regular_file(const char *path) {
   return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
 }
 
+/* nav_replay_raw_fn over a nav_rinex_source. */
+static nav_status rinex_next(void *user, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag) {
+  return nav_rinex_source_next(user, ep, got, diag);
+}
+
 int navsim_replay(int argc, char **argv) {
   const char *imu = NULL, *gnss = NULL, *truth = NULL, *config = NULL, *out_dir = "out/replay", *init = NULL;
+  const char *rinex_obs = NULL, *rinex_nav = NULL;
+  bool has_t0_gps = false;
+  double t0_gps = 0.0;
+  nav_rinex_source *rsrc = NULL;
+  nav_rinex_source_config rsc = nav_rinex_source_config_default();
   bool quiet = false, peers_auto = true, smooth = false, force = false;
   /* 10 IMU steps (50 ms at 200 Hz): on the long drive the smoothed positions move by < 2e-5 m
    * and the sigmas by < 1e-4 relative against step-by-step, at a third of the forward cost. */
@@ -722,6 +778,18 @@ int navsim_replay(int argc, char **argv) {
                          : (a[2] == 'c' || a[2] == 's') ? &config
                                        : &out_dir;
       *dst = v;
+    } else if (strcmp(a, "--rinex-obs") == 0 || strcmp(a, "--rinex-nav") == 0) {
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
+      *(a[8] == 'o' ? &rinex_obs : &rinex_nav) = argv[++i];
+    } else if (strcmp(a, "--t0-gps") == 0) {
+      if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
+      const char *v = argv[++i];
+      if (!navsim_parse_double(v, &t0_gps) || !(t0_gps >= 0.0 && t0_gps < 1e10)) {
+        fprintf(stderr, "navsim replay: --t0-gps: expected GPS seconds since 1980-01-06 (0 to 1e10), got \"%s\"\n",
+                v);
+        return EXIT_INVALID;
+      }
+      has_t0_gps = true;
     } else if (strcmp(a, "--init") == 0) {
       if (!navsim_need_value("replay", argc, i, a)) return EXIT_INVALID;
       init = argv[++i];
@@ -808,11 +876,26 @@ int navsim_replay(int argc, char **argv) {
     fprintf(stderr, "navsim replay: --imu and --truth are required\n%s%s", k_usage_replay, k_usage_replay_tail);
     return EXIT_INVALID;
   }
+  if ((rinex_obs != NULL) != (rinex_nav != NULL)) {
+    fprintf(stderr, "navsim replay: --rinex-obs and --rinex-nav go together (observations and ephemerides)\n");
+    return EXIT_INVALID;
+  }
+  if (rinex_obs && gnss) {
+    fprintf(stderr, "navsim replay: --rinex-obs and --gnss are exclusive (raw measurements or fixes)\n");
+    return EXIT_INVALID;
+  }
+  if (rinex_obs && !config) {
+    fprintf(stderr, "navsim replay: --rinex-obs needs --scene (the receiver's clock model and measurement "
+                    "sigmas of the tightly coupled filter)\n");
+    return EXIT_INVALID;
+  }
+  if (has_t0_gps && !rinex_obs)
+    fprintf(stderr, "navsim replay: warning: --t0-gps has no effect without --rinex-obs\n");
   if (rc.has_start && rc.has_end && !(rc.t_end_s > rc.t_start_s)) {
     fprintf(stderr, "navsim replay: --end must be after --start\n");
     return EXIT_INVALID;
   }
-  if (rc.outage_count > 0 && !gnss)
+  if (rc.outage_count > 0 && !gnss && !rinex_obs)
     fprintf(stderr, "navsim replay: warning: --outage has no effect without --gnss\n");
   {
     /* Before anything is read: an --out holding the recorded files (or anything else navsim did
@@ -831,6 +914,17 @@ int navsim_replay(int argc, char **argv) {
               st == NAV_ERR_PARSE ? "not a valid scene (errors above)" : nav_status_str(st));
       free(scene);
       return st == NAV_ERR_PARSE ? EXIT_INVALID : EXIT_FAIL;
+    }
+    if (rinex_obs) {
+      /* Raw measurements: the tightly coupled filter of this scene (its clock states and
+       * model), whatever navigation.scheme says; the sigmas and t = 0 of its constellation. */
+      scene->navigation.scheme = NAV_SCHEME_INS_GNSS_TIGHT;
+      rsc.pr_sd_m = scene->gnss.constellation.raw.code_sd_m;
+      rsc.rr_sd_mps = scene->gnss.constellation.raw.range_rate_sd_mps;
+      if (!has_t0_gps && scene->gnss.constellation.enabled) {
+        t0_gps = scene->gnss.constellation.epoch_gps_s;
+        has_t0_gps = true;
+      }
     }
     rc.nav = nav_ins_gnss_config_from_scene(scene);
     /* Recorded data lives on the real Earth: WGS-84 whatever the scene's earth.model says. */
@@ -924,12 +1018,68 @@ int navsim_replay(int argc, char **argv) {
     rc.has_initial = true;
   }
 
+  if (rinex_obs) {
+    /* t = 0 without a scene epoch: the start of the GPS week of the first observation epoch. */
+    nav_diag d;
+    memset(&d, 0, sizeof d);
+    nav_status rs = NAV_OK;
+    if (!has_t0_gps) {
+      nav_rinex_obs_reader *orr = NULL;
+      nav_rinex_obs_epoch *e1 = malloc(sizeof *e1);
+      bool got = false;
+      rs = e1 ? nav_rinex_obs_open(rinex_obs, &orr, &d) : NAV_ERR_NO_MEMORY;
+      if (rs == NAV_OK) {
+        rs = nav_rinex_obs_next(orr, e1, NULL, &got);
+        if (rs != NAV_OK) d = *nav_rinex_obs_diag(orr);
+      }
+      if (rs == NAV_OK && got) t0_gps = floor(e1->t_gps_s / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S;
+      nav_rinex_obs_destroy(orr);
+      free(e1);
+    }
+    rsc.obs_path = rinex_obs;
+    rsc.nav_path = rinex_nav;
+    rsc.t0_gps_s = t0_gps;
+    /* Every record is read once before the run, wherever it is: a malformed one is reported at
+       FILE:LINE:COL (exit 2) before any result is written. */
+    if (rs == NAV_OK) rs = nav_rinex_source_create(&rsc, &rsrc, &d);
+    long n_epochs = 0;
+    for (bool got = true; rs == NAV_OK && got;) {
+      nav_ins_gnss_raw_epoch ep;
+      rs = nav_rinex_source_next(rsrc, &ep, &got, &d);
+      if (rs == NAV_OK && got) ++n_epochs;
+    }
+    nav_rinex_source_destroy(rsrc);
+    rsrc = NULL;
+    if (rs == NAV_OK && n_epochs == 0) {
+      fprintf(stderr, "%s: error: the observation file holds no epoch; expected '>' epoch records after the header\n",
+              rinex_obs);
+      free(reqs);
+      free(verdicts);
+      return EXIT_INVALID;
+    }
+    if (rs == NAV_OK) rs = nav_rinex_source_create(&rsc, &rsrc, &d);
+    if (rs != NAV_OK) {
+      if (d.message[0]) navsim_print_diag(NULL, &d);
+      else fprintf(stderr, "navsim replay: %s\n", nav_status_str(rs));
+      free(reqs);
+      free(verdicts);
+      return rs == NAV_ERR_PARSE || rs == NAV_ERR_INVALID_ARG || rs == NAV_ERR_OUT_OF_RANGE ? EXIT_INVALID : EXIT_FAIL;
+    }
+    rc.raw = rinex_next;
+    rc.raw_user = rsrc;
+  }
   int rc_exit = EXIT_FAIL;
   nav_status st = NAV_OK;
   nav_resultdir *rd = NULL;
   out_files o;
   memset(&o, 0, sizeof o);
   o.show_progress = !quiet && isatty(STDERR_FILENO);
+  if (smooth && rinex_obs) {
+    fprintf(stderr, "navsim replay: --smooth is not supported with --rinex-obs (the smoother does not carry the "
+                    "receiver-clock states yet)\n");
+    rc_exit = EXIT_INVALID;
+    goto cleanup;
+  }
   if (smooth && gnss) {
     st = smooth_out_create(&rc.nav.filter, smooth_group, &o.so, &rc.nav.smoother);
     if (st != NAV_OK) {
@@ -1004,6 +1154,11 @@ int navsim_replay(int argc, char **argv) {
                 "may be incomplete\n",
                 paths[i], cut[i]);
   }
+  if (rinex_obs && sum.gnss_applied == 0)
+    fprintf(stderr,
+            "%s: warning: no observation epoch fell on the IMU's time span %.3f .. %.3f s (IMU time = GPS time - "
+            "%.17g s, see --t0-gps); the replay ran without GNSS\n",
+            rinex_obs, sum.t_first_s, sum.t_last_s, t0_gps);
   for (int i = 0; i < 3; ++i) {
     const bool bad = ferror(o.f[i]) != 0;
     const int cl = fclose(o.f[i]);
@@ -1039,6 +1194,10 @@ int navsim_replay(int argc, char **argv) {
   job.gnss = gnss;
   job.truth = truth;
   job.config = config;
+  job.rinex_obs = rinex_obs;
+  job.rinex_nav = rinex_nav;
+  job.t0_gps_s = t0_gps;
+  job.rinex = nav_rinex_source_get_counts(rsrc);
   job.rc = &rc;
   job.sum = &sum;
   job.dcase = sum.free_ins            ? CASE_FREE_INS
@@ -1111,6 +1270,7 @@ cleanup:
   smooth_out_destroy(o.so);
   run_stats_destroy(&o.rstats);
   navsim_req_buffer_free(&req_buf);
+  nav_rinex_source_destroy(rsrc);
   free(reqs);
   free(verdicts);
   return rc_exit;

@@ -63,6 +63,11 @@ typedef struct nav_gnss_orbit {
   double delta_n_rps;   /**< mean motion difference from sqrt(mu/A^3) [rad/s] (0 for almanacs) */
   double af0_s;         /**< satellite clock bias [s] */
   double af1_sps;       /**< satellite clock drift [s/s] */
+  /** Harmonic corrections of a broadcast ephemeris (IS-GPS-200N Table 20-III, e.g. read from a
+   *  RINEX navigation file): amplitudes of the cosine and sine terms of twice the argument of
+   *  latitude in the argument of latitude [rad], the orbit radius [m] and the inclination [rad].
+   *  0 for almanacs and the nominal constellations. */
+  double cuc_rad, cus_rad, crc_m, crs_m, cic_rad, cis_rad;
 } nav_gnss_orbit;
 
 /** A set of satellites (any mix of systems). Plain data. */
@@ -80,8 +85,8 @@ NAV_API double nav_gnss_gps_time_s(int year, int month, int day, int hour, int m
 /**
  * Satellite position and velocity in ECEF (WGS-84 frame of the GPS user algorithm) at GPS time
  * @p t_gps_s, with the user algorithm of IS-GPS-200N Table 20-IV (Kepler equation solved by
- * Newton iteration to 1e-15 rad) and its velocity equations (Table 20-IV, "SV velocity"), without
- * the harmonic corrections an almanac does not carry. t_k = t - toe is not wrapped: toe_s is a
+ * Newton iteration to 1e-15 rad) and its velocity equations (Table 20-IV, "SV velocity"), with
+ * the harmonic corrections when the orbit has any (broadcast ephemerides; an almanac has none). t_k = t - toe is not wrapped: toe_s is a
  * continuous time. Leaf maths.
  * @param[out] r_es_e_m   position of the satellite [m]
  * @param[out] v_es_e_mps velocity relative to ECEF, resolved in ECEF [m/s]

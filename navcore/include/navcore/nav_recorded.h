@@ -296,6 +296,14 @@ typedef struct nav_replay_record {
 
 typedef nav_callback_result (*nav_replay_record_fn)(void *user, const nav_replay_record *r);
 
+/**
+ * A source of raw GNSS measurements for a tightly coupled replay (e.g. nav_rinex_source_next()
+ * of nav_rinex_read.h): writes the next receiver epoch, in time order, into @p ep (its pointers
+ * valid until the next call) and sets @p got, false at the end. On failure it returns the status
+ * with FILE:LINE:COL in @p diag.
+ */
+typedef nav_status (*nav_replay_raw_fn)(void *raw_user, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag);
+
 /** Replay inputs and settings. Start from nav_replay_config_default(). */
 typedef struct nav_replay_config {
   const char *imu_path;  /**< IMU increments (required) */
@@ -335,6 +343,15 @@ typedef struct nav_replay_config {
   /** May be NULL; called with the errors of every scored epoch, the initial one included (the
    *  epochs of nav_replay_summary.stats plus the initial epoch), in time order. */
   void (*scored)(void *user, const nav_epoch_errors *e);
+  /**
+   * Tightly coupled replay (docs/rinex.md "Reading and replay"): when set, the GNSS aiding is the
+   * raw measurements of this source instead of gnss_path's fixes (which must then be NULL), each
+   * epoch applied with nav_ins_gnss_update_raw() at the IMU epoch within dt/2 of its t_s, as fixes
+   * are; nav.filter must have the receiver-clock states (NAV_FILTER_STATE_RX_CLOCK). Outages drop
+   * epochs as they drop fixes; the summary's gnss_* counts count epochs. Default NULL.
+   */
+  nav_replay_raw_fn raw;
+  void *raw_user; /**< passed to @p raw */
 } nav_replay_config;
 
 /**

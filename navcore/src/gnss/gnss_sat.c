@@ -29,8 +29,9 @@ double nav_gnss_gps_time_s(int year, int month, int day, int hour, int minute, d
 }
 
 void nav_gnss_orbit_state(const nav_gnss_orbit *o, double t, nav_vec3 *r_es_e_m, nav_vec3 *v_es_e_mps) {
-  /* IS-GPS-200N Table 20-IV, "Elements of Coordinate Systems", without the harmonic
-   * corrections (C_us, C_uc, C_rs, C_rc, C_is, C_ic = 0 for almanacs, Table 20-VI). */
+  /* IS-GPS-200N Table 20-IV, "Elements of Coordinate Systems"; the harmonic corrections (C_us,
+   * C_uc, C_rs, C_rc, C_is, C_ic) only when the orbit has any (0 for almanacs, Table 20-VI), so
+   * almanac and nominal orbits take exactly the arithmetic they always took. */
   const double mu = NAV_GPS_MU_M3PS2, we = NAV_GPS_OMEGA_E_RPS;
   const double A = o->sqrt_a_sqrtm * o->sqrt_a_sqrtm;
   const double n0 = sqrt(mu / (A * A * A));
@@ -48,9 +49,20 @@ void nav_gnss_orbit_state(const nav_gnss_orbit *o, double t, nav_vec3 *r_es_e_m,
   const double sE = sin(E), cE = cos(E);
   const double sq = sqrt(1.0 - o->e * o->e);
   const double nu = atan2(sq * sE, cE - o->e);
-  const double u = nu + o->w_rad;
-  const double r = A * (1.0 - o->e * cE);
-  const double inc = o->i0_rad + o->idot_rps * tk;
+  const bool harmonics = o->cuc_rad != 0.0 || o->cus_rad != 0.0 || o->crc_m != 0.0 || o->crs_m != 0.0 ||
+                         o->cic_rad != 0.0 || o->cis_rad != 0.0;
+  const double phi = nu + o->w_rad; /* argument of latitude before the corrections */
+  double du = 0.0, dr = 0.0, di = 0.0, s2 = 0.0, c2 = 0.0;
+  if (harmonics) {
+    s2 = sin(2.0 * phi);
+    c2 = cos(2.0 * phi);
+    du = o->cus_rad * s2 + o->cuc_rad * c2;
+    dr = o->crs_m * s2 + o->crc_m * c2;
+    di = o->cis_rad * s2 + o->cic_rad * c2;
+  }
+  const double u = harmonics ? phi + du : phi;
+  const double r = harmonics ? A * (1.0 - o->e * cE) + dr : A * (1.0 - o->e * cE);
+  const double inc = harmonics ? o->i0_rad + o->idot_rps * tk + di : o->i0_rad + o->idot_rps * tk;
   const double xp = r * cos(u), yp = r * sin(u);
   /* Omega_k = Omega_0 + (Omega_dot - Omega_dot_e) t_k - Omega_dot_e t_oe, t_oe in seconds of week. */
   const double toe_sow = o->toe_s - floor(o->toe_s / NAV_GNSS_WEEK_S) * NAV_GNSS_WEEK_S;
@@ -64,12 +76,18 @@ void nav_gnss_orbit_state(const nav_gnss_orbit *o, double t, nav_vec3 *r_es_e_m,
   if (v_es_e_mps) {
     /* IS-GPS-200N Table 20-IV, SV velocity: E_dot, nu_dot, u_dot, r_dot, Omega_dot_k, x'_dot, y'_dot. */
     const double Edot = n / (1.0 - o->e * cE);
-    const double nudot = Edot * sq / (1.0 - o->e * cE);
-    const double rdot = A * o->e * sE * Edot;
+    double nudot = Edot * sq / (1.0 - o->e * cE);
+    double rdot = A * o->e * sE * Edot;
+    double idot = o->idot_rps;
+    if (harmonics) {
+      /* d/dt of the corrections: 2 phi_dot (C_s cos 2 phi - C_c sin 2 phi), phi_dot = nu_dot. */
+      rdot += 2.0 * nudot * (o->crs_m * c2 - o->crc_m * s2);
+      idot += 2.0 * nudot * (o->cis_rad * c2 - o->cic_rad * s2);
+      nudot *= 1.0 + 2.0 * (o->cus_rad * c2 - o->cuc_rad * s2); /* u_dot */
+    }
     const double Omdot = o->omega_dot_rps - we;
     const double xpd = rdot * cos(u) - yp * nudot;
     const double ypd = rdot * sin(u) + xp * nudot;
-    const double idot = o->idot_rps;
     v_es_e_mps->x = -xp * Omdot * sO + xpd * cO - ypd * sO * ci - yp * (Omdot * cO * ci - idot * sO * si);
     v_es_e_mps->y = xp * Omdot * cO + xpd * sO + ypd * cO * ci - yp * (Omdot * sO * ci + idot * cO * si);
     v_es_e_mps->z = yp * idot * ci + ypd * si;
