@@ -2,6 +2,7 @@
 // Debian's libnetcdf, and the gazetteer file made at build time. The format and the closing of
 // bin-clipped segments into areas are written up in docs/map-data.md.
 #include "navview/nav_map_data.h"
+#include "navcore/nav_paths.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -494,13 +495,10 @@ bool NavMapLoadLayers(const std::string &dir, NavShoreRes res, double lat0, doub
 std::string NavMapPlacesFile() {
   const char *e = std::getenv("NAVVIEW_PLACES");
   if (e && *e) return e;
-#ifdef NAVVIEW_PLACES_BUILD_FILE
-  if (Exists(NAVVIEW_PLACES_BUILD_FILE)) return NAVVIEW_PLACES_BUILD_FILE;
-#endif
-#ifdef NAVVIEW_PLACES_INSTALL_FILE
-  if (Exists(NAVVIEW_PLACES_INSTALL_FILE)) return NAVVIEW_PLACES_INSTALL_FILE;
-#endif
-  return std::string();
+  char share[4096];
+  if (!nav_paths_share_dir(share, sizeof share)) return std::string();
+  const std::string path = std::string(share) + "/places.tsv";
+  return Exists(path) ? path : std::string();
 }
 
 bool NavMapLoadPlaces(const std::string &path, const std::vector<NavPlace> **places, std::string *error) {
