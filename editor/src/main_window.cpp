@@ -20,6 +20,7 @@
 #include <QSettings>
 #include <QSplitter>
 #include <QTabBar>
+#include <QTemporaryDir>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QTextBrowser>
@@ -918,7 +919,25 @@ bool MainWindow::ExportReport(const QString &path, QString *error) {
   r.receiver = QString::fromUtf8(sc.gnss.catalog);
   const std::shared_ptr<const SimResult> res = last_result_;
   r.result = res && !res->preview ? res.get() : nullptr;
-  r.images.push_back({tr("navstudio: map, 3D view and panels"), Screenshot()});
+  // The single views, without the forms: as File > Export picture writes them once there is a
+  // result to draw (issue 19: the report embedded a grab of the whole window), else the map and
+  // 3D view as they stand on the screen.
+  bool drawn = false;
+  QTemporaryDir tmp;
+  if (view3d_->SceneResult() && view3d_->Scene() && tmp.isValid()) {
+    const QString p3 = tmp.filePath("3d.png"), pm = tmp.filePath("map.png");
+    QString e3, em;
+    if (ExportPicture(p3, "3d", kReportPictureWidth, kReportPictureHeight, &e3) &&
+        ExportPicture(pm, "map", kReportPictureWidth, kReportPictureHeight, &em)) {
+      r.images.push_back({tr("3D view: reference and estimate, attitude triads, error envelope"), QImage(p3)});
+      r.images.push_back({tr("map: reference and estimate on the geodetic map"), QImage(pm)});
+      drawn = true;
+    }
+  }
+  if (!drawn)
+    for (PathView *v : {map_, view3d_})
+      if (v->isVisible() && v->width() > 0 && v->height() > 0)
+        r.images.push_back({v == map_ ? tr("map view") : tr("3D view"), v->Grab()});
   if (chart_ && !chart_->Picture().isNull())
     r.images.push_back(
         {tr("errors against time (horizontal, vertical, velocity, attitude)"), chart_->Picture()});

@@ -70,8 +70,12 @@ public:
    *  in @p errors. */
   bool ImportTrack(const QString &path, QStringList *errors = nullptr);
   bool SaveAs(const QString &path);
+  /** Size of the 3D and map pictures the report embeds (as File > Export picture writes them). */
+  static constexpr int kReportPictureWidth = 1280;
+  static constexpr int kReportPictureHeight = 720;
   /** File > Export report: one self-contained HTML file (report_export.h) with the last full
-   *  run's verdicts and statistics and pictures of the window and the error chart. */
+   *  run's verdicts and statistics, the 3D view and the map as single pictures (no forms) and
+   *  the error chart. */
   bool ExportReport(const QString &path, QString *error);
   /** Draw the error band of @p r about its estimate in both views (3 sigma or 3 RMS). */
   void SetEnvelopes(const SimResult &r, bool preview);

@@ -83,6 +83,15 @@ double MapMetresPerPixel(PathView *v) {
 
 
 
+/** The PNG pictures a report embeds, in order. */
+QList<QImage> ReportImages(const QString &html) {
+  QList<QImage> out;
+  const QRegularExpression re("data:image/png;base64,([A-Za-z0-9+/=]+)\"");
+  for (auto it = re.globalMatch(html); it.hasNext();)
+    out.push_back(QImage::fromData(QByteArray::fromBase64(it.next().captured(1).toLatin1()), "PNG"));
+  return out;
+}
+
 } // namespace
 
 class TestNavstudio : public QObject {
@@ -520,6 +529,17 @@ private slots:
     const QString hb = QString::fromUtf8(fb.readAll());
     QVERIFY(hb.contains("No simulation has been run for this scene yet."));
     QVERIFY(hb.contains("data:image/png;base64,"));
+    // Before a run the report embeds the map and the 3D view as they stand, each at its view's
+    // size, never a grab of the window with its forms (issue 19).
+    const QList<QImage> before_imgs = ReportImages(hb);
+    QVERIFY(!before_imgs.isEmpty());
+    for (const QImage &im : before_imgs) {
+      qInfo("report before a run: picture %d x %d (window %d x %d, map %d x %d, 3D %d x %d)", im.width(), im.height(),
+            w->width(), w->height(), w->MapView()->width(), w->MapView()->height(), w->View3D()->width(),
+            w->View3D()->height());
+      QVERIFY(im.size() == w->MapView()->size() || im.size() == w->View3D()->size());
+      QVERIFY(im.size() != w->size());
+    }
 
     QTest::mouseClick(w->findChild<QPushButton *>("addRequirement"), Qt::LeftButton);
     TypeInto(w->findChild<QLineEdit *>("simulation.runs"), "8");
@@ -541,7 +561,26 @@ private slots:
     QVERIFY(h.contains(v.pass ? ">PASS<" : ">FAIL<"));
     QVERIFY(h.contains(QString::number(v.value, 'g', 4)));
     QVERIFY(h.contains("horizontal position"));
-    QCOMPARE(h.count("data:image/png;base64,"), 2);
+    // Three pictures: the 3D view and the map as File > Export picture writes them (the view
+    // alone at kReportPictureWidth x kReportPictureHeight, no forms; issue 19: the report
+    // embedded a grab of the whole window), and the error chart.
+    QCOMPARE(h.count("data:image/png;base64,"), 3);
+    const QList<QImage> imgs = ReportImages(h);
+    QCOMPARE(imgs.size(), 3);
+    const QSize pic(MainWindow::kReportPictureWidth, MainWindow::kReportPictureHeight);
+    QVERIFY(w->size() != pic); // else the sizes could not tell a view from the window
+    const char *names[2] = {"3d", "map"};
+    for (int k = 0; k < 2; ++k) {
+      qInfo("report picture %s: %d x %d (window %d x %d)", names[k], imgs[k].width(), imgs[k].height(), w->width(),
+            w->height());
+      QCOMPARE(imgs[k].size(), pic);
+      QVERIFY(imgs[k].save(dir + QString("/report-%1.png").arg(names[k])));
+      // The same picture as File > Export picture of that view at that size.
+      const QString exported = dir + QString("/report-export-%1.png").arg(names[k]);
+      QString e2;
+      QVERIFY2(w->ExportPicture(exported, names[k], pic.width(), pic.height(), &e2), qPrintable(e2));
+      QCOMPARE(imgs[k].convertToFormat(QImage::Format_RGB32), QImage(exported).convertToFormat(QImage::Format_RGB32));
+    }
     QVERIFY(h.trimmed().endsWith("</html>"));
     qInfo("report: %lld bytes, verdict %s = %.4g", static_cast<long long>(f.size()), v.id, v.value);
     // An unwritable path: an error naming it, and no file.

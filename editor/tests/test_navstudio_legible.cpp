@@ -32,6 +32,8 @@
 #include <vector>
 
 #include "main_window.h"
+#include "playback.h"
+#include "navview/nav_view_chart.h"
 #include "navview/nav_view_result.h"
 #include "navview/nav_view_scene.h"
 #include "studio_test_support.h"
@@ -232,6 +234,29 @@ private slots:
     const long tint = CountColour(pic, 250, 227, 243, 6);
     qInfo("outage tint pixels: %ld", tint);
     QVERIFY(tint > 1000);
+    // The same chart as laid out (issue 19): with the urban drive's two outages each legend lies
+    // outside every plot area (it covered the second outage's peak), and its two horizontal
+    // requirements get different dash patterns (both FAIL limits shared one style).
+    const std::shared_ptr<NavResult> nr = studio::ToNavResult(*r, w->Doc()->Scene());
+    QCOMPARE(static_cast<int>(nr->gnss.outage_t0_s.size()), 2);
+    NavChartOptions co;
+    co.width_px = pic.width();
+    co.height_px = pic.height();
+    std::vector<unsigned char> rgb;
+    NavErrorChartLayout lay;
+    std::string chart_err;
+    QVERIFY2(NavRenderErrorChartRgb(*nr, co, &rgb, &lay, &chart_err), chart_err.c_str());
+    QVERIFY(lay.plots.size() >= 4 && lay.legends.size() == lay.plots.size());
+    for (size_t i = 0; i < lay.legends.size(); ++i) {
+      const NavChartRect &l = lay.legends[i];
+      qInfo("%s: legend x %.0f..%.0f y %.0f..%.0f, plot x %.0f..%.0f", lay.titles[i].c_str(), l.x, l.x + l.w, l.y,
+            l.y + l.h, lay.plots[i].x, lay.plots[i].x + lay.plots[i].w);
+      QVERIFY(l.w > 0 && l.h > 0);
+      for (const NavChartRect &p : lay.plots)
+        QVERIFY(!l.Intersects(p));
+    }
+    QCOMPARE(static_cast<int>(lay.limit_pens[0].size()), 2);
+    QVERIFY(lay.limit_pens[0][0] != lay.limit_pens[0][1]);
     Shot(w.get(), "legible-04-errors-window");
   }
 

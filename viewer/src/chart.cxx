@@ -17,6 +17,7 @@
 #include <vtkChartLegend.h>
 #include <vtkChartMatrix.h>
 #include <vtkChartXY.h>
+#include <vtkContext2D.h>
 #include <vtkContextScene.h>
 #include <vtkContextView.h>
 #include <vtkDoubleArray.h>
@@ -25,6 +26,7 @@
 #include <vtkPlot.h>
 #include <vtkPlotArea.h>
 #include <vtkRenderWindow.h>
+#include <vtkRect.h>
 #include <vtkRenderer.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
@@ -229,7 +231,7 @@ Series LimitSeries(const NavRequirementVerdict &r, size_t n, double scale, int i
 
 // The error panels in a context view of the options' size (NavRenderErrorChartPng/Rgb).
 bool BuildErrorChart(const NavResult &result, const NavChartOptions &opt, vtkContextView *view,
-                     std::string *error) {
+                     std::string *error, NavErrorChartLayout *layout = nullptr) {
   const NavErrorSeries &e = result.errors;
   if (e.Size() < 2) {
     *error = (result.dir.empty() ? std::string("result") : result.dir) +
@@ -397,6 +399,32 @@ bool BuildErrorChart(const NavResult &result, const NavChartOptions &opt, vtkCon
     }
     view->Render();
   }
+  if (layout) {
+    *layout = NavErrorChartLayout();
+    const char *titles[4] = {"horizontal", "vertical", vel ? "velocity" : "attitude", "attitude"};
+    for (size_t i = 0; i < charts.size(); ++i) {
+      vtkChartXY *c = charts[i];
+      int p1[2], p2[2];
+      c->GetPoint1(p1);
+      c->GetPoint2(p2);
+      layout->titles.push_back(titles[i]);
+      layout->plots.push_back({double(p1[0]), double(p1[1]), double(p2[0] - p1[0]), double(p2[1] - p1[1])});
+      NavChartRect lr;
+      if (c->GetShowLegend()) {
+        // The box of the last paint (vtkChartLegend caches it while nothing changed).
+        const vtkRectf r = c->GetLegend()->GetBoundingRect(view->GetContext());
+        lr = {r.GetX(), r.GetY(), r.GetWidth(), r.GetHeight()};
+      }
+      layout->legends.push_back(lr);
+      std::vector<int> pens;
+      for (vtkIdType pi = 0; pi < c->GetNumberOfPlots(); ++pi) {
+        vtkPlot *p = c->GetPlot(pi);
+        const std::string label = p->GetLabel();
+        if (label.compare(0, 6, "limit ") == 0) pens.push_back(p->GetPen()->GetLineType());
+      }
+      layout->limit_pens.push_back(pens);
+    }
+  }
   return true;
 }
 
@@ -411,8 +439,13 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opt,
 
 bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &opt,
                             std::vector<unsigned char> *rgb, std::string *error) {
+  return NavRenderErrorChartRgb(result, opt, rgb, nullptr, error);
+}
+
+bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &opt,
+                            std::vector<unsigned char> *rgb, NavErrorChartLayout *layout, std::string *error) {
   vtkNew<vtkContextView> view;
-  if (!BuildErrorChart(result, opt, view, error)) return false;
+  if (!BuildErrorChart(result, opt, view, error, layout)) return false;
   const int w = opt.width_px, h = opt.height_px;
   unsigned char *px = view->GetRenderWindow()->GetPixelData(0, 0, w - 1, h - 1, 0, 0);
   if (!px) {

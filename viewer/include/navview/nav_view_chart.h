@@ -45,6 +45,31 @@ bool NavRenderErrorChartPng(const NavResult &result, const NavChartOptions &opti
 bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &options,
                             std::vector<unsigned char> *rgb, std::string *error);
 
+/** A rectangle of a chart picture in pixels; x from the left, y from the BOTTOM row up. */
+struct NavChartRect {
+  double x = 0, y = 0, w = 0, h = 0;
+  /** True when the two rectangles share an area (touching edges do not count). */
+  bool Intersects(const NavChartRect &o) const {
+    return x < o.x + o.w && o.x < x + w && y < o.y + o.h && o.y < y + h;
+  }
+};
+
+/** Where the error chart put things, one entry per panel from the top (horizontal first). */
+struct NavErrorChartLayout {
+  std::vector<std::string> titles;
+  std::vector<NavChartRect> plots;   ///< the plot area inside the axes
+  std::vector<NavChartRect> legends; ///< the legend box (w = h = 0 when text is off)
+  /** Per panel: the vtkPen line type of each requirement-limit line, in the panel's order. */
+  std::vector<std::vector<int>> limit_pens;
+};
+
+/**
+ * NavRenderErrorChartRgb and the chart's layout as drawn (for tests and for programs that place
+ * read-outs over the picture).
+ */
+bool NavRenderErrorChartRgb(const NavResult &result, const NavChartOptions &options,
+                            std::vector<unsigned char> *rgb, NavErrorChartLayout *layout, std::string *error);
+
 /**
  * Simulated sensor errors of run 0 (imu_errors.csv; the paper's Fig. 2): gyro errors [deg/h] and
  * accelerometer errors [mg] per axis against time, two panels.
