@@ -686,6 +686,45 @@ static void test_predict_scene_points(void **state) {
   free(sc);
 }
 
+/* nav_req_predict_threads: the quantile statistics bit-identical for 1, 2, 3 and 7 threads, on
+ * 1000 epochs whose sigmas vary (circular, elliptical, degenerate; a jump half-way) so that
+ * bisection steps end both by the early "no" and by the full sum, and with a few epochs (no
+ * helpers); the values equal nav_req_predict's. */
+static void test_predict_threads(void **state) {
+  (void)state;
+  enum { N = 1000 };
+  nav_cov_point *pts = calloc(N, sizeof *pts);
+  assert_non_null(pts);
+  for (int i = 0; i < N; ++i) {
+    const double g = 1.0 + 0.5 * sin(0.01 * i) + (i >= N / 2 ? 3.0 : 0.0);
+    pts[i].t_s = 0.1 * i;
+    pts[i].pos_sd_n_m = nav_vec3_make(g, i % 97 == 0 ? 0.0 : g * (0.3 + 0.7 * (i % 7) / 6.0), 2.0 * g);
+    pts[i].pos_h_sd_m = hypot(pts[i].pos_sd_n_m.x, pts[i].pos_sd_n_m.y);
+    pts[i].att_sd_rad = nav_vec3_make(0.0, 0.0, 1e-3 * g);
+  }
+  nav_requirement q[4] = {req("c50", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP50, 5.0, NAV_REQ_UNIT_M),
+                          req("c95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 5.0, NAV_REQ_UNIT_M),
+                          req("v95", NAV_REQ_VERTICAL_POSITION, NAV_REQ_P95, 5.0, NAV_REQ_UNIT_M),
+                          req("y95", NAV_REQ_YAW, NAV_REQ_P95, 1.0, NAV_REQ_UNIT_MRAD)};
+  const size_t counts[2] = {N, 40};
+  for (int c = 0; c < 2; ++c) {
+    nav_requirement_verdict one[4], many[4];
+    assert_int_equal(nav_req_predict(q, 4, pts, counts[c], NULL, 0, one), NAV_OK);
+    for (int k = 0; k < 4; ++k) assert_true(one[k].evaluated && one[k].value > 0.0);
+    const int threads[4] = {1, 2, 3, 7};
+    for (int t = 0; t < 4; ++t) {
+      memset(many, 0x5a, sizeof many);
+      assert_int_equal(nav_req_predict_threads(q, 4, pts, counts[c], NULL, 0, threads[t], many), NAV_OK);
+      for (int k = 0; k < 4; ++k) {
+        assert_memory_equal(&one[k].value, &many[k].value, sizeof one[k].value);
+        assert_int_equal(one[k].pass, many[k].pass);
+        assert_int_equal(one[k].samples, many[k].samples);
+      }
+    }
+  }
+  free(pts);
+}
+
 
 /* The outages of a scene as the simulation applies them: gnss.outages plus the segments with
  * gnss_visible: false (merged when they touch). */
@@ -742,6 +781,7 @@ int main(void) {
       cmocka_unit_test(test_scene_round_trip),
       cmocka_unit_test(test_scene_outages),
       cmocka_unit_test(test_predict_scene_points),
+      cmocka_unit_test(test_predict_threads),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -16,6 +16,7 @@
  */
 #include <math.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -826,41 +827,142 @@ typedef struct pred_point {
   bool radial; /* 2-D radius, else |1-D| */
 } pred_point;
 
+/* One point's CDF at @p r. */
+static double point_cdf(const pred_point *p, double r, const radius_nodes *nodes) {
+  return p->radial ? cdf_radius(r, p->a, p->b, nodes) : cdf_abs_normal(r, p->a);
+}
+
+/* Points between two looks at the stop rule of mixture_cdf_at_least. */
+#define MIX_BLOCK 64u
+
+/*
+ * The points' CDFs of one bisection step computed ahead by helper threads: helper k fills
+ * t[lo_k, hi_k) (a contiguous share of the points after the caller's own), which the caller
+ * reads after joining it; it stops early when the caller has already decided (stop). The caller
+ * adds the values in point order with the same stop rule, so the sum and the decision are those
+ * of the one-thread loop: each value is the same pure function of (r, point), whoever computes it.
+ */
+typedef struct mix_share {
+  const pred_point *p;
+  const radius_nodes *nodes;
+  double r;
+  double *t;
+  size_t lo, hi;
+  atomic_bool *stop;
+} mix_share;
+
+static int mix_share_run(void *arg) {
+  mix_share *s = arg;
+  for (size_t i = s->lo; i < s->hi; ++i) {
+    if ((i & (MIX_BLOCK - 1u)) == 0 && atomic_load_explicit(s->stop, memory_order_relaxed)) break;
+    s->t[i] = point_cdf(&s->p[i], s->r, s->nodes);
+  }
+  return 0;
+}
+
+/* Helper threads of mixture_quantile (at most NAV_REQ_MAX_THREADS - 1) and their value buffer. */
+#define NAV_REQ_MAX_THREADS 16
+typedef struct mix_pool {
+  int helpers;     /* 0: the one-thread loop */
+  double *t;       /* n values */
+  size_t own;      /* the caller computes points [0, own) itself */
+} mix_pool;
+
 /*
  * Whether the mixture CDF at @p r, the mean of the points' CDFs summed in order, is >= @p q.
  * Every point's CDF lies in [0, 1] (cdf_radius is clamped to 1, erf <= 1; a NaN point makes the
  * mean NaN, i.e. "no"), so once the sum so far plus one for every point still to come stays
  * below q n with room for the rounding of the remaining additions (relative 2^-53 per addition,
  * bounded here by 1e-15 each), the answer is "no" whatever the remaining points give: the loop
- * stops there. Otherwise the whole sum decides, as it always did.
+ * stops there. Otherwise the whole sum decides, as it always did. With helpers (@p pool), the
+ * points after pool->own are computed by them concurrently; the sum and its stop rule are the
+ * same, in the same order.
  */
-static bool mixture_cdf_at_least(const pred_point *p, size_t n, double r, double q, const radius_nodes *nodes) {
+static bool mixture_cdf_at_least(const pred_point *p, size_t n, double r, double q, const radius_nodes *nodes,
+                                 const mix_pool *pool) {
   const double qn = q * (double)n * (1.0 - 1e-12);
-  double s = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b, nodes) : cdf_abs_normal(r, p[i].a);
-    if ((i & 63u) == 63u) {
-      const double rest = (double)(n - 1 - i);
-      if ((s + rest) * (1.0 + 1e-15 * (rest + 2.0)) < qn) return false;
+  mix_share sh[NAV_REQ_MAX_THREADS];
+  nav_thread th[NAV_REQ_MAX_THREADS];
+  nav_thread_call calls[NAV_REQ_MAX_THREADS];
+  bool started[NAV_REQ_MAX_THREADS] = {false}, joined[NAV_REQ_MAX_THREADS] = {false};
+  atomic_bool stop;
+  atomic_init(&stop, false);
+  const int nh = pool ? pool->helpers : 0;
+  const size_t own = nh > 0 ? pool->own : n;
+  if (nh > 0) {
+    const size_t rest = n - own;
+    for (int k = 0; k < nh; ++k) {
+      sh[k].p = p;
+      sh[k].nodes = nodes;
+      sh[k].r = r;
+      sh[k].t = pool->t;
+      sh[k].lo = own + rest * (size_t)k / (size_t)nh;
+      sh[k].hi = own + rest * (size_t)(k + 1) / (size_t)nh;
+      sh[k].stop = &stop;
+      started[k] = nav_thread_start(&th[k], &calls[k], mix_share_run, &sh[k]);
+      /* A helper that could not start: its share is computed below, in the caller. */
     }
   }
-  return s / (double)n >= q;
+  double s = 0.0;
+  bool decided_no = false;
+  int k = 0; /* helper whose share holds point i (i >= own) */
+  for (size_t i = 0; i < n; ++i) {
+    double v;
+    if (i < own) v = point_cdf(&p[i], r, nodes);
+    else {
+      while (i >= sh[k].hi) ++k;
+      if (!started[k]) v = point_cdf(&p[i], r, nodes);
+      else {
+        if (!joined[k]) { /* the helper's values are all there once it has ended */
+          nav_thread_join(th[k]);
+          joined[k] = true;
+        }
+        v = pool->t[i];
+      }
+    }
+    s += v;
+    if ((i & (MIX_BLOCK - 1u)) == MIX_BLOCK - 1u) {
+      const double rest = (double)(n - 1 - i);
+      if ((s + rest) * (1.0 + 1e-15 * (rest + 2.0)) < qn) {
+        decided_no = true;
+        break;
+      }
+    }
+  }
+  if (nh > 0) {
+    atomic_store_explicit(&stop, true, memory_order_relaxed);
+    for (int j = 0; j < nh; ++j)
+      if (started[j] && !joined[j]) nav_thread_join(th[j]);
+  }
+  return !decided_no && s / (double)n >= q;
 }
 
-/* Smallest r with mixture CDF >= q (bisection to 1e-9 relative). */
-static double mixture_quantile(const pred_point *p, size_t n, double q) {
+/* Smallest r with mixture CDF >= q (bisection to 1e-9 relative); @p threads computing it
+ * (the same value for any count). */
+static double mixture_quantile(const pred_point *p, size_t n, double q, int threads) {
   double hi = 0.0;
   for (size_t i = 0; i < n; ++i) hi = fmax(hi, p[i].radial ? hypot(p[i].a, p[i].b) : p[i].a);
   if (!(hi > 0.0)) return 0.0;
   radius_nodes nodes;
   radius_nodes_init(&nodes);
+  mix_pool pool = {0, NULL, n};
+  if (threads > NAV_REQ_MAX_THREADS) threads = NAV_REQ_MAX_THREADS;
+  /* Helpers only where there is enough work to share (a few hundred points and more). */
+  if (threads > 1 && n >= 4u * MIX_BLOCK) {
+    pool.t = malloc(n * sizeof *pool.t);
+    if (pool.t) {
+      pool.helpers = threads - 1;
+      pool.own = n / (size_t)threads;
+    }
+  }
   hi *= 10.0; /* P(|x| > 10 sigma_max) < 1e-20 */
   double lo = 0.0;
   for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
     const double mid = 0.5 * (lo + hi);
-    if (mixture_cdf_at_least(p, n, mid, q, &nodes)) hi = mid;
+    if (mixture_cdf_at_least(p, n, mid, q, &nodes, pool.helpers > 0 ? &pool : NULL)) hi = mid;
     else lo = mid;
   }
+  free(pool.t);
   return hi;
 }
 
@@ -880,6 +982,12 @@ static double mean_square(nav_req_metric m, const nav_cov_point *c) {
 
 nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov_point *pts, size_t npts,
                            const nav_req_interval *outages, int n_outages, nav_requirement_verdict *out) {
+  return nav_req_predict_threads(reqs, count, pts, npts, outages, n_outages, 1, out);
+}
+
+nav_status nav_req_predict_threads(const nav_requirement *reqs, int count, const nav_cov_point *pts, size_t npts,
+                                   const nav_req_interval *outages, int n_outages, int threads,
+                                   nav_requirement_verdict *out) {
   if ((count > 0 && (!reqs || !out)) || (npts > 0 && !pts) || n_outages < 0 || (n_outages > 0 && !outages))
     return NAV_ERR_INVALID_ARG;
   if (nav_requirements_validate(reqs, count, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
@@ -954,7 +1062,7 @@ nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov
                                                             : pts[j].att_sd_rad.z;
         pp[j].b = pts[j].pos_sd_n_m.y;
       }
-      value = mixture_quantile(pp, npts, quantile_percent(q->statistic) / 100.0);
+      value = mixture_quantile(pp, npts, quantile_percent(q->statistic) / 100.0, threads);
       samples = (long)npts;
     }
     v->samples = samples;
@@ -1029,15 +1137,24 @@ static nav_status predict_scene_begin(const nav_scene *scene, nav_requirement_ve
 
 nav_status nav_req_predict_scene_points(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
                                         nav_requirement_verdict *out) {
+  return nav_req_predict_scene_points_threads(scene, pts, npts, 1, out);
+}
+
+nav_status nav_req_predict_scene_points_threads(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
+                                                int threads, nav_requirement_verdict *out) {
   if (!nav_req_predict_scene_uses_sim_covariance(scene)) return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   const nav_status st = predict_scene_begin(scene, out, iv, &ni);
   if (st != NAV_OK) return st;
-  return nav_req_predict(scene->requirements, scene->n_requirements, pts, npts, iv, ni, out);
+  return nav_req_predict_threads(scene->requirements, scene->n_requirements, pts, npts, iv, ni, threads, out);
 }
 
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
+  return nav_req_predict_scene_threads(scene, 1, out);
+}
+
+nav_status nav_req_predict_scene_threads(const nav_scene *scene, int threads, nav_requirement_verdict *out) {
   /* gyro_free_gnss and ins_gnss_tight: their filters' covariance analysis (nav_sim_covariance). */
   const bool gfg = nav_req_predict_scene_uses_sim_covariance(scene);
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
@@ -1057,7 +1174,8 @@ nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict
     st = nav_budget_run(scene, false, keep_point, &b, NULL, NULL, 0);
   }
   if (b.failed) st = NAV_ERR_NO_MEMORY;
-  if (st == NAV_OK) st = nav_req_predict(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, out);
+  if (st == NAV_OK)
+    st = nav_req_predict_threads(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, threads, out);
   free(b.p);
   return st;
 }
