@@ -19,6 +19,7 @@
  *   1.2 (iv)): analytic_pos_v_valid is 1 while (t/tau_v)^2/12 < 1 %, always on a flat Earth.
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* getloadavg */
 #include "cli_util.h"
 #include "estimate_cmd.h"
 #include "navcore/nav_size_limits.h"
@@ -42,6 +43,7 @@
 
 static const char *k_usage_estimate =
     "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet] [--allow-large] [--threads N]\n"
+    "                      [--no-csv]\n"
     "\n"
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
@@ -67,9 +69,12 @@ static const char *k_usage_estimate =
     "\n"
     "options:\n"
     "  --allow-large  go ahead above the limits below\n"
-    "  --threads N    threads (default one per core): the requirements' own covariance analysis runs\n"
+    "  --threads N    threads (default one per idle core: the cores less the load average, at\n"
+    "                 least one): the requirements' own covariance analysis runs\n"
     "                 beside the one of estimate.csv, and the quantile statistics share out their\n"
     "                 quadrature; the outputs are bit-identical for any N\n"
+    "  --no-csv       write estimate.json and summary.json only, without estimate.csv (what\n"
+    "                 navsim serve's POST /api/estimate answers with); the same values\n"
     "\n" NAV_LIMITS_HELP "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
@@ -319,7 +324,7 @@ static bool flush_batch(est_stream *s) {
   s->st = eval_epochs(s->c, s->batch, s->nb, s->tbuf, s->abuf);
   s->analytic_wall_s += navsim_now_s() - t0;
   if (s->st != NAV_OK) return false;
-  for (size_t i = 0; i < s->nb; ++i)
+  for (size_t i = 0; i < s->nb && s->f; ++i)
     write_row(s->f, s->c, &s->batch[i], s->with_cov ? &s->cov[i] : NULL);
   s->nb = 0;
   return true;
@@ -445,6 +450,7 @@ int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool quiet = false, force = false, allow_large = false;
   long threads = 0; /* 0: one per core */
+  bool no_csv = false;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
@@ -455,6 +461,8 @@ int navsim_estimate(int argc, char **argv) {
       force = true;
     } else if (strcmp(argv[i], "--allow-large") == 0) {
       allow_large = true;
+    } else if (strcmp(argv[i], "--no-csv") == 0) {
+      no_csv = true;
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
     } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
@@ -480,8 +488,15 @@ int navsim_estimate(int argc, char **argv) {
     return 2;
   }
   if (threads == 0) {
+    /* One per idle core: the cores less the 1-minute load average (which counts the other
+     * programs running), at least one. On a busy machine a second thread would only wait for a
+     * core and do speculative work; the outputs are the same either way. */
     const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    threads = cores < 1 ? 1 : cores > 16 ? 16 : cores;
+    double load = 0.0;
+    const long busy = getloadavg(&load, 1) == 1 && load > 0.0 ? lround(load) : 0;
+    threads = cores - busy;
+    if (threads > 16) threads = 16;
+    if (threads < 1) threads = 1;
   }
   nav_scene sc;
   const int lrc = navsim_load_scene(scene_path, &sc);
@@ -564,12 +579,15 @@ int navsim_estimate(int argc, char **argv) {
   rc = navsim_out_begin("estimate", out_dir, force, &rd);
   if (rc != 0) goto cleanup;
   rc = 1;
-  const char *csv = nav_resultdir_file(rd, "estimate.csv");
-  f = csv ? fopen(csv, "w") : NULL;
-  if (!f) goto cleanup;
-  write_header(f, &ctx);
-  const long header_end = ftell(f);
-  es.f = f;
+  long header_end = 0;
+  if (!no_csv) {
+    const char *csv = nav_resultdir_file(rd, "estimate.csv");
+    f = csv ? fopen(csv, "w") : NULL;
+    if (!f) goto cleanup;
+    write_header(f, &ctx);
+    header_end = ftell(f);
+  }
+  es.f = f; /* NULL: no rows written (--no-csv) */
 
   /* The covariance analysis streams its output epochs into the rows (WGS-84 scenes). */
   bool have_cov = false;
@@ -605,7 +623,7 @@ int navsim_estimate(int argc, char **argv) {
   if (!have_cov) {
     /* No covariance analysis (flat Earth), or one whose epochs are not the output epochs: the
      * analytic rows alone, from the first epoch. */
-    if (fflush(f) != 0 || fseek(f, header_end, SEEK_SET) != 0 || ftruncate(fileno(f), header_end) != 0)
+    if (f && (fflush(f) != 0 || fseek(f, header_end, SEEK_SET) != 0 || ftruncate(fileno(f), header_end) != 0))
       goto cleanup;
     es.with_cov = false;
     es.n = es.nb = 0;
@@ -621,8 +639,8 @@ int navsim_estimate(int argc, char **argv) {
   }
   t_cov -= have_cov ? es.analytic_wall_s : 0.0;
   const double t_analytic = es.analytic_wall_s;
-  const bool bad = ferror(f) != 0;
-  if (fclose(f) != 0 || bad) {
+  const bool bad = f && ferror(f) != 0;
+  if (f && (fclose(f) != 0 || bad)) {
     f = NULL;
     goto cleanup;
   }
