@@ -14,6 +14,7 @@
  * [HIST_LO, HIST_HI] SI, one under- and one overflow bin) and keeps the exact minimum and maximum.
  * The set of values is the same whatever the order, so the final state is too.
  */
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -764,9 +765,10 @@ static double cdf_abs_normal(double r, double s, double *dens) {
  * N = cos^2 + e sin^2, D = e cos^2 + sin^2, J = sqrt(e) / D, X = r^2 D / (2 a b N).
  * The integrands are smooth and even about 0 and pi/2 (one quarter of a periodic function), so the
  * trapezoid rule with halved end nodes converges geometrically: the node count doubles (every new
- * node midway between old ones) until P changes by at most 1e-15 and dP/dr by at most 1e-9 of
- * itself (the root finder needs only the slope's direction and scale), looked at first with a node
- * spacing at most sqrt(e), the width of the integrand's features. 1 - exp is taken as -expm1 so a
+ * node midway between old ones) until P changes by at most 1e-15 (plus the sum's rounding,
+ * sqrt(nodes) ulps of P) and dP/dr by at most 1e-9 of itself (the root finder needs only the
+ * slope's direction and scale), looked at first with a node spacing at most sqrt(e), the width
+ * of the integrand's features. 1 - exp is taken as -expm1 so a
  * small P keeps its relative accuracy. b below 1e-9 a: the 1-D |x| <= r (the y part adds < 1e-9 a).
  */
 static double cdf_radius(double r, double a, double b, double *dens) {
@@ -803,7 +805,9 @@ static double cdf_radius(double r, double a, double b, double *dens) {
       sd += jac * exp(-x) * den / num;
     }
     const double pn = sp * (0.5 * h) / quarter, dn = sd * (0.5 * h) / quarter;
-    const bool settled = 2 * n >= first && fabs(pn - p) <= 1e-15 && fabs(dn - d) <= 1e-9 * dn;
+    /* The sum's own rounding grows like sqrt(nodes) ulps of P: a change below it is converged. */
+    const double ptol = 1e-15 + DBL_EPSILON * sqrt(2.0 * n) * pn;
+    const bool settled = 2 * n >= first && fabs(pn - p) <= ptol && fabs(dn - d) <= 1e-9 * dn;
     p = pn;
     d = dn;
     if (settled) break;
