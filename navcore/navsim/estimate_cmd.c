@@ -19,12 +19,14 @@
  *   1.2 (iv)): analytic_pos_v_valid is 1 while (t/tau_v)^2/12 < 1 %, always on a flat Earth.
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* getloadavg */
 #include "cli_util.h"
 #include "estimate_cmd.h"
 #include "navcore/nav_size_limits.h"
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,7 +42,8 @@
 #include "navcore/nav_version.h"
 
 static const char *k_usage_estimate =
-    "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet] [--allow-large]\n"
+    "usage: navsim estimate SCENE [--out DIR] [--force] [--quiet] [--allow-large] [--threads N]\n"
+    "                      [--no-csv]\n"
     "\n"
     "Preliminary estimate of the scene's navigation errors, without simulation:\n"
     "  analytic    one-sigma error growth of a free-inertial INS per level axis from the IMU\n"
@@ -66,6 +69,12 @@ static const char *k_usage_estimate =
     "\n"
     "options:\n"
     "  --allow-large  go ahead above the limits below\n"
+    "  --threads N    threads (default one per idle core: the cores less the load average, at\n"
+    "                 least one): the requirements' own covariance analysis runs\n"
+    "                 beside the one of estimate.csv, and the quantile statistics share out their\n"
+    "                 quadrature; the outputs are bit-identical for any N\n"
+    "  --no-csv       write estimate.json and summary.json only, without estimate.csv (what\n"
+    "                 navsim serve's POST /api/estimate answers with); the same values\n"
     "\n" NAV_LIMITS_HELP "\n"
     "exit codes: 0 success; 2 invalid scene or options; 1 other failure\n";
 
@@ -315,7 +324,7 @@ static bool flush_batch(est_stream *s) {
   s->st = eval_epochs(s->c, s->batch, s->nb, s->tbuf, s->abuf);
   s->analytic_wall_s += navsim_now_s() - t0;
   if (s->st != NAV_OK) return false;
-  for (size_t i = 0; i < s->nb; ++i)
+  for (size_t i = 0; i < s->nb && s->f; ++i)
     write_row(s->f, s->c, &s->batch[i], s->with_cov ? &s->cov[i] : NULL);
   s->nb = 0;
   return true;
@@ -360,6 +369,22 @@ static nav_callback_result stream_cov(void *user, const nav_cov_point *p) {
     return NAV_STOP;
   }
   return stream_epoch(s, p) ? NAV_CONTINUE : NAV_STOP;
+}
+
+/* The requirements predicted by their own covariance analysis (nav_req_predict_scene_threads),
+ * run on a thread of its own beside the analysis that fills estimate.csv: the two share nothing
+ * but the scene, which neither changes. */
+typedef struct predict_job {
+  const nav_scene *sc;
+  int threads;
+  nav_requirement_verdict *out;
+  nav_status st;
+} predict_job;
+
+static void *predict_job_run(void *arg) {
+  predict_job *j = arg;
+  j->st = nav_req_predict_scene_threads(j->sc, j->threads, j->out);
+  return NULL;
 }
 
 /*
@@ -424,6 +449,8 @@ static int write_estimate_json(const char *path, const nav_scene *sc, const char
 int navsim_estimate(int argc, char **argv) {
   const char *scene_path = NULL, *out_dir = NULL;
   bool quiet = false, force = false, allow_large = false;
+  long threads = 0; /* 0: one per core */
+  bool no_csv = false;
   for (int i = 0; i < argc; ++i) {
     if (navsim_is_help(argv[i])) {
       fputs(k_usage_estimate, stdout);
@@ -434,8 +461,18 @@ int navsim_estimate(int argc, char **argv) {
       force = true;
     } else if (strcmp(argv[i], "--allow-large") == 0) {
       allow_large = true;
+    } else if (strcmp(argv[i], "--no-csv") == 0) {
+      no_csv = true;
     } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
+    } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+      char *end = NULL;
+      errno = 0;
+      threads = strtol(argv[++i], &end, 10);
+      if (errno != 0 || end == argv[i] || *end != '\0' || threads < 1 || threads > 256) {
+        fprintf(stderr, "navsim estimate: --threads expects an integer from 1 to 256, got \"%s\"\n", argv[i]);
+        return 2;
+      }
     } else if (argv[i][0] == '-') {
       fprintf(stderr, "navsim estimate: unknown or incomplete option \"%s\" (see navsim estimate --help)\n", argv[i]);
       return 2;
@@ -449,6 +486,17 @@ int navsim_estimate(int argc, char **argv) {
   if (!scene_path) {
     fprintf(stderr, "navsim estimate: missing SCENE\n%s", k_usage_estimate);
     return 2;
+  }
+  if (threads == 0) {
+    /* One per idle core: the cores less the 1-minute load average (which counts the other
+     * programs running), at least one. On a busy machine a second thread would only wait for a
+     * core and do speculative work; the outputs are the same either way. */
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    double load = 0.0;
+    const long busy = getloadavg(&load, 1) == 1 && load > 0.0 ? lround(load) : 0;
+    threads = cores - busy;
+    if (threads > 16) threads = 16;
+    if (threads < 1) threads = 1;
   }
   nav_scene sc;
   const int lrc = navsim_load_scene(scene_path, &sc);
@@ -471,6 +519,9 @@ int navsim_estimate(int argc, char **argv) {
   nav_sim *sim = NULL;
   nav_resultdir *rd = NULL;
   nav_requirement_verdict *pred = NULL; /* predicted requirement verdicts */
+  predict_job job = {&sc, (int)threads, NULL, NAV_OK};
+  pthread_t job_thread;
+  bool job_running = false, job_started = false;
   est_stream es;
   memset(&es, 0, sizeof es);
   FILE *f = NULL;
@@ -528,12 +579,15 @@ int navsim_estimate(int argc, char **argv) {
   rc = navsim_out_begin("estimate", out_dir, force, &rd);
   if (rc != 0) goto cleanup;
   rc = 1;
-  const char *csv = nav_resultdir_file(rd, "estimate.csv");
-  f = csv ? fopen(csv, "w") : NULL;
-  if (!f) goto cleanup;
-  write_header(f, &ctx);
-  const long header_end = ftell(f);
-  es.f = f;
+  long header_end = 0;
+  if (!no_csv) {
+    const char *csv = nav_resultdir_file(rd, "estimate.csv");
+    f = csv ? fopen(csv, "w") : NULL;
+    if (!f) goto cleanup;
+    write_header(f, &ctx);
+    header_end = ftell(f);
+  }
+  es.f = f; /* NULL: no rows written (--no-csv) */
 
   /* The covariance analysis streams its output epochs into the rows (WGS-84 scenes). */
   bool have_cov = false;
@@ -543,6 +597,11 @@ int navsim_estimate(int argc, char **argv) {
     st = nav_sim_create(&sc, &sim);
     es.with_cov = true;
     es.keep_points = sc.n_requirements > 0 && nav_req_predict_scene_uses_sim_covariance(&sc);
+    if (st == NAV_OK && sc.n_requirements > 0 && !es.keep_points && threads > 1) {
+      /* The requirements' own analysis beside this one (used when this one covers the epochs). */
+      job.out = calloc((size_t)sc.n_requirements, sizeof *job.out);
+      job_running = job_started = job.out && pthread_create(&job_thread, NULL, predict_job_run, &job) == 0;
+    }
     if (st == NAV_OK) {
       const double tc = navsim_now_s();
       st = nav_sim_covariance(sim, stream_cov, &es);
@@ -564,7 +623,7 @@ int navsim_estimate(int argc, char **argv) {
   if (!have_cov) {
     /* No covariance analysis (flat Earth), or one whose epochs are not the output epochs: the
      * analytic rows alone, from the first epoch. */
-    if (fflush(f) != 0 || fseek(f, header_end, SEEK_SET) != 0 || ftruncate(fileno(f), header_end) != 0)
+    if (f && (fflush(f) != 0 || fseek(f, header_end, SEEK_SET) != 0 || ftruncate(fileno(f), header_end) != 0))
       goto cleanup;
     es.with_cov = false;
     es.n = es.nb = 0;
@@ -580,8 +639,8 @@ int navsim_estimate(int argc, char **argv) {
   }
   t_cov -= have_cov ? es.analytic_wall_s : 0.0;
   const double t_analytic = es.analytic_wall_s;
-  const bool bad = ferror(f) != 0;
-  if (fclose(f) != 0 || bad) {
+  const bool bad = f && ferror(f) != 0;
+  if (f && (fclose(f) != 0 || bad)) {
     f = NULL;
     goto cleanup;
   }
@@ -593,9 +652,18 @@ int navsim_estimate(int argc, char **argv) {
     if (!pred) goto cleanup;
     /* The covariance analysis plus the truth's scale factors the filter does not estimate
        (nav_req_predict_scene, as navsim select predicts); nothing without a covariance analysis. */
-    st = !have_cov       ? nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred)
-         : es.keep_points ? nav_req_predict_scene_points(&sc, es.pts, es.npts, pred)
-                          : nav_req_predict_scene(&sc, pred);
+    if (job_running) {
+      pthread_join(job_thread, NULL);
+      job_running = false;
+    }
+    if (have_cov && job_started) {
+      memcpy(pred, job.out, (size_t)sc.n_requirements * sizeof *pred);
+      st = job.st;
+    } else {
+      st = !have_cov       ? nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred)
+           : es.keep_points ? nav_req_predict_scene_points_threads(&sc, es.pts, es.npts, (int)threads, pred)
+                            : nav_req_predict_scene_threads(&sc, (int)threads, pred);
+    }
     if (st != NAV_OK) {
       fprintf(stderr, "navsim estimate: predicting the requirements failed: %s\n", nav_status_str(st));
       goto cleanup;
@@ -715,6 +783,8 @@ int navsim_estimate(int argc, char **argv) {
   }
   rc = 0;
 cleanup:
+  if (job_running) pthread_join(job_thread, NULL);
+  free(job.out);
   if (f) fclose(f);
   nav_resultdir_abort(rd);
   nav_sim_destroy(sim);

@@ -19,6 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "nav_test.h"
 #include "navsim_cli.h"
@@ -308,6 +309,72 @@ static void test_estimate_predictions(void **state) {
   nav_test_assert_matches(requirements_of(js), "\"id\": \"v-tiny\", .*\"value\": null, \"pass\": false");
 }
 
+/* navsim estimate --threads N and --no-csv: estimate.json (with a cep95 predicted by the threaded
+ * quadrature over 601 epochs) and estimate.csv byte-identical for 1, 2 and 3 threads; --no-csv
+ * writes the same estimate.json and no estimate.csv; a bad thread count is refused (exit 2). */
+static void test_estimate_threads_identical(void **state) {
+  (void)state;
+  nav_test_write_file(
+      WORK, "estq.yaml",
+      "format_version: 1\n"
+      "name: estq\n"
+      "earth: {model: wgs84, origin: {lat_deg: 45, lon_deg: 7, h_m: 200}}\n"
+      "trajectory:\n"
+      "  type: segments\n"
+      "  segments:\n"
+      "    v0_b_mps: [10, 0, 0]\n"
+      "    items:\n"
+      "      - {kind: hold, duration_s: 60}\n"
+      "imu: {rate_hz: 100, catalog: \"Xsens MTi-300\"}\n"
+      "gnss: {enabled: true, catalog: \"SBAS (WAAS/EGNOS class)\", outages: [[20, 40]]}\n"
+      "initial_errors: {position_m: 2, velocity_mps: 0.1, attitude_deg: [0.5, 0.5, 2]}\n"
+      "navigation: {scheme: ins_gnss}\n"
+      "output: {rate_hz: 10}\n"
+      "requirements:\n"
+      "  - {id: h-end, metric: horizontal_position, statistic: outage_end, limit: 50, unit: m}\n"
+      "  - {id: h-cep, metric: horizontal_position, statistic: cep95, limit: 50, unit: m}\n"
+      "  - {id: v-p95, metric: vertical_position, statistic: p95, limit: 50, unit: m}\n");
+  static const char *const runs[4] = {"estimate estq.yaml --out estq-1 --threads 1",
+                                      "estimate estq.yaml --out estq-2 --threads 2",
+                                      "estimate estq.yaml --out estq-3 --threads 3",
+                                      "estimate estq.yaml --out estq-n --threads 2 --no-csv"};
+  for (int i = 0; i < 4; ++i) {
+    nav_cli_result *r = navsim(runs[i]);
+    if (r->code != 0) fail_msg("navsim %s exited %d: %s", runs[i], r->code, r->err);
+  }
+  size_t l1 = 0, lk = 0;
+  char *j1 = nav_test_slurp_len(WORK "/estq-1/estimate.json", &l1);
+  char *c1 = nav_test_slurp_len(WORK "/estq-1/estimate.csv", &lk);
+  assert_non_null(j1);
+  assert_non_null(c1);
+  nav_test_assert_matches(requirements_of(j1), "\"id\": \"h-cep\", .*\"value\": [0-9.e+-]+, \"pass\": true");
+  static const char *const dirs[3] = {WORK "/estq-2", WORK "/estq-3", WORK "/estq-n"};
+  for (int i = 0; i < 3; ++i) {
+    char path[512];
+    size_t l = 0;
+    snprintf(path, sizeof path, "%s/estimate.json", dirs[i]);
+    char *j = nav_test_slurp_len(path, &l);
+    assert_non_null(j);
+    assert_int_equal(l, l1);
+    assert_memory_equal(j, j1, l1);
+    free(j);
+    snprintf(path, sizeof path, "%s/estimate.csv", dirs[i]);
+    if (i < 2) {
+      char *c = nav_test_slurp_len(path, &l);
+      assert_non_null(c);
+      assert_int_equal(l, lk);
+      assert_memory_equal(c, c1, lk);
+      free(c);
+    } else {
+      assert_int_equal(access(path, F_OK), -1); /* --no-csv */
+    }
+  }
+  free(j1);
+  free(c1);
+  assert_int_equal(navsim("estimate estq.yaml --out estq-bad --threads 0")->code, 2);
+  assert_int_equal(navsim("estimate estq.yaml --out estq-bad --threads two")->code, 2);
+}
+
 
 /* navsim budget: budget.csv sorted by share within each requirement, the shares of each
  * requirement summing to 1 (covariance); a flat-Earth scene by Monte Carlo. Runs after
@@ -379,6 +446,7 @@ int main(void) {
       cmocka_unit_test(test_issue_25_replay_no_scored_epoch),
       cmocka_unit_test(test_issue_25_unevaluable_requirements_refused),
       cmocka_unit_test(test_estimate_predictions),
+      cmocka_unit_test(test_estimate_threads_identical),
       cmocka_unit_test(test_budget_cli),
   };
   return cmocka_run_group_tests(tests, setup, NULL);

@@ -686,6 +686,172 @@ static void test_predict_scene_points(void **state) {
   free(sc);
 }
 
+/* nav_req_predict_threads: the quantile statistics bit-identical for 1, 2, 3 and 7 threads, on
+ * 1000 epochs whose sigmas vary (circular, elliptical, degenerate; a jump half-way), and with a
+ * few epochs (no helpers); the values equal nav_req_predict's. */
+static void test_predict_threads(void **state) {
+  (void)state;
+  enum { N = 1000 };
+  nav_cov_point *pts = calloc(N, sizeof *pts);
+  assert_non_null(pts);
+  for (int i = 0; i < N; ++i) {
+    const double g = 1.0 + 0.5 * sin(0.01 * i) + (i >= N / 2 ? 3.0 : 0.0);
+    pts[i].t_s = 0.1 * i;
+    pts[i].pos_sd_n_m = nav_vec3_make(g, i % 97 == 0 ? 0.0 : g * (0.3 + 0.7 * (i % 7) / 6.0), 2.0 * g);
+    pts[i].pos_h_sd_m = hypot(pts[i].pos_sd_n_m.x, pts[i].pos_sd_n_m.y);
+    pts[i].att_sd_rad = nav_vec3_make(0.0, 0.0, 1e-3 * g);
+  }
+  nav_requirement q[4] = {req("c50", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP50, 5.0, NAV_REQ_UNIT_M),
+                          req("c95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 5.0, NAV_REQ_UNIT_M),
+                          req("v95", NAV_REQ_VERTICAL_POSITION, NAV_REQ_P95, 5.0, NAV_REQ_UNIT_M),
+                          req("y95", NAV_REQ_YAW, NAV_REQ_P95, 1.0, NAV_REQ_UNIT_MRAD)};
+  const size_t counts[2] = {N, 40};
+  for (int c = 0; c < 2; ++c) {
+    nav_requirement_verdict one[4], many[4];
+    assert_int_equal(nav_req_predict(q, 4, pts, counts[c], NULL, 0, one), NAV_OK);
+    for (int k = 0; k < 4; ++k) assert_true(one[k].evaluated && one[k].value > 0.0);
+    const int threads[4] = {1, 2, 3, 7};
+    for (int t = 0; t < 4; ++t) {
+      memset(many, 0x5a, sizeof many);
+      assert_int_equal(nav_req_predict_threads(q, 4, pts, counts[c], NULL, 0, threads[t], many), NAV_OK);
+      for (int k = 0; k < 4; ++k) {
+        assert_memory_equal(&one[k].value, &many[k].value, sizeof one[k].value);
+        assert_int_equal(one[k].pass, many[k].pass);
+        assert_int_equal(one[k].samples, many[k].samples);
+      }
+    }
+  }
+  free(pts);
+}
+
+
+
+/* ---- cep of covariance points against independent references (docs/estimate-cep.md) ---- */
+
+/* A covariance point with horizontal sigmas (a north, b east). */
+static nav_cov_point cep_point(double a, double b) {
+  nav_cov_point p;
+  memset(&p, 0, sizeof p);
+  p.pos_sd_n_m = nav_vec3_make(a, b, 1.0);
+  p.pos_h_sd_m = hypot(a, b);
+  p.att_sd_rad = nav_vec3_make(0.0, 0.0, 1e-3);
+  return p;
+}
+
+/* The predicted cep50 (k = 0) and cep95 (k = 1) of @p n points, with @p threads threads. */
+static void predict_ceps(const nav_cov_point *pts, size_t n, int threads, double out[2]) {
+  nav_requirement q[2] = {req("c50", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP50, 5.0, NAV_REQ_UNIT_M),
+                          req("c95", NAV_REQ_HORIZONTAL_POSITION, NAV_REQ_CEP95, 5.0, NAV_REQ_UNIT_M)};
+  nav_requirement_verdict v[2];
+  assert_int_equal(nav_req_predict_threads(q, 2, pts, n, NULL, 0, threads, v), NAV_OK);
+  for (int k = 0; k < 2; ++k) {
+    assert_true(v[k].evaluated);
+    out[k] = v[k].value;
+  }
+}
+
+/* Reference P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2), a >= b: x = r sin u,
+ * P = int_{-pi/2}^{pi/2} phi(r sin u / a) / a erf(r cos u / (sqrt 2 b)) r cos u du, composite
+ * Simpson on m intervals (a formula independent of the library's polar trapezoid). */
+static double ref_cdf_radius(double r, double a, double b, int m) {
+  const double h = NAV_PI / m;
+  double sum = 0.0;
+  for (int i = 0; i <= m; ++i) {
+    const double u = -0.5 * NAV_PI + h * i, x = r * sin(u), c = r * cos(u);
+    const double f = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * erf(c / (sqrt(2.0) * b)) * c;
+    sum += f * ((i == 0 || i == m) ? 1.0 : (i % 2 ? 4.0 : 2.0));
+  }
+  return sum * h / 3.0;
+}
+
+/* Smallest r with the mean of the reference CDFs >= q, by bisection to the last bits. */
+static double ref_quantile(const double *a, const double *b, int n, double q, int m) {
+  double lo = 0.0, hi = 0.0;
+  for (int i = 0; i < n; ++i) hi = fmax(hi, 10.0 * a[i]);
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += ref_cdf_radius(mid, a[i], b[i], m);
+    if (s / n >= q) hi = mid;
+    else lo = mid;
+  }
+  return hi;
+}
+
+/* Circular points: cep = a sqrt(-2 ln(1 - q)) exactly (Rayleigh). */
+static void test_cep_predict_circular(void **state) {
+  (void)state;
+  const double sig[3] = {1e-3, 1.0, 250.0};
+  for (int i = 0; i < 3; ++i) {
+    const nav_cov_point p = cep_point(sig[i], sig[i]);
+    double c[2];
+    predict_ceps(&p, 1, 1, c);
+    assert_true(fabs(c[0] / (sig[i] * sqrt(2.0 * log(2.0))) - 1.0) < 1e-13);
+    assert_true(fabs(c[1] / (sig[i] * sqrt(-2.0 * log(0.05))) - 1.0) < 1e-13);
+  }
+}
+
+/* Nearly 1-D points (b = 1e-7 a, the polar sum with thousands of nodes): cep = the quantile of
+ * |N(0, a^2)| (the y part moves it by ~(b / r)^2 = 1e-14 relative), found by bisection on erf. */
+static void test_cep_predict_one_dimensional_limit(void **state) {
+  (void)state;
+  const double a = 3.0, qs[2] = {0.5, 0.95};
+  const nav_cov_point p = cep_point(a, 1e-7 * a), p_swapped = cep_point(1e-7 * a, a);
+  double c[2], cs[2];
+  predict_ceps(&p, 1, 1, c);
+  predict_ceps(&p_swapped, 1, 1, cs);
+  for (int k = 0; k < 2; ++k) {
+    double lo = 0.0, hi = 10.0 * a;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (erf(mid / (sqrt(2.0) * a)) >= qs[k]) hi = mid;
+      else lo = mid;
+    }
+    assert_true(fabs(c[k] / hi - 1.0) < 1e-12);
+    assert_true(fabs(cs[k] / hi - 1.0) < 1e-12);
+  }
+}
+
+/* Eccentric single points (a / b = 1.5 .. 1000) and a mixture of them against the bisection on
+ * the reference CDF with 40 000 Simpson intervals. */
+static void test_cep_predict_eccentric_reference(void **state) {
+  (void)state;
+  const double a[5] = {2.0, 1.0, 0.5, 4.0, 1.0}, b[5] = {2.0 / 1.5, 0.1, 0.005, 0.004, 0.7};
+  const double qs[2] = {0.5, 0.95};
+  nav_cov_point pts[5];
+  for (int i = 0; i < 5; ++i) {
+    pts[i] = cep_point(a[i], b[i]);
+    double c[2];
+    predict_ceps(&pts[i], 1, 1, c);
+    for (int k = 0; k < 2; ++k) {
+      const double ref = ref_quantile(&a[i], &b[i], 1, qs[k], 40000);
+      assert_true(fabs(c[k] / ref - 1.0) < 1e-11);
+    }
+  }
+  double c[2];
+  predict_ceps(pts, 5, 1, c);
+  for (int k = 0; k < 2; ++k) {
+    const double ref = ref_quantile(a, b, 5, qs[k], 40000);
+    assert_true(fabs(c[k] / ref - 1.0) < 1e-11);
+  }
+}
+
+/* 1 and 3 threads give the same cep bits on 600 points of varied eccentricity. */
+static void test_cep_predict_threads_identical(void **state) {
+  (void)state;
+  enum { N = 600 };
+  nav_cov_point *pts = calloc(N, sizeof *pts);
+  assert_non_null(pts);
+  for (int i = 0; i < N; ++i) {
+    const double a = 1.0 + 0.8 * sin(0.05 * i);
+    pts[i] = cep_point(a, a * pow(10.0, -(i % 5)));
+  }
+  double one[2], three[2];
+  predict_ceps(pts, N, 1, one);
+  predict_ceps(pts, N, 3, three);
+  assert_memory_equal(one, three, sizeof one);
+  free(pts);
+}
 
 /* The outages of a scene as the simulation applies them: gnss.outages plus the segments with
  * gnss_visible: false (merged when they touch). */
@@ -742,6 +908,11 @@ int main(void) {
       cmocka_unit_test(test_scene_round_trip),
       cmocka_unit_test(test_scene_outages),
       cmocka_unit_test(test_predict_scene_points),
+      cmocka_unit_test(test_predict_threads),
+      cmocka_unit_test(test_cep_predict_circular),
+      cmocka_unit_test(test_cep_predict_one_dimensional_limit),
+      cmocka_unit_test(test_cep_predict_eccentric_reference),
+      cmocka_unit_test(test_cep_predict_threads_identical),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -267,6 +267,21 @@ cli = json.loads(read(os.path.join(cli_dir, "estimate.json")))
 for k in ("analytic_final", "requirements"):
     check(j and j.get(k) == cli.get(k), f"estimate {k} equals navsim estimate's")
 print(f"POST /api/estimate paper-parametric: {dt:.2f} s wall (machine load {os.getloadavg()[0]:.1f})")
+# The answer is navsim estimate's estimate.json byte for byte (the scene saved as scene.yaml), also
+# when it comes from the server's cache of answers by scene text; another text, another answer.
+os.makedirs(os.path.join(srv.root, "estimate-same"), exist_ok=True)
+with open(os.path.join(srv.root, "estimate-same", "scene.yaml"), "wb") as fh:
+    fh.write(PARAMETRIC)
+subprocess.run([NAVSIM, "estimate", "scene.yaml", "--out", "est", "--quiet"], check=True,
+               cwd=os.path.join(srv.root, "estimate-same"))
+same = read(os.path.join(srv.root, "estimate-same", "est", "estimate.json"))
+for i in range(2):
+    st, _, body = srv.request("POST", "/api/estimate", PARAMETRIC)
+    check(st == 200 and body == same, f"estimate answer {i + 1} identical to navsim estimate's estimate.json")
+renamed = PARAMETRIC.replace(b"name: paper-parametric", b"name: paper-parametric-2", 1)
+check(renamed != PARAMETRIC, "the scene has a name to change")
+st, _, j = srv.json("POST", "/api/estimate", renamed)
+check(st == 200 and j and j.get("scene", {}).get("name") == "paper-parametric-2", f"a changed scene is estimated anew ({st})")
 st, _, j = srv.json("POST", "/api/estimate", b"format_version: 1\nimu: {rate_hz: -1}\n")
 check(st == 422 and j["errors"][0]["path"] == "imu.rate_hz", f"estimate of an invalid scene -> 422 ({st})")
 st, _, j = srv.json("GET", "/api/estimate")

@@ -45,6 +45,7 @@ serve_config serve_config_default(void) {
   c.retry_after_s = 10;
   c.estimate_cpu_s = 10;
   c.max_parallel_estimates = 2;
+  c.estimate_cache_entries = 64;
   c.slurm = 0;
   c.slurm_max_runs = 100000;
   c.slurm_tasks = 1;
@@ -92,6 +93,7 @@ static const key_def k_keys[] = {
     {"retry_after_s", K_INT, OFF(retry_after_s), 0, 1, 86400},
     {"estimate_cpu_s", K_LONG, OFF(estimate_cpu_s), 0, 1, 3600},
     {"max_parallel_estimates", K_INT, OFF(max_parallel_estimates), 0, 1, 256},
+    {"estimate_cache_entries", K_INT, OFF(estimate_cache_entries), 0, 0, 1024},
     {"slurm", K_INT, OFF(slurm), 0, 0, 1},
     {"slurm_max_runs", K_LONG, OFF(slurm_max_runs), 0, 1, NAV_SCENE_MAX_RUNS},
     {"slurm_tasks", K_INT, OFF(slurm_tasks), 0, 1, 100000},

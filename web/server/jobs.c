@@ -818,6 +818,7 @@ void serve_jobs_stop(void) {
     pthread_join(g.workers[i], NULL);
   pthread_join(g.janitor, NULL);
   g.started = false;
+  serve_estimate_cache_clear();
 }
 
 /* ------------------------------------------------------------------ the API */
@@ -1098,10 +1099,108 @@ void serve_streams_leave(const char *client) {
 
 /* ------------------------------------------------------------------ estimates */
 
+/*
+ * Answers of POST /api/estimate kept by scene text. `navsim estimate` is deterministic and its
+ * estimate.json depends only on the scene file's bytes (always written as scene.yaml) and this
+ * program's navsim and resources, so a scene posted again (the library scenes every new page
+ * loads, a form changed back) gets the bytes computing it again would give. At most
+ * estimate_cache_entries answers of at most ESTIMATE_CACHE_MAX_BYTES (scene plus answer) each,
+ * the least recently used replaced; estimate_cache_entries = 0 turns the cache off.
+ */
+#define ESTIMATE_CACHE_MAX_BYTES (256u * 1024u)
+#define ESTIMATE_CACHE_MAX_ENTRIES 1024
+
+typedef struct est_entry {
+  uint64_t hash;
+  char *text, *json;
+  size_t len, json_len;
+  uint64_t used; /* last use, from est_clock */
+} est_entry;
+
+static struct {
+  est_entry e[ESTIMATE_CACHE_MAX_ENTRIES];
+  uint64_t clock;
+} est_cache; /* under g.mu */
+
+static uint64_t text_hash(const char *t, size_t n) {
+  uint64_t h = 1469598103934665603ull; /* FNV-1a, 64 bits */
+  for (size_t i = 0; i < n; ++i) {
+    h ^= (unsigned char)t[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+static int est_cache_size(void) {
+  const int n = g.cfg.estimate_cache_entries;
+  return n < 0 ? 0 : n > ESTIMATE_CACHE_MAX_ENTRIES ? ESTIMATE_CACHE_MAX_ENTRIES : n;
+}
+
+/* A copy of the cached answer for @p text into *json (under g.mu); false when there is none. */
+static bool est_cache_get(uint64_t h, const char *text, size_t len, char **json, size_t *json_len) {
+  for (int i = 0; i < est_cache_size(); ++i) {
+    est_entry *e = &est_cache.e[i];
+    if (!e->text || e->hash != h || e->len != len || memcmp(e->text, text, len) != 0) continue;
+    char *c = malloc(e->json_len + 1);
+    if (!c) return false;
+    memcpy(c, e->json, e->json_len + 1);
+    *json = c;
+    *json_len = e->json_len;
+    e->used = ++est_cache.clock;
+    return true;
+  }
+  return false;
+}
+
+/* Keeps a copy of an answer (under g.mu); nothing when it is too large or memory is short. */
+static void est_cache_put(uint64_t h, const char *text, size_t len, const char *json, size_t json_len) {
+  const int n = est_cache_size();
+  if (n == 0 || len + json_len > ESTIMATE_CACHE_MAX_BYTES) return;
+  int slot = 0;
+  for (int i = 0; i < n; ++i) {
+    est_entry *e = &est_cache.e[i];
+    if (e->text && e->hash == h && e->len == len && memcmp(e->text, text, len) == 0) return; /* already */
+    if (!e->text) {
+      slot = i;
+      break;
+    }
+    if (e->used < est_cache.e[slot].used) slot = i;
+  }
+  char *t = malloc(len + 1), *j = malloc(json_len + 1);
+  if (!t || !j) {
+    free(t);
+    free(j);
+    return;
+  }
+  memcpy(t, text, len);
+  t[len] = '\0';
+  memcpy(j, json, json_len);
+  j[json_len] = '\0';
+  est_entry *e = &est_cache.e[slot];
+  free(e->text);
+  free(e->json);
+  *e = (est_entry){h, t, j, len, json_len, ++est_cache.clock};
+}
+
+void serve_estimate_cache_clear(void) {
+  pthread_mutex_lock(&g.mu);
+  for (int i = 0; i < ESTIMATE_CACHE_MAX_ENTRIES; ++i) {
+    free(est_cache.e[i].text);
+    free(est_cache.e[i].json);
+    est_cache.e[i] = (est_entry){0};
+  }
+  pthread_mutex_unlock(&g.mu);
+}
+
 estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
                            size_t why_size) {
   *json = NULL;
+  const uint64_t h = text_hash(text, len);
   pthread_mutex_lock(&g.mu);
+  if (!g.stopping && est_cache_get(h, text, len, json, json_len)) {
+    pthread_mutex_unlock(&g.mu);
+    return EST_OK;
+  }
   const bool busy = g.n_estimates >= g.cfg.max_parallel_estimates || g.stopping;
   if (!busy) ++g.n_estimates;
   pthread_mutex_unlock(&g.mu);
@@ -1121,7 +1220,8 @@ estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *js
     off += (size_t)w;
   }
   if (fd < 0 || close(fd) != 0 || off != len) goto cleanup;
-  char *argv[] = {"navsim", "estimate", "scene.yaml", "--out", "est", "--quiet", NULL};
+  /* estimate.json is the answer: without estimate.csv (--no-csv), whose rows nobody reads here. */
+  char *argv[] = {"navsim", "estimate", "scene.yaml", "--out", "est", "--quiet", "--no-csv", NULL};
   const pid_t pid = serve_spawn(dir, argv, -1, g.cfg.estimate_cpu_s, "log.txt");
   if (pid < 0) goto cleanup;
   struct rusage ru;
@@ -1131,6 +1231,11 @@ estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *js
     snprintf(path, sizeof path, "%s/est/estimate.json", dir);
     *json = serve_read_file(path, 64u << 20, json_len);
     if (*json) rc = EST_OK;
+    if (*json) {
+      pthread_mutex_lock(&g.mu);
+      est_cache_put(h, text, len, *json, *json_len);
+      pthread_mutex_unlock(&g.mu);
+    }
   } else if (watchdog ||
              (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))) {
     snprintf(why, why_size, "the estimate exceeded its CPU limit of %ld s (estimate_cpu_s)",

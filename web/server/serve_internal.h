@@ -47,6 +47,7 @@ typedef struct serve_config {
   int retry_after_s;                  /**< retry_after_s: Retry-After of 429 answers */
   long estimate_cpu_s;                /**< estimate_cpu_s: CPU seconds of one POST /api/estimate */
   int max_parallel_estimates;         /**< max_parallel_estimates: estimates computed at once */
+  int estimate_cache_entries;         /**< estimate_cache_entries: answers kept by scene text (0: none) */
   int slurm;                          /**< slurm: 1 hands campaigns above max_runs to Slurm */
   long slurm_max_runs;                /**< slurm_max_runs: Monte Carlo runs of a Slurm campaign */
   int slurm_tasks;                    /**< slurm_tasks: srun -n (MPI ranks) of a campaign */
@@ -202,6 +203,8 @@ void serve_streams_leave(const char *client);
 
 /** POST /api/estimate: run `navsim estimate` on the (checked) scene in a sandboxed child. */
 typedef enum estimate_rc { EST_OK, EST_BUSY, EST_FAILED } estimate_rc;
+/* Forgets the answers POST /api/estimate keeps by scene text. */
+void serve_estimate_cache_clear(void);
 estimate_rc serve_estimate(const char *text, size_t len, char **json, size_t *json_len, char *why,
                            size_t why_size);
 

@@ -316,6 +316,24 @@ NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_points(const struct nav_s
                                                               const struct nav_cov_point *pts, size_t npts,
                                                               nav_requirement_verdict *out);
 
+/**
+ * nav_req_predict, nav_req_predict_scene and nav_req_predict_scene_points with @p threads
+ * threads (1 or less: the caller's alone) sharing the quadrature of the quantile statistics (p95,
+ * cep50, cep95): each bisection step's per-epoch CDFs are computed by the threads and added in
+ * epoch order by the caller, so the verdicts are bit-identical for any thread count.
+ */
+NAV_API NAV_NODISCARD nav_status nav_req_predict_threads(const nav_requirement *reqs, int count,
+                                                         const struct nav_cov_point *pts, size_t npts,
+                                                         const nav_req_interval *outages, int n_outages, int threads,
+                                                         nav_requirement_verdict *out);
+/** nav_req_predict_scene with @p threads (nav_req_predict_threads). */
+NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_threads(const struct nav_scene *scene, int threads,
+                                                               nav_requirement_verdict *out);
+/** nav_req_predict_scene_points with @p threads (nav_req_predict_threads). */
+NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_points_threads(const struct nav_scene *scene,
+                                                                      const struct nav_cov_point *pts, size_t npts,
+                                                                      int threads, nav_requirement_verdict *out);
+
 NAV_END_DECLS
 
 #endif /* NAV_REQUIREMENTS_H */

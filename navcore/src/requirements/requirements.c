@@ -14,6 +14,7 @@
  * [HIST_LO, HIST_HI] SI, one under- and one overflow bin) and keeps the exact minimum and maximum.
  * The set of values is the same whatever the order, so the final state is too.
  */
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -742,83 +743,77 @@ nav_run_observer nav_req_evaluator_observer(nav_req_evaluator *ev) {
 
 /* ================================================================ prediction from covariance */
 
-/* P(|x| <= r), x ~ N(0, s^2). */
-static double cdf_abs_normal(double r, double s) {
-  if (!(s > 0.0)) return r >= 0.0 ? 1.0 : 0.0;
+/* P(|x| <= r), x ~ N(0, s^2), and its derivative in r (*dens). */
+static double cdf_abs_normal(double r, double s, double *dens) {
+  if (!(s > 0.0)) {
+    *dens = 0.0;
+    return r >= 0.0 ? 1.0 : 0.0;
+  }
+  *dens = sqrt(2.0 / NAV_PI) / s * exp(-0.5 * (r / s) * (r / s));
   return erf(r / (sqrt(2.0) * s));
 }
 
-/* Intervals of the Simpson rule of cdf_radius (even). */
-#define CDF_RADIUS_N 256
+/* Nodes of the first look at the stop rule of cdf_radius, and the most it doubles to. */
+#define CDF_RADIUS_MIN_NODES 8
+#define CDF_RADIUS_MAX_NODES (1 << 21)
 
-/* sin and cos of the Simpson nodes over the whole half circle, u = -pi/2 + h i with h = pi/256:
- * the nodes of every cdf_radius call whose radius stays within 9 sigma (umax = pi/2). Computed
- * once per quantile with the same expressions as the nodes themselves, so the same values. */
-typedef struct radius_nodes {
-  double u[CDF_RADIUS_N + 1], s[CDF_RADIUS_N + 1], c[CDF_RADIUS_N + 1];
-} radius_nodes;
-
-static void radius_nodes_init(radius_nodes *t) {
-  const double umax = 0.5 * NAV_PI;
-  const double h = 2.0 * umax / CDF_RADIUS_N;
-  for (int i = 0; i <= CDF_RADIUS_N; ++i) {
-    const double u = -umax + h * i;
-    t->u[i] = u;
-    t->s[i] = sin(u);
-    t->c[i] = cos(u);
-  }
-}
-
-/* erf(x) for x >= 6 is 1 - erfc(x) with erfc(6) = 2.2e-17 below half the spacing of the doubles
- * just under 1 (2^-54 = 5.6e-17): exactly 1.0 in every correctly or faithfully rounded erf. */
-#define ERF_ONE_FROM 6.0
-
-/* P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2) independent: with x = r sin(u),
- * P = int phi(r sin u / a) / a * erf(r cos u / (sqrt 2 b)) r cos u du over |r sin u| <= 9 a (a >= b),
- * composite Simpson on 256 intervals (smooth in u). Degenerate sigmas reduce to 1-D.
- * @p nodes: sin and cos of the nodes for umax = pi/2 (the same values the loop would compute).
- * The integrand depends on u through (sin u)^2 and cos u only, and sin is odd and cos even in
- * round-to-nearest arithmetic: a node whose u is exactly minus that of its mirror node (n - i)
- * has the same integrand value, taken from the mirror. The sum runs over the nodes in order. */
-static double cdf_radius(double r, double a, double b, const radius_nodes *nodes) {
-  if (r <= 0.0) return 0.0;
+/*
+ * P(hypot(x, y) <= r), x ~ N(0, a^2), y ~ N(0, b^2) independent, and its derivative in r (*dens).
+ * docs/estimate-cep.md derives it: with e = b / a (a >= b) and tan(phi) = tan(theta) / sqrt(e),
+ *   P = (2/pi) int_0^{pi/2} J(theta) (1 - exp(-X(theta))) dtheta,
+ *   dP/dr = (2/pi) r / (a b) int_0^{pi/2} J(theta) exp(-X(theta)) D(theta) / N(theta) dtheta,
+ * N = cos^2 + e sin^2, D = e cos^2 + sin^2, J = sqrt(e) / D, X = r^2 D / (2 a b N).
+ * The integrands are smooth and even about 0 and pi/2 (one quarter of a periodic function), so the
+ * trapezoid rule with halved end nodes converges geometrically: the node count doubles (every new
+ * node midway between old ones) until P changes by at most 1e-15 (plus the sum's rounding,
+ * sqrt(nodes) ulps of P) and dP/dr by at most 1e-9 of itself (the root finder needs only the
+ * slope's direction and scale), looked at first with a node spacing at most sqrt(e), the width
+ * of the integrand's features. 1 - exp is taken as -expm1 so a
+ * small P keeps its relative accuracy. b below 1e-9 a: the 1-D |x| <= r (the y part adds < 1e-9 a).
+ */
+static double cdf_radius(double r, double a, double b, double *dens) {
+  *dens = 0.0;
+  if (!(r > 0.0)) return 0.0;
   if (a < b) {
     const double t = a;
     a = b;
     b = t;
   }
   if (!(a > 0.0)) return 1.0;
-  if (!(b > 0.0) || b < 1e-9 * a) return cdf_abs_normal(r, a);
-  /* |x| beyond 9 a carries < 1e-18: integrate u over [-U, U], r sin U = min(r, 9 a). */
-  const bool whole = !(9.0 * a < r);
-  const double umax = whole ? 0.5 * NAV_PI : asin(9.0 * a / r);
-  const int n = CDF_RADIUS_N;
-  const double h = 2.0 * umax / n;
-  double f[CDF_RADIUS_N + 1], us[CDF_RADIUS_N + 1];
-  for (int i = 0; i <= n; ++i) {
-    const double u = whole ? nodes->u[i] : -umax + h * i;
-    us[i] = u;
-    if (2 * i > n && us[n - i] == -u) {
-      f[i] = f[n - i];
-      continue;
-    }
-    double su, cu;
-    if (whole) {
-      su = nodes->s[i];
-      cu = nodes->c[i];
-    } else {
-      su = sin(u);
-      cu = cos(u);
-    }
-    const double x = r * su, c = r * cu;
-    const double e = c / (sqrt(2.0) * b);
-    const double ef = e >= ERF_ONE_FROM ? 1.0 : erf(e);
-    f[i] = exp(-0.5 * (x / a) * (x / a)) / (a * sqrt(2.0 * NAV_PI)) * ef * c;
+  if (!(b > 0.0) || b < 1e-9 * a) return cdf_abs_normal(r, a, dens);
+  const double e = b / a, se = sqrt(e);
+  const double w = (r / a) * (r / b) * 0.5; /* r^2 / (2 a b) */
+  const double quarter = 0.5 * NAV_PI;
+  int first = CDF_RADIUS_MIN_NODES;
+  while (first < CDF_RADIUS_MAX_NODES && quarter / first > se) first *= 2;
+  double sp = 0.0, sd = 0.0; /* sums over the nodes so far, end nodes halved */
+  for (int k = 0; k <= 1; ++k) {
+    const double th = quarter * k, c = cos(th), s = sin(th);
+    const double den = e * c * c + s * s, num = c * c + e * s * s;
+    const double x = w * den / num, jac = se / den;
+    sp += 0.5 * jac * -expm1(-x);
+    sd += 0.5 * jac * exp(-x) * den / num;
   }
-  double sum = 0.0;
-  for (int i = 0; i <= n; ++i)
-    sum += f[i] * ((i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0));
-  return fmin(1.0, sum * h / 3.0);
+  double p = 0.0, d = 0.0;
+  for (int n = 1; n < CDF_RADIUS_MAX_NODES; n *= 2) {
+    const double h = quarter / n;
+    for (int k = 0; k < n; ++k) { /* the new nodes, midway between the n + 1 old ones */
+      const double th = (k + 0.5) * h, c = cos(th), s = sin(th);
+      const double den = e * c * c + s * s, num = c * c + e * s * s;
+      const double x = w * den / num, jac = se / den;
+      sp += jac * -expm1(-x);
+      sd += jac * exp(-x) * den / num;
+    }
+    const double pn = sp * (0.5 * h) / quarter, dn = sd * (0.5 * h) / quarter;
+    /* The sum's own rounding grows like sqrt(nodes) ulps of P: a change below it is converged. */
+    const double ptol = 1e-15 + DBL_EPSILON * sqrt(2.0 * n) * pn;
+    const bool settled = 2 * n >= first && fabs(pn - p) <= ptol && fabs(dn - d) <= 1e-9 * dn;
+    p = pn;
+    d = dn;
+    if (settled) break;
+  }
+  *dens = d * (r / a) / b;
+  return fmin(1.0, fmax(0.0, p));
 }
 
 typedef struct pred_point {
@@ -826,42 +821,123 @@ typedef struct pred_point {
   bool radial; /* 2-D radius, else |1-D| */
 } pred_point;
 
-/*
- * Whether the mixture CDF at @p r, the mean of the points' CDFs summed in order, is >= @p q.
- * Every point's CDF lies in [0, 1] (cdf_radius is clamped to 1, erf <= 1; a NaN point makes the
- * mean NaN, i.e. "no"), so once the sum so far plus one for every point still to come stays
- * below q n with room for the rounding of the remaining additions (relative 2^-53 per addition,
- * bounded here by 1e-15 each), the answer is "no" whatever the remaining points give: the loop
- * stops there. Otherwise the whole sum decides, as it always did.
- */
-static bool mixture_cdf_at_least(const pred_point *p, size_t n, double r, double q, const radius_nodes *nodes) {
-  const double qn = q * (double)n * (1.0 - 1e-12);
-  double s = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    s += p[i].radial ? cdf_radius(r, p[i].a, p[i].b, nodes) : cdf_abs_normal(r, p[i].a);
-    if ((i & 63u) == 63u) {
-      const double rest = (double)(n - 1 - i);
-      if ((s + rest) * (1.0 + 1e-15 * (rest + 2.0)) < qn) return false;
-    }
-  }
-  return s / (double)n >= q;
+/* One point's CDF at @p r and its derivative (*dens). */
+static double point_cdf(const pred_point *p, double r, double *dens) {
+  return p->radial ? cdf_radius(r, p->a, p->b, dens) : cdf_abs_normal(r, p->a, dens);
 }
 
-/* Smallest r with mixture CDF >= q (bisection to 1e-9 relative). */
-static double mixture_quantile(const pred_point *p, size_t n, double q) {
-  double hi = 0.0;
-  for (size_t i = 0; i < n; ++i) hi = fmax(hi, p[i].radial ? hypot(p[i].a, p[i].b) : p[i].a);
-  if (!(hi > 0.0)) return 0.0;
-  radius_nodes nodes;
-  radius_nodes_init(&nodes);
-  hi *= 10.0; /* P(|x| > 10 sigma_max) < 1e-20 */
-  double lo = 0.0;
-  for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    if (mixture_cdf_at_least(p, n, mid, q, &nodes)) hi = mid;
-    else lo = mid;
+/*
+ * The points' CDFs and densities at one radius computed by helper threads: helper k fills
+ * cdf/dens[lo_k, hi_k) (a contiguous share of the points after the caller's own), which the
+ * caller reads after joining it and adds in point order: each value is the same pure function of
+ * (r, point), whoever computes it, so the sums are those of the one-thread loop.
+ */
+typedef struct mix_share {
+  const pred_point *p;
+  double r;
+  double *cdf, *dens;
+  size_t lo, hi;
+} mix_share;
+
+static int mix_share_run(void *arg) {
+  mix_share *s = arg;
+  for (size_t i = s->lo; i < s->hi; ++i) s->cdf[i] = point_cdf(&s->p[i], s->r, &s->dens[i]);
+  return 0;
+}
+
+/* Helper threads of mixture_quantile (at most NAV_REQ_MAX_THREADS - 1) and their value buffers. */
+#define NAV_REQ_MAX_THREADS 16
+typedef struct mix_pool {
+  int helpers;        /* 0: the one-thread loop */
+  double *cdf, *dens; /* n values each */
+  size_t own;         /* the caller computes points [0, own) itself */
+} mix_pool;
+
+/* The mixture CDF at @p r (the mean of the points' CDFs, summed in point order) and its
+ * derivative (*dens), with the helpers of @p pool (NULL: none). */
+static double mixture_cdf(const pred_point *p, size_t n, double r, const mix_pool *pool, double *dens) {
+  mix_share sh[NAV_REQ_MAX_THREADS];
+  nav_thread th[NAV_REQ_MAX_THREADS];
+  nav_thread_call calls[NAV_REQ_MAX_THREADS];
+  bool started[NAV_REQ_MAX_THREADS] = {false};
+  const int nh = pool ? pool->helpers : 0;
+  const size_t own = nh > 0 ? pool->own : n;
+  for (int k = 0; k < nh; ++k) {
+    const size_t rest = n - own;
+    sh[k] = (mix_share){p, r, pool->cdf, pool->dens, own + rest * (size_t)k / (size_t)nh,
+                        own + rest * (size_t)(k + 1) / (size_t)nh};
+    started[k] = nav_thread_start(&th[k], &calls[k], mix_share_run, &sh[k]);
+    if (!started[k]) mix_share_run(&sh[k]); /* a helper that could not start: its share here */
   }
-  return hi;
+  double s = 0.0, sd = 0.0;
+  for (size_t i = 0; i < own; ++i) {
+    double di;
+    s += point_cdf(&p[i], r, &di);
+    sd += di;
+  }
+  for (int k = 0; k < nh; ++k) {
+    if (started[k]) nav_thread_join(th[k]);
+    for (size_t i = sh[k].lo; i < sh[k].hi; ++i) {
+      s += pool->cdf[i];
+      sd += pool->dens[i];
+    }
+  }
+  *dens = sd / (double)n;
+  return s / (double)n;
+}
+
+/* Relative width of the quantile's last step or bracket. */
+#define MIX_QUANTILE_RTOL 1e-13
+
+/*
+ * r with mixture CDF F(r) = q: Newton's method on F(r) - q with the exact derivative, kept inside
+ * a bracket [lo, hi] with F(lo) < q <= F(hi) (from [0, 10 sigma_max]); a step that leaves the
+ * bracket, or a zero slope, bisects instead. Stops when the step or the bracket is within 1e-13
+ * of r (docs/estimate-cep.md). @p threads computing it (the same value for any count).
+ */
+static double mixture_quantile(const pred_point *p, size_t n, double q, int threads) {
+  double hi = 0.0, ms = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    hi = fmax(hi, p[i].radial ? hypot(p[i].a, p[i].b) : p[i].a);
+    ms += p[i].a * p[i].a + (p[i].radial ? p[i].b * p[i].b : 0.0);
+  }
+  if (!(hi > 0.0)) return 0.0;
+  mix_pool pool = {0, NULL, NULL, n};
+  if (threads > NAV_REQ_MAX_THREADS) threads = NAV_REQ_MAX_THREADS;
+  /* Helpers only where there is enough work to share (a few hundred points and more). */
+  if (threads > 1 && n >= 256u) {
+    pool.cdf = malloc(2 * n * sizeof *pool.cdf);
+    if (pool.cdf) {
+      pool.dens = pool.cdf + n;
+      pool.helpers = threads - 1;
+      pool.own = n / (size_t)threads;
+    }
+  }
+  const mix_pool *pp = pool.helpers > 0 ? &pool : NULL;
+  hi *= 10.0; /* P(|x| > 10 sigma_max) < 1e-20 */
+  const double hi0 = hi;
+  double lo = 0.0;
+  /* Start at the points' RMS radius (inside the bracket unless the input is NaN). */
+  double r = sqrt(ms / (double)n);
+  if (!(r > lo && r < hi)) r = 0.5 * (lo + hi);
+  for (int it = 0; it < 200; ++it) {
+    double dens;
+    const double f = mixture_cdf(p, n, r, pp, &dens) - q;
+    if (f != f) { /* a NaN point: F is never >= q, as the bisection had it: the bracket's top */
+      r = hi0;
+      break;
+    }
+    if (f >= 0.0) hi = r;
+    else lo = r;
+    if (f == 0.0 || hi - lo <= MIX_QUANTILE_RTOL * hi) break;
+    double next = dens > 0.0 ? r - f / dens : NAN;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const bool small = fabs(next - r) <= MIX_QUANTILE_RTOL * r;
+    r = next;
+    if (small) break;
+  }
+  free(pool.cdf);
+  return r;
 }
 
 /* E[metric^2] at one covariance epoch (NaN: not predicted). */
@@ -880,6 +956,12 @@ static double mean_square(nav_req_metric m, const nav_cov_point *c) {
 
 nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov_point *pts, size_t npts,
                            const nav_req_interval *outages, int n_outages, nav_requirement_verdict *out) {
+  return nav_req_predict_threads(reqs, count, pts, npts, outages, n_outages, 1, out);
+}
+
+nav_status nav_req_predict_threads(const nav_requirement *reqs, int count, const nav_cov_point *pts, size_t npts,
+                                   const nav_req_interval *outages, int n_outages, int threads,
+                                   nav_requirement_verdict *out) {
   if ((count > 0 && (!reqs || !out)) || (npts > 0 && !pts) || n_outages < 0 || (n_outages > 0 && !outages))
     return NAV_ERR_INVALID_ARG;
   if (nav_requirements_validate(reqs, count, NULL, NULL) != NAV_OK) return NAV_ERR_INVALID_ARG;
@@ -954,7 +1036,7 @@ nav_status nav_req_predict(const nav_requirement *reqs, int count, const nav_cov
                                                             : pts[j].att_sd_rad.z;
         pp[j].b = pts[j].pos_sd_n_m.y;
       }
-      value = mixture_quantile(pp, npts, quantile_percent(q->statistic) / 100.0);
+      value = mixture_quantile(pp, npts, quantile_percent(q->statistic) / 100.0, threads);
       samples = (long)npts;
     }
     v->samples = samples;
@@ -1029,15 +1111,24 @@ static nav_status predict_scene_begin(const nav_scene *scene, nav_requirement_ve
 
 nav_status nav_req_predict_scene_points(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
                                         nav_requirement_verdict *out) {
+  return nav_req_predict_scene_points_threads(scene, pts, npts, 1, out);
+}
+
+nav_status nav_req_predict_scene_points_threads(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
+                                                int threads, nav_requirement_verdict *out) {
   if (!nav_req_predict_scene_uses_sim_covariance(scene)) return NAV_ERR_INVALID_ARG;
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
   int ni = 0;
   const nav_status st = predict_scene_begin(scene, out, iv, &ni);
   if (st != NAV_OK) return st;
-  return nav_req_predict(scene->requirements, scene->n_requirements, pts, npts, iv, ni, out);
+  return nav_req_predict_threads(scene->requirements, scene->n_requirements, pts, npts, iv, ni, threads, out);
 }
 
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
+  return nav_req_predict_scene_threads(scene, 1, out);
+}
+
+nav_status nav_req_predict_scene_threads(const nav_scene *scene, int threads, nav_requirement_verdict *out) {
   /* gyro_free_gnss and ins_gnss_tight: their filters' covariance analysis (nav_sim_covariance). */
   const bool gfg = nav_req_predict_scene_uses_sim_covariance(scene);
   nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
@@ -1057,7 +1148,8 @@ nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict
     st = nav_budget_run(scene, false, keep_point, &b, NULL, NULL, 0);
   }
   if (b.failed) st = NAV_ERR_NO_MEMORY;
-  if (st == NAV_OK) st = nav_req_predict(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, out);
+  if (st == NAV_OK)
+    st = nav_req_predict_threads(scene->requirements, scene->n_requirements, b.p, b.n, iv, ni, threads, out);
   free(b.p);
   return st;
 }

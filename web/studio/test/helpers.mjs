@@ -30,9 +30,10 @@ export function missing() {
 
 // Start `navsim serve --port 0`; resolves with {url, stop(), output()} once the first stdout line
 // ("listening on http://HOST:PORT/") arrived.
-export function startServer() {
+// extra: more arguments of navsim serve (e.g. ['--config', FILE]).
+export function startServer(extra = []) {
   const dataDir = mkdtempSync(join(tmpdir(), 'navsim-serve-'));
-  const proc = spawn(env.navsim, ['serve', '--port', '0', '--data-dir', dataDir, '--studio-dir', env.studio],
+  const proc = spawn(env.navsim, ['serve', '--port', '0', '--data-dir', dataDir, '--studio-dir', env.studio, ...extra],
     { stdio: ['ignore', 'pipe', 'pipe'] });
   let out = '', err = '';
   proc.stderr.on('data', (d) => { err += d; });
