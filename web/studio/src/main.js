@@ -75,7 +75,12 @@ function status(msg) { $('status').textContent = msg; }
 
 // ---------------------------------------------------------------- change propagation
 let pendingCheck = null;
+// Every change of the scene counts here: an answer to a validate or estimate request sent for an
+// older scene is dropped, so it cannot overwrite the state of a newer one whose check is still
+// waiting for its debounce.
+let sceneGen = 0;
 function changed(source, structure = false) {
+  ++sceneGen;
   // A loaded scene is validated and estimated at once: the requests go out before the forms
   // and the map are built, which overlap the server's work.
   if (source === 'load') {
@@ -305,9 +310,10 @@ async function postRetrying(url, text) {
 }
 async function checkOnce() {
   const text = scene.text();
+  const gen = sceneGen;
   const t0 = performance.now();
   const v = await postRetrying('api/validate', text);
-  if (checkAgain) return;
+  if (checkAgain || gen !== sceneGen) return;
   const st = $('yaml-status');
   if (v.status === 200) {
     const warns = (v.json && Array.isArray(v.json.warnings)) ? v.json.warnings : [];
@@ -323,7 +329,7 @@ async function checkOnce() {
     return;
   }
   const e = await postRetrying('api/estimate', text);
-  if (checkAgain) return;
+  if (checkAgain || gen !== sceneGen) return;
   studio.timings.estimate_ms = performance.now() - t0;
   showEstimate(e);
 }
@@ -950,6 +956,8 @@ $('yaml').addEventListener('input', () => {
   try {
     scene.load($('yaml').value);
   } catch (err) {
+    ++sceneGen; // an answer still on its way is for the text before this edit
+    clearTimeout(pendingCheck);
     $('yaml-status').className = 'bad';
     $('yaml-status').textContent = `YAML: ${err.message}`;
     $('estimate').dataset.state = 'invalid';
