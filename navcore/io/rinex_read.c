@@ -1126,20 +1126,17 @@ static const nav_rinex_glo_eph *glo_eph_for(const nav_rinex_nav *nv, int slot, d
   return best;
 }
 
-/* Derivative of the GLONASS state [r, v] (PZ-90, rotating) under the ICD force model (ICD
- * GLONASS Edition 5.1, 2008, A.3.1.2: central body, J2 zonal term, centrifugal and Coriolis
- * terms) plus the record's constant luni-solar acceleration. */
+/* Derivative of the GLONASS state [r, v] (PZ-90, rotating): the ICD force model
+ * (nav_rinex_glo_force, the one the writer fits its records to) plus the record's constant
+ * luni-solar acceleration. */
 static void glo_deriv(const double x[6], nav_vec3 acc, double dx[6]) {
-  const double mu = 398600.4418e9, ae = 6378136.0, J2 = 1082625.75e-9, w = 7.292115e-5;
-  const double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2], r = sqrt(r2), r3 = r2 * r;
-  const double k = 1.5 * J2 * mu * ae * ae / (r3 * r2); /* 3/2 J2 mu ae^2 / r^5 */
-  const double z2 = x[2] * x[2] / r2;
+  const nav_vec3 a = nav_vec3_add(nav_rinex_glo_force(nav_vec3_make(x[0], x[1], x[2]), nav_vec3_make(x[3], x[4], x[5])), acc);
   dx[0] = x[3];
   dx[1] = x[4];
   dx[2] = x[5];
-  dx[3] = (-mu / r3 - k * (1.0 - 5.0 * z2)) * x[0] + w * w * x[0] + 2.0 * w * x[4] + acc.x;
-  dx[4] = (-mu / r3 - k * (1.0 - 5.0 * z2)) * x[1] + w * w * x[1] - 2.0 * w * x[3] + acc.y;
-  dx[5] = (-mu / r3 - k * (3.0 - 5.0 * z2)) * x[2] + acc.z;
+  dx[3] = a.x;
+  dx[4] = a.y;
+  dx[5] = a.z;
 }
 
 /* The satellite's ECEF state at @p t from its record: fourth-order Runge-Kutta from tb in steps

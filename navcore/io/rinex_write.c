@@ -127,7 +127,7 @@ double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s, bool wi
 /* ICD GLONASS Edition 5.1 (2008), A.3.1.2: the satellite's acceleration in the rotating PZ-90
  * frame from the central body, the J2 zonal term and the frame's rotation (centrifugal and
  * Coriolis); PZ-90 constants of section 3.1.3. */
-static nav_vec3 glo_force(nav_vec3 r, nav_vec3 v) {
+nav_vec3 nav_rinex_glo_force(nav_vec3 r, nav_vec3 v) {
   const double mu = 398600.4418e9, ae = 6378136.0, J2 = 1082625.75e-9, w = 7.292115e-5;
   const double r2 = nav_vec3_dot(r, r), rn = sqrt(r2), r3 = r2 * rn;
   const double a = 1.5 * J2 * mu * ae * ae / (r3 * r2); /* 3/2 J2 mu ae^2 / r^5 */
@@ -151,7 +151,7 @@ static nav_vec3 force_gap(const nav_gnss_orbit *o, double t) {
   nav_gnss_orbit_state(o, t + h, NULL, &vp);
   nav_gnss_orbit_state(o, t - h, NULL, &vm);
   const nav_vec3 a_true = nav_vec3_scale(nav_vec3_sub(vp, vm), 0.5 / h);
-  return nav_vec3_sub(a_true, glo_force(r, v));
+  return nav_vec3_sub(a_true, nav_rinex_glo_force(r, v));
 }
 
 nav_rinex_glo_eph nav_rinex_glo_eph_from_orbit(const nav_gnss_orbit *o, double tb_gps_s, int channel,

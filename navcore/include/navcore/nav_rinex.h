@@ -163,6 +163,13 @@ NAV_API nav_rinex_gps_eph nav_rinex_gps_eph_from_orbit(const nav_gnss_orbit *o, 
  *  af0 + af1 (t - toc) + af2 (t - toc)^2 + F e sqrt(A) sin E_k, minus TGD when @p with_tgd). */
 NAV_API double nav_rinex_gps_clock_s(const nav_rinex_gps_eph *e, double t_gps_s, bool with_tgd);
 
+/** The acceleration of a GLONASS satellite at ECEF position @p r_m [m] with velocity @p v_mps [m/s]
+ * in the rotating PZ-90 frame under the ICD force model (ICD GLONASS Edition 5.1, 2008, A.3.1.2:
+ * central body, J2 zonal term, centrifugal and Coriolis terms; PZ-90 constants of 3.1.3), without
+ * the luni-solar term a record carries [m/s^2]. The writer fits records to it and the reader
+ * integrates records with it. */
+NAV_API nav_vec3 nav_rinex_glo_force(nav_vec3 r_m, nav_vec3 v_mps);
+
 /**
  * The GLONASS record of @p o at tb = @p tb_gps_s: position and velocity from
  * nav_gnss_orbit_state(), and as acceleration term the difference between the orbit's true ECEF
