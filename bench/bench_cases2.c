@@ -96,6 +96,11 @@ const char *bench_navview_exe(void) {
   return nav_paths_program("navview", path, sizeof path) ? path : NULL;
 }
 
+double bench_log_field(const char *line, const char *key) {
+  const char *p = strstr(line, key);
+  return p ? atof(p + strlen(key)) : NAN;
+}
+
 bool bench_have_display(void) {
   const char *d = getenv("DISPLAY");
   return d && d[0];

@@ -50,6 +50,8 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
 /* navview of this build, or NULL; whether an X display is set. */
 const char *bench_navview_exe(void);
 bool bench_have_display(void);
+/* The number after @p key (e.g. " median=") in a child's log line; NAN when the key is absent. */
+double bench_log_field(const char *line, const char *key);
 int bench_make_dir(const char *path);
 bool bench_load_library_scene(const char *name, nav_scene *sc);
 

@@ -26,12 +26,6 @@ static const char *navstudio_exe(void) {
   return nav_paths_program("navstudio", path, sizeof path) ? path : NULL;
 }
 
-/* Value of "key=" in line (NAN when absent). */
-static double field(const char *line, const char *key) {
-  const char *p = strstr(line, key);
-  return p ? atof(p + strlen(key)) : NAN;
-}
-
 void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, int *n, int cap) {
   if (*n >= cap) return;
   bench_row *r = &rows[*n];
@@ -67,13 +61,13 @@ void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, 
   double samples = NAN, median = NAN, p90 = NAN, renders = NAN, frames = NAN, load = NAN, cpu = NAN;
   while (f && fgets(line, sizeof line, f)) {
     if (strncmp(line, "preview_latency_ms:", 19) != 0) continue;
-    samples = field(line, " samples=");
-    median = field(line, " median=");
-    p90 = field(line, " p90=");
-    renders = field(line, " renders_per_view_per_edit=");
-    frames = field(line, " frames_per_view_per_edit=");
-    load = field(line, " loadavg=");
-    cpu = field(line, " cpu_per_edit_ms=");
+    samples = bench_log_field(line, " samples=");
+    median = bench_log_field(line, " median=");
+    p90 = bench_log_field(line, " p90=");
+    renders = bench_log_field(line, " renders_per_view_per_edit=");
+    frames = bench_log_field(line, " frames_per_view_per_edit=");
+    load = bench_log_field(line, " loadavg=");
+    cpu = bench_log_field(line, " cpu_per_edit_ms=");
   }
   if (f) fclose(f);
   if (!c.exited_ok || !(median > 0)) {

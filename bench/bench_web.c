@@ -46,12 +46,6 @@ static bool find_in_path(const char *name, char *buf, size_t cap) {
   return false;
 }
 
-/* Value of "key=" in line (NAN when absent). */
-static double field(const char *line, const char *key) {
-  const char *p = strstr(line, key);
-  return p ? atof(p + strlen(key)) : NAN;
-}
-
 /* env value, else <exe dir>/rel; empty when neither exists. */
 static void locate(const char *env, const char *exe, const char *rel, char *buf, size_t cap) {
   const char *e = getenv(env);
@@ -135,21 +129,18 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
   FILE *f = fopen(log, "r");
   char line[1024];
   double count = NAN, median = NAN, p90 = NAN, before = NAN, est = NAN, prev = NAN, cmed = NAN, cest = NAN;
-  double sel = NAN, sprev = NAN, sest = NAN, load = NAN;
+  double load = NAN;
   while (f && fgets(line, sizeof line, f)) {
     if (strncmp(line, "first_picture_ms:", 17) != 0) continue;
-    count = field(line, " samples=");
-    median = field(line, " median=");
-    p90 = field(line, " p90=");
-    before = field(line, " before_scene_median=");
-    est = field(line, " estimate_median=");
-    prev = field(line, " preview_median=");
-    cmed = field(line, " cached_median=");
-    cest = field(line, " cached_estimate_median=");
-    sel = field(line, " select_median=");
-    sprev = field(line, " select_preview_median=");
-    sest = field(line, " select_estimate_median=");
-    load = field(line, " loadavg=");
+    count = bench_log_field(line, " samples=");
+    median = bench_log_field(line, " median=");
+    p90 = bench_log_field(line, " p90=");
+    before = bench_log_field(line, " before_scene_median=");
+    est = bench_log_field(line, " estimate_median=");
+    prev = bench_log_field(line, " preview_median=");
+    cmed = bench_log_field(line, " cached_median=");
+    cest = bench_log_field(line, " cached_estimate_median=");
+    load = bench_log_field(line, " loadavg=");
   }
   if (f) fclose(f);
   if (!c.exited_ok || !(median > 0)) {
@@ -162,9 +153,6 @@ void bench_case_web_first_picture(bool full, const char *out_dir, bench_row *row
   r->wall_s = median * 1e-3;
   r->load1 = load;
   /* The parts (the log has the whole line): page before the scene, validate + estimate, map. */
-  (void)sel;
-  (void)sprev;
-  (void)sest;
   snprintf(r->note, sizeof r->note,
            "fresh page, estimate computed: p90 %.0f ms; page %.0f, validate+estimate %.0f, map %.0f ms; "
            "answer cached: %.0f ms (estimate %.0f); load %.1f",
