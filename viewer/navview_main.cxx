@@ -12,6 +12,7 @@
 
 #include "navcore/nav_version.h"
 #include "navview/navview.h"
+#include "navview/nav_map_tiles.h"
 
 namespace {
 
@@ -40,6 +41,11 @@ void Usage(FILE *f) {
                "  --map               same as --view map\n"
                "  --map-span KM       map width [km] (default: fit the tracks); e.g. 4000 continent, 0.5 street\n"
                "  --map-center LAT,LON  map centre [deg] (default: the tracks' centre)\n"
+               "  --tiles SRC         map tile layer (streets at street scale) over the land/water fill:\n"
+               "                      FILE.mbtiles, a DIR of {z}/{x}/{y}.png tiles, a template\n"
+               "                      DIR/{z}/{x}/{y}.png, or http(s)://HOST/{z}/{x}/{y}.png (fetched, cached\n"
+               "                      in $NAVVIEW_TILE_CACHE or ~/.cache/navsim/tiles); zoom chosen by scale\n"
+               "  --tiles-attribution TEXT  credit shown for the tiles (default: the MBTiles attribution)\n"
                "  --movie DIR         playback movie: DIR/frame_NNNN.png over the run (fixed camera) and\n"
                "                      DIR/playback.ogv (Ogg Theora); --movie-frames N (120), --movie-fps F\n"
                "                      (24), --movie-no-video (PNG frames only)\n"
@@ -329,6 +335,11 @@ static int NavviewMain(int argc, char **argv) {
         bad(s.c_str());
       mopt.center_lat_deg = la;
       mopt.center_lon_deg = lo;
+    } else if (a == "--tiles") {
+      mopt.tiles = need("an MBTiles FILE, a tile DIR or template DIR/{z}/{x}/{y}.png, or a URL template");
+      if (mopt.tiles.empty()) bad("");
+    } else if (a == "--tiles-attribution") {
+      mopt.tiles_attribution = need("TEXT");
     } else if (a == "--movie") {
       const std::string m = need("DIR|FILE.mp4|FILE.webm");
       const bool video_file = (m.size() > 4 && m.compare(m.size() - 4, 4, ".mp4") == 0) ||
@@ -413,6 +424,19 @@ static int NavviewMain(int argc, char **argv) {
   mopt.show_text = opt.show_text;
   mopt.show_gnss = opt.show_gnss;
   mopt.multisamples = opt.multisamples;
+  // The tile source is checked before anything is drawn: a file that is not an MBTiles database,
+  // a missing directory or a template without {z}/{x}/{y} is a bad option (exit 2).
+  if (!mopt.tiles.empty()) {
+    std::shared_ptr<NavTileSource> tiles;
+    std::string terr;
+    if (!NavTileSourceOpen(mopt.tiles, &tiles, &terr)) {
+      std::fprintf(stderr, "navview: %s\n", terr.c_str());
+      return 2;
+    }
+  } else if (!mopt.tiles_attribution.empty()) {
+    std::fprintf(stderr, "navview: --tiles-attribution applies to --tiles only\n");
+    return 2;
+  }
   // Chart-only modes: no result directory.
   if (!tradeoff_req.empty() && tradeoff_csv.empty()) {
     std::fprintf(stderr, "navview: --requirement applies to --tradeoff only\n");
@@ -531,8 +555,15 @@ static int NavviewMain(int argc, char **argv) {
   int rc = 0;
   if (!png.empty() && view_kind != "3d") {
     bool ok = false;
-    if (view_kind == "map")
-      ok = NavRenderMapPng(*result, mopt, png, &err);
+    if (view_kind == "map") {
+      NavMapInfo minfo;
+      ok = NavRenderMapPng(*result, mopt, png, &err, &minfo);
+      // With a tile layer its notes (offline, unreadable tiles, not at this scale) also go to
+      // stderr: they are on the map, but a script should see them too.
+      if (ok && !mopt.tiles.empty())
+        for (const std::string &n : minfo.notes)
+          std::fprintf(stderr, "navview: warning: %s\n", n.c_str());
+    }
     else if (view_kind == "errors")
       ok = NavRenderErrorChartPng(*result, copt, png, &err);
     else

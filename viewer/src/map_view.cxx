@@ -6,6 +6,7 @@
 
 #include "navview_internal.h"
 #include "navview/nav_map_data.h"
+#include "navview/nav_map_tiles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -451,6 +452,30 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
   } else {
     info.notes.push_back(derr);
   }
+  // The user's tiles over the fill: every pixel centre taken back to lat/lon and resampled from
+  // the Web-Mercator tiles, so the streets sit where the azimuthal projection puts them.
+  if (!opt.tiles.empty()) {
+    std::shared_ptr<NavTileSource> tiles;
+    if (!NavTileSourceOpen(opt.tiles, &tiles, error)) return false;
+    double clat = pr.lat0, clon = pr.lon0;
+    pr.Inv(cx, cy, &clat, &clon);
+    NavTilePaint tp;
+    NavMapPaintTiles(*tiles,
+                     [&](double px, double py, double *lat_deg, double *lon_deg) {
+                       double x, y, la, lo;
+                       to_world(px, py, &x, &y);
+                       if (!pr.Inv(x, y, &la, &lo)) return false;
+                       *lat_deg = la / kD2R;
+                       *lon_deg = lo / kD2R;
+                       return true;
+                     },
+                     m_px, clat / kD2R, W, H, &img, &tp);
+    info.tile_zoom = tp.zoom;
+    info.tiles = tp.tiles;
+    info.tile_coverage = tp.coverage;
+    if (tp.tiles > 0) info.tile_credit = NavTileCredit(*tiles, opt.tiles_attribution);
+    info.notes.insert(info.notes.end(), tp.notes.begin(), tp.notes.end());
+  }
   {
     vtkNew<vtkImageData> im;
     im->SetDimensions(W, H, 1);
@@ -487,7 +512,9 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
     }
     return out;
   };
-  if (have_shore) {
+  // Tiles covering the whole view carry their own coasts and rivers: GSHHG's lines would only
+  // disagree with them by the difference of the two surveys.
+  if (have_shore && info.tile_coverage < 0.999) {
     // River classes: 0 double-lined, 1-4 permanent (major to minor), 5-10 intermittent, canals.
     const int river_max = m_px < 60.0 ? 5 : m_px < 600.0 ? 3 : m_px < 3000.0 ? 2 : 1;
     const double c_river[3] = {0.36, 0.58, 0.84}, c_border[3] = {0.52, 0.30, 0.50}, c_state[3] = {0.66, 0.55, 0.64};
@@ -714,10 +741,11 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
     std::string lt = "black: reference   red: estimate (run 0)";
     if (result.gnss.Size() > 0) lt += "   green dots: GNSS fixes";
     if (!result.gnss.outage_t0_s.empty()) lt += "   pink: GNSS outage";
-    if (have_shore) {
+    if (have_shore && info.tile_coverage < 0.999) {
       lt += std::string("\nGSHHG 2.3.7 (") + NavShoreResLetter(layers.res) +
             ") land, lakes, WDBII rivers and borders";
     }
+    if (!info.tile_credit.empty()) lt += "\n" + info.tile_credit;
     // GeoNames asks for credit (CC BY 4.0).
     if (places) lt += "\nplace names: GeoNames (CC BY 4.0)";
     for (const std::string &n : info.notes)

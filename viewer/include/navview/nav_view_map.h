@@ -36,6 +36,12 @@ struct NavMapOptions {
   std::string places_file;
   bool show_places = true;
   int multisamples = 8;
+  /** Optional raster tile layer (streets at street scale) drawn over the GSHHG fill and under
+   *  the lines, tracks and texts: an MBTiles file, an XYZ directory or template, or an XYZ URL
+   *  template (nav_map_tiles.h); empty: none. A source that cannot be opened fails the build. */
+  std::string tiles;
+  /** Credit for the tiles shown on the map; empty: the MBTiles metadata's attribution. */
+  std::string tiles_attribution;
 };
 
 /** A text placed on the map, as a box in display pixels (origin bottom left). */
@@ -53,6 +59,10 @@ struct NavMapInfo {
   double view_x_m = 0.0, view_y_m = 0.0;         /**< view centre in the projection [m] */
   char shore_res = 0;                            /**< GSHHG resolution letter (c l i h f), 0: none */
   int bins = 0;                                  /**< GSHHG bins read */
+  int tile_zoom = -1;                            /**< zoom of the tile layer drawn, -1: none */
+  int tiles = 0;                                 /**< tiles drawn */
+  double tile_coverage = 0.0;                    /**< fraction of the view painted from tiles */
+  std::string tile_credit;                       /**< the tiles' credit line ("" without tiles) */
   std::vector<NavMapLabel> labels;               /**< every text placed, place names first */
   std::vector<std::string> notes;                /**< missing data */
   double build_ms = 0.0;                         /**< time to build the layers (no render) */
