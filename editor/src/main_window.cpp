@@ -4,6 +4,12 @@
 #include "track_import.h"
 
 #include <QAction>
+#include <QMessageBox>
+#include <QDialog>
+#include <QPushButton>
+#include <QLineEdit>
+#include <QHBoxLayout>
+#include <QDialogButtonBox>
 #include <QApplication>
 #include <QCloseEvent>
 #include <QCryptographicHash>
@@ -32,6 +38,7 @@
 #include <QProgressDialog>
 #include <QVBoxLayout>
 
+#include "navview/nav_map_tiles.h"
 #include "navview/nav_view_map.h"
 #include "navview/nav_view_scene.h"
 
@@ -365,11 +372,82 @@ void MainWindow::BuildActions() {
   });
   view->addAction(reset);
 
+  // The map's tile layer (streets at street scale): a source and its credit, kept in QSettings.
+  QAction *tiles = act(tr("Map &tiles..."), "actionMapTiles", QKeySequence());
+  connect(tiles, &QAction::triggered, this, [this] { EditMapTiles(); });
+  view->addAction(tiles);
+  {
+    QSettings st;
+    const QString src = st.value("map/tiles").toString(), attr = st.value("map/tilesAttribution").toString();
+    QString err;
+    if (!src.isEmpty() && !SetMapTiles(src, attr, &err)) statusBar()->showMessage(err, 10000);
+  }
+
   tb->addActions({nw, open, save});
   tb->addSeparator();
   tb->addActions({undo, redo});
   tb->addSeparator();
   tb->addActions({run_act_, cancel_act_, preview_act_});
+}
+
+bool MainWindow::SetMapTiles(const QString &source, const QString &attribution, QString *error) {
+  if (!source.isEmpty()) {
+    std::shared_ptr<NavTileSource> src;
+    std::string err;
+    if (!NavTileSourceOpen(source.toStdString(), &src, &err)) {
+      if (error) *error = QString::fromStdString(err);
+      return false;
+    }
+  }
+  map_tiles_ = source;
+  map_tiles_attribution_ = source.isEmpty() ? QString() : attribution;
+  QSettings st;
+  st.setValue("map/tiles", map_tiles_);
+  st.setValue("map/tilesAttribution", map_tiles_attribution_);
+  map_->SetMapTiles(map_tiles_, map_tiles_attribution_);
+  return true;
+}
+
+void MainWindow::EditMapTiles() {
+  QDialog d(this);
+  d.setObjectName("mapTilesDialog");
+  d.setWindowTitle(tr("Map tiles"));
+  auto *lay = new QVBoxLayout(&d);
+  auto *help = new QLabel(tr("Streets at street scale from raster tiles in the Web-Mercator tiling: an MBTiles "
+                             "file, a directory of {z}/{x}/{y}.png tiles (or a template DIR/{z}/{x}/{y}.png), or "
+                             "a URL template https://HOST/{z}/{x}/{y}.png where you have a network and the "
+                             "server's permission. Empty: no tiles."),
+                          &d);
+  help->setWordWrap(true);
+  lay->addWidget(help);
+  auto *row = new QHBoxLayout;
+  auto *src = new QLineEdit(map_tiles_, &d);
+  src->setObjectName("mapTilesSource");
+  auto *browse = new QPushButton(tr("&File..."), &d);
+  row->addWidget(src, 1);
+  row->addWidget(browse);
+  lay->addLayout(row);
+  connect(browse, &QPushButton::clicked, &d, [&] {
+    const QString f = QFileDialog::getOpenFileName(&d, tr("MBTiles file"), DialogPath("tiles"),
+                                                   tr("MBTiles (*.mbtiles);;All files (*)"));
+    if (!f.isEmpty()) src->setText(f);
+  });
+  lay->addWidget(new QLabel(tr("Attribution shown on the map (default: the MBTiles file's own):"), &d));
+  auto *attr = new QLineEdit(map_tiles_attribution_, &d);
+  attr->setObjectName("mapTilesAttribution");
+  lay->addWidget(attr);
+  auto *buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, &d);
+  lay->addWidget(buttons);
+  connect(buttons, &QDialogButtonBox::rejected, &d, &QDialog::reject);
+  connect(buttons, &QDialogButtonBox::accepted, &d, [&] {
+    QString err;
+    if (SetMapTiles(src->text().trimmed(), attr->text().trimmed(), &err)) {
+      d.accept();
+      return;
+    }
+    QMessageBox::warning(&d, tr("Map tiles"), err); // the dialog stays open with what was typed
+  });
+  d.exec();
 }
 
 bool MainWindow::StartTradeoff(const QString &out_dir, int runs, QString *error) {
@@ -1073,6 +1151,8 @@ bool MainWindow::ExportPicture(const QString &path, const QString &view, int wid
     NavMapOptions mo;
     mo.width_px = width;
     mo.height_px = height;
+    mo.tiles = map_tiles_.toStdString();
+    mo.tiles_attribution = map_tiles_attribution_.toStdString();
     ok = NavRenderMapPng(*res, mo, path.toStdString(), &err);
   } else {
     NavSceneView pic;

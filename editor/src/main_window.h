@@ -119,6 +119,13 @@ public:
   void SetLiveFrameHoldMs(int ms) { frame_hold_ms_ = ms; }
   SceneDocument *Doc() { return &doc_; }
   PathView *MapView() { return map_; }
+  /** The map's tile layer (View > Map tiles...): checked (an unusable source is refused with the
+   *  reason in @p error and nothing changes), remembered in QSettings (map/tiles,
+   *  map/tilesAttribution), used by the map view and the exported map picture. Empty: none. */
+  bool SetMapTiles(const QString &source, const QString &attribution, QString *error);
+  QString MapTiles() const { return map_tiles_; }
+  /** View > Map tiles...: the dialog (source, attribution). */
+  void EditMapTiles();
   PathView *View3D() { return view3d_; }
   ProfileChart *Profile() { return profile_; }
   ScenePanels *Panels() { return panels_; }
@@ -158,6 +165,7 @@ protected:
   bool event(QEvent *e) override;
 
 private:
+  QString map_tiles_, map_tiles_attribution_;
   void BuildUi();
   void BuildActions();
   bool MaybeSave();

@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <sys/stat.h>
 
 #include "navview/nav_map_data.h"
+#include "navview/nav_map_tiles.h"
 #include "navview/nav_view_map.h"
 
 extern "C" {
@@ -132,7 +134,7 @@ std::string MapDataDir() {
 }
 
 void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
-                        int w_px, int h_px) {
+                        int w_px, int h_px, const MapTiles *tiles) {
   *out = MapBackground();
   const nav_frame fr = nav_frame_from_scene(&s);
   // The lat/lon box of the rectangle (its boundary and inside, sampled), longitudes relative to the
@@ -184,6 +186,39 @@ void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, dou
       out->land_w = w_px;
       out->land_h = h_px;
       out->shore_res = NavShoreResLetter(layers.res);
+    }
+  }
+  // The user's tiles over the fill: each pixel centre taken back to lat/lon through the scene's
+  // frame and resampled from the Web-Mercator tiles.
+  if (tiles && !tiles->source.empty() && w_px > 0 && h_px > 0) {
+    std::shared_ptr<NavTileSource> src;
+    std::string err;
+    if (!NavTileSourceOpen(tiles->source, &src, &err)) {
+      out->note = QString::fromStdString(err);
+    } else {
+      if (out->land_rgb.size() != 3 * static_cast<size_t>(w_px) * static_cast<size_t>(h_px)) {
+        // No GSHHG fill: the tiles go over the plain land colour.
+        out->land_rgb.assign(3 * static_cast<size_t>(w_px) * static_cast<size_t>(h_px), 0);
+        for (size_t i = 0; i < out->land_rgb.size(); i += 3)
+          std::copy(kNavMapLandRgb, kNavMapLandRgb + 3, out->land_rgb.begin() + static_cast<std::ptrdiff_t>(i));
+        out->land_w = w_px;
+        out->land_h = h_px;
+      }
+      NavTilePaint tp;
+      NavMapPaintTiles(*src,
+                       [&](double px, double py, double *lat_deg, double *lon_deg) {
+                         const double x = x0 + px / w_px * (x1 - x0), y = y0 + py / h_px * (y1 - y0);
+                         const nav_geodetic g = nav_frame_local_to_geodetic(&fr, nav_vec3{y, x, 0.0});
+                         *lat_deg = g.lat_rad / kD2R;
+                         *lon_deg = g.lon_rad / kD2R;
+                         return true;
+                       },
+                       (x1 - x0) / w_px, c.lat_rad / kD2R, w_px, h_px, &out->land_rgb, &tp);
+      out->tile_zoom = tp.zoom;
+      out->tile_coverage = tp.coverage;
+      if (tp.tiles > 0) out->tile_credit = QString::fromStdString(NavTileCredit(*src, tiles->attribution));
+      for (const std::string &n : tp.notes)
+        out->note += (out->note.isEmpty() ? "" : "; ") + QString::fromStdString(n);
     }
   }
   if (gshhg && span > kCoastSpanM) {

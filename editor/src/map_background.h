@@ -37,6 +37,17 @@ struct MapBackground {
   std::vector<MapLabel> labels;
   double lat_step_deg = 0.0, lon_step_deg = 0.0;
   QString note; /**< "" or why there is no coastline (data missing) */
+  /** The user's tile layer, painted into land_rgb over the GSHHG fill: its credit line ("" when
+   *  no tile was drawn), the zoom used (-1: none) and the share of the view it covers. */
+  QString tile_credit;
+  int tile_zoom = -1;
+  double tile_coverage = 0.0;
+};
+
+/** The map's optional tile layer (nav_map_tiles.h): an MBTiles file, an XYZ directory or
+ *  template, or an XYZ URL template; @c attribution overrides the source's own credit. */
+struct MapTiles {
+  std::string source, attribution;
 };
 
 /** Views narrower than this [m] are "street scale": the local metric grid, no graticule. */
@@ -51,9 +62,11 @@ std::string MapDataDir();
  *  the local rectangle [x0, x1] x [y0, y1] (East, North [m]) of the scene @p s. With a pixel size
  *  (@p w_px, @p h_px > 0) also land and water at every scale, from GSHHG at the resolution of the
  *  scale (navview's map data, nav_map_data.h), and rivers and borders above kCoastSpanM; the
- *  coastlines then come from GSHHG too (python-cartopy-data only when GSHHG is missing). */
+ *  coastlines then come from GSHHG too (python-cartopy-data only when GSHHG is missing). With
+ *  @p tiles (and a pixel size) the tiles are resampled into the same image, over the fill; a
+ *  source that cannot be opened leaves the fill and says why in the note. */
 void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
-                        int w_px = 0, int h_px = 0);
+                        int w_px = 0, int h_px = 0, const MapTiles *tiles = nullptr);
 
 } // namespace studio
 

@@ -1010,6 +1010,7 @@ void PathView::UpdateCaption() {
   if (wp) facts << tr("%1 waypoints").arg(count);
   if (path_.Size() > 0) facts << tr("%1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
   if (mode_ == Mode::Map && !bg_note_.isEmpty()) facts << bg_note_;
+  if (mode_ == Mode::Map && !tile_credit_.isEmpty()) facts << tile_credit_;
   QString hint;
   if (mode_ == Mode::Map && !wp)
     hint = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type));
@@ -1086,6 +1087,16 @@ long PathView::LandColourAt(double e, double n) const {
   return (long(p[0]) << 16) | (long(p[1]) << 8) | long(p[2]);
 }
 
+void PathView::SetMapTiles(const QString &source, const QString &attribution) {
+  tiles_source_ = source.toStdString();
+  tiles_attribution_ = attribution.toStdString();
+  if (mode_ != Mode::Map) return;
+  bg_key_[3] = -1.0; // force the rebuild
+  UpdateBackground();
+  UpdateCaption();
+  Render();
+}
+
 bool PathView::MetricGridShown() const { return grid_->GetVisibility() != 0; }
 
 void PathView::UpdateBackground() {
@@ -1102,8 +1113,11 @@ void PathView::UpdateBackground() {
   const double half_h = key[2], half_w = half_h * w / h, cx = f[0], cy = f[1];
   const double span = 2.0 * std::max(half_w, half_h);
   MapBackground bg;
+  const MapTiles tiles{tiles_source_, tiles_attribution_};
   BuildMapBackground(doc_->Scene(), cx - half_w, cy - half_h, cx + half_w, cy + half_h, &bg, static_cast<int>(w),
-                     static_cast<int>(h));
+                     static_cast<int>(h), tiles_source_.empty() ? nullptr : &tiles);
+  tile_credit_ = bg.tile_credit;
+  tile_zoom_ = bg.tile_zoom;
   coast_count_ = SetXyPolylines(InputOf(coast_), bg.coast, -0.06);
   SetXyPolylines(InputOf(rivers_), bg.rivers, -0.065);
   SetXyPolylines(InputOf(borders_), bg.borders, -0.062);

@@ -131,6 +131,13 @@ public:
   /** The land/water fill's colour at local East/North (@p e, @p n) [m] as 0xRRGGBB; -1 when no
    *  fill is shown or the point is outside the view. */
   long LandColourAt(double e, double n) const;
+  /** Map view: the tile layer drawn over the land/water fill (View > Map tiles...; an MBTiles
+   *  file, an XYZ directory or template, or a URL template; empty source: none). Rebuilds the
+   *  background. */
+  void SetMapTiles(const QString &source, const QString &attribution);
+  /** The tile layer's credit shown in the caption ("" when no tile is drawn) and its zoom (-1). */
+  QString MapTilesCredit() const { return tile_credit_; }
+  int MapTileZoom() const { return tile_zoom_; }
   size_t GraticuleCount() const { return graticule_count_; }
   QStringList GraticuleLabels() const;
   bool MetricGridShown() const;
@@ -216,6 +223,9 @@ private:
   bool street_ = true;
   size_t coast_count_ = 0, graticule_count_ = 0;
   QString bg_note_;
+  std::string tiles_source_, tiles_attribution_;
+  QString tile_credit_;
+  int tile_zoom_ = -1;
   double graticule_step_deg_ = 0.0;
   long render_count_ = 0, frame_count_ = 0, swapped_render_count_ = 0;
   int resized_ = 0; // frames to swap after a resize before the one more render (constructor)
