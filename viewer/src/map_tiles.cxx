@@ -587,15 +587,48 @@ void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, dou
     }
     return *(last = &tiles.emplace(std::make_pair(tx, ty), std::move(im)).first->second);
   };
+  // Web-Mercator position, in tiles from the north-west corner of the world at zoom z, of a
+  // display position; false off the Earth or beyond the Mercator latitudes.
+  auto mercator = [&](double px, double py, double *fx, double *fy) {
+    double la, lo;
+    if (!from_pixel(px, py, &la, &lo) || !std::isfinite(la) || !std::isfinite(lo)) return false;
+    if (std::fabs(la) > kMercMaxLat) return false;
+    *fx = (std::remainder(lo, 360.0) + 180.0) / 360.0 * n;
+    *fy = (1.0 - std::asinh(std::tan(la * kPi / 180.0)) / kPi) * 0.5 * n;
+    return true;
+  };
+  // The exact mapping at the pixel centres of a grid every kCell pixels, bilinear in between:
+  // the mapping bends on the scale of the Earth's radius, so over kCell pixels the interpolation
+  // is off by about kCell^2 / 8 / (R / m_per_px) pixels (0.02 px for a view 4000 km across,
+  // nothing at street scale), and it saves the inverse projection of every pixel (measured on a
+  // 1280 x 800 map 1.5 km across: the tile layer cost 0.23 s of CPU projecting every pixel,
+  // 0.06 s with this grid). A cell with a corner off the Earth or across the date line is
+  // mapped pixel by pixel.
+  constexpr int kCell = 16;
+  const int gw = w / kCell + 2, gh = h / kCell + 2;
+  std::vector<double> gfx(static_cast<size_t>(gw) * gh), gfy(gfx.size());
+  std::vector<char> gok(gfx.size());
+  for (int gj = 0; gj < gh; ++gj)
+    for (int gi = 0; gi < gw; ++gi) {
+      const size_t k = static_cast<size_t>(gj) * gw + gi;
+      gok[k] = mercator(gi * kCell + 0.5, gj * kCell + 0.5, &gfx[k], &gfy[k]);
+    }
   size_t painted = 0;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      double la, lo;
-      if (!from_pixel(i + 0.5, j + 0.5, &la, &lo) || !std::isfinite(la) || !std::isfinite(lo)) continue;
-      if (std::fabs(la) > kMercMaxLat) continue;
-      // Web-Mercator, in tiles from the north-west corner of the world at zoom z.
-      const double fx = (std::remainder(lo, 360.0) + 180.0) / 360.0 * n;
-      const double fy = (1.0 - std::asinh(std::tan(la * kPi / 180.0)) / kPi) * 0.5 * n;
+      const int gi = i / kCell, gj = j / kCell;
+      const size_t k00 = static_cast<size_t>(gj) * gw + gi, k10 = k00 + 1, k01 = k00 + gw, k11 = k01 + 1;
+      double fx, fy;
+      const bool cell = gok[k00] && gok[k10] && gok[k01] && gok[k11] &&
+                        std::max({gfx[k00], gfx[k10], gfx[k01], gfx[k11]}) -
+                                std::min({gfx[k00], gfx[k10], gfx[k01], gfx[k11]}) < 0.5 * n;
+      if (cell) {
+        const double a = static_cast<double>(i - gi * kCell) / kCell, b = static_cast<double>(j - gj * kCell) / kCell;
+        fx = (1 - b) * ((1 - a) * gfx[k00] + a * gfx[k10]) + b * ((1 - a) * gfx[k01] + a * gfx[k11]);
+        fy = (1 - b) * ((1 - a) * gfy[k00] + a * gfy[k10]) + b * ((1 - a) * gfy[k01] + a * gfy[k11]);
+      } else if (!mercator(i + 0.5, j + 0.5, &fx, &fy)) {
+        continue;
+      }
       int tx = static_cast<int>(std::floor(fx)), ty = static_cast<int>(std::floor(fy));
       if (ty < 0 || ty >= static_cast<int>(n)) continue;
       tx = ((tx % static_cast<int>(n)) + static_cast<int>(n)) % static_cast<int>(n);
