@@ -369,6 +369,56 @@ void test_damaged_tile(void **) {
   assert_true(GshhgLandAt(im, info, qlat, qlon));
 }
 
+void test_antimeridian_and_poles(void **) {
+  // The four tiles of zoom 1 (x 0: west, 1: east; y 0: north, 1: south) and a made-up view
+  // 200 x 100 px in plate carree from 170 E across the date line to 170 W and from 89 N to
+  // 79 N: west of 180 the pixels show the eastern tiles, east of it the western ones; beyond
+  // Web-Mercator's 85.05 N nothing is painted (the background stays).
+  const std::string d = OutDir() + "/tiles_world";
+  for (int x = 0; x < 2; ++x)
+    for (int y = 0; y < 2; ++y) {
+      const std::string dir = d + "/1/" + std::to_string(x);
+      tilefix::MkDirs(dir);
+      const std::vector<unsigned char> png = tilefix::TilePng(1, x, y);
+      std::ofstream(dir + "/" + std::to_string(y) + ".png", std::ios::binary)
+          .write(reinterpret_cast<const char *>(png.data()), static_cast<std::streamsize>(png.size()));
+    }
+  std::shared_ptr<NavTileSource> src;
+  std::string err;
+  if (!NavTileSourceOpen(d, &src, &err)) fail_msg("%s", err.c_str());
+  assert_int_equal(src->MinZoom(), 1);
+  assert_int_equal(src->MaxZoom(), 1);
+  const int w = 200, h = 100;
+  std::vector<unsigned char> rgb(3 * w * h, 7);
+  NavTilePaint tp;
+  // m_per_px chosen so that the zoom is 1: 2 pi a cos(80 deg) / (256 x 2^1) = 13.7 km.
+  NavMapPaintTiles(*src,
+                   [&](double px, double py, double *lat, double *lon) {
+                     *lon = 170.0 + 20.0 * px / w; // 170 .. 190 (= 170 W)
+                     *lat = 79.0 + 10.0 * py / h;  // 79 .. 89 N
+                     return true;
+                   },
+                   13.7e3, 80.0, w, h, &rgb, &tp);
+  assert_int_equal(tp.zoom, 1);
+  auto at = [&](int i, int j) { return &rgb[3 * (static_cast<size_t>(j) * w + i)]; };
+  unsigned char east[3], west[3];
+  tilefix::TileRgb(1, 1, 0, east);
+  tilefix::TileRgb(1, 0, 0, west);
+  for (int j : {5, 30, 55}) { // 79.5, 82, 84.5 N
+    for (int i : {10, 90}) // 171, 179 E
+      assert_memory_equal(at(i, j), east, 3);
+    for (int i : {110, 190}) // 179 W, 171 W
+      assert_memory_equal(at(i, j), west, 3);
+  }
+  for (int j : {65, 95}) // 85.5, 88.5 N: beyond Web-Mercator
+    for (int i : {10, 110, 190}) {
+      const unsigned char bg[3] = {7, 7, 7};
+      assert_memory_equal(at(i, j), bg, 3);
+    }
+  std::printf("  date line and pole: %d tiles, %.1f %% painted\n", tp.tiles, 100.0 * tp.coverage);
+  assert_int_equal(tp.tiles, 2);
+}
+
 } // namespace
 
 int main(void) {
@@ -376,6 +426,7 @@ int main(void) {
       cmocka_unit_test(test_street_scale_mbtiles), cmocka_unit_test(test_xyz_directory_same_picture),
       cmocka_unit_test(test_zoom_follows_scale),   cmocka_unit_test(test_fallback_beyond_tiles),
       cmocka_unit_test(test_open_errors),          cmocka_unit_test(test_damaged_tile),
+      cmocka_unit_test(test_antimeridian_and_poles),
   };
   return cmocka_run_group_tests(tests, Setup, nullptr);
 }
