@@ -44,6 +44,7 @@ constexpr double kMercMaxLat = 85.05112877980659;
 constexpr int kUrlMaxZoom = 19;
 constexpr size_t kKeepDecoded = 160; // decoded tiles kept per source (~30 MB of 256 x 256 RGBA)
 constexpr long kCacheFreshS = 7L * 24 * 3600;
+constexpr long kOfflineRetryS = 60;
 
 bool IsDir(const std::string &p) {
   struct stat st;
@@ -207,6 +208,7 @@ struct NavTileSource::Impl {
   sqlite3_stmt *get = nullptr;
   CURL *curl = nullptr;
   std::string cache_dir, offline;
+  time_t offline_since = 0;
   std::mutex mu;
   // Most recently used decoded tiles; a missing tile is kept as an empty image.
   std::list<std::tuple<int, int, int>> lru;
@@ -396,6 +398,9 @@ struct NavTileSource::Impl {
     const std::string cached = cache_dir + "/" + std::to_string(z) + "/" + std::to_string(x) + "/" + std::to_string(y) + ext;
     time_t mtime = 0;
     const bool have_cache = IsFile(cached, &mtime);
+    // A long-lived process (navstudio, an interactive map) asks the server again a minute after
+    // it was found unreachable.
+    if (!offline.empty() && std::time(nullptr) - offline_since > kOfflineRetryS) offline.clear();
     if (have_cache && (!offline.empty() || std::time(nullptr) - mtime < kCacheFreshS)) {
       if (!ReadFile(cached, data)) data->clear();
       return true;
@@ -423,6 +428,7 @@ struct NavTileSource::Impl {
           cc == CURLE_COULDNT_RESOLVE_PROXY || cc == CURLE_SEND_ERROR || cc == CURLE_RECV_ERROR ||
           cc == CURLE_GOT_NOTHING || cc == CURLE_SSL_CONNECT_ERROR) {
         // Unreachable: do not wait a timeout per tile; use what the cache holds from now on.
+        offline_since = std::time(nullptr);
         offline = std::string("tiles: cannot reach the tile server (") + (errbuf[0] ? errbuf : curl_easy_strerror(cc)) +
                   "): offline? only cached tiles are drawn";
         if (have_cache && !ReadFile(cached, data)) data->clear();

@@ -15,7 +15,7 @@
  *  - `http://HOST/.../{z}/{x}/{y}.png` or `https://...`: fetched with libcurl, kept in a disk cache
  *    ($NAVVIEW_TILE_CACHE, else $XDG_CACHE_HOME/navsim/tiles, else ~/.cache/navsim/tiles; a cached
  *    tile younger than 7 days is used without asking the server), zoom 0 to 19. When the server
- *    cannot be reached the layer keeps to the cached tiles and says so in a note.
+ *    cannot be reached the layer keeps to the cached tiles for a minute and says so in a note.
  *
  * Thread-safety: a source serialises its own calls with a mutex; the process keeps one source
  * per spec (NavTileSourceOpen), with its most recently used decoded tiles.
