@@ -171,6 +171,16 @@ public:
       vtkInteractorStyleTrackballCamera::OnLeftButtonUp();
     if (was_down && !moved_) view->OnClick(px_, py_, ctrl_);
   }
+  // The map zooms about the pointer (the point under it stays under it), 1.25x a wheel step;
+  // the 3D view keeps the trackball's dolly.
+  void OnMouseWheelForward() override {
+    const int *p = GetInteractor()->GetEventPosition();
+    if (!map || !view->ZoomMapAt(p[0], p[1], 1.25)) vtkInteractorStyleTrackballCamera::OnMouseWheelForward();
+  }
+  void OnMouseWheelBackward() override {
+    const int *p = GetInteractor()->GetEventPosition();
+    if (!map || !view->ZoomMapAt(p[0], p[1], 1.0 / 1.25)) vtkInteractorStyleTrackballCamera::OnMouseWheelBackward();
+  }
   void OnKeyPress() override {
     const char *sym = GetInteractor()->GetKeySym();
     if (sym && (std::strcmp(sym, "Delete") == 0 || std::strcmp(sym, "BackSpace") == 0)) view->OnDeleteKey();
@@ -1085,6 +1095,25 @@ long PathView::LandColourAt(double e, double n) const {
   if (x < 0 || y < 0 || x >= d[0] || y >= d[1]) return -1;
   const auto *p = static_cast<const unsigned char *>(land_image_->GetScalarPointer(x, y, 0));
   return (long(p[0]) << 16) | (long(p[1]) << 8) | long(p[2]);
+}
+
+bool PathView::ZoomMapAt(int x, int y, double factor) {
+  if (mode_ != Mode::Map || !(factor > 0.0)) return false;
+  double n = 0.0, e = 0.0;
+  if (!GroundAt(x, y, 0.0, &n, &e)) return false;
+  vtkCamera *cam = renderer_->GetActiveCamera();
+  const double s0 = cam->GetParallelScale();
+  // Between 5 m and 20 000 km from the centre to the top edge.
+  const double s = std::clamp(s0 / factor, 5.0, 2.0e7);
+  const double k = s / s0; // the focal point moves towards the pointed point by 1 - k
+  const double *f = cam->GetFocalPoint(), *p = cam->GetPosition();
+  const double fx = e + (f[0] - e) * k, fy = n + (f[1] - n) * k;
+  cam->SetFocalPoint(fx, fy, f[2]);
+  cam->SetPosition(fx, fy, std::max(p[2] - f[2], 10.0 * s + 1000.0) + f[2]);
+  cam->SetParallelScale(s);
+  renderer_->ResetCameraClippingRange();
+  Render();
+  return true;
 }
 
 void PathView::SetMapTiles(const QString &source, const QString &attribution) {

@@ -131,6 +131,10 @@ public:
   /** The land/water fill's colour at local East/North (@p e, @p n) [m] as 0xRRGGBB; -1 when no
    *  fill is shown or the point is outside the view. */
   long LandColourAt(double e, double n) const;
+  /** Map view: zoom by @p factor (> 1: in) about VTK display point @p x, @p y (origin bottom
+   *  left), which keeps showing the same ground point (the mouse wheel, 1.25 a step). false in
+   *  the 3D view or off the ground. */
+  bool ZoomMapAt(int x, int y, double factor);
   /** Map view: the tile layer drawn over the land/water fill (View > Map tiles...; an MBTiles
    *  file, an XYZ directory or template, or a URL template; empty source: none). Rebuilds the
    *  background. */

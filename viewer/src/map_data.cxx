@@ -548,3 +548,63 @@ bool NavMapLoadPlaces(const std::string &path, const std::vector<NavPlace> **pla
   cache[path] = std::move(v);
   return true;
 }
+
+std::vector<NavMapPlaceLabel> NavMapChoosePlaces(const std::vector<NavPlace> &places,
+                                                 const std::function<bool(double lat_deg, double lon_deg)> &may_show,
+                                                 const NavMapToPixel &to_pixel, int w, int h, int font_pt,
+                                                 const NavMapTextSize &text_size,
+                                                 std::vector<std::array<double, 4>> taken) {
+  std::vector<NavMapPlaceLabel> out;
+  const size_t max_labels = std::clamp<size_t>(static_cast<size_t>(w) * static_cast<size_t>(h) / 30000, 3, 40);
+  auto hits = [](const std::array<double, 4> &a, const std::array<double, 4> &b) {
+    return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+  };
+  std::vector<std::array<double, 4>> dot_boxes;
+  size_t looked = 0;
+  for (const NavPlace &p : places) {
+    if (out.size() >= max_labels || looked > 20000) break;
+    if (may_show && !may_show(p.lat_deg, p.lon_deg)) continue;
+    double px, py;
+    if (!to_pixel(p.lat_deg, p.lon_deg, &px, &py)) continue;
+    if (px < 4 || py < 4 || px > w - 4 || py > h - 4) continue;
+    ++looked;
+    const int size = p.population >= 1000000 ? font_pt : p.population >= 100000 ? font_pt - 1 : font_pt - 2;
+    const bool bold = p.capital || p.population >= 1000000;
+    const std::array<double, 4> dot{px - 3, py - 3, px + 3, py + 3};
+    bool dot_free = true;
+    for (const auto &o : taken)
+      dot_free = dot_free && !hits(o, dot);
+    if (!dot_free) continue;
+    double tw, th;
+    text_size(p.name, size, bold, &tw, &th);
+    const std::array<double, 4> cand[4] = {{px + 5, py - 0.5 * th, px + 5 + tw, py + 0.5 * th},
+                                           {px - 5 - tw, py - 0.5 * th, px - 5, py + 0.5 * th},
+                                           {px - 0.5 * tw, py + 4, px + 0.5 * tw, py + 4 + th},
+                                           {px - 0.5 * tw, py - 4 - th, px + 0.5 * tw, py - 4}};
+    for (const auto &b : cand) {
+      if (b[0] < 2 || b[1] < 2 || b[2] > w - 2 || b[3] > h - 2) continue;
+      const std::array<double, 4> pad{b[0] - 3, b[1] - 2, b[2] + 3, b[3] + 2};
+      bool clash = false;
+      for (const auto &o : taken)
+        clash = clash || hits(o, pad);
+      for (const auto &o : dot_boxes)
+        clash = clash || hits(o, pad);
+      if (clash) continue;
+      NavMapPlaceLabel l;
+      l.place = &p;
+      l.dot_x = px;
+      l.dot_y = py;
+      l.x0 = b[0];
+      l.y0 = b[1];
+      l.x1 = b[2];
+      l.y1 = b[3];
+      l.size_pt = size;
+      l.bold = bold;
+      out.push_back(l);
+      taken.push_back(b);
+      dot_boxes.push_back(dot);
+      break;
+    }
+  }
+  return out;
+}

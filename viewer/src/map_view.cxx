@@ -9,6 +9,7 @@
 #include "navview/nav_map_tiles.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -799,58 +800,48 @@ bool NavBuildMapView(const NavResult &result, const NavMapOptions &opt, const Na
   // Place names: the most populous places in view first, each with a dot, its name right of the
   // dot (else left, above, below), never over another text; at most one label per ~30 000 px^2.
   if (places) {
-    const size_t max_labels = std::clamp<size_t>(static_cast<size_t>(W) * H / 30000, 3, 40);
     const double c_place[3] = {0.10, 0.10, 0.14};
+    std::vector<std::array<double, 4>> boxes;
+    for (const Box &o : taken)
+      boxes.push_back({o.x0, o.y0, o.x1, o.y1});
+    const std::vector<NavMapPlaceLabel> chosen = NavMapChoosePlaces(
+        *places,
+        [&](double lat_deg, double lon_deg) {
+          const double la = lat_deg * kD2R, lo = lon_deg * kD2R;
+          if (la < lat_lo || la > lat_hi) return false;
+          if (all_lon) return true;
+          const double d = std::remainder(lo - pr.lon0, 2 * kPi);
+          return d >= dlon_lo && d <= dlon_hi;
+        },
+        [&](double lat_deg, double lon_deg, double *px, double *py) {
+          double x, y;
+          if (!pr.Fwd(lat_deg * kD2R, lon_deg * kD2R, &x, &y)) return false;
+          to_px(x, y, px, py);
+          return true;
+        },
+        W, H, font,
+        [&](const std::string &text, int size, bool bold, double *w, double *h) {
+          // Measured as drawn: the background widens the text's box.
+          auto t = Text(text, size, c_place);
+          t->GetTextProperty()->SetBold(bold);
+          t->GetTextProperty()->SetBackgroundColor(kLand[0], kLand[1], kLand[2]);
+          t->GetTextProperty()->SetBackgroundOpacity(0.55);
+          TextSize(t->GetTextProperty(), text, w, h);
+        },
+        boxes);
     std::vector<double> dots;
-    std::vector<Box> dot_boxes;
-    size_t looked = 0;
-    for (const NavPlace &p : *places) {
-      if (placed >= max_labels || looked > 20000) break;
-      const double la = p.lat_deg * kD2R, lo = p.lon_deg * kD2R;
-      if (la < lat_lo || la > lat_hi) continue;
-      if (!all_lon) {
-        const double d = std::remainder(lo - pr.lon0, 2 * kPi);
-        if (d < dlon_lo || d > dlon_hi) continue;
-      }
-      double x, y;
-      if (!pr.Fwd(la, lo, &x, &y)) continue;
-      double px, py;
-      to_px(x, y, &px, &py);
-      if (px < 4 || py < 4 || px > W - 4 || py > H - 4) continue;
-      ++looked;
-      const int size = p.population >= 1000000 ? font : p.population >= 100000 ? font - 1 : font - 2;
-      auto t = Text(p.name, size, c_place);
-      t->GetTextProperty()->SetBold(p.capital || p.population >= 1000000);
+    for (const NavMapPlaceLabel &l : chosen) {
+      auto t = Text(l.place->name, l.size_pt, c_place);
+      t->GetTextProperty()->SetBold(l.bold);
       t->GetTextProperty()->SetBackgroundColor(kLand[0], kLand[1], kLand[2]);
       t->GetTextProperty()->SetBackgroundOpacity(0.55);
-      double w, h;
-      TextSize(t->GetTextProperty(), p.name, &w, &h);
-      const Box dot{px - 3, py - 3, px + 3, py + 3};
-      const Box cand[4] = {{px + 5, py - 0.5 * h, px + 5 + w, py + 0.5 * h},
-                           {px - 5 - w, py - 0.5 * h, px - 5, py + 0.5 * h},
-                           {px - 0.5 * w, py + 4, px + 0.5 * w, py + 4 + h},
-                           {px - 0.5 * w, py - 4 - h, px + 0.5 * w, py - 4}};
-      bool dot_free = true;
-      for (const Box &o : taken)
-        dot_free = dot_free && !o.Hits(dot);
-      if (!dot_free) continue;
-      for (const Box &b : cand) {
-        if (b.x0 < 2 || b.y0 < 2 || b.x1 > W - 2 || b.y1 > H - 2) continue;
-        const Box pad{b.x0 - 3, b.y0 - 2, b.x1 + 3, b.y1 + 2};
-        bool clash = false;
-        for (const Box &o : taken)
-          clash = clash || o.Hits(pad);
-        for (const Box &o : dot_boxes)
-          clash = clash || o.Hits(pad);
-        if (clash) continue;
-        add_text(t, b.x0, b.y0, NavMapLabel::Place, p.name, w, h);
-        // Place labels first in the list (the documented order): move this one forward.
-        std::rotate(info.labels.begin() + static_cast<std::ptrdiff_t>(placed), info.labels.end() - 1, info.labels.end());
-        dots.insert(dots.end(), {x, y});
-        dot_boxes.push_back(dot);
-        ++placed;
-        break;
-      }
+      add_text(t, l.x0, l.y0, NavMapLabel::Place, l.place->name, l.x1 - l.x0, l.y1 - l.y0);
+      // Place labels first in the list (the documented order): move this one forward.
+      std::rotate(info.labels.begin() + static_cast<std::ptrdiff_t>(placed), info.labels.end() - 1, info.labels.end());
+      double x, y;
+      to_world(l.dot_x, l.dot_y, &x, &y);
+      dots.insert(dots.end(), {x, y});
+      ++placed;
     }
     if (!dots.empty()) {
       vtkNew<vtkPoints> pts;

@@ -14,6 +14,7 @@
 #ifndef NAV_MAP_DATA_H
 #define NAV_MAP_DATA_H
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -105,5 +106,32 @@ std::string NavMapPlacesFile();
  *  @return false with file:line and the field on bad input. The returned pointer stays valid for
  *  the life of the process. */
 bool NavMapLoadPlaces(const std::string &path, const std::vector<NavPlace> **places, std::string *error);
+
+/** A place name chosen for a map view: the place, its dot and its text box (display pixels,
+ *  origin bottom left), and the text's size [pt] and weight. */
+struct NavMapPlaceLabel {
+  const NavPlace *place = nullptr;
+  double dot_x = 0.0, dot_y = 0.0;
+  double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
+  int size_pt = 0;
+  bool bold = false;
+};
+
+/** The extent [px] of @p text drawn at @p size_pt, bold or not (the caller's font renderer). */
+using NavMapTextSize = std::function<void(const std::string &text, int size_pt, bool bold, double *w_px, double *h_px)>;
+
+/** Choose the place names of a @p w x @p h pixel view (the one placement of navview's map and
+ *  navstudio's map view): the most populous places first (@p places in gazetteer order), each
+ *  with a dot and its name right of the dot (else left, above, below), never over a box of
+ *  @p taken (x0, y0, x1, y1: texts already placed) nor over another name or dot; at most one name
+ *  per 30 000 px^2 (3 to 40). Names of a million inhabitants and more are @p font_pt and bold (as
+ *  are capitals), of 100 000 one point smaller, else two. @p may_show: a cheap test before the
+ *  projection (a latitude/longitude box of the view); @p to_pixel: the view's projection.
+ *  @return the names placed, in placement order. */
+std::vector<NavMapPlaceLabel> NavMapChoosePlaces(const std::vector<NavPlace> &places,
+                                                 const std::function<bool(double lat_deg, double lon_deg)> &may_show,
+                                                 const NavMapToPixel &to_pixel, int w, int h, int font_pt,
+                                                 const NavMapTextSize &text_size,
+                                                 std::vector<std::array<double, 4>> taken);
 
 #endif /* NAV_MAP_DATA_H */
