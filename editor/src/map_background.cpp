@@ -3,6 +3,7 @@
 #include <QObject>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -134,7 +135,7 @@ std::string MapDataDir() {
 }
 
 void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
-                        int w_px, int h_px, const MapTiles *tiles) {
+                        int w_px, int h_px, const MapTiles *tiles, const NavMapTextSize &text_size) {
   *out = MapBackground();
   const nav_frame fr = nav_frame_from_scene(&s);
   // The lat/lon box of the rectangle (its boundary and inside, sampled), longitudes relative to the
@@ -295,6 +296,51 @@ void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, dou
       l.text = FormatDeg(WrapDeg(lo), false, lon_step);
       if (anchor(lines, false, &l)) out->labels.push_back(l);
       out->graticule.insert(out->graticule.end(), lines.begin(), lines.end());
+    }
+  }
+
+  // Place names, placed as on navview's map, clear of the caption (bottom), the legend (top right)
+  // and, above street scale, the graticule labels (top and right edges).
+  if (text_size && w_px > 0 && h_px > 0) {
+    const std::string path = NavMapPlacesFile();
+    const std::vector<NavPlace> *places = nullptr;
+    std::string err;
+    if (!path.empty() && NavMapLoadPlaces(path, &places, &err)) {
+      out->have_gazetteer = true;
+      const double W = w_px, H = h_px;
+      std::vector<std::array<double, 4>> taken = {{0, 0, W, 70}, {W - 300, H - 90, W, H}};
+      if (span >= kStreetScaleSpanM) {
+        taken.push_back({0, H - 26, W, H});
+        taken.push_back({W - 90, 0, W, H});
+      }
+      const double arc_max = std::min(M_PI, 0.75 * std::hypot(std::max(std::fabs(x0), std::fabs(x1)),
+                                                              std::max(std::fabs(y0), std::fabs(y1))) / 6371e3 +
+                                                  10.0 * kD2R);
+      const double down_max = 6371e3 * (1.0 - std::cos(arc_max)) + 1.0;
+      const std::vector<NavMapPlaceLabel> chosen = NavMapChoosePlaces(
+          *places,
+          [&](double lat, double lon) {
+            return lat >= la0 && lat <= la1 && (dlo1 - dlo0 > 300.0 || (WrapDeg(lon - lonc) >= dlo0 && WrapDeg(lon - lonc) <= dlo1));
+          },
+          [&](double lat, double lon, double *px, double *py) {
+            const nav_vec3 r = nav_frame_geodetic_to_local(&fr, nav_geodetic{lat * kD2R, lon * kD2R, 0.0});
+            if (r.z > down_max) return false;
+            *px = (r.y - x0) / (x1 - x0) * W;
+            *py = (r.x - y0) / (y1 - y0) * H;
+            return true;
+          },
+          w_px, h_px, 13, text_size, taken);
+      for (const NavMapPlaceLabel &l : chosen) {
+        MapPlace p;
+        p.name = l.place->name;
+        p.dot_x = x0 + l.dot_x / W * (x1 - x0);
+        p.dot_y = y0 + l.dot_y / H * (y1 - y0);
+        p.text_x = x0 + l.x0 / W * (x1 - x0);
+        p.text_y = y0 + l.y0 / H * (y1 - y0);
+        p.size_pt = l.size_pt;
+        p.bold = l.bold;
+        out->places.push_back(p);
+      }
     }
   }
 }

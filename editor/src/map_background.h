@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "navview/nav_map_data.h"
+
 extern "C" {
 #include "navcore/nav_scene.h"
 }
@@ -23,6 +25,14 @@ struct MapLabel {
   std::string text;
   double x = 0.0, y = 0.0; /**< local East/North of the label's anchor [m] */
   bool latitude = false;   /**< a parallel (anchored on the right edge), else a meridian (top edge) */
+};
+
+/** A place name on the map: its dot and the bottom-left corner of its text (local East/North [m]). */
+struct MapPlace {
+  std::string name;
+  double dot_x = 0.0, dot_y = 0.0, text_x = 0.0, text_y = 0.0;
+  int size_pt = 0;
+  bool bold = false;
 };
 
 struct MapBackground {
@@ -42,6 +52,10 @@ struct MapBackground {
   QString tile_credit;
   int tile_zoom = -1;
   double tile_coverage = 0.0;
+  /** Place names (GeoNames gazetteer, chosen like navview's map: NavMapChoosePlaces), when a
+   *  text measure was given. */
+  std::vector<MapPlace> places;
+  bool have_gazetteer = false; /**< a gazetteer was found and read */
 };
 
 /** The map's optional tile layer (nav_map_tiles.h): an MBTiles file, an XYZ directory or
@@ -64,9 +78,12 @@ std::string MapDataDir();
  *  scale (navview's map data, nav_map_data.h), and rivers and borders above kCoastSpanM; the
  *  coastlines then come from GSHHG too (python-cartopy-data only when GSHHG is missing). With
  *  @p tiles (and a pixel size) the tiles are resampled into the same image, over the fill; a
- *  source that cannot be opened leaves the fill and says why in the note. */
+ *  source that cannot be opened leaves the fill and says why in the note. With @p text_size (the
+ *  view's font measure) also the place names, clear of the caption (bottom), the legend (top
+ *  right) and the graticule labels. */
 void BuildMapBackground(const nav_scene &s, double x0, double y0, double x1, double y1, MapBackground *out,
-                        int w_px = 0, int h_px = 0, const MapTiles *tiles = nullptr);
+                        int w_px = 0, int h_px = 0, const MapTiles *tiles = nullptr,
+                        const NavMapTextSize &text_size = NavMapTextSize());
 
 } // namespace studio
 

@@ -382,6 +382,8 @@ PathView::PathView(SceneDocument *doc, Mode mode, QWidget *parent) : QWidget(par
     renderer_->AddActor(rivers_);
     renderer_->AddActor(borders_);
     renderer_->AddActor(coast_);
+    place_dots_ = MakeActor(vtkNew<vtkPolyData>(), 0.10, 0.10, 0.14, 5.0); // place names' dots
+    renderer_->AddActor(place_dots_);
   }
   grid_ = MakeActor(vtkNew<vtkPolyData>(), 0.70, 0.74, 0.70, 1.0);
   if (mode == Mode::ThreeD) grid_->GetProperty()->SetColor(0.74, 0.77, 0.74);
@@ -1021,6 +1023,8 @@ void PathView::UpdateCaption() {
   if (path_.Size() > 0) facts << tr("%1 s").arg(s.trajectory.duration_s, 0, 'f', 0);
   if (mode_ == Mode::Map && !bg_note_.isEmpty()) facts << bg_note_;
   if (mode_ == Mode::Map && !tile_credit_.isEmpty()) facts << tile_credit_;
+  // GeoNames asks for credit (CC BY 4.0).
+  if (mode_ == Mode::Map && !place_names_.isEmpty()) facts << tr("place names: GeoNames (CC BY 4.0)");
   QString hint;
   if (mode_ == Mode::Map && !wp)
     hint = tr("A %1 trajectory: edit it in the Trajectory panel").arg(TrajectoryKindName(s.trajectory.type));
@@ -1143,8 +1147,24 @@ void PathView::UpdateBackground() {
   const double span = 2.0 * std::max(half_w, half_h);
   MapBackground bg;
   const MapTiles tiles{tiles_source_, tiles_attribution_};
+  // Place names are measured in the font they are drawn with (the text renderer's box).
+  const NavMapTextSize measure = [this](const std::string &text, int size, bool bold, double *tw, double *th) {
+    vtkNew<vtkTextProperty> tp;
+    tp->SetFontSize(size);
+    tp->SetBold(bold);
+    tp->SetBackgroundOpacity(0.55);
+    int bb[4] = {0, 0, 0, 0};
+    vtkTextRenderer *tr = vtkTextRenderer::GetInstance();
+    if (tr && tr->GetBoundingBox(tp, text, bb, window_->GetDPI())) {
+      *tw = bb[1] - bb[0] + 1;
+      *th = bb[3] - bb[2] + 1;
+    } else {
+      *tw = 0.62 * size * static_cast<double>(text.size());
+      *th = 1.25 * size;
+    }
+  };
   BuildMapBackground(doc_->Scene(), cx - half_w, cy - half_h, cx + half_w, cy + half_h, &bg, static_cast<int>(w),
-                     static_cast<int>(h), tiles_source_.empty() ? nullptr : &tiles);
+                     static_cast<int>(h), tiles_source_.empty() ? nullptr : &tiles, measure);
   tile_credit_ = bg.tile_credit;
   tile_zoom_ = bg.tile_zoom;
   coast_count_ = SetXyPolylines(InputOf(coast_), bg.coast, -0.06);
@@ -1200,6 +1220,41 @@ void PathView::UpdateBackground() {
     t->GetTextProperty()->SetVerticalJustification(l.latitude ? VTK_TEXT_BOTTOM : VTK_TEXT_TOP);
     t->GetPositionCoordinate()->SetValue(l.x + (l.latitude ? -0.01 : 0.01) * half_w, l.y + (l.latitude ? 0.01 : -0.01) * half_h, 0.0);
   }
+  // Place names: a dot and the name beside it (navview's placement, NavMapChoosePlaces).
+  while (place_labels_.size() < bg.places.size()) {
+    auto t = vtkSmartPointer<vtkTextActor>::New();
+    vtkTextProperty *tp = t->GetTextProperty();
+    tp->SetColor(0.10, 0.10, 0.14);
+    tp->SetBackgroundColor(kNavMapLandRgb[0] / 255.0, kNavMapLandRgb[1] / 255.0, kNavMapLandRgb[2] / 255.0);
+    tp->SetBackgroundOpacity(0.55);
+    tp->SetJustificationToLeft();
+    tp->SetVerticalJustificationToBottom();
+    t->GetPositionCoordinate()->SetCoordinateSystemToWorld();
+    renderer_->AddViewProp(t);
+    place_labels_.push_back(t);
+  }
+  place_names_.clear();
+  auto dot_pts = vtkSmartPointer<vtkPoints>::New();
+  auto dot_cells = vtkSmartPointer<vtkCellArray>::New();
+  for (size_t i = 0; i < place_labels_.size(); ++i) {
+    vtkTextActor *t = place_labels_[i];
+    if (i >= bg.places.size()) {
+      t->SetVisibility(0);
+      continue;
+    }
+    const MapPlace &p = bg.places[i];
+    place_names_ << QString::fromStdString(p.name);
+    t->SetVisibility(1);
+    t->SetInput(p.name.c_str());
+    t->GetTextProperty()->SetFontSize(p.size_pt);
+    t->GetTextProperty()->SetBold(p.bold);
+    t->GetPositionCoordinate()->SetValue(p.text_x, p.text_y, 0.0);
+    const vtkIdType id = dot_pts->InsertNextPoint(p.dot_x, p.dot_y, 0.2);
+    dot_cells->InsertNextCell(1, &id);
+  }
+  InputOf(place_dots_)->SetPoints(dot_pts);
+  InputOf(place_dots_)->SetVerts(dot_cells);
+  InputOf(place_dots_)->Modified();
   UpdateCaption();
   Render();
 }

@@ -143,6 +143,8 @@ public:
   QString MapTilesCredit() const { return tile_credit_; }
   int MapTileZoom() const { return tile_zoom_; }
   size_t GraticuleCount() const { return graticule_count_; }
+  /** Map view: the place names shown (GeoNames gazetteer; none without it). */
+  QStringList PlaceNames() const { return place_names_; }
   QStringList GraticuleLabels() const;
   bool MetricGridShown() const;
   /** During a live drag, draw a changed path with the next estimate (SetEstimate), at most
@@ -222,6 +224,9 @@ private:
   vtkSmartPointer<vtkImageData> land_image_;
   char land_res_ = 0;
   std::vector<vtkSmartPointer<vtkTextActor>> geo_labels_;
+  std::vector<vtkSmartPointer<vtkTextActor>> place_labels_;
+  vtkSmartPointer<vtkActor> place_dots_;
+  QStringList place_names_;
   QTimer bg_timer_;
   double bg_key_[5] = {0, 0, 0, 0, 0};
   bool street_ = true;

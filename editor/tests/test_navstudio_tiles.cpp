@@ -2,7 +2,9 @@
 // makes (viewer/tests/tile_fixture.h, around the new drive's origin in Berlin), refuses a corrupt
 // one with the reason, remembers the choice in QSettings for the next window, draws the tiles'
 // colours and streets where their lat/lon fall in the map view, credits them in the caption, and
-// shows the GSHHG fill again when zoomed out beyond the tiles. Screenshots: Testing/navstudio/tiles-*.png.
+// shows the GSHHG fill again when zoomed out beyond the tiles. Also the map view's place names
+// (navview's placement) and its zoom about the pointer (issue 19 item 2). Screenshots:
+// Testing/navstudio/tiles-*.png, map-places-*.png.
 #include <QApplication>
 #include <QDialog>
 #include <QDialogButtonBox>
@@ -17,7 +19,11 @@
 #include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+
+#include <vtkCommand.h>
+#include <vtkRenderWindowInteractor.h>
 
 #include "main_window.h"
 #include "navview/nav_map_tiles.h"
@@ -123,6 +129,48 @@ private slots:
     QVERIFY(seen);
     QVERIFY(w2->MapTiles().isEmpty());
     QVERIFY(QSettings().value("map/tiles").toString().isEmpty());
+  }
+
+  // Place names as on navview's map (GeoNames: Berlin and its neighbours at 60 km), none over
+  // another; the wheel zooms about the pointer: the ground point under it stays under it.
+  void map_places_zoom() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->NewDrive());
+    PathView *map = w->MapView();
+    map->SetMapExtent(0.0, 0.0, 30e3);
+    const QStringList names = map->PlaceNames();
+    QVERIFY2(names.contains("Berlin"), qPrintable(names.join(", ")));
+    QVERIFY2(names.contains("Potsdam"), qPrintable(names.join(", ")));
+    QVERIFY2(map->CaptionText().contains("GeoNames (CC BY 4.0)"), qPrintable(map->CaptionText()));
+    Shot(w.get(), "map-places-01-60km");
+    // Street scale in the middle of Berlin: fewer, local names or none, never a crash.
+    map->SetMapExtent(0.0, 0.0, 400.0);
+    Shot(w.get(), "map-places-02-street");
+    map->SetMapExtent(0.0, 0.0, 30e3);
+
+    // A point off the centre: what lies under it before and after a wheel step.
+    int x = 0, y = 0;
+    QVERIFY(map->DisplayOf(9000.0, -12000.0, 0.0, &x, &y));
+    double n0 = 0, e0 = 0, n1 = 0, e1 = 0;
+    QVERIFY(map->GroundAt(x, y, 0.0, &n0, &e0));
+    vtkRenderWindowInteractor *i = map->Interactor();
+    i->SetEventPosition(x, y);
+    i->InvokeEvent(vtkCommand::MouseWheelForwardEvent);
+    QApplication::processEvents();
+    QVERIFY(map->GroundAt(x, y, 0.0, &n1, &e1));
+    const double m_px = 60e3 / 1.25 / std::max(1, map->height());
+    std::printf("wheel at (%d, %d): ground point (%.1f, %.1f) m -> (%.1f, %.1f) m\n", x, y, n0, e0, n1, e1);
+    QVERIFY2(std::hypot(n1 - n0, e1 - e0) < 2.0 * m_px, "the point under the pointer moved");
+    // And in: 1.25 x closer each step, so 10 steps bring 60 km down to 6.4 km, about the pointer.
+    for (int k = 0; k < 10; ++k)
+      i->InvokeEvent(vtkCommand::MouseWheelForwardEvent);
+    QApplication::processEvents();
+    QVERIFY(map->GroundAt(x, y, 0.0, &n1, &e1));
+    QVERIFY2(std::hypot(n1 - n0, e1 - e0) < 20.0, "the point under the pointer moved");
+    QVERIFY(map->MetricGridShown()); // street scale: the map was rebuilt for the new view
+    Shot(w.get(), "map-places-03-zoomed-about-pointer");
   }
 
 private:
