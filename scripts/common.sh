@@ -20,7 +20,7 @@ NAV_PACKAGES=(
   rtklib                            # rnx2rtkp: independent oracle of GNSS satellite positions and of the RINEX export (issue 22)
   python3-yaml python3-jsonschema   # scenes against `navsim schema` (issue 18, test_navsim_schema)
   libnetcdf-dev gmt-gshhg-high gmt-gshhg-full # map land/water, rivers, borders (GSHHG binned netCDF)
-  libsqlite3-dev libcurl4-openssl-dev sqlite3 # map tile layer: MBTiles (SQLite), XYZ URLs (libcurl); sqlite3 CLI in its tests
+  libsqlite3-dev libcurl4-openssl-dev # map tile layer: MBTiles files (SQLite), XYZ URL tiles (libcurl)
   ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
 )
 

@@ -91,8 +91,11 @@ std::string Replace(std::string s, const std::string &what, const std::string &w
   return s;
 }
 
+/** The tile's path or URL; {s} (a server letter of some URL templates) is always "a". */
 std::string Expand(const std::string &tmpl, int z, int x, int y) {
-  return Replace(Replace(Replace(tmpl, "{z}", std::to_string(z)), "{x}", std::to_string(x)), "{y}", std::to_string(y));
+  return Replace(Replace(Replace(Replace(tmpl, "{z}", std::to_string(z)), "{x}", std::to_string(x)), "{y}",
+                         std::to_string(y)),
+                 "{s}", "a");
 }
 
 /** Attribution text for the map: HTML tags dropped, the few entities attributions use decoded. */
@@ -180,9 +183,11 @@ size_t CurlWrite(char *ptr, size_t size, size_t nmemb, void *user) {
 }
 
 std::string CacheRoot() {
-  if (const char *e = std::getenv("NAVVIEW_TILE_CACHE"); e && *e) return e;
-  if (const char *e = std::getenv("XDG_CACHE_HOME"); e && *e) return std::string(e) + "/navsim/tiles";
-  if (const char *e = std::getenv("HOME"); e && *e) return std::string(e) + "/.cache/navsim/tiles";
+  const char *own = std::getenv("NAVVIEW_TILE_CACHE"), *xdg = std::getenv("XDG_CACHE_HOME"),
+             *home = std::getenv("HOME");
+  if (own && *own) return own;
+  if (xdg && *xdg) return std::string(xdg) + "/navsim/tiles";
+  if (home && *home) return std::string(home) + "/.cache/navsim/tiles";
   return "/tmp/navsim-tiles";
 }
 
@@ -241,8 +246,8 @@ struct NavTileSource::Impl {
       sqlite3_stmt *st = nullptr;
       if (sqlite3_prepare_v2(db, "SELECT name, value FROM metadata", -1, &st, nullptr) != SQLITE_OK)
         return fail(std::string("not an MBTiles file: no readable metadata table (") + sqlite3_errmsg(db) + ")");
-      int rc;
-      while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+      int rc = sqlite3_step(st);
+      for (; rc == SQLITE_ROW; rc = sqlite3_step(st)) {
         const unsigned char *k = sqlite3_column_text(st, 0), *v = sqlite3_column_text(st, 1);
         if (k && v) meta[reinterpret_cast<const char *>(k)] = reinterpret_cast<const char *>(v);
       }
@@ -318,8 +323,9 @@ struct NavTileSource::Impl {
     // DIR/{z}/...: the zoom levels present are DIR's numeric subdirectories.
     if (head == dir && tmpl.compare(head.size(), 4, "{z}/") == 0) {
       int lo = 99, hi = -1;
-      if (DIR *d = opendir(dir.c_str())) {
-        while (dirent *e = readdir(d)) {
+      DIR *d = opendir(dir.c_str());
+      if (d) {
+        for (dirent *e = readdir(d); e; e = readdir(d)) {
           char *end = nullptr;
           const long z = std::strtol(e->d_name, &end, 10);
           if (end != e->d_name && *end == '\0' && z >= 0 && z <= 30 && IsDir(dir + e->d_name)) {
