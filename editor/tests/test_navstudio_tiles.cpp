@@ -37,7 +37,9 @@ using studio::PathView;
 
 namespace {
 
-long Rgb(const unsigned char c[3]) { return (long(c[0]) << 16) | (long(c[1]) << 8) | long(c[2]); }
+long Rgb(const unsigned char c[3]) {
+  return (long(c[0]) << 16) | (long(c[1]) << 8) | long(c[2]);
+}
 
 /** Local East, North [m] of @p lat, @p lon in the window's scene. */
 void EastNorth(studio::MainWindow *w, double lat, double lon, double *e, double *n) {

@@ -103,9 +103,12 @@ std::string PlainText(const std::string &html) {
   std::string s;
   bool tag = false;
   for (char c : html) {
-    if (c == '<') tag = true;
-    else if (c == '>') tag = false;
-    else if (!tag) s += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;
+    if (c == '<')
+      tag = true;
+    else if (c == '>')
+      tag = false;
+    else if (!tag)
+      s += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;
   }
   s = Replace(Replace(Replace(Replace(s, "&copy;", "\u00a9"), "&amp;", "&"), "&lt;", "<"), "&gt;", ">");
   s = Replace(s, "&nbsp;", " ");
@@ -144,8 +147,9 @@ bool Decode(const std::vector<unsigned char> &data, NavTileImage *out, std::stri
   int dims[3] = {0, 0, 0};
   im->GetDimensions(dims);
   vtkDataArray *sc = im->GetPointData() ? im->GetPointData()->GetScalars() : nullptr;
-  if (dims[0] < 1 || dims[1] < 1 || !sc || sc->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] ||
-      dims[0] > 4096 || dims[1] > 4096) {
+  if (dims[0] < 1 || dims[1] < 1 || !sc ||
+      sc->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] || dims[0] > 4096 ||
+      dims[1] > 4096) {
     *why = std::string("damaged ") + (png ? "PNG" : "JPEG") + " image";
     return false;
   }
@@ -160,7 +164,8 @@ bool Decode(const std::vector<unsigned char> &data, NavTileImage *out, std::stri
       const vtkIdType id = static_cast<vtkIdType>(vy) * out->w + c;
       unsigned char *p = &out->rgba[4 * (static_cast<size_t>(r) * out->w + c)];
       auto comp = [&](int k) {
-        return static_cast<unsigned char>(std::lround(std::clamp(sc->GetComponent(id, k) * scale, 0.0, 255.0)));
+        return static_cast<unsigned char>(
+            std::lround(std::clamp(sc->GetComponent(id, k) * scale, 0.0, 255.0)));
       };
       if (nc >= 3) {
         p[0] = comp(0);
@@ -178,7 +183,8 @@ bool Decode(const std::vector<unsigned char> &data, NavTileImage *out, std::stri
 
 size_t CurlWrite(char *ptr, size_t size, size_t nmemb, void *user) {
   auto *v = static_cast<std::vector<unsigned char> *>(user);
-  v->insert(v->end(), reinterpret_cast<unsigned char *>(ptr), reinterpret_cast<unsigned char *>(ptr) + size * nmemb);
+  v->insert(v->end(), reinterpret_cast<unsigned char *>(ptr),
+            reinterpret_cast<unsigned char *>(ptr) + size * nmemb);
   return size * nmemb;
 }
 
@@ -217,7 +223,8 @@ struct NavTileSource::Impl {
   std::mutex mu;
   // Most recently used decoded tiles; a missing tile is kept as an empty image.
   std::list<std::tuple<int, int, int>> lru;
-  std::map<std::tuple<int, int, int>, std::pair<NavTileImage, std::list<std::tuple<int, int, int>>::iterator>> decoded;
+  std::map<std::tuple<int, int, int>, std::pair<NavTileImage, std::list<std::tuple<int, int, int>>::iterator>>
+      decoded;
 
   ~Impl() {
     if (get) sqlite3_finalize(get);
@@ -239,13 +246,15 @@ struct NavTileSource::Impl {
                     "\"SQLite format 3\")");
     }
     if (sqlite3_open_v2(spec.c_str(), &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
-      return fail(std::string("cannot open the SQLite database: ") + (db ? sqlite3_errmsg(db) : "out of memory"));
+      return fail(std::string("cannot open the SQLite database: ") +
+                  (db ? sqlite3_errmsg(db) : "out of memory"));
     // Metadata (MBTiles 1.3: name/value rows); format png|jpg, attribution, zoom range.
     std::map<std::string, std::string> meta;
     {
       sqlite3_stmt *st = nullptr;
       if (sqlite3_prepare_v2(db, "SELECT name, value FROM metadata", -1, &st, nullptr) != SQLITE_OK)
-        return fail(std::string("not an MBTiles file: no readable metadata table (") + sqlite3_errmsg(db) + ")");
+        return fail(std::string("not an MBTiles file: no readable metadata table (") + sqlite3_errmsg(db) +
+                    ")");
       int rc = sqlite3_step(st);
       for (; rc == SQLITE_ROW; rc = sqlite3_step(st)) {
         const unsigned char *k = sqlite3_column_text(st, 0), *v = sqlite3_column_text(st, 1);
@@ -261,10 +270,12 @@ struct NavTileSource::Impl {
         return fail("metadata format is \"" + f + "\": raster tiles (png or jpg) expected" +
                     (f == "pbf" ? " (vector tiles are not drawn)" : ""));
     }
-    if (sqlite3_prepare_v2(db, "SELECT tile_data FROM tiles WHERE zoom_level = ? AND tile_column = ? AND tile_row = ?",
-                           -1, &get, nullptr) != SQLITE_OK)
-      return fail(std::string("not an MBTiles file: no table tiles(zoom_level, tile_column, tile_row, tile_data) (") +
-                  sqlite3_errmsg(db) + ")");
+    if (sqlite3_prepare_v2(
+            db, "SELECT tile_data FROM tiles WHERE zoom_level = ? AND tile_column = ? AND tile_row = ?", -1,
+            &get, nullptr) != SQLITE_OK)
+      return fail(
+          std::string("not an MBTiles file: no table tiles(zoom_level, tile_column, tile_row, tile_data) (") +
+          sqlite3_errmsg(db) + ")");
     auto zoom_of = [&](const char *key, int *z) {
       if (!meta.count(key)) return false;
       char *end = nullptr;
@@ -276,7 +287,8 @@ struct NavTileSource::Impl {
     bool have_min = zoom_of("minzoom", &min_zoom), have_max = zoom_of("maxzoom", &max_zoom);
     if (!have_min || !have_max) { // not in the metadata (it is optional): from the table
       sqlite3_stmt *st = nullptr;
-      if (sqlite3_prepare_v2(db, "SELECT MIN(zoom_level), MAX(zoom_level) FROM tiles", -1, &st, nullptr) != SQLITE_OK)
+      if (sqlite3_prepare_v2(db, "SELECT MIN(zoom_level), MAX(zoom_level) FROM tiles", -1, &st, nullptr) !=
+          SQLITE_OK)
         return fail(std::string("reading the zoom levels: ") + sqlite3_errmsg(db));
       const int rc = sqlite3_step(st);
       if (rc != SQLITE_ROW) {
@@ -336,7 +348,8 @@ struct NavTileSource::Impl {
         closedir(d);
       }
       if (hi < 0) {
-        *error = spec + ": error: " + dir + " holds no zoom-level directories (0, 1, ... 19): not a tile directory";
+        *error = spec + ": error: " + dir +
+                 " holds no zoom-level directories (0, 1, ... 19): not a tile directory";
         return false;
       }
       min_zoom = lo;
@@ -349,7 +362,8 @@ struct NavTileSource::Impl {
     tmpl = spec;
     if (tmpl.find("{z}") == std::string::npos || tmpl.find("{x}") == std::string::npos ||
         tmpl.find("{y}") == std::string::npos) {
-      *error = spec + ": error: a tile URL template needs {z}, {x} and {y} (e.g. https://HOST/{z}/{x}/{y}.png)";
+      *error =
+          spec + ": error: a tile URL template needs {z}, {x} and {y} (e.g. https://HOST/{z}/{x}/{y}.png)";
       return false;
     }
     static std::once_flag curl_once;
@@ -378,7 +392,8 @@ struct NavTileSource::Impl {
       if (rc == SQLITE_ROW) {
         const void *b = sqlite3_column_blob(get, 0);
         const int n = sqlite3_column_bytes(get, 0);
-        if (b && n > 0) data->assign(static_cast<const unsigned char *>(b), static_cast<const unsigned char *>(b) + n);
+        if (b && n > 0)
+          data->assign(static_cast<const unsigned char *>(b), static_cast<const unsigned char *>(b) + n);
         sqlite3_reset(get);
         return true;
       }
@@ -401,7 +416,8 @@ struct NavTileSource::Impl {
     std::string ext = tmpl.substr(tmpl.rfind('/') + 1);
     ext = ext.find('.') != std::string::npos ? ext.substr(ext.rfind('.')) : ".tile";
     if (ext.find_first_of("?&=") != std::string::npos) ext = ".tile";
-    const std::string cached = cache_dir + "/" + std::to_string(z) + "/" + std::to_string(x) + "/" + std::to_string(y) + ext;
+    const std::string cached =
+        cache_dir + "/" + std::to_string(z) + "/" + std::to_string(x) + "/" + std::to_string(y) + ext;
     time_t mtime = 0;
     const bool have_cache = IsFile(cached, &mtime);
     // A long-lived process (navstudio, an interactive map) asks the server again a minute after
@@ -435,8 +451,8 @@ struct NavTileSource::Impl {
           cc == CURLE_GOT_NOTHING || cc == CURLE_SSL_CONNECT_ERROR) {
         // Unreachable: do not wait a timeout per tile; use what the cache holds from now on.
         offline_since = std::time(nullptr);
-        offline = std::string("tiles: cannot reach the tile server (") + (errbuf[0] ? errbuf : curl_easy_strerror(cc)) +
-                  "): offline? only cached tiles are drawn";
+        offline = std::string("tiles: cannot reach the tile server (") +
+                  (errbuf[0] ? errbuf : curl_easy_strerror(cc)) + "): offline? only cached tiles are drawn";
         if (have_cache && !ReadFile(cached, data)) data->clear();
         return true;
       }
@@ -464,12 +480,24 @@ struct NavTileSource::Impl {
 
 NavTileSource::NavTileSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 NavTileSource::~NavTileSource() = default;
-NavTileSource::Kind NavTileSource::GetKind() const { return impl_->kind; }
-const std::string &NavTileSource::Spec() const { return impl_->spec; }
-const std::string &NavTileSource::Name() const { return impl_->name; }
-const std::string &NavTileSource::Attribution() const { return impl_->attribution; }
-int NavTileSource::MinZoom() const { return impl_->min_zoom; }
-int NavTileSource::MaxZoom() const { return impl_->max_zoom; }
+NavTileSource::Kind NavTileSource::GetKind() const {
+  return impl_->kind;
+}
+const std::string &NavTileSource::Spec() const {
+  return impl_->spec;
+}
+const std::string &NavTileSource::Name() const {
+  return impl_->name;
+}
+const std::string &NavTileSource::Attribution() const {
+  return impl_->attribution;
+}
+int NavTileSource::MinZoom() const {
+  return impl_->min_zoom;
+}
+int NavTileSource::MaxZoom() const {
+  return impl_->max_zoom;
+}
 
 std::string NavTileSource::OfflineNote() const {
   std::lock_guard<std::mutex> lock(impl_->mu);
@@ -517,7 +545,8 @@ bool NavTileSourceOpen(const std::string &spec, std::shared_ptr<NavTileSource> *
   static std::map<std::string, std::shared_ptr<NavTileSource>> open;
   std::lock_guard<std::mutex> lock(mu);
   if (spec.empty()) {
-    *error = "tiles: error: empty tile source (expected an MBTiles file, a tile directory or template, or a URL)";
+    *error =
+        "tiles: error: empty tile source (expected an MBTiles file, a tile directory or template, or a URL)";
     return false;
   }
   auto it = open.find(spec);
@@ -556,8 +585,8 @@ std::string NavTileCredit(const NavTileSource &src, const std::string &attributi
   return "map tiles: " + src.Name() + " (no attribution given: --tiles-attribution)";
 }
 
-void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, double m_per_px, double lat_deg, int w,
-                      int h, std::vector<unsigned char> *rgb, NavTilePaint *res) {
+void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, double m_per_px, double lat_deg,
+                      int w, int h, std::vector<unsigned char> *rgb, NavTilePaint *res) {
   *res = NavTilePaint();
   if (w < 1 || h < 1 || rgb->size() < 3 * static_cast<size_t>(w) * static_cast<size_t>(h)) return;
   // The nearest zoom to the scale: the tiles' pixels are then between 0.71 and 1.41 display
@@ -569,7 +598,8 @@ void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, dou
   if (z > src.MaxZoom()) z = src.MaxZoom();
   if (z < src.MinZoom()) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "map tiles: not drawn at this scale (zoom %d needed, the tiles start at %d)", z,
+    std::snprintf(buf, sizeof buf,
+                  "map tiles: not drawn at this scale (zoom %d needed, the tiles start at %d)", z,
                   src.MinZoom());
     res->notes.push_back(buf);
     return;
@@ -633,9 +663,11 @@ void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, dou
       double fx, fy;
       const bool cell = gok[k00] && gok[k10] && gok[k01] && gok[k11] &&
                         std::max({gfx[k00], gfx[k10], gfx[k01], gfx[k11]}) -
-                                std::min({gfx[k00], gfx[k10], gfx[k01], gfx[k11]}) < 0.5 * n;
+                                std::min({gfx[k00], gfx[k10], gfx[k01], gfx[k11]}) <
+                            0.5 * n;
       if (cell) {
-        const double a = static_cast<double>(i - gi * kCell) / kCell, b = static_cast<double>(j - gj * kCell) / kCell;
+        const double a = static_cast<double>(i - gi * kCell) / kCell,
+                     b = static_cast<double>(j - gj * kCell) / kCell;
         fx = (1 - b) * ((1 - a) * gfx[k00] + a * gfx[k10]) + b * ((1 - a) * gfx[k01] + a * gfx[k11]);
         fy = (1 - b) * ((1 - a) * gfy[k00] + a * gfy[k10]) + b * ((1 - a) * gfy[k01] + a * gfy[k11]);
       } else if (!mercator(i + 0.5, j + 0.5, &fx, &fy)) {
@@ -654,8 +686,11 @@ void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, dou
       const double au = u - u0, av = v - v0;
       double c[4];
       for (int k = 0; k < 4; ++k) {
-        auto px = [&](int uu, int vv) { return double(t.rgba[4 * (static_cast<size_t>(vv) * t.w + uu) + k]); };
-        c[k] = (1 - av) * ((1 - au) * px(u0, v0) + au * px(u1, v0)) + av * ((1 - au) * px(u0, v1) + au * px(u1, v1));
+        auto px = [&](int uu, int vv) {
+          return double(t.rgba[4 * (static_cast<size_t>(vv) * t.w + uu) + k]);
+        };
+        c[k] = (1 - av) * ((1 - au) * px(u0, v0) + au * px(u1, v0)) +
+               av * ((1 - au) * px(u0, v1) + au * px(u1, v1));
       }
       const double a = c[3] / 255.0;
       if (a <= 0.0) continue;
@@ -667,5 +702,6 @@ void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, dou
   res->coverage = static_cast<double>(painted) / (static_cast<double>(w) * h);
   const std::string off = src.OfflineNote();
   if (!off.empty()) res->notes.push_back(off);
-  if (res->failed > 1) res->notes.push_back("map tiles: " + std::to_string(res->failed) + " tiles could not be read");
+  if (res->failed > 1)
+    res->notes.push_back("map tiles: " + std::to_string(res->failed) + " tiles could not be read");
 }

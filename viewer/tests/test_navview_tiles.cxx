@@ -47,7 +47,9 @@ std::string OutDir() {
   tilefix::MkDirs(d);
   return d;
 }
-std::string Fixture() { return OutDir() + "/tiles_fixture"; }
+std::string Fixture() {
+  return OutDir() + "/tiles_fixture";
+}
 
 struct Image {
   int w = 0, h = 0;
@@ -105,8 +107,9 @@ NavMapInfo Render(const std::string &tiles, const std::string &attribution, cons
   std::string err;
   if (!NavRenderMapPng(Track(), o, png, &err, &info)) fail_msg("%s: %s", name, err.c_str());
   *im = ReadPng(png);
-  std::printf("%s: %s: %.3g km across, zoom %d, %d tiles, %.1f %% of the view from tiles, built in %.0f ms\n", name,
-              png.c_str(), span_km, info.tile_zoom, info.tiles, 100.0 * info.tile_coverage, info.build_ms);
+  std::printf("%s: %s: %.3g km across, zoom %d, %d tiles, %.1f %% of the view from tiles, built in %.0f ms\n",
+              name, png.c_str(), span_km, info.tile_zoom, info.tiles, 100.0 * info.tile_coverage,
+              info.build_ms);
   for (const std::string &n : info.notes)
     std::printf("  note: %s\n", n.c_str());
   assert_int_equal(im->w, kW);
@@ -120,7 +123,9 @@ bool UnderText(const NavMapInfo &info, double px, double py, double pad) {
   return false;
 }
 
-bool Dark(const unsigned char *c) { return c[0] < 70 && c[1] < 70 && c[2] < 70; }
+bool Dark(const unsigned char *c) {
+  return c[0] < 70 && c[1] < 70 && c[2] < 70;
+}
 
 /** Centre of the dark run along a row (@p horizontal) or column through (@p x, @p y), searched
  *  within +-@p reach pixels; NaN when there is none. */
@@ -170,9 +175,10 @@ int CheckTiles(const Image &im, const NavMapInfo &info, int z) {
       for (double o : off) {
         const double c = DarkCentre(im, static_cast<int>(px), static_cast<int>(py + o), true, reach);
         const double r = DarkCentre(im, static_cast<int>(px + o), static_cast<int>(py), false, reach);
-        std::printf("  z%d tile %d/%d: street crossing at (%.1f, %.1f) px; meridian street at x %.2f (row %+.0f), "
-                    "parallel street at y %.2f (column %+.0f)\n",
-                    z, tx, ty, px, py, c, o, r, o);
+        std::printf(
+            "  z%d tile %d/%d: street crossing at (%.1f, %.1f) px; meridian street at x %.2f (row %+.0f), "
+            "parallel street at y %.2f (column %+.0f)\n",
+            z, tx, ty, px, py, c, o, r, o);
         assert_near(c, px, 1.5);
         assert_near(r, py, 1.5);
       }
@@ -184,11 +190,12 @@ int CheckTiles(const Image &im, const NavMapInfo &info, int z) {
       for (int a = -1; a <= 1; ++a)
         for (int b = -1; b <= 1; ++b) {
           const unsigned char *p = im.At(static_cast<int>(qx) + a, static_cast<int>(qy) + b);
-          match += std::abs(p[0] - want[0]) <= 4 && std::abs(p[1] - want[1]) <= 4 && std::abs(p[2] - want[2]) <= 4;
+          match +=
+              std::abs(p[0] - want[0]) <= 4 && std::abs(p[1] - want[1]) <= 4 && std::abs(p[2] - want[2]) <= 4;
         }
       const unsigned char *p = im.At(static_cast<int>(qx), static_cast<int>(qy));
-      std::printf("  z%d tile %d/%d colour at (%.0f, %.0f): %d %d %d, expected %d %d %d (%d of 9)\n", z, tx, ty, qx, qy,
-                  p[0], p[1], p[2], want[0], want[1], want[2], match);
+      std::printf("  z%d tile %d/%d colour at (%.0f, %.0f): %d %d %d, expected %d %d %d (%d of 9)\n", z, tx,
+                  ty, qx, qy, p[0], p[1], p[2], want[0], want[1], want[2], match);
       assert_true(match >= 6);
       ++checked;
     }
@@ -229,7 +236,8 @@ void test_street_scale_mbtiles(void **) {
   assert_true(info.tile_coverage > 0.999);
   assert_true(CheckTiles(im, info, 16) >= 2);
   // The attribution: the metadata's HTML as text, in the legend, drawn (dark text pixels).
-  assert_string_equal(info.tile_credit.c_str(), (std::string("map tiles: ") + tilefix::kAttributionText).c_str());
+  assert_string_equal(info.tile_credit.c_str(),
+                      (std::string("map tiles: ") + tilefix::kAttributionText).c_str());
   bool found = false;
   for (const NavMapLabel &l : info.labels) {
     if (l.kind != NavMapLabel::Legend || l.text.find(info.tile_credit) == std::string::npos) continue;
@@ -237,8 +245,8 @@ void test_street_scale_mbtiles(void **) {
     for (int y = static_cast<int>(l.y0); y < static_cast<int>(l.y1); ++y)
       for (int x = static_cast<int>(l.x0); x < static_cast<int>(l.x1); ++x)
         dark += Dark(im.At(std::clamp(x, 0, kW - 1), std::clamp(y, 0, kH - 1)));
-    std::printf("  legend with the credit at (%.0f, %.0f)-(%.0f, %.0f): %d dark text pixels\n", l.x0, l.y0, l.x1, l.y1,
-                dark);
+    std::printf("  legend with the credit at (%.0f, %.0f)-(%.0f, %.0f): %d dark text pixels\n", l.x0, l.y0,
+                l.x1, l.y1, dark);
     assert_true(dark >= 200);
     found = true;
   }
@@ -249,8 +257,8 @@ void test_xyz_directory_same_picture(void **) {
   Image a, b, c;
   Render(Fixture() + "/tiles.mbtiles", "", "mbtiles_places_1500m", 1.5, &a, true);
   const NavMapInfo ib = Render(Fixture() + "/xyz", tilefix::kAttributionText, "xyz_1500m", 1.5, &b, true);
-  const NavMapInfo ic =
-      Render(Fixture() + "/xyz/{z}/{x}/{y}.png", tilefix::kAttributionText, "xyz_template_1500m", 1.5, &c, true);
+  const NavMapInfo ic = Render(Fixture() + "/xyz/{z}/{x}/{y}.png", tilefix::kAttributionText,
+                               "xyz_template_1500m", 1.5, &c, true);
   assert_int_equal(ib.tile_zoom, 16);
   assert_int_equal(ic.tile_zoom, 16);
   size_t diff_b = 0, diff_c = 0;
@@ -298,9 +306,7 @@ void test_open_errors(void **) {
   struct Case {
     std::string spec, expect;
   };
-  {
-    std::ofstream(d + "/garbage.mbtiles") << "this is not a database\n";
-  }
+  { std::ofstream(d + "/garbage.mbtiles") << "this is not a database\n"; }
   { // the first 3 kB of a good file: a SQLite header over missing pages
     std::ifstream in(Fixture() + "/tiles.mbtiles", std::ios::binary);
     std::vector<char> buf(3072);
@@ -351,8 +357,9 @@ void test_damaged_tile(void **) {
   const int tx = static_cast<int>(fx), ty = static_cast<int>(fy);
   sqlite3 *db = nullptr;
   assert_int_equal(sqlite3_open(dst.c_str(), &db), SQLITE_OK);
-  const std::string sql = "UPDATE tiles SET tile_data = X'3c68746d6c3e' WHERE zoom_level = 16 AND tile_column = " +
-                          std::to_string(tx) + " AND tile_row = " + std::to_string((1 << 16) - 1 - ty);
+  const std::string sql =
+      "UPDATE tiles SET tile_data = X'3c68746d6c3e' WHERE zoom_level = 16 AND tile_column = " +
+      std::to_string(tx) + " AND tile_row = " + std::to_string((1 << 16) - 1 - ty);
   assert_int_equal(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
   assert_int_equal(sqlite3_changes(db), 1);
   sqlite3_close(db);
@@ -360,8 +367,8 @@ void test_damaged_tile(void **) {
   const NavMapInfo info = Render(dst, "", "damaged_1500m", 1.5, &im);
   bool note = false;
   for (const std::string &n : info.notes)
-    note = note || (n.find("tile 16/" + std::to_string(tx) + "/" + std::to_string(ty) + ": not a PNG or JPEG image") !=
-                    std::string::npos);
+    note = note || (n.find("tile 16/" + std::to_string(tx) + "/" + std::to_string(ty) +
+                           ": not a PNG or JPEG image") != std::string::npos);
   assert_true(note);
   assert_true(info.tile_coverage < 0.98);
   double qlat, qlon;
@@ -392,20 +399,21 @@ void test_antimeridian_and_poles(void **) {
   std::vector<unsigned char> rgb(3 * w * h, 7);
   NavTilePaint tp;
   // m_per_px chosen so that the zoom is 1: 2 pi a cos(80 deg) / (256 x 2^1) = 13.7 km.
-  NavMapPaintTiles(*src,
-                   [&](double px, double py, double *lat, double *lon) {
-                     *lon = 170.0 + 20.0 * px / w; // 170 .. 190 (= 170 W)
-                     *lat = 79.0 + 10.0 * py / h;  // 79 .. 89 N
-                     return true;
-                   },
-                   13.7e3, 80.0, w, h, &rgb, &tp);
+  NavMapPaintTiles(
+      *src,
+      [&](double px, double py, double *lat, double *lon) {
+        *lon = 170.0 + 20.0 * px / w; // 170 .. 190 (= 170 W)
+        *lat = 79.0 + 10.0 * py / h;  // 79 .. 89 N
+        return true;
+      },
+      13.7e3, 80.0, w, h, &rgb, &tp);
   assert_int_equal(tp.zoom, 1);
   auto at = [&](int i, int j) { return &rgb[3 * (static_cast<size_t>(j) * w + i)]; };
   unsigned char east[3], west[3];
   tilefix::TileRgb(1, 1, 0, east);
   tilefix::TileRgb(1, 0, 0, west);
   for (int j : {5, 30, 55}) { // 79.5, 82, 84.5 N
-    for (int i : {10, 90}) // 171, 179 E
+    for (int i : {10, 90})    // 171, 179 E
       assert_memory_equal(at(i, j), east, 3);
     for (int i : {110, 190}) // 179 W, 171 W
       assert_memory_equal(at(i, j), west, 3);
@@ -423,9 +431,12 @@ void test_antimeridian_and_poles(void **) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_street_scale_mbtiles), cmocka_unit_test(test_xyz_directory_same_picture),
-      cmocka_unit_test(test_zoom_follows_scale),   cmocka_unit_test(test_fallback_beyond_tiles),
-      cmocka_unit_test(test_open_errors),          cmocka_unit_test(test_damaged_tile),
+      cmocka_unit_test(test_street_scale_mbtiles),
+      cmocka_unit_test(test_xyz_directory_same_picture),
+      cmocka_unit_test(test_zoom_follows_scale),
+      cmocka_unit_test(test_fallback_beyond_tiles),
+      cmocka_unit_test(test_open_errors),
+      cmocka_unit_test(test_damaged_tile),
       cmocka_unit_test(test_antimeridian_and_poles),
   };
   return cmocka_run_group_tests(tests, Setup, nullptr);

@@ -96,10 +96,11 @@ inline int MakeTiles(const std::string &dir, double lat, double lon, int z0, int
     sqlite3_close(db);
     return -1;
   }
-  const char *ddl = "CREATE TABLE metadata (name TEXT, value TEXT);"
-                    "CREATE TABLE tiles (zoom_level INTEGER, tile_column INTEGER, tile_row INTEGER, tile_data BLOB);"
-                    "CREATE UNIQUE INDEX tile_index ON tiles (zoom_level, tile_column, tile_row);"
-                    "BEGIN;";
+  const char *ddl =
+      "CREATE TABLE metadata (name TEXT, value TEXT);"
+      "CREATE TABLE tiles (zoom_level INTEGER, tile_column INTEGER, tile_row INTEGER, tile_data BLOB);"
+      "CREATE UNIQUE INDEX tile_index ON tiles (zoom_level, tile_column, tile_row);"
+      "BEGIN;";
   char *msg = nullptr;
   if (sqlite3_exec(db, ddl, nullptr, nullptr, &msg) != SQLITE_OK) {
     *error = std::string("sqlite: ") + (msg ? msg : "?");

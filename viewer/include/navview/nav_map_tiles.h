@@ -68,7 +68,8 @@ public:
 
 private:
   explicit NavTileSource(std::unique_ptr<Impl> impl);
-  friend bool NavTileSourceOpen(const std::string &spec, std::shared_ptr<NavTileSource> *out, std::string *error);
+  friend bool NavTileSourceOpen(const std::string &spec, std::shared_ptr<NavTileSource> *out,
+                                std::string *error);
   std::unique_ptr<Impl> impl_;
 };
 
@@ -88,12 +89,13 @@ using NavMapFromPixel = std::function<bool(double px, double py, double *lat_deg
 
 /** What NavMapPaintTiles drew. */
 struct NavTilePaint {
-  int zoom = -1;          /**< the zoom level used; -1: none (the scale is beyond the source's levels) */
-  int tiles = 0;          /**< tiles drawn */
-  int missing = 0;        /**< tiles the view needed that the source does not have */
-  int failed = 0;         /**< tiles that could not be read or decoded */
-  double coverage = 0.0;  /**< fraction of the image's pixels painted from tiles */
-  std::vector<std::string> notes; /**< for the map's credits (offline, first failure, no tiles at this scale) */
+  int zoom = -1;         /**< the zoom level used; -1: none (the scale is beyond the source's levels) */
+  int tiles = 0;         /**< tiles drawn */
+  int missing = 0;       /**< tiles the view needed that the source does not have */
+  int failed = 0;        /**< tiles that could not be read or decoded */
+  double coverage = 0.0; /**< fraction of the image's pixels painted from tiles */
+  std::vector<std::string>
+      notes; /**< for the map's credits (offline, first failure, no tiles at this scale) */
 };
 
 /** Paint the tiles of @p src over @p rgb (@p w x @p h x 3 bytes, row 0 at the bottom; tile
@@ -101,8 +103,8 @@ struct NavTilePaint {
  *  @p m_per_px, @p lat_deg), lowered to the source's MaxZoom (the tiles are then magnified); below
  *  its MinZoom nothing is painted. Each pixel centre is mapped through @p from_pixel to lat/lon
  *  and into the Web-Mercator tile (bilinear), so any map projection is resampled exactly. */
-void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, double m_per_px, double lat_deg, int w,
-                      int h, std::vector<unsigned char> *rgb, NavTilePaint *result);
+void NavMapPaintTiles(NavTileSource &src, const NavMapFromPixel &from_pixel, double m_per_px, double lat_deg,
+                      int w, int h, std::vector<unsigned char> *rgb, NavTilePaint *result);
 
 /** The credit line of a tile layer: "map tiles: ATTRIBUTION" from @p attribution_override, else
  *  the source's attribution, else its name with "(no attribution given)". */
