@@ -558,13 +558,13 @@ static int NavviewMain(int argc, char **argv) {
     if (view_kind == "map") {
       NavMapInfo minfo;
       ok = NavRenderMapPng(*result, mopt, png, &err, &minfo);
-      // With a tile layer its notes (offline, unreadable tiles, not at this scale) also go to
+      // The tile layer's notes (offline, unreadable tiles, not at this scale) also go to
       // stderr: they are on the map, but a script should see them too.
       if (ok && !mopt.tiles.empty())
         for (const std::string &n : minfo.notes)
-          std::fprintf(stderr, "navview: warning: %s\n", n.c_str());
-    }
-    else if (view_kind == "errors")
+          if (n.rfind("map tiles", 0) == 0 || n.rfind("tiles:", 0) == 0 || n.rfind(mopt.tiles + ":", 0) == 0)
+            std::fprintf(stderr, "navview: warning: %s\n", n.c_str());
+    } else if (view_kind == "errors")
       ok = NavRenderErrorChartPng(*result, copt, png, &err);
     else
       ok = NavRenderSensorErrorChartPng(*result, copt, png, &err);
