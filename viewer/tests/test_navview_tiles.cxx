@@ -16,8 +16,11 @@
 
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkCommand.h>
 #include <vtkPNGReader.h>
+#include <vtkRenderWindowInteractor.h>
 
+#include "map_interactive_internal.h"
 #include "navview/nav_map_data.h"
 #include "navview/nav_map_tiles.h"
 #include "navview/nav_view_map.h"
@@ -376,6 +379,38 @@ void test_damaged_tile(void **) {
   assert_true(GshhgLandAt(im, info, qlat, qlon));
 }
 
+// navview's interactive map with tiles: each wheel step rebuilds the map, and the tile zoom
+// follows the scale (8 km across: 14; after six steps in, 2.1 km: 16), the credit stays.
+void test_interactive_zoom(void **) {
+  NavMapOptions o;
+  o.width_px = kW;
+  o.height_px = kH;
+  o.center_lat_deg = kLat;
+  o.center_lon_deg = kLon;
+  o.span_km = 8.0;
+  o.multisamples = 0;
+  o.show_places = false;
+  o.tiles = Fixture() + "/tiles.mbtiles";
+  NavMapInteractive m;
+  std::string err;
+  const NavResult r = Track();
+  if (!m.Open(r, o, &err)) fail_msg("%s", err.c_str());
+  assert_int_equal(m.Info.tile_zoom, 14);
+  int zooms[7] = {m.Info.tile_zoom};
+  for (int k = 1; k <= 6; ++k) {
+    m.Iren->SetEventPosition(kW / 2, kH / 2);
+    m.Iren->InvokeEvent(vtkCommand::MouseWheelForwardEvent);
+    zooms[k] = m.Info.tile_zoom;
+    std::printf("  wheel step %d: %.3g km across, tile zoom %d, %d tiles, %.1f %% covered, rebuild %.0f ms\n",
+                k, m.Info.span_x_m / 1e3, m.Info.tile_zoom, m.Info.tiles, 100.0 * m.Info.tile_coverage,
+                m.LastRebuildMs);
+    assert_true(zooms[k] >= zooms[k - 1]);
+    assert_false(m.Info.tile_credit.empty());
+  }
+  assert_near(m.Info.span_x_m, 8e3 / std::pow(1.25, 6), 1e-6);
+  assert_int_equal(m.Info.tile_zoom, 16);
+}
+
 void test_antimeridian_and_poles(void **) {
   // The four tiles of zoom 1 (x 0: west, 1: east; y 0: north, 1: south) and a made-up view
   // 200 x 100 px in plate carree from 170 E across the date line to 170 W and from 89 N to
@@ -438,6 +473,7 @@ int main(void) {
       cmocka_unit_test(test_open_errors),
       cmocka_unit_test(test_damaged_tile),
       cmocka_unit_test(test_antimeridian_and_poles),
+      cmocka_unit_test(test_interactive_zoom),
   };
   return cmocka_run_group_tests(tests, Setup, nullptr);
 }
