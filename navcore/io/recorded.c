@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <threads.h>
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
@@ -722,6 +723,170 @@ nav_status nav_rec_load_pva(const char *path, nav_rec_pva *out, size_t capacity,
   return load(path, NAV_REC_PVA, read_pva_v, out, sizeof *out, capacity, count, diag);
 }
 
+/* ---------------------------------------------------------------- IMU file in memory */
+
+/* Files below this size are read by one thread: a second one would not pay for its start. */
+#define SPLIT_MIN_BYTES (4u * 1024u * 1024u)
+
+/* The records of one stretch of an IMU file (a memory reader over it), its line count and the
+ * state a sequential reader would carry into the next stretch. */
+typedef struct imu_part {
+  const char *text, *name;
+  size_t len;
+  nav_imu_increment *rec;
+  size_t n, cap;
+  long lines, cut_line, last_line;
+  nav_status st;
+  nav_diag diag;
+} imu_part;
+
+static int imu_part_read(void *arg) {
+  imu_part *q = arg;
+  nav_rec_reader *r = NULL;
+  q->st = nav_rec_reader_open_memory(q->text, q->len, q->name, NAV_REC_IMU, &r);
+  for (bool got = true; q->st == NAV_OK && got;) {
+    if (q->n == q->cap) {
+      const size_t cap = q->cap ? 2 * q->cap : 1024;
+      nav_imu_increment *g = realloc(q->rec, cap * sizeof *g);
+      if (!g) {
+        q->st = NAV_ERR_NO_MEMORY;
+        break;
+      }
+      q->rec = g;
+      q->cap = cap;
+    }
+    q->st = nav_rec_read_imu(r, &q->rec[q->n], &got);
+    if (q->st != NAV_OK) q->diag = r->diag;
+    if (q->st == NAV_OK && got) q->n++;
+  }
+  if (r) {
+    q->lines = r->line;
+    q->cut_line = r->cut_line;
+    q->last_line = r->rec_line;
+  }
+  nav_rec_reader_destroy(r);
+  return 0;
+}
+
+void nav_rec_imu_array_free(nav_rec_imu_array *a) {
+  if (!a) return;
+  free(a->records);
+  memset(a, 0, sizeof *a);
+}
+
+static void imu_part_to_array(imu_part *q, nav_rec_imu_array *out) {
+  out->records = q->rec;
+  out->count = q->n;
+  out->cut_line = q->cut_line;
+  out->last_record_line = q->last_line;
+  q->rec = NULL;
+}
+
+nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out, nav_diag *diag) {
+  if (!path || !out) return NAV_ERR_INVALID_ARG;
+  FILE *f = NULL;
+  char *text = NULL;
+  imu_part a, b;
+  memset(&a, 0, sizeof a);
+  memset(&b, 0, sizeof b);
+  char why[320];
+  nav_status st = nav_io_fopen_regular(path, &f, why, sizeof why);
+  if (st != NAV_OK) {
+    /* The reader's wording of the same failure ("cannot open the IMU file: ..."). */
+    nav_rec_reader *r = NULL;
+    st = nav_rec_reader_open(path, NAV_REC_IMU, &r, diag);
+    nav_rec_reader_destroy(r);
+    return st != NAV_OK ? st : NAV_ERR_IO;
+  }
+  struct stat sb;
+  if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) || sb.st_size < 0) {
+    fclose(f);
+    diag_set(diag, path, 0, 0, "", "cannot read the IMU file: not a regular file");
+    return NAV_ERR_IO;
+  }
+  const size_t size = (size_t)sb.st_size;
+  if (size > max_bytes) {
+    fclose(f);
+    diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size, max_bytes);
+    return NAV_ERR_OUT_OF_RANGE;
+  }
+  /* One read of the whole file (a file that grows meanwhile is read to the size it had). */
+  text = malloc(size + 1);
+  if (!text) {
+    fclose(f);
+    return NAV_ERR_NO_MEMORY;
+  }
+  const size_t got = fread(text, 1, size, f);
+  const bool read_err = ferror(f) != 0;
+  fclose(f);
+  if (read_err) {
+    diag_set(diag, path, 0, 0, "", "read error: %s", strerror(errno));
+    free(text);
+    return NAV_ERR_IO;
+  }
+  /* Split at the line end nearest past the middle; the second half's reader starts at a line
+   * start, as the sequential one reaches it. */
+  const char *nl = got >= SPLIT_MIN_BYTES ? memchr(text + got / 2, '\n', got - got / 2) : NULL;
+  const size_t split = nl ? (size_t)(nl - text) + 1 : got;
+  a.text = text;
+  a.len = split;
+  a.name = path;
+  b.text = text + split;
+  b.len = got - split;
+  b.name = path;
+  thrd_t th;
+  bool threaded = false;
+  if (b.len > 0) threaded = thrd_create(&th, imu_part_read, &b) == thrd_success;
+  imu_part_read(&a);
+  if (b.len > 0) {
+    if (threaded)
+      thrd_join(th, NULL);
+    else
+      imu_part_read(&b);
+  }
+  /* The second half continues the first: record indices and line numbers go on, the first
+   * interval spans the split, and time must increase across it. */
+  bool joined = a.st == NAV_OK && b.st == NAV_OK;
+  if (joined && b.n > 0 && a.n > 0 && !(b.rec[0].t_s > a.rec[a.n - 1].t_s)) joined = false;
+  if (joined && b.len > 0) {
+    nav_imu_increment *all = a.n + b.n > a.cap ? realloc(a.rec, (a.n + b.n) * sizeof *all) : a.rec;
+    if (!all) {
+      st = NAV_ERR_NO_MEMORY;
+      goto cleanup;
+    }
+    a.rec = all;
+    for (size_t i = 0; i < b.n; ++i) {
+      nav_imu_increment m = b.rec[i];
+      m.k += (int64_t)a.n;
+      if (i == 0 && a.n > 0) m.dt_s = m.t_s - a.rec[a.n - 1].t_s;
+      all[a.n + i] = m;
+    }
+    a.n += b.n;
+    if (b.n > 0) a.last_line = a.lines + b.last_line;
+    a.cut_line = b.cut_line ? a.lines + b.cut_line : a.cut_line;
+  } else if (!joined && b.len > 0) {
+    /* An error somewhere, or time not increasing across the split: the sequential reader over the
+     * whole text finds the first problem and words it exactly. */
+    free(a.rec);
+    memset(&a, 0, sizeof a);
+    a.text = text;
+    a.len = got;
+    a.name = path;
+    imu_part_read(&a);
+  }
+  st = a.st;
+  if (st != NAV_OK) {
+    if (diag) *diag = a.diag;
+    goto cleanup;
+  }
+  imu_part_to_array(&a, out);
+cleanup:
+  free(a.rec);
+  free(b.rec);
+  free(text);
+  return st;
+}
+
 nav_traj_state nav_rec_pva_to_state(const nav_rec_pva *row) {
   nav_traj_state s;
   memset(&s, 0, sizeof s);
@@ -751,6 +916,7 @@ nav_replay_config nav_replay_config_default(void) {
   c.ref_sync_tol_s = 1e-4;
   c.output_interval_s = 0.1;
   c.gap_factor = 1.5;
+  c.read_ahead = true;
   return c;
 }
 
@@ -805,12 +971,186 @@ static nav_frame frame_at(nav_geodetic p) {
   return f;
 }
 
+/* A reference row with the parts of its errors that depend on it alone (ned_errors()), which the
+ * reading thread computes ahead of the navigation. */
+typedef struct ref_item {
+  nav_rec_pva row;
+  double slt, clt, sot, cot; /* sin and cos of its latitude and longitude */
+  nav_quat qt;               /* q_b_n of its Euler angles */
+} ref_item;
+
+static void ref_item_fill(ref_item *it) {
+  const nav_rec_pva *ref = &it->row;
+  it->slt = sin(ref->pos.lat_rad);
+  it->clt = cos(ref->pos.lat_rad);
+  it->sot = sin(ref->pos.lon_rad);
+  it->cot = cos(ref->pos.lon_rad);
+  it->qt = nav_euler_to_quat(ref->att);
+}
+
+/*
+ * Read-ahead of one streamed input (IMU or reference): a thread reads records into a ring of
+ * RA_CAP slots, handed over in batches under a mutex, so the navigation rarely waits and the
+ * memory stays flat. Each slot carries what the consumer would have asked the reader right after
+ * that record (status, progress fraction, cut line), so the replay sees exactly what reading on
+ * its own thread gives. After a terminal slot (an error or the end) the thread stops; the reader's
+ * diag is then stable and read by the consumer.
+ */
+#define RA_CAP 2048u
+#define RA_BATCH 64u
+
+typedef struct ra_item {
+  nav_status st;
+  bool got;
+  double fraction;
+  long cut_line;
+  union {
+    nav_imu_increment imu;
+    ref_item ref;
+  } u;
+} ra_item;
+
+typedef struct read_ahead {
+  nav_rec_reader *r;
+  bool threaded;
+  thrd_t th;
+  mtx_t m;
+  cnd_t nonempty, nonfull;
+  size_t head, tail; /* published by producer / released by consumer (under m) */
+  bool stop;         /* under m */
+  size_t c_head, c_tail, released; /* the consumer's view */
+  bool ended;
+  ra_item last;
+  ra_item *ring;
+} read_ahead;
+
+static void ra_read_one(nav_rec_reader *r, ra_item *it) {
+  if (r->fmt == NAV_REC_IMU) {
+    it->st = nav_rec_read_imu(r, &it->u.imu, &it->got);
+  } else {
+    it->st = nav_rec_read_pva(r, &it->u.ref.row, &it->got);
+    if (it->st == NAV_OK && it->got) ref_item_fill(&it->u.ref);
+  }
+  it->fraction = nav_rec_reader_fraction(r);
+  it->cut_line = r->cut_line;
+}
+
+static int ra_main(void *arg) {
+  read_ahead *a = arg;
+  size_t head = 0;
+  for (bool end = false; !end;) {
+    mtx_lock(&a->m);
+    while (head - a->tail == RA_CAP && !a->stop)
+      cnd_wait(&a->nonfull, &a->m);
+    const bool stop = a->stop;
+    const size_t room = RA_CAP - (head - a->tail);
+    mtx_unlock(&a->m);
+    if (stop) break;
+    const size_t n = room < RA_BATCH ? room : RA_BATCH;
+    size_t k = 0;
+    while (k < n && !end) {
+      ra_item *it = &a->ring[(head + k) % RA_CAP];
+      ra_read_one(a->r, it);
+      end = it->st != NAV_OK || !it->got;
+      ++k;
+    }
+    head += k;
+    mtx_lock(&a->m);
+    a->head = head;
+    cnd_signal(&a->nonempty);
+    mtx_unlock(&a->m);
+  }
+  return 0;
+}
+
+/* Start reading @p r ahead (on a thread when @p threaded and one can be made). */
+static nav_status ra_start(read_ahead *a, nav_rec_reader *r, bool threaded) {
+  memset(a, 0, sizeof *a);
+  a->r = r;
+  a->ring = malloc((threaded ? RA_CAP : 1u) * sizeof *a->ring);
+  if (!a->ring) return NAV_ERR_NO_MEMORY;
+  if (!threaded) return NAV_OK;
+  if (mtx_init(&a->m, mtx_plain) != thrd_success) return NAV_OK;
+  if (cnd_init(&a->nonempty) != thrd_success) {
+    mtx_destroy(&a->m);
+    return NAV_OK;
+  }
+  if (cnd_init(&a->nonfull) != thrd_success) {
+    cnd_destroy(&a->nonempty);
+    mtx_destroy(&a->m);
+    return NAV_OK;
+  }
+  if (thrd_create(&a->th, ra_main, a) != thrd_success) {
+    cnd_destroy(&a->nonfull);
+    cnd_destroy(&a->nonempty);
+    mtx_destroy(&a->m);
+    return NAV_OK; /* read on the calling thread */
+  }
+  a->threaded = true;
+  return NAV_OK;
+}
+
+/* The next record; valid until the next call. */
+static const ra_item *ra_next(read_ahead *a) {
+  if (a->ended) return &a->last;
+  const ra_item *it;
+  if (!a->threaded) {
+    ra_read_one(a->r, &a->ring[0]);
+    it = &a->ring[0];
+  } else {
+    /* The slots consumed so far (the previous item included: its caller is done with it) go back
+     * to the producer a batch at a time. */
+    if (a->c_tail - a->released >= RA_BATCH || a->c_tail == a->c_head) {
+      mtx_lock(&a->m);
+      a->tail = a->c_tail;
+      a->released = a->c_tail;
+      cnd_signal(&a->nonfull);
+      while (a->head == a->c_tail)
+        cnd_wait(&a->nonempty, &a->m);
+      a->c_head = a->head;
+      mtx_unlock(&a->m);
+    }
+    it = &a->ring[a->c_tail++ % RA_CAP];
+  }
+  if (it->st != NAV_OK || !it->got) {
+    a->last = *it;
+    a->ended = true;
+    return &a->last;
+  }
+  return it;
+}
+
+/* Stop the thread (it finishes at most one batch) and release the ring; the reader stays. */
+static void ra_stop(read_ahead *a) {
+  if (a->threaded) {
+    mtx_lock(&a->m);
+    a->stop = true;
+    cnd_signal(&a->nonfull);
+    mtx_unlock(&a->m);
+    thrd_join(a->th, NULL);
+    cnd_destroy(&a->nonfull);
+    cnd_destroy(&a->nonempty);
+    mtx_destroy(&a->m);
+    a->threaded = false;
+  }
+  free(a->ring);
+  a->ring = NULL;
+}
+
 /* The open inputs of a replay with one record of look-ahead each. */
 typedef struct replay {
   const nav_replay_config *cfg;
   nav_rec_reader *imu, *gnss, *ref;
+  read_ahead imu_ra, ref_ra;
+  bool imu_ra_on, ref_ra_on;
+  size_t imu_idx;      /* cfg->imu: records handed out */
+  bool imu_end_seen;   /* cfg->imu: a read past the last record */
+  double imu_fraction; /* progress */
+  long imu_cut_line;   /* as nav_rec_reader_cut_line() at this point of the reading */
+  ref_item ref_it;     /* the current reference row and its precomputed parts */
   nav_rec_pva ref_row;
   bool ref_have;
+  long ref_cut_line;
   nav_ins_gnss_fix fix;
   bool fix_have;
   nav_ins_gnss_raw_epoch raw; /* cfg->raw: the next raw epoch */
@@ -824,9 +1164,45 @@ static nav_status reader_failed(replay *p, const nav_rec_reader *r, nav_status s
 }
 
 static nav_status ref_next(replay *p) {
-  const nav_status st = nav_rec_read_pva(p->ref, &p->ref_row, &p->ref_have);
-  if (st != NAV_OK) return reader_failed(p, p->ref, st);
-  if (p->ref_have) p->sum->ref_rows++;
+  const ra_item *it = ra_next(&p->ref_ra);
+  if (it->st != NAV_OK) {
+    p->ref_have = false;
+    return reader_failed(p, p->ref, it->st);
+  }
+  p->ref_have = it->got;
+  p->ref_cut_line = it->cut_line;
+  if (p->ref_have) {
+    p->ref_it = it->u.ref;
+    p->ref_row = p->ref_it.row;
+    p->sum->ref_rows++;
+  }
+  return NAV_OK;
+}
+
+/* The next IMU record: from the caller's array, or the (read-ahead) reader. */
+static nav_status imu_next(replay *p, nav_imu_increment *inc, bool *got) {
+  const nav_rec_imu_array *a = p->cfg->imu;
+  if (a) {
+    *got = p->imu_idx < a->count;
+    if (*got) {
+      *inc = a->records[p->imu_idx++];
+    } else {
+      p->imu_end_seen = true;
+    }
+    p->imu_fraction = a->count ? (double)p->imu_idx / (double)a->count : 1.0;
+    /* The streaming reader has read the last line once it returned the record on it, or tried to
+     * read past the last record. */
+    if (a->cut_line && (p->imu_end_seen || (p->imu_idx == a->count && a->cut_line == a->last_record_line)))
+      p->imu_cut_line = a->cut_line;
+    return NAV_OK;
+  }
+  const ra_item *it = ra_next(&p->imu_ra);
+  p->imu_fraction = it->fraction;
+  p->imu_cut_line = it->cut_line;
+  *got = false;
+  if (it->st != NAV_OK) return it->st;
+  *got = it->got;
+  if (*got) *inc = it->u.imu;
   return NAV_OK;
 }
 
@@ -929,11 +1305,12 @@ static nav_vec3 ecef_of(double sl, double cl, double so, double co, double h) {
  * Euler angles (the reference's straight from its row). The values agree with the general path
  * to rounding (a few 1e-10 m, 1e-14 rad: the same formulas without the geodetic inversions).
  */
-static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e) {
+static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
+  const nav_rec_pva *ref = &ri->row;
   nav_epoch_errors r;
   r.t_s = ref->t_s;
-  const double slt = sin(ref->pos.lat_rad), clt = cos(ref->pos.lat_rad);
-  const double sot = sin(ref->pos.lon_rad), cot = cos(ref->pos.lon_rad);
+  const double slt = ri->slt, clt = ri->clt;
+  const double sot = ri->sot, cot = ri->cot;
   const double sle = e->sin_lat, cle = e->cos_lat;
   const double soe = sin(e->pos.lon_rad), coe = cos(e->pos.lon_rad);
   const nav_mat3 Ct = dcm_n_e(slt, clt, sot, cot), Ce = dcm_n_e(sle, cle, soe, coe);
@@ -947,7 +1324,7 @@ static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e)
   r.vel_err_n_mps = nav_mat3_mul_vec(Ct_t, dv);
   r.vel_err_mps = nav_vec3_norm(r.vel_err_n_mps);
   /* C_b_e(ref)^T C_b_e(est) = C_n_b(ref) M C_b_n(est) with M = C_e_n(ref) C_n_e(est) ~ I. */
-  const nav_quat qt = nav_euler_to_quat(ref->att);
+  const nav_quat qt = ri->qt;
   const nav_quat qm = nav_quat_from_dcm(nav_mat3_mul(Ct_t, Ce));
   r.att_err_rad = nav_quat_angle_between(qt, nav_quat_mul(qm, e->q_b_n));
   const nav_euler ee = nav_quat_to_euler(e->q_b_n, NULL);
@@ -958,10 +1335,10 @@ static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e)
 }
 
 /* The errors at a reference row: the NED path when the navigation has one, else the general. */
-static nav_epoch_errors errors_at(const nav_frame *frame, const nav_rec_pva *ref, const nav_side *n) {
+static nav_epoch_errors errors_at(const nav_frame *frame, const ref_item *ref, const nav_side *n) {
   nav_ins_ned ned;
   if (nav_ned(n, &ned)) return ned_errors(ref, &ned);
-  const nav_traj_state ts = nav_rec_pva_to_state(ref);
+  const nav_traj_state ts = nav_rec_pva_to_state(&ref->row);
   return nav_errors_compute(frame, &ts, nav_state(n));
 }
 
@@ -985,9 +1362,17 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->free_ins = cfg->gnss_path == NULL && cfg->raw == NULL;
   const bool aided = !sum->free_ins;
 
-  st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
+  if (!cfg->imu) st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
   if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
+  if (st == NAV_OK && p.imu) {
+    st = ra_start(&p.imu_ra, p.imu, cfg->read_ahead);
+    p.imu_ra_on = st == NAV_OK;
+  }
+  if (st == NAV_OK) {
+    st = ra_start(&p.ref_ra, p.ref, cfg->read_ahead);
+    p.ref_ra_on = st == NAV_OK;
+  }
   if (st != NAV_OK) goto cleanup;
   st = ref_next(&p);
   if (st == NAV_OK && aided) st = fix_next(&p);
@@ -998,7 +1383,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   nav_imu_increment inc;
   bool got = false;
   for (;;) {
-    st = nav_rec_read_imu(p.imu, &inc, &got);
+    st = imu_next(&p, &inc, &got);
     if (st != NAV_OK) {
       reader_failed(&p, p.imu, st);
       goto cleanup;
@@ -1077,7 +1462,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0, gap_max_h = 0.0;
   bool have_fix = false, have_spacing = false;
   while (!stop) {
-    st = nav_rec_read_imu(p.imu, &inc, &got);
+    st = imu_next(&p, &inc, &got);
     if (st != NAV_OK) {
       reader_failed(&p, p.imu, st);
       goto cleanup;
@@ -1129,7 +1514,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
           g.t1_s = p.fix.t_s;
           g.pos_h_max_m = gap_max_h;
           if (has_ref) {
-            const nav_epoch_errors e = errors_at(&frame, &p.ref_row, &nav);
+            const nav_epoch_errors e = errors_at(&frame, &p.ref_it, &nav);
             g.has_end_errors = true;
             g.pos_h_end_m = e.pos_err_h_m;
             g.pos_v_end_m = e.pos_err_v_m;
@@ -1165,7 +1550,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const bool output = j != last_out && fabs(t - (double)j * cfg->output_interval_s) <= 0.5 * dt;
     if (output) last_out = j;
     if (has_ref) {
-      err = errors_at(&frame, &p.ref_row, &nav);
+      err = errors_at(&frame, &p.ref_it, &nav);
       nav_replay_stats_add(&acc, &err);
       if (cfg->scored) cfg->scored(cfg->user, &err);
       if (output) nav_replay_stats_add(&acc_out, &err);
@@ -1184,7 +1569,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       if (st != NAV_OK) goto cleanup;
     }
     if (cfg->progress && sum->imu_steps % 8192 == 0) {
-      const nav_progress pr = {"replay", 0, nav_rec_reader_fraction(p.imu), t};
+      const nav_progress pr = {"replay", 0, p.imu_fraction, t};
       if (cfg->progress(cfg->user, &pr) == NAV_STOP) stop = true;
     }
   }
@@ -1211,13 +1596,15 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->stats_output = nav_replay_stats_result(&acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
-  sum->imu_cut_line = nav_rec_reader_cut_line(p.imu);
+  sum->imu_cut_line = p.imu_cut_line;
   sum->gnss_cut_line = nav_rec_reader_cut_line(p.gnss);
-  sum->ref_cut_line = nav_rec_reader_cut_line(p.ref);
+  sum->ref_cut_line = p.ref_cut_line;
   *out = *sum;
   st = stop ? NAV_ERR_CANCELLED : NAV_OK;
 
 cleanup:
+  if (p.imu_ra_on) ra_stop(&p.imu_ra);
+  if (p.ref_ra_on) ra_stop(&p.ref_ra);
   nav_ins_gnss_destroy(nav.x);
   nav_ins_destroy(nav.ins);
   nav_rec_reader_destroy(p.imu);
