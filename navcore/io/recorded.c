@@ -44,6 +44,7 @@ struct nav_rec_reader {
   int gnss_cols;      /* column count fixed by the first GNSS record (0 before) */
   long cut_line;      /* a last line without a line end (the file may have been cut), else 0 */
   locale_t c_numeric; /* "C" numbers for strtod, whatever the process locale (a GUI may set one) */
+  size_t file_left;   /* bytes of the file still to read (a stretch of it; SIZE_MAX: to its end) */
 };
 
 /* ---------------------------------------------------------------- diagnostics */
@@ -155,6 +156,7 @@ static nav_status reader_new(nav_rec_format fmt, const char *name, nav_rec_reade
   }
   r->fmt = fmt;
   r->failed = NAV_OK;
+  r->file_left = SIZE_MAX;
   snprintf(r->diag.file, sizeof r->diag.file, "%s", name ? name : "");
   *out = r;
   return NAV_OK;
@@ -221,9 +223,10 @@ static nav_status refill(nav_rec_reader *r) {
     r->len -= r->pos;
     r->pos = 0;
   }
-  const size_t room = BUF_CAP - r->len;
+  size_t room = BUF_CAP - r->len;
   size_t got = 0;
   if (r->f) {
+    if (room > r->file_left) room = r->file_left;
     got = fread(r->buf + r->len, 1, room, r->f);
     if (got < room) {
       if (ferror(r->f)) {
@@ -232,6 +235,10 @@ static nav_status refill(nav_rec_reader *r) {
         return fail(r, NAV_ERR_IO, 0, 0, "", msg);
       }
       r->src_eof = true;
+    }
+    if (r->file_left != SIZE_MAX) {
+      r->file_left -= got;
+      if (r->file_left == 0) r->src_eof = true;
     }
   } else {
     got = r->mem_len - r->mem_pos < room ? r->mem_len - r->mem_pos : room;
@@ -728,11 +735,12 @@ nav_status nav_rec_load_pva(const char *path, nav_rec_pva *out, size_t capacity,
 /* Files below this size are read by one thread: a second one would not pay for its start. */
 #define SPLIT_MIN_BYTES (4u * 1024u * 1024u)
 
-/* The records of one stretch of an IMU file (a memory reader over it), its line count and the
- * state a sequential reader would carry into the next stretch. */
+/* The records of one stretch of an IMU file ([off, off + len), or all of it when whole), its
+ * line count and the state a sequential reader would carry into the next stretch. */
 typedef struct imu_part {
-  const char *text, *name;
-  size_t len;
+  const char *path;
+  size_t off, len;
+  bool whole;
   nav_imu_increment *rec;
   size_t n, cap;
   long lines, cut_line, last_line;
@@ -743,10 +751,17 @@ typedef struct imu_part {
 static int imu_part_read(void *arg) {
   imu_part *q = arg;
   nav_rec_reader *r = NULL;
-  q->st = nav_rec_reader_open_memory(q->text, q->len, q->name, NAV_REC_IMU, &r);
+  q->st = nav_rec_reader_open(q->path, NAV_REC_IMU, &r, &q->diag);
+  if (q->st == NAV_OK && !q->whole) {
+    r->file_left = q->len;
+    if (fseeko(r->f, (off_t)q->off, SEEK_SET) != 0) {
+      diag_set(&q->diag, q->path, 0, 0, "", "cannot read the IMU file: %s", strerror(errno));
+      q->st = NAV_ERR_IO;
+    }
+  }
   for (bool got = true; q->st == NAV_OK && got;) {
     if (q->n == q->cap) {
-      const size_t cap = q->cap ? 2 * q->cap : 1024;
+      const size_t cap = q->cap ? 2 * q->cap : 4096;
       nav_imu_increment *g = realloc(q->rec, cap * sizeof *g);
       if (!g) {
         q->st = NAV_ERR_NO_MEMORY;
@@ -774,21 +789,22 @@ void nav_rec_imu_array_free(nav_rec_imu_array *a) {
   memset(a, 0, sizeof *a);
 }
 
-static void imu_part_to_array(imu_part *q, nav_rec_imu_array *out) {
-  out->records = q->rec;
-  out->count = q->n;
-  out->cut_line = q->cut_line;
-  out->last_record_line = q->last_line;
-  q->rec = NULL;
+/* Offset just past the first line end at or after @p from (0 when there is none within 64 KiB,
+ * longer than any record line). */
+static size_t line_start_after(FILE *f, size_t from) {
+  char win[64 * 1024];
+  if (fseeko(f, (off_t)from, SEEK_SET) != 0) return 0;
+  const size_t n = fread(win, 1, sizeof win, f);
+  const char *nl = memchr(win, '\n', n);
+  return nl ? from + (size_t)(nl - win) + 1 : 0;
 }
 
 nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out, nav_diag *diag) {
   if (!path || !out) return NAV_ERR_INVALID_ARG;
-  FILE *f = NULL;
-  char *text = NULL;
   imu_part a, b;
   memset(&a, 0, sizeof a);
   memset(&b, 0, sizeof b);
+  FILE *f = NULL;
   char why[320];
   nav_status st = nav_io_fopen_regular(path, &f, why, sizeof why);
   if (st != NAV_OK) {
@@ -799,56 +815,38 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
     return st != NAV_OK ? st : NAV_ERR_IO;
   }
   struct stat sb;
-  if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) || sb.st_size < 0) {
-    fclose(f);
-    diag_set(diag, path, 0, 0, "", "cannot read the IMU file: not a regular file");
-    return NAV_ERR_IO;
-  }
-  const size_t size = (size_t)sb.st_size;
+  size_t size = 0, split = 0;
+  if (fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0) size = (size_t)sb.st_size;
   if (size > max_bytes) {
     fclose(f);
     diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size, max_bytes);
     return NAV_ERR_OUT_OF_RANGE;
   }
-  /* One read of the whole file (a file that grows meanwhile is read to the size it had). */
-  text = malloc(size + 1);
-  if (!text) {
-    fclose(f);
-    return NAV_ERR_NO_MEMORY;
-  }
-  const size_t got = fread(text, 1, size, f);
-  const bool read_err = ferror(f) != 0;
+  /* Two stretches split at a line start past the middle: the second reader starts where the
+   * sequential one would start that line. */
+  if (size >= SPLIT_MIN_BYTES) split = line_start_after(f, size / 2);
   fclose(f);
-  if (read_err) {
-    diag_set(diag, path, 0, 0, "", "read error: %s", strerror(errno));
-    free(text);
-    return NAV_ERR_IO;
-  }
-  /* Split at the line end nearest past the middle; the second half's reader starts at a line
-   * start, as the sequential one reaches it. */
-  const char *nl = got >= SPLIT_MIN_BYTES ? memchr(text + got / 2, '\n', got - got / 2) : NULL;
-  const size_t split = nl ? (size_t)(nl - text) + 1 : got;
-  a.text = text;
+  a.path = path;
+  b.path = path;
+  a.whole = split == 0;
   a.len = split;
-  a.name = path;
-  b.text = text + split;
-  b.len = got - split;
-  b.name = path;
+  b.off = split;
+  b.len = size - split;
   thrd_t th;
   bool threaded = false;
-  if (b.len > 0) threaded = thrd_create(&th, imu_part_read, &b) == thrd_success;
+  if (split > 0) threaded = thrd_create(&th, imu_part_read, &b) == thrd_success;
   imu_part_read(&a);
-  if (b.len > 0) {
+  if (split > 0) {
     if (threaded)
       thrd_join(th, NULL);
     else
       imu_part_read(&b);
   }
-  /* The second half continues the first: record indices and line numbers go on, the first
+  /* The second stretch continues the first: record indices and line numbers go on, the first
    * interval spans the split, and time must increase across it. */
   bool joined = a.st == NAV_OK && b.st == NAV_OK;
   if (joined && b.n > 0 && a.n > 0 && !(b.rec[0].t_s > a.rec[a.n - 1].t_s)) joined = false;
-  if (joined && b.len > 0) {
+  if (split > 0 && joined) {
     nav_imu_increment *all = a.n + b.n > a.cap ? realloc(a.rec, (a.n + b.n) * sizeof *all) : a.rec;
     if (!all) {
       st = NAV_ERR_NO_MEMORY;
@@ -864,14 +862,13 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
     a.n += b.n;
     if (b.n > 0) a.last_line = a.lines + b.last_line;
     a.cut_line = b.cut_line ? a.lines + b.cut_line : a.cut_line;
-  } else if (!joined && b.len > 0) {
+  } else if (split > 0) {
     /* An error somewhere, or time not increasing across the split: the sequential reader over the
-     * whole text finds the first problem and words it exactly. */
+     * whole file finds the first problem and words it exactly. */
     free(a.rec);
     memset(&a, 0, sizeof a);
-    a.text = text;
-    a.len = got;
-    a.name = path;
+    a.path = path;
+    a.whole = true;
     imu_part_read(&a);
   }
   st = a.st;
@@ -879,11 +876,14 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
     if (diag) *diag = a.diag;
     goto cleanup;
   }
-  imu_part_to_array(&a, out);
+  out->records = a.rec;
+  out->count = a.n;
+  out->cut_line = a.cut_line;
+  out->last_record_line = a.last_line;
+  a.rec = NULL;
 cleanup:
   free(a.rec);
   free(b.rec);
-  free(text);
   return st;
 }
 
@@ -1040,8 +1040,11 @@ static int ra_main(void *arg) {
   size_t head = 0;
   for (bool end = false; !end;) {
     mtx_lock(&a->m);
-    while (head - a->tail == RA_CAP && !a->stop)
-      cnd_wait(&a->nonfull, &a->m);
+    /* When the ring is full, wait for half a ring of room, not one slot: one sleep and wake-up
+     * per RA_CAP / 2 records instead of one per batch. */
+    if (head - a->tail == RA_CAP)
+      while (RA_CAP - (head - a->tail) < RA_CAP / 2 && !a->stop)
+        cnd_wait(&a->nonfull, &a->m);
     const bool stop = a->stop;
     const size_t room = RA_CAP - (head - a->tail);
     mtx_unlock(&a->m);
@@ -1104,7 +1107,7 @@ static const ra_item *ra_next(read_ahead *a) {
       mtx_lock(&a->m);
       a->tail = a->c_tail;
       a->released = a->c_tail;
-      cnd_signal(&a->nonfull);
+      if (RA_CAP - (a->head - a->tail) >= RA_CAP / 2) cnd_signal(&a->nonfull);
       while (a->head == a->c_tail)
         cnd_wait(&a->nonempty, &a->m);
       a->c_head = a->head;
