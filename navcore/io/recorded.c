@@ -989,16 +989,125 @@ static void ref_item_fill(ref_item *it) {
 }
 
 /*
- * Read-ahead of one streamed input (IMU or reference): a thread reads records into a ring of
- * RA_CAP slots, handed over in batches under a mutex, so the navigation rarely waits and the
- * memory stays flat. Each slot carries what the consumer would have asked the reader right after
- * that record (status, progress fraction, cut line), so the replay sees exactly what reading on
- * its own thread gives. After a terminal slot (an error or the end) the thread stops; the reader's
- * diag is then stable and read by the consumer.
+ * A single-producer single-consumer queue of fixed-size items between two threads: a ring of
+ * RING_CAP slots handed over in batches under a mutex. Each side sleeps only when the ring is full
+ * (producer) or empty (consumer), and is woken once half a ring is free or filled (or at the end),
+ * so a run of 193 000 items costs a few hundred wake-ups, not one per item. Items keep their
+ * order, so what the consumer sees is what one thread doing both would see.
  */
-#define RA_CAP 2048u
-#define RA_BATCH 64u
+#define RING_CAP 2048u
+#define RING_BATCH 64u
 
+typedef struct ring {
+  mtx_t m;
+  cnd_t nonempty, nonfull;
+  size_t head, tail;   /* published / released items (under m) */
+  bool closed, stopped; /* producer finished / consumer wants no more (under m) */
+  size_t size;         /* bytes per item */
+  unsigned char *buf;
+  size_t p_head, p_pub, p_tail;           /* producer's view */
+  size_t c_head, c_tail, c_rel;           /* consumer's view */
+  bool c_closed;
+} ring;
+
+static bool ring_init(ring *r, size_t item_size) {
+  memset(r, 0, sizeof *r);
+  r->size = item_size;
+  r->buf = malloc(RING_CAP * item_size);
+  if (!r->buf) return false;
+  if (mtx_init(&r->m, mtx_plain) != thrd_success) goto fail_buf;
+  if (cnd_init(&r->nonempty) != thrd_success) goto fail_m;
+  if (cnd_init(&r->nonfull) != thrd_success) goto fail_ne;
+  return true;
+fail_ne:
+  cnd_destroy(&r->nonempty);
+fail_m:
+  mtx_destroy(&r->m);
+fail_buf:
+  free(r->buf);
+  r->buf = NULL;
+  return false;
+}
+
+static void ring_destroy(ring *r) {
+  if (!r->buf) return;
+  cnd_destroy(&r->nonfull);
+  cnd_destroy(&r->nonempty);
+  mtx_destroy(&r->m);
+  free(r->buf);
+  r->buf = NULL;
+}
+
+/* Producer: publish the committed items (under m, with the wake-up rule above). */
+static void ring_publish(ring *r, bool closing) {
+  mtx_lock(&r->m);
+  r->head = r->p_head;
+  if (closing) r->closed = true;
+  r->p_tail = r->tail;
+  if (closing || r->head - r->tail >= RING_CAP / 2) cnd_signal(&r->nonempty);
+  mtx_unlock(&r->m);
+  r->p_pub = r->p_head;
+}
+
+/* Producer: the next free slot (write it, then ring_commit()), or NULL when the consumer stopped. */
+static void *ring_slot(ring *r) {
+  if (r->p_head - r->p_tail == RING_CAP) {
+    mtx_lock(&r->m);
+    r->head = r->p_head;
+    r->p_pub = r->p_head;
+    cnd_signal(&r->nonempty);
+    while (RING_CAP - (r->p_head - r->tail) < RING_CAP / 2 && !r->stopped)
+      cnd_wait(&r->nonfull, &r->m);
+    r->p_tail = r->tail;
+    const bool stopped = r->stopped;
+    mtx_unlock(&r->m);
+    if (stopped) return NULL;
+  }
+  return r->buf + (r->p_head % RING_CAP) * r->size;
+}
+
+static void ring_commit(ring *r) {
+  ++r->p_head;
+  if (r->p_head - r->p_pub >= RING_BATCH) ring_publish(r, false);
+}
+
+/* Producer: no more items. */
+static void ring_close(ring *r) { ring_publish(r, true); }
+
+/* Consumer: the next item (valid until the next call), or NULL after the last one. */
+static const void *ring_next(ring *r) {
+  if (r->c_tail == r->c_head || r->c_tail - r->c_rel >= RING_BATCH) {
+    if (r->c_tail == r->c_head && r->c_closed) return NULL;
+    mtx_lock(&r->m);
+    /* The items consumed so far (the previous one included: its caller is done with it). */
+    r->tail = r->c_tail;
+    r->c_rel = r->c_tail;
+    if (RING_CAP - (r->head - r->tail) >= RING_CAP / 2) cnd_signal(&r->nonfull);
+    while (r->head == r->c_tail && !r->closed)
+      cnd_wait(&r->nonempty, &r->m);
+    r->c_head = r->head;
+    r->c_closed = r->closed;
+    mtx_unlock(&r->m);
+    if (r->c_tail == r->c_head) return NULL;
+  }
+  return r->buf + (r->c_tail++ % RING_CAP) * r->size;
+}
+
+/* Consumer: want no more items (the producer's next ring_slot() returns NULL). */
+static void ring_stop(ring *r) {
+  mtx_lock(&r->m);
+  r->stopped = true;
+  cnd_signal(&r->nonfull);
+  mtx_unlock(&r->m);
+}
+
+/*
+ * Read-ahead of one streamed input (IMU or reference) on a thread, through a ring: memory stays
+ * flat. Each item carries what the consumer would have asked the reader right after that record
+ * (status, progress fraction, cut line), so the replay sees exactly what reading on its own
+ * thread gives. After a terminal item (an error or the end) the thread stops; the reader's diag is
+ * then stable and read by the consumer.
+ */
 typedef struct ra_item {
   nav_status st;
   bool got;
@@ -1014,14 +1123,10 @@ typedef struct read_ahead {
   nav_rec_reader *r;
   bool threaded;
   thrd_t th;
-  mtx_t m;
-  cnd_t nonempty, nonfull;
-  size_t head, tail; /* published by producer / released by consumer (under m) */
-  bool stop;         /* under m */
-  size_t c_head, c_tail, released; /* the consumer's view */
+  ring q;
   bool ended;
+  ra_item one; /* without a thread: the record just read */
   ra_item last;
-  ra_item *ring;
 } read_ahead;
 
 static void ra_read_one(nav_rec_reader *r, ra_item *it) {
@@ -1037,107 +1142,54 @@ static void ra_read_one(nav_rec_reader *r, ra_item *it) {
 
 static int ra_main(void *arg) {
   read_ahead *a = arg;
-  size_t head = 0;
-  for (bool end = false; !end;) {
-    mtx_lock(&a->m);
-    /* When the ring is full, wait for half a ring of room, not one slot: one sleep and wake-up
-     * per RA_CAP / 2 records instead of one per batch. */
-    if (head - a->tail == RA_CAP)
-      while (RA_CAP - (head - a->tail) < RA_CAP / 2 && !a->stop)
-        cnd_wait(&a->nonfull, &a->m);
-    const bool stop = a->stop;
-    const size_t room = RA_CAP - (head - a->tail);
-    mtx_unlock(&a->m);
-    if (stop) break;
-    const size_t n = room < RA_BATCH ? room : RA_BATCH;
-    size_t k = 0;
-    while (k < n && !end) {
-      ra_item *it = &a->ring[(head + k) % RA_CAP];
-      ra_read_one(a->r, it);
-      end = it->st != NAV_OK || !it->got;
-      ++k;
-    }
-    head += k;
-    mtx_lock(&a->m);
-    a->head = head;
-    cnd_signal(&a->nonempty);
-    mtx_unlock(&a->m);
+  for (;;) {
+    ra_item *it = ring_slot(&a->q);
+    if (!it) break;
+    ra_read_one(a->r, it);
+    ring_commit(&a->q);
+    if (it->st != NAV_OK || !it->got) break;
   }
+  ring_close(&a->q);
   return 0;
 }
 
 /* Start reading @p r ahead (on a thread when @p threaded and one can be made). */
-static nav_status ra_start(read_ahead *a, nav_rec_reader *r, bool threaded) {
+static void ra_start(read_ahead *a, nav_rec_reader *r, bool threaded) {
   memset(a, 0, sizeof *a);
   a->r = r;
-  a->ring = malloc((threaded ? RA_CAP : 1u) * sizeof *a->ring);
-  if (!a->ring) return NAV_ERR_NO_MEMORY;
-  if (!threaded) return NAV_OK;
-  if (mtx_init(&a->m, mtx_plain) != thrd_success) return NAV_OK;
-  if (cnd_init(&a->nonempty) != thrd_success) {
-    mtx_destroy(&a->m);
-    return NAV_OK;
-  }
-  if (cnd_init(&a->nonfull) != thrd_success) {
-    cnd_destroy(&a->nonempty);
-    mtx_destroy(&a->m);
-    return NAV_OK;
-  }
+  if (!threaded || !ring_init(&a->q, sizeof(ra_item))) return;
   if (thrd_create(&a->th, ra_main, a) != thrd_success) {
-    cnd_destroy(&a->nonfull);
-    cnd_destroy(&a->nonempty);
-    mtx_destroy(&a->m);
-    return NAV_OK; /* read on the calling thread */
+    ring_destroy(&a->q);
+    return; /* read on the calling thread */
   }
   a->threaded = true;
-  return NAV_OK;
 }
 
 /* The next record; valid until the next call. */
 static const ra_item *ra_next(read_ahead *a) {
   if (a->ended) return &a->last;
-  const ra_item *it;
-  if (!a->threaded) {
-    ra_read_one(a->r, &a->ring[0]);
-    it = &a->ring[0];
+  const ra_item *it = &a->one;
+  if (a->threaded) {
+    it = ring_next(&a->q);
   } else {
-    /* The slots consumed so far (the previous item included: its caller is done with it) go back
-     * to the producer a batch at a time. */
-    if (a->c_tail - a->released >= RA_BATCH || a->c_tail == a->c_head) {
-      mtx_lock(&a->m);
-      a->tail = a->c_tail;
-      a->released = a->c_tail;
-      if (RA_CAP - (a->head - a->tail) >= RA_CAP / 2) cnd_signal(&a->nonfull);
-      while (a->head == a->c_tail)
-        cnd_wait(&a->nonempty, &a->m);
-      a->c_head = a->head;
-      mtx_unlock(&a->m);
-    }
-    it = &a->ring[a->c_tail++ % RA_CAP];
+    ra_read_one(a->r, &a->one);
   }
-  if (it->st != NAV_OK || !it->got) {
-    a->last = *it;
+  if (!it || it->st != NAV_OK || !it->got) {
+    /* (it is never NULL: the producer's last item is terminal.) */
+    if (it) a->last = *it;
     a->ended = true;
     return &a->last;
   }
   return it;
 }
 
-/* Stop the thread (it finishes at most one batch) and release the ring; the reader stays. */
+/* Stop the thread (it finishes the record in hand) and release the ring; the reader stays. */
 static void ra_stop(read_ahead *a) {
-  if (a->threaded) {
-    mtx_lock(&a->m);
-    a->stop = true;
-    cnd_signal(&a->nonfull);
-    mtx_unlock(&a->m);
-    thrd_join(a->th, NULL);
-    cnd_destroy(&a->nonfull);
-    cnd_destroy(&a->nonempty);
-    mtx_destroy(&a->m);
-    a->threaded = false;
-  }
-  free(a->ring);
-  a->ring = NULL;
+  if (!a->threaded) return;
+  ring_stop(&a->q);
+  thrd_join(a->th, NULL);
+  ring_destroy(&a->q);
+  a->threaded = false;
 }
 
 /* The open inputs of a replay with one record of look-ahead each. */
@@ -1368,15 +1420,13 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (!cfg->imu) st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
   if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
-  if (st == NAV_OK && p.imu) {
-    st = ra_start(&p.imu_ra, p.imu, cfg->read_ahead);
-    p.imu_ra_on = st == NAV_OK;
-  }
-  if (st == NAV_OK) {
-    st = ra_start(&p.ref_ra, p.ref, cfg->read_ahead);
-    p.ref_ra_on = st == NAV_OK;
-  }
   if (st != NAV_OK) goto cleanup;
+  if (p.imu) {
+    ra_start(&p.imu_ra, p.imu, cfg->read_ahead);
+    p.imu_ra_on = true;
+  }
+  ra_start(&p.ref_ra, p.ref, cfg->read_ahead);
+  p.ref_ra_on = true;
   st = ref_next(&p);
   if (st == NAV_OK && aided) st = fix_next(&p);
   if (st != NAV_OK) goto cleanup;
