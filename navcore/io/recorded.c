@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <stdatomic.h>
 #include <threads.h>
 
 #include "navcore/nav_earth.h"
@@ -1397,6 +1398,117 @@ static nav_epoch_errors errors_at(const nav_frame *frame, const ref_item *ref, c
   return nav_errors_compute(frame, &ts, nav_state(n));
 }
 
+/*
+ * Scoring of the epochs: errors against the reference, statistics, GNSS gap bookkeeping, and the
+ * scored and record callbacks, fed in epoch order with what the navigation had at each epoch.
+ * On the calling thread (one item at a time, straight after the step) or, with
+ * callbacks_on_worker, on a second thread through a ring while the navigation goes on: the same
+ * items in the same order, so the same figures, files and callbacks.
+ */
+typedef enum sc_kind {
+  SC_EPOCH, /* an epoch with a reference row or an output */
+  SC_GAP,   /* a GNSS gap ended at this epoch (before its fix): gap filled but for pos_h_max_m */
+  SC_FIX    /* a fix was applied: the largest error of the next gap starts again */
+} sc_kind;
+
+typedef struct sc_item {
+  sc_kind kind;
+  bool has_ref, output, updated, has_ned;
+  nav_ins_ned ned;    /* has_ned: the NED state */
+  nav_ins_state nav;  /* !has_ned or output: the e-frame state */
+  ref_item ref;       /* has_ref */
+  nav_replay_gap gap; /* SC_GAP */
+} sc_item;
+
+typedef struct scorer {
+  const nav_replay_config *cfg;
+  const nav_frame *frame;
+  nav_replay_summary *sum;
+  nav_replay_stats_acc acc, acc_out;
+  double gap_max_h;  /* largest horizontal error since the last fix [m] */
+  atomic_bool stop;  /* record returned NAV_STOP */
+  bool threaded;
+  thrd_t th;
+  ring q;
+  sc_item one; /* on the calling thread: the item being filled */
+} scorer;
+
+static void score_one(scorer *sc, const sc_item *it) {
+  nav_replay_summary *sum = sc->sum;
+  if (it->kind == SC_FIX) {
+    sc->gap_max_h = 0.0;
+    return;
+  }
+  if (it->kind == SC_GAP) {
+    nav_replay_gap g = it->gap;
+    g.pos_h_max_m = g.has_end_errors ? fmax(sc->gap_max_h, g.pos_h_end_m) : sc->gap_max_h;
+    if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
+    sum->gap_count++;
+    return;
+  }
+  const nav_replay_config *cfg = sc->cfg;
+  nav_epoch_errors err;
+  if (it->has_ref) {
+    if (it->has_ned) {
+      err = ned_errors(&it->ref, &it->ned);
+    } else {
+      const nav_traj_state ts = nav_rec_pva_to_state(&it->ref.row);
+      err = nav_errors_compute(sc->frame, &ts, &it->nav);
+    }
+    nav_replay_stats_add(&sc->acc, &err);
+    if (cfg->scored) cfg->scored(cfg->user, &err);
+    if (it->output) nav_replay_stats_add(&sc->acc_out, &err);
+    sum->final = err;
+    sc->gap_max_h = fmax(sc->gap_max_h, err.pos_err_h_m);
+  }
+  if (it->output && cfg->record) {
+    nav_traj_state ts;
+    if (it->has_ref) ts = nav_rec_pva_to_state(&it->ref.row);
+    const nav_replay_record rec = {sc->frame, &it->nav, it->has_ref ? &ts : NULL, it->has_ref ? &err : NULL,
+                                   it->updated};
+    if (cfg->record(cfg->user, &rec) == NAV_STOP) atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
+  }
+}
+
+static int scorer_main(void *arg) {
+  scorer *sc = arg;
+  for (const sc_item *it = ring_next(&sc->q); it; it = ring_next(&sc->q))
+    score_one(sc, it);
+  return 0;
+}
+
+static void scorer_start(scorer *sc, bool threaded) {
+  sc->threaded = false;
+  if (!threaded || !ring_init(&sc->q, sizeof(sc_item))) return;
+  if (thrd_create(&sc->th, scorer_main, sc) != thrd_success) {
+    ring_destroy(&sc->q);
+    return;
+  }
+  sc->threaded = true;
+}
+
+/* The item to fill for the next epoch or event (then scorer_push()). */
+static sc_item *scorer_slot(scorer *sc) {
+  /* The consumer never stops early, so a slot always comes. */
+  return sc->threaded ? ring_slot(&sc->q) : &sc->one;
+}
+
+static void scorer_push(scorer *sc) {
+  if (sc->threaded)
+    ring_commit(&sc->q);
+  else
+    score_one(sc, &sc->one);
+}
+
+/* Score everything pushed so far and stop the thread; the results are then in sc. */
+static void scorer_finish(scorer *sc) {
+  if (!sc->threaded) return;
+  ring_close(&sc->q);
+  thrd_join(sc->th, NULL);
+  ring_destroy(&sc->q);
+  sc->threaded = false;
+}
+
 static nav_status nav_fail(nav_diag *diag, nav_status st, const char *what, const char *detail) {
   diag_set(diag, "replay", 0, 0, "", "%s: %s", what, detail && detail[0] ? detail : nav_status_str(st));
   return st;
@@ -1410,6 +1522,10 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (!sum) return NAV_ERR_NO_MEMORY;
   replay p;
   memset(&p, 0, sizeof p);
+  scorer sc;
+  memset(&sc, 0, sizeof sc);
+  sc.cfg = cfg;
+  sc.sum = sum;
   p.cfg = cfg;
   p.sum = sum;
   p.diag = diag;
@@ -1470,6 +1586,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   const nav_rec_pva row0 = p.ref_row;
   const nav_traj_state ts0 = nav_rec_pva_to_state(&row0);
   const nav_frame frame = frame_at(row0.pos);
+  sc.frame = &frame;
   if (cfg->has_initial && !(fabs(cfg->initial.t_s - inc.t_s) <= tol)) {
     diag_set(diag, cfg->imu_path, 0, 0, "",
              "the given initial state is at t = %.17g s, but the initial epoch (the first IMU epoch with a "
@@ -1508,11 +1625,9 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (st != NAV_OK) goto cleanup;
 
   /* 2. Every following increment. */
-  nav_replay_stats_acc acc, acc_out;
-  memset(&acc, 0, sizeof acc);
-  memset(&acc_out, 0, sizeof acc_out);
+  scorer_start(&sc, cfg->callbacks_on_worker);
   const double t_first = inc.t_s;
-  double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0, gap_max_h = 0.0;
+  double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0;
   bool have_fix = false, have_spacing = false;
   while (!stop) {
     st = imu_next(&p, &inc, &got);
@@ -1560,22 +1675,22 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       } else {
         const double spacing = p.fix.t_s - last_fix_t;
         if (have_fix && have_spacing && spacing > cfg->gap_factor * min_spacing) {
-          /* The end of a GNSS gap: errors just before the fix that ends it. */
-          nav_replay_gap g;
-          memset(&g, 0, sizeof g);
-          g.t0_s = last_fix_t;
-          g.t1_s = p.fix.t_s;
-          g.pos_h_max_m = gap_max_h;
+          /* The end of a GNSS gap: errors just before the fix that ends it (the largest error
+             inside it is the scorer's). */
+          sc_item *gi = scorer_slot(&sc);
+          gi->kind = SC_GAP;
+          nav_replay_gap *g = &gi->gap;
+          memset(g, 0, sizeof *g);
+          g->t0_s = last_fix_t;
+          g->t1_s = p.fix.t_s;
           if (has_ref) {
             const nav_epoch_errors e = errors_at(&frame, &p.ref_it, &nav);
-            g.has_end_errors = true;
-            g.pos_h_end_m = e.pos_err_h_m;
-            g.pos_v_end_m = e.pos_err_v_m;
-            g.pos_h_max_m = fmax(gap_max_h, e.pos_err_h_m);
-            g.end_errors = e;
+            g->has_end_errors = true;
+            g->pos_h_end_m = e.pos_err_h_m;
+            g->pos_v_end_m = e.pos_err_v_m;
+            g->end_errors = e;
           }
-          if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
-          sum->gap_count++;
+          scorer_push(&sc);
         }
         if (cfg->raw)
           st = nav_ins_gnss_update_raw(nav.x, &p.raw, NULL);
@@ -1591,7 +1706,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
         }
         have_fix = true;
         last_fix_t = p.fix.t_s;
-        gap_max_h = 0.0;
+        scorer_slot(&sc)->kind = SC_FIX;
+        scorer_push(&sc);
         updated = true;
         sum->gnss_applied++;
       }
@@ -1602,20 +1718,17 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const long long j = llround(t / cfg->output_interval_s);
     const bool output = j != last_out && fabs(t - (double)j * cfg->output_interval_s) <= 0.5 * dt;
     if (output) last_out = j;
-    if (has_ref) {
-      err = errors_at(&frame, &p.ref_it, &nav);
-      nav_replay_stats_add(&acc, &err);
-      if (cfg->scored) cfg->scored(cfg->user, &err);
-      if (output) nav_replay_stats_add(&acc_out, &err);
-      sum->final = err;
-      gap_max_h = fmax(gap_max_h, err.pos_err_h_m);
-    }
-    if (output && cfg->record) {
-      nav_traj_state ts;
-      if (has_ref) ts = nav_rec_pva_to_state(&p.ref_row);
-      const nav_replay_record rec = {&frame, nav_state(&nav), has_ref ? &ts : NULL, has_ref ? &err : NULL,
-                                     updated};
-      if (cfg->record(cfg->user, &rec) == NAV_STOP) stop = true;
+    if (has_ref || (output && cfg->record)) {
+      sc_item *it = scorer_slot(&sc);
+      it->kind = SC_EPOCH;
+      it->has_ref = has_ref;
+      it->output = output;
+      it->updated = updated;
+      it->has_ned = has_ref && nav_ned(&nav, &it->ned);
+      if (!it->has_ned || output) it->nav = *nav_state(&nav);
+      if (has_ref) it->ref = p.ref_it;
+      scorer_push(&sc);
+      if (atomic_load_explicit(&sc.stop, memory_order_relaxed)) stop = true;
     }
     if (has_ref) {
       st = ref_next(&p);
@@ -1626,6 +1739,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       if (cfg->progress(cfg->user, &pr) == NAV_STOP) stop = true;
     }
   }
+  scorer_finish(&sc);
+  if (atomic_load_explicit(&sc.stop, memory_order_relaxed)) stop = true;
   /* A gap still open at the end of the run. */
   if (aided && have_fix && have_spacing && sum->t_last_s - last_fix_t > cfg->gap_factor * min_spacing) {
     nav_replay_gap g;
@@ -1636,7 +1751,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     g.has_end_errors = fabs(sum->final.t_s - sum->t_last_s) <= tol;
     g.pos_h_end_m = sum->final.pos_err_h_m;
     g.pos_v_end_m = sum->final.pos_err_v_m;
-    g.pos_h_max_m = gap_max_h;
+    g.pos_h_max_m = sc.gap_max_h;
     g.end_errors = sum->final;
     if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
     sum->gap_count++;
@@ -1645,8 +1760,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const nav_progress pr = {"replay", 0, 1.0, sum->t_last_s};
     (void)cfg->progress(cfg->user, &pr);
   }
-  sum->stats = nav_replay_stats_result(&acc);
-  sum->stats_output = nav_replay_stats_result(&acc_out);
+  sum->stats = nav_replay_stats_result(&sc.acc);
+  sum->stats_output = nav_replay_stats_result(&sc.acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
   sum->imu_cut_line = p.imu_cut_line;
@@ -1656,6 +1771,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   st = stop ? NAV_ERR_CANCELLED : NAV_OK;
 
 cleanup:
+  scorer_finish(&sc);
   if (p.imu_ra_on) ra_stop(&p.imu_ra);
   if (p.ref_ra_on) ra_stop(&p.ref_ra);
   nav_ins_gnss_destroy(nav.x);

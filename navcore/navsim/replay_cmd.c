@@ -1140,6 +1140,10 @@ int navsim_replay(int argc, char **argv) {
   rc.progress = on_progress;
   rc.scored = run_stats_on_scored;
   rc.user = &o;
+  /* Scoring, the statistics and the CSV rows on a second thread while the filter runs; not with
+     --smooth, whose recorder marks the filter's state at each output epoch. on_progress shares
+     nothing with on_record and run_stats_on_scored. */
+  rc.callbacks_on_worker = o.so == NULL;
   if (n_reqs > 0) o.req = &req_buf;
 
   nav_replay_summary sum;

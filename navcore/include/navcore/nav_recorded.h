@@ -397,6 +397,15 @@ typedef struct nav_replay_config {
    * messages; memory stays flat. Default true; false reads them on the calling thread.
    */
   bool read_ahead;
+  /**
+   * Score the epochs and call @p record and @p scored on a second thread, in epoch order and with
+   * the same arguments, while the navigation goes on (the initial epoch's calls stay on the
+   * calling thread). The callbacks must then not share unsynchronised data with @p progress or
+   * the caller, nor read the filter; a NAV_STOP from @p record stops the navigation up to a few
+   * thousand epochs later (the partial summary counts them). Default false: every callback on the
+   * calling thread, the run stopped at once.
+   */
+  bool callbacks_on_worker;
 } nav_replay_config;
 
 /**
