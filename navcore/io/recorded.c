@@ -1434,6 +1434,9 @@ typedef struct scorer {
 } scorer;
 
 static void score_one(scorer *sc, const sc_item *it) {
+  /* After a NAV_STOP nothing more is scored or called back, as on the calling thread, where the
+   * navigation stops at once. */
+  if (atomic_load_explicit(&sc->stop, memory_order_relaxed)) return;
   nav_replay_summary *sum = sc->sum;
   if (it->kind == SC_FIX) {
     sc->gap_max_h = 0.0;
