@@ -94,6 +94,11 @@ static const uint64_t nav_fmt_pow5_wide[28][2] = {
     {0x29c30f1029939b14ull, 0x6664242d97d9f649ull}, /* 5^54 */
     {0xd0cf4b50cfe20765ull, 0xfff4b4e3f741cf6dull}, /* 5^55 */};
 
+/* "00" "01" ... "99": two decimal digits per entry. */
+static const char nav_fmt_digit_pairs[201] =
+    "0001020304050607080910111213141516171819202122232425262728293031323334353637383940414243444546474849"
+    "5051525354555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+
 /* round(P / 2^sh) to nearest, ties to even, for P = p2 2^128 + p1 2^64 + p0 and 64 <= sh < 192;
  * UINT64_MAX when it does not fit below 2^63. */
 static inline uint64_t nav_fmt_shift192(uint64_t p2, uint64_t p1, uint64_t p0, int sh) {
@@ -185,11 +190,21 @@ static inline int nav_fmt_g17(char *buf, double x) {
     else
       break;
   }
+  /* The 17 digits: 9 + 8 in two 32-bit halves, two digits per step (short dependency chains of
+   * 32-bit divisions by constants instead of 17 64-bit ones). */
   char dig[17];
-  for (int i = 16; i >= 0; --i) {
-    dig[i] = (char)('0' + (int)(d % 10u));
-    d /= 10u;
+  uint32_t hi = (uint32_t)(d / 100000000u), lo = (uint32_t)(d % 100000000u);
+  for (int i = 16; i > 8; i -= 2) {
+    const uint32_t two = lo % 100u;
+    lo /= 100u;
+    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
   }
+  for (int i = 8; i > 0; i -= 2) {
+    const uint32_t two = hi % 100u;
+    hi /= 100u;
+    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
+  }
+  dig[0] = (char)('0' + hi);
   int nd = 17; /* significant digits after removing trailing zeros */
   while (nd > 1 && dig[nd - 1] == '0')
     --nd;
