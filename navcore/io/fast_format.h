@@ -155,7 +155,8 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
 
 /**
  * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
- * terminating NUL. @return the length.
+ * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
+ * digits). @return the length.
  */
 static inline int nav_fmt_g17(char *buf, double x) {
   uint64_t bits;
@@ -192,7 +193,9 @@ static inline int nav_fmt_g17(char *buf, double x) {
   }
   /* The 17 digits: 9 + 8 in two 32-bit halves, two digits per step (short dependency chains of
    * 32-bit divisions by constants instead of 17 64-bit ones). */
-  char dig[17];
+  /* dig: the 17 digits, then '0' padding so that the fixed-size copies below stay inside it. */
+  char dig[40];
+  memset(dig + 17, '0', sizeof dig - 17);
   uint32_t hi = (uint32_t)(d / 100000000u), lo = (uint32_t)(d % 100000000u);
   for (int i = 16; i > 8; i -= 2) {
     const uint32_t two = lo % 100u;
@@ -208,15 +211,17 @@ static inline int nav_fmt_g17(char *buf, double x) {
   int nd = 17; /* significant digits after removing trailing zeros */
   while (nd > 1 && dig[nd - 1] == '0')
     --nd;
-  char *p = buf;
+  /* The text is laid out in t with copies of fixed size (short variable-length copies cost more
+   * than the digits: rep movsb), then t's first NAV_FMT_G17_SIZE bytes go to buf. */
+  char t[64];
+  memset(t, 0, NAV_FMT_G17_SIZE);
+  char *p = t;
   if (neg) *p++ = '-';
   if (x10 < -4 || x10 >= 17) {
-    *p++ = dig[0];
-    if (nd > 1) {
-      *p++ = '.';
-      memcpy(p, dig + 1, (size_t)(nd - 1));
-      p += nd - 1;
-    }
+    p[0] = dig[0];
+    p[1] = '.';
+    memcpy(p + 2, dig + 1, 16);
+    p += nd > 1 ? nd + 1 : 1;
     *p++ = 'e';
     int ex = x10;
     *p++ = ex < 0 ? '-' : '+';
@@ -225,24 +230,25 @@ static inline int nav_fmt_g17(char *buf, double x) {
     *p++ = (char)('0' + ex / 10 % 10);
     *p++ = (char)('0' + ex % 10);
   } else if (x10 >= 0) {
-    const int ni = x10 + 1; /* integer digits */
-    memcpy(p, dig, (size_t)ni);
-    p += ni;
+    const int ni = x10 + 1; /* integer digits, 1..17 */
+    memcpy(p, dig, 17);
     if (nd > ni) {
-      *p++ = '.';
-      memcpy(p, dig + ni, (size_t)(nd - ni));
-      p += nd - ni;
+      p[ni] = '.';
+      memcpy(p + ni + 1, dig + ni, 16);
+      p += nd + 1;
+    } else {
+      p += ni;
     }
   } else {
-    *p++ = '0';
-    *p++ = '.';
-    for (int i = 0; i < -x10 - 1; ++i)
-      *p++ = '0';
-    memcpy(p, dig, (size_t)nd);
+    /* -4 <= x10 <= -1: "0." and -x10 - 1 zeros before the digits. */
+    memcpy(p, "0.000", 5);
+    p += 2 + (-x10 - 1);
+    memcpy(p, dig, 17);
     p += nd;
   }
   *p = '\0';
-  return (int)(p - buf);
+  memcpy(buf, t, NAV_FMT_G17_SIZE);
+  return (int)(p - t);
 }
 
 #endif /* NAV_IO_FAST_FORMAT_H */
