@@ -11,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <pthread.h>
 #include <stdatomic.h>
-#include <threads.h>
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
@@ -749,7 +749,7 @@ typedef struct imu_part {
   nav_diag diag;
 } imu_part;
 
-static int imu_part_read(void *arg) {
+static void *imu_part_read(void *arg) {
   imu_part *q = arg;
   nav_rec_reader *r = NULL;
   q->st = nav_rec_reader_open(q->path, NAV_REC_IMU, &r, &q->diag);
@@ -781,7 +781,7 @@ static int imu_part_read(void *arg) {
     q->last_line = r->rec_line;
   }
   nav_rec_reader_destroy(r);
-  return 0;
+  return NULL;
 }
 
 void nav_rec_imu_array_free(nav_rec_imu_array *a) {
@@ -833,15 +833,16 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
   a.len = split;
   b.off = split;
   b.len = size - split;
-  thrd_t th;
+  /* POSIX threads (as the navsim commands): ThreadSanitizer follows them, not C11 thrd_create. */
+  pthread_t th;
   bool threaded = false;
-  if (split > 0) threaded = thrd_create(&th, imu_part_read, &b) == thrd_success;
-  imu_part_read(&a);
+  if (split > 0) threaded = pthread_create(&th, NULL, imu_part_read, &b) == 0;
+  (void)imu_part_read(&a);
   if (split > 0) {
     if (threaded)
-      thrd_join(th, NULL);
+      (void)pthread_join(th, NULL);
     else
-      imu_part_read(&b);
+      (void)imu_part_read(&b);
   }
   /* The second stretch continues the first: record indices and line numbers go on, the first
    * interval spans the split, and time must increase across it. */
@@ -870,7 +871,7 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
     memset(&a, 0, sizeof a);
     a.path = path;
     a.whole = true;
-    imu_part_read(&a);
+    (void)imu_part_read(&a);
   }
   st = a.st;
   if (st != NAV_OK) {
@@ -1000,8 +1001,8 @@ static void ref_item_fill(ref_item *it) {
 #define RING_BATCH 64u
 
 typedef struct ring {
-  mtx_t m;
-  cnd_t nonempty, nonfull;
+  pthread_mutex_t m;
+  pthread_cond_t nonempty, nonfull;
   size_t head, tail;   /* published / released items (under m) */
   bool closed, stopped; /* producer finished / consumer wants no more (under m) */
   size_t size;         /* bytes per item */
@@ -1016,14 +1017,14 @@ static bool ring_init(ring *r, size_t item_size) {
   r->size = item_size;
   r->buf = malloc(RING_CAP * item_size);
   if (!r->buf) return false;
-  if (mtx_init(&r->m, mtx_plain) != thrd_success) goto fail_buf;
-  if (cnd_init(&r->nonempty) != thrd_success) goto fail_m;
-  if (cnd_init(&r->nonfull) != thrd_success) goto fail_ne;
+  if (pthread_mutex_init(&r->m, NULL) != 0) goto fail_buf;
+  if (pthread_cond_init(&r->nonempty, NULL) != 0) goto fail_m;
+  if (pthread_cond_init(&r->nonfull, NULL) != 0) goto fail_ne;
   return true;
 fail_ne:
-  cnd_destroy(&r->nonempty);
+  pthread_cond_destroy(&r->nonempty);
 fail_m:
-  mtx_destroy(&r->m);
+  pthread_mutex_destroy(&r->m);
 fail_buf:
   free(r->buf);
   r->buf = NULL;
@@ -1032,36 +1033,36 @@ fail_buf:
 
 static void ring_destroy(ring *r) {
   if (!r->buf) return;
-  cnd_destroy(&r->nonfull);
-  cnd_destroy(&r->nonempty);
-  mtx_destroy(&r->m);
+  pthread_cond_destroy(&r->nonfull);
+  pthread_cond_destroy(&r->nonempty);
+  pthread_mutex_destroy(&r->m);
   free(r->buf);
   r->buf = NULL;
 }
 
 /* Producer: publish the committed items (under m, with the wake-up rule above). */
 static void ring_publish(ring *r, bool closing) {
-  mtx_lock(&r->m);
+  pthread_mutex_lock(&r->m);
   r->head = r->p_head;
   if (closing) r->closed = true;
   r->p_tail = r->tail;
-  if (closing || r->head - r->tail >= RING_CAP / 2) cnd_signal(&r->nonempty);
-  mtx_unlock(&r->m);
+  if (closing || r->head - r->tail >= RING_CAP / 2) pthread_cond_signal(&r->nonempty);
+  pthread_mutex_unlock(&r->m);
   r->p_pub = r->p_head;
 }
 
 /* Producer: the next free slot (write it, then ring_commit()), or NULL when the consumer stopped. */
 static void *ring_slot(ring *r) {
   if (r->p_head - r->p_tail == RING_CAP) {
-    mtx_lock(&r->m);
+    pthread_mutex_lock(&r->m);
     r->head = r->p_head;
     r->p_pub = r->p_head;
-    cnd_signal(&r->nonempty);
+    pthread_cond_signal(&r->nonempty);
     while (RING_CAP - (r->p_head - r->tail) < RING_CAP / 2 && !r->stopped)
-      cnd_wait(&r->nonfull, &r->m);
+      pthread_cond_wait(&r->nonfull, &r->m);
     r->p_tail = r->tail;
     const bool stopped = r->stopped;
-    mtx_unlock(&r->m);
+    pthread_mutex_unlock(&r->m);
     if (stopped) return NULL;
   }
   return r->buf + (r->p_head % RING_CAP) * r->size;
@@ -1079,16 +1080,16 @@ static void ring_close(ring *r) { ring_publish(r, true); }
 static const void *ring_next(ring *r) {
   if (r->c_tail == r->c_head || r->c_tail - r->c_rel >= RING_BATCH) {
     if (r->c_tail == r->c_head && r->c_closed) return NULL;
-    mtx_lock(&r->m);
+    pthread_mutex_lock(&r->m);
     /* The items consumed so far (the previous one included: its caller is done with it). */
     r->tail = r->c_tail;
     r->c_rel = r->c_tail;
-    if (RING_CAP - (r->head - r->tail) >= RING_CAP / 2) cnd_signal(&r->nonfull);
+    if (RING_CAP - (r->head - r->tail) >= RING_CAP / 2) pthread_cond_signal(&r->nonfull);
     while (r->head == r->c_tail && !r->closed)
-      cnd_wait(&r->nonempty, &r->m);
+      pthread_cond_wait(&r->nonempty, &r->m);
     r->c_head = r->head;
     r->c_closed = r->closed;
-    mtx_unlock(&r->m);
+    pthread_mutex_unlock(&r->m);
     if (r->c_tail == r->c_head) return NULL;
   }
   return r->buf + (r->c_tail++ % RING_CAP) * r->size;
@@ -1096,10 +1097,10 @@ static const void *ring_next(ring *r) {
 
 /* Consumer: want no more items (the producer's next ring_slot() returns NULL). */
 static void ring_stop(ring *r) {
-  mtx_lock(&r->m);
+  pthread_mutex_lock(&r->m);
   r->stopped = true;
-  cnd_signal(&r->nonfull);
-  mtx_unlock(&r->m);
+  pthread_cond_signal(&r->nonfull);
+  pthread_mutex_unlock(&r->m);
 }
 
 /*
@@ -1123,7 +1124,7 @@ typedef struct ra_item {
 typedef struct read_ahead {
   nav_rec_reader *r;
   bool threaded;
-  thrd_t th;
+  pthread_t th;
   ring q;
   bool ended;
   ra_item one; /* without a thread: the record just read */
@@ -1141,7 +1142,7 @@ static void ra_read_one(nav_rec_reader *r, ra_item *it) {
   it->cut_line = r->cut_line;
 }
 
-static int ra_main(void *arg) {
+static void *ra_main(void *arg) {
   read_ahead *a = arg;
   for (;;) {
     ra_item *it = ring_slot(&a->q);
@@ -1151,7 +1152,7 @@ static int ra_main(void *arg) {
     if (it->st != NAV_OK || !it->got) break;
   }
   ring_close(&a->q);
-  return 0;
+  return NULL;
 }
 
 /* Start reading @p r ahead (on a thread when @p threaded and one can be made). */
@@ -1159,7 +1160,7 @@ static void ra_start(read_ahead *a, nav_rec_reader *r, bool threaded) {
   memset(a, 0, sizeof *a);
   a->r = r;
   if (!threaded || !ring_init(&a->q, sizeof(ra_item))) return;
-  if (thrd_create(&a->th, ra_main, a) != thrd_success) {
+  if (pthread_create(&a->th, NULL, ra_main, a) != 0) {
     ring_destroy(&a->q);
     return; /* read on the calling thread */
   }
@@ -1188,7 +1189,7 @@ static const ra_item *ra_next(read_ahead *a) {
 static void ra_stop(read_ahead *a) {
   if (!a->threaded) return;
   ring_stop(&a->q);
-  thrd_join(a->th, NULL);
+  (void)pthread_join(a->th, NULL);
   ring_destroy(&a->q);
   a->threaded = false;
 }
@@ -1428,7 +1429,7 @@ typedef struct scorer {
   double gap_max_h;  /* largest horizontal error since the last fix [m] */
   atomic_bool stop;  /* record returned NAV_STOP */
   bool threaded;
-  thrd_t th;
+  pthread_t th;
   ring q;
   sc_item one; /* on the calling thread: the item being filled */
 } scorer;
@@ -1473,17 +1474,17 @@ static void score_one(scorer *sc, const sc_item *it) {
   }
 }
 
-static int scorer_main(void *arg) {
+static void *scorer_main(void *arg) {
   scorer *sc = arg;
   for (const sc_item *it = ring_next(&sc->q); it; it = ring_next(&sc->q))
     score_one(sc, it);
-  return 0;
+  return NULL;
 }
 
 static void scorer_start(scorer *sc, bool threaded) {
   sc->threaded = false;
   if (!threaded || !ring_init(&sc->q, sizeof(sc_item))) return;
-  if (thrd_create(&sc->th, scorer_main, sc) != thrd_success) {
+  if (pthread_create(&sc->th, NULL, scorer_main, sc) != 0) {
     ring_destroy(&sc->q);
     return;
   }
@@ -1507,7 +1508,7 @@ static void scorer_push(scorer *sc) {
 static void scorer_finish(scorer *sc) {
   if (!sc->threaded) return;
   ring_close(&sc->q);
-  thrd_join(sc->th, NULL);
+  (void)pthread_join(sc->th, NULL);
   ring_destroy(&sc->q);
   sc->threaded = false;
 }
