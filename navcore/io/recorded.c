@@ -786,7 +786,8 @@ static void *imu_part_read(void *arg) {
 
 void nav_rec_imu_array_free(nav_rec_imu_array *a) {
   if (!a) return;
-  free(a->records);
+  free(a->part[0]);
+  free(a->part[1]);
   memset(a, 0, sizeof *a);
 }
 
@@ -849,26 +850,18 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
   bool joined = a.st == NAV_OK && b.st == NAV_OK;
   if (joined && b.n > 0 && a.n > 0 && !(b.rec[0].t_s > a.rec[a.n - 1].t_s)) joined = false;
   if (split > 0 && joined) {
-    nav_imu_increment *all = a.n + b.n > a.cap ? realloc(a.rec, (a.n + b.n) * sizeof *all) : a.rec;
-    if (!all) {
-      st = NAV_ERR_NO_MEMORY;
-      goto cleanup;
-    }
-    a.rec = all;
-    for (size_t i = 0; i < b.n; ++i) {
-      nav_imu_increment m = b.rec[i];
-      m.k += (int64_t)a.n;
-      if (i == 0 && a.n > 0) m.dt_s = m.t_s - a.rec[a.n - 1].t_s;
-      all[a.n + i] = m;
-    }
-    a.n += b.n;
+    for (size_t i = 0; i < b.n; ++i)
+      b.rec[i].k += (int64_t)a.n;
+    if (b.n > 0 && a.n > 0) b.rec[0].dt_s = b.rec[0].t_s - a.rec[a.n - 1].t_s;
     if (b.n > 0) a.last_line = a.lines + b.last_line;
     a.cut_line = b.cut_line ? a.lines + b.cut_line : a.cut_line;
   } else if (split > 0) {
     /* An error somewhere, or time not increasing across the split: the sequential reader over the
      * whole file finds the first problem and words it exactly. */
     free(a.rec);
+    free(b.rec);
     memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
     a.path = path;
     a.whole = true;
     (void)imu_part_read(&a);
@@ -878,11 +871,15 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
     if (diag) *diag = a.diag;
     goto cleanup;
   }
-  out->records = a.rec;
-  out->count = a.n;
+  out->part[0] = a.rec;
+  out->part_count[0] = a.n;
+  out->part[1] = b.rec;
+  out->part_count[1] = b.n;
+  out->count = a.n + b.n;
   out->cut_line = a.cut_line;
   out->last_record_line = a.last_line;
   a.rec = NULL;
+  b.rec = NULL;
 cleanup:
   free(a.rec);
   free(b.rec);
@@ -1242,7 +1239,7 @@ static nav_status imu_next(replay *p, nav_imu_increment *inc, bool *got) {
   if (a) {
     *got = p->imu_idx < a->count;
     if (*got) {
-      *inc = a->records[p->imu_idx++];
+      *inc = *nav_rec_imu_array_at(a, p->imu_idx++);
     } else {
       p->imu_end_seen = true;
     }

@@ -124,15 +124,16 @@ static bool same_bits(double a, double b) {
   return memcmp(&a, &b, sizeof a) == 0;
 }
 
-static void assert_same_records(const nav_imu_increment *a, const nav_imu_increment *b, size_t n) {
+static void assert_same_records(const nav_rec_imu_array *arr, const nav_imu_increment *b, size_t n) {
   for (size_t i = 0; i < n; ++i) {
-    const double va[8] = {a[i].t_s,           a[i].dt_s,          a[i].dtheta_b_rad.x, a[i].dtheta_b_rad.y,
-                          a[i].dtheta_b_rad.z, a[i].dv_b_mps.x,   a[i].dv_b_mps.y,     a[i].dv_b_mps.z};
-    const double vb[8] = {b[i].t_s,           b[i].dt_s,          b[i].dtheta_b_rad.x, b[i].dtheta_b_rad.y,
-                          b[i].dtheta_b_rad.z, b[i].dv_b_mps.x,   b[i].dv_b_mps.y,     b[i].dv_b_mps.z};
+    const nav_imu_increment *a = nav_rec_imu_array_at(arr, i);
+    const double va[8] = {a->t_s,           a->dt_s,         a->dtheta_b_rad.x, a->dtheta_b_rad.y,
+                          a->dtheta_b_rad.z, a->dv_b_mps.x,  a->dv_b_mps.y,     a->dv_b_mps.z};
+    const double vb[8] = {b[i].t_s,           b[i].dt_s,        b[i].dtheta_b_rad.x, b[i].dtheta_b_rad.y,
+                          b[i].dtheta_b_rad.z, b[i].dv_b_mps.x, b[i].dv_b_mps.y,     b[i].dv_b_mps.z};
     for (int k = 0; k < 8; ++k)
       if (!same_bits(va[k], vb[k])) fail_msg("record %zu, value %d: %.17g != %.17g", i, k, va[k], vb[k]);
-    if (a[i].k != b[i].k) fail_msg("record %zu: index %lld != %lld", i, (long long)a[i].k, (long long)b[i].k);
+    if (a->k != b[i].k) fail_msg("record %zu: index %lld != %lld", i, (long long)a->k, (long long)b[i].k);
   }
 }
 
@@ -157,7 +158,8 @@ static void test_imu_array_matches_reader(void **state) {
     assert_int_equal(nav_rec_imu_array_load(path, (size_t)1 << 30, &a, &d), NAV_OK);
     assert_int_equal(a.count, (size_t)sizes[c]);
     assert_int_equal(a.count, s.n);
-    assert_same_records(a.records, s.rec, s.n);
+    assert_same_records(&a, s.rec, s.n);
+    if (c < 2) assert_true(a.part_count[1] > 0); /* split on two threads */
     assert_int_equal(a.cut_line, s.cut_line);
     assert_int_equal(a.last_record_line, s.last_line);
     if (last_nl)
@@ -167,7 +169,7 @@ static void test_imu_array_matches_reader(void **state) {
     print_message("  %d lines, %zu bytes: %zu records, cut line %ld, as the streaming reader\n", sizes[c], len, a.count,
                   a.cut_line);
     nav_rec_imu_array_free(&a);
-    assert_null(a.records);
+    assert_null(a.part[0]);
     free(s.rec);
     free(text);
     unlink(path);
@@ -248,7 +250,7 @@ static void test_imu_array_errors_match_check(void **state) {
     assert_int_equal(sc, NAV_ERR_PARSE);
     assert_int_equal(sa, sc);
     assert_same_diag(&da, &dc);
-    assert_null(a.records);
+    assert_null(a.part[0]);
     free(t);
   }
   unlink(path);
@@ -263,7 +265,7 @@ static void test_imu_array_size_limit(void **state) {
   nav_diag d;
   memset(&d, 0, sizeof d);
   assert_int_equal(nav_rec_imu_array_load(SLICE_IMU, 1000, &a, &d), NAV_ERR_OUT_OF_RANGE);
-  assert_null(a.records);
+  assert_null(a.part[0]);
   assert_non_null(strstr(d.message, "more than the 1000"));
   memset(&d, 0, sizeof d);
   assert_int_equal(nav_rec_imu_array_load(REPLAY_DIR "no-such-file.txt", 1000, &a, &d), NAV_ERR_IO);

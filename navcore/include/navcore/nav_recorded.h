@@ -176,11 +176,20 @@ NAV_API NAV_NODISCARD nav_status nav_rec_load_pva(const char *path, nav_rec_pva 
  * (nav_replay_config.imu). Made by nav_rec_imu_array_load(), released by nav_rec_imu_array_free().
  */
 typedef struct nav_rec_imu_array {
-  nav_imu_increment *records; /**< count records in file order (owned) */
-  size_t count;               /**< number of records */
-  long cut_line;              /**< nav_rec_reader_cut_line() after the whole file, else 0 */
-  long last_record_line;      /**< 1-based line of the last record (0 without records) */
+  /** The records in file order: part[0], then part[1] (the two halves parsed on two threads are
+   *  kept where they were parsed, not copied together); owned, part[1] may be NULL. Read them
+   *  with nav_rec_imu_array_at(). */
+  nav_imu_increment *part[2];
+  size_t part_count[2];  /**< records in each part */
+  size_t count;          /**< number of records, part_count[0] + part_count[1] */
+  long cut_line;         /**< nav_rec_reader_cut_line() after the whole file, else 0 */
+  long last_record_line; /**< 1-based line of the last record (0 without records) */
 } nav_rec_imu_array;
+
+/** Record @p i (0 <= i < a->count) of @p a, borrowed. */
+static inline const nav_imu_increment *nav_rec_imu_array_at(const nav_rec_imu_array *a, size_t i) {
+  return i < a->part_count[0] ? &a->part[0][i] : &a->part[1][i - a->part_count[0]];
+}
 
 /**
  * Read every record of an IMU file into memory, with the checks and messages of
