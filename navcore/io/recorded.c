@@ -1201,8 +1201,9 @@ typedef struct replay {
   bool imu_end_seen;   /* cfg->imu: a read past the last record */
   double imu_fraction; /* progress */
   long imu_cut_line;   /* as nav_rec_reader_cut_line() at this point of the reading */
-  ref_item ref_it;     /* the current reference row and its precomputed parts */
-  nav_rec_pva ref_row;
+  /* The current reference row and its precomputed parts, borrowed from the read-ahead (valid
+   * until the next ref_next(); read in place: no copy per epoch). */
+  const ref_item *ref_it;
   bool ref_have;
   long ref_cut_line;
   nav_ins_gnss_fix fix;
@@ -1226,8 +1227,7 @@ static nav_status ref_next(replay *p) {
   p->ref_have = it->got;
   p->ref_cut_line = it->cut_line;
   if (p->ref_have) {
-    p->ref_it = it->u.ref;
-    p->ref_row = p->ref_it.row;
+    p->ref_it = &it->u.ref;
     p->sum->ref_rows++;
   }
   return NAV_OK;
@@ -1409,13 +1409,19 @@ typedef enum sc_kind {
   SC_FIX    /* a fix was applied: the largest error of the next gap starts again */
 } sc_kind;
 
+/* The fields an ordinary epoch writes come first and together: each item crosses to the other
+ * core, so the fewer cache lines it touches the better. */
 typedef struct sc_item {
   sc_kind kind;
   bool has_ref, output, updated, has_ned;
-  nav_ins_ned ned;    /* has_ned: the NED state */
-  nav_ins_state nav;  /* !has_ned or output: the e-frame state */
-  ref_item ref;       /* has_ref */
-  nav_replay_gap gap; /* SC_GAP */
+  union {
+    struct {
+      nav_ins_ned ned;   /* has_ned: the NED state */
+      ref_item ref;      /* has_ref */
+      nav_ins_state nav; /* !has_ned or output: the e-frame state */
+    } e;                 /* SC_EPOCH */
+    nav_replay_gap gap;  /* SC_GAP */
+  } u;
 } sc_item;
 
 typedef struct scorer {
@@ -1441,7 +1447,7 @@ static void score_one(scorer *sc, const sc_item *it) {
     return;
   }
   if (it->kind == SC_GAP) {
-    nav_replay_gap g = it->gap;
+    nav_replay_gap g = it->u.gap;
     g.pos_h_max_m = g.has_end_errors ? fmax(sc->gap_max_h, g.pos_h_end_m) : sc->gap_max_h;
     if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
     sum->gap_count++;
@@ -1451,10 +1457,10 @@ static void score_one(scorer *sc, const sc_item *it) {
   nav_epoch_errors err;
   if (it->has_ref) {
     if (it->has_ned) {
-      err = ned_errors(&it->ref, &it->ned);
+      err = ned_errors(&it->u.e.ref, &it->u.e.ned);
     } else {
-      const nav_traj_state ts = nav_rec_pva_to_state(&it->ref.row);
-      err = nav_errors_compute(sc->frame, &ts, &it->nav);
+      const nav_traj_state ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+      err = nav_errors_compute(sc->frame, &ts, &it->u.e.nav);
     }
     nav_replay_stats_add(&sc->acc, &err);
     if (cfg->scored) cfg->scored(cfg->user, &err);
@@ -1464,8 +1470,8 @@ static void score_one(scorer *sc, const sc_item *it) {
   }
   if (it->output && cfg->record) {
     nav_traj_state ts;
-    if (it->has_ref) ts = nav_rec_pva_to_state(&it->ref.row);
-    const nav_replay_record rec = {sc->frame, &it->nav, it->has_ref ? &ts : NULL, it->has_ref ? &err : NULL,
+    if (it->has_ref) ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+    const nav_replay_record rec = {sc->frame, &it->u.e.nav, it->has_ref ? &ts : NULL, it->has_ref ? &err : NULL,
                                    it->updated};
     if (cfg->record(cfg->user, &rec) == NAV_STOP) atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
   }
@@ -1560,11 +1566,11 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     }
     if (got) sum->imu_records++;
     if (got && !(cfg->has_start && inc.t_s < cfg->t_start_s - tol)) {
-      while (p.ref_have && p.ref_row.t_s < inc.t_s - tol) {
+      while (p.ref_have && p.ref_it->row.t_s < inc.t_s - tol) {
         st = ref_next(&p);
         if (st != NAV_OK) goto cleanup;
       }
-      if (p.ref_have && fabs(p.ref_row.t_s - inc.t_s) <= tol &&
+      if (p.ref_have && fabs(p.ref_it->row.t_s - inc.t_s) <= tol &&
           !(cfg->has_end && inc.t_s > cfg->t_end_s + tol))
         break;
     }
@@ -1584,7 +1590,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       goto cleanup;
     }
   }
-  const nav_rec_pva row0 = p.ref_row;
+  const nav_rec_pva row0 = p.ref_it->row;
   const nav_traj_state ts0 = nav_rec_pva_to_state(&row0);
   const nav_frame frame = frame_at(row0.pos);
   sc.frame = &frame;
@@ -1656,12 +1662,12 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     sum->t_last_s = t;
 
     /* The reference row of this epoch, if any (rows in between are counted, not scored). */
-    while (p.ref_have && p.ref_row.t_s < t - tol) {
+    while (p.ref_have && p.ref_it->row.t_s < t - tol) {
       sum->ref_unmatched++;
       st = ref_next(&p);
       if (st != NAV_OK) goto cleanup;
     }
-    const bool has_ref = p.ref_have && fabs(p.ref_row.t_s - t) <= tol;
+    const bool has_ref = p.ref_have && fabs(p.ref_it->row.t_s - t) <= tol;
 
     /* GNSS fixes of this epoch: time of validity within dt/2 (numerics.md 6.5). */
     bool updated = false;
@@ -1680,12 +1686,12 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
              inside it is the scorer's). */
           sc_item *gi = scorer_slot(&sc);
           gi->kind = SC_GAP;
-          nav_replay_gap *g = &gi->gap;
+          nav_replay_gap *g = &gi->u.gap;
           memset(g, 0, sizeof *g);
           g->t0_s = last_fix_t;
           g->t1_s = p.fix.t_s;
           if (has_ref) {
-            const nav_epoch_errors e = errors_at(&frame, &p.ref_it, &nav);
+            const nav_epoch_errors e = errors_at(&frame, p.ref_it, &nav);
             g->has_end_errors = true;
             g->pos_h_end_m = e.pos_err_h_m;
             g->pos_v_end_m = e.pos_err_v_m;
@@ -1725,9 +1731,9 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       it->has_ref = has_ref;
       it->output = output;
       it->updated = updated;
-      it->has_ned = has_ref && nav_ned(&nav, &it->ned);
-      if (!it->has_ned || output) it->nav = *nav_state(&nav);
-      if (has_ref) it->ref = p.ref_it;
+      it->has_ned = has_ref && nav_ned(&nav, &it->u.e.ned);
+      if (has_ref) it->u.e.ref = *p.ref_it;
+      if (!it->has_ned || output) it->u.e.nav = *nav_state(&nav);
       scorer_push(&sc);
       if (atomic_load_explicit(&sc.stop, memory_order_relaxed)) stop = true;
     }
