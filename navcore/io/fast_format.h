@@ -64,35 +64,35 @@ static const uint64_t nav_fmt_pow5[28] = {1ull,
 
 /* 5^28 .. 5^55 as {high, low} 64-bit halves (5^55 < 2^128): the scale factors of the small
  * magnitudes, 1e-39 <= |x| < 1e-11, whose products m 5^k need up to 181 bits. */
-static const uint64_t nav_fmt_pow5_wide[28][2] = {
-    {0x0000000000000002ull, 0x04fce5e3e2502611ull}, /* 5^28 */
-    {0x000000000000000aull, 0x18f07d736b90be55ull}, /* 5^29 */
-    {0x0000000000000032ull, 0x7cb2734119d3b7a9ull}, /* 5^30 */
-    {0x00000000000000fcull, 0x6f7c40458122964dull}, /* 5^31 */
-    {0x00000000000004eeull, 0x2d6d415b85acef81ull}, /* 5^32 */
-    {0x00000000000018a6ull, 0xe32246c99c60ad85ull}, /* 5^33 */
-    {0x0000000000007b42ull, 0x6fab61f00de36399ull}, /* 5^34 */
-    {0x000000000002684cull, 0x2e58e9b04570f1fdull}, /* 5^35 */
-    {0x00000000000c097cull, 0xe7bc90715b34b9f1ull}, /* 5^36 */
-    {0x00000000003c2f70ull, 0x86aed236c807a1b5ull}, /* 5^37 */
-    {0x00000000012ced32ull, 0xa16a1b11e8262889ull}, /* 5^38 */
-    {0x0000000005e0a1fdull, 0x2712875988becaadull}, /* 5^39 */
-    {0x000000001d6329f1ull, 0xc35ca4bfabb9f561ull}, /* 5^40 */
-    {0x0000000092efd1b8ull, 0xd0cf37be5aa1cae5ull}, /* 5^41 */
-    {0x00000002deaf189cull, 0x140c16b7c528f679ull}, /* 5^42 */
-    {0x0000000e596b7b0cull, 0x643c7196d9ccd05dull}, /* 5^43 */
-    {0x00000047bf19673dull, 0xf52e37f2410011d1ull}, /* 5^44 */
-    {0x00000166bb7f0435ull, 0xc9e717bb45005915ull}, /* 5^45 */
-    {0x00000701a97b150cull, 0xf18376a85901bd69ull}, /* 5^46 */
-    {0x000023084f676940ull, 0xb7915149bd08b30dull}, /* 5^47 */
-    {0x0000af298d050e43ull, 0x95d69670b12b7f41ull}, /* 5^48 */
-    {0x00036bcfc1194751ull, 0xed30f03375d97c45ull}, /* 5^49 */
-    {0x00111b0ec57e6499ull, 0xa1f4b1014d3f6d59ull}, /* 5^50 */
-    {0x00558749db77f700ull, 0x29c77506823d22bdull}, /* 5^51 */
-    {0x01aba4714957d300ull, 0xd0e549208b31adb1ull}, /* 5^52 */
-    {0x085a36366eb71f04ull, 0x147a6da2b7f86475ull}, /* 5^53 */
-    {0x29c30f1029939b14ull, 0x6664242d97d9f649ull}, /* 5^54 */
-    {0xd0cf4b50cfe20765ull, 0xfff4b4e3f741cf6dull}, /* 5^55 */};
+static const uint64_t nav_fmt_pow5_wide[28][2] = {{0x0000000000000002ull, 0x04fce5e3e2502611ull}, /* 5^28 */
+                                                  {0x000000000000000aull, 0x18f07d736b90be55ull}, /* 5^29 */
+                                                  {0x0000000000000032ull, 0x7cb2734119d3b7a9ull}, /* 5^30 */
+                                                  {0x00000000000000fcull, 0x6f7c40458122964dull}, /* 5^31 */
+                                                  {0x00000000000004eeull, 0x2d6d415b85acef81ull}, /* 5^32 */
+                                                  {0x00000000000018a6ull, 0xe32246c99c60ad85ull}, /* 5^33 */
+                                                  {0x0000000000007b42ull, 0x6fab61f00de36399ull}, /* 5^34 */
+                                                  {0x000000000002684cull, 0x2e58e9b04570f1fdull}, /* 5^35 */
+                                                  {0x00000000000c097cull, 0xe7bc90715b34b9f1ull}, /* 5^36 */
+                                                  {0x00000000003c2f70ull, 0x86aed236c807a1b5ull}, /* 5^37 */
+                                                  {0x00000000012ced32ull, 0xa16a1b11e8262889ull}, /* 5^38 */
+                                                  {0x0000000005e0a1fdull, 0x2712875988becaadull}, /* 5^39 */
+                                                  {0x000000001d6329f1ull, 0xc35ca4bfabb9f561ull}, /* 5^40 */
+                                                  {0x0000000092efd1b8ull, 0xd0cf37be5aa1cae5ull}, /* 5^41 */
+                                                  {0x00000002deaf189cull, 0x140c16b7c528f679ull}, /* 5^42 */
+                                                  {0x0000000e596b7b0cull, 0x643c7196d9ccd05dull}, /* 5^43 */
+                                                  {0x00000047bf19673dull, 0xf52e37f2410011d1ull}, /* 5^44 */
+                                                  {0x00000166bb7f0435ull, 0xc9e717bb45005915ull}, /* 5^45 */
+                                                  {0x00000701a97b150cull, 0xf18376a85901bd69ull}, /* 5^46 */
+                                                  {0x000023084f676940ull, 0xb7915149bd08b30dull}, /* 5^47 */
+                                                  {0x0000af298d050e43ull, 0x95d69670b12b7f41ull}, /* 5^48 */
+                                                  {0x00036bcfc1194751ull, 0xed30f03375d97c45ull}, /* 5^49 */
+                                                  {0x00111b0ec57e6499ull, 0xa1f4b1014d3f6d59ull}, /* 5^50 */
+                                                  {0x00558749db77f700ull, 0x29c77506823d22bdull}, /* 5^51 */
+                                                  {0x01aba4714957d300ull, 0xd0e549208b31adb1ull}, /* 5^52 */
+                                                  {0x085a36366eb71f04ull, 0x147a6da2b7f86475ull}, /* 5^53 */
+                                                  {0x29c30f1029939b14ull, 0x6664242d97d9f649ull}, /* 5^54 */
+                                                  {0xd0cf4b50cfe20765ull, 0xfff4b4e3f741cf6dull},
+                                                  /* 5^55 */};
 
 /* "00" "01" ... "99": two decimal digits per entry. */
 static const char nav_fmt_digit_pairs[201] =

@@ -2,10 +2,10 @@
 /*
  * The exact fast path of the CSV writers (navcore/io/fast_format.h): nav_fmt_g17 must write
  * byte for byte what glibc's printf("%.17g") writes, for every double, on and off its fast path
- * (1e-39 <= |x| < 1e17; below 1e-11 with the three-limb products). Random bit patterns (every exponent), random values inside the fast
- * path with full and short significands (decimal-looking numbers such as 100000.005, small
- * binary fractions, which give exact ties at the 17th digit), the boundaries of every decade and
- * of the fast path, and the special values. The tie case is also checked against its digits.
+ * (1e-39 <= |x| < 1e17; below 1e-11 with the three-limb products). Random bit patterns (every exponent),
+ * random values inside the fast path with full and short significands (decimal-looking numbers such as
+ * 100000.005, small binary fractions, which give exact ties at the 17th digit), the boundaries of every
+ * decade and of the fast path, and the special values. The tie case is also checked against its digits.
  */
 #include <stdarg.h>
 #include <stddef.h>

@@ -82,11 +82,11 @@ static char *make_imu_text(int lines, bool last_newline, size_t *len) {
     }
     const double ts = 100000.0 + 0.005 * (double)(i + 1);
     if (i % 3 == 0)
-      n += (size_t)snprintf(t + n, cap - n, "%.6f %.12e %.12e %.12e %.12e %.12e %.12e", ts, v[0], v[1], v[2], v[3],
-                            v[4], v[5]);
+      n += (size_t)snprintf(t + n, cap - n, "%.6f %.12e %.12e %.12e %.12e %.12e %.12e", ts, v[0], v[1], v[2],
+                            v[3], v[4], v[5]);
     else
-      n += (size_t)snprintf(t + n, cap - n, "%.6f\t%.9g %+.9g %.9g %.9E %.9g %.9g", ts, v[0], v[1], v[2], v[3], v[4],
-                            v[5]);
+      n += (size_t)snprintf(t + n, cap - n, "%.6f\t%.9g %+.9g %.9g %.9E %.9g %.9g", ts, v[0], v[1], v[2],
+                            v[3], v[4], v[5]);
     if (i + 1 < lines || last_newline) t[n++] = '\n';
   }
   t[n] = '\0';
@@ -127,10 +127,12 @@ static bool same_bits(double a, double b) {
 static void assert_same_records(const nav_rec_imu_array *arr, const nav_imu_increment *b, size_t n) {
   for (size_t i = 0; i < n; ++i) {
     const nav_imu_increment *a = nav_rec_imu_array_at(arr, i);
-    const double va[8] = {a->t_s,           a->dt_s,         a->dtheta_b_rad.x, a->dtheta_b_rad.y,
-                          a->dtheta_b_rad.z, a->dv_b_mps.x,  a->dv_b_mps.y,     a->dv_b_mps.z};
-    const double vb[8] = {b[i].t_s,           b[i].dt_s,        b[i].dtheta_b_rad.x, b[i].dtheta_b_rad.y,
-                          b[i].dtheta_b_rad.z, b[i].dv_b_mps.x, b[i].dv_b_mps.y,     b[i].dv_b_mps.z};
+    const double va[8] = {
+        a->t_s,        a->dt_s,       a->dtheta_b_rad.x, a->dtheta_b_rad.y, a->dtheta_b_rad.z,
+        a->dv_b_mps.x, a->dv_b_mps.y, a->dv_b_mps.z};
+    const double vb[8] = {
+        b[i].t_s,        b[i].dt_s,       b[i].dtheta_b_rad.x, b[i].dtheta_b_rad.y, b[i].dtheta_b_rad.z,
+        b[i].dv_b_mps.x, b[i].dv_b_mps.y, b[i].dv_b_mps.z};
     for (int k = 0; k < 8; ++k)
       if (!same_bits(va[k], vb[k])) fail_msg("record %zu, value %d: %.17g != %.17g", i, k, va[k], vb[k]);
     if (a->k != b[i].k) fail_msg("record %zu: index %lld != %lld", i, (long long)a->k, (long long)b[i].k);
@@ -166,8 +168,8 @@ static void test_imu_array_matches_reader(void **state) {
       assert_int_equal(a.cut_line, 0);
     else
       assert_true(a.cut_line > 0);
-    print_message("  %d lines, %zu bytes: %zu records, cut line %ld, as the streaming reader\n", sizes[c], len, a.count,
-                  a.cut_line);
+    print_message("  %d lines, %zu bytes: %zu records, cut line %ld, as the streaming reader\n", sizes[c],
+                  len, a.count, a.cut_line);
     nav_rec_imu_array_free(&a);
     assert_null(a.part[0]);
     free(s.rec);
@@ -221,9 +223,11 @@ static void test_imu_array_errors_match_check(void **state) {
     } else if (c == 2) {
       /* The first record of the second half repeats the time of the last of the first. */
       const char *prev = t + split - 2;
-      while (*prev != '\n') --prev;
+      while (*prev != '\n')
+        --prev;
       ++prev;
-      if (*prev == '#' || *prev == ' ' || *(t + split) == '#' || *(t + split) == ' ' || *(t + split) == '\n') {
+      if (*prev == '#' || *prev == ' ' || *(t + split) == '#' || *(t + split) == ' ' ||
+          *(t + split) == '\n') {
         free(t);
         continue; /* the split fell next to a comment line: nothing to do here */
       }
@@ -234,7 +238,8 @@ static void test_imu_array_errors_match_check(void **state) {
       char *p = strchr(t + len - len / 8, '\n') + 1;
       char *e = strchr(p, '\n');
       char *last = e;
-      while (last[-1] != ' ' && last[-1] != '\t') --last;
+      while (last[-1] != ' ' && last[-1] != '\t')
+        --last;
       memset(last - 1, ' ', (size_t)(e - last + 1));
       what = "too few columns in the second half";
     }
@@ -295,10 +300,10 @@ static void fnv_doubles(uint64_t *h, const double *v, int n) {
 }
 
 static void hash_errors(uint64_t *h, const nav_epoch_errors *e) {
-  const double v[14] = {e->t_s,         e->pos_err_n_m.x,      e->pos_err_n_m.y,       e->pos_err_n_m.z,
-                        e->pos_err_h_m, e->pos_err_v_m,        e->vel_err_n_mps.x,     e->vel_err_n_mps.y,
-                        e->vel_err_n_mps.z, e->vel_err_mps,    e->att_err_rad,         e->euler_err.roll_rad,
-                        e->euler_err.pitch_rad, e->euler_err.yaw_rad};
+  const double v[14] = {
+      e->t_s,         e->pos_err_n_m.x,      e->pos_err_n_m.y,       e->pos_err_n_m.z,    e->pos_err_h_m,
+      e->pos_err_v_m, e->vel_err_n_mps.x,    e->vel_err_n_mps.y,     e->vel_err_n_mps.z,  e->vel_err_mps,
+      e->att_err_rad, e->euler_err.roll_rad, e->euler_err.pitch_rad, e->euler_err.yaw_rad};
   fnv_doubles(h, v, 14);
 }
 
@@ -310,8 +315,8 @@ static nav_callback_result on_record(void *user, const nav_replay_record *r) {
                         s->q_b_f.x,      s->q_b_f.y,      s->q_b_f.z};
   fnv_doubles(&t->h_rec, v, 11);
   if (r->ref) {
-    const double w[7] = {r->ref->t_s, r->ref->r_fb_f_m.x, r->ref->r_fb_f_m.y, r->ref->r_fb_f_m.z,
-                         r->ref->q_b_f.w, r->ref->q_b_f.x, r->ref->q_b_f.z};
+    const double w[7] = {r->ref->t_s,     r->ref->r_fb_f_m.x, r->ref->r_fb_f_m.y, r->ref->r_fb_f_m.z,
+                         r->ref->q_b_f.w, r->ref->q_b_f.x,    r->ref->q_b_f.z};
     fnv_doubles(&t->h_rec, w, 7);
   }
   if (r->err) hash_errors(&t->h_rec, r->err);
@@ -329,13 +334,13 @@ static void on_scored(void *user, const nav_epoch_errors *e) {
 }
 
 static void hash_stats(uint64_t *h, const nav_replay_stats *s) {
-  const nav_replay_stat *st[8] = {&s->pos_h_m, &s->pos_v_m, &s->vel_h_mps, &s->vel_v_mps,
-                                  &s->roll_rad, &s->pitch_rad, &s->yaw_rad, &s->att_rad};
+  const nav_replay_stat *st[8] = {&s->pos_h_m,  &s->pos_v_m,   &s->vel_h_mps, &s->vel_v_mps,
+                                  &s->roll_rad, &s->pitch_rad, &s->yaw_rad,   &s->att_rad};
   for (int i = 0; i < 8; ++i) {
     const double v[3] = {st[i]->rms, st[i]->max, st[i]->t_max_s};
     fnv_doubles(h, v, 3);
   }
-  const double m[6] = {s->pos_mean_n_m.x, s->pos_mean_n_m.y, s->pos_mean_n_m.z,
+  const double m[6] = {s->pos_mean_n_m.x,   s->pos_mean_n_m.y,   s->pos_mean_n_m.z,
                        s->vel_mean_n_mps.x, s->vel_mean_n_mps.y, s->vel_mean_n_mps.z};
   fnv_doubles(h, m, 6);
   fnv(h, &s->epochs, sizeof s->epochs);
@@ -344,15 +349,15 @@ static void hash_stats(uint64_t *h, const nav_replay_stats *s) {
 /* Everything of a summary but padding, as one hash. */
 static uint64_t hash_summary(const nav_replay_summary *s) {
   uint64_t h = 14695981039346656037ull;
-  const long counts[14] = {s->imu_records,    s->imu_steps,         s->imu_gaps,       s->ref_rows,
-                           s->ref_unmatched,  s->gnss_records,      s->gnss_applied,   s->gnss_dropped,
-                           s->gnss_before_start, s->gnss_unmatched, s->gap_count,      s->imu_cut_line,
-                           s->gnss_cut_line,  s->ref_cut_line};
+  const long counts[14] = {s->imu_records,       s->imu_steps,      s->imu_gaps,     s->ref_rows,
+                           s->ref_unmatched,     s->gnss_records,   s->gnss_applied, s->gnss_dropped,
+                           s->gnss_before_start, s->gnss_unmatched, s->gap_count,    s->imu_cut_line,
+                           s->gnss_cut_line,     s->ref_cut_line};
   fnv(&h, counts, sizeof counts);
   const unsigned char flags[3] = {s->free_ins, s->gnss_has_vel, s->partial};
   fnv(&h, flags, sizeof flags);
-  const double v[9] = {s->t_first_s, s->t_last_s, s->imu_dt_max_s, s->b_g_rps.x, s->b_g_rps.y,
-                       s->b_g_rps.z, s->b_a_mps2.x, s->b_a_mps2.y, s->b_a_mps2.z};
+  const double v[9] = {s->t_first_s, s->t_last_s,   s->imu_dt_max_s, s->b_g_rps.x, s->b_g_rps.y,
+                       s->b_g_rps.z, s->b_a_mps2.x, s->b_a_mps2.y,   s->b_a_mps2.z};
   fnv_doubles(&h, v, 9);
   hash_stats(&h, &s->stats);
   hash_stats(&h, &s->stats_output);
@@ -459,8 +464,8 @@ static void test_replay_modes_identical(void **state) {
       for (int m = 1; m < 5; ++m) {
         const outcome o = run_mode(&k_modes[m], imus[f], SLICE_TRUTH, true, w == 1, 0);
         print_message("  %-22s %s%s: %ld records, %ld scored, gaps %ld, cut line %ld\n", k_modes[m].name,
-                      f ? "cut IMU file" : "IMU file", w ? ", --end" : "", o.tr.records, o.tr.scored, o.sum.gap_count,
-                      o.sum.imu_cut_line);
+                      f ? "cut IMU file" : "IMU file", w ? ", --end" : "", o.tr.records, o.tr.scored,
+                      o.sum.gap_count, o.sum.imu_cut_line);
         assert_int_equal(o.st, NAV_OK);
         assert_true(o.h_sum == ref.h_sum);
         assert_int_equal(o.tr.records, ref.tr.records);
@@ -494,7 +499,8 @@ static void test_replay_reference_error_read_ahead(void **state) {
   /* Damage a row in the middle (its height). */
   char *p = truth + strlen(truth) / 2;
   p = strchr(p, '\n') + 1;
-  for (int k = 0; k < 4; ++k) p = strchr(p, ' ') + 1;
+  for (int k = 0; k < 4; ++k)
+    p = strchr(p, ' ') + 1;
   p[0] = 'z';
   char path[256];
   temp_path(path, sizeof path, "truth-bad.nav");
