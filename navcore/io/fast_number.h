@@ -98,7 +98,7 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
         w -= 0x30303030u;
         if (m == 0 && w != 0) sig -= __builtin_ctz(w) >> 3;
         if (m != 0 || w != 0) sig += 4;
-        w = (w * 10u) + (w >> 8);                                     /* two-digit values in bytes 0, 2 */
+        w = (w * 10u) + (w >> 8);                                   /* two-digit values in bytes 0, 2 */
         w = ((w & 0x000000FFu) * 100u) + ((w >> 16) & 0x000000FFu); /* the four-digit value */
         m = m * 10000u + w;
         digits += 4;

@@ -801,7 +801,8 @@ static size_t line_start_after(FILE *f, size_t from) {
   return nl ? from + (size_t)(nl - win) + 1 : 0;
 }
 
-nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out, nav_diag *diag) {
+nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out,
+                                  nav_diag *diag) {
   if (!path || !out) return NAV_ERR_INVALID_ARG;
   imu_part a, b;
   memset(&a, 0, sizeof a);
@@ -821,7 +822,8 @@ nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_im
   if (fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0) size = (size_t)sb.st_size;
   if (size > max_bytes) {
     fclose(f);
-    diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size, max_bytes);
+    diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size,
+             max_bytes);
     return NAV_ERR_OUT_OF_RANGE;
   }
   /* Two stretches split at a line start past the middle: the second reader starts where the
@@ -1000,12 +1002,12 @@ static void ref_item_fill(ref_item *it) {
 typedef struct ring {
   pthread_mutex_t m;
   pthread_cond_t nonempty, nonfull;
-  size_t head, tail;   /* published / released items (under m) */
+  size_t head, tail;    /* published / released items (under m) */
   bool closed, stopped; /* producer finished / consumer wants no more (under m) */
-  size_t size;         /* bytes per item */
+  size_t size;          /* bytes per item */
   unsigned char *buf;
-  size_t p_head, p_pub, p_tail;           /* producer's view */
-  size_t c_head, c_tail, c_rel;           /* consumer's view */
+  size_t p_head, p_pub, p_tail; /* producer's view */
+  size_t c_head, c_tail, c_rel; /* consumer's view */
   bool c_closed;
 } ring;
 
@@ -1071,7 +1073,9 @@ static void ring_commit(ring *r) {
 }
 
 /* Producer: no more items. */
-static void ring_close(ring *r) { ring_publish(r, true); }
+static void ring_close(ring *r) {
+  ring_publish(r, true);
+}
 
 /* Consumer: the next item (valid until the next call), or NULL after the last one. */
 static const void *ring_next(ring *r) {
@@ -1429,8 +1433,8 @@ typedef struct scorer {
   const nav_frame *frame;
   nav_replay_summary *sum;
   nav_replay_stats_acc acc, acc_out;
-  double gap_max_h;  /* largest horizontal error since the last fix [m] */
-  atomic_bool stop;  /* record returned NAV_STOP */
+  double gap_max_h; /* largest horizontal error since the last fix [m] */
+  atomic_bool stop; /* record returned NAV_STOP */
   bool threaded;
   pthread_t th;
   ring q;
@@ -1471,9 +1475,10 @@ static void score_one(scorer *sc, const sc_item *it) {
   if (it->output && cfg->record) {
     nav_traj_state ts;
     if (it->has_ref) ts = nav_rec_pva_to_state(&it->u.e.ref.row);
-    const nav_replay_record rec = {sc->frame, &it->u.e.nav, it->has_ref ? &ts : NULL, it->has_ref ? &err : NULL,
-                                   it->updated};
-    if (cfg->record(cfg->user, &rec) == NAV_STOP) atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
+    const nav_replay_record rec = {sc->frame, &it->u.e.nav, it->has_ref ? &ts : NULL,
+                                   it->has_ref ? &err : NULL, it->updated};
+    if (cfg->record(cfg->user, &rec) == NAV_STOP)
+      atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
   }
 }
 

@@ -236,8 +236,10 @@ static void test_malformed_reported(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_random_digit_strings), cmocka_unit_test(test_random_printf_values),
-      cmocka_unit_test(test_edges),                cmocka_unit_test(test_shared_files),
+      cmocka_unit_test(test_random_digit_strings),
+      cmocka_unit_test(test_random_printf_values),
+      cmocka_unit_test(test_edges),
+      cmocka_unit_test(test_shared_files),
       cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),
   };

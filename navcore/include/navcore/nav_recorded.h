@@ -205,8 +205,8 @@ static inline const nav_imu_increment *nav_rec_imu_array_at(const nav_rec_imu_ar
  * @return NAV_OK; NAV_ERR_OUT_OF_RANGE (larger than max_bytes); NAV_ERR_NO_MEMORY; the statuses of
  *         nav_rec_reader_open() and nav_rec_read_imu().
  */
-NAV_API NAV_NODISCARD nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out,
-                                                        nav_diag *diag);
+NAV_API NAV_NODISCARD nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes,
+                                                        nav_rec_imu_array *out, nav_diag *diag);
 
 /** Release the records of @p a and zero it; accepts NULL and a zeroed array. */
 NAV_API void nav_rec_imu_array_free(nav_rec_imu_array *a);
