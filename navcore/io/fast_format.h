@@ -11,8 +11,11 @@
  * x 10^k = m 5^k 2^(k+e) is an integer m 5^k (< 2^116, exact in 128 bits: 5^27 < 2^63) times a
  * power of two, so D = round(x 10^k) is computed exactly by a shift with a round-half-even on
  * the bits shifted out. k is chosen so that 10^16 <= D < 10^17, i.e. D holds the 17 digits.
- * This covers 1e-11 <= |x| < 1e17, where all navigation outputs live; zero is printed directly
- * and everything else (tiny or huge magnitudes, subnormals, infinities, NaN) goes to snprintf.
+ * This covers 1e-11 <= |x| < 1e17, where all navigation outputs live. Below, down to 1e-39
+ * (k <= 55, 5^55 < 2^128), the product m 5^k takes up to 181 bits and is formed in three 64-bit
+ * limbs, with the same exact shift and round-half-even: the e-16 velocities of a state at rest and
+ * other rounding residues are that small. Zero is printed directly and everything else (tinier or
+ * huge magnitudes, subnormals, infinities, NaN) goes to snprintf.
  * The layout then follows C11 7.21.6.1 for %g with precision 17: exponent X of D; style e when
  * X < -4 or X >= 17, else style f with 16 - X fraction digits; trailing zeros (and a trailing
  * point) removed; at least two exponent digits.
@@ -59,8 +62,83 @@ static const uint64_t nav_fmt_pow5[28] = {1ull,
                                           1490116119384765625ull,
                                           7450580596923828125ull};
 
-/* round(m 5^k 2^s) to nearest, ties to even; UINT64_MAX when it does not fit below 2^63. */
+/* 5^28 .. 5^55 as {high, low} 64-bit halves (5^55 < 2^128): the scale factors of the small
+ * magnitudes, 1e-39 <= |x| < 1e-11, whose products m 5^k need up to 181 bits. */
+static const uint64_t nav_fmt_pow5_wide[28][2] = {{0x0000000000000002ull, 0x04fce5e3e2502611ull}, /* 5^28 */
+                                                  {0x000000000000000aull, 0x18f07d736b90be55ull}, /* 5^29 */
+                                                  {0x0000000000000032ull, 0x7cb2734119d3b7a9ull}, /* 5^30 */
+                                                  {0x00000000000000fcull, 0x6f7c40458122964dull}, /* 5^31 */
+                                                  {0x00000000000004eeull, 0x2d6d415b85acef81ull}, /* 5^32 */
+                                                  {0x00000000000018a6ull, 0xe32246c99c60ad85ull}, /* 5^33 */
+                                                  {0x0000000000007b42ull, 0x6fab61f00de36399ull}, /* 5^34 */
+                                                  {0x000000000002684cull, 0x2e58e9b04570f1fdull}, /* 5^35 */
+                                                  {0x00000000000c097cull, 0xe7bc90715b34b9f1ull}, /* 5^36 */
+                                                  {0x00000000003c2f70ull, 0x86aed236c807a1b5ull}, /* 5^37 */
+                                                  {0x00000000012ced32ull, 0xa16a1b11e8262889ull}, /* 5^38 */
+                                                  {0x0000000005e0a1fdull, 0x2712875988becaadull}, /* 5^39 */
+                                                  {0x000000001d6329f1ull, 0xc35ca4bfabb9f561ull}, /* 5^40 */
+                                                  {0x0000000092efd1b8ull, 0xd0cf37be5aa1cae5ull}, /* 5^41 */
+                                                  {0x00000002deaf189cull, 0x140c16b7c528f679ull}, /* 5^42 */
+                                                  {0x0000000e596b7b0cull, 0x643c7196d9ccd05dull}, /* 5^43 */
+                                                  {0x00000047bf19673dull, 0xf52e37f2410011d1ull}, /* 5^44 */
+                                                  {0x00000166bb7f0435ull, 0xc9e717bb45005915ull}, /* 5^45 */
+                                                  {0x00000701a97b150cull, 0xf18376a85901bd69ull}, /* 5^46 */
+                                                  {0x000023084f676940ull, 0xb7915149bd08b30dull}, /* 5^47 */
+                                                  {0x0000af298d050e43ull, 0x95d69670b12b7f41ull}, /* 5^48 */
+                                                  {0x00036bcfc1194751ull, 0xed30f03375d97c45ull}, /* 5^49 */
+                                                  {0x00111b0ec57e6499ull, 0xa1f4b1014d3f6d59ull}, /* 5^50 */
+                                                  {0x00558749db77f700ull, 0x29c77506823d22bdull}, /* 5^51 */
+                                                  {0x01aba4714957d300ull, 0xd0e549208b31adb1ull}, /* 5^52 */
+                                                  {0x085a36366eb71f04ull, 0x147a6da2b7f86475ull}, /* 5^53 */
+                                                  {0x29c30f1029939b14ull, 0x6664242d97d9f649ull}, /* 5^54 */
+                                                  {0xd0cf4b50cfe20765ull, 0xfff4b4e3f741cf6dull},
+                                                  /* 5^55 */};
+
+/* "00" "01" ... "99": two decimal digits per entry. */
+static const char nav_fmt_digit_pairs[201] =
+    "0001020304050607080910111213141516171819202122232425262728293031323334353637383940414243444546474849"
+    "5051525354555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+
+/* round(P / 2^sh) to nearest, ties to even, for P = p2 2^128 + p1 2^64 + p0 and 64 <= sh < 192;
+ * UINT64_MAX when it does not fit below 2^63. */
+static inline uint64_t nav_fmt_shift192(uint64_t p2, uint64_t p1, uint64_t p0, int sh) {
+  const nav_fmt_u128 hi = ((nav_fmt_u128)p2 << 64) | p1; /* P = hi 2^64 + p0 */
+  const int sh2 = sh - 64;                               /* 0 <= sh2 < 128 */
+  nav_fmt_u128 q = sh2 ? hi >> sh2 : hi;
+  /* The bits shifted out: rem_hi 2^64 + p0, compared with half = 2^(sh - 1). */
+  const nav_fmt_u128 rem_hi = sh2 ? hi & ((((nav_fmt_u128)1) << sh2) - 1u) : 0;
+  int cmp; /* sign of (rem - half) */
+  if (sh2 == 0) {
+    cmp = p0 > (1ull << 63) ? 1 : (p0 == (1ull << 63) ? 0 : -1);
+  } else {
+    const nav_fmt_u128 half_hi = ((nav_fmt_u128)1) << (sh2 - 1);
+    cmp = rem_hi > half_hi ? 1 : (rem_hi < half_hi ? -1 : (p0 > 0 ? 1 : 0));
+  }
+  if (cmp > 0 || (cmp == 0 && (q & 1u))) ++q;
+  return q >> 63 ? UINT64_MAX : (uint64_t)q;
+}
+
+/* round(m 5^k 2^s) to nearest, ties to even; UINT64_MAX when it does not fit below 2^63.
+ * 0 <= k <= 55; for k > 27, s < 0 (the small magnitudes). */
 static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
+  if (k > 27) {
+    if (s >= 0) return UINT64_MAX;
+    const uint64_t h = nav_fmt_pow5_wide[k - 28][0], l = nav_fmt_pow5_wide[k - 28][1];
+    const nav_fmt_u128 a = (nav_fmt_u128)m * l, b = (nav_fmt_u128)m * h;
+    const nav_fmt_u128 t = (a >> 64) + (uint64_t)b;
+    const uint64_t p0 = (uint64_t)a, p1 = (uint64_t)t, p2 = (uint64_t)(b >> 64) + (uint64_t)(t >> 64);
+    const int sh = -s;
+    if (sh >= 192) return 0; /* P < 2^181: far below one half */
+    if (sh >= 64) return nav_fmt_shift192(p2, p1, p0, sh);
+    /* sh < 64: the quotient would need P < 2^127 to fit below 2^63. */
+    if (p2 != 0 || (p1 >> 62) != 0) return UINT64_MAX;
+    const nav_fmt_u128 p = ((nav_fmt_u128)p1 << 64) | p0;
+    nav_fmt_u128 q = p >> sh;
+    const nav_fmt_u128 rem = p - (q << sh);
+    const nav_fmt_u128 half = (nav_fmt_u128)1 << (sh - 1);
+    if (rem > half || (rem == half && (q & 1u))) ++q;
+    return q >> 63 ? UINT64_MAX : (uint64_t)q;
+  }
   const nav_fmt_u128 p = (nav_fmt_u128)m * nav_fmt_pow5[k];
   if (s >= 0) {
     if (s > 62 || (p >> (63 - s)) != 0) return UINT64_MAX;
@@ -77,7 +155,8 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
 
 /**
  * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
- * terminating NUL. @return the length.
+ * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
+ * digits). @return the length.
  */
 static inline int nav_fmt_g17(char *buf, double x) {
   uint64_t bits;
@@ -103,7 +182,7 @@ static inline int nav_fmt_g17(char *buf, double x) {
   int tries = 0;
   for (;;) {
     const int k = 16 - x10;
-    if (k < 0 || k > 27 || ++tries > 4) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
+    if (k < 0 || k > 55 || ++tries > 4) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
     d = nav_fmt_scaled(m, k, k + e);
     if (d >= 100000000000000000ull)
       ++x10;
@@ -112,23 +191,37 @@ static inline int nav_fmt_g17(char *buf, double x) {
     else
       break;
   }
-  char dig[17];
-  for (int i = 16; i >= 0; --i) {
-    dig[i] = (char)('0' + (int)(d % 10u));
-    d /= 10u;
+  /* The 17 digits: 9 + 8 in two 32-bit halves, two digits per step (short dependency chains of
+   * 32-bit divisions by constants instead of 17 64-bit ones). */
+  /* dig: the 17 digits, then '0' padding so that the fixed-size copies below stay inside it. */
+  char dig[40];
+  memset(dig + 17, '0', sizeof dig - 17);
+  uint32_t hi = (uint32_t)(d / 100000000u), lo = (uint32_t)(d % 100000000u);
+  for (int i = 16; i > 8; i -= 2) {
+    const uint32_t two = lo % 100u;
+    lo /= 100u;
+    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
   }
+  for (int i = 8; i > 0; i -= 2) {
+    const uint32_t two = hi % 100u;
+    hi /= 100u;
+    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
+  }
+  dig[0] = (char)('0' + hi);
   int nd = 17; /* significant digits after removing trailing zeros */
   while (nd > 1 && dig[nd - 1] == '0')
     --nd;
-  char *p = buf;
+  /* The text is laid out in t with copies of fixed size (short variable-length copies cost more
+   * than the digits: rep movsb), then t's first NAV_FMT_G17_SIZE bytes go to buf. */
+  char t[64];
+  memset(t, 0, NAV_FMT_G17_SIZE);
+  char *p = t;
   if (neg) *p++ = '-';
   if (x10 < -4 || x10 >= 17) {
-    *p++ = dig[0];
-    if (nd > 1) {
-      *p++ = '.';
-      memcpy(p, dig + 1, (size_t)(nd - 1));
-      p += nd - 1;
-    }
+    p[0] = dig[0];
+    p[1] = '.';
+    memcpy(p + 2, dig + 1, 16);
+    p += nd > 1 ? nd + 1 : 1;
     *p++ = 'e';
     int ex = x10;
     *p++ = ex < 0 ? '-' : '+';
@@ -137,24 +230,25 @@ static inline int nav_fmt_g17(char *buf, double x) {
     *p++ = (char)('0' + ex / 10 % 10);
     *p++ = (char)('0' + ex % 10);
   } else if (x10 >= 0) {
-    const int ni = x10 + 1; /* integer digits */
-    memcpy(p, dig, (size_t)ni);
-    p += ni;
+    const int ni = x10 + 1; /* integer digits, 1..17 */
+    memcpy(p, dig, 17);
     if (nd > ni) {
-      *p++ = '.';
-      memcpy(p, dig + ni, (size_t)(nd - ni));
-      p += nd - ni;
+      p[ni] = '.';
+      memcpy(p + ni + 1, dig + ni, 16);
+      p += nd + 1;
+    } else {
+      p += ni;
     }
   } else {
-    *p++ = '0';
-    *p++ = '.';
-    for (int i = 0; i < -x10 - 1; ++i)
-      *p++ = '0';
-    memcpy(p, dig, (size_t)nd);
+    /* -4 <= x10 <= -1: "0." and -x10 - 1 zeros before the digits. */
+    memcpy(p, "0.000", 5);
+    p += 2 + (-x10 - 1);
+    memcpy(p, dig, 17);
     p += nd;
   }
   *p = '\0';
-  return (int)(p - buf);
+  memcpy(buf, t, NAV_FMT_G17_SIZE);
+  return (int)(p - t);
 }
 
 #endif /* NAV_IO_FAST_FORMAT_H */

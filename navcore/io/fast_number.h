@@ -60,17 +60,27 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
   }
   if (p != end && *p == '.') {
     ++p;
-    /* Eight fraction digits at a time once the significand has started (SWAR: the usual
-     * digit test and the three multiply-shift steps that combine 8 ASCII digits into their
-     * value); the byte loop below finishes. Reads only inside [p, end). */
+    /* Eight, then four fraction digits at a time (SWAR: the usual digit test and the
+     * multiply-shift steps that combine ASCII digits into their value); the byte loop below
+     * finishes. Leading zeros of the significand (0.000123) are skipped without counting them as
+     * significant. Reads only inside [p, end). */
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-    while (m != 0 && sig <= 11 && end - p >= 8) {
+    while (sig <= 11 && end - p >= 8) {
       uint64_t w;
       memcpy(&w, p, 8);
       if (((w & 0xF0F0F0F0F0F0F0F0ull) | (((w + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) !=
           0x3333333333333333ull)
         break;
       w -= 0x3030303030303030ull; /* digit bytes, first digit in the lowest byte (little endian) */
+      if (m == 0) {
+        if (w == 0) { /* eight leading zeros */
+          digits += 8;
+          frac += 8;
+          p += 8;
+          continue;
+        }
+        sig -= __builtin_ctzll(w) >> 3; /* zeros before the first significant digit */
+      }
       w = (w * 10u) + (w >> 8);
       w = (((w & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
            (((w >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
@@ -80,6 +90,21 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
       digits += 8;
       frac += 8;
       p += 8;
+    }
+    if (sig <= 15 && end - p >= 4) {
+      uint32_t w;
+      memcpy(&w, p, 4);
+      if (((w & 0xF0F0F0F0u) | (((w + 0x06060606u) & 0xF0F0F0F0u) >> 4)) == 0x33333333u) {
+        w -= 0x30303030u;
+        if (m == 0 && w != 0) sig -= __builtin_ctz(w) >> 3;
+        if (m != 0 || w != 0) sig += 4;
+        w = (w * 10u) + (w >> 8);                                   /* two-digit values in bytes 0, 2 */
+        w = ((w & 0x000000FFu) * 100u) + ((w >> 16) & 0x000000FFu); /* the four-digit value */
+        m = m * 10000u + w;
+        digits += 4;
+        frac += 4;
+        p += 4;
+      }
     }
 #endif
     while (p != end && (unsigned)(*p - '0') < 10u) {

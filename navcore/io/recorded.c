@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <pthread.h>
+#include <stdatomic.h>
 
 #include "navcore/nav_earth.h"
 #include "navcore/nav_io.h"
@@ -43,6 +45,7 @@ struct nav_rec_reader {
   int gnss_cols;      /* column count fixed by the first GNSS record (0 before) */
   long cut_line;      /* a last line without a line end (the file may have been cut), else 0 */
   locale_t c_numeric; /* "C" numbers for strtod, whatever the process locale (a GUI may set one) */
+  size_t file_left;   /* bytes of the file still to read (a stretch of it; SIZE_MAX: to its end) */
 };
 
 /* ---------------------------------------------------------------- diagnostics */
@@ -154,6 +157,7 @@ static nav_status reader_new(nav_rec_format fmt, const char *name, nav_rec_reade
   }
   r->fmt = fmt;
   r->failed = NAV_OK;
+  r->file_left = SIZE_MAX;
   snprintf(r->diag.file, sizeof r->diag.file, "%s", name ? name : "");
   *out = r;
   return NAV_OK;
@@ -220,9 +224,10 @@ static nav_status refill(nav_rec_reader *r) {
     r->len -= r->pos;
     r->pos = 0;
   }
-  const size_t room = BUF_CAP - r->len;
+  size_t room = BUF_CAP - r->len;
   size_t got = 0;
   if (r->f) {
+    if (room > r->file_left) room = r->file_left;
     got = fread(r->buf + r->len, 1, room, r->f);
     if (got < room) {
       if (ferror(r->f)) {
@@ -231,6 +236,10 @@ static nav_status refill(nav_rec_reader *r) {
         return fail(r, NAV_ERR_IO, 0, 0, "", msg);
       }
       r->src_eof = true;
+    }
+    if (r->file_left != SIZE_MAX) {
+      r->file_left -= got;
+      if (r->file_left == 0) r->src_eof = true;
     }
   } else {
     got = r->mem_len - r->mem_pos < room ? r->mem_len - r->mem_pos : room;
@@ -722,6 +731,163 @@ nav_status nav_rec_load_pva(const char *path, nav_rec_pva *out, size_t capacity,
   return load(path, NAV_REC_PVA, read_pva_v, out, sizeof *out, capacity, count, diag);
 }
 
+/* ---------------------------------------------------------------- IMU file in memory */
+
+/* Files below this size are read by one thread: a second one would not pay for its start. */
+#define SPLIT_MIN_BYTES (4u * 1024u * 1024u)
+
+/* The records of one stretch of an IMU file ([off, off + len), or all of it when whole), its
+ * line count and the state a sequential reader would carry into the next stretch. */
+typedef struct imu_part {
+  const char *path;
+  size_t off, len;
+  bool whole;
+  nav_imu_increment *rec;
+  size_t n, cap;
+  long lines, cut_line, last_line;
+  nav_status st;
+  nav_diag diag;
+} imu_part;
+
+static void *imu_part_read(void *arg) {
+  imu_part *q = arg;
+  nav_rec_reader *r = NULL;
+  q->st = nav_rec_reader_open(q->path, NAV_REC_IMU, &r, &q->diag);
+  if (q->st == NAV_OK && !q->whole) {
+    r->file_left = q->len;
+    if (fseeko(r->f, (off_t)q->off, SEEK_SET) != 0) {
+      diag_set(&q->diag, q->path, 0, 0, "", "cannot read the IMU file: %s", strerror(errno));
+      q->st = NAV_ERR_IO;
+    }
+  }
+  for (bool got = true; q->st == NAV_OK && got;) {
+    if (q->n == q->cap) {
+      const size_t cap = q->cap ? 2 * q->cap : 4096;
+      nav_imu_increment *g = realloc(q->rec, cap * sizeof *g);
+      if (!g) {
+        q->st = NAV_ERR_NO_MEMORY;
+        break;
+      }
+      q->rec = g;
+      q->cap = cap;
+    }
+    q->st = nav_rec_read_imu(r, &q->rec[q->n], &got);
+    if (q->st != NAV_OK) q->diag = r->diag;
+    if (q->st == NAV_OK && got) q->n++;
+  }
+  if (r) {
+    q->lines = r->line;
+    q->cut_line = r->cut_line;
+    q->last_line = r->rec_line;
+  }
+  nav_rec_reader_destroy(r);
+  return NULL;
+}
+
+void nav_rec_imu_array_free(nav_rec_imu_array *a) {
+  if (!a) return;
+  free(a->part[0]);
+  free(a->part[1]);
+  memset(a, 0, sizeof *a);
+}
+
+/* Offset just past the first line end at or after @p from (0 when there is none within 64 KiB,
+ * longer than any record line). */
+static size_t line_start_after(FILE *f, size_t from) {
+  char win[64 * 1024];
+  if (fseeko(f, (off_t)from, SEEK_SET) != 0) return 0;
+  const size_t n = fread(win, 1, sizeof win, f);
+  const char *nl = memchr(win, '\n', n);
+  return nl ? from + (size_t)(nl - win) + 1 : 0;
+}
+
+nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes, nav_rec_imu_array *out,
+                                  nav_diag *diag) {
+  if (!path || !out) return NAV_ERR_INVALID_ARG;
+  imu_part a, b;
+  memset(&a, 0, sizeof a);
+  memset(&b, 0, sizeof b);
+  FILE *f = NULL;
+  char why[320];
+  nav_status st = nav_io_fopen_regular(path, &f, why, sizeof why);
+  if (st != NAV_OK) {
+    /* The reader's wording of the same failure ("cannot open the IMU file: ..."). */
+    nav_rec_reader *r = NULL;
+    st = nav_rec_reader_open(path, NAV_REC_IMU, &r, diag);
+    nav_rec_reader_destroy(r);
+    return st != NAV_OK ? st : NAV_ERR_IO;
+  }
+  struct stat sb;
+  size_t size = 0, split = 0;
+  if (fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0) size = (size_t)sb.st_size;
+  if (size > max_bytes) {
+    fclose(f);
+    diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size,
+             max_bytes);
+    return NAV_ERR_OUT_OF_RANGE;
+  }
+  /* Two stretches split at a line start past the middle: the second reader starts where the
+   * sequential one would start that line. */
+  if (size >= SPLIT_MIN_BYTES) split = line_start_after(f, size / 2);
+  fclose(f);
+  a.path = path;
+  b.path = path;
+  a.whole = split == 0;
+  a.len = split;
+  b.off = split;
+  b.len = size - split;
+  /* POSIX threads (as the navsim commands): ThreadSanitizer follows them, not C11 thrd_create. */
+  pthread_t th;
+  bool threaded = false;
+  if (split > 0) threaded = pthread_create(&th, NULL, imu_part_read, &b) == 0;
+  (void)imu_part_read(&a);
+  if (split > 0) {
+    if (threaded)
+      (void)pthread_join(th, NULL);
+    else
+      (void)imu_part_read(&b);
+  }
+  /* The second stretch continues the first: record indices and line numbers go on, the first
+   * interval spans the split, and time must increase across it. */
+  bool joined = a.st == NAV_OK && b.st == NAV_OK;
+  if (joined && b.n > 0 && a.n > 0 && !(b.rec[0].t_s > a.rec[a.n - 1].t_s)) joined = false;
+  if (split > 0 && joined) {
+    for (size_t i = 0; i < b.n; ++i)
+      b.rec[i].k += (int64_t)a.n;
+    if (b.n > 0 && a.n > 0) b.rec[0].dt_s = b.rec[0].t_s - a.rec[a.n - 1].t_s;
+    if (b.n > 0) a.last_line = a.lines + b.last_line;
+    a.cut_line = b.cut_line ? a.lines + b.cut_line : a.cut_line;
+  } else if (split > 0) {
+    /* An error somewhere, or time not increasing across the split: the sequential reader over the
+     * whole file finds the first problem and words it exactly. */
+    free(a.rec);
+    free(b.rec);
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    a.path = path;
+    a.whole = true;
+    (void)imu_part_read(&a);
+  }
+  st = a.st;
+  if (st != NAV_OK) {
+    if (diag) *diag = a.diag;
+    goto cleanup;
+  }
+  out->part[0] = a.rec;
+  out->part_count[0] = a.n;
+  out->part[1] = b.rec;
+  out->part_count[1] = b.n;
+  out->count = a.n + b.n;
+  out->cut_line = a.cut_line;
+  out->last_record_line = a.last_line;
+  a.rec = NULL;
+  b.rec = NULL;
+cleanup:
+  free(a.rec);
+  free(b.rec);
+  return st;
+}
+
 nav_traj_state nav_rec_pva_to_state(const nav_rec_pva *row) {
   nav_traj_state s;
   memset(&s, 0, sizeof s);
@@ -751,6 +917,7 @@ nav_replay_config nav_replay_config_default(void) {
   c.ref_sync_tol_s = 1e-4;
   c.output_interval_s = 0.1;
   c.gap_factor = 1.5;
+  c.read_ahead = true;
   return c;
 }
 
@@ -805,12 +972,244 @@ static nav_frame frame_at(nav_geodetic p) {
   return f;
 }
 
+/* A reference row with the parts of its errors that depend on it alone (ned_errors()), which the
+ * reading thread computes ahead of the navigation. */
+typedef struct ref_item {
+  nav_rec_pva row;
+  double slt, clt, sot, cot; /* sin and cos of its latitude and longitude */
+  nav_quat qt;               /* q_b_n of its Euler angles */
+} ref_item;
+
+static void ref_item_fill(ref_item *it) {
+  const nav_rec_pva *ref = &it->row;
+  it->slt = sin(ref->pos.lat_rad);
+  it->clt = cos(ref->pos.lat_rad);
+  it->sot = sin(ref->pos.lon_rad);
+  it->cot = cos(ref->pos.lon_rad);
+  it->qt = nav_euler_to_quat(ref->att);
+}
+
+/*
+ * A single-producer single-consumer queue of fixed-size items between two threads: a ring of
+ * RING_CAP slots handed over in batches under a mutex. Each side sleeps only when the ring is full
+ * (producer) or empty (consumer), and is woken once half a ring is free or filled (or at the end),
+ * so a run of 193 000 items costs a few hundred wake-ups, not one per item. Items keep their
+ * order, so what the consumer sees is what one thread doing both would see.
+ */
+#define RING_CAP 2048u
+#define RING_BATCH 64u
+
+typedef struct ring {
+  pthread_mutex_t m;
+  pthread_cond_t nonempty, nonfull;
+  size_t head, tail;    /* published / released items (under m) */
+  bool closed, stopped; /* producer finished / consumer wants no more (under m) */
+  size_t size;          /* bytes per item */
+  unsigned char *buf;
+  size_t p_head, p_pub, p_tail; /* producer's view */
+  size_t c_head, c_tail, c_rel; /* consumer's view */
+  bool c_closed;
+} ring;
+
+static bool ring_init(ring *r, size_t item_size) {
+  memset(r, 0, sizeof *r);
+  r->size = item_size;
+  r->buf = malloc(RING_CAP * item_size);
+  if (!r->buf) return false;
+  if (pthread_mutex_init(&r->m, NULL) != 0) goto fail_buf;
+  if (pthread_cond_init(&r->nonempty, NULL) != 0) goto fail_m;
+  if (pthread_cond_init(&r->nonfull, NULL) != 0) goto fail_ne;
+  return true;
+fail_ne:
+  pthread_cond_destroy(&r->nonempty);
+fail_m:
+  pthread_mutex_destroy(&r->m);
+fail_buf:
+  free(r->buf);
+  r->buf = NULL;
+  return false;
+}
+
+static void ring_destroy(ring *r) {
+  if (!r->buf) return;
+  pthread_cond_destroy(&r->nonfull);
+  pthread_cond_destroy(&r->nonempty);
+  pthread_mutex_destroy(&r->m);
+  free(r->buf);
+  r->buf = NULL;
+}
+
+/* Producer: publish the committed items (under m, with the wake-up rule above). */
+static void ring_publish(ring *r, bool closing) {
+  pthread_mutex_lock(&r->m);
+  r->head = r->p_head;
+  if (closing) r->closed = true;
+  r->p_tail = r->tail;
+  if (closing || r->head - r->tail >= RING_CAP / 2) pthread_cond_signal(&r->nonempty);
+  pthread_mutex_unlock(&r->m);
+  r->p_pub = r->p_head;
+}
+
+/* Producer: the next free slot (write it, then ring_commit()), or NULL when the consumer stopped. */
+static void *ring_slot(ring *r) {
+  if (r->p_head - r->p_tail == RING_CAP) {
+    pthread_mutex_lock(&r->m);
+    r->head = r->p_head;
+    r->p_pub = r->p_head;
+    pthread_cond_signal(&r->nonempty);
+    while (RING_CAP - (r->p_head - r->tail) < RING_CAP / 2 && !r->stopped)
+      pthread_cond_wait(&r->nonfull, &r->m);
+    r->p_tail = r->tail;
+    const bool stopped = r->stopped;
+    pthread_mutex_unlock(&r->m);
+    if (stopped) return NULL;
+  }
+  return r->buf + (r->p_head % RING_CAP) * r->size;
+}
+
+static void ring_commit(ring *r) {
+  ++r->p_head;
+  if (r->p_head - r->p_pub >= RING_BATCH) ring_publish(r, false);
+}
+
+/* Producer: no more items. */
+static void ring_close(ring *r) {
+  ring_publish(r, true);
+}
+
+/* Consumer: the next item (valid until the next call), or NULL after the last one. */
+static const void *ring_next(ring *r) {
+  if (r->c_tail == r->c_head || r->c_tail - r->c_rel >= RING_BATCH) {
+    if (r->c_tail == r->c_head && r->c_closed) return NULL;
+    pthread_mutex_lock(&r->m);
+    /* The items consumed so far (the previous one included: its caller is done with it). */
+    r->tail = r->c_tail;
+    r->c_rel = r->c_tail;
+    if (RING_CAP - (r->head - r->tail) >= RING_CAP / 2) pthread_cond_signal(&r->nonfull);
+    while (r->head == r->c_tail && !r->closed)
+      pthread_cond_wait(&r->nonempty, &r->m);
+    r->c_head = r->head;
+    r->c_closed = r->closed;
+    pthread_mutex_unlock(&r->m);
+    if (r->c_tail == r->c_head) return NULL;
+  }
+  return r->buf + (r->c_tail++ % RING_CAP) * r->size;
+}
+
+/* Consumer: want no more items (the producer's next ring_slot() returns NULL). */
+static void ring_stop(ring *r) {
+  pthread_mutex_lock(&r->m);
+  r->stopped = true;
+  pthread_cond_signal(&r->nonfull);
+  pthread_mutex_unlock(&r->m);
+}
+
+/*
+ * Read-ahead of one streamed input (IMU or reference) on a thread, through a ring: memory stays
+ * flat. Each item carries what the consumer would have asked the reader right after that record
+ * (status, progress fraction, cut line), so the replay sees exactly what reading on its own
+ * thread gives. After a terminal item (an error or the end) the thread stops; the reader's diag is
+ * then stable and read by the consumer.
+ */
+typedef struct ra_item {
+  nav_status st;
+  bool got;
+  double fraction;
+  long cut_line;
+  union {
+    nav_imu_increment imu;
+    ref_item ref;
+  } u;
+} ra_item;
+
+typedef struct read_ahead {
+  nav_rec_reader *r;
+  bool threaded;
+  pthread_t th;
+  ring q;
+  bool ended;
+  ra_item one; /* without a thread: the record just read */
+  ra_item last;
+} read_ahead;
+
+static void ra_read_one(nav_rec_reader *r, ra_item *it) {
+  if (r->fmt == NAV_REC_IMU) {
+    it->st = nav_rec_read_imu(r, &it->u.imu, &it->got);
+  } else {
+    it->st = nav_rec_read_pva(r, &it->u.ref.row, &it->got);
+    if (it->st == NAV_OK && it->got) ref_item_fill(&it->u.ref);
+  }
+  it->fraction = nav_rec_reader_fraction(r);
+  it->cut_line = r->cut_line;
+}
+
+static void *ra_main(void *arg) {
+  read_ahead *a = arg;
+  for (;;) {
+    ra_item *it = ring_slot(&a->q);
+    if (!it) break;
+    ra_read_one(a->r, it);
+    ring_commit(&a->q);
+    if (it->st != NAV_OK || !it->got) break;
+  }
+  ring_close(&a->q);
+  return NULL;
+}
+
+/* Start reading @p r ahead (on a thread when @p threaded and one can be made). */
+static void ra_start(read_ahead *a, nav_rec_reader *r, bool threaded) {
+  memset(a, 0, sizeof *a);
+  a->r = r;
+  if (!threaded || !ring_init(&a->q, sizeof(ra_item))) return;
+  if (pthread_create(&a->th, NULL, ra_main, a) != 0) {
+    ring_destroy(&a->q);
+    return; /* read on the calling thread */
+  }
+  a->threaded = true;
+}
+
+/* The next record; valid until the next call. */
+static const ra_item *ra_next(read_ahead *a) {
+  if (a->ended) return &a->last;
+  const ra_item *it = &a->one;
+  if (a->threaded) {
+    it = ring_next(&a->q);
+  } else {
+    ra_read_one(a->r, &a->one);
+  }
+  if (!it || it->st != NAV_OK || !it->got) {
+    /* (it is never NULL: the producer's last item is terminal.) */
+    if (it) a->last = *it;
+    a->ended = true;
+    return &a->last;
+  }
+  return it;
+}
+
+/* Stop the thread (it finishes the record in hand) and release the ring; the reader stays. */
+static void ra_stop(read_ahead *a) {
+  if (!a->threaded) return;
+  ring_stop(&a->q);
+  (void)pthread_join(a->th, NULL);
+  ring_destroy(&a->q);
+  a->threaded = false;
+}
+
 /* The open inputs of a replay with one record of look-ahead each. */
 typedef struct replay {
   const nav_replay_config *cfg;
   nav_rec_reader *imu, *gnss, *ref;
-  nav_rec_pva ref_row;
+  read_ahead imu_ra, ref_ra;
+  bool imu_ra_on, ref_ra_on;
+  size_t imu_idx;      /* cfg->imu: records handed out */
+  bool imu_end_seen;   /* cfg->imu: a read past the last record */
+  double imu_fraction; /* progress */
+  long imu_cut_line;   /* as nav_rec_reader_cut_line() at this point of the reading */
+  /* The current reference row and its precomputed parts, borrowed from the read-ahead (valid
+   * until the next ref_next(); read in place: no copy per epoch). */
+  const ref_item *ref_it;
   bool ref_have;
+  long ref_cut_line;
   nav_ins_gnss_fix fix;
   bool fix_have;
   nav_ins_gnss_raw_epoch raw; /* cfg->raw: the next raw epoch */
@@ -824,9 +1223,44 @@ static nav_status reader_failed(replay *p, const nav_rec_reader *r, nav_status s
 }
 
 static nav_status ref_next(replay *p) {
-  const nav_status st = nav_rec_read_pva(p->ref, &p->ref_row, &p->ref_have);
-  if (st != NAV_OK) return reader_failed(p, p->ref, st);
-  if (p->ref_have) p->sum->ref_rows++;
+  const ra_item *it = ra_next(&p->ref_ra);
+  if (it->st != NAV_OK) {
+    p->ref_have = false;
+    return reader_failed(p, p->ref, it->st);
+  }
+  p->ref_have = it->got;
+  p->ref_cut_line = it->cut_line;
+  if (p->ref_have) {
+    p->ref_it = &it->u.ref;
+    p->sum->ref_rows++;
+  }
+  return NAV_OK;
+}
+
+/* The next IMU record: from the caller's array, or the (read-ahead) reader. */
+static nav_status imu_next(replay *p, nav_imu_increment *inc, bool *got) {
+  const nav_rec_imu_array *a = p->cfg->imu;
+  if (a) {
+    *got = p->imu_idx < a->count;
+    if (*got) {
+      *inc = *nav_rec_imu_array_at(a, p->imu_idx++);
+    } else {
+      p->imu_end_seen = true;
+    }
+    p->imu_fraction = a->count ? (double)p->imu_idx / (double)a->count : 1.0;
+    /* The streaming reader has read the last line once it returned the record on it, or tried to
+     * read past the last record. */
+    if (a->cut_line && (p->imu_end_seen || (p->imu_idx == a->count && a->cut_line == a->last_record_line)))
+      p->imu_cut_line = a->cut_line;
+    return NAV_OK;
+  }
+  const ra_item *it = ra_next(&p->imu_ra);
+  p->imu_fraction = it->fraction;
+  p->imu_cut_line = it->cut_line;
+  *got = false;
+  if (it->st != NAV_OK) return it->st;
+  *got = it->got;
+  if (*got) *inc = it->u.imu;
   return NAV_OK;
 }
 
@@ -929,11 +1363,12 @@ static nav_vec3 ecef_of(double sl, double cl, double so, double co, double h) {
  * Euler angles (the reference's straight from its row). The values agree with the general path
  * to rounding (a few 1e-10 m, 1e-14 rad: the same formulas without the geodetic inversions).
  */
-static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e) {
+static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
+  const nav_rec_pva *ref = &ri->row;
   nav_epoch_errors r;
   r.t_s = ref->t_s;
-  const double slt = sin(ref->pos.lat_rad), clt = cos(ref->pos.lat_rad);
-  const double sot = sin(ref->pos.lon_rad), cot = cos(ref->pos.lon_rad);
+  const double slt = ri->slt, clt = ri->clt;
+  const double sot = ri->sot, cot = ri->cot;
   const double sle = e->sin_lat, cle = e->cos_lat;
   const double soe = sin(e->pos.lon_rad), coe = cos(e->pos.lon_rad);
   const nav_mat3 Ct = dcm_n_e(slt, clt, sot, cot), Ce = dcm_n_e(sle, cle, soe, coe);
@@ -947,7 +1382,7 @@ static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e)
   r.vel_err_n_mps = nav_mat3_mul_vec(Ct_t, dv);
   r.vel_err_mps = nav_vec3_norm(r.vel_err_n_mps);
   /* C_b_e(ref)^T C_b_e(est) = C_n_b(ref) M C_b_n(est) with M = C_e_n(ref) C_n_e(est) ~ I. */
-  const nav_quat qt = nav_euler_to_quat(ref->att);
+  const nav_quat qt = ri->qt;
   const nav_quat qm = nav_quat_from_dcm(nav_mat3_mul(Ct_t, Ce));
   r.att_err_rad = nav_quat_angle_between(qt, nav_quat_mul(qm, e->q_b_n));
   const nav_euler ee = nav_quat_to_euler(e->q_b_n, NULL);
@@ -958,11 +1393,132 @@ static nav_epoch_errors ned_errors(const nav_rec_pva *ref, const nav_ins_ned *e)
 }
 
 /* The errors at a reference row: the NED path when the navigation has one, else the general. */
-static nav_epoch_errors errors_at(const nav_frame *frame, const nav_rec_pva *ref, const nav_side *n) {
+static nav_epoch_errors errors_at(const nav_frame *frame, const ref_item *ref, const nav_side *n) {
   nav_ins_ned ned;
   if (nav_ned(n, &ned)) return ned_errors(ref, &ned);
-  const nav_traj_state ts = nav_rec_pva_to_state(ref);
+  const nav_traj_state ts = nav_rec_pva_to_state(&ref->row);
   return nav_errors_compute(frame, &ts, nav_state(n));
+}
+
+/*
+ * Scoring of the epochs: errors against the reference, statistics, GNSS gap bookkeeping, and the
+ * scored and record callbacks, fed in epoch order with what the navigation had at each epoch.
+ * On the calling thread (one item at a time, straight after the step) or, with
+ * callbacks_on_worker, on a second thread through a ring while the navigation goes on: the same
+ * items in the same order, so the same figures, files and callbacks.
+ */
+typedef enum sc_kind {
+  SC_EPOCH, /* an epoch with a reference row or an output */
+  SC_GAP,   /* a GNSS gap ended at this epoch (before its fix): gap filled but for pos_h_max_m */
+  SC_FIX    /* a fix was applied: the largest error of the next gap starts again */
+} sc_kind;
+
+/* The fields an ordinary epoch writes come first and together: each item crosses to the other
+ * core, so the fewer cache lines it touches the better. */
+typedef struct sc_item {
+  sc_kind kind;
+  bool has_ref, output, updated, has_ned;
+  union {
+    struct {
+      nav_ins_ned ned;   /* has_ned: the NED state */
+      ref_item ref;      /* has_ref */
+      nav_ins_state nav; /* !has_ned or output: the e-frame state */
+    } e;                 /* SC_EPOCH */
+    nav_replay_gap gap;  /* SC_GAP */
+  } u;
+} sc_item;
+
+typedef struct scorer {
+  const nav_replay_config *cfg;
+  const nav_frame *frame;
+  nav_replay_summary *sum;
+  nav_replay_stats_acc acc, acc_out;
+  double gap_max_h; /* largest horizontal error since the last fix [m] */
+  atomic_bool stop; /* record returned NAV_STOP */
+  bool threaded;
+  pthread_t th;
+  ring q;
+  sc_item one; /* on the calling thread: the item being filled */
+} scorer;
+
+static void score_one(scorer *sc, const sc_item *it) {
+  /* After a NAV_STOP nothing more is scored or called back, as on the calling thread, where the
+   * navigation stops at once. */
+  if (atomic_load_explicit(&sc->stop, memory_order_relaxed)) return;
+  nav_replay_summary *sum = sc->sum;
+  if (it->kind == SC_FIX) {
+    sc->gap_max_h = 0.0;
+    return;
+  }
+  if (it->kind == SC_GAP) {
+    nav_replay_gap g = it->u.gap;
+    g.pos_h_max_m = g.has_end_errors ? fmax(sc->gap_max_h, g.pos_h_end_m) : sc->gap_max_h;
+    if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
+    sum->gap_count++;
+    return;
+  }
+  const nav_replay_config *cfg = sc->cfg;
+  nav_epoch_errors err;
+  if (it->has_ref) {
+    if (it->has_ned) {
+      err = ned_errors(&it->u.e.ref, &it->u.e.ned);
+    } else {
+      const nav_traj_state ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+      err = nav_errors_compute(sc->frame, &ts, &it->u.e.nav);
+    }
+    nav_replay_stats_add(&sc->acc, &err);
+    if (cfg->scored) cfg->scored(cfg->user, &err);
+    if (it->output) nav_replay_stats_add(&sc->acc_out, &err);
+    sum->final = err;
+    sc->gap_max_h = fmax(sc->gap_max_h, err.pos_err_h_m);
+  }
+  if (it->output && cfg->record) {
+    nav_traj_state ts;
+    if (it->has_ref) ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+    const nav_replay_record rec = {sc->frame, &it->u.e.nav, it->has_ref ? &ts : NULL,
+                                   it->has_ref ? &err : NULL, it->updated};
+    if (cfg->record(cfg->user, &rec) == NAV_STOP)
+      atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
+  }
+}
+
+static void *scorer_main(void *arg) {
+  scorer *sc = arg;
+  for (const sc_item *it = ring_next(&sc->q); it; it = ring_next(&sc->q))
+    score_one(sc, it);
+  return NULL;
+}
+
+static void scorer_start(scorer *sc, bool threaded) {
+  sc->threaded = false;
+  if (!threaded || !ring_init(&sc->q, sizeof(sc_item))) return;
+  if (pthread_create(&sc->th, NULL, scorer_main, sc) != 0) {
+    ring_destroy(&sc->q);
+    return;
+  }
+  sc->threaded = true;
+}
+
+/* The item to fill for the next epoch or event (then scorer_push()). */
+static sc_item *scorer_slot(scorer *sc) {
+  /* The consumer never stops early, so a slot always comes. */
+  return sc->threaded ? ring_slot(&sc->q) : &sc->one;
+}
+
+static void scorer_push(scorer *sc) {
+  if (sc->threaded)
+    ring_commit(&sc->q);
+  else
+    score_one(sc, &sc->one);
+}
+
+/* Score everything pushed so far and stop the thread; the results are then in sc. */
+static void scorer_finish(scorer *sc) {
+  if (!sc->threaded) return;
+  ring_close(&sc->q);
+  (void)pthread_join(sc->th, NULL);
+  ring_destroy(&sc->q);
+  sc->threaded = false;
 }
 
 static nav_status nav_fail(nav_diag *diag, nav_status st, const char *what, const char *detail) {
@@ -978,6 +1534,10 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (!sum) return NAV_ERR_NO_MEMORY;
   replay p;
   memset(&p, 0, sizeof p);
+  scorer sc;
+  memset(&sc, 0, sizeof sc);
+  sc.cfg = cfg;
+  sc.sum = sum;
   p.cfg = cfg;
   p.sum = sum;
   p.diag = diag;
@@ -985,10 +1545,16 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->free_ins = cfg->gnss_path == NULL && cfg->raw == NULL;
   const bool aided = !sum->free_ins;
 
-  st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
+  if (!cfg->imu) st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
   if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
   if (st != NAV_OK) goto cleanup;
+  if (p.imu) {
+    ra_start(&p.imu_ra, p.imu, cfg->read_ahead);
+    p.imu_ra_on = true;
+  }
+  ra_start(&p.ref_ra, p.ref, cfg->read_ahead);
+  p.ref_ra_on = true;
   st = ref_next(&p);
   if (st == NAV_OK && aided) st = fix_next(&p);
   if (st != NAV_OK) goto cleanup;
@@ -998,18 +1564,18 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   nav_imu_increment inc;
   bool got = false;
   for (;;) {
-    st = nav_rec_read_imu(p.imu, &inc, &got);
+    st = imu_next(&p, &inc, &got);
     if (st != NAV_OK) {
       reader_failed(&p, p.imu, st);
       goto cleanup;
     }
     if (got) sum->imu_records++;
     if (got && !(cfg->has_start && inc.t_s < cfg->t_start_s - tol)) {
-      while (p.ref_have && p.ref_row.t_s < inc.t_s - tol) {
+      while (p.ref_have && p.ref_it->row.t_s < inc.t_s - tol) {
         st = ref_next(&p);
         if (st != NAV_OK) goto cleanup;
       }
-      if (p.ref_have && fabs(p.ref_row.t_s - inc.t_s) <= tol &&
+      if (p.ref_have && fabs(p.ref_it->row.t_s - inc.t_s) <= tol &&
           !(cfg->has_end && inc.t_s > cfg->t_end_s + tol))
         break;
     }
@@ -1029,9 +1595,10 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       goto cleanup;
     }
   }
-  const nav_rec_pva row0 = p.ref_row;
+  const nav_rec_pva row0 = p.ref_it->row;
   const nav_traj_state ts0 = nav_rec_pva_to_state(&row0);
   const nav_frame frame = frame_at(row0.pos);
+  sc.frame = &frame;
   if (cfg->has_initial && !(fabs(cfg->initial.t_s - inc.t_s) <= tol)) {
     diag_set(diag, cfg->imu_path, 0, 0, "",
              "the given initial state is at t = %.17g s, but the initial epoch (the first IMU epoch with a "
@@ -1070,14 +1637,12 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   if (st != NAV_OK) goto cleanup;
 
   /* 2. Every following increment. */
-  nav_replay_stats_acc acc, acc_out;
-  memset(&acc, 0, sizeof acc);
-  memset(&acc_out, 0, sizeof acc_out);
+  scorer_start(&sc, cfg->callbacks_on_worker);
   const double t_first = inc.t_s;
-  double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0, gap_max_h = 0.0;
+  double dt_nominal = 0.0, last_fix_t = 0.0, min_spacing = 0.0;
   bool have_fix = false, have_spacing = false;
   while (!stop) {
-    st = nav_rec_read_imu(p.imu, &inc, &got);
+    st = imu_next(&p, &inc, &got);
     if (st != NAV_OK) {
       reader_failed(&p, p.imu, st);
       goto cleanup;
@@ -1102,12 +1667,12 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     sum->t_last_s = t;
 
     /* The reference row of this epoch, if any (rows in between are counted, not scored). */
-    while (p.ref_have && p.ref_row.t_s < t - tol) {
+    while (p.ref_have && p.ref_it->row.t_s < t - tol) {
       sum->ref_unmatched++;
       st = ref_next(&p);
       if (st != NAV_OK) goto cleanup;
     }
-    const bool has_ref = p.ref_have && fabs(p.ref_row.t_s - t) <= tol;
+    const bool has_ref = p.ref_have && fabs(p.ref_it->row.t_s - t) <= tol;
 
     /* GNSS fixes of this epoch: time of validity within dt/2 (numerics.md 6.5). */
     bool updated = false;
@@ -1122,22 +1687,22 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
       } else {
         const double spacing = p.fix.t_s - last_fix_t;
         if (have_fix && have_spacing && spacing > cfg->gap_factor * min_spacing) {
-          /* The end of a GNSS gap: errors just before the fix that ends it. */
-          nav_replay_gap g;
-          memset(&g, 0, sizeof g);
-          g.t0_s = last_fix_t;
-          g.t1_s = p.fix.t_s;
-          g.pos_h_max_m = gap_max_h;
+          /* The end of a GNSS gap: errors just before the fix that ends it (the largest error
+             inside it is the scorer's). */
+          sc_item *gi = scorer_slot(&sc);
+          gi->kind = SC_GAP;
+          nav_replay_gap *g = &gi->u.gap;
+          memset(g, 0, sizeof *g);
+          g->t0_s = last_fix_t;
+          g->t1_s = p.fix.t_s;
           if (has_ref) {
-            const nav_epoch_errors e = errors_at(&frame, &p.ref_row, &nav);
-            g.has_end_errors = true;
-            g.pos_h_end_m = e.pos_err_h_m;
-            g.pos_v_end_m = e.pos_err_v_m;
-            g.pos_h_max_m = fmax(gap_max_h, e.pos_err_h_m);
-            g.end_errors = e;
+            const nav_epoch_errors e = errors_at(&frame, p.ref_it, &nav);
+            g->has_end_errors = true;
+            g->pos_h_end_m = e.pos_err_h_m;
+            g->pos_v_end_m = e.pos_err_v_m;
+            g->end_errors = e;
           }
-          if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
-          sum->gap_count++;
+          scorer_push(&sc);
         }
         if (cfg->raw)
           st = nav_ins_gnss_update_raw(nav.x, &p.raw, NULL);
@@ -1153,7 +1718,8 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
         }
         have_fix = true;
         last_fix_t = p.fix.t_s;
-        gap_max_h = 0.0;
+        scorer_slot(&sc)->kind = SC_FIX;
+        scorer_push(&sc);
         updated = true;
         sum->gnss_applied++;
       }
@@ -1164,30 +1730,29 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const long long j = llround(t / cfg->output_interval_s);
     const bool output = j != last_out && fabs(t - (double)j * cfg->output_interval_s) <= 0.5 * dt;
     if (output) last_out = j;
-    if (has_ref) {
-      err = errors_at(&frame, &p.ref_row, &nav);
-      nav_replay_stats_add(&acc, &err);
-      if (cfg->scored) cfg->scored(cfg->user, &err);
-      if (output) nav_replay_stats_add(&acc_out, &err);
-      sum->final = err;
-      gap_max_h = fmax(gap_max_h, err.pos_err_h_m);
-    }
-    if (output && cfg->record) {
-      nav_traj_state ts;
-      if (has_ref) ts = nav_rec_pva_to_state(&p.ref_row);
-      const nav_replay_record rec = {&frame, nav_state(&nav), has_ref ? &ts : NULL, has_ref ? &err : NULL,
-                                     updated};
-      if (cfg->record(cfg->user, &rec) == NAV_STOP) stop = true;
+    if (has_ref || (output && cfg->record)) {
+      sc_item *it = scorer_slot(&sc);
+      it->kind = SC_EPOCH;
+      it->has_ref = has_ref;
+      it->output = output;
+      it->updated = updated;
+      it->has_ned = has_ref && nav_ned(&nav, &it->u.e.ned);
+      if (has_ref) it->u.e.ref = *p.ref_it;
+      if (!it->has_ned || output) it->u.e.nav = *nav_state(&nav);
+      scorer_push(&sc);
+      if (atomic_load_explicit(&sc.stop, memory_order_relaxed)) stop = true;
     }
     if (has_ref) {
       st = ref_next(&p);
       if (st != NAV_OK) goto cleanup;
     }
     if (cfg->progress && sum->imu_steps % 8192 == 0) {
-      const nav_progress pr = {"replay", 0, nav_rec_reader_fraction(p.imu), t};
+      const nav_progress pr = {"replay", 0, p.imu_fraction, t};
       if (cfg->progress(cfg->user, &pr) == NAV_STOP) stop = true;
     }
   }
+  scorer_finish(&sc);
+  if (atomic_load_explicit(&sc.stop, memory_order_relaxed)) stop = true;
   /* A gap still open at the end of the run. */
   if (aided && have_fix && have_spacing && sum->t_last_s - last_fix_t > cfg->gap_factor * min_spacing) {
     nav_replay_gap g;
@@ -1198,7 +1763,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     g.has_end_errors = fabs(sum->final.t_s - sum->t_last_s) <= tol;
     g.pos_h_end_m = sum->final.pos_err_h_m;
     g.pos_v_end_m = sum->final.pos_err_v_m;
-    g.pos_h_max_m = gap_max_h;
+    g.pos_h_max_m = sc.gap_max_h;
     g.end_errors = sum->final;
     if (sum->gap_count < NAV_REPLAY_MAX_GAPS) sum->gaps[sum->gap_count] = g;
     sum->gap_count++;
@@ -1207,17 +1772,20 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
     const nav_progress pr = {"replay", 0, 1.0, sum->t_last_s};
     (void)cfg->progress(cfg->user, &pr);
   }
-  sum->stats = nav_replay_stats_result(&acc);
-  sum->stats_output = nav_replay_stats_result(&acc_out);
+  sum->stats = nav_replay_stats_result(&sc.acc);
+  sum->stats_output = nav_replay_stats_result(&sc.acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
-  sum->imu_cut_line = nav_rec_reader_cut_line(p.imu);
+  sum->imu_cut_line = p.imu_cut_line;
   sum->gnss_cut_line = nav_rec_reader_cut_line(p.gnss);
-  sum->ref_cut_line = nav_rec_reader_cut_line(p.ref);
+  sum->ref_cut_line = p.ref_cut_line;
   *out = *sum;
   st = stop ? NAV_ERR_CANCELLED : NAV_OK;
 
 cleanup:
+  scorer_finish(&sc);
+  if (p.imu_ra_on) ra_stop(&p.imu_ra);
+  if (p.ref_ra_on) ra_stop(&p.ref_ra);
   nav_ins_gnss_destroy(nav.x);
   nav_ins_destroy(nav.ins);
   nav_rec_reader_destroy(p.imu);

@@ -109,6 +109,54 @@ static void test_random_printf_values(void **state) {
   assert_true(t.fast > 250000);
 }
 
+/* Fractions with runs of leading zeros (0.000000001234..., which the eight- and four-digit steps
+ * skip without counting them as significant) followed by 1..22 significant digits, at every
+ * alignment against the eight- and four-byte steps, with and without an exponent. Accepted values
+ * are strtod's; those with at most 15 significant digits and a scale within 10^+-22 must be
+ * accepted. */
+static void test_leading_zero_fractions(void **state) {
+  (void)state;
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 5u, 0u);
+  tally t = {0, 0};
+  long must = 0;
+  char s[128];
+  for (int it = 0; it < 300000; ++it) {
+    size_t p = 0;
+    if (next_u(&r, 3) == 0) s[p++] = '-';
+    const int lead_int = (int)next_u(&r, 3); /* "", "0", "00" */
+    for (int i = 0; i < lead_int; ++i)
+      s[p++] = '0';
+    s[p++] = '.';
+    const int zeros = (int)next_u(&r, 25);
+    for (int i = 0; i < zeros; ++i)
+      s[p++] = '0';
+    const int nsig = 1 + (int)next_u(&r, 22);
+    s[p++] = (char)('1' + next_u(&r, 9));
+    for (int i = 1; i < nsig; ++i)
+      s[p++] = (char)('0' + next_u(&r, 10));
+    const int trail = (int)next_u(&r, 4); /* trailing zeros are digits too */
+    for (int i = 0; i < trail; ++i)
+      s[p++] = '0';
+    int e = 0;
+    if (next_u(&r, 2) == 0) {
+      e = (int)next_u(&r, 41) - 20;
+      p += (size_t)snprintf(s + p, sizeof s - p, "e%d", e);
+    }
+    s[p] = '\0';
+    const bool fast = check_one(s, &t);
+    /* Scale of the last digit: 10^(e - zeros - nsig - trail); significant digits nsig + trail. */
+    const int q = e - zeros - nsig - trail;
+    if (nsig + trail <= 15 && q >= -22 && q <= 22) {
+      must++;
+      if (!fast) fail_msg("\"%s\" should be on the fast path", s);
+    }
+  }
+  print_message("[ fastnum  ] leading-zero fractions: %ld fast (%ld required), %ld declined\n", t.fast, must,
+                t.declined);
+  assert_true(must > 50000);
+}
+
 /* Edge cases: exact results at the limits of the fast path, signed zeros, and the texts that
  * must be declined. */
 static void test_edges(void **state) {
@@ -188,8 +236,11 @@ static void test_malformed_reported(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_random_digit_strings), cmocka_unit_test(test_random_printf_values),
-      cmocka_unit_test(test_edges),                cmocka_unit_test(test_shared_files),
+      cmocka_unit_test(test_random_digit_strings),
+      cmocka_unit_test(test_random_printf_values),
+      cmocka_unit_test(test_edges),
+      cmocka_unit_test(test_shared_files),
+      cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

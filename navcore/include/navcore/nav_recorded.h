@@ -171,6 +171,47 @@ NAV_API NAV_NODISCARD nav_status nav_rec_load_pva(const char *path, nav_rec_pva 
                                                   size_t *count, nav_diag *diag);
 
 /**
+ * Every record of an IMU file, read and checked once (as nav_rec_check_file() does) and kept in
+ * memory, so that a replay that checks its inputs before the run does not parse the file twice
+ * (nav_replay_config.imu). Made by nav_rec_imu_array_load(), released by nav_rec_imu_array_free().
+ */
+typedef struct nav_rec_imu_array {
+  /** The records in file order: part[0], then part[1] (the two halves parsed on two threads are
+   *  kept where they were parsed, not copied together); owned, part[1] may be NULL. Read them
+   *  with nav_rec_imu_array_at(). */
+  nav_imu_increment *part[2];
+  size_t part_count[2];  /**< records in each part */
+  size_t count;          /**< number of records, part_count[0] + part_count[1] */
+  long cut_line;         /**< nav_rec_reader_cut_line() after the whole file, else 0 */
+  long last_record_line; /**< 1-based line of the last record (0 without records) */
+} nav_rec_imu_array;
+
+/** Record @p i (0 <= i < a->count) of @p a, borrowed. */
+static inline const nav_imu_increment *nav_rec_imu_array_at(const nav_rec_imu_array *a, size_t i) {
+  return i < a->part_count[0] ? &a->part[0][i] : &a->part[1][i - a->part_count[0]];
+}
+
+/**
+ * Read every record of an IMU file into memory, with the checks and messages of
+ * nav_rec_read_imu(). Large files are split at a line end and the halves parsed on two threads;
+ * the records, their indices and intervals, and any error message are those of the sequential
+ * reader (a half with an error, or a time step across the split that does not increase, is read
+ * again sequentially for its exact message).
+ * @param[in]  path      IMU file (KF-GINS text)
+ * @param[in]  max_bytes files larger than this are refused with NAV_ERR_OUT_OF_RANGE and nothing
+ *                       read (the caller then streams them: memory stays bounded)
+ * @param[out] out       the records (written on NAV_OK; release with nav_rec_imu_array_free())
+ * @param[out] diag      on failure, what and where (may be NULL)
+ * @return NAV_OK; NAV_ERR_OUT_OF_RANGE (larger than max_bytes); NAV_ERR_NO_MEMORY; the statuses of
+ *         nav_rec_reader_open() and nav_rec_read_imu().
+ */
+NAV_API NAV_NODISCARD nav_status nav_rec_imu_array_load(const char *path, size_t max_bytes,
+                                                        nav_rec_imu_array *out, nav_diag *diag);
+
+/** Release the records of @p a and zero it; accepts NULL and a zeroed array. */
+NAV_API void nav_rec_imu_array_free(nav_rec_imu_array *a);
+
+/**
  * A .nav row as a reference state in ECEF (F = e of nav_frames.h): r_eb_e from the geodetic
  * position, v_eb_e = C_n_e v_n, q_b_e = q_n_e (x) q_b_n; accelerations and rates are zero (not
  * in the format). Leaf function.
@@ -352,6 +393,28 @@ typedef struct nav_replay_config {
    */
   nav_replay_raw_fn raw;
   void *raw_user; /**< passed to @p raw */
+  /**
+   * The IMU records already read from imu_path (nav_rec_imu_array_load(); not kept, must outlive
+   * the call): the replay takes them instead of reading the file again, with the same results
+   * (imu_path still names the file in messages; the progress fraction counts records). Default
+   * NULL: imu_path is streamed.
+   */
+  const nav_rec_imu_array *imu;
+  /**
+   * Read the reference (and a streamed IMU file) on a second thread, ahead of the navigation,
+   * through a bounded queue: the same records in the same order, so the same results and
+   * messages; memory stays flat. Default true; false reads them on the calling thread.
+   */
+  bool read_ahead;
+  /**
+   * Score the epochs and call @p record and @p scored on a second thread, in epoch order and with
+   * the same arguments, while the navigation goes on (the initial epoch's calls stay on the
+   * calling thread). The callbacks must then not share unsynchronised data with @p progress or
+   * the caller, nor read the filter; a NAV_STOP from @p record stops the navigation up to a few
+   * thousand epochs later (the partial summary counts them). Default false: every callback on the
+   * calling thread, the run stopped at once.
+   */
+  bool callbacks_on_worker;
 } nav_replay_config;
 
 /**
@@ -371,7 +434,8 @@ NAV_API nav_replay_config nav_replay_config_default(void);
  * the integration subtracts its bias estimates), apply the fixes whose time is within dt/2 of the
  * epoch (position, and velocity for 13-column files), and score the epoch if a reference row
  * coincides with it (ref_sync_tol_s). The navigation never reads the reference after the initial
- * epoch. Streams all three files: memory does not grow with their length.
+ * epoch. Streams all three files (read_ahead: on a second thread): memory does not grow with their
+ * length, except for the caller's nav_replay_config.imu.
  *
  * @param[in]  cfg  inputs and settings (not kept)
  * @param[out] out  summary; written on NAV_OK and on NAV_ERR_CANCELLED (partial)
