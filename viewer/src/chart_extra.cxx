@@ -674,6 +674,7 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
   const int cs = col({"status"});
   const int cc = col({"case"});
   const int ca = col({"algorithm"}), cf = col({"frame"});
+  const int cp = col({"peer"});
   if (cx < 0 || cy < 0 || cv < 0) {
     *error = bench_csv + ":1: error: expected columns mech_samples_per_s (or samples_per_s), pos_err_m (or "
                          "error) and variant (or algorithm)";
@@ -683,7 +684,7 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
   // marker's colour is its algorithm and frame, the same in every panel.
   struct Point {
     double x, y;
-    std::string label, series;
+    std::string label, series, peer;
   };
   std::map<std::string, std::vector<Point>> by_case;
   std::vector<std::string> cases, series;
@@ -695,6 +696,7 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
     if (!(p.x > 0.0) || !(p.y > 0.0)) continue;
     p.label = r[static_cast<size_t>(cv)];
     p.series = p.label;
+    if (cp >= 0 && cp < static_cast<int>(r.size())) p.peer = r[static_cast<size_t>(cp)];
     if (ca >= 0 && cf >= 0 && std::max(ca, cf) < static_cast<int>(r.size()))
       p.series = r[static_cast<size_t>(ca)] + ", " + r[static_cast<size_t>(cf)];
     const std::string k = cc >= 0 && cc < static_cast<int>(r.size()) ? r[static_cast<size_t>(cc)] : std::string("bench");
@@ -706,6 +708,15 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
     *error = bench_csv + ": error: no row with a positive speed and error (status ok)";
     return false;
   }
+  // Rows of one case with the same variant (a replay scored against two peers) are told apart by
+  // their peer column.
+  for (auto &kv : by_case) {
+    std::vector<int> same(kv.second.size(), 0);
+    for (size_t i = 0; i < kv.second.size(); ++i)
+      for (const Point &q : kv.second) same[i] += q.label == kv.second[i].label;
+    for (size_t i = 0; i < kv.second.size(); ++i)
+      if (same[i] > 1 && !kv.second[i].peer.empty()) kv.second[i].label += " vs " + kv.second[i].peer;
+  }
   static const unsigned char pal[10][3] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
                                            {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
                                            {188, 189, 34},  {23, 190, 207}};
@@ -713,12 +724,40 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
                                  vtkPlotPoints::CROSS};
   const int n = static_cast<int>(cases.size());
   const int ncols = n == 1 ? 1 : (n <= 4 ? 2 : 3);
-  const int nrows = (n + ncols - 1) / ncols;
+  // Grid cells, filled left to right from the top; a case with many variants (more than fit one
+  // above the other in a cell) takes two whole rows, so that its labels find room.
+  constexpr size_t kBigCase = 8;
+  std::vector<int> cell_col(static_cast<size_t>(n)), cell_top(static_cast<size_t>(n));
+  std::vector<bool> big(static_cast<size_t>(n));
+  int top = 0, colk = 0;
+  for (int k = 0; k < n; ++k) {
+    big[static_cast<size_t>(k)] = ncols > 1 && by_case[cases[static_cast<size_t>(k)]].size() > kBigCase;
+    if (big[static_cast<size_t>(k)]) {
+      if (colk != 0) {
+        ++top;
+        colk = 0;
+      }
+      cell_col[static_cast<size_t>(k)] = 0;
+      cell_top[static_cast<size_t>(k)] = top;
+      top += 2;
+      continue;
+    }
+    cell_col[static_cast<size_t>(k)] = colk;
+    cell_top[static_cast<size_t>(k)] = top;
+    if (++colk == ncols) {
+      colk = 0;
+      ++top;
+    }
+  }
+  const int nrows = top + (colk != 0 ? 1 : 0);
   ChartCanvas c;
   if (!MakeCanvas(&c, opt, nrows, error, ncols)) return false;
   for (int k = 0; k < n; ++k) {
-    // Row 0 of vtkChartMatrix is at the bottom: the first case goes top left.
-    const int cidx = k % ncols, ridx = nrows - 1 - k / ncols;
+    // Row 0 of vtkChartMatrix is at the bottom and a span grows upwards: the first case goes top left.
+    const bool wide = big[static_cast<size_t>(k)];
+    const int cidx = cell_col[static_cast<size_t>(k)];
+    const int ridx = nrows - 1 - cell_top[static_cast<size_t>(k)] - (wide ? 1 : 0);
+    if (wide) c.matrix->SetChartSpan(vtkVector2i(cidx, ridx), vtkVector2i(ncols, 2));
     vtkChartXY *chart = vtkChartXY::SafeDownCast(c.matrix->GetChart(vtkVector2i(cidx, ridx)));
     if (!chart) {
       *error = "vtkChartMatrix did not create an XY chart";
@@ -728,6 +767,12 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
     if (layout) {
       layout->cases.push_back(cases[static_cast<size_t>(k)]);
       layout->labels.emplace_back();
+      NavBenchChartLayout::Cell cell;
+      cell.col = cidx;
+      cell.row = cell_top[static_cast<size_t>(k)];
+      cell.cols = wide ? ncols : 1;
+      cell.rows = wide ? 2 : 1;
+      layout->cells.push_back(cell);
     }
     double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
     std::vector<Line> lines;
@@ -780,7 +825,7 @@ bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOption
       chart->AddPlot(lab);
       if (layout) layout->labels.back() = lab->labels;
     }
-    const bool bottom_row = k / ncols == nrows - 1 || k + ncols >= n;
+    const bool bottom_row = ridx == 0;
     StyleChart(chart, cases[static_cast<size_t>(k)] + " (" + std::to_string(pts.size()) + " variant" +
                           (pts.size() == 1 ? ")" : "s)"),
                bottom_row ? "speed [samples/s]" : "", cidx == 0 ? "position error [m]" : "", opt, c.font);

@@ -110,6 +110,41 @@ int main() {
   } else {
     Check(false, "label lists: " + std::to_string(lay.labels.size()) + ", expected 4");
   }
+  // A case of more than eight variants spans two whole rows; rows of one case with the same
+  // variant (a replay against two peers) are labelled with their peers.
+  {
+    const std::string big = out + "_big.csv";
+    FILE *f = std::fopen(big.c_str(), "w");
+    Check(f != nullptr, "cannot write " + big);
+    if (f) {
+      std::fputs("case,variant,algorithm,frame,mech_samples_per_s,pos_err_m,peer,status\n", f);
+      std::fputs("small,a,first_order,ned,1e6,1e-3,,ok\n", f);
+      for (int i = 0; i < 10; ++i)
+        std::fprintf(f, "many,v%d,high_order,ned,%g,%g,,ok\n", i, 1e6 * (1 + i), 1e-4 * (1 + i));
+      std::fputs("replay,GNSS.txt,high_order,ned,5e5,0.02,KF-GINS,ok\n", f);
+      std::fputs("replay,GNSS.txt,high_order,ned,5e5,0.02,pyins,ok\n", f);
+      std::fputs("other,b,high_order,ecef,2e6,2e-4,,ok\n", f);
+      std::fclose(f);
+    }
+    ok = NavRenderSpeedVsErrorPng(big, o, out + "_big.png", &err, &lay);
+    Check(ok, "big case: " + err);
+    Check(lay.cases == std::vector<std::string>({"small", "many", "replay", "other"}), "big: cases " + Join(lay.cases));
+    if (lay.cells.size() == 4) {
+      // Two columns (four cases): small at (0, 0); many from the next row, both columns x two rows;
+      // replay and other after it.
+      const auto &c1 = lay.cells[1], &c2 = lay.cells[2], &c3 = lay.cells[3];
+      Check(lay.cells[0].col == 0 && lay.cells[0].row == 0, "small not top left");
+      Check(c1.col == 0 && c1.row == 1 && c1.cols == 2 && c1.rows == 2,
+            "many: cell " + std::to_string(c1.col) + "," + std::to_string(c1.row) + " span " + std::to_string(c1.cols) +
+                "x" + std::to_string(c1.rows) + ", expected 0,1 span 2x2");
+      Check(c2.col == 0 && c2.row == 3 && c2.cols == 1 && c3.col == 1 && c3.row == 3, "replay/other after the wide panel");
+    } else {
+      Check(false, "big: cells " + std::to_string(lay.cells.size()));
+    }
+    Check(lay.labels.size() == 4 && lay.labels[2] == std::vector<std::string>({"GNSS.txt vs KF-GINS", "GNSS.txt vs pyins"}),
+          "replay labels: " + (lay.labels.size() == 4 ? Join(lay.labels[2]) : std::string("?")));
+    Check(lay.labels.size() == 4 && lay.labels[1].size() == 10, "many: labels");
+  }
   // The old single-case file: one panel.
   o.width_px = 300;
   o.height_px = 240;

@@ -95,8 +95,14 @@ bool NavRenderAllanChartPng(const std::string &allan_csv, const NavChartOptions 
  * was drawn: the case of each panel and the labels written next to its markers.
  */
 struct NavBenchChartLayout {
+  /** Grid cell of a panel: column and row from the top left, and how many it spans. */
+  struct Cell {
+    int col = 0, row = 0, cols = 1, rows = 1;
+  };
   std::vector<std::string> cases;               /**< panel titles' cases, first panel top left */
   std::vector<std::vector<std::string>> labels; /**< per panel, the marker labels drawn (show_text) */
+  std::vector<Cell> cells;                      /**< per panel, its place (a case of more than eight
+                                                     variants spans two whole rows) */
 };
 bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &options, const std::string &path,
                               std::string *error, NavBenchChartLayout *layout = nullptr);
