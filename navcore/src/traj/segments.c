@@ -792,8 +792,7 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   double sn[3][NAV_KIN_MAX_NODES], cs[3][NAV_KIN_MAX_NODES];
   for (int c = 0; c < 3; ++c) {
     const double a0 = ang[c][0];
-    sn[c][0] = sin(a0);
-    cs[c][0] = cos(a0);
+    nav_kin_sincos(a0, &sn[c][0], &cs[c][0]); /* none for a zero angle (a car's pitch and roll) */
     for (int i = 1; i < n; ++i) {
       const double d = ang[c][i] - a0;
       if (d == 0.0) {
