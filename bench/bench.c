@@ -462,7 +462,7 @@ static const char *k_usage_bench =
     "              the same code as ours; without it, KF-GINS's published figures are shown, labelled\n"
     "              with the machine they were measured on\n"
     "  --peer-gnss-ins-sim DIR  a checkout of Aceinna/gnss-ins-sim: its Sim.run on the long drive runs\n"
-    "              in this suite (Debian's /usr/bin/python3 with python3-numpy and python3-scipy), against\n"
+    "              in this suite (Debian's /usr/bin/python3 with python3-numpy), against\n"
     "              our truth + IMU generation per sample; without it, its figure measured on this\n"
     "              project's machine is shown, labelled with date and load\n"
     "Each row records the 1-minute load average when its case was timed (column load1).\n"

@@ -25,7 +25,7 @@
  * runs, so the 154 s of extra straight driving in gnss-ins-sim's plan would favour us per sample).
  *
  * gnss-ins-sim's figure: measured in this run with --peer-gnss-ins-sim DIR (a checkout of
- * Aceinna/gnss-ins-sim; it needs Debian's python3-numpy and python3-scipy; the timing script below
+ * Aceinna/gnss-ins-sim; its Sim.run needs only Debian's python3-numpy; the timing script below
  * is written into DIR_OUT/logs and run by /usr/bin/python3), else the figure measured on this
  * project's machine, labelled with its date and load.
  */
@@ -49,7 +49,7 @@
 #define TG_TARGET 100.0
 
 /* gnss-ins-sim @ 966ff271 on the long drive (193 036 samples), Debian 12 python3 3.11.2,
- * python3-numpy 1.24.2, python3-scipy 1.10.1, on this project's 2-core AMD EPYC machine,
+ * python3-numpy 1.24.2, on this project's 2-core AMD EPYC machine,
  * 2026-11-27 07:10 UTC, load average 5.0-5.3 (other engineers' builds): CPU seconds of path_gen
  * (truth + ideal IMU) and of the whole Sim.run (+ IMU errors, GPS, derived data). */
 #define TG_PUBLISHED_SAMPLES 193036.0
@@ -200,7 +200,7 @@ static bool run_peer(const char *gis_dir, const char *out_dir, char *msg, size_t
     snprintf(msg, msg_size, "cannot write %.200s", script);
     return false;
   }
-  /* Debian's interpreter (python3-numpy, python3-scipy): a python3 earlier on PATH may lack them. */
+  /* Debian's interpreter (python3-numpy): a python3 earlier on PATH may lack it. */
   char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
   char *argv[] = {py, script, (char *)gis_dir, motion, NULL};
   const child_result c = bench_run_child(argv, log, 600.0);

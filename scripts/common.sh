@@ -21,6 +21,7 @@ NAV_PACKAGES=(
   python3-yaml python3-jsonschema   # scenes against `navsim schema` (issue 18, test_navsim_schema)
   libnetcdf-dev gmt-gshhg-high gmt-gshhg-full # map land/water, rivers, borders (GSHHG binned netCDF)
   ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
+  python3-numpy                     # gnss-ins-sim as the bench's truth-generation peer (navsim bench --peer-gnss-ins-sim)
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
