@@ -455,7 +455,8 @@ int bench_make_dir(const char *path) {
 }
 
 static const char *k_usage_bench =
-    "usage: navsim bench [--suite quick|full] [--out DIR] [--peer-kfgins PATH] [--quiet]\n"
+    "usage: navsim bench [--suite quick|full] [--out DIR] [--peer-kfgins PATH] [--peer-gnss-ins-sim DIR]\n"
+    "                    [--quiet]\n"
     "\n"
     "Speed against error: for each algorithm x Earth model x mechanization frame x rate,\n"
     "the throughput of truth generation and of the mechanization (IMU samples per second,\n"
@@ -469,13 +470,17 @@ static const char *k_usage_bench =
     "              alternating with navsim replay (medians of 3 each), and its solution is scored by\n"
     "              the same code as ours; without it, KF-GINS's published figures are shown, labelled\n"
     "              with the machine they were measured on\n"
+    "  --peer-gnss-ins-sim DIR  a checkout of Aceinna/gnss-ins-sim: its Sim.run on the long drive runs\n"
+    "              in this suite (Debian's /usr/bin/python3 with python3-numpy), against\n"
+    "              our truth + IMU generation per sample; without it, its figure measured on this\n"
+    "              project's machine is shown, labelled with date and load\n"
     "Each row records the 1-minute load average when its case was timed (column load1).\n"
     "  --quiet     do not print the table\n"
     "\n"
     "exit codes: 0 success (failed cases are reported in the table), 2 bad options, 1 I/O failure\n";
 
 int navsim_bench(int argc, char **argv) {
-  const char *out_dir = "out/bench", *peer_kfgins = NULL;
+  const char *out_dir = "out/bench", *peer_kfgins = NULL, *peer_gis = NULL;
   bool full = false, quiet = false;
   for (int i = 0; i < argc; ++i) {
     const char *a = argv[i];
@@ -488,6 +493,15 @@ int navsim_bench(int argc, char **argv) {
       peer_kfgins = argv[++i];
       if (access(peer_kfgins, X_OK) != 0) {
         fprintf(stderr, "navsim bench: --peer-kfgins: \"%s\" is not an executable file\n", peer_kfgins);
+        return 2;
+      }
+    } else if (strcmp(a, "--peer-gnss-ins-sim") == 0 && i + 1 < argc) {
+      peer_gis = argv[++i];
+      char probe[4200];
+      snprintf(probe, sizeof probe, "%s/gnss_ins_sim/sim/ins_sim.py", peer_gis);
+      if (access(probe, R_OK) != 0) {
+        fprintf(stderr, "navsim bench: --peer-gnss-ins-sim: \"%s\" is not a gnss-ins-sim checkout (no %s)\n", peer_gis,
+                "gnss_ins_sim/sim/ins_sim.py");
         return 2;
       }
     } else if (strcmp(a, "--stage") == 0 && i + 3 < argc && strcmp(argv[i + 2], "--steps") == 0) {
@@ -620,6 +634,8 @@ int navsim_bench(int argc, char **argv) {
   if (!quiet) fputc('\n', stderr);
   /* Covariance rate, long-drive per algorithm and rate, MPI ranks, viewer fps, memory (bench_cases2.c). */
   bench_cases2(full, out_dir, rows, &n_all, CAP, quiet);
+  /* Truth + IMU generation of the long drive against gnss-ins-sim (bench_truthgen.c). */
+  bench_case_truthgen(full, out_dir, peer_gis, rows, &n_all, CAP);
 
   int rc = 0;
   char path[1200], tmp[1300];

@@ -85,6 +85,11 @@ void bench_web_target_md(FILE *md, const bench_row *rows, int n);
 void bench_case_estimate_library(bool full, const char *out_dir, bench_row *rows, int *n, int cap);
 void bench_estimate_target_md(FILE *md, const bench_row *rows, int n);
 
+/* Truth + IMU generation of the long drive against gnss-ins-sim, per sample (bench_truthgen.c): its
+ * rows (with @p gis_dir, a gnss-ins-sim checkout, the peer runs in this suite), and its target line. */
+void bench_case_truthgen(bool full, const char *out_dir, const char *gis_dir, bench_row *rows, int *n, int cap);
+void bench_truthgen_target_md(FILE *md, const bench_row *rows, int n);
+
 /* Per-stage floating-point operation counts (bench_report.c). */
 typedef struct bench_flops {
   const char *stage;

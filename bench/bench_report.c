@@ -579,6 +579,7 @@ void bench_report_md(FILE *md, bool full, const char *out_dir, const bench_row *
     bench_studio_target_md(md, rows, n);
     bench_web_target_md(md, rows, n);
     bench_estimate_target_md(md, rows, n);
+    bench_truthgen_target_md(md, rows, n);
   }
   {
     struct rusage self, kids;

@@ -55,7 +55,8 @@ void Usage(FILE *f) {
                "  --follow            follow camera: behind and above the vehicle (--follow-distance M,\n"
                "                      default automatic, 60 m for a drive of a few km)\n"
                "  --allan ALLAN_CSV   Allan deviation chart of navsim allan's allan.csv (with --png; no DIR)\n"
-               "  --speed-vs-error BENCH_CSV  speed-vs-error chart of navsim bench's bench.csv (with --png)\n"
+               "  --speed-vs-error BENCH_CSV  speed against error of navsim bench's bench.csv, one labelled panel\n"
+               "                      per case (with --png; default size 1500x1200)\n"
                "  --tradeoff TRADEOFF_CSV  CPU time against requirement error of navsim tradeoff's tradeoff.csv,\n"
                "                      one panel per requirement (--requirement ID: that one only), labelled\n"
                "                      points, intervals, tolerance band and Pareto front (with --png)\n"
@@ -482,8 +483,9 @@ static int NavviewMain(int argc, char **argv) {
       return 2;
     }
     if (!size_given) {
-      copt.width_px = 900;
-      copt.height_px = allan_csv.empty() ? 600 : 800;
+      // The speed-against-error chart is a grid of one panel per bench case.
+      copt.width_px = allan_csv.empty() ? 1500 : 900;
+      copt.height_px = allan_csv.empty() ? 1200 : 800;
     }
     std::string e2;
     const bool ok = allan_csv.empty() ? NavRenderSpeedVsErrorPng(bench_csv, copt, png, &e2)

@@ -944,7 +944,7 @@ int navsim_report(int argc, char **argv) {
       {"noise", "Simulated sensor errors", "Measured minus ideal IMU output of run 0 (gyros, accelerometers).",
        false},
       {"allan", "Allan deviation", "Log-log, with slope guides.", false},
-      {"bench", "Speed against error", "navsim bench: one marker per variant.", false},
+      {"bench", "Speed against error", "navsim bench: one panel per case, each marker labelled with its variant.", false},
       {"tradeoff", "Speed against error per modelling choice",
        "navsim tradeoff: CPU time per Monte Carlo run against each requirement's value with its 95 % "
        "bootstrap interval; green within the tolerance of the full model (dashed band), grey outside, the full "

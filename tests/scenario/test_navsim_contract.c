@@ -73,6 +73,7 @@ static void test_version_and_help(void **state) {
   r = navsim(NULL, "bench --help");
   assert_int_equal(r->code, 0);
   assert_non_null(strstr(r->out, "--suite"));
+  assert_non_null(strstr(r->out, "--peer-gnss-ins-sim DIR"));
 }
 
 static void test_usage_errors_exit_2(void **state) {
@@ -87,6 +88,10 @@ static void test_usage_errors_exit_2(void **state) {
   assert_non_null(strstr(r->err, "--seed"));
   assert_int_equal(navsim(NULL, "run " SCENE " --seed 18446744073709551616")->code, 2);
   assert_int_equal(navsim(NULL, "bench --suite huge")->code, 2);
+  /* A directory that is not a gnss-ins-sim checkout is refused before any case runs (issue 23). */
+  r = navsim(NULL, "bench --peer-gnss-ins-sim " NAV_SOURCE_DIR "/scenes");
+  assert_int_equal(r->code, 2);
+  assert_non_null(strstr(r->err, "is not a gnss-ins-sim checkout"));
 }
 
 static void test_check_scene_library(void **state) {

@@ -119,7 +119,7 @@ struct ChartCanvas {
   int font = 12;
 };
 
-bool MakeCanvas(ChartCanvas *c, const NavChartOptions &opt, int rows, std::string *error) {
+bool MakeCanvas(ChartCanvas *c, const NavChartOptions &opt, int rows, std::string *error, int cols = 1) {
   if (opt.width_px < 64 || opt.height_px < 64 || opt.width_px > 8192 || opt.height_px > 8192) {
     *error = "chart size out of range (64..8192 pixels)";
     return false;
@@ -131,14 +131,19 @@ bool MakeCanvas(ChartCanvas *c, const NavChartOptions &opt, int rows, std::strin
   c->view->GetRenderWindow()->SetSize(opt.width_px, opt.height_px);
   c->view->GetRenderWindow()->SetMultiSamples(8);
   c->view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
-  c->matrix->SetSize(vtkVector2i(1, rows));
+  c->matrix->SetSize(vtkVector2i(cols, rows));
   c->font = std::max(10, static_cast<int>(std::lround(std::min(opt.height_px / (rows == 1 ? 40.0 : 52.0),
                                                                 opt.width_px / 60.0))));
+  // A grid of panels: the font of one panel's size (about 24 lines high, 40 characters wide).
+  if (cols > 1 || rows > 2)
+    c->font = std::max(9, static_cast<int>(std::lround(std::min(opt.height_px / (rows * 24.0),
+                                                                 opt.width_px / (cols * 40.0)))));
   const bool text = opt.show_text;
   const int f = c->font;
   c->matrix->SetBorders(static_cast<int>((text ? 5.2 : 1.0) * f), static_cast<int>((text ? 3.4 : 1.0) * f),
                         static_cast<int>(1.5 * f), static_cast<int>((text ? 2.2 : 1.0) * f));
-  c->matrix->SetGutter(vtkVector2f(0.0f, static_cast<float>((text ? 4.0 : 1.0) * f)));
+  c->matrix->SetGutter(vtkVector2f(cols > 1 ? static_cast<float>((text ? 6.0 : 1.0) * f) : 0.0f,
+                                    static_cast<float>((text ? 4.0 : 1.0) * f)));
   c->view->GetScene()->AddItem(c->matrix);
   return true;
 }
@@ -364,91 +369,6 @@ bool NavRenderAllanChartPng(const std::string &allan_csv, const NavChartOptions 
     chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
     chart->GetAxis(vtkAxis::LEFT)->SetRange(ymin / 3.0, ymax * 3.0);
   }
-  c.view->Render();
-  return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
-}
-
-bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &opt, const std::string &path,
-                              std::string *error) {
-  std::vector<std::string> h;
-  std::vector<std::vector<std::string>> rows;
-  if (!ReadTextCsv(bench_csv, &h, &rows, error)) return false;
-  auto col = [&](std::initializer_list<const char *> names) {
-    for (const char *n : names)
-      for (size_t i = 0; i < h.size(); ++i)
-        if (h[i] == n) return static_cast<int>(i);
-    return -1;
-  };
-  const int cx = col({"mech_samples_per_s", "samples_per_s"});
-  const int cy = col({"pos_err_m", "error", "error_m"});
-  const int cv = col({"variant", "algorithm"});
-  const int cs = col({"status"});
-  const int cc = col({"case"});
-  const int ca = col({"algorithm"}), cf = col({"frame"});
-  if (cx < 0 || cy < 0 || cv < 0) {
-    *error = bench_csv + ":1: error: expected columns mech_samples_per_s (or samples_per_s), pos_err_m (or "
-                         "error) and variant (or algorithm)";
-    return false;
-  }
-  std::map<std::string, Line> by_variant;
-  std::vector<std::string> order;
-  double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
-  for (const auto &r : rows) {
-    if (static_cast<int>(r.size()) <= std::max(cx, std::max(cy, cv))) continue;
-    if (cs >= 0 && cs < static_cast<int>(r.size()) && r[static_cast<size_t>(cs)] != "ok") continue;
-    double x, y;
-    if (!ParseNum(r[static_cast<size_t>(cx)], &x) || !ParseNum(r[static_cast<size_t>(cy)], &y)) continue;
-    if (!(x > 0.0) || !(y > 0.0)) continue;
-    // Series: algorithm + frame when bench.csv has them (each row, i.e. each variant, is one
-    // marker; the rates of a series line up along it), else the variant name.
-    std::string v = r[static_cast<size_t>(cv)];
-    if (ca >= 0 && cf >= 0 && std::max(ca, cf) < static_cast<int>(r.size()))
-      v = r[static_cast<size_t>(ca)] + ", " + r[static_cast<size_t>(cf)];
-    if (v.empty() && cc >= 0) v = r[static_cast<size_t>(cc)];
-    if (!by_variant.count(v)) order.push_back(v);
-    Line &l = by_variant[v];
-    l.x.push_back(x);
-    l.y.push_back(y);
-    xmin = std::min(xmin, x);
-    xmax = std::max(xmax, x);
-    ymin = std::min(ymin, y);
-    ymax = std::max(ymax, y);
-  }
-  if (order.empty()) {
-    *error = bench_csv + ": error: no row with a positive speed and error (status ok)";
-    return false;
-  }
-  static const unsigned char pal[10][3] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
-                                           {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
-                                           {188, 189, 34},  {23, 190, 207}};
-  static const int markers[4] = {vtkPlotPoints::CIRCLE, vtkPlotPoints::SQUARE, vtkPlotPoints::DIAMOND,
-                                 vtkPlotPoints::CROSS};
-  std::vector<Line> lines;
-  for (size_t i = 0; i < order.size(); ++i) {
-    Line l = by_variant[order[i]];
-    l.name = order[i];
-    std::copy(pal[i % 10], pal[i % 10] + 3, l.rgb);
-    l.points = true;
-    l.marker = markers[(i / 10) % 4];
-    l.width = 4.0f;
-    lines.push_back(l);
-  }
-  ChartCanvas c;
-  if (!MakeCanvas(&c, opt, 1, error)) return false;
-  vtkChartXY *chart = Panel(&c, 0);
-  if (!chart) {
-    *error = "vtkChartMatrix did not create an XY chart";
-    return false;
-  }
-  AddLines(chart, lines);
-  StyleChart(chart, "speed against error (navsim bench): one marker per variant",
-             "speed [mechanization samples/s]", "position error [m]", opt, c.font);
-  chart->GetAxis(vtkAxis::LEFT)->SetLogScale(true);
-  chart->GetAxis(vtkAxis::BOTTOM)->SetLogScale(true);
-  chart->GetAxis(vtkAxis::BOTTOM)->SetBehavior(vtkAxis::FIXED);
-  chart->GetAxis(vtkAxis::BOTTOM)->SetRange(xmin / 2.0, xmax * 2.0);
-  chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
-  chart->GetAxis(vtkAxis::LEFT)->SetRange(ymin / 3.0, ymax * 3.0);
   c.view->Render();
   return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
 }
@@ -734,6 +654,191 @@ bool NavRenderTradeoffPng(const std::string &csv, const std::string &requirement
   }
   cv.view->Render();
   return NavWriteWindowPng(cv.view->GetRenderWindow(), path, error);
+}
+
+bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &opt, const std::string &path,
+                              std::string *error, NavBenchChartLayout *layout) {
+  if (layout) *layout = NavBenchChartLayout();
+  std::vector<std::string> h;
+  std::vector<std::vector<std::string>> rows;
+  if (!ReadTextCsv(bench_csv, &h, &rows, error)) return false;
+  auto col = [&](std::initializer_list<const char *> names) {
+    for (const char *n : names)
+      for (size_t i = 0; i < h.size(); ++i)
+        if (h[i] == n) return static_cast<int>(i);
+    return -1;
+  };
+  const int cx = col({"mech_samples_per_s", "samples_per_s"});
+  const int cy = col({"pos_err_m", "error", "error_m"});
+  const int cv = col({"variant", "algorithm"});
+  const int cs = col({"status"});
+  const int cc = col({"case"});
+  const int ca = col({"algorithm"}), cf = col({"frame"});
+  const int cp = col({"peer"});
+  if (cx < 0 || cy < 0 || cv < 0) {
+    *error = bench_csv + ":1: error: expected columns mech_samples_per_s (or samples_per_s), pos_err_m (or "
+                         "error) and variant (or algorithm)";
+    return false;
+  }
+  // One panel per case (in the order of bench.csv), one labelled marker per variant (row); the
+  // marker's colour is its algorithm and frame, the same in every panel.
+  struct Point {
+    double x, y;
+    std::string label, series, peer;
+  };
+  std::map<std::string, std::vector<Point>> by_case;
+  std::vector<std::string> cases, series;
+  for (const auto &r : rows) {
+    if (static_cast<int>(r.size()) <= std::max(cx, std::max(cy, cv))) continue;
+    if (cs >= 0 && cs < static_cast<int>(r.size()) && r[static_cast<size_t>(cs)] != "ok") continue;
+    Point p;
+    if (!ParseNum(r[static_cast<size_t>(cx)], &p.x) || !ParseNum(r[static_cast<size_t>(cy)], &p.y)) continue;
+    if (!(p.x > 0.0) || !(p.y > 0.0)) continue;
+    p.label = r[static_cast<size_t>(cv)];
+    p.series = p.label;
+    if (cp >= 0 && cp < static_cast<int>(r.size())) p.peer = r[static_cast<size_t>(cp)];
+    if (ca >= 0 && cf >= 0 && std::max(ca, cf) < static_cast<int>(r.size()))
+      p.series = r[static_cast<size_t>(ca)] + ", " + r[static_cast<size_t>(cf)];
+    const std::string k = cc >= 0 && cc < static_cast<int>(r.size()) ? r[static_cast<size_t>(cc)] : std::string("bench");
+    if (!by_case.count(k)) cases.push_back(k);
+    if (std::find(series.begin(), series.end(), p.series) == series.end()) series.push_back(p.series);
+    by_case[k].push_back(p);
+  }
+  if (cases.empty()) {
+    *error = bench_csv + ": error: no row with a positive speed and error (status ok)";
+    return false;
+  }
+  // Rows of one case with the same variant (a replay scored against two peers) are told apart by
+  // their peer column.
+  for (auto &kv : by_case) {
+    std::vector<int> same(kv.second.size(), 0);
+    for (size_t i = 0; i < kv.second.size(); ++i)
+      for (const Point &q : kv.second) same[i] += q.label == kv.second[i].label;
+    for (size_t i = 0; i < kv.second.size(); ++i)
+      if (same[i] > 1 && !kv.second[i].peer.empty()) kv.second[i].label += " vs " + kv.second[i].peer;
+  }
+  static const unsigned char pal[10][3] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
+                                           {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
+                                           {188, 189, 34},  {23, 190, 207}};
+  static const int markers[4] = {vtkPlotPoints::CIRCLE, vtkPlotPoints::SQUARE, vtkPlotPoints::DIAMOND,
+                                 vtkPlotPoints::CROSS};
+  const int n = static_cast<int>(cases.size());
+  const int ncols = n == 1 ? 1 : (n <= 4 ? 2 : 3);
+  // Grid cells, filled left to right from the top; a case with many variants (more than fit one
+  // above the other in a cell) takes two whole rows, so that its labels find room.
+  constexpr size_t kBigCase = 8;
+  std::vector<int> cell_col(static_cast<size_t>(n)), cell_top(static_cast<size_t>(n));
+  std::vector<bool> big(static_cast<size_t>(n));
+  int top = 0, colk = 0;
+  for (int k = 0; k < n; ++k) {
+    big[static_cast<size_t>(k)] = ncols > 1 && by_case[cases[static_cast<size_t>(k)]].size() > kBigCase;
+    if (big[static_cast<size_t>(k)]) {
+      if (colk != 0) {
+        ++top;
+        colk = 0;
+      }
+      cell_col[static_cast<size_t>(k)] = 0;
+      cell_top[static_cast<size_t>(k)] = top;
+      top += 2;
+      continue;
+    }
+    cell_col[static_cast<size_t>(k)] = colk;
+    cell_top[static_cast<size_t>(k)] = top;
+    if (++colk == ncols) {
+      colk = 0;
+      ++top;
+    }
+  }
+  const int nrows = top + (colk != 0 ? 1 : 0);
+  ChartCanvas c;
+  if (!MakeCanvas(&c, opt, nrows, error, ncols)) return false;
+  for (int k = 0; k < n; ++k) {
+    // Row 0 of vtkChartMatrix is at the bottom and a span grows upwards: the first case goes top left.
+    const bool wide = big[static_cast<size_t>(k)];
+    const int cidx = cell_col[static_cast<size_t>(k)];
+    const int ridx = nrows - 1 - cell_top[static_cast<size_t>(k)] - (wide ? 1 : 0);
+    if (wide) c.matrix->SetChartSpan(vtkVector2i(cidx, ridx), vtkVector2i(ncols, 2));
+    vtkChartXY *chart = vtkChartXY::SafeDownCast(c.matrix->GetChart(vtkVector2i(cidx, ridx)));
+    if (!chart) {
+      *error = "vtkChartMatrix did not create an XY chart";
+      return false;
+    }
+    const std::vector<Point> &pts = by_case[cases[static_cast<size_t>(k)]];
+    if (layout) {
+      layout->cases.push_back(cases[static_cast<size_t>(k)]);
+      layout->labels.emplace_back();
+      NavBenchChartLayout::Cell cell;
+      cell.col = cidx;
+      cell.row = cell_top[static_cast<size_t>(k)];
+      cell.cols = wide ? ncols : 1;
+      cell.rows = wide ? 2 : 1;
+      layout->cells.push_back(cell);
+    }
+    double xmin = INFINITY, xmax = 0.0, ymin = INFINITY, ymax = 0.0;
+    std::vector<Line> lines;
+    for (size_t si = 0; si < series.size(); ++si) {
+      Line l;
+      l.name = series[si];
+      for (const Point &p : pts)
+        if (p.series == series[si]) {
+          l.x.push_back(p.x);
+          l.y.push_back(p.y);
+        }
+      if (l.x.empty()) continue;
+      std::copy(pal[si % 10], pal[si % 10] + 3, l.rgb);
+      l.points = true;
+      l.marker = markers[(si / 10) % 4];
+      l.width = 3.0f;
+      lines.push_back(l);
+    }
+    for (const Point &p : pts) {
+      xmin = std::min(xmin, p.x);
+      xmax = std::max(xmax, p.x);
+      ymin = std::min(ymin, p.y);
+      ymax = std::max(ymax, p.y);
+    }
+    AddLines(chart, lines);
+    // Axes: log-log; room on the right of the fastest point for its label.
+    const double x_lo = xmin / 2.0, x_hi = xmax * 12.0, y_lo = ymin / 3.0, y_hi = ymax * 3.0;
+    if (opt.show_text) {
+      // The label layer paints in the chart's (log10) data coordinates.
+      vtkNew<vtkNavLabelledPoints> lab;
+      vtkNew<vtkTable> table;
+      vtkNew<vtkDoubleArray> xc, yc;
+      xc->SetName("speed");
+      yc->SetName("labels");
+      table->AddColumn(xc);
+      table->AddColumn(yc);
+      table->SetNumberOfRows(static_cast<vtkIdType>(pts.size()));
+      for (size_t i = 0; i < pts.size(); ++i) {
+        lab->x.push_back(std::log10(pts[i].x));
+        lab->y.push_back(std::log10(pts[i].y));
+        lab->labels.push_back(pts[i].label);
+        table->SetValue(static_cast<vtkIdType>(i), 0, pts[i].x);
+        table->SetValue(static_cast<vtkIdType>(i), 1, pts[i].y);
+      }
+      lab->font = std::max(8, c.font - 2);
+      lab->y_lo = std::log10(y_lo);
+      lab->y_hi = std::log10(y_hi);
+      lab->SetInputData(table, 0, 1);
+      lab->SetLegendVisibility(false);
+      chart->AddPlot(lab);
+      if (layout) layout->labels.back() = lab->labels;
+    }
+    const bool bottom_row = ridx == 0;
+    StyleChart(chart, cases[static_cast<size_t>(k)] + " (" + std::to_string(pts.size()) + " variant" +
+                          (pts.size() == 1 ? ")" : "s)"),
+               bottom_row ? "speed [samples/s]" : "", cidx == 0 ? "position error [m]" : "", opt, c.font);
+    chart->SetShowLegend(false); // every marker carries its variant's label
+    chart->GetAxis(vtkAxis::LEFT)->SetLogScale(true);
+    chart->GetAxis(vtkAxis::BOTTOM)->SetLogScale(true);
+    chart->GetAxis(vtkAxis::BOTTOM)->SetBehavior(vtkAxis::FIXED);
+    chart->GetAxis(vtkAxis::BOTTOM)->SetRange(x_lo, x_hi);
+    chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+    chart->GetAxis(vtkAxis::LEFT)->SetRange(y_lo, y_hi);
+  }
+  c.view->Render();
+  return NavWriteWindowPng(c.view->GetRenderWindow(), path, error);
 }
 
 // ------------------------------------------------------------------ GNSS sky plot and DOP chart

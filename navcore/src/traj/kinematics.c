@@ -14,10 +14,17 @@
 
 void nav_kin_euler_rates(nav_jet roll, nav_jet pitch, nav_jet yaw, nav_vec3 *w_nb_b_rps,
                          nav_vec3 *dw_nb_b_rps2) {
-  /* numerics.md E3.4 ([TW] ch. 3, [G] eq. 2.59 inverted), differentiated by the jets. */
+  nav_kin_euler_rates_sc(roll, pitch, yaw, sin(roll.d[0]), cos(roll.d[0]), sin(pitch.d[0]), cos(pitch.d[0]),
+                         w_nb_b_rps, dw_nb_b_rps2);
+}
+
+void nav_kin_euler_rates_sc(nav_jet roll, nav_jet pitch, nav_jet yaw, double sr, double cr, double sp,
+                            double cp, nav_vec3 *w_nb_b_rps, nav_vec3 *dw_nb_b_rps2) {
+  /* numerics.md E3.4 ([TW] ch. 3, [G] eq. 2.59 inverted), differentiated by the jets; the sine and
+   * cosine jets are those of nav_jet_sin / nav_jet_cos from the given values. */
   const nav_jet dphi = nav_jet_deriv(roll), dth = nav_jet_deriv(pitch), dpsi = nav_jet_deriv(yaw);
-  const nav_jet sth = nav_jet_sin(pitch), cth = nav_jet_cos(pitch);
-  const nav_jet sph = nav_jet_sin(roll), cph = nav_jet_cos(roll);
+  const nav_jet sth = nav_jet_chain(pitch, sp, cp, -sp, -cp), cth = nav_jet_chain(pitch, cp, -sp, -cp, sp);
+  const nav_jet sph = nav_jet_chain(roll, sr, cr, -sr, -cr), cph = nav_jet_chain(roll, cr, -sr, -cr, sr);
   const nav_jet wx = nav_jet_sub(dphi, nav_jet_mul(dpsi, sth));
   const nav_jet wy = nav_jet_add(nav_jet_mul(dth, cph), nav_jet_mul(dpsi, nav_jet_mul(cth, sph)));
   const nav_jet wz = nav_jet_sub(nav_jet_mul(dpsi, nav_jet_mul(cth, cph)), nav_jet_mul(dth, sph));
@@ -229,6 +236,19 @@ static void channel_state_k(const nav_kin_channel *c, ptrdiff_t k, double t, dou
 
 static void channel_state(const nav_kin_channel *c, double t, double *x, double *y, double r[4]) {
   channel_state_k(c, find_step(c, t), t, x, y, r);
+}
+
+double nav_kin_channel_eval_value(const nav_kin_channel *c, double t_s, ptrdiff_t *hint) {
+  /* The x of channel_state_k and after_state, expression for expression. */
+  const ptrdiff_t k = find_step_hint(c, t_s, hint);
+  if (k < 0) return c->x_init + c->r_init * t_s;
+  const nav_kin_step *s = &c->steps[k];
+  const double d = t_s - s->t0_s;
+  if (d < s->len_s) {
+    const double T = s->len_s, u = d / T;
+    return s->x0 + s->r0 * d + s->dr * T * ss_I(u);
+  }
+  return s->x0 + s->r0 * d + s->dr * (d - 0.5 * s->len_s);
 }
 
 nav_jet nav_kin_channel_eval_hint(const nav_kin_channel *c, double t_s, ptrdiff_t *hint) {

@@ -59,8 +59,9 @@ typedef struct seg_model {
   /* Cached step indices of the channels (speed only, never a result): of the node evaluation,
    * of seg_state and of seg_velocity, whose time patterns differ. */
   ptrdiff_t hint[CH_N], st_hint[CH_N], vel_hint[CH_N];
-  /* seg_velocity: the last Euler angles and their DCM, reused while the angles are unchanged. */
-  double vel_ang[3];
+  /* seg_velocity: the last Euler angles (roll, pitch, yaw), their sines and cosines and their DCM,
+   * each reused while its angle is unchanged. */
+  double vel_ang[3], vel_sin[3], vel_cos[3];
   nav_mat3 vel_C;
 } seg_model;
 
@@ -668,24 +669,49 @@ static seg_att seg_state(seg_model *m, double t) {
   return a;
 }
 
+/* C_b_n = R_z(yaw) R_y(pitch) R_x(roll) from the sines and cosines of roll, pitch and yaw: the
+ * expressions of nav_euler_to_dcm, so equal inputs give the same bits. */
+static nav_mat3 dcm_of(double sr, double cr, double sp, double cp, double sy, double cy) {
+  nav_mat3 c = {{{cp * cy, -cr * sy + sr * sp * cy, sr * sy + cr * sp * cy},
+                 {cp * sy, cr * cy + sr * sp * sy, -sr * cy + cr * sp * sy},
+                 {-sp, sr * cp, cr * cp}}};
+  return c;
+}
+
+/* The quaternion of nav_euler_to_quat from the sines and cosines of the half angles (the same
+ * products in the same order). */
+static nav_quat quat_of(double shr, double chr, double shp, double chp, double shy, double chy) {
+  const nav_quat q_roll = {chr, shr, 0.0, 0.0};
+  const nav_quat q_pitch = {chp, 0.0, shp, 0.0};
+  const nav_quat q_yaw = {chy, 0.0, 0.0, shy};
+  return nav_quat_mul(nav_quat_mul(q_yaw, q_pitch), q_roll);
+}
+
+/* v_n at t, the integrand of the position quadrature (eight calls per position): channel values
+ * only, and the sine and cosine of an Euler angle only when that angle changed since the last call
+ * (a car turns about yaw alone). The numbers are those of seg_eval's velocity. */
 static nav_vec3 seg_velocity(void *self, double t) {
   seg_model *m = self;
   ptrdiff_t *h = m->vel_hint;
-  const double yaw = nav_kin_channel_eval_hint(&m->ch[CH_YAW], t, &h[CH_YAW]).d[0];
-  const double pitch = nav_kin_channel_eval_hint(&m->ch[CH_PITCH], t, &h[CH_PITCH]).d[0];
-  double roll = nav_kin_channel_eval_hint(&m->ch[CH_ROLL], t, &h[CH_ROLL]).d[0];
-  const double u = nav_kin_channel_eval_hint(&m->ch[CH_U], t, &h[CH_U]).d[0];
+  const double yaw = nav_kin_channel_eval_value(&m->ch[CH_YAW], t, &h[CH_YAW]);
+  const double pitch = nav_kin_channel_eval_value(&m->ch[CH_PITCH], t, &h[CH_PITCH]);
+  double roll = nav_kin_channel_eval_value(&m->ch[CH_ROLL], t, &h[CH_ROLL]);
+  const double u = nav_kin_channel_eval_value(&m->ch[CH_U], t, &h[CH_U]);
   if (m->ch[CH_CYAW].n > 0)
     roll += atan(u * nav_kin_channel_eval_hint(&m->ch[CH_CYAW], t, &h[CH_CYAW]).d[1] / m->g_mps2);
-  if (!(roll == m->vel_ang[0] && pitch == m->vel_ang[1] && yaw == m->vel_ang[2])) {
-    const nav_euler e = {roll, pitch, yaw};
-    m->vel_C = nav_euler_to_dcm(e);
-    m->vel_ang[0] = roll;
-    m->vel_ang[1] = pitch;
-    m->vel_ang[2] = yaw;
-  }
-  const nav_vec3 vb = nav_vec3_make(u, nav_kin_channel_eval_hint(&m->ch[CH_V], t, &h[CH_V]).d[0],
-                                    nav_kin_channel_eval_hint(&m->ch[CH_W], t, &h[CH_W]).d[0]);
+  const double ang[3] = {roll, pitch, yaw};
+  bool changed = false;
+  for (int i = 0; i < 3; ++i)
+    /* Same value and sign (a cached sin(+0) must not stand for sin(-0)); NaN never matches. */
+    if (!(ang[i] == m->vel_ang[i] && signbit(ang[i]) == signbit(m->vel_ang[i]))) {
+      nav_kin_sincos(ang[i], &m->vel_sin[i], &m->vel_cos[i]);
+      m->vel_ang[i] = ang[i];
+      changed = true;
+    }
+  if (changed)
+    m->vel_C = dcm_of(m->vel_sin[0], m->vel_cos[0], m->vel_sin[1], m->vel_cos[1], m->vel_sin[2], m->vel_cos[2]);
+  const nav_vec3 vb = nav_vec3_make(u, nav_kin_channel_eval_value(&m->ch[CH_V], t, &h[CH_V]),
+                                    nav_kin_channel_eval_value(&m->ch[CH_W], t, &h[CH_W]));
   return nav_mat3_mul_vec(m->vel_C, vb);
 }
 
@@ -706,11 +732,20 @@ static double seg_step(void *self, double ta, double tb) {
 static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
   seg_model *m = self;
   const seg_att a = seg_state(m, t_s);
-  const nav_euler e = {a.roll.d[0], a.pitch.d[0], a.yaw.d[0]};
+  /* nav_euler_to_quat, nav_kin_euler_rates and nav_euler_to_dcm of the Euler angles, with each
+   * sine and cosine computed once (and none for a zero angle): the same numbers. */
+  const double roll = a.roll.d[0], pitch = a.pitch.d[0], yaw = a.yaw.d[0];
+  double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
+  nav_kin_sincos(roll, &sr, &cr);
+  nav_kin_sincos(pitch, &sp, &cp);
+  nav_kin_sincos(yaw, &sy, &cy);
+  nav_kin_sincos(0.5 * roll, &shr, &chr);
+  nav_kin_sincos(0.5 * pitch, &shp, &chp);
+  nav_kin_sincos(0.5 * yaw, &shy, &chy);
   nav_local_kin k;
-  k.q_b_n = nav_euler_to_quat(e);
-  nav_kin_euler_rates(a.roll, a.pitch, a.yaw, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
-  const nav_mat3 C = nav_euler_to_dcm(e);
+  k.q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
+  nav_kin_euler_rates_sc(a.roll, a.pitch, a.yaw, sr, cr, sp, cp, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
+  const nav_mat3 C = dcm_of(sr, cr, sp, cp, sy, cy);
   const nav_vec3 vb = nav_vec3_make(a.u.d[0], a.v.d[0], a.w.d[0]);
   const nav_vec3 vb_dot = nav_vec3_make(a.u.d[1], a.v.d[1], a.w.d[1]);
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
@@ -757,8 +792,7 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   double sn[3][NAV_KIN_MAX_NODES], cs[3][NAV_KIN_MAX_NODES];
   for (int c = 0; c < 3; ++c) {
     const double a0 = ang[c][0];
-    sn[c][0] = sin(a0);
-    cs[c][0] = cos(a0);
+    nav_kin_sincos(a0, &sn[c][0], &cs[c][0]); /* none for a zero angle (a car's pitch and roll) */
     for (int i = 1; i < n; ++i) {
       const double d = ang[c][i] - a0;
       if (d == 0.0) {

@@ -98,12 +98,12 @@ typedef struct ned_kin {
   nav_vec3 v_n, dv_n, w_en_n, dw_en_n;
 } ned_kin;
 
-static ned_kin geo_to_ned_kin(const nav_geo_kin *g) {
-  const double lat = g->pos.lat_rad, h = g->pos.h_m;
-  const double sl = sin(lat), cl = cos(lat);
+/* geo_to_ned_kin from sin and cos of the latitude and the radii R_M, R_N there (as
+ * nav_earth_radius_meridian_m / nav_earth_radius_prime_vertical_m return them). */
+static ned_kin geo_to_ned_kin_sc(const nav_geo_kin *g, double sl, double cl, double RM, double RN) {
+  const double h = g->pos.h_m;
   const double dlat = g->dpos.x, dlon = g->dpos.y, dh = g->dpos.z;
   const double ddlat = g->ddpos.x, ddlon = g->ddpos.y, ddh = g->ddpos.z;
-  const double RM = nav_earth_radius_meridian_m(lat), RN = nav_earth_radius_prime_vertical_m(lat);
   const double den = 1.0 - NAV_WGS84_E2 * sl * sl;
   const double dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl / den * dlat;
   const double dRN = NAV_WGS84_E2 * RN * sl * cl / den * dlat;
@@ -116,12 +116,32 @@ static ned_kin geo_to_ned_kin(const nav_geo_kin *g) {
   return k;
 }
 
-static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+static ned_kin geo_to_ned_kin(const nav_geo_kin *g) {
   const double lat = g->pos.lat_rad;
-  const ned_kin nk = geo_to_ned_kin(g);
+  return geo_to_ned_kin_sc(g, sin(lat), cos(lat), nav_earth_radius_meridian_m(lat),
+                           nav_earth_radius_prime_vertical_m(lat));
+}
+
+/* E2M = 1 - e^2, as earth.c writes it (the same constant folding). */
+#define TRAJ_E2M (1.0 - NAV_WGS84_E2)
+
+static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+  const double lat = g->pos.lat_rad, lon = g->pos.lon_rad, h = g->pos.h_m;
+  /* One sine and cosine each of latitude and longitude and one square root, shared by what
+   * nav_earth_radius_meridian_m, nav_earth_radius_prime_vertical_m, nav_earth_dcm_n_e and
+   * nav_earth_geodetic_to_ecef would each compute again: their expressions, term for term
+   * (Groves 2nd ed. eqs. 2.105, 2.106, 2.112), so the numbers are the same. */
+  const double sl = sin(lat), cl = cos(lat);
+  const double so = sin(lon), co = cos(lon);
+  const double den2 = 1.0 - NAV_WGS84_E2 * sl * sl;
+  const double sqrt_den = sqrt(den2);
+  const double RM = NAV_WGS84_A_M * TRAJ_E2M / (den2 * sqrt_den);
+  const double RN = NAV_WGS84_A_M / sqrt_den;
+  const ned_kin nk = geo_to_ned_kin_sc(g, sl, cl, RM, RN);
   const nav_vec3 v_n = nk.v_n, dv_n = nk.dv_n, w_en_n = nk.w_en_n, dw_en_n = nk.dw_en_n;
-  const nav_mat3 C_n_e = nav_earth_dcm_n_e(lat, g->pos.lon_rad);
-  s->r_fb_f_m = nav_earth_geodetic_to_ecef(g->pos);
+  const nav_mat3 C_n_e = {{{-sl * co, -so, -cl * co}, {-sl * so, co, -cl * so}, {cl, 0.0, -sl}}};
+  const double rho = (RN + h) * cl;
+  s->r_fb_f_m = nav_vec3_make(rho * co, rho * so, (NAV_WGS84_A_M * TRAJ_E2M / sqrt_den + h) * sl);
   s->v_fb_f_mps = nav_mat3_mul_vec(C_n_e, v_n);
   s->a_fb_f_mps2 = nav_mat3_mul_vec(C_n_e, nav_vec3_add(dv_n, nav_vec3_cross(w_en_n, v_n)));
   s->q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), g->q_b_n));

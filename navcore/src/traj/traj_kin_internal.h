@@ -107,6 +107,22 @@ static inline nav_jet nav_jet_atan2(nav_jet y, nav_jet x) {
 }
 
 /**
+ * sin(a) and cos(a), with a = +-0 answered without the library: sin(+-0) = +-0 and cos(+-0) = 1
+ * exactly, so the numbers are those of sin() and cos() for every a. Most Euler angles of a
+ * vehicle's trajectory (pitch and roll of a car, every angle at rest) are exactly zero for long
+ * stretches.
+ */
+static inline void nav_kin_sincos(double a, double *s, double *c) {
+  if (a == 0.0) {
+    *s = a;
+    *c = 1.0;
+  } else {
+    *s = sin(a);
+    *c = cos(a);
+  }
+}
+
+/**
  * Body rate of b relative to n and its derivative from ZYX Euler-angle jets (numerics.md E3.4):
  *   w_nb_b = [phi' - psi' sin(theta); theta' cos(phi) + psi' cos(theta) sin(phi);
  *             -theta' sin(phi) + psi' cos(theta) cos(phi)]
@@ -114,6 +130,10 @@ static inline nav_jet nav_jet_atan2(nav_jet y, nav_jet x) {
  */
 void nav_kin_euler_rates(nav_jet roll, nav_jet pitch, nav_jet yaw, nav_vec3 *w_nb_b_rps,
                          nav_vec3 *dw_nb_b_rps2);
+/** nav_kin_euler_rates with sin and cos of the roll and pitch values given (sr = sin(roll.d[0]),
+ *  ...), so that a caller that needs them anyway computes them once; the same numbers. */
+void nav_kin_euler_rates_sc(nav_jet roll, nav_jet pitch, nav_jet yaw, double sr, double cr, double sp,
+                            double cp, nav_vec3 *w_nb_b_rps, nav_vec3 *dw_nb_b_rps2);
 
 /* ================================================================ ramps, channels, moves */
 
@@ -153,6 +173,9 @@ nav_jet nav_kin_channel_eval(const nav_kin_channel *c, double t_s);
 nav_jet nav_kin_channel_eval_integral(const nav_kin_channel *c, double t_s);
 /** nav_kin_channel_eval through a cached step index @p hint (start with -1; the same numbers). */
 nav_jet nav_kin_channel_eval_hint(const nav_kin_channel *c, double t_s, ptrdiff_t *hint);
+/** x alone at t (nav_kin_channel_eval's value: the same expression, hence the same number),
+ *  through the cached step index @p hint (start with -1). */
+double nav_kin_channel_eval_value(const nav_kin_channel *c, double t_s, ptrdiff_t *hint);
 /** x, its rate r and r' at t (the numbers of nav_kin_channel_eval). @p hint caches the step
  *  index between calls (start with -1); it only saves the search and never changes a result. */
 void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,

@@ -86,13 +86,26 @@ bool NavRenderAllanChartPng(const std::string &allan_csv, const NavChartOptions 
                             std::string *error);
 
 /**
- * Speed against error from bench.csv (`navsim bench`): log-log, x = mechanization samples per
- * second (mech_samples_per_s, else samples_per_s), y = position error [m] (pos_err_m, else
- * error); one marker series per variant (variant, else algorithm column). Rows with a status other
- * than ok, or a non-positive value, are skipped.
+ * Speed against error from bench.csv (`navsim bench`): one log-log panel per case (column case, in
+ * the file's order; a grid of up to three columns, first case top left), x = mechanization samples
+ * per second (mech_samples_per_s, else samples_per_s), y = position error [m] (pos_err_m, else
+ * error); each row one marker labelled with its variant (variant, else algorithm column; labels
+ * only with options.show_text), coloured by algorithm and frame alike in every panel. Rows with a
+ * status other than ok, or a non-positive value, are skipped. @p layout (may be NULL) gets what
+ * was drawn: the case of each panel and the labels written next to its markers.
  */
+struct NavBenchChartLayout {
+  /** Grid cell of a panel: column and row from the top left, and how many it spans. */
+  struct Cell {
+    int col = 0, row = 0, cols = 1, rows = 1;
+  };
+  std::vector<std::string> cases;               /**< panel titles' cases, first panel top left */
+  std::vector<std::vector<std::string>> labels; /**< per panel, the marker labels drawn (show_text) */
+  std::vector<Cell> cells;                      /**< per panel, its place (a case of more than eight
+                                                     variants spans two whole rows) */
+};
 bool NavRenderSpeedVsErrorPng(const std::string &bench_csv, const NavChartOptions &options, const std::string &path,
-                              std::string *error);
+                              std::string *error, NavBenchChartLayout *layout = nullptr);
 
 /**
  * Speed against error from tradeoff.csv (`navsim tradeoff`): per requirement (one panel each, or
