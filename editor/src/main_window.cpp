@@ -86,6 +86,7 @@ MainWindow::MainWindow(QWidget *parent) : QMainWindow(parent) {
   autosave_timer_.setInterval(ok && ms > 0 ? ms : 30000);
   connect(&autosave_timer_, &QTimer::timeout, this, &MainWindow::Autosave);
   autosave_timer_.start();
+  RemoveStaleTempFiles(AutosaveDir()); // an autosave a killed navstudio did not finish
   UpdateTitle();
   ShowIssues();
   ShowResultsHint();
@@ -686,6 +687,11 @@ bool MainWindow::event(QEvent *e) {
 }
 
 void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
+  if (r->status == kStatusCrashed) {
+    // The preview's process crashed: the window stays, the last preview stays drawn.
+    status_->setText(tr("Live preview: %1").arg(r->message));
+    return;
+  }
   if (r->status != NAV_OK) return; // cancelled by a newer edit, or failed (the issues list says why)
   const qint64 arrived_ns = SceneDocument::NowNs();
   last_preview_ = r;
