@@ -815,7 +815,9 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
     preview_timer_.start(); // edits made during the run
   if (r->status != NAV_OK) {
     progress_->setValue(0);
-    const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1) : r->message;
+    const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1)
+                         : r->status == kStatusCrashed ? tr("Run failed: %1").arg(r->message)
+                                                       : r->message;
     // The last complete results stay (the cancelled or failed run has none to show).
     status_->setText(last_result_ ? tr("%1 — the last complete results are kept").arg(what) : what);
     if (!last_result_) results_->setHtml(QStringLiteral("<p><b>%1</b></p>").arg(what.toHtmlEscaped()));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -15,6 +16,7 @@
 #include <poll.h>
 #include <pthread.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -77,12 +79,25 @@ SimWorker::SimWorker(QObject *parent) : QObject(parent) {
   qRegisterMetaType<std::shared_ptr<const studio::SimResult>>();
   poll_.setInterval(50);
   connect(&poll_, &QTimer::timeout, this, [this] { emit Progress(Fraction()); });
+  // The helper process is started now, while this program is small (forking it later, with the
+  // views' memory, would cost each start milliseconds); its page of progress atomics is shared.
+  void *page = mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (page != MAP_FAILED) {
+    shared_page_ = new (page) Shared;
+    QString err;
+    StartHelper(&err); // on failure the first run starts it (and reports why not)
+  }
 }
 
 SimWorker::~SimWorker() {
   queued_.reset();
   Cancel();
   if (thread_.joinable()) thread_.join();
+  StopHelper();
+  if (shared_page_) {
+    shared_page_->~Shared();
+    munmap(shared_page_, sizeof(Shared));
+  }
 }
 
 void SimWorker::Start(const nav_scene &scene, long runs, bool preview, qint64 stamp, bool preempt) {
@@ -313,41 +328,137 @@ const char *SignalText(int sig) {
   }
 }
 
-/* The child: run, send the result, end without running the parent's exit handlers. Only
- * system calls and RunCore. */
-[[noreturn]] void ChildMain(int wfd, const nav_scene &scene, long runs, bool preview, bool crash,
-                            std::atomic<double> *fraction, std::atomic<bool> *cancel, std::atomic<long> *beats,
-                            SimResult *out) {
-  // A fault ends this process with its signal (no handler of the parent's, no core file).
-  for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGPIPE, SIGTERM, SIGINT})
+bool WriteAll(int fd, const void *p, size_t n, bool nosignal) {
+  const char *c = static_cast<const char *>(p);
+  while (n > 0) {
+    // The window's side never takes SIGPIPE from a helper that died (MSG_NOSIGNAL).
+    const ssize_t w = nosignal ? send(fd, c, n, MSG_NOSIGNAL) : write(fd, c, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    c += w;
+    n -= static_cast<size_t>(w);
+  }
+  return true;
+}
+
+bool ReadAll(int fd, void *p, size_t n) {
+  char *c = static_cast<char *>(p);
+  while (n > 0) {
+    const ssize_t r = read(fd, c, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    c += r;
+    n -= static_cast<size_t>(r);
+  }
+  return true;
+}
+
+/* What the window sends the helper per run: this header, the scene's bytes, then a recorded
+ * reference's control points (count x (3 + 4) doubles; the scene's pointers are not sent). */
+struct JobHeader {
+  uint32_t magic;
+  int32_t runs;
+  uint8_t preview, crash;
+};
+
+/* The helper process: runs the jobs the window sends on fd 3, one at a time, and answers each
+ * with its encoded result (a 64-bit length, then Encode's bytes). It ends at the end of its
+ * input (the window closed it or is gone) and, like any process, with a fault in a run: the
+ * window then reports the crash and starts another helper. Only system calls and RunCore. */
+[[noreturn]] void HelperMain(int fd, SimWorker::Shared *sh) {
+  // A fault ends this process with its signal (no handler of the window's, no core file).
+  for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGPIPE, SIGTERM, SIGINT, SIGCHLD})
     std::signal(sig, SIG_DFL);
   sigset_t none;
   sigemptyset(&none);
   pthread_sigmask(SIG_SETMASK, &none, nullptr);
   const struct rlimit no_core = {0, 0};
   setrlimit(RLIMIT_CORE, &no_core);
-  // The result pipe becomes fd 3; every other descriptor of the parent is closed (another
-  // worker's pipe left open here would keep that worker waiting for its end of file).
-  if (wfd != 3) {
-    if (dup2(wfd, 3) < 0) _exit(126);
-  }
+  // The socket becomes fd 3; every other descriptor of the window is closed (another helper's
+  // socket left open here would hide that helper's end from the window).
+  if (fd != 3 && dup2(fd, 3) < 0) _exit(126);
   if (close_range(4, ~0U, 0) != 0)
-    for (int fd = 4; fd < 4096; ++fd)
-      close(fd);
-  std::string detail;
-  const int st = RunCore(scene, runs, preview, crash, fraction, cancel, beats, out, &detail);
-  const std::vector<char> b = Encode(st, detail, *out);
-  size_t at = 0;
-  while (at < b.size()) {
-    const ssize_t w = write(3, b.data() + at, b.size() - at);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) _exit(125);
-    at += static_cast<size_t>(w);
+    for (int f = 4; f < 4096; ++f)
+      close(f);
+  for (;;) {
+    JobHeader h{};
+    auto scene = std::make_unique<nav_scene>();
+    if (!ReadAll(3, &h, sizeof h) || h.magic != kMagic || !ReadAll(3, scene.get(), sizeof(nav_scene))) _exit(0);
+    std::vector<nav_vec3> ctrl_ned;
+    std::vector<nav_quat> ctrl_q;
+    nav_traj_recorded &rec = scene->trajectory.recorded;
+    const size_t nc = rec.ctrl_ned_m && rec.count > 0 ? static_cast<size_t>(rec.count) : 0;
+    ctrl_ned.resize(nc);
+    ctrl_q.resize(nc);
+    if (nc > 0 && (!ReadAll(3, ctrl_ned.data(), nc * sizeof(nav_vec3)) || !ReadAll(3, ctrl_q.data(), nc * sizeof(nav_quat))))
+      _exit(0);
+    // A borrowed view of the control points (never released here).
+    rec.ctrl_ned_m = nc > 0 ? ctrl_ned.data() : nullptr;
+    rec.ctrl_q = nc > 0 ? ctrl_q.data() : nullptr;
+    SimResult out;
+    std::string detail;
+    const int st = RunCore(*scene, h.runs, h.preview != 0, h.crash != 0, &sh->fraction, &sh->cancel, &sh->beats, &out,
+                           &detail);
+    const std::vector<char> b = Encode(st, detail, out);
+    const uint64_t len = b.size();
+    if (!WriteAll(3, &len, sizeof len, false) || !WriteAll(3, b.data(), b.size(), false)) _exit(0);
   }
-  _exit(0);
 }
 
 } // namespace
+
+bool SimWorker::StartHelper(QString *error) {
+  int sv[2] = {-1, -1};
+  if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv) != 0) {
+    *error = QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(errno)));
+    return false;
+  }
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(sv[0]);
+    HelperMain(sv[1], shared_page_);
+  }
+  const int e = errno;
+  close(sv[1]);
+  if (pid < 0) {
+    close(sv[0]);
+    *error = QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(e)));
+    return false;
+  }
+  helper_pid_ = pid;
+  helper_fd_ = sv[0];
+  return true;
+}
+
+double SimWorker::HelperCpuS() const {
+  const pid_t pid = helper_pid_.load();
+  if (pid <= 0) return 0.0;
+  char path[64];
+  std::snprintf(path, sizeof path, "/proc/%d/stat", static_cast<int>(pid));
+  FILE *f = std::fopen(path, "r");
+  if (!f) return 0.0;
+  char buf[1024];
+  const size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  buf[n] = '\0';
+  // Fields after the command name (in parentheses): state is the 3rd, utime and stime the 14th
+  // and 15th, in clock ticks.
+  const char *p = std::strrchr(buf, ')');
+  unsigned long long ut = 0, st = 0;
+  if (!p || std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &st) != 2) return 0.0;
+  return static_cast<double>(ut + st) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+void SimWorker::StopHelper() {
+  if (helper_fd_ >= 0) close(helper_fd_);
+  helper_fd_ = -1;
+  if (helper_pid_ > 0) {
+    kill(helper_pid_, SIGKILL);
+    while (waitpid(helper_pid_, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }
+  helper_pid_ = -1;
+}
 
 void SimWorker::RunInChild(Job *job, SimResult *out) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -358,40 +469,51 @@ void SimWorker::RunInChild(Job *job, SimResult *out) {
   if (scene.gnss.enabled)
     out->outages.assign(scene.gnss.model.outages, scene.gnss.model.outages + scene.gnss.model.outage_count);
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-
-  void *page = mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-  int fds[2] = {-1, -1};
-  if (page == MAP_FAILED || pipe2(fds, O_CLOEXEC) != 0) {
-    const int e = errno;
-    if (page != MAP_FAILED) munmap(page, sizeof(Shared));
+  Shared *sh = shared_page_;
+  if (!sh) {
     out->status = NAV_ERR_NO_MEMORY;
-    out->message = QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(e)));
+    out->message = QStringLiteral("cannot start the simulation process: no shared memory");
     out->wall_s = wall();
     return;
   }
-  Shared *sh = new (page) Shared;
   {
     std::lock_guard<std::mutex> lock(sim_mutex_);
+    sh->fraction.store(0.0);
+    sh->beats.store(0);
     sh->cancel.store(cancel_.load());
     shared_ = sh;
   }
-  const pid_t pid = fork();
-  if (pid == 0) {
-    close(fds[0]);
-    ChildMain(fds[1], scene, job->runs, job->preview, job->crash_for_test, &sh->fraction, &sh->cancel, &sh->beats,
-              out);
+  // The job to the helper (started again when an earlier run crashed it).
+  const JobHeader h{kMagic, static_cast<int32_t>(std::min<long>(job->runs, INT32_MAX)), uint8_t(job->preview ? 1 : 0),
+                    uint8_t(job->crash_for_test ? 1 : 0)};
+  const nav_traj_recorded &rec = scene.trajectory.recorded;
+  const size_t nc = rec.ctrl_ned_m && rec.ctrl_q && rec.count > 0 ? static_cast<size_t>(rec.count) : 0;
+  nav_scene sent = scene;
+  if (nc == 0) sent.trajectory.recorded.ctrl_ned_m = nullptr; // the helper reads no points then
+  auto send_job = [&] {
+    return WriteAll(helper_fd_, &h, sizeof h, true) && WriteAll(helper_fd_, &sent, sizeof sent, true) &&
+           (nc == 0 || (WriteAll(helper_fd_, rec.ctrl_ned_m, nc * sizeof(nav_vec3), true) &&
+                        WriteAll(helper_fd_, rec.ctrl_q, nc * sizeof(nav_quat), true)));
+  };
+  QString err;
+  bool sent_ok = false;
+  for (int attempt = 0; attempt < 2 && !sent_ok; ++attempt) {
+    if (helper_fd_ < 0 && !StartHelper(&err)) break;
+    sent_ok = send_job();
+    if (!sent_ok) StopHelper(); // the helper had ended: one more with a new one
   }
-  const int fork_errno = errno;
-  close(fds[1]);
   std::vector<char> data;
-  bool stalled = false;
-  if (pid > 0) {
+  bool stalled = false, complete = false;
+  if (sent_ok) {
+    // The answer: its length, then its bytes. A run whose callbacks stop for kStallS (a hang)
+    // is ended: the worker stays usable.
+    uint64_t want = 0;
+    size_t have_len = 0;
     char buf[65536];
-    // A run whose callbacks stop for kStallS (a hang) is ended: the worker stays usable.
     long beats = -1;
     auto last_beat = std::chrono::steady_clock::now();
     for (;;) {
-      pollfd pf{fds[0], POLLIN, 0};
+      pollfd pf{helper_fd_, POLLIN, 0};
       const int r = poll(&pf, 1, 50);
       fraction_.store(sh->fraction.load());
       const long b = sh->beats.load();
@@ -400,48 +522,61 @@ void SimWorker::RunInChild(Job *job, SimResult *out) {
         beats = b;
         last_beat = now;
       } else if (!stalled && std::chrono::duration<double>(now - last_beat).count() > kStallS) {
-        kill(pid, SIGKILL);
+        kill(helper_pid_, SIGKILL);
         stalled = true;
       }
       if (r == 0 || (r < 0 && errno == EINTR)) continue;
-      const ssize_t n = read(fds[0], buf, sizeof buf);
+      const size_t room = have_len < sizeof want ? sizeof want - have_len : static_cast<size_t>(std::min<uint64_t>(sizeof buf, want - data.size()));
+      const ssize_t n = read(helper_fd_, have_len < sizeof want ? reinterpret_cast<char *>(&want) + have_len : buf, room);
       if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      data.insert(data.end(), buf, buf + n);
+      if (n <= 0) break; // the helper ended
+      if (have_len < sizeof want) {
+        have_len += static_cast<size_t>(n);
+        if (have_len == sizeof want) data.reserve(static_cast<size_t>(std::min<uint64_t>(want, 1ull << 31)));
+      } else {
+        data.insert(data.end(), buf, buf + n);
+      }
+      if (have_len == sizeof want && data.size() == want) {
+        complete = true;
+        break;
+      }
     }
   }
-  close(fds[0]);
   int wstatus = 0;
-  if (pid > 0)
-    while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+  bool ended = false;
+  if (sent_ok && !complete) {
+    // The helper ended during the run: collect how.
+    close(helper_fd_);
+    helper_fd_ = -1;
+    while (waitpid(helper_pid_, &wstatus, 0) < 0 && errno == EINTR) {
     }
+    helper_pid_ = -1;
+    ended = true;
+  }
   {
     std::lock_guard<std::mutex> lock(sim_mutex_);
     shared_ = nullptr;
   }
-  sh->~Shared();
-  munmap(page, sizeof(Shared));
 
   int st = 0;
   std::string detail;
-  if (pid < 0) {
+  if (!sent_ok) {
     out->status = NAV_ERR_NO_MEMORY;
-    out->message =
-        QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(fork_errno)));
+    out->message = err.isEmpty() ? QStringLiteral("cannot start the simulation process") : err;
   } else if (stalled) {
     out->status = kStatusCrashed;
     out->crash_signal = SIGKILL;
     out->message = QStringLiteral("the simulation stopped responding for %1 s and was ended; navstudio kept running")
                        .arg(kStallS, 0, 'f', 0);
-  } else if (WIFSIGNALED(wstatus)) {
+  } else if (ended && WIFSIGNALED(wstatus)) {
     out->status = kStatusCrashed;
     out->crash_signal = WTERMSIG(wstatus);
     out->message = QStringLiteral("the simulation crashed (%1); navstudio kept running")
                        .arg(QString::fromLatin1(SignalText(out->crash_signal)));
-  } else if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || !Decode(data, &st, &detail, out)) {
+  } else if (ended || !Decode(data, &st, &detail, out)) {
     out->status = kStatusCrashed;
     out->message = QStringLiteral("the simulation process ended without a result (exit code %1)")
-                       .arg(WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
+                       .arg(ended && WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
   } else {
     out->status = st;
     if (st == NAV_ERR_CANCELLED)

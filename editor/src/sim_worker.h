@@ -14,6 +14,8 @@
 #include <QString>
 #include <QTimer>
 
+#include <sys/types.h>
+
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -86,6 +88,8 @@ public:
   double Fraction() const;
   /** Wait until the worker is idle (tests, shutdown); processes nothing. */
   void Join();
+  /** CPU time the helper process that runs the simulations has used so far [s] (0 without one). */
+  double HelperCpuS() const;
 
 signals:
   void Progress(double fraction);
@@ -100,7 +104,8 @@ private:
     qint64 stamp = 0;
     bool crash_for_test = false; /**< NAVSTUDIO_TEST_CRASH_RUN: the run crashes (SIGSEGV) */
   };
-  /** Progress and cancellation shared with the run's child process (a MAP_SHARED page). */
+public:
+  /** Progress and cancellation shared with the helper process (a MAP_SHARED page). */
   struct Shared {
     std::atomic<double> fraction{0.0};
     std::atomic<bool> cancel{false};
@@ -108,10 +113,16 @@ private:
   };
   /** A run none of whose callbacks came for this long is taken as hung and ended [s]. */
   static constexpr double kStallS = 120.0;
+
+private:
   void Launch(std::unique_ptr<Job> job);
   void OnThreadDone(std::shared_ptr<const SimResult> r);
-  /** On the worker thread: fork the child that runs @p job, read its result into @p out. */
+  /** On the worker thread: send @p job to the helper process, read its result into @p out. */
   void RunInChild(Job *job, SimResult *out);
+  /** Fork the helper process that runs the jobs (HelperMain); false with @p error. */
+  bool StartHelper(QString *error);
+  /** End the helper process (SIGKILL) and collect it. */
+  void StopHelper();
 
   std::thread thread_;
   std::unique_ptr<Job> running_;
@@ -120,7 +131,11 @@ private:
   std::atomic<double> fraction_{0.0};
   std::atomic<bool> cancel_{false};
   mutable std::mutex sim_mutex_;
-  Shared *shared_ = nullptr; /* guarded by sim_mutex_: the running child's page */
+  Shared *shared_ = nullptr; /* guarded by sim_mutex_: shared_page_ while a job runs */
+  Shared *shared_page_ = nullptr;
+  /* the helper process, -1 when there is none (changed by the worker thread after construction) */
+  std::atomic<pid_t> helper_pid_{-1};
+  int helper_fd_ = -1;    /* its socket */
   QTimer poll_;
 };
 

@@ -147,7 +147,7 @@ private slots:
     };
     const double dt = r->t_s[1] - r->t_s[0];
 
-    // The horizontal panel, 60 % along (inside the second outage of the urban drive).
+    // The horizontal panel, 60 % along (between the urban drive's two outages).
     chart->ensureVisible(0, 0);
     const QPoint ph = at(0, 0.6, 0.5);
     QTest::mouseMove(label, ph);
