@@ -247,12 +247,26 @@ def main():
                "; autosave %d bytes" % len(read(auto)) if auto else "",
                "; left %d hidden temporary file(s)" % len(left) if left else ""))
 
-    # A last start (the loop ends at once) removes the last kill's temporary files.
+    # A last start (the loop ends at once) removes the last kill's temporary files, and only
+    # those of processes that no longer run: a temporary file of a running process (this test's
+    # id stands for a navstudio saving at that moment) stays.
     restore_scene()
+    done = subprocess.Popen(["true"])
+    done.wait()
+    dead = os.path.join(scene_dir, ".drive.yaml.navstudio-tmp-%d" % done.pid)
+    alive = os.path.join(scene_dir, ".drive.yaml.navstudio-tmp-%d" % os.getpid())
+    for p in (dead, alive):
+        with open(p, "wb") as f:
+            f.write(b"partial")
     s = Studio(a.navstudio, scene, dict(env, NAVSTUDIO_TEST_SAVE_LOOP="save", NAVSTUDIO_TEST_SAVE_LOOP_CYCLES="0"))
     if s.finish(timeout_s=300) != 0:
         fail("final start failed:\n" + "\n".join(s.lines[-20:]))
     cleaned += len(left)
+    if os.path.exists(dead):
+        fail("the temporary file of an ended process was not removed: %s" % dead)
+    if not os.path.exists(alive):
+        fail("the temporary file of a running process was removed: %s" % alive)
+    os.remove(alive)
     rest = litter([scene_dir, auto_dir])
     if rest:
         fail("temporary files remain after a new start: %s" % rest)
