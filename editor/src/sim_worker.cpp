@@ -150,7 +150,7 @@ void SimWorker::Launch(std::unique_ptr<Job> job) {
   poll_.start();
   thread_ = std::thread([this, j] {
     auto result = std::make_shared<SimResult>();
-    RunInChild(j, result.get());
+    RunInHelper(j, result.get());
     std::shared_ptr<const SimResult> done = result;
     // The one crossing to the GUI thread: a queued call on this object (dropped if it is gone).
     QMetaObject::invokeMethod(this, [this, done] { OnThreadDone(done); }, Qt::QueuedConnection);
@@ -169,7 +169,7 @@ void SimWorker::OnThreadDone(std::shared_ptr<const SimResult> r) {
 
 namespace {
 
-/* The run itself, in the child process: navcore and the standard library only (a child forked
+/* The run itself, in the helper process: navcore and the standard library only (a child forked
  * from a threaded program uses nothing another thread may have held: no Qt, no locks of the
  * parent). @p detail gets navcore's message of a failed run. */
 int RunCore(const nav_scene &scene, long runs, bool preview, bool crash, std::atomic<double> *fraction,
@@ -245,7 +245,7 @@ int RunCore(const nav_scene &scene, long runs, bool preview, bool crash, std::at
   return st;
 }
 
-// The per-epoch series a result carries from the child to the parent, in this order.
+// The per-epoch series a result carries from the helper to the window, in this order.
 std::vector<double> SimResult::*const kSeries[] = {
     &SimResult::t_s,           &SimResult::truth_ned,       &SimResult::nav_ned,       &SimResult::err_h_m,
     &SimResult::truth_euler,   &SimResult::nav_euler,       &SimResult::err_ned_m,     &SimResult::err_v_m,
@@ -460,7 +460,7 @@ void SimWorker::StopHelper() {
   helper_pid_ = -1;
 }
 
-void SimWorker::RunInChild(Job *job, SimResult *out) {
+void SimWorker::RunInHelper(Job *job, SimResult *out) {
   const auto t0 = std::chrono::steady_clock::now();
   out->preview = job->preview;
   out->runs = job->runs;

@@ -1,11 +1,12 @@
 /*
- * navstudio: simulation on a background thread (style.md section 7), run in a child process.
- * The worker thread forks a child that only calls navcore (nav_sim_run) and fills a plain
- * SimResult, which it sends back through a pipe; a crash of the run (a signal in navcore) ends
- * the child, never the window, and is reported as a failed run. Progress and cancellation cross
- * through a shared memory page of atomics; the worker thread never touches Qt widgets or VTK.
- * The result crosses to the GUI thread once, through a queued call, as a shared_ptr to an
- * immutable SimResult.
+ * navstudio: simulation on a background thread (style.md section 7), run in a helper process.
+ * Each SimWorker forks one helper process when it is created (while the program is small); its
+ * worker thread sends each job (the scene's bytes) to the helper over a socket and reads back a
+ * plain SimResult. The helper only calls navcore (nav_sim_run); a crash of a run (a signal in
+ * navcore) ends the helper, never the window, and is reported as a failed run; the next job
+ * starts a new helper. Progress and cancellation cross through a shared memory page of atomics;
+ * the worker thread never touches Qt widgets or VTK. The result crosses to the GUI thread once,
+ * through a queued call, as a shared_ptr to an immutable SimResult.
  */
 #ifndef NAVSTUDIO_SIM_WORKER_H
 #define NAVSTUDIO_SIM_WORKER_H
@@ -118,7 +119,7 @@ private:
   void Launch(std::unique_ptr<Job> job);
   void OnThreadDone(std::shared_ptr<const SimResult> r);
   /** On the worker thread: send @p job to the helper process, read its result into @p out. */
-  void RunInChild(Job *job, SimResult *out);
+  void RunInHelper(Job *job, SimResult *out);
   /** Fork the helper process that runs the jobs (HelperMain); false with @p error. */
   bool StartHelper(QString *error);
   /** End the helper process (SIGKILL) and collect it. */
