@@ -359,6 +359,7 @@ struct JobHeader {
   uint32_t magic;
   int32_t runs;
   uint8_t preview, crash;
+  uint64_t n_ctrl; /* control points that follow the scene (0: none) */
 };
 
 /* The helper process: runs the jobs the window sends on fd 3, one at a time, and answers each
@@ -387,7 +388,8 @@ struct JobHeader {
     std::vector<nav_vec3> ctrl_ned;
     std::vector<nav_quat> ctrl_q;
     nav_traj_recorded &rec = scene->trajectory.recorded;
-    const size_t nc = rec.ctrl_ned_m && rec.count > 0 ? static_cast<size_t>(rec.count) : 0;
+    if (h.n_ctrl > (1ull << 28)) _exit(0);
+    const size_t nc = static_cast<size_t>(h.n_ctrl);
     ctrl_ned.resize(nc);
     ctrl_q.resize(nc);
     if (nc > 0 && (!ReadAll(3, ctrl_ned.data(), nc * sizeof(nav_vec3)) || !ReadAll(3, ctrl_q.data(), nc * sizeof(nav_quat))))
@@ -484,14 +486,12 @@ void SimWorker::RunInHelper(Job *job, SimResult *out) {
     shared_ = sh;
   }
   // The job to the helper (started again when an earlier run crashed it).
-  const JobHeader h{kMagic, static_cast<int32_t>(std::min<long>(job->runs, INT32_MAX)), uint8_t(job->preview ? 1 : 0),
-                    uint8_t(job->crash_for_test ? 1 : 0)};
   const nav_traj_recorded &rec = scene.trajectory.recorded;
   const size_t nc = rec.ctrl_ned_m && rec.ctrl_q && rec.count > 0 ? static_cast<size_t>(rec.count) : 0;
-  nav_scene sent = scene;
-  if (nc == 0) sent.trajectory.recorded.ctrl_ned_m = nullptr; // the helper reads no points then
+  const JobHeader h{kMagic, static_cast<int32_t>(std::min<long>(job->runs, INT32_MAX)), uint8_t(job->preview ? 1 : 0),
+                    uint8_t(job->crash_for_test ? 1 : 0), nc};
   auto send_job = [&] {
-    return WriteAll(helper_fd_, &h, sizeof h, true) && WriteAll(helper_fd_, &sent, sizeof sent, true) &&
+    return WriteAll(helper_fd_, &h, sizeof h, true) && WriteAll(helper_fd_, &scene, sizeof scene, true) &&
            (nc == 0 || (WriteAll(helper_fd_, rec.ctrl_ned_m, nc * sizeof(nav_vec3), true) &&
                         WriteAll(helper_fd_, rec.ctrl_q, nc * sizeof(nav_quat), true)));
   };

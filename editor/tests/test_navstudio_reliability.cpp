@@ -16,6 +16,11 @@
 #include "error_chart.h"
 #include "main_window.h"
 #include "navview/nav_view_chart.h"
+
+extern "C" {
+#include "navcore/nav_frames.h"
+#include "navcore/nav_traj.h"
+}
 #include "studio_test_support.h"
 
 using studio::MainWindow;
@@ -112,6 +117,41 @@ private slots:
     w->Doc()->Edit("seed", [](nav_scene &s) { s.simulation.seed += 1; });
     QVERIFY(WaitUntil([&] { return w->LastPreview() != before && !w->PreviewWorker()->IsBusy(); }, 120000));
     QCOMPARE(w->LastPreview()->status, static_cast<int>(NAV_OK));
+  }
+
+  // A recorded reference crosses to the helper process with its control points (the scene's
+  // bytes carry only pointers to them): the run follows the recorded path.
+  void recorded_scene_runs() {
+    auto w = MakeWindow();
+    QVERIFY(w);
+    w->SetLivePreview(false);
+    QVERIFY(w->OpenFile(QStringLiteral(NAVSTUDIO_SOURCE_DIR "/scenes/recorded-adis16465.yaml")));
+    QCOMPARE(w->Doc()->Scene().trajectory.type, NAV_TRAJ_RECORDED);
+    QVERIFY(w->Doc()->Scene().trajectory.recorded.count > 0);
+    w->Doc()->Edit("runs", [](nav_scene &s) { s.simulation.runs = 2; });
+    QVERIFY(RunAndWait(w.get(), 600000));
+    const auto r = w->LastResult();
+    QVERIFY2(r && r->status == NAV_OK, r ? qPrintable(r->message) : "no result");
+    QVERIFY(r->t_s.size() > 10 && r->truth_ned.size() == 3 * r->t_s.size());
+    // The reference is the recorded drive: at the last epoch it is where navcore's trajectory
+    // of the same scene, evaluated in this process, puts it.
+    const size_t n = r->t_s.size();
+    const nav_scene &sc = w->Doc()->Scene();
+    nav_traj *traj = nullptr;
+    QCOMPARE(nav_traj_create(&sc, 1.0 / sc.imu.rate_hz, &traj), NAV_OK);
+    nav_traj_state st{};
+    const nav_status es = nav_traj_eval(traj, r->t_s[n - 1], &st);
+    const nav_frame fr = nav_traj_frame(traj);
+    nav_traj_destroy(traj);
+    QCOMPARE(es, NAV_OK);
+    const nav_local_view v = nav_frame_view(&fr, st.r_fb_f_m, st.v_fb_f_mps, st.q_b_f);
+    const double dn = r->truth_ned[3 * (n - 1)] - v.r_ned_m.x, de = r->truth_ned[3 * (n - 1) + 1] - v.r_ned_m.y;
+    const double moved = std::hypot(r->truth_ned[3 * (n - 1)] - r->truth_ned[0], r->truth_ned[3 * (n - 1) + 1] - r->truth_ned[1]);
+    qInfo("recorded reference: %zu epochs, %.2f m from the start at %.2f s; against this process's trajectory "
+          "dN %.2e m, dE %.2e m", n, moved, r->t_s[n - 1], dn, de);
+    QVERIFY(moved > 1.0);
+    QVERIFY(std::fabs(dn) < 1e-6 && std::fabs(de) < 1e-6);
+    QVERIFY(std::isfinite(r->summary.final.pos_err_h_m));
   }
 
   // Hovering a plot of the Errors tab shows a vertical line and a label with the time and the
