@@ -65,11 +65,13 @@ QString PanelText(const NavResult &r, const std::string &panel, size_t i) {
   const bool filter = NavSigmaNed(r, NavEnvelopeSource::Filter, t, s3);
   if (panel == "horizontal") {
     parts << QStringLiteral("horizontal %1 m").arg(Num(e.pos_err_h_m[i]));
-    if (mc) parts << QStringLiteral("%1 %2 m").arg(runs, Num(NavInterpolate(env.t_s, env.pos_h_rms_m, 1, 0, t)));
+    if (mc)
+      parts << QStringLiteral("%1 %2 m").arg(runs, Num(NavInterpolate(env.t_s, env.pos_h_rms_m, 1, 0, t)));
     if (filter) parts << QStringLiteral("filter 1\u03c3 %1 m").arg(Num(std::hypot(s3[0], s3[1])));
   } else if (panel == "vertical") {
     parts << QStringLiteral("vertical %1 m").arg(Num(e.pos_err_v_m[i]));
-    if (mc) parts << QStringLiteral("%1 %2 m").arg(runs, Num(NavInterpolate(env.t_s, env.pos_rms_ned_m, 3, 2, t)));
+    if (mc)
+      parts << QStringLiteral("%1 %2 m").arg(runs, Num(NavInterpolate(env.t_s, env.pos_rms_ned_m, 3, 2, t)));
     if (filter) parts << QStringLiteral("filter 1\u03c3 %1 m").arg(Num(s3[2]));
   } else if (panel == "velocity") {
     parts << QStringLiteral("velocity %1 m/s").arg(Num(i < e.vel_err_mps.size() ? e.vel_err_mps[i] : NAN));
@@ -80,7 +82,8 @@ QString PanelText(const NavResult &r, const std::string &panel, size_t i) {
           << QStringLiteral("pitch %1\u00b0").arg(Num(e.euler_err_rad[3 * i + 1] * kRadToDeg))
           << QStringLiteral("yaw %1\u00b0").arg(Num(e.euler_err_rad[3 * i + 2] * kRadToDeg));
     if (mc && env.att_rms_rad.size() == env.Size())
-      parts << QStringLiteral("%1 %2\u00b0").arg(runs, Num(NavInterpolate(env.t_s, env.att_rms_rad, 1, 0, t) * kRadToDeg));
+      parts << QStringLiteral("%1 %2\u00b0")
+                   .arg(runs, Num(NavInterpolate(env.t_s, env.att_rms_rad, 1, 0, t) * kRadToDeg));
   }
   return parts.join(QStringLiteral(" \u00b7 "));
 }
@@ -256,7 +259,8 @@ QString ErrorChart::ReadoutAt(QPoint p, bool show) {
   if (show) {
     hover_panel_ = panel;
     hover_epoch_ = i;
-    hover_x_ = static_cast<int>(std::lround(r.x + (ts[i] - l.t_min_s[k]) / (l.t_max_s[k] - l.t_min_s[k]) * r.w - 0.5));
+    hover_x_ = static_cast<int>(
+        std::lround(r.x + (ts[i] - l.t_min_s[k]) / (l.t_max_s[k] - l.t_min_s[k]) * r.w - 0.5));
     if (text != readout_) {
       readout_ = text;
       emit ReadoutChanged(readout_);

@@ -56,7 +56,8 @@ nav_callback_result OnRecord(void *user, const nav_sim_record *r) {
   if (c->crash && ++c->records == 10) raise(SIGSEGV);
   // navcore reports progress every 65536 IMU samples: a preview's single run is done sooner.
   if (c->single_run_s > 0.0) c->fraction->store(std::min(1.0, r->truth->t_s / c->single_run_s));
-  const nav_local_view tv = nav_frame_view(r->frame, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
+  const nav_local_view tv =
+      nav_frame_view(r->frame, r->truth->r_fb_f_m, r->truth->v_fb_f_mps, r->truth->q_b_f);
   const nav_local_view nv = nav_frame_view(r->frame, r->nav->r_fb_f_m, r->nav->v_fb_f_mps, r->nav->q_b_f);
   SimResult *o = c->out;
   o->t_s.push_back(r->truth->t_s);
@@ -66,11 +67,13 @@ nav_callback_result OnRecord(void *user, const nav_sim_record *r) {
   const nav_euler te = nav_quat_to_euler(tv.q_b_n, nullptr), ne = nav_quat_to_euler(nv.q_b_n, nullptr);
   o->truth_euler.insert(o->truth_euler.end(), {te.roll_rad, te.pitch_rad, te.yaw_rad});
   o->nav_euler.insert(o->nav_euler.end(), {ne.roll_rad, ne.pitch_rad, ne.yaw_rad});
-  o->err_ned_m.insert(o->err_ned_m.end(), {r->err->pos_err_n_m.x, r->err->pos_err_n_m.y, r->err->pos_err_n_m.z});
+  o->err_ned_m.insert(o->err_ned_m.end(),
+                      {r->err->pos_err_n_m.x, r->err->pos_err_n_m.y, r->err->pos_err_n_m.z});
   o->err_v_m.push_back(r->err->pos_err_v_m);
   o->att_err_rad.push_back(r->err->att_err_rad);
   o->err_vel_mps.push_back(r->err->vel_err_mps);
-  o->euler_err_rad.insert(o->euler_err_rad.end(), {r->err->euler_err.roll_rad, r->err->euler_err.pitch_rad, r->err->euler_err.yaw_rad});
+  o->euler_err_rad.insert(o->euler_err_rad.end(), {r->err->euler_err.roll_rad, r->err->euler_err.pitch_rad,
+                                                   r->err->euler_err.yaw_rad});
   return c->cancel->load() ? NAV_STOP : NAV_CONTINUE;
 }
 } // namespace
@@ -153,7 +156,8 @@ void SimWorker::Launch(std::unique_ptr<Job> job) {
     RunInHelper(j, result.get());
     std::shared_ptr<const SimResult> done = result;
     // The one crossing to the GUI thread: a queued call on this object (dropped if it is gone).
-    QMetaObject::invokeMethod(this, [this, done] { OnThreadDone(done); }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        this, [this, done] { OnThreadDone(done); }, Qt::QueuedConnection);
   });
 }
 
@@ -195,7 +199,8 @@ int RunCore(const nav_scene &scene, long runs, bool preview, bool crash, std::at
 
   // The live preview shows the estimate and the final error, not verdicts: no evaluator.
   nav_req_evaluator *ev = nullptr;
-  if (!preview && scene.n_requirements > 0 && nav_req_evaluator_create_for_scene(&scene, false, &ev) != NAV_OK)
+  if (!preview && scene.n_requirements > 0 &&
+      nav_req_evaluator_create_for_scene(&scene, false, &ev) != NAV_OK)
     ev = nullptr;
 
   RunCtx ctx{fraction, cancel, beats, out, runs == 1 ? scene.trajectory.duration_s : 0.0, crash, 0};
@@ -225,14 +230,17 @@ int RunCore(const nav_scene &scene, long runs, bool preview, bool crash, std::at
     for (size_t i = 0; env && i < n; ++i) {
       out->env_t_s.push_back(env[i].t_s);
       out->env_h_rms_m.push_back(env[i].pos_h_rms_m);
-      out->env_rms_ned_m.insert(out->env_rms_ned_m.end(), {env[i].pos_rms_n_m.x, env[i].pos_rms_n_m.y, env[i].pos_rms_n_m.z});
+      out->env_rms_ned_m.insert(out->env_rms_ned_m.end(),
+                                {env[i].pos_rms_n_m.x, env[i].pos_rms_n_m.y, env[i].pos_rms_n_m.z});
       out->env_att_rms_rad.push_back(env[i].att_rms_rad);
       out->env_vel_rms_mps.push_back(env[i].vel_rms_mps);
-      if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS || scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
+      if (scene.navigation.scheme == NAV_SCHEME_INS_GNSS ||
+          scene.navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS ||
           scene.navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT) {
         out->env_sd_h_m.push_back(std::hypot(env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y));
-        out->env_sd_ned_m.insert(out->env_sd_ned_m.end(), {env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y,
-                                                           env[i].pos_sd_reported_n_m.z});
+        out->env_sd_ned_m.insert(
+            out->env_sd_ned_m.end(),
+            {env[i].pos_sd_reported_n_m.x, env[i].pos_sd_reported_n_m.y, env[i].pos_sd_reported_n_m.z});
       }
     }
     if (ev) {
@@ -246,12 +254,24 @@ int RunCore(const nav_scene &scene, long runs, bool preview, bool crash, std::at
 }
 
 // The per-epoch series a result carries from the helper to the window, in this order.
-std::vector<double> SimResult::*const kSeries[] = {
-    &SimResult::t_s,           &SimResult::truth_ned,       &SimResult::nav_ned,       &SimResult::err_h_m,
-    &SimResult::truth_euler,   &SimResult::nav_euler,       &SimResult::err_ned_m,     &SimResult::err_v_m,
-    &SimResult::att_err_rad,   &SimResult::err_vel_mps,     &SimResult::euler_err_rad, &SimResult::env_rms_ned_m,
-    &SimResult::env_att_rms_rad, &SimResult::env_vel_rms_mps, &SimResult::env_sd_ned_m, &SimResult::env_t_s,
-    &SimResult::env_h_rms_m,   &SimResult::env_sd_h_m};
+std::vector<double> SimResult::*const kSeries[] = {&SimResult::t_s,
+                                                   &SimResult::truth_ned,
+                                                   &SimResult::nav_ned,
+                                                   &SimResult::err_h_m,
+                                                   &SimResult::truth_euler,
+                                                   &SimResult::nav_euler,
+                                                   &SimResult::err_ned_m,
+                                                   &SimResult::err_v_m,
+                                                   &SimResult::att_err_rad,
+                                                   &SimResult::err_vel_mps,
+                                                   &SimResult::euler_err_rad,
+                                                   &SimResult::env_rms_ned_m,
+                                                   &SimResult::env_att_rms_rad,
+                                                   &SimResult::env_vel_rms_mps,
+                                                   &SimResult::env_sd_ned_m,
+                                                   &SimResult::env_t_s,
+                                                   &SimResult::env_h_rms_m,
+                                                   &SimResult::env_sd_h_m};
 constexpr uint32_t kMagic = 0x4e535231u; /* "NSR1" */
 static_assert(std::is_trivially_copyable<nav_sim_summary>::value, "the summary crosses the pipe as bytes");
 static_assert(std::is_trivially_copyable<nav_requirement_verdict>::value, "verdicts cross the pipe as bytes");
@@ -297,7 +317,8 @@ bool Decode(const std::vector<char> &b, int *status, std::string *detail, SimRes
   uint32_t magic = 0;
   int32_t st = 0;
   uint64_t n = 0;
-  if (!get(&magic, sizeof magic) || magic != kMagic || !get(&st, sizeof st) || !get(&r->summary, sizeof r->summary))
+  if (!get(&magic, sizeof magic) || magic != kMagic || !get(&st, sizeof st) ||
+      !get(&r->summary, sizeof r->summary))
     return false;
   if (!count(&n, 1)) return false;
   detail->assign(b.data() + at, static_cast<size_t>(n));
@@ -384,7 +405,8 @@ struct JobHeader {
   for (;;) {
     JobHeader h{};
     auto scene = std::make_unique<nav_scene>();
-    if (!ReadAll(3, &h, sizeof h) || h.magic != kMagic || !ReadAll(3, scene.get(), sizeof(nav_scene))) _exit(0);
+    if (!ReadAll(3, &h, sizeof h) || h.magic != kMagic || !ReadAll(3, scene.get(), sizeof(nav_scene)))
+      _exit(0);
     std::vector<nav_vec3> ctrl_ned;
     std::vector<nav_quat> ctrl_q;
     nav_traj_recorded &rec = scene->trajectory.recorded;
@@ -392,15 +414,16 @@ struct JobHeader {
     const size_t nc = static_cast<size_t>(h.n_ctrl);
     ctrl_ned.resize(nc);
     ctrl_q.resize(nc);
-    if (nc > 0 && (!ReadAll(3, ctrl_ned.data(), nc * sizeof(nav_vec3)) || !ReadAll(3, ctrl_q.data(), nc * sizeof(nav_quat))))
+    if (nc > 0 && (!ReadAll(3, ctrl_ned.data(), nc * sizeof(nav_vec3)) ||
+                   !ReadAll(3, ctrl_q.data(), nc * sizeof(nav_quat))))
       _exit(0);
     // A borrowed view of the control points (never released here).
     rec.ctrl_ned_m = nc > 0 ? ctrl_ned.data() : nullptr;
     rec.ctrl_q = nc > 0 ? ctrl_q.data() : nullptr;
     SimResult out;
     std::string detail;
-    const int st = RunCore(*scene, h.runs, h.preview != 0, h.crash != 0, &sh->fraction, &sh->cancel, &sh->beats, &out,
-                           &detail);
+    const int st = RunCore(*scene, h.runs, h.preview != 0, h.crash != 0, &sh->fraction, &sh->cancel,
+                           &sh->beats, &out, &detail);
     const std::vector<char> b = Encode(st, detail, out);
     const uint64_t len = b.size();
     if (!WriteAll(3, &len, sizeof len, false) || !WriteAll(3, b.data(), b.size(), false)) _exit(0);
@@ -412,7 +435,8 @@ struct JobHeader {
 bool SimWorker::StartHelper(QString *error) {
   int sv[2] = {-1, -1};
   if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv) != 0) {
-    *error = QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(errno)));
+    *error = QStringLiteral("cannot start the simulation process: %1")
+                 .arg(QString::fromLocal8Bit(std::strerror(errno)));
     return false;
   }
   const pid_t pid = fork();
@@ -424,7 +448,8 @@ bool SimWorker::StartHelper(QString *error) {
   close(sv[1]);
   if (pid < 0) {
     close(sv[0]);
-    *error = QStringLiteral("cannot start the simulation process: %1").arg(QString::fromLocal8Bit(std::strerror(e)));
+    *error = QStringLiteral("cannot start the simulation process: %1")
+                 .arg(QString::fromLocal8Bit(std::strerror(e)));
     return false;
   }
   helper_pid_ = pid;
@@ -447,7 +472,8 @@ double SimWorker::HelperCpuS() const {
   // and 15th, in clock ticks.
   const char *p = std::strrchr(buf, ')');
   unsigned long long ut = 0, st = 0;
-  if (!p || std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &st) != 2) return 0.0;
+  if (!p || std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &st) != 2)
+    return 0.0;
   return static_cast<double>(ut + st) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
@@ -488,8 +514,8 @@ void SimWorker::RunInHelper(Job *job, SimResult *out) {
   // The job to the helper (started again when an earlier run crashed it).
   const nav_traj_recorded &rec = scene.trajectory.recorded;
   const size_t nc = rec.ctrl_ned_m && rec.ctrl_q && rec.count > 0 ? static_cast<size_t>(rec.count) : 0;
-  const JobHeader h{kMagic, static_cast<int32_t>(std::min<long>(job->runs, INT32_MAX)), uint8_t(job->preview ? 1 : 0),
-                    uint8_t(job->crash_for_test ? 1 : 0), nc};
+  const JobHeader h{kMagic, static_cast<int32_t>(std::min<long>(job->runs, INT32_MAX)),
+                    uint8_t(job->preview ? 1 : 0), uint8_t(job->crash_for_test ? 1 : 0), nc};
   auto send_job = [&] {
     return WriteAll(helper_fd_, &h, sizeof h, true) && WriteAll(helper_fd_, &scene, sizeof scene, true) &&
            (nc == 0 || (WriteAll(helper_fd_, rec.ctrl_ned_m, nc * sizeof(nav_vec3), true) &&
@@ -526,8 +552,11 @@ void SimWorker::RunInHelper(Job *job, SimResult *out) {
         stalled = true;
       }
       if (r == 0 || (r < 0 && errno == EINTR)) continue;
-      const size_t room = have_len < sizeof want ? sizeof want - have_len : static_cast<size_t>(std::min<uint64_t>(sizeof buf, want - data.size()));
-      const ssize_t n = read(helper_fd_, have_len < sizeof want ? reinterpret_cast<char *>(&want) + have_len : buf, room);
+      const size_t room = have_len < sizeof want
+                              ? sizeof want - have_len
+                              : static_cast<size_t>(std::min<uint64_t>(sizeof buf, want - data.size()));
+      const ssize_t n =
+          read(helper_fd_, have_len < sizeof want ? reinterpret_cast<char *>(&want) + have_len : buf, room);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) break; // the helper ended
       if (have_len < sizeof want) {
@@ -566,8 +595,9 @@ void SimWorker::RunInHelper(Job *job, SimResult *out) {
   } else if (stalled) {
     out->status = kStatusCrashed;
     out->crash_signal = SIGKILL;
-    out->message = QStringLiteral("the simulation stopped responding for %1 s and was ended; navstudio kept running")
-                       .arg(kStallS, 0, 'f', 0);
+    out->message =
+        QStringLiteral("the simulation stopped responding for %1 s and was ended; navstudio kept running")
+            .arg(kStallS, 0, 'f', 0);
   } else if (ended && WIFSIGNALED(wstatus)) {
     out->status = kStatusCrashed;
     out->crash_signal = WTERMSIG(wstatus);
@@ -583,8 +613,8 @@ void SimWorker::RunInHelper(Job *job, SimResult *out) {
       out->message = QStringLiteral("cancelled");
     else if (st != NAV_OK)
       out->message = QStringLiteral("simulation failed: %1%2%3")
-                         .arg(QString::fromUtf8(nav_status_str(static_cast<nav_status>(st))), detail.empty() ? "" : ": ",
-                              QString::fromUtf8(detail.c_str()));
+                         .arg(QString::fromUtf8(nav_status_str(static_cast<nav_status>(st))),
+                              detail.empty() ? "" : ": ", QString::fromUtf8(detail.c_str()));
   }
   out->wall_s = wall();
 }

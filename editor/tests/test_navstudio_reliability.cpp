@@ -40,7 +40,9 @@ bool RunAndWait(MainWindow *w, int timeout_ms) {
   return WaitUntil([&] { return !w->Worker()->IsBusy(); }, timeout_ms);
 }
 
-QString StatusText(MainWindow *w) { return w->findChild<QLabel *>("statusText")->text(); }
+QString StatusText(MainWindow *w) {
+  return w->findChild<QLabel *>("statusText")->text();
+}
 
 /** The first number after @p key in @p text (NaN when absent). */
 double NumberAfter(const QString &text, const QString &key) {
@@ -77,7 +79,7 @@ private slots:
     qInfo("status after the crash: %s", qPrintable(status));
     QVERIFY2(status.contains("crashed") && status.contains("SIGSEGV"), qPrintable(status));
     QVERIFY2(status.contains("last complete results are kept"), qPrintable(status));
-    QVERIFY(w->LastResult() == before);        // the previous results remain...
+    QVERIFY(w->LastResult() == before);         // the previous results remain...
     QCOMPARE(w->ResultsText(), results_before); // ...and are still shown
     QVERIFY(w->findChild<QAction *>("actionRun")->isEnabled());
     QVERIFY(!w->findChild<QAction *>("actionCancel")->isEnabled());
@@ -145,10 +147,14 @@ private slots:
     nav_traj_destroy(traj);
     QCOMPARE(es, NAV_OK);
     const nav_local_view v = nav_frame_view(&fr, st.r_fb_f_m, st.v_fb_f_mps, st.q_b_f);
-    const double dn = r->truth_ned[3 * (n - 1)] - v.r_ned_m.x, de = r->truth_ned[3 * (n - 1) + 1] - v.r_ned_m.y;
-    const double moved = std::hypot(r->truth_ned[3 * (n - 1)] - r->truth_ned[0], r->truth_ned[3 * (n - 1) + 1] - r->truth_ned[1]);
-    qInfo("recorded reference: %zu epochs, %.2f m from the start at %.2f s; against this process's trajectory "
-          "dN %.2e m, dE %.2e m", n, moved, r->t_s[n - 1], dn, de);
+    const double dn = r->truth_ned[3 * (n - 1)] - v.r_ned_m.x,
+                 de = r->truth_ned[3 * (n - 1) + 1] - v.r_ned_m.y;
+    const double moved = std::hypot(r->truth_ned[3 * (n - 1)] - r->truth_ned[0],
+                                    r->truth_ned[3 * (n - 1) + 1] - r->truth_ned[1]);
+    qInfo(
+        "recorded reference: %zu epochs, %.2f m from the start at %.2f s; against this process's trajectory "
+        "dN %.2e m, dE %.2e m",
+        n, moved, r->t_s[n - 1], dn, de);
     QVERIFY(moved > 1.0);
     QVERIFY(std::fabs(dn) < 1e-6 && std::fabs(de) < 1e-6);
     QVERIFY(std::isfinite(r->summary.final.pos_err_h_m));
@@ -200,7 +206,8 @@ private slots:
     const double px_s = (lay.t_max_s[0] - lay.t_min_s[0]) / lay.plots[0].w;
     QVERIFY2(std::fabs(t - time_at(0, ph)) <= 0.5 * dt + px_s + 0.05, qPrintable(th));
     size_t i = 0;
-    while (i + 1 < r->t_s.size() && std::fabs(r->t_s[i + 1] - t) < std::fabs(r->t_s[i] - t)) ++i;
+    while (i + 1 < r->t_s.size() && std::fabs(r->t_s[i + 1] - t) < std::fabs(r->t_s[i] - t))
+      ++i;
     const double h = NumberAfter(th, "horizontal");
     qInfo("epoch %zu: t %.3f s, run 0 horizontal %.4f m; read-out %.4f m", i, r->t_s[i], r->err_h_m[i], h);
     QVERIFY(std::fabs(h - r->err_h_m[i]) <= 0.006 * std::max(1.0, std::fabs(r->err_h_m[i])));
