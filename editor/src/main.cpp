@@ -5,6 +5,12 @@
 //                                     live-preview edit-to-picture latency (median, p90, max) [ms]:
 //                                     from the edit to the swap of the window frame showing the
 //                                     re-simulated estimate; renders and frames per view per edit
+// Test hooks (the kill-during-save test, editor/tests/navstudio_kill_save.py), by environment:
+//   NAVSTUDIO_TEST_SAVE_LOOP=save|autosave  after opening SCENE, change its seed and undo it in
+//                                     turn, saving (File > Save) or autosaving after each change,
+//                                     until killed or NAVSTUDIO_TEST_SAVE_LOOP_CYCLES changes
+//   NAVSTUDIO_TEST_SLOW_WRITE_US=US   write files in small pieces US microseconds apart (a slow
+//                                     disk) and report each write's begin and end on stderr
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QSurfaceFormat>
@@ -51,10 +57,12 @@ int BenchPreview(studio::MainWindow *w, int n) {
   // triads, tube, vehicle and legend; greyed and overdrawn by each new preview during the drag).
   WaitFor([&] { return w->View3D()->Scene() != nullptr; }, 10000);
   const size_t before = w->PreviewLatenciesMs().size();
-  auto cpu_s = [] {
+  // This process and the helper processes that run the simulations (sim_worker.h).
+  auto cpu_s = [w] {
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
-    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) +
+           w->PreviewWorker()->HelperCpuS() + w->Worker()->HelperCpuS();
   };
   {
     // Cost of the GUI thread's per-edit work (validation, path sampling, one render per view).
@@ -125,6 +133,37 @@ int BenchPreview(studio::MainWindow *w, int n) {
               doc->Scene().trajectory.duration_s, doc->Scene().imu.rate_hz, load);
   return 0;
 }
+// NAVSTUDIO_TEST_SAVE_LOOP: save (or autosave) after each of a series of changes that alternate
+// between two scenes, so that the file on disk is always one of two known texts. "save loop
+// ready" on stderr marks the start; the loop ends after @p cycles changes (negative: never).
+int SaveLoop(studio::MainWindow *w, bool autosave, int cycles) {
+  studio::SceneDocument *doc = w->Doc();
+  auto change = [doc] { doc->Edit(QStringLiteral("test: seed"), [](nav_scene &s) { s.simulation.seed += 1; }); };
+  // An autosave is written only for a modified document: both of its scenes differ from the file.
+  if (autosave) change();
+  std::fprintf(stderr, "navstudio: test: save loop ready (%s)\n", autosave ? "autosave" : "save");
+  int done = 0;
+  QTimer tick;
+  tick.setInterval(0);
+  QObject::connect(&tick, &QTimer::timeout, [&] {
+    if (cycles >= 0 && done >= cycles) {
+      tick.stop();
+      QApplication::exit(0);
+      return;
+    }
+    if (done % 2 == 0)
+      change();
+    else
+      doc->UndoStack()->undo();
+    if (autosave)
+      w->Autosave();
+    else
+      w->Save();
+    ++done;
+  });
+  tick.start();
+  return QApplication::exec();
+}
 } // namespace
 
 int main(int argc, char **argv) {
@@ -163,13 +202,23 @@ int main(int argc, char **argv) {
     }
   }
   studio::MainWindow w;
-  if (!shot.isEmpty() || bench > 0) qputenv("NAVSTUDIO_NO_DIALOGS", "1");
+  const QString loop = scene.isEmpty() ? QString() : qEnvironmentVariable("NAVSTUDIO_TEST_SAVE_LOOP");
+  if (!shot.isEmpty() || bench > 0 || !loop.isEmpty()) qputenv("NAVSTUDIO_NO_DIALOGS", "1");
+  // The save loop answers "Recover the autosave?" (an earlier loop's) with No, as a user who
+  // keeps the file's version would: the loop starts from the scene file.
+  if (!loop.isEmpty())
+    w.SetAsk([](const QString &, const QString &, QMessageBox::StandardButtons) { return QMessageBox::No; });
   if (shot.isEmpty() && bench == 0) w.FitToScreen(); // screenshots and the bench keep the default size
   w.show();
   if (!scene.isEmpty() && !w.OpenFile(scene)) {
-    if (!shot.isEmpty() || bench > 0) return 2;
+    if (!shot.isEmpty() || bench > 0 || !loop.isEmpty()) return 2;
   }
   if (scene.isEmpty() && shot.isEmpty() && bench == 0) w.CheckRecovery();
+  if (!loop.isEmpty()) {
+    bool ok = false;
+    const int cycles = qEnvironmentVariableIntValue("NAVSTUDIO_TEST_SAVE_LOOP_CYCLES", &ok);
+    return SaveLoop(&w, loop == "autosave", ok ? cycles : -1);
+  }
   if (bench > 0) return BenchPreview(&w, bench);
   if (!shot.isEmpty()) {
     WaitFor([&] { return !w.PreviewWorker()->IsBusy() && w.LastPreview() != nullptr && !w.PreviewLatenciesMs().empty(); },

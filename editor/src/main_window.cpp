@@ -93,6 +93,7 @@ MainWindow::MainWindow(QWidget *parent) : QMainWindow(parent) {
   autosave_timer_.setInterval(ok && ms > 0 ? ms : 30000);
   connect(&autosave_timer_, &QTimer::timeout, this, &MainWindow::Autosave);
   autosave_timer_.start();
+  RemoveStaleTempFiles(AutosaveDir()); // an autosave a killed navstudio did not finish
   UpdateTitle();
   ShowIssues();
   ShowResultsHint();
@@ -764,6 +765,11 @@ bool MainWindow::event(QEvent *e) {
 }
 
 void MainWindow::OnPreviewFinished(std::shared_ptr<const SimResult> r) {
+  if (r->status == kStatusCrashed) {
+    // The preview's process crashed: the window stays, the last preview stays drawn.
+    status_->setText(tr("Live preview: %1").arg(r->message));
+    return;
+  }
   if (r->status != NAV_OK) return; // cancelled by a newer edit, or failed (the issues list says why)
   const qint64 arrived_ns = SceneDocument::NowNs();
   last_preview_ = r;
@@ -887,7 +893,9 @@ void MainWindow::OnFinished(std::shared_ptr<const SimResult> r) {
     preview_timer_.start(); // edits made during the run
   if (r->status != NAV_OK) {
     progress_->setValue(0);
-    const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1) : r->message;
+    const QString what = r->status == NAV_ERR_CANCELLED ? tr("Cancelled after %1 s").arg(r->wall_s, 0, 'f', 1)
+                         : r->status == kStatusCrashed ? tr("Run failed: %1").arg(r->message)
+                                                       : r->message;
     // The last complete results stay (the cancelled or failed run has none to show).
     status_->setText(last_result_ ? tr("%1 — the last complete results are kept").arg(what) : what);
     if (!last_result_) results_->setHtml(QStringLiteral("<p><b>%1</b></p>").arg(what.toHtmlEscaped()));

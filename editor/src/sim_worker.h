@@ -1,8 +1,12 @@
 /*
- * navstudio: simulation on a background thread (style.md section 7). The worker thread only
- * calls navcore (nav_sim_run) and fills a plain SimResult; it never touches Qt widgets or VTK.
- * Progress is published through atomics that the GUI thread polls; the result crosses to the GUI
- * thread once, through a queued call, as a shared_ptr to an immutable SimResult.
+ * navstudio: simulation on a background thread (style.md section 7), run in a helper process.
+ * Each SimWorker forks one helper process when it is created (while the program is small); its
+ * worker thread sends each job (the scene's bytes) to the helper over a socket and reads back a
+ * plain SimResult. The helper only calls navcore (nav_sim_run); a crash of a run (a signal in
+ * navcore) ends the helper, never the window, and is reported as a failed run; the next job
+ * starts a new helper. Progress and cancellation cross through a shared memory page of atomics;
+ * the worker thread never touches Qt widgets or VTK. The result crosses to the GUI thread once,
+ * through a queued call, as a shared_ptr to an immutable SimResult.
  */
 #ifndef NAVSTUDIO_SIM_WORKER_H
 #define NAVSTUDIO_SIM_WORKER_H
@@ -10,6 +14,8 @@
 #include <QObject>
 #include <QString>
 #include <QTimer>
+
+#include <sys/types.h>
 
 #include <atomic>
 #include <memory>
@@ -25,12 +31,18 @@ extern "C" {
 
 namespace studio {
 
+/** SimResult::status of a run whose process crashed (killed by a signal) or ended without a
+ *  complete result; not a nav_status. */
+constexpr int kStatusCrashed = -1;
+
 /** What a simulation produced (plain data; immutable once published). */
 struct SimResult {
   bool preview = false;       /**< a single-run live preview */
   long runs = 0;              /**< runs requested */
-  int status = 0;             /**< nav_status of nav_sim_run */
+  /** nav_status of nav_sim_run, or kStatusCrashed when the run's process ended abnormally */
+  int status = 0;
   QString message;            /**< failure text ("" on success) */
+  int crash_signal = 0;       /**< the signal that ended the run's process (kStatusCrashed) */
   nav_sim_summary summary{};  /**< navcore's summary */
   double wall_s = 0.0;        /**< wall time of the run [s] */
   qint64 scene_change_ns = 0; /**< SceneDocument::LastChangeNs() of the scene that was run */
@@ -74,9 +86,11 @@ public:
   void Cancel();
   bool IsBusy() const { return busy_; }
   /** Fraction 0..1 of the running job. */
-  double Fraction() const { return fraction_.load(); }
+  double Fraction() const;
   /** Wait until the worker is idle (tests, shutdown); processes nothing. */
   void Join();
+  /** CPU time the helper process that runs the simulations has used so far [s] (0 without one). */
+  double HelperCpuS() const;
 
 signals:
   void Progress(double fraction);
@@ -89,10 +103,27 @@ private:
     long runs = 1;
     bool preview = false;
     qint64 stamp = 0;
+    bool crash_for_test = false; /**< NAVSTUDIO_TEST_CRASH_RUN: the run crashes (SIGSEGV) */
   };
+public:
+  /** Progress and cancellation shared with the helper process (a MAP_SHARED page). */
+  struct Shared {
+    std::atomic<double> fraction{0.0};
+    std::atomic<bool> cancel{false};
+    std::atomic<long> beats{0}; /**< callbacks of the run so far */
+  };
+  /** A run none of whose callbacks came for this long is taken as hung and ended [s]. */
+  static constexpr double kStallS = 120.0;
+
+private:
   void Launch(std::unique_ptr<Job> job);
   void OnThreadDone(std::shared_ptr<const SimResult> r);
-  static void RunJob(SimWorker *self, Job *job, SimResult *out);
+  /** On the worker thread: send @p job to the helper process, read its result into @p out. */
+  void RunInHelper(Job *job, SimResult *out);
+  /** Fork the helper process that runs the jobs (HelperMain); false with @p error. */
+  bool StartHelper(QString *error);
+  /** End the helper process (SIGKILL) and collect it. */
+  void StopHelper();
 
   std::thread thread_;
   std::unique_ptr<Job> running_;
@@ -100,8 +131,12 @@ private:
   bool busy_ = false;
   std::atomic<double> fraction_{0.0};
   std::atomic<bool> cancel_{false};
-  std::mutex sim_mutex_;
-  nav_sim *sim_ = nullptr; /* guarded by sim_mutex_ */
+  mutable std::mutex sim_mutex_;
+  Shared *shared_ = nullptr; /* guarded by sim_mutex_: shared_page_ while a job runs */
+  Shared *shared_page_ = nullptr;
+  /* the helper process, -1 when there is none (changed by the worker thread after construction) */
+  std::atomic<pid_t> helper_pid_{-1};
+  int helper_fd_ = -1;    /* its socket */
   QTimer poll_;
 };
 

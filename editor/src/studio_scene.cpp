@@ -13,7 +13,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -396,6 +399,9 @@ bool SceneDocument::Load(const QString &path, QStringList *errors) {
   Normalize(s.get());
   RememberUserText(path, *s);
   path_ = QFileInfo(path).absoluteFilePath();
+  // A save of this folder's scenes that a killed navstudio left unfinished (the scene itself is
+  // whole: saves write a temporary file and rename it).
+  RemoveStaleTempFiles(QFileInfo(path_).absolutePath());
   undo_.clear();
   live_ = false;
   *scene_ = *s;
@@ -464,6 +470,27 @@ void SceneDocument::RememberUserText(const QString &path, const nav_scene &read_
   }
 }
 
+QString TempPrefix(const QString &file_name) { return "." + file_name + ".navstudio-tmp-"; }
+
+int RemoveStaleTempFiles(const QString &dir) {
+  const QDir d(dir);
+  if (!d.exists()) return 0;
+  int removed = 0;
+  const QStringList names = d.entryList({QStringLiteral(".*.navstudio-tmp-*")}, QDir::Files | QDir::Hidden | QDir::System);
+  for (const QString &name : names) {
+    const int at = name.lastIndexOf(QStringLiteral(".navstudio-tmp-"));
+    bool ok = false;
+    const qint64 pid = name.mid(at + 15).toLongLong(&ok);
+    if (at < 1 || !ok || pid <= 0) continue;
+    // Saves run on the GUI thread, which is here: a file of this process id is a leftover of
+    // an earlier process that had the same id. Another running process's file is left alone.
+    const bool stale = pid == QCoreApplication::applicationPid() ||
+                       (kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH);
+    if (stale && QFile::remove(d.filePath(name))) ++removed;
+  }
+  return removed;
+}
+
 namespace {
 /* navcore's writer's text of @p s (empty on failure). */
 QByteArray CanonicalText(const nav_scene &s) {
@@ -475,31 +502,80 @@ QByteArray CanonicalText(const nav_scene &s) {
   return out;
 }
 
-/* Write @p text to @p path atomically: a temporary file in the same directory, fsync, rename. */
+/* Test hook (NAVSTUDIO_TEST_SLOW_WRITE_US, the kill-during-save test): the text is written in
+ * small pieces with this pause between them, as on a slow disk, so that a kill lands inside the
+ * write; the start and end of each write are reported on stderr. 0 (unset): one write. */
+long SlowWriteUs() {
+  bool ok = false;
+  const int us = qEnvironmentVariableIntValue("NAVSTUDIO_TEST_SLOW_WRITE_US", &ok);
+  return ok && us > 0 ? us : 0;
+}
+
+bool WriteAll(int fd, const char *p, size_t n, long pause_us) {
+  const size_t piece = pause_us > 0 ? 64 : n;
+  while (n > 0) {
+    const ssize_t w = write(fd, p, std::min(piece, n));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    p += w;
+    n -= static_cast<size_t>(w);
+    if (pause_us > 0 && n > 0) usleep(static_cast<useconds_t>(pause_us));
+  }
+  return true;
+}
+
+/* Write @p text to @p path atomically: a temporary file in the same directory, fsync, rename.
+ * The temporary file is hidden (TempPrefix) and carries the process id, so that a later
+ * navstudio can tell the temporary files of a killed one from those of a running one
+ * (RemoveStaleTempFiles). */
 bool WriteAtomically(const QString &path, const QByteArray &text, QString *error) {
+  const QFileInfo fi(path);
   const QByteArray final_path = QFile::encodeName(path);
-  const QByteArray tmp = final_path + ".tmp-" + QByteArray::number(QCoreApplication::applicationPid());
-  FILE *f = std::fopen(tmp.constData(), "wb");
-  bool ok = f != nullptr;
-  if (ok) ok = std::fwrite(text.constData(), 1, static_cast<size_t>(text.size()), f) == static_cast<size_t>(text.size());
-  if (ok) ok = std::fflush(f) == 0 && fsync(fileno(f)) == 0;
-  if (f && std::fclose(f) != 0) ok = false;
-  // The file keeps its permissions; the rename is made durable with the directory.
-  if (ok && QFileInfo::exists(path)) QFile::setPermissions(QFile::decodeName(tmp), QFile::permissions(path));
-  if (ok) ok = std::rename(tmp.constData(), final_path.constData()) == 0;
+  const QByteArray tmp = QFile::encodeName(fi.absolutePath() + "/" + TempPrefix(fi.fileName()) +
+                                           QString::number(QCoreApplication::applicationPid()));
+  const long pause_us = SlowWriteUs();
+  if (pause_us > 0) std::fprintf(stderr, "navstudio: test: write begin %s\n", final_path.constData());
+  const int fd = open(tmp.constData(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  bool ok = fd >= 0;
+  int saved_errno = ok ? 0 : errno;
+  if (ok && !WriteAll(fd, text.constData(), static_cast<size_t>(text.size()), pause_us)) ok = false;
+  // The file keeps its permissions; a new one gets rw-rw-rw- less the umask.
   if (ok) {
-    const QByteArray dir = QFile::encodeName(QFileInfo(path).absolutePath());
-    const int fd = open(dir.constData(), O_RDONLY | O_DIRECTORY);
-    if (fd >= 0) {
-      (void)fsync(fd);
-      close(fd);
+    struct stat st {};
+    if (stat(final_path.constData(), &st) == 0) {
+      ok = fchmod(fd, st.st_mode & 07777) == 0;
+    } else {
+      const mode_t um = umask(0);
+      umask(um);
+      ok = fchmod(fd, 0666 & ~um) == 0;
+    }
+  }
+  if (ok) ok = fsync(fd) == 0;
+  if (!ok && saved_errno == 0) saved_errno = errno;
+  if (fd >= 0 && close(fd) != 0 && ok) {
+    ok = false;
+    saved_errno = errno;
+  }
+  if (ok && std::rename(tmp.constData(), final_path.constData()) != 0) {
+    ok = false;
+    saved_errno = errno;
+  }
+  if (ok) {
+    // The rename is made durable with the directory.
+    const QByteArray dir = QFile::encodeName(fi.absolutePath());
+    const int dfd = open(dir.constData(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+      (void)fsync(dfd);
+      close(dfd);
     }
   }
   if (!ok) {
     std::remove(tmp.constData());
-    if (error) *error = QStringLiteral("%1: error: cannot write the scene (%2)").arg(path, QString::fromLocal8Bit(std::strerror(errno)));
+    if (error)
+      *error = QStringLiteral("%1: error: cannot write the scene (%2)").arg(path, QString::fromLocal8Bit(std::strerror(saved_errno)));
     return false;
   }
+  if (pause_us > 0) std::fprintf(stderr, "navstudio: test: write end %s\n", final_path.constData());
   return true;
 }
 } // namespace
@@ -579,13 +655,13 @@ bool SceneDocument::Save(const QString &path, QString *error) {
 }
 
 bool SceneDocument::WriteCopy(const QString &path, QString *error) const {
-  const QByteArray p = QFile::encodeName(path);
-  const nav_status st = nav_scene_write_file(p.constData(), scene_.get());
-  if (st != NAV_OK) {
-    if (error) *error = QStringLiteral("%1: error: cannot write the scene (%2)").arg(path, nav_status_str(st));
+  // navcore's writer's text, through the same atomic write as Save() (and its test hook).
+  const QByteArray text = CanonicalText(*scene_);
+  if (text.isEmpty()) {
+    if (error) *error = QStringLiteral("%1: error: cannot write the scene (the writer failed)").arg(path);
     return false;
   }
-  return true;
+  return WriteAtomically(QFileInfo(path).absoluteFilePath(), text, error);
 }
 
 } // namespace studio

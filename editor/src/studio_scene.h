@@ -117,6 +117,13 @@ private:
   QString errors_;
 };
 
+/** The start of the hidden temporary file a save of @p file_name writes next to it before
+ *  renaming it over the file: ".<file_name>.navstudio-tmp-", then the writer's process id. */
+QString TempPrefix(const QString &file_name);
+/** Remove from @p dir the temporary files of saves that did not finish because their navstudio
+ *  was killed (their process no longer runs); returns how many were removed. */
+int RemoveStaleTempFiles(const QString &dir);
+
 /**
  * The document: the scene being edited, its file, its undo stack. Every edit goes through Edit()
  * (one undo step) or through Preview()/Commit() (a drag: many live updates, one undo step).

@@ -423,6 +423,10 @@ bool BuildErrorChart(const NavResult &result, const NavChartOptions &opt, vtkCon
         if (label.compare(0, 6, "limit ") == 0) pens.push_back(p->GetPen()->GetLineType());
       }
       layout->limit_pens.push_back(pens);
+      layout->t_min_s.push_back(c->GetAxis(vtkAxis::BOTTOM)->GetMinimum());
+      layout->t_max_s.push_back(c->GetAxis(vtkAxis::BOTTOM)->GetMaximum());
+      layout->y_min.push_back(c->GetAxis(vtkAxis::LEFT)->GetMinimum());
+      layout->y_max.push_back(c->GetAxis(vtkAxis::LEFT)->GetMaximum());
     }
   }
   return true;

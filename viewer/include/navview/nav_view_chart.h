@@ -61,6 +61,9 @@ struct NavErrorChartLayout {
   std::vector<NavChartRect> legends; ///< the legend box (w = h = 0 when text is off)
   /** Per panel: the vtkPen line type of each requirement-limit line, in the panel's order. */
   std::vector<std::vector<int>> limit_pens;
+  /** Per panel: the axis ranges as drawn, time [s] across the plot and the panel's unit up it
+   *  (hover read-outs map a pixel of a plot to these). */
+  std::vector<double> t_min_s, t_max_s, y_min, y_max;
 };
 
 /**
