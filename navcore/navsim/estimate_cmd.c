@@ -311,8 +311,8 @@ typedef struct est_stream {
   nav_cov_point cov_last;         /* covariance of the last epoch received */
   size_t show_i[N_SHOW];          /* first epoch at or after each read-out time; nt: none yet */
   nav_cov_point show_cov[N_SHOW]; /* its covariance */
-  /* Every covariance point, kept when the requirements are predicted from this very analysis
-   * (nav_req_predict_scene_uses_sim_covariance): nav_req_predict_scene would run it again. */
+  /* Every total-model point (nav_sim_covariance_total), kept when the requirements are predicted
+   * from this very analysis: nav_req_predict_scene would run it again. */
   bool keep_points;
   nav_cov_point *pts;
   size_t npts, pts_cap;
@@ -330,8 +330,9 @@ static bool flush_batch(est_stream *s) {
   return true;
 }
 
-/* Epoch s->n (its covariance point @p p, or NULL). */
-static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
+/* Epoch s->n (its covariance point @p p, or NULL; @p keep: the point the requirements are
+ * predicted from, kept when s->keep_points). */
+static bool stream_epoch(est_stream *s, const nav_cov_point *p, const nav_cov_point *keep) {
   const size_t i = s->n++;
   const double t = epoch_time(s->c, i);
   s->batch[s->nb].t_s = t;
@@ -339,7 +340,7 @@ static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
     s->cov[s->nb] = *p;
     s->hmax = fmax(s->hmax, p->pos_h_sd_m);
     s->cov_last = *p;
-    if (s->keep_points) {
+    if (s->keep_points && keep) {
       if (s->npts == s->pts_cap) {
         const size_t nc = s->pts_cap ? 2 * s->pts_cap : 1024;
         nav_cov_point *g = realloc(s->pts, nc * sizeof *g);
@@ -350,7 +351,7 @@ static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
         s->pts = g;
         s->pts_cap = nc;
       }
-      s->pts[s->npts++] = *p;
+      s->pts[s->npts++] = *keep;
     }
   }
   for (size_t q = 0; q < N_SHOW; ++q)
@@ -368,7 +369,18 @@ static nav_callback_result stream_cov(void *user, const nav_cov_point *p) {
     s->n = s->c->nt + 1;
     return NAV_STOP;
   }
-  return stream_epoch(s, p) ? NAV_CONTINUE : NAV_STOP;
+  return stream_epoch(s, p, p) ? NAV_CONTINUE : NAV_STOP;
+}
+
+/* nav_sim_covariance_total: the filter's point into the rows, the total model's kept for the
+ * requirements. */
+static nav_callback_result stream_cov_total(void *user, const nav_cov_point *p, const nav_cov_point *total) {
+  est_stream *s = user;
+  if (s->n >= s->c->nt) {
+    s->n = s->c->nt + 1;
+    return NAV_STOP;
+  }
+  return stream_epoch(s, p, total) ? NAV_CONTINUE : NAV_STOP;
 }
 
 /* The requirements predicted by their own covariance analysis (nav_req_predict_scene_threads),
@@ -596,7 +608,11 @@ int navsim_estimate(int argc, char **argv) {
   if (sc.earth.model == NAV_EARTH_WGS84) {
     st = nav_sim_create(&sc, &sim);
     es.with_cov = true;
-    es.keep_points = sc.n_requirements > 0 && nav_req_predict_scene_uses_sim_covariance(&sc);
+    /* The requirements' covariance model (nav_req_predict_scene: the filter, plus the truth's
+     * scale factors the filter does not estimate as consider states) comes out of this very
+     * analysis (nav_sim_covariance_total), except for PVT fixes, whose budget model is not the
+     * filter's: there it runs on its own, beside this one when there is a second thread. */
+    es.keep_points = sc.n_requirements > 0 && !nav_scene_gnss_pvt_fixes(&sc);
     if (st == NAV_OK && sc.n_requirements > 0 && !es.keep_points && threads > 1) {
       /* The requirements' own analysis beside this one (used when this one covers the epochs). */
       job.out = calloc((size_t)sc.n_requirements, sizeof *job.out);
@@ -604,7 +620,8 @@ int navsim_estimate(int argc, char **argv) {
     }
     if (st == NAV_OK) {
       const double tc = navsim_now_s();
-      st = nav_sim_covariance(sim, stream_cov, &es);
+      st = es.keep_points ? nav_sim_covariance_total(sim, stream_cov_total, &es)
+                          : nav_sim_covariance(sim, stream_cov, &es);
       if (st == NAV_OK || st == NAV_ERR_CANCELLED) flush_batch(&es);
       t_cov = navsim_now_s() - tc;
     }
@@ -630,7 +647,7 @@ int navsim_estimate(int argc, char **argv) {
     for (size_t q = 0; q < N_SHOW; ++q)
       es.show_i[q] = nt;
     for (size_t i = 0; i < nt; ++i)
-      if (!stream_epoch(&es, NULL)) break;
+      if (!stream_epoch(&es, NULL, NULL)) break;
     flush_batch(&es);
     if (es.st != NAV_OK) {
       fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(es.st));
@@ -661,7 +678,7 @@ int navsim_estimate(int argc, char **argv) {
       st = job.st;
     } else {
       st = !have_cov       ? nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred)
-           : es.keep_points ? nav_req_predict_scene_points_threads(&sc, es.pts, es.npts, (int)threads, pred)
+           : es.keep_points ? nav_req_predict_scene_total_points_threads(&sc, es.pts, es.npts, (int)threads, pred)
                             : nav_req_predict_scene_threads(&sc, (int)threads, pred);
     }
     if (st != NAV_OK) {
