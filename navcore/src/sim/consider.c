@@ -15,7 +15,21 @@
 #include "sim/consider_internal.h"
 
 #define NMAX NAV_FILTER_MAX_STATES
-#define NS 6 /* consider states: gyro scale factors x, y, z, then accelerometer ones */
+#define NS 6  /* consider states: gyro scale factors x, y, z, then accelerometer ones */
+#define LDS 8 /* row stride of S and its products: two zero columns, so the rows vectorise */
+#if defined(__GNUC__) && !defined(__clang__)
+#define UNROLL_LDS _Pragma("GCC unroll 8")
+#else
+#define UNROLL_LDS
+#endif
+/* As the filter's kernels (ekf.c): also an AVX2 clone picked at load time on x86-64, the same
+ * elementwise multiplies and adds (no FMA), so the same values on every machine. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(__SANITIZE_THREAD__)
+#define CONSIDER_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CONSIDER_CLONES
+#endif
 
 static nav_vec3 sq3(nav_vec3 v) { return nav_vec3_make(v.x * v.x, v.y * v.y, v.z * v.z); }
 static double vmax3(nav_vec3 v) { return fmax(fmax(v.x, v.y), v.z); }
@@ -59,7 +73,7 @@ struct nav_consider {
   unsigned decimation;
   double proc_diag[NMAX]; /* F diagonal of the consider layout's sensor blocks */
   double pss[NS];         /* variances of the consider states (constant: never updated) */
-  double S[NMAX * NS];    /* sensitivity of the navigation states to the consider states */
+  double S[NMAX * LDS];    /* sensitivity of the navigation states to the consider states */
   interval iv;
   double F[NMAX * NMAX]; /* the navigation filter's F (nr x nr) */
   double A[NMAX * NMAX]; /* A_xx = F T (nr x nr); zero outside its pattern */
@@ -173,7 +187,7 @@ static void put_block(double *a, size_t w, size_t r, size_t c, nav_mat3 b, doubl
  * A_xx is the navigation filter's F T (its layout's F at the interval means, with the blocks
  * linear in C_b_n from the interval sums, as ekf.c pending_integrals); A_xs has only the blocks
  * C diag(f) T (dv by s_a) and -C diag(w) T (phi by s_g), the interval sums Cf_T and Cw_T. */
-static void step(nav_consider *k) {
+CONSIDER_CLONES static void step(nav_consider *k) {
   const interval *iv = &k->iv;
   const size_t nr = k->nr;
   const double T = iv->T;
@@ -197,29 +211,31 @@ static void step(nav_consider *k) {
   put_block(k->A, nr, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_BA, iv->C_T, 1.0);
   put_block(k->A, nr, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_BG, iv->C_T, -1.0);
   /* U = A_xx S + A_xs over the non-zeros of A_xx (about a third of it). */
-  double U[NMAX * NS];
+  double U[NMAX * LDS];
   for (size_t i = 0; i < nr; ++i) {
-    double u[NS] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    double u[LDS] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     for (size_t e = k->row[i]; e < k->row[i + 1]; ++e) {
       const size_t j = k->nz[e] - i * nr;
       const double aij = k->A[k->nz[e]];
-      for (size_t a = 0; a < NS; ++a) u[a] += aij * k->S[j * NS + a];
+      UNROLL_LDS
+      for (size_t a = 0; a < LDS; ++a) u[a] += aij * k->S[j * LDS + a];
     }
-    for (size_t a = 0; a < NS; ++a) U[i * NS + a] = u[a];
+    for (size_t a = 0; a < LDS; ++a) U[i * LDS + a] = u[a];
   }
   for (size_t i = 0; i < 3; ++i)
     for (size_t j = 0; j < 3; ++j) {
-      U[(NAV_FILTER_IDX_DV + i) * NS + 3 + j] += iv->Cf_T.m[i][j];
-      U[(NAV_FILTER_IDX_PHI + i) * NS + j] -= iv->Cw_T.m[i][j];
+      U[(NAV_FILTER_IDX_DV + i) * LDS + 3 + j] += iv->Cf_T.m[i][j];
+      U[(NAV_FILTER_IDX_PHI + i) * LDS + j] -= iv->Cw_T.m[i][j];
     }
   for (size_t i = 0; i < nr; ++i) {
-    double au[NS] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    double au[LDS] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     for (size_t e = k->row[i]; e < k->row[i + 1]; ++e) {
       const size_t j = k->nz[e] - i * nr;
       const double aij = k->A[k->nz[e]];
-      for (size_t a = 0; a < NS; ++a) au[a] += aij * U[j * NS + a];
+      UNROLL_LDS
+      for (size_t a = 0; a < LDS; ++a) au[a] += aij * U[j * LDS + a];
     }
-    for (size_t a = 0; a < NS; ++a) k->S[i * NS + a] += U[i * NS + a] + 0.5 * au[a];
+    for (size_t a = 0; a < LDS; ++a) k->S[i * LDS + a] += U[i * LDS + a] + 0.5 * au[a];
   }
   memset(&k->iv, 0, sizeof k->iv);
 }
@@ -244,7 +260,7 @@ nav_status nav_consider_update(nav_consider *c, const double *P, const nav_filte
     nav_filter_build_H_pos(c->Hc, &c->lay_c, nav, l_ba_b_m);
   /* The filter's gain K = P H^T (H P H^T + R)^-1 (nr x 3), H its own rows (the navigation
    * columns of the consider layout's H). */
-  double Hx[3 * NMAX], PHt[NMAX * 3], Sm[9], L[9], K[NMAX * 3], M[3 * NS];
+  double Hx[3 * NMAX], PHt[NMAX * 3], Sm[9], L[9], K[NMAX * 3], M[3 * LDS];
   for (size_t q = 0; q < 3; ++q)
     for (size_t i = 0; i < nr; ++i) Hx[q * nr + i] = c->Hc[q * nc + c->col[i]];
   for (size_t i = 0; i < nr; ++i)
@@ -279,12 +295,12 @@ nav_status nav_consider_update(nav_consider *c, const double *P, const nav_filte
   for (size_t q = 0; q < 3; ++q)
     for (size_t a = 0; a < NS; ++a) {
       double s = c->Hc[q * nc + NAV_FILTER_IDX_SG + a];
-      for (size_t j = 0; j < nr; ++j) s += Hx[q * nr + j] * c->S[j * NS + a];
-      M[q * NS + a] = s;
+      for (size_t j = 0; j < nr; ++j) s += Hx[q * nr + j] * c->S[j * LDS + a];
+      M[q * LDS + a] = s;
     }
   for (size_t i = 0; i < nr; ++i)
     for (size_t a = 0; a < NS; ++a)
-      c->S[i * NS + a] -= K[i * 3] * M[a] + K[i * 3 + 1] * M[NS + a] + K[i * 3 + 2] * M[2 * NS + a];
+      c->S[i * LDS + a] -= K[i * 3] * M[a] + K[i * 3 + 1] * M[LDS + a] + K[i * 3 + 2] * M[2 * LDS + a];
   return NAV_OK;
 }
 
@@ -292,7 +308,7 @@ void nav_consider_total_diag(const nav_consider *c, const double *P, size_t m, d
   const size_t nr = c->nr;
   for (size_t i = 0; i < m && i < nr; ++i) {
     double s = 0.0;
-    for (size_t a = 0; a < NS; ++a) s += c->S[i * NS + a] * c->S[i * NS + a] * c->pss[a];
+    for (size_t a = 0; a < NS; ++a) s += c->S[i * LDS + a] * c->S[i * LDS + a] * c->pss[a];
     diag[i] = P[i * nr + i] + s;
   }
 }
