@@ -71,9 +71,9 @@ struct nav_consider {
   size_t nr;                      /* navigation states */
   size_t col[NMAX];               /* column of navigation state i in the consider layout */
   unsigned decimation;
-  double proc_diag[NMAX]; /* F diagonal of the consider layout's sensor blocks */
+  double proc_diag[NMAX]; /* F diagonal of the navigation filter's sensor blocks */
   double pss[NS];         /* variances of the consider states (constant: never updated) */
-  double S[NMAX * LDS];    /* sensitivity of the navigation states to the consider states */
+  double S[NMAX * LDS];   /* sensitivity of the navigation states to the consider states */
   interval iv;
   double F[NMAX * NMAX]; /* the navigation filter's F (nr x nr) */
   double A[NMAX * NMAX]; /* A_xx = F T (nr x nr); zero outside its pattern */

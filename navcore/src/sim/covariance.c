@@ -172,15 +172,21 @@ static nav_status consider_update(nav_sim *sim, cov_filter *c, nav_consider *k, 
                                   nav_vec3 rp, nav_vec3 rv, nav_vec3 l) {
   nav_status st = nav_filter_flush(c->kf);
   nav_consider_flush(k);
+  const size_t n = nav_filter_get_layout(c->kf).n_states;
+  double P[NAV_FILTER_MAX_STATES * NAV_FILTER_MAX_STATES];
   for (int u = 0; u < 2 && st == NAV_OK; ++u) {
     const nav_vec3 r = u ? rv : rp;
-    st = nav_consider_update(k, nav_filter_get_cov(c->kf), nv, l, r, u == 1);
+    /* The filter first, so that its failure is reported as without the consider part; the
+     * consider part's gain from the filter's covariance before this update. */
+    memcpy(P, nav_filter_get_cov(c->kf), n * n * sizeof *P);
+    st = u ? nav_filter_update_gnss_vel(c->kf, nv, nav_vec3_zero(), &r, l)
+           : nav_filter_update_gnss_pos(c->kf, nv, nav_vec3_zero(), &r, l);
+    if (st != NAV_OK) break;
+    st = nav_consider_update(k, P, nv, l, r, u == 1);
     if (st != NAV_OK) {
       nav_sim_set_error(sim, "consider states: the innovation covariance is not positive definite");
       return st;
     }
-    st = u ? nav_filter_update_gnss_vel(c->kf, nv, nav_vec3_zero(), &r, l)
-           : nav_filter_update_gnss_pos(c->kf, nv, nav_vec3_zero(), &r, l);
   }
   if (st != NAV_OK) nav_sim_set_error(sim, cf_error(c));
   return st;
