@@ -70,9 +70,10 @@ static const char *k_usage_estimate =
     "options:\n"
     "  --allow-large  go ahead above the limits below\n"
     "  --threads N    threads (default one per idle core: the cores less the load average, at\n"
-    "                 least one): the requirements' own covariance analysis runs\n"
-    "                 beside the one of estimate.csv, and the quantile statistics share out their\n"
-    "                 quadrature; the outputs are bit-identical for any N\n"
+    "                 least one): the quantile statistics share out their quadrature, and with\n"
+    "                 PVT fixes (whose requirements need a covariance analysis of their own; the\n"
+    "                 other scenes get theirs from the one of estimate.csv) that analysis runs\n"
+    "                 beside the one of estimate.csv; the outputs are bit-identical for any N\n"
     "  --no-csv       write estimate.json and summary.json only, without estimate.csv (what\n"
     "                 navsim serve's POST /api/estimate answers with); the same values\n"
     "\n" NAV_LIMITS_HELP "\n"
@@ -266,30 +267,64 @@ static int header_columns(const est_ctx *c) {
   return n;
 }
 
+/* A row of estimate.csv built in memory: numbers as printf's "%.17g" (nav_format_g17, the same
+ * bytes at a fraction of the cost: formatting was a seventh of ship's estimate), flags as "%d". */
+typedef struct row_buf {
+  char s[(NAV_FORMAT_G17_SIZE + 1) * (32 + 3 * NAV_ANALYTIC_TERM_COUNT)];
+  size_t n;
+} row_buf;
+
+static void put_g(row_buf *b, double x) {
+  if (b->n) b->s[b->n++] = ',';
+  b->n += (size_t)nav_format_g17(b->s + b->n, x);
+}
+static void put_flag(row_buf *b, bool v) {
+  b->s[b->n++] = ',';
+  b->s[b->n++] = v ? '1' : '0';
+}
+
 /* One row of estimate.csv (cov NULL: empty covariance columns). */
 static void write_row(FILE *f, const est_ctx *c, const est_epoch *e, const nav_cov_point *p) {
   const nav_analytic_estimate_point *a = &e->ana;
-  fprintf(f, "%.17g,%.17g,%.17g,%.17g,%d", e->t_s, a->gyro_ins.pos_sd_m, a->gyro_ins.vel_sd_mps,
-          a->gyro_ins.att_sd_rad, a->gyro_ins_short_time_ok ? 1 : 0);
+  row_buf b;
+  b.n = 0;
+  put_g(&b, e->t_s);
+  put_g(&b, a->gyro_ins.pos_sd_m);
+  put_g(&b, a->gyro_ins.vel_sd_mps);
+  put_g(&b, a->gyro_ins.att_sd_rad);
+  put_flag(&b, a->gyro_ins_short_time_ok);
   if (p) {
-    fprintf(f, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", p->pos_sd_n_m.x,
-            p->pos_sd_n_m.y, p->pos_sd_n_m.z, p->pos_h_sd_m, p->vel_sd_n_mps.x, p->vel_sd_n_mps.y,
-            p->vel_sd_n_mps.z, p->att_sd_rad.x, p->att_sd_rad.y, p->att_sd_rad.z);
+    const double v[10] = {p->pos_sd_n_m.x,   p->pos_sd_n_m.y,   p->pos_sd_n_m.z,   p->pos_h_sd_m,
+                          p->vel_sd_n_mps.x, p->vel_sd_n_mps.y, p->vel_sd_n_mps.z, p->att_sd_rad.x,
+                          p->att_sd_rad.y,   p->att_sd_rad.z};
+    for (int i = 0; i < 10; ++i) put_g(&b, v[i]);
   } else {
-    fputs(",,,,,,,,,,", f);
+    memcpy(b.s + b.n, ",,,,,,,,,,", 10);
+    b.n += 10;
   }
-  fprintf(f, ",%.17g,%.17g,%.17g,%d", sqrt(2.0) * a->gyro_ins.pos_sd_m, sqrt(2.0) * a->gyro_ins.vel_sd_mps,
-          e->pos_v_m, e->t_s < c->t_v_max_s ? 1 : 0);
-  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q)
-    fprintf(f, ",%.17g,%.17g,%.17g", e->tab.term[q].pos_m, e->tab.term[q].vel_mps, e->tab.term[q].att_rad);
-  if (c->acfg.with_gyrofree)
-    fprintf(f, ",%.17g,%.17g,%.17g,%d,%.17g", a->gyrofree.pos_sd_m, a->gyrofree.vel_sd_mps,
-            a->gyrofree.att_sd_rad, a->gyrofree_small_angle_ok ? 1 : 0, a->gyrofree_paper_pos_m);
+  put_g(&b, sqrt(2.0) * a->gyro_ins.pos_sd_m);
+  put_g(&b, sqrt(2.0) * a->gyro_ins.vel_sd_mps);
+  put_g(&b, e->pos_v_m);
+  put_flag(&b, e->t_s < c->t_v_max_s);
+  for (int q = 0; q < NAV_ANALYTIC_TERM_COUNT; ++q) {
+    put_g(&b, e->tab.term[q].pos_m);
+    put_g(&b, e->tab.term[q].vel_mps);
+    put_g(&b, e->tab.term[q].att_rad);
+  }
+  if (c->acfg.with_gyrofree) {
+    put_g(&b, a->gyrofree.pos_sd_m);
+    put_g(&b, a->gyrofree.vel_sd_mps);
+    put_g(&b, a->gyrofree.att_sd_rad);
+    put_flag(&b, a->gyrofree_small_angle_ok);
+    put_g(&b, a->gyrofree_paper_pos_m);
+  }
   if (c->schuler) {
     const nav_analytic_schuler_error se = schuler_sd(&c->acfg.imu, c->schuler_r, e->t_s);
-    fprintf(f, ",%.17g,%.17g", se.pos_m, se.vel_mps);
+    put_g(&b, se.pos_m);
+    put_g(&b, se.vel_mps);
   }
-  fputc('\n', f);
+  b.s[b.n++] = '\n';
+  fwrite(b.s, 1, b.n, f);
 }
 
 /* The rows of estimate.csv as they are computed: a batch of epochs (with their covariance points
@@ -311,8 +346,8 @@ typedef struct est_stream {
   nav_cov_point cov_last;         /* covariance of the last epoch received */
   size_t show_i[N_SHOW];          /* first epoch at or after each read-out time; nt: none yet */
   nav_cov_point show_cov[N_SHOW]; /* its covariance */
-  /* Every covariance point, kept when the requirements are predicted from this very analysis
-   * (nav_req_predict_scene_uses_sim_covariance): nav_req_predict_scene would run it again. */
+  /* Every total-model point (nav_sim_covariance_total), kept when the requirements are predicted
+   * from this very analysis: nav_req_predict_scene would run it again. */
   bool keep_points;
   nav_cov_point *pts;
   size_t npts, pts_cap;
@@ -330,8 +365,9 @@ static bool flush_batch(est_stream *s) {
   return true;
 }
 
-/* Epoch s->n (its covariance point @p p, or NULL). */
-static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
+/* Epoch s->n (its covariance point @p p, or NULL; @p keep: the point the requirements are
+ * predicted from, kept when s->keep_points). */
+static bool stream_epoch(est_stream *s, const nav_cov_point *p, const nav_cov_point *keep) {
   const size_t i = s->n++;
   const double t = epoch_time(s->c, i);
   s->batch[s->nb].t_s = t;
@@ -339,7 +375,7 @@ static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
     s->cov[s->nb] = *p;
     s->hmax = fmax(s->hmax, p->pos_h_sd_m);
     s->cov_last = *p;
-    if (s->keep_points) {
+    if (s->keep_points && keep) {
       if (s->npts == s->pts_cap) {
         const size_t nc = s->pts_cap ? 2 * s->pts_cap : 1024;
         nav_cov_point *g = realloc(s->pts, nc * sizeof *g);
@@ -350,7 +386,7 @@ static bool stream_epoch(est_stream *s, const nav_cov_point *p) {
         s->pts = g;
         s->pts_cap = nc;
       }
-      s->pts[s->npts++] = *p;
+      s->pts[s->npts++] = *keep;
     }
   }
   for (size_t q = 0; q < N_SHOW; ++q)
@@ -368,7 +404,18 @@ static nav_callback_result stream_cov(void *user, const nav_cov_point *p) {
     s->n = s->c->nt + 1;
     return NAV_STOP;
   }
-  return stream_epoch(s, p) ? NAV_CONTINUE : NAV_STOP;
+  return stream_epoch(s, p, p) ? NAV_CONTINUE : NAV_STOP;
+}
+
+/* nav_sim_covariance_total: the filter's point into the rows, the total model's kept for the
+ * requirements. */
+static nav_callback_result stream_cov_total(void *user, const nav_cov_point *p, const nav_cov_point *total) {
+  est_stream *s = user;
+  if (s->n >= s->c->nt) {
+    s->n = s->c->nt + 1;
+    return NAV_STOP;
+  }
+  return stream_epoch(s, p, total) ? NAV_CONTINUE : NAV_STOP;
 }
 
 /* The requirements predicted by their own covariance analysis (nav_req_predict_scene_threads),
@@ -596,7 +643,11 @@ int navsim_estimate(int argc, char **argv) {
   if (sc.earth.model == NAV_EARTH_WGS84) {
     st = nav_sim_create(&sc, &sim);
     es.with_cov = true;
-    es.keep_points = sc.n_requirements > 0 && nav_req_predict_scene_uses_sim_covariance(&sc);
+    /* The requirements' covariance model (nav_req_predict_scene: the filter, plus the truth's
+     * scale factors the filter does not estimate as consider states) comes out of this very
+     * analysis (nav_sim_covariance_total), except for PVT fixes, whose budget model is not the
+     * filter's: there it runs on its own, beside this one when there is a second thread. */
+    es.keep_points = sc.n_requirements > 0 && !nav_scene_gnss_pvt_fixes(&sc);
     if (st == NAV_OK && sc.n_requirements > 0 && !es.keep_points && threads > 1) {
       /* The requirements' own analysis beside this one (used when this one covers the epochs). */
       job.out = calloc((size_t)sc.n_requirements, sizeof *job.out);
@@ -604,7 +655,8 @@ int navsim_estimate(int argc, char **argv) {
     }
     if (st == NAV_OK) {
       const double tc = navsim_now_s();
-      st = nav_sim_covariance(sim, stream_cov, &es);
+      st = es.keep_points ? nav_sim_covariance_total(sim, stream_cov_total, &es)
+                          : nav_sim_covariance(sim, stream_cov, &es);
       if (st == NAV_OK || st == NAV_ERR_CANCELLED) flush_batch(&es);
       t_cov = navsim_now_s() - tc;
     }
@@ -630,7 +682,7 @@ int navsim_estimate(int argc, char **argv) {
     for (size_t q = 0; q < N_SHOW; ++q)
       es.show_i[q] = nt;
     for (size_t i = 0; i < nt; ++i)
-      if (!stream_epoch(&es, NULL)) break;
+      if (!stream_epoch(&es, NULL, NULL)) break;
     flush_batch(&es);
     if (es.st != NAV_OK) {
       fprintf(stderr, "navsim estimate: analytic estimate failed: %s\n", nav_status_str(es.st));
@@ -661,7 +713,7 @@ int navsim_estimate(int argc, char **argv) {
       st = job.st;
     } else {
       st = !have_cov       ? nav_req_predict(sc.requirements, sc.n_requirements, NULL, 0, NULL, 0, pred)
-           : es.keep_points ? nav_req_predict_scene_points_threads(&sc, es.pts, es.npts, (int)threads, pred)
+           : es.keep_points ? nav_req_predict_scene_total_points_threads(&sc, es.pts, es.npts, (int)threads, pred)
                             : nav_req_predict_scene_threads(&sc, (int)threads, pred);
     }
     if (st != NAV_OK) {

@@ -333,6 +333,19 @@ NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_threads(const struct nav_
 NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_points_threads(const struct nav_scene *scene,
                                                                       const struct nav_cov_point *pts, size_t npts,
                                                                       int threads, nav_requirement_verdict *out);
+/**
+ * nav_req_predict_scene from the total points of nav_sim_covariance_total() for @p scene, already
+ * computed (every point it gave, in order): the same checks and outages, and the verdicts of
+ * nav_req_predict_scene to rounding for free_ins and ins_gnss (there the total model's consider
+ * part is carried beside the filter instead of in a second, larger filter; docs/estimate-speed.md
+ * gives the measured differences), bit for bit for the schemes of
+ * nav_req_predict_scene_uses_sim_covariance(). @p threads as nav_req_predict_threads.
+ * @return as nav_req_predict_scene.
+ */
+NAV_API NAV_NODISCARD nav_status nav_req_predict_scene_total_points_threads(const struct nav_scene *scene,
+                                                                            const struct nav_cov_point *pts,
+                                                                            size_t npts, int threads,
+                                                                            nav_requirement_verdict *out);
 
 NAV_END_DECLS
 

@@ -190,6 +190,21 @@ typedef nav_callback_result (*nav_cov_fn)(void *user, const nav_cov_point *p);
  */
 NAV_API NAV_NODISCARD nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user);
 
+/** An output epoch of nav_sim_covariance_total(): the filter's point and the total model's. */
+typedef nav_callback_result (*nav_cov_total_fn)(void *user, const nav_cov_point *filter, const nav_cov_point *total);
+
+/**
+ * nav_sim_covariance() (the same @p filter points, bit for bit) and, in the same pass, the
+ * total model the requirements are predicted from (nav_budget.h, nav_req_predict_scene()): for
+ * free_ins and ins_gnss, the filter plus the truth's scale factors the filter does not estimate
+ * as consider states, carried as their sensitivity beside the filter (docs/estimate-speed.md;
+ * the same covariance as the budget's larger filter, to rounding); for the other schemes the
+ * filter's own points. WGS-84 scenes, second-order discretisation when there are consider states.
+ * @return as nav_sim_covariance(); NAV_ERR_INVALID_ARG also for ins_gnss with PVT fixes
+ *         (gnss.constellation.fixes: pvt), whose budget model is not the filter's.
+ */
+NAV_API NAV_NODISCARD nav_status nav_sim_covariance_total(nav_sim *sim, nav_cov_total_fn fn, void *user);
+
 /**
  * Attach recorded GNSS fixes (scene gnss.file) to a simulation: the INS/GNSS and gyro-free/GNSS
  * runs then apply these fixes instead of the receiver model's, each at the IMU epoch nearest its

@@ -17,6 +17,7 @@
 #include "navcore/nav_ins_gnss.h"
 #include "navcore/nav_truth.h"
 #include "requirements/budget_internal.h"
+#include "sim/consider_internal.h"
 #include "sim/sim_internal.h"
 
 #define NMAX NAV_FILTER_MAX_STATES
@@ -116,12 +117,7 @@ static r_split split_r(const nav_gnss_model_config *g, const nav_ins_gnss_config
 }
 
 /* Scale-factor variance of the truth per axis (sd^2 + fixed^2), gyro (a = false) or accel. */
-static nav_vec3 sf_var(const nav_scene *sc, bool accel) {
-  const unsigned terms = accel ? sc->imu.model.accel.terms : sc->imu.model.gyro.terms;
-  if (!(terms & NAV_IMU_TERM_SCALE_FACTOR)) return nav_vec3_zero();
-  return accel ? nav_vec3_add(sq3(sc->imu.model.accel.scale_factor_sd), sq3(sc->imu.model.accel.scale_factor_fixed))
-               : nav_vec3_add(sq3(sc->imu.model.gyro.scale_factor_sd), sq3(sc->imu.model.gyro.scale_factor_fixed));
-}
+static nav_vec3 sf_var(const nav_scene *sc, bool accel) { return nav_consider_sf_var(sc, accel); }
 
 /* P0 diagonal and process noise of source s; false when the source is absent. */
 static bool source_input(const nav_scene *sc, const nav_filter_config *c, const nav_filter_layout *lay, int s,
@@ -406,19 +402,8 @@ nav_status nav_budget_run(const nav_scene *sc, bool sources, nav_budget_fn fn, v
   const nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
   const nav_filter_config cr = xc.filter; /* the navigation filter: its gains */
   /* Scale factors of the truth that the filter does not estimate: consider states. */
-  nav_filter_config c = cr;
-  const bool consider = (vmax3(sf_var(sc, false)) > 0.0 || vmax3(sf_var(sc, true)) > 0.0) &&
-                        !(cr.states & NAV_FILTER_STATE_SCALE_FACTORS);
-  if (consider) {
-    c.states |= NAV_FILTER_STATE_SCALE_FACTORS;
-    c.gyro_sf_terms = 0u; /* random constants */
-    c.accel_sf_terms = 0u;
-    const nav_vec3 vg = sf_var(sc, false), va = sf_var(sc, true);
-    for (int i = 0; i < 3; ++i) {
-      nav_vec3_set(&c.init.gyro_sf_sd, i, fmax(sqrt(nav_vec3_get(vg, i)), 1e-9));
-      nav_vec3_set(&c.init.accel_sf_sd, i, fmax(sqrt(nav_vec3_get(va, i)), 1e-9));
-    }
-  }
+  nav_filter_config c;
+  const bool consider = nav_consider_config(sc, &cr, &c);
   nav_filter *kref = NULL; /* consider mode: the navigation filter itself, for the gains */
   nav_gnss_model_config gcfg;
   st = nav_sim_gnss_config(sc, 1.0 / sc->imu.rate_hz, &gcfg, m2, sizeof m2);

@@ -1124,6 +1124,16 @@ nav_status nav_req_predict_scene_points_threads(const nav_scene *scene, const na
   return nav_req_predict_threads(scene->requirements, scene->n_requirements, pts, npts, iv, ni, threads, out);
 }
 
+nav_status nav_req_predict_scene_total_points_threads(const nav_scene *scene, const nav_cov_point *pts, size_t npts,
+                                                      int threads, nav_requirement_verdict *out) {
+  if (npts > 0 && !pts) return NAV_ERR_INVALID_ARG;
+  nav_req_interval iv[NAV_REQ_MAX_OUTAGES];
+  int ni = 0;
+  const nav_status st = predict_scene_begin(scene, out, iv, &ni);
+  if (st != NAV_OK) return st;
+  return nav_req_predict_threads(scene->requirements, scene->n_requirements, pts, npts, iv, ni, threads, out);
+}
+
 nav_status nav_req_predict_scene(const nav_scene *scene, nav_requirement_verdict *out) {
   return nav_req_predict_scene_threads(scene, 1, out);
 }

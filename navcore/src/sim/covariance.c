@@ -14,6 +14,7 @@
 #include "navcore/nav_truth.h"
 #include "filter/filter_internal.h"
 #include "integration/ins_gnss_internal.h"
+#include "sim/consider_internal.h"
 #include "sim/sim_internal.h"
 
 static bool in_outage(const nav_gnss_model_config *g, double t) {
@@ -140,8 +141,58 @@ static nav_status pvt_update(nav_filter *kf, const nav_scene *sc, const nav_gnss
   return st;
 }
 
-nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
-  if (!sim || !fn) return NAV_ERR_INVALID_ARG;
+/* Where the output epochs go: the filter's points (fn), or those and the budget's total model
+ * (tfn, nav_sim_covariance_total). */
+typedef struct cov_sink {
+  nav_cov_fn fn;
+  nav_cov_total_fn tfn;
+  void *user;
+} cov_sink;
+
+/* The point of the total model: the filter's, plus the consider part when there is one. */
+static nav_callback_result emit(const cov_sink *s, const nav_cov_point *p, const cov_filter *cf,
+                                const nav_consider *k) {
+  if (s->fn) return s->fn(s->user, p);
+  if (!k) return s->tfn(s->user, p, p);
+  double v[9];
+  nav_consider_total_diag(k, nav_filter_get_cov(cf->kf), 9, v);
+  nav_cov_point q;
+  memset(&q, 0, sizeof q);
+  q.t_s = p->t_s;
+  q.pos_sd_n_m = nav_vec3_make(sqrt(v[0]), sqrt(v[1]), sqrt(v[2]));
+  q.pos_h_sd_m = hypot(q.pos_sd_n_m.x, q.pos_sd_n_m.y);
+  q.vel_sd_n_mps = nav_vec3_make(sqrt(v[3]), sqrt(v[4]), sqrt(v[5]));
+  q.att_sd_rad = nav_vec3_make(sqrt(v[6]), sqrt(v[7]), sqrt(v[8]));
+  return s->tfn(s->user, p, &q);
+}
+
+/* The GNSS position and velocity updates of the gyro INS filter with the consider part
+ * following each (its gain from the filter's covariance before that update). */
+static nav_status consider_update(nav_sim *sim, cov_filter *c, nav_consider *k, const nav_filter_nav *nv,
+                                  nav_vec3 rp, nav_vec3 rv, nav_vec3 l) {
+  nav_status st = nav_filter_flush(c->kf);
+  nav_consider_flush(k);
+  const size_t n = nav_filter_get_layout(c->kf).n_states;
+  double P[NAV_FILTER_MAX_STATES * NAV_FILTER_MAX_STATES];
+  for (int u = 0; u < 2 && st == NAV_OK; ++u) {
+    const nav_vec3 r = u ? rv : rp;
+    /* The filter first, so that its failure is reported as without the consider part; the
+     * consider part's gain from the filter's covariance before this update. */
+    memcpy(P, nav_filter_get_cov(c->kf), n * n * sizeof *P);
+    st = u ? nav_filter_update_gnss_vel(c->kf, nv, nav_vec3_zero(), &r, l)
+           : nav_filter_update_gnss_pos(c->kf, nv, nav_vec3_zero(), &r, l);
+    if (st != NAV_OK) break;
+    st = nav_consider_update(k, P, nv, l, r, u == 1);
+    if (st != NAV_OK) {
+      nav_sim_set_error(sim, "consider states: the innovation covariance is not positive definite");
+      return st;
+    }
+  }
+  if (st != NAV_OK) nav_sim_set_error(sim, cf_error(c));
+  return st;
+}
+
+static nav_status cov_run(nav_sim *sim, const cov_sink *sink) {
   const nav_scene *sc = nav_sim_scene(sim);
   if (sc->earth.model != NAV_EARTH_WGS84) {
     nav_sim_set_error(sim, "covariance analysis needs the wgs84 Earth model (the error model is the NED one)");
@@ -155,6 +206,7 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
   const bool gfg = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   nav_truth *truth = NULL;
   cov_filter cf = {NULL, NULL};
+  nav_consider *cons = NULL; /* the total model's consider part (nav_sim_covariance_total) */
   char msg[200];
   nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
   if (st != NAV_OK) {
@@ -199,8 +251,25 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
       goto cleanup;
     }
   }
+  /* The total model's consider part (nav_sim_covariance_total): the truth's scale factors the
+   * gyro INS filter does not estimate, as the budget has them (ins_gnss with the receiver's
+   * fixes, free_ins); the other schemes' total is their filter. */
+  if (sink->tfn && !gfg && !tight) {
+    if (pvt) {
+      nav_sim_set_error(sim, "the total covariance model is the budget's, which has no PVT fixes "
+                             "(gnss.constellation.fixes: pvt)");
+      st = NAV_ERR_INVALID_ARG;
+      goto cleanup;
+    }
+    st = nav_consider_create(sc, &xc.filter, &cons);
+    if (st != NAV_OK) {
+      nav_sim_set_error(sim, st == NAV_ERR_NO_MEMORY ? "out of memory"
+                                                     : "consider states need the second-order discretisation");
+      goto cleanup;
+    }
+  }
   nav_cov_point p0 = make_point(0.0, &cf);
-  if (fn(user, &p0) == NAV_STOP) goto cleanup;
+  if (emit(sink, &p0, &cf, cons) == NAV_STOP) goto cleanup;
   for (int64_t k = 1; k <= n; ++k) {
     nav_imu_increment imu;
     nav_traj_state ts;
@@ -219,6 +288,7 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
       nav_sim_set_error(sim, cf_error(&cf));
       goto cleanup;
     }
+    if (cons) nav_consider_predict(cons, &nv, imu.dt_s);
     while (gnss) {
       const double t_fix = (double)next_epoch / g->update_rate_hz;
       if (!(t_fix <= imu.t_s + 0.5 * dt)) break;
@@ -254,6 +324,11 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
         nav_vec3_set(&rp, i, sp * sp);
         nav_vec3_set(&rv, i, sv * sv);
       }
+      if (cons) {
+        st = consider_update(sim, &cf, cons, &nv, rp, rv, g->r_ba_b_m);
+        if (st != NAV_OK) goto cleanup;
+        continue;
+      }
       st = cf_update(&cf, &nv, rp, rv, g->r_ba_b_m);
       if (st != NAV_OK) {
         nav_sim_set_error(sim, cf_error(&cf));
@@ -263,16 +338,30 @@ nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
     if (k % out_stride == 0 || k == n) {
       st = cf.kf ? nav_filter_flush(cf.kf) : NAV_OK;
       if (st != NAV_OK) goto cleanup;
+      if (cons) nav_consider_flush(cons);
       nav_cov_point p = make_point(imu.t_s, &cf);
-      if (fn(user, &p) == NAV_STOP) {
+      if (emit(sink, &p, &cf, cons) == NAV_STOP) {
         st = NAV_ERR_CANCELLED;
         goto cleanup;
       }
     }
   }
 cleanup:
+  nav_consider_destroy(cons);
   nav_filter_destroy(cf.kf);
   nav_gfg_filter_destroy(cf.gf);
   nav_truth_destroy(truth);
   return st;
+}
+
+nav_status nav_sim_covariance(nav_sim *sim, nav_cov_fn fn, void *user) {
+  if (!sim || !fn) return NAV_ERR_INVALID_ARG;
+  const cov_sink sink = {fn, NULL, user};
+  return cov_run(sim, &sink);
+}
+
+nav_status nav_sim_covariance_total(nav_sim *sim, nav_cov_total_fn fn, void *user) {
+  if (!sim || !fn) return NAV_ERR_INVALID_ARG;
+  const cov_sink sink = {NULL, fn, user};
+  return cov_run(sim, &sink);
 }
