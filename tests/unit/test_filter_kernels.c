@@ -11,6 +11,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -276,6 +277,160 @@ static void test_time_update_buffers_match_full_passes(void **state) {
   }
 }
 
+/* all_finite (the per-step part of the propagation guard) is false exactly when some entry is
+ * NaN or infinite, at every position, for the instantiated and the generic sizes; extreme finite
+ * values (DBL_MAX, subnormals, -0.0) are finite. */
+static void test_all_finite_every_position(void **state) {
+  (void)state;
+  static const size_t sizes[] = {3, 15, 17, 18, 21, 24};
+  const double bad[] = {NAN, INFINITY, -INFINITY};
+  const double odd[] = {DBL_MAX, -DBL_MAX, 4.9e-324, -0.0, 0.0, 2.2250738585072014e-308};
+  nav_rng r;
+  nav_rng_init(&r, SEED, 0, 7);
+  double a[NN];
+  for (size_t s = 0; s < sizeof sizes / sizeof *sizes; ++s) {
+    const size_t n = sizes[s];
+    for (size_t i = 0; i < n * n; ++i)
+      a[i] = nav_rng_gauss(&r) * 1e3;
+    for (size_t i = 0; i < n * n; ++i) a[i] = odd[i % (sizeof odd / sizeof *odd)] + (i % 7 == 0 ? a[i] : 0.0);
+    if (!all_finite(a, n)) fail_msg("n = %zu: a finite matrix reported non-finite", n);
+    for (size_t pos = 0; pos < n * n; ++pos)
+      for (size_t b = 0; b < 3; ++b) {
+        const double keep = a[pos];
+        a[pos] = bad[b];
+        if (all_finite(a, n)) fail_msg("n = %zu: %g at entry %zu not seen", n, bad[b], pos);
+        a[pos] = keep;
+      }
+  }
+}
+
+/* The sandwich computes only the columns j >= i rounded down to a multiple of 4 of Phi W^T:
+ * every entry of Pn is, bit for bit, the plain loops' value with the same order of operations
+ * (W = Phi S over the pattern, then Phi W^T + Qh), for all three padded widths. */
+static void test_sandwich_matches_plain(void **state) {
+  (void)state;
+  static const size_t sizes[] = {15, 16, 17, 18, 20, 21, 24};
+  nav_rng r;
+  nav_rng_init(&r, SEED, 0, 8);
+  static double phi[NN], sp[NN], qh[NN], pn[NN], w[NN], wt[NN], wref[NN];
+  row_pattern pt;
+  for (size_t s = 0; s < sizeof sizes / sizeof *sizes; ++s) {
+    const size_t n = sizes[s], ld = ld_of(n);
+    for (size_t rep = 0; rep < 20; ++rep) {
+      memset(phi, 0, sizeof phi);
+      memset(sp, 0, sizeof sp);
+      /* A sparse Phi with its diagonal, about a third of the entries non-zero. */
+      for (size_t i = 0; i < n; ++i) {
+        unsigned char c = 0;
+        for (size_t j = 0; j < n; ++j)
+          if (i == j || nav_rng_uniform(&r) < 0.33) {
+            phi[i * ld + j] = nav_rng_gauss(&r);
+            pt.col[i][c++] = (unsigned char)j;
+          }
+        pt.cnt[i] = c;
+      }
+      random_sym(qh, n, &r, 0.5);
+      double tmp[NN];
+      random_sym(tmp, n, &r, 1.0);
+      for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < n; ++j)
+          sp[i * ld + j] = tmp[i * n + j];
+      for (size_t i = 0; i < NN; ++i)
+        pn[i] = NAN;
+      pattern_sandwich(pn, phi, &pt, sp, qh, n, ld, w, wt);
+      for (size_t i = 0; i < n; ++i)
+        for (size_t c = 0; c < n; ++c) {
+          double v = phi[i * ld + pt.col[i][0]] * sp[pt.col[i][0] * ld + c];
+          for (unsigned p = 1; p < pt.cnt[i]; ++p)
+            v += phi[i * ld + pt.col[i][p]] * sp[pt.col[i][p] * ld + c];
+          wref[i * n + c] = v;
+        }
+      for (size_t i = 0; i < n; ++i)
+        for (size_t j = i; j < n; ++j) {
+          double v = phi[i * ld + pt.col[i][0]] * wref[j * n + pt.col[i][0]];
+          for (unsigned p = 1; p < pt.cnt[i]; ++p)
+            v += phi[i * ld + pt.col[i][p]] * wref[j * n + pt.col[i][p]];
+          v += qh[i * n + j];
+          if (memcmp(&pn[i * n + j], &v, sizeof v) != 0 || memcmp(&pn[j * n + i], &v, sizeof v) != 0)
+            fail_msg("n = %zu, rep %zu: Pn(%zu,%zu) = %.17g / %.17g, plain %.17g", n, rep, i, j, pn[i * n + j],
+                     pn[j * n + i], v);
+        }
+    }
+  }
+}
+
+/* A filter at rest at 45 deg latitude with covariance step every predict. */
+static nav_filter_nav guard_nav(void) {
+  nav_filter_nav g;
+  memset(&g, 0, sizeof g);
+  g.lat_rad = 0.785;
+  g.h_m = 100.0;
+  g.C_b_n = nav_euler_to_dcm((nav_euler){0.0, 0.0, 0.3});
+  g.f_ib_b_mps2 = nav_vec3_make(0.0, 0.0, -9.8);
+  return g;
+}
+
+/* The propagation guard: a P that is not positive definite although its diagonal is positive and
+ * every entry finite (a 3 x 3 correlation block with eigenvalue -0.8) is reported as
+ * NAV_ERR_NUMERIC by at most COV_FULL_CHECK_EVERY covariance steps, with the message of the full
+ * check, and P is left as it was; a non-finite entry or a non-positive diagonal is reported by
+ * the very next step; an update on such a P always reports it (the updated P is fully checked). */
+static void test_predict_guard_reports_lost_definiteness(void **state) {
+  (void)state;
+  const nav_filter_nav g = guard_nav();
+  for (int variant = 0; variant < 4; ++variant) {
+    nav_filter_config c = nav_filter_config_default();
+    nav_filter *f = NULL;
+    assert_int_equal(nav_filter_create(&c, &f), NAV_OK);
+    const size_t n = f->n;
+    /* Some steps with a valid P first: the counter is part of the state. */
+    for (int k = 0; k < 5; ++k)
+      assert_int_equal(nav_filter_predict(f, &g, 0.01), NAV_OK);
+    const double rho = 0.9;
+    const double blk[3][3] = {{1.0, rho, rho}, {rho, 1.0, -rho}, {rho, -rho, 1.0}};
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t j = 0; j < 3; ++j)
+        f->P[i * n + j] = blk[i][j];
+    if (variant == 1) f->P[1 * n + 7] = f->P[7 * n + 1] = NAN;
+    if (variant == 2) f->P[4 * n + 4] = -1e-3;
+    double before[NN];
+    if (variant == 3) {
+      /* A position update (H = [I 0]) on the indefinite P. */
+      double Hm[3 * NMAX];
+      memset(Hm, 0, sizeof Hm);
+      for (size_t i = 0; i < 3; ++i)
+        Hm[i * n + i] = 1.0;
+      const double z[3] = {0.1, -0.2, 0.3}, R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      memcpy(before, f->P, n * n * sizeof *before);
+      const nav_status st = nav_filter_update_linear(f, 3, Hm, z, R);
+      assert_int_equal(st, NAV_ERR_NUMERIC);
+      assert_memory_equal(before, f->P, n * n * sizeof *before);
+      nav_filter_destroy(f);
+      continue;
+    }
+    int failed_at = -1;
+    for (int k = 1; k <= (int)COV_FULL_CHECK_EVERY && failed_at < 0; ++k) {
+      memcpy(before, f->P, n * n * sizeof *before);
+      const nav_status st = nav_filter_predict(f, &g, 0.01);
+      if (st != NAV_OK) {
+        assert_int_equal(st, NAV_ERR_NUMERIC);
+        assert_memory_equal(before, f->P, n * n * sizeof *before);
+        failed_at = k;
+      }
+    }
+    print_message("[ guard    ] variant %d: reported at covariance step %d: %s\n", variant, failed_at,
+                  nav_filter_last_error(f));
+    if (failed_at < 0) fail_msg("variant %d: not reported within %u steps", variant, COV_FULL_CHECK_EVERY);
+    if (variant == 0) assert_non_null(strstr(nav_filter_last_error(f), "not positive definite"));
+    if (variant == 1) {
+      assert_int_equal(failed_at, 1);
+      assert_non_null(strstr(nav_filter_last_error(f), "not finite"));
+    }
+    if (variant == 2) assert_int_equal(failed_at, 1);
+    nav_filter_destroy(f);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chol_ok_matches_reference),
@@ -284,6 +439,9 @@ int main(void) {
       cmocka_unit_test(test_update_instantiations_bit_identical),
       cmocka_unit_test(test_gauss_streams_equal_single_draws),
       cmocka_unit_test(test_time_update_buffers_match_full_passes),
+      cmocka_unit_test(test_all_finite_every_position),
+      cmocka_unit_test(test_sandwich_matches_plain),
+      cmocka_unit_test(test_predict_guard_reports_lost_definiteness),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

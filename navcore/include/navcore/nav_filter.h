@@ -35,8 +35,12 @@
  * Measurement updates (6.4-6.5): GNSS antenna position and velocity with the lever arm, one
  * 3-vector update each (not sequential), K from a Cholesky solve with S = H P H^T + R (never an
  * explicit inverse), Joseph form (E6.5), P symmetrised after every covariance propagation and
- * update and checked by a Cholesky factorisation; any failure is NAV_ERR_NUMERIC with a message
- * and leaves x and P as they were. Nothing is clamped.
+ * update. Every updated P is proved positive definite by a Cholesky factorisation; every
+ * propagated P is checked for non-finite entries and a non-positive diagonal, and proved positive
+ * definite by the Cholesky factorisation at least every 16th covariance step (a propagation
+ * cannot make a positive definite P indefinite except by rounding, so a lost definiteness is
+ * reported at most 15 covariance steps late, or by the next update). Any failure is
+ * NAV_ERR_NUMERIC with a message and leaves x and P as they were. Nothing is clamped.
  *
  * Covariance analysis (6.6): drive the same object with the reference (true) trajectory in
  * nav_filter_nav and zero measurements; P, S and K do not depend on z. See the second example.
@@ -320,8 +324,9 @@ NAV_API nav_filter_layout nav_filter_get_layout(const nav_filter *f);
  * @param[in] dt_s interval [s], finite and > 0
  * @return NAV_OK; NAV_ERR_INVALID_ARG (NULL, dt_s <= 0); NAV_ERR_OUT_OF_RANGE (cos(lat) <
  *         1e-6: the NED model is singular at the poles); NAV_ERR_NUMERIC (a non-finite input,
- *         the matrix exponential failing, or a propagated P that is not finite or not positive
- *         definite). On error x, P and the pending accumulation are unchanged and
+ *         the matrix exponential failing, or a propagated P that is not finite, has a
+ *         non-positive diagonal entry, or, at the full check of every 16th covariance step, is
+ *         not positive definite). On error x, P and the pending accumulation are unchanged and
  *         nav_filter_last_error() says why.
  */
 NAV_API NAV_NODISCARD nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double dt_s);

@@ -11,13 +11,17 @@
  * with Q = G Q_c G^T T. The sandwich runs row-wise on zero-padded rows of 16, 20 or 24 doubles
  * (n rounded up to a multiple of 4), W = Phi S, a 4 x 4-block transpose, then the upper
  * triangle of Phi W^T, each row an unrolled multiply-add that the compiler vectorises (an AVX2
- * clone is picked at load time on x86-64; same values). Positivity is checked on every step by
- * a right-looking Cholesky on padded rows, whose success also proves P finite (chol_ok).
+ * clone is picked at load time on x86-64; same values). Every propagated P is checked for
+ * non-finite entries and a non-positive diagonal; positive definiteness is proved by a
+ * right-looking Cholesky on padded rows, whose success also proves P finite (chol_ok), on every
+ * update and on every COV_FULL_CHECK_EVERY-th covariance step in between (check_cov_predict).
  * Measured with callgrind on the Monte Carlo bench scene (18 states: the core plus three GNSS
  * error states; cov_decimation 10): 19k instructions per covariance step (sandwich 8.3k,
  * Cholesky check 6.2k, Phi 2.1k, the rest 2.5k) plus 4.8k for F and the interval sums
  * (pending_integrals); the calls in between only accumulate the sums of struct pending (~350
- * instructions with the input checks). Measurement updates (GNSS rate) use the Joseph form as
+ * instructions with the input checks). Since then the sandwich computes only the columns it
+ * keeps (7.4k) and the full Cholesky check runs on the updates and on a schedule; the per-step
+ * guard (all_finite and the diagonal) costs 0.5k (issue 23). Measurement updates (GNSS rate) use the Joseph form as
  * (A P) A^T with A = I - K H never formed, O(n^2 m), instantiated with compile-time sizes for
  * the GNSS cases: 32k instructions per 3-component update. Every one of these transformations
  * keeps the values bit for bit.
@@ -25,6 +29,7 @@
 #include <assert.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,6 +95,10 @@ struct nav_filter {
   double H[MMAX * NMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
   double xn[NMAX];
   double vl_work[VL_WORK];
+
+  /* Covariance steps since P was last proved positive definite by a full Cholesky
+   * (check_cov_predict). */
+  unsigned cov_unproved;
 
   nav_filter_innovation innov;
   char last_error[256];
@@ -329,6 +338,10 @@ NAV_KERNEL_CLONES static bool chol_ok(const double *p, size_t n, size_t ld, doub
   return chol_ok_ld(p, n, a, 24);
 }
 
+/* Covariance steps between two full positive-definiteness proofs of a propagated P (see
+ * check_cov_predict). */
+#define COV_FULL_CHECK_EVERY 16u
+
 /* Check a covariance candidate: every entry finite, Cholesky succeeds (which implies a
  * positive diagonal; numerics.md 6.5), on every call. p must be exactly symmetric (every caller
  * mirrors or symmetrises it): the Cholesky reads the upper triangle only, and its success proves
@@ -361,6 +374,64 @@ static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
             "%s: P is not positive definite: the Cholesky factorisation fails at state %zu (P(%zu,%zu) = %g)",
             what, bad, bad, bad, p[bad * n + bad]);
   return NAV_ERR_NUMERIC;
+}
+
+/* Every entry of the n x n matrix p finite: x - x is +0.0 (all bits clear) for a finite x and
+ * NaN otherwise, so the OR of the bits of p_i - p_i over the matrix is zero exactly when every
+ * entry is finite; four lanes of independent ORs (no chain of floating-point adds), vectorised.
+ * count = n * n is a compile-time constant in the instantiations. */
+static NAV_ALWAYS_INLINE bool all_finite_nn(const double *p, const size_t count) {
+  uint64_t acc[4] = {0, 0, 0, 0};
+  const size_t blocks = count / 4;
+  for (size_t q = 0; q < blocks; ++q)
+    for (size_t c = 0; c < 4; ++c) {
+      const double d = p[4 * q + c] - p[4 * q + c];
+      uint64_t b;
+      memcpy(&b, &d, sizeof b);
+      acc[c] |= b;
+    }
+  for (size_t i = 4 * blocks; i < count; ++i) {
+    const double d = p[i] - p[i];
+    uint64_t b;
+    memcpy(&b, &d, sizeof b);
+    acc[0] |= b;
+  }
+  return (acc[0] | acc[1] | acc[2] | acc[3]) == 0;
+}
+
+NAV_KERNEL_CLONES static bool all_finite(const double *p, size_t n) {
+  if (n == 15) return all_finite_nn(p, 225);
+  if (n == 18) return all_finite_nn(p, 324);
+  return all_finite_nn(p, n * n);
+}
+
+/*
+ * The guard of a propagated covariance. P+ = Phi (P + Q/2) Phi^T + Q/2 is a
+ * congruence of a positive definite matrix plus a positive semi-definite one, so in exact
+ * arithmetic it is positive definite whenever P was; in floating point it can lose that only when
+ * P is already near singular (an eigenvalue within rounding of zero relative to its norm), which
+ * the measurement updates, not the propagation, produce. So every step checks what is cheap and
+ * catches a blow-up at once (every entry finite, the diagonal positive: a necessary condition),
+ * and the full Cholesky proof runs on every COV_FULL_CHECK_EVERY-th step after the last full
+ * proof (the updates prove every P they make: do_update) and whenever the cheap test fails, where
+ * it decides and picks the message (check_cov). The checks never change a value, so a P that
+ * stays positive definite gives the same numbers as a full proof at every step; a P that lost
+ * definiteness is reported at the latest COV_FULL_CHECK_EVERY - 1 steps later, by the next
+ * scheduled proof or by the next update's. The full proof on every step cost a quarter of the
+ * covariance step.
+ */
+static nav_status check_cov_predict(nav_filter *f, const double *p) {
+  const size_t n = f->n;
+  f->cov_unproved++;
+  if (f->cov_unproved < COV_FULL_CHECK_EVERY) {
+    bool diag_ok = true;
+    for (size_t i = 0; i < n; ++i)
+      diag_ok &= p[i * (n + 1)] > 0.0;
+    if (diag_ok && all_finite(p, n)) return NAV_OK;
+  }
+  const nav_status st = check_cov(f, p, "predict");
+  if (st == NAV_OK) f->cov_unproved = 0;
+  return st;
 }
 
 /* Wt = W^T for the n x n part of padded matrices (stride LD). With GCC vector extensions: 4 x 4
@@ -403,6 +474,17 @@ static NAV_ALWAYS_INLINE void transpose_ld(double *restrict Wt, const double *re
 }
 #endif
 
+/* Columns c0 .. c0 + len - 1 of row i of Phi W^T (len = LD - c0, a compile-time constant in
+ * every call): row = sum over the pattern of Phi_ik (row k of W^T), in pattern order. */
+static NAV_ALWAYS_INLINE void upper_row(double *row, const double *phi_i, const unsigned char *col, unsigned cnt,
+                                        const double *Wt, size_t c0, const size_t LD, const size_t len) {
+  scal_fixed(row + c0, phi_i[col[0]], Wt + col[0] * LD + c0, len);
+  for (unsigned p = 1; p < cnt; ++p) {
+    const size_t k = col[p];
+    axpy_fixed(row + c0, phi_i[k], Wt + k * LD + c0, len);
+  }
+}
+
 static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
                                           const double *Qh, size_t n, double *W, double *Wt, const size_t LD) {
   for (size_t i = 0; i < n; ++i) {
@@ -418,13 +500,18 @@ static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const r
   transpose_ld(Wt, W, n, LD);
   double row[NMAX + 4];
   for (size_t i = 0; i < n; ++i) {
-    /* Full rows (only j >= i is used): a fixed width unrolls completely, which costs less than
-     * the loop control of a shorter variable-length row. */
+    /* Only j >= i is used: the row from column c0 = i rounded down to a multiple of 4, at one of
+     * the compile-time widths LD - c0 (unrolled completely; the columns below c0 were computed
+     * and discarded before). Each entry gets the same operations either way. */
     const double *phi_i = Phi + i * LD;
-    scal_fixed(row, phi_i[pt->col[i][0]], Wt + pt->col[i][0] * LD, LD);
-    for (unsigned p = 1; p < pt->cnt[i]; ++p) {
-      const size_t k = pt->col[i][p];
-      axpy_fixed(row, phi_i[k], Wt + k * LD, LD);
+    const size_t c0 = i & ~(size_t)3;
+    switch (LD - c0) {
+    case 24: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, 0, LD, 24); break;
+    case 20: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 20, LD, 20); break;
+    case 16: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 16, LD, 16); break;
+    case 12: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 12, LD, 12); break;
+    case 8: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 8, LD, 8); break;
+    default: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 4, LD, 4); break;
     }
     for (size_t j = i; j < n; ++j) {
       const double v = row[j] + Qh[i * n + j];
@@ -572,7 +659,7 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
     phi_second_order(f->Phi, f->A, &f->a_pat, n, ld);
   }
   pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt);
-  const nav_status st = check_cov(f, f->Pn, "predict");
+  const nav_status st = check_cov_predict(f, f->Pn);
   if (st != NAV_OK) return st;
   pattern_mul_vec(f->xn, f->Phi, pt, f->x, ld, n);
   memcpy(f->P, f->Pn, n * n * sizeof *f->P);
@@ -916,6 +1003,7 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
     }
   st = check_cov(f, f->Pn, what);
   if (st != NAV_OK) return st;
+  f->cov_unproved = 0;
 
   /* Commit, and keep y, S and the NIS y^T S^-1 y for consistency tests (T6.5). */
   memcpy(f->P, f->Pn, n * n * sizeof *f->P);
@@ -1099,6 +1187,7 @@ nav_status nav_filter_set_cov(nav_filter *f, const double *P) {
   nav_matn_symmetrize(f->Pn, n);
   st = check_cov(f, f->Pn, "set_cov");
   if (st != NAV_OK) return st;
+  f->cov_unproved = 0;
   memcpy(f->P, f->Pn, n * n * sizeof *P);
   return NAV_OK;
 }

@@ -37,20 +37,9 @@ static inline uint64_t rotl64(uint64_t x, int k) {
   return (x << k) | (x >> (64 - k));
 }
 
-/* One step of xoshiro256** (Blackman and Vigna's reference xoshiro256starstar.c, public domain).
- * The ** scrambler makes every output bit usable, including the low byte the ziggurat takes as
- * its layer index (the + variant's low bits would not do). */
+/* One step of xoshiro256**: nav_rng_next_inline (rng_internal.h, rotl64 written out there). */
 static inline uint64_t next_u64(nav_rng *r) {
-  uint64_t *s = r->s;
-  const uint64_t result = rotl64(s[1] * 5u, 7) * 9u;
-  const uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl64(s[3], 45);
-  return result;
+  return nav_rng_next_inline(r);
 }
 
 /* Uniform in (0, 1) on the 53-bit grid k * 2^-53, k in [1, 2^53 - 1]. Rejecting k = 0 (rather
@@ -105,8 +94,11 @@ double nav_rng_uniform(nav_rng *r) {
 
 /* ------------------------------------------------------------------------------- ziggurat */
 
-/* Number of layers. 256 gives a 98.8 % one-comparison acceptance and 4 KiB of tables. */
-#define NAV_ZIG_LAYERS 256
+/* Number of layers (NAV_RNG_ZIG_LAYERS, rng_internal.h): 256 gives a 98.8 % one-comparison
+ * acceptance and 4 KiB of tables. The edges are shared with the inline fast path of
+ * rng_internal.h as nav_rng_zig_x; this file (and its white-box test) call them zig_x. */
+#define NAV_ZIG_LAYERS NAV_RNG_ZIG_LAYERS
+#define zig_x nav_rng_zig_x
 
 /* Ziggurat for f(x) = exp(-x^2/2) on x >= 0 (Marsaglia and Tsang, J. Stat. Softw. 5(8), 2000).
  * zig_x[i] is the right edge of layer i: zig_x[0] = v / f(r) (the base layer, a rectangle of
@@ -119,7 +111,7 @@ double nav_rng_uniform(nav_rng *r) {
  * each entry rounded to nearest double and printed with 13 hex digits (so the columns line up).
  * test_rng checks these identities on the stored values. */
 
-static const double zig_x[NAV_ZIG_LAYERS + 1] = {
+const double nav_rng_zig_x[NAV_ZIG_LAYERS + 1] = {
     0x1.f493b7815d982p+1, 0x1.d3bb48209ad33p+1, 0x1.b981f3878fdb0p+1, 0x1.a8fdc78947759p+1,
     0x1.9cbee014057aap+1, 0x1.92ee0946f4496p+1, 0x1.8ab0fbfaa7c14p+1, 0x1.839030529f233p+1,
     0x1.7d42df4d6ce8bp+1, 0x1.7799556090672p+1, 0x1.72728f05f7a33p+1, 0x1.6db6b8d09e231p+1,
@@ -268,12 +260,13 @@ static double gauss_tail(nav_rng *r) {
 /* The rest of the ziggurat after a first word that was not accepted at once: the wedge test of
  * that word, the tail, and the retries with fresh words (the loop of Marsaglia and Tsang). Out of
  * line: it runs for 1.2 % of the draws, and keeping it (with its calls to exp and log) out of
- * the fast path below leaves that path without register saves or a stack frame. */
+ * the fast path (nav_rng_gauss_inline, rng_internal.h) leaves that path without register saves
+ * or a stack frame. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline))
 #endif
-static double
-gauss_slow(nav_rng *r, uint64_t bits) {
+double
+nav_rng_gauss_slow(nav_rng *r, uint64_t bits) {
   for (;;) {
     const unsigned layer = (unsigned)(bits & 0xffu);
     const double sign = 1.0 - 2.0 * (double)((bits >> 8) & 1u);
@@ -292,42 +285,13 @@ gauss_slow(nav_rng *r, uint64_t bits) {
   }
 }
 
-/* One normal deviate: the accept-at-once test of the first word inline, everything else in
- * gauss_slow (which repeats that test on the same word: the sequence of words consumed and the
- * value returned are those of a single loop). */
 static inline double gauss_one(nav_rng *r) {
-  /* Disjoint bits for layer (0-7), sign (8) and abscissa (11-63): Doornik ("An improved
-   * ziggurat method to generate normal random samples", Nuffield College, 2005) showed that
-   * sharing bits between the layer index and the abscissa, as the original 32-bit code did,
-   * correlates them and fails tests. */
-  const uint64_t bits = next_u64(r);
-  const unsigned layer = (unsigned)(bits & 0xffu);
-  const double x = (double)(bits >> 11) * TWO_POW_M53 * zig_x[layer];
-  /* Inside the part of the layer that lies wholly under the curve: accept at once, with the
-   * sign bit 8 copied into the IEEE sign bit: without a branch (the sign is a coin flip, which a
-   * branch predictor cannot learn) and exactly the value (1 - 2 bit8) * x of gauss_slow, -0.0
-   * included (x >= 0 here). */
-  if (x < zig_x[layer + 1]) {
-    uint64_t xb;
-    memcpy(&xb, &x, sizeof xb);
-    xb |= (bits & UINT64_C(0x100)) << 55;
-    double v;
-    memcpy(&v, &xb, sizeof v);
-    return v;
-  }
-  return gauss_slow(r, bits);
+  return nav_rng_gauss_inline(r);
 }
 
 double nav_rng_gauss(nav_rng *r) {
   assert(r != NULL);
   return gauss_one(r);
-}
-
-void nav_rng_gauss_streams(nav_rng *r, size_t n_streams, size_t per_stream, double *out) {
-  assert(r != NULL && out != NULL);
-  for (size_t s = 0; s < n_streams; ++s)
-    for (size_t d = 0; d < per_stream; ++d)
-      out[s * per_stream + d] = gauss_one(&r[s]);
 }
 
 nav_vec3 nav_rng_gauss_vec3(nav_rng *r) {
