@@ -40,17 +40,6 @@ bool bench_resources_dir(char *buf, size_t size) {
   return nav_paths_resources_dir(buf, size);
 }
 
-static int cmp_double(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, cmp_double);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-
 /* Run one scene: time truth generation and mechanization separately; closure at the end. */
 void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
   nav_truth *truth = NULL;
@@ -115,7 +104,7 @@ void bench_scene(const nav_scene *sc, int reps, bench_row *row) {
       ins = NULL;
     }
   }
-  const double mech_s = median(times, reps);
+  const double mech_s = bench_median(times, reps);
   row->mech_sps = (double)n / mech_s;
   row->wall_s = truth_s + mech_s;
   const nav_frame fr = nav_truth_frame(truth);

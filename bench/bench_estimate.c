@@ -27,18 +27,6 @@
 static double s_slowest_s = NAN;
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
-static int cmp_dbl(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-/* Median of v[0..n) (sorts v). */
-static double median(double *v, int n) {
-  if (n <= 0) return NAN;
-  qsort(v, (size_t)n, sizeof *v, cmp_dbl);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 void bench_case_estimate_library(bool full, const char *out_dir, bench_row *rows, int *n, int cap) {
   if (*n >= cap) return;
   bench_row *r = &rows[*n];
@@ -99,7 +87,7 @@ void bench_case_estimate_library(bool full, const char *out_dir, bench_row *rows
     }
     if (!ok) ++failed;
     if (nc == 0) continue;
-    const double m = median(cpu, nc);
+    const double m = bench_median(cpu, nc);
     per_scene[measured++] = m;
     if (m > slowest_s) {
       slowest_s = m;
@@ -114,7 +102,7 @@ void bench_case_estimate_library(bool full, const char *out_dir, bench_row *rows
     s_slowest_s = slowest_s;
     char slow[64];
     snprintf(slow, sizeof slow, "%.*s", (int)(strlen(names[slowest]) - 5), names[slowest]);
-    r->wall_s = median(per_scene, measured);
+    r->wall_s = bench_median(per_scene, measured);
     r->load1 = bench_load1();
     char note[512];
     snprintf(note, sizeof note, "CPU s per scene (median of %d): median %.3f, slowest %s %.3f; %d of %d exit non-zero; load %.1f",

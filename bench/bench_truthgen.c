@@ -98,17 +98,6 @@ static struct {
 /* Our plan's duration of the long drive [s] (NaN: not generated). */
 static double s_planned_s = NAN;
 
-static int cmp_dbl(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-  if (n <= 0) return NAN;
-  qsort(v, (size_t)n, sizeof *v, cmp_dbl);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 static double cpu_now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
@@ -282,7 +271,7 @@ void bench_case_truthgen(bool full, const char *out_dir, const char *gis_dir, be
       snprintf(r[v]->error, sizeof r[v]->error, "%.200s", msg);
       continue;
     }
-    const double c = median(cpu, reps), w = median(wall, reps);
+    const double c = bench_median(cpu, reps), w = bench_median(wall, reps);
     r[v]->ok = true;
     r[v]->samples = (long long)ns;
     r[v]->wall_s = w;
