@@ -334,7 +334,7 @@ test('A/B with other scene origins: A (urban-drive moved 500 m north, 300 m east
     assertNear(got.estA, exaggerated(refWant, estWant, got.k), 0.5, "A's first estimate point in B's frame (3D)");
     assert.equal(await page.$eval('#three-legend-a-far', (e) => e.textContent), " (A is 583 m from B's origin)");
     console.log(`3D: A's first reference point ${got.refA.map((x) => x.toFixed(3))} m, expected ${refWant.map((x) => x.toFixed(3))} m`);
-    await page.screenshot({ path: shotPath('AB7-3d-other-origin.png') });
+    await page.screenshot({ path: shotPath('AB7-3d-other-origin.png'), fullPage: true });
 
     await selectTab(page, 'tab-map');
     assert.equal(await page.$eval('#map-legend-a-far', (e) => e.textContent), " (A is 583 m from B's origin)");
@@ -342,7 +342,7 @@ test('A/B with other scene origins: A (urban-drive moved 500 m north, 300 m east
     assertNear(onMap.refA, refWant.slice(0, 2), 0.5, "A's first reference point in B's frame (map)");
     assertNear(onMap.estA, estWant.slice(0, 2), 0.5, "A's first estimate point in B's frame (map)");
     await page.evaluate(() => new Promise((res) => { window.__studio.map.map.once('rendercomplete', res); window.__studio.map.map.render(); }));
-    await page.screenshot({ path: shotPath('AB8-map-other-origin.png') });
+    await page.screenshot({ path: shotPath('AB8-map-other-origin.png'), fullPage: true });
     assert.deepEqual(problems, []);
     assert.deepEqual(await page.evaluate(() => window.__studio.errors), []);
     await page.close();
