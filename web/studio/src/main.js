@@ -706,8 +706,8 @@ async function updateCompare() {
   $('map-legend-a').hidden = false;
   $('three-legend-a').hidden = false;
   // Another scene origin: A's local metres are not B's; the 3D view takes them to B's frame
-  // through latitude, longitude and height (the map draws each run about its own origin), and
-  // the legends say how far A's origin is from B's.
+  // through the two geodetic origins (geo.js, exact through ECEF; the map draws each run about
+  // its own origin), and the legends say how far A's origin is from B's.
   const originB = runOrigin(B) || null;
   const away = originA && originB && !same(originA, originB) ? originDistance(originA, originB) : 0;
   const farText = originA && originB && !same(originA, originB) ? ` (A is ${formatDistance(away)} from B's origin)` : '';
