@@ -10,6 +10,7 @@ import { drawCharts, drawCompareCharts, chartPng, parseCsv } from './charts.js';
 import { sceneDiff, modelDiff, verdictRows, formatValue, fmtNum, verdictText, change } from './compare.js';
 import { buildReport } from './report.js';
 import { View3D } from './view3d.js';
+import { nedFrameChange, originDistance, formatDistance } from './geo.js';
 
 void nedToLonLat;
 const $ = (id) => document.getElementById(id);
@@ -567,7 +568,7 @@ function showRun(run) {
 // The scene origin of a run's local NED coordinates (undefined: the edited scene's).
 function runOrigin(run) {
   const o = (parseYamlSafe(run.sceneText).earth || {}).origin || {};
-  return Number.isFinite(o.lat_deg) && Number.isFinite(o.lon_deg) ? { lat: o.lat_deg, lon: o.lon_deg } : undefined;
+  return Number.isFinite(o.lat_deg) && Number.isFinite(o.lon_deg) ? { lat: o.lat_deg, lon: o.lon_deg, h: Number.isFinite(o.h_m) ? o.h_m : 0 } : undefined;
 }
 const chartWidth = () => Math.max(320, $('work').clientWidth - 40);
 const sceneName = (run) => String(parseYamlSafe(run.sceneText).name || 'scene').replace(/[^A-Za-z0-9._-]+/g, '_');
@@ -658,6 +659,7 @@ async function updateCompare() {
     if (view3d) view3d.setCompare(null);
     $('map-legend-a').hidden = true;
     $('three-legend-a').hidden = true;
+    for (const id of ['map-legend-a-far', 'three-legend-a-far']) $(id).textContent = '';
     return;
   }
   if (!A.entry) A.entry = sessionRuns.find((r) => r.id === A.id);
@@ -703,7 +705,15 @@ async function updateCompare() {
   mapView.setCompare(originA, A.truth && !sameRef ? A.truth.pos_n_m : null, A.truth && !sameRef ? A.truth.pos_e_m : null, A.nav && A.nav.pos_n_m, A.nav && A.nav.pos_e_m);
   $('map-legend-a').hidden = false;
   $('three-legend-a').hidden = false;
-  if (view3d && A.truth && A.nav) view3d.setCompare(A.truth, A.nav);
+  // Another scene origin: A's local metres are not B's; the 3D view takes them to B's frame
+  // through the two geodetic origins (geo.js, exact through ECEF; the map draws each run about
+  // its own origin), and the legends say how far A's origin is from B's.
+  const originB = runOrigin(B) || null;
+  const away = originA && originB && !same(originA, originB) ? originDistance(originA, originB) : 0;
+  const farText = originA && originB && !same(originA, originB) ? ` (A is ${formatDistance(away)} from B's origin)` : '';
+  for (const id of ['map-legend-a-far', 'three-legend-a-far']) $(id).textContent = farText;
+  studio.compareOriginDistance = away;
+  if (view3d && A.truth && A.nav) view3d.setCompare(A.truth, A.nav, nedFrameChange(originA, originB));
   host.dataset.state = 'ready';
   studio.compare = { a: A.id, b: B.id, diff: diff.map((d) => d.path) };
 }

@@ -19,26 +19,11 @@ import { Style, Stroke, Fill, Circle as CircleStyle, Text } from 'ol/style.js';
 import { fromLonLat, toLonLat } from 'ol/proj.js';
 import { defaults as defaultControls, ScaleLine } from 'ol/control.js';
 import { boundingExtent } from 'ol/extent.js';
+import { nedToLonLat, lonLatToNed } from './geo.js';
 
 void TileLayer;
 
-// WGS-84 radii of curvature: local NED (m) <-> geodetic (deg) around an origin, small offsets.
-const A = 6378137.0, E2 = 6.69437999014e-3;
-function radii(latDeg) {
-  const s = Math.sin((latDeg * Math.PI) / 180);
-  const w = Math.sqrt(1 - E2 * s * s);
-  return { rn: A / w, rm: (A * (1 - E2)) / (w * w * w) };
-}
-export function nedToLonLat(origin, n, e) {
-  const { rn, rm } = radii(origin.lat);
-  const lat = origin.lat + ((n / rm) * 180) / Math.PI;
-  const lon = origin.lon + ((e / (rn * Math.cos((origin.lat * Math.PI) / 180))) * 180) / Math.PI;
-  return [lon, lat];
-}
-export function lonLatToNed(origin, lon, lat) {
-  const { rn, rm } = radii(origin.lat);
-  return [((lat - origin.lat) * Math.PI * rm) / 180, ((lon - origin.lon) * Math.PI * rn * Math.cos((origin.lat * Math.PI) / 180)) / 180];
-}
+export { nedToLonLat, lonLatToNed };
 
 export class StudioMap {
   constructor(target, creditsEl) {
@@ -151,6 +136,15 @@ export class StudioMap {
     const o = origin || this.origin;
     if (refN && refN.length > 1) this.refASrc.addFeature(new Feature(new LineString(this.lineFromNed(refN, refE, o))));
     if (estN && estN.length > 1) this.estASrc.addFeature(new Feature(new LineString(this.lineFromNed(estN, estE, o))));
+  }
+  // The first point of a drawn line ('ref', 'est', 'refA', 'estA') as local NED [n, e] about
+  // `origin` (default the shown scene's), read back from the map's geometry; null when not drawn.
+  firstNed(which, origin = this.origin) {
+    const src = { ref: this.refSrc, est: this.estSrc, refA: this.refASrc, estA: this.estASrc }[which];
+    const f = src && src.getFeatures()[0];
+    if (!f) return null;
+    const [lon, lat] = toLonLat(f.getGeometry().getFirstCoordinate());
+    return lonLatToNed(origin, lon, lat);
   }
   setFixes(lons, lats) {
     this.fixSrc.clear();

@@ -91,10 +91,20 @@ export class View3D {
     this.build();
   }
   // A/B comparison: run A's estimate (blue, deviation from A's reference x the exaggeration) and
-  // A's reference (grey) when it is not the shown run's; null removes them.
-  setCompare(truthA, navA) {
-    this.compare = truthA && navA ? { truth: truthA, nav: navA } : null;
+  // A's reference (grey) when it is not the shown run's; null removes them. toShown: a function
+  // (n, e, d) -> [n, e, d] from A's local NED to the shown run's (geo.js nedFrameChange, for
+  // runs with other scene origins); omitted: the same frame.
+  setCompare(truthA, navA, toShown) {
+    this.compare = truthA && navA ? { truth: truthA, nav: navA, toShown: toShown || ((n, e, d) => [n, e, d]) } : null;
     if (this.data) this.build(false);
+  }
+  // The first point of a drawn line ('ref', 'est', 'refA', 'estA') as local NED [n, e, d] of the
+  // shown run, read back from the line's geometry (what the GPU gets); null when not drawn.
+  firstNed(which) {
+    const l = this.lines && this.lines[which];
+    if (!l) return null;
+    const p = l.geometry.getAttribute('position');
+    return [-p.getZ(0), p.getX(0), -p.getY(0)];
   }
   setExaggeration(k) {
     this.exaggeration = k;
@@ -122,25 +132,33 @@ export class View3D {
     const refA = [], estA = [];
     let sameRef = true;
     if (this.compare) {
-      const { truth: tA, nav: nA } = this.compare;
+      // A's positions in the shown run's local frame (through latitude, longitude and height
+      // when the scene origins differ), then drawn as the shown run's.
+      const { truth: tA, nav: nA, toShown } = this.compare;
       const stepA = Math.max(1, Math.ceil(tA.length / 3000));
       if (tA.length !== n) sameRef = false;
       for (let i = 0; i < tA.length; i += stepA) {
-        const r = toR(tA.pos_n_m[i], tA.pos_e_m[i], tA.pos_d_m[i]);
+        const [rn, re, rd] = toShown(tA.pos_n_m[i], tA.pos_e_m[i], tA.pos_d_m[i]);
+        const r = toR(rn, re, rd);
         refA.push(r);
-        if (sameRef && Math.abs(tA.pos_n_m[i] - truth.pos_n_m[i]) + Math.abs(tA.pos_e_m[i] - truth.pos_e_m[i]) + Math.abs(tA.pos_d_m[i] - truth.pos_d_m[i]) > 1e-3) sameRef = false;
+        if (sameRef && Math.abs(rn - truth.pos_n_m[i]) + Math.abs(re - truth.pos_e_m[i]) + Math.abs(rd - truth.pos_d_m[i]) > 1e-3) sameRef = false;
         if (i < nA.length) {
-          const e = toR(nA.pos_n_m[i], nA.pos_e_m[i], nA.pos_d_m[i]);
+          const e = toR(...toShown(nA.pos_n_m[i], nA.pos_e_m[i], nA.pos_d_m[i]));
           estA.push(r.clone().add(e.sub(r).multiplyScalar(k)));
         }
       }
     }
     const box = new THREE.Box3().setFromPoints(sameRef ? ref : [...ref, ...refA]);
     const size = box.getSize(new THREE.Vector3()).length() || 10;
-    this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(ref), new THREE.LineBasicMaterial({ color: 0x111111 })));
-    if (est.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(est), new THREE.LineBasicMaterial({ color: 0xd1401f })));
-    if (!sameRef && refA.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(refA), new THREE.LineBasicMaterial({ color: 0x8a8f98 })));
-    if (estA.length > 1) this.group.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(estA), new THREE.LineBasicMaterial({ color: 0x1f5fbf })));
+    this.lines = {};
+    const line = (name, pts, color) => {
+      this.lines[name] = new THREE.Line(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color }));
+      this.group.add(this.lines[name]);
+    };
+    line('ref', ref, 0x111111);
+    if (est.length > 1) line('est', est, 0xd1401f);
+    if (!sameRef && refA.length > 1) line('refA', refA, 0x8a8f98);
+    if (estA.length > 1) line('estA', estA, 0x1f5fbf);
     if (sigmaH && ref.length > 1) {
       const maxR = size * 0.08;
       const tube = new THREE.Mesh(tubeGeometry(ref, rad.map((r) => Math.min(r, maxR)), 12),

@@ -6,6 +6,9 @@
 // the map and in 3D, survive a reload (the run ids are in the URL fragment), and the report must
 // be a self-contained page with the verdicts, decodable embedded pictures and the scene that
 // reruns. Controls are driven by the keyboard. Screenshots go to the build tree (web/shots).
+// A second test runs urban-drive with its origin moved 500 m north and 300 m east as A and the
+// original as B: A's first points must be drawn in B's frame where exact ECEF maths puts them
+// (within 0.5 m) in 3D and on the map, and the legends must give the distance.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { writeFileSync, mkdtempSync } from 'node:fs';
@@ -153,6 +156,14 @@ test('A/B: run A, pin it, another IMU, run B: diff, overlaid charts, verdicts si
     const threeInk = await canvasInk(page, '#three canvas', [[31, 95, 191]]);
     assert.ok(threeInk.ink > 0.01 * threeInk.pixels && threeInk.colours[0] > 100, `A's estimate in 3D ${JSON.stringify(threeInk)}`);
     assert.equal(await page.$eval('#three-legend-a', (e) => e.hidden), false);
+    // Equal scene origins: A is drawn from its own local metres, unchanged (the same numbers as
+    // its truth.csv and nav.csv, float32 in the GPU's buffer), and no distance is reported.
+    const [tA, nA] = [await csvFirst(`api/runs/${idA}/files/truth.csv`), await csvFirst(`api/runs/${idA}/files/nav.csv`)];
+    const same3d = await page.evaluate(() => ({ k: window.__studio.view3d.exaggeration, estA: window.__studio.view3d.firstNed('estA'), refA: window.__studio.view3d.firstNed('refA') }));
+    assert.equal(same3d.refA, null, 'the same reference is not drawn twice');
+    assertNear(same3d.estA, exaggerated(ned(tA), ned(nA), same3d.k), 1e-3, "A's first estimate point in 3D, equal origins");
+    assert.equal(await page.$eval('#three-legend-a-far', (e) => e.textContent), '');
+    assert.equal(await page.$eval('#map-legend-a-far', (e) => e.textContent), '');
 
     // report.html: a download made in the page; a valid page with the verdicts, the comparison,
     // decodable embedded pictures and the scene, opened from a file without a network.
@@ -242,3 +253,97 @@ test('A/B: run A, pin it, another IMU, run B: diff, overlaid charts, verdicts si
   });
 
 function location_hash(u) { return new URL(u).hash; }
+
+// The first data row of a result CSV as {column: number}.
+async function csvFirst(path) {
+  const r = await api(path);
+  assert.equal(r.status, 200, path);
+  const lines = r.text.split('\n').filter((l) => l && !l.startsWith('#'));
+  const head = lines[0].split(','), row = lines[1].split(',').map(Number);
+  return Object.fromEntries(head.map((h, i) => [h.trim(), row[i]]));
+}
+const ned = (row) => [row.pos_n_m, row.pos_e_m, row.pos_d_m];
+const add = (a, b) => a.map((x, i) => x + b[i]);
+// How view3d draws an estimate point: its reference plus the deviation times the exaggeration.
+const exaggerated = (r, e, k) => r.map((x, i) => x + k * (e[i] - x));
+function assertNear(got, want, tol, what) {
+  assert.ok(Array.isArray(got), `${what}: drawn (${JSON.stringify(got)})`);
+  const d = Math.hypot(...want.map((w, i) => got[i] - w));
+  assert.ok(d <= tol, `${what}: drawn at ${JSON.stringify(got)}, expected ${JSON.stringify(want)} (${d.toFixed(4)} m off, tolerance ${tol} m)`);
+}
+// WGS-84 geodetic -> ECEF, and the NED coordinates of an ECEF point about an origin: the exact
+// tangent-plane maths (not the studio's small-offset formulas), as an independent expectation.
+const WGS_A = 6378137.0, WGS_F = 1 / 298.257223563, WGS_E2 = WGS_F * (2 - WGS_F);
+function ecef(latDeg, lonDeg, h) {
+  const la = (latDeg * Math.PI) / 180, lo = (lonDeg * Math.PI) / 180;
+  const rn = WGS_A / Math.sqrt(1 - WGS_E2 * Math.sin(la) ** 2);
+  return [(rn + h) * Math.cos(la) * Math.cos(lo), (rn + h) * Math.cos(la) * Math.sin(lo), (rn * (1 - WGS_E2) + h) * Math.sin(la)];
+}
+function nedAbout(o, p) {
+  const la = (o.lat * Math.PI) / 180, lo = (o.lon * Math.PI) / 180;
+  const r0 = ecef(o.lat, o.lon, o.h), d = p.map((x, i) => x - r0[i]);
+  const [sl, cl, so, co] = [Math.sin(la), Math.cos(la), Math.sin(lo), Math.cos(lo)];
+  return [-sl * co * d[0] - sl * so * d[1] + cl * d[2], -so * d[0] + co * d[1], -cl * co * d[0] - cl * so * d[1] - sl * d[2]];
+}
+
+test('A/B with other scene origins: A (urban-drive moved 500 m north, 300 m east) is drawn in B\'s frame in 3D and on the map',
+  { skip: why || false, timeout: 300000 }, async () => {
+    const { page, problems } = await openPage(browser, server.url);
+    assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok');
+    await page.$eval('#runs', (e) => { e.value = ''; });
+    await page.type('#runs', '1');
+    await page.$eval('#runs', (e) => e.dispatchEvent(new Event('change')));
+    await page.waitForFunction(() => /\bruns: 1\b/.test(document.getElementById('yaml').value));
+    const yamlB = await page.$eval('#yaml', (e) => e.value);
+    const mo = yamlB.match(/origin: \{ ?lat_deg: ([-0-9.]+), lon_deg: ([-0-9.]+), h_m: ([-0-9.]+) ?\}/);
+    assert.ok(mo, 'urban-drive has an origin mapping');
+    const oB = { lat: +mo[1], lon: +mo[2], h: +mo[3] };
+    // A's origin: 500 m north and 300 m east of B's (WGS-84 radii of curvature at B's latitude),
+    // written to 1e-7 degrees; the expectation below is computed from the written numbers.
+    const s = Math.sin((oB.lat * Math.PI) / 180), w = Math.sqrt(1 - WGS_E2 * s * s);
+    const rm = (WGS_A * (1 - WGS_E2)) / w ** 3, rn = WGS_A / w;
+    const oA = { lat: +(oB.lat + (500 / rm) * (180 / Math.PI)).toFixed(7), lon: +(oB.lon + (300 / (rn * Math.cos((oB.lat * Math.PI) / 180))) * (180 / Math.PI)).toFixed(7), h: oB.h };
+    const yamlA = yamlB.replace(mo[0], `origin: {lat_deg: ${oA.lat}, lon_deg: ${oA.lon}, h_m: ${oA.h}}`);
+    const setYaml = async (t) => {
+      await page.$eval('#yaml', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, t);
+      await page.waitForFunction((v) => document.getElementById('yaml').value === v || document.getElementById('yaml').value.includes(v.match(/origin: .*/)[0]), {}, t);
+      assert.equal(await waitAttr(page, '#estimate', 'data-state', ['ok', 'error', 'invalid'], 60000), 'ok');
+    };
+    await setYaml(yamlA);
+    const idA = await runAndWait(page);
+    await press(page, 'pin-a');
+    await page.waitForFunction(() => document.getElementById('pin-a').getAttribute('aria-pressed') === 'true');
+    await setYaml(yamlB);
+    const idB = await runAndWait(page);
+    await selectTab(page, 'tab-compare');
+    assert.equal(await waitAttr(page, '#compare', 'data-state', ['ready'], 60000), 'ready');
+    const diff = await page.$$eval('#compare-diff tbody tr', (rs) => rs.map((r) => r.cells[0].textContent));
+    assert.deepEqual(diff, ['earth.origin.lat_deg', 'earth.origin.lon_deg'], 'only the origin differs');
+
+    // Where A's first point belongs in B's frame: A's local NED plus A's origin, exactly in ECEF.
+    const offset = nedAbout(oB, ecef(oA.lat, oA.lon, oA.h));
+    assert.ok(Math.abs(offset[0] - 500) < 0.1 && Math.abs(offset[1] - 300) < 0.1, `A's origin in B's frame ${offset}`);
+    const [tA, nA] = [await csvFirst(`api/runs/${idA}/files/truth.csv`), await csvFirst(`api/runs/${idA}/files/nav.csv`)];
+    const refWant = add(ned(tA), offset), estWant = add(ned(nA), offset);
+
+    await selectTab(page, 'tab-3d');
+    const got = await page.evaluate(() => ({ k: window.__studio.view3d.exaggeration, ref: window.__studio.view3d.firstNed('ref'), refA: window.__studio.view3d.firstNed('refA'), estA: window.__studio.view3d.firstNed('estA') }));
+    const tB = await csvFirst(`api/runs/${idB}/files/truth.csv`);
+    assertNear(got.ref, ned(tB), 1e-3, "B's reference in 3D");
+    assertNear(got.refA, refWant, 0.5, "A's first reference point in B's frame (3D)");
+    assertNear(got.estA, exaggerated(refWant, estWant, got.k), 0.5, "A's first estimate point in B's frame (3D)");
+    assert.equal(await page.$eval('#three-legend-a-far', (e) => e.textContent), " (A is 583 m from B's origin)");
+    console.log(`3D: A's first reference point ${got.refA.map((x) => x.toFixed(3))} m, expected ${refWant.map((x) => x.toFixed(3))} m`);
+    await page.screenshot({ path: shotPath('AB7-3d-other-origin.png'), fullPage: true });
+
+    await selectTab(page, 'tab-map');
+    assert.equal(await page.$eval('#map-legend-a-far', (e) => e.textContent), " (A is 583 m from B's origin)");
+    const onMap = await page.evaluate((o) => ({ refA: window.__studio.map.firstNed('refA', o), estA: window.__studio.map.firstNed('estA', o) }), oB);
+    assertNear(onMap.refA, refWant.slice(0, 2), 0.5, "A's first reference point in B's frame (map)");
+    assertNear(onMap.estA, estWant.slice(0, 2), 0.5, "A's first estimate point in B's frame (map)");
+    await page.evaluate(() => new Promise((res) => { window.__studio.map.map.once('rendercomplete', res); window.__studio.map.map.render(); }));
+    await page.screenshot({ path: shotPath('AB8-map-other-origin.png'), fullPage: true });
+    assert.deepEqual(problems, []);
+    assert.deepEqual(await page.evaluate(() => window.__studio.errors), []);
+    await page.close();
+  });
