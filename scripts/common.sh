@@ -23,6 +23,7 @@ NAV_PACKAGES=(
   libsqlite3-dev libcurl4-openssl-dev # map tile layer: MBTiles files (SQLite), XYZ URL tiles (libcurl)
   ffmpeg                            # movies of the 3D playback: H.264 (libx264) / VP9 (libvpx) encoder, ffprobe in tests
   python3-numpy                     # gnss-ins-sim as the bench's truth-generation peer (navsim bench --peer-gnss-ins-sim)
+  strace                            # test_navsim_replay_io: the replay's writes and fsyncs seen from the system calls
 )
 
 NAV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
