@@ -506,8 +506,14 @@ static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const r
     const double *phi_i = Phi + i * LD;
     const size_t c0 = i & ~(size_t)3;
     switch (LD - c0) {
-    case 24: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, 0, LD, 24); break;
-    case 20: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 20, LD, 20); break;
+    /* LD >= 24 / 20: the wider cases cannot occur in the narrower instantiations (LD - c0 <= LD);
+     * the guard folds them away there, so that no compiler sees a row start of LD - 20 < 0. */
+    case 24:
+      if (LD >= 24) upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, 0, LD, 24);
+      break;
+    case 20:
+      if (LD >= 20) upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 20, LD, 20);
+      break;
     case 16: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 16, LD, 16); break;
     case 12: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 12, LD, 12); break;
     case 8: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 8, LD, 8); break;
