@@ -33,11 +33,7 @@ static uint64_t splitmix64_next(uint64_t *state) {
   return mix64(*state);
 }
 
-static inline uint64_t rotl64(uint64_t x, int k) {
-  return (x << k) | (x >> (64 - k));
-}
-
-/* One step of xoshiro256**: nav_rng_next_inline (rng_internal.h, rotl64 written out there). */
+/* One step of xoshiro256**: nav_rng_next_inline (rng_internal.h). */
 static inline uint64_t next_u64(nav_rng *r) {
   return nav_rng_next_inline(r);
 }
