@@ -52,6 +52,11 @@ static uint64_t inverse_mod_2_64(uint64_t a) {
   return x;
 }
 
+/* Rotate left by k (0 < k < 64). */
+static uint64_t rotl64(uint64_t x, int k) {
+  return (x << k) | (x >> (64 - k));
+}
+
 /* A state whose next xoshiro256** output is exactly `word`: the output is rotl(s1 * 5, 7) * 9 and
  * depends on s[1] only, so invert it. The other words are unrelated filler (splitmix64 constants;
  * filler with s[0] ^ s[2] = ~0 would make the following output nearly ~word). */
