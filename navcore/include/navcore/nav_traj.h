@@ -14,6 +14,7 @@
 #include "nav_export.h"
 #include "nav_frames.h"
 #include <stddef.h>
+#include <stdint.h>
 
 #include "nav_math.h"
 #include "nav_scene.h"
@@ -93,6 +94,23 @@ NAV_API NAV_NODISCARD nav_status nav_traj_inertial(nav_traj *traj, double t_s, n
 NAV_API NAV_NODISCARD nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n,
                                                              const double *x, const double *w,
                                                              nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad);
+
+/**
+ * Sample k of the grid t_k = k dt (dt of the create call, k >= 1) for a caller that walks the
+ * samples in order: the state at t_k and the increments over [t_(k-1), t_k] of
+ * nav_traj_inertial_increment (the same numbers). The two share work: for models whose position
+ * is the integral of their velocity (segment scripts, waypoints) the position of the state is the
+ * position chain R(k) that the increment computes anyway, R(k) = R(k-1) + the rule's integral of
+ * the velocity over the interval, restarted from the model's own position at every 64th sample
+ * (docs/truth-generation-speed.md gives the difference from nav_traj_eval's position: at most
+ * about 1e-9 m); every other field, and the whole state of other models, has the numbers of
+ * nav_traj_eval(t_k). The results depend only on k and the rule, never on earlier calls; walking
+ * k = 1, 2, ... is the fast case.
+ * @return as nav_traj_inertial_increment (NAV_ERR_INVALID_ARG also for k < 1).
+ */
+NAV_API NAV_NODISCARD nav_status nav_traj_sample(nav_traj *traj, int64_t k, int n, const double *x,
+                                                 const double *w, nav_traj_state *state, nav_vec3 *dv_b_mps,
+                                                 nav_vec3 *dtheta_b_rad);
 
 /** Duration of the trajectory [s]. */
 NAV_API double nav_traj_duration(const nav_traj *traj);

@@ -48,6 +48,20 @@ NAV_API NAV_NODISCARD nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_
  *  the position, velocity or attitude evaluates non-finite (numerical guard). */
 NAV_API NAV_NODISCARD nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out);
 
+/**
+ * Sample k >= 1 for a caller that wants every sample in order (a whole-run truth, an export):
+ * the reference state at t_k = k dt and the ideal increments over [t_(k-1), t_k], as
+ * nav_truth_state(k dt) and nav_truth_imu(k) but with their work shared (nav_traj_sample): the
+ * increment has the same numbers; the state's position, for segment-script and waypoint
+ * trajectories, is the chain of interval quadratures of the velocity restarted every 64 samples
+ * from the exact position, which differs from nav_truth_state's by rounding-level amounts (at most
+ * about 1e-9 m; docs/truth-generation-speed.md). The state at t_0 is nav_truth_state(0).
+ * Results depend only on k, never on earlier calls; walking k = 1, 2, ... is the fast case.
+ * NAV_ERR_NUMERIC as the two functions it replaces (outputs untouched).
+ */
+NAV_API NAV_NODISCARD nav_status nav_truth_sample(nav_truth *truth, int64_t k, nav_traj_state *state,
+                                                  nav_imu_increment *imu);
+
 /** IMU interval [s]. */
 NAV_API double nav_truth_dt(const nav_truth *truth);
 /** Number of IMU samples in the scene duration: floor(duration / dt + 1e-9). */

@@ -729,8 +729,7 @@ static double seg_step(void *self, double ta, double tb) {
   return w > 1.0 ? 0.5 / w : 0.5;
 }
 
-static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
-  seg_model *m = self;
+static nav_status seg_kin(seg_model *m, double t_s, nav_local_kin *out, bool with_pos) {
   const seg_att a = seg_state(m, t_s);
   /* nav_euler_to_quat, nav_kin_euler_rates and nav_euler_to_dcm of the Euler angles, with each
    * sine and cosine computed once (and none for a zero angle): the same numbers. */
@@ -750,9 +749,17 @@ static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
   const nav_vec3 vb_dot = nav_vec3_make(a.u.d[1], a.v.d[1], a.w.d[1]);
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
   k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
-  k.r_ned_m = nav_kin_path_eval(&m->path, t_s);
+  k.r_ned_m = with_pos ? nav_kin_path_eval(&m->path, t_s) : nav_vec3_zero();
   *out = k;
   return NAV_OK;
+}
+
+static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
+  return seg_kin(self, t_s, out, true);
+}
+
+static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
+  return seg_kin(self, t_s, out, false);
 }
 
 /*
@@ -929,6 +936,7 @@ nav_status nav_traj_segments_create(const nav_scene *scene, double dt_s, nav_tra
   out->duration_s = m->end_s;
   out->self = m;
   out->eval_local = seg_eval;
+  out->eval_local_nopos = seg_eval_nopos;
   out->destroy = seg_destroy;
   m = NULL;
 cleanup:

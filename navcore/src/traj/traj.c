@@ -225,8 +225,17 @@ double nav_traj_duration(const nav_traj *traj) { return traj ? traj->m.duration_
 
 nav_frame nav_traj_frame(const nav_traj *traj) { return traj->frame; }
 
-nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
-  if (!traj || !out || !isfinite(t_s)) return NAV_ERR_INVALID_ARG;
+/* The local kinematics at t: the model's own, or, with r_ned (a local model with
+ * eval_local_nopos), everything but the position from the model and the position r_ned. */
+static nav_status local_kin(nav_traj *traj, double t_s, const nav_vec3 *r_ned, nav_local_kin *k) {
+  if (!r_ned || !traj->m.eval_local_nopos) return traj->m.eval_local(traj->m.self, t_s, k);
+  const nav_status st = traj->m.eval_local_nopos(traj->m.self, t_s, k);
+  k->r_ned_m = *r_ned;
+  return st;
+}
+
+/* nav_traj_eval, with the local position r_ned instead of the model's when given (see local_kin). */
+static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, nav_traj_state *out) {
   nav_traj_state s;
   nav_status st = NAV_OK;
   s.t_s = t_s;
@@ -235,7 +244,7 @@ nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
     s.t_s = t_s;
   } else if (traj->m.eval_local && traj->frame.model == NAV_EARTH_FLAT) {
     nav_local_kin k;
-    st = traj->m.eval_local(traj->m.self, t_s, &k);
+    st = local_kin(traj, t_s, r_ned, &k);
     s.r_fb_f_m = k.r_ned_m;
     s.v_fb_f_mps = k.v_ned_mps;
     s.a_fb_f_mps2 = k.a_ned_mps2;
@@ -246,7 +255,7 @@ nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
     nav_geo_kin g;
     if (traj->m.eval_local) {
       nav_local_kin k;
-      st = traj->m.eval_local(traj->m.self, t_s, &k);
+      st = local_kin(traj, t_s, r_ned, &k);
       g = local_to_geo(&traj->frame, &k);
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
@@ -256,6 +265,11 @@ nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
   if (st != NAV_OK) return st;
   *out = s;
   return NAV_OK;
+}
+
+nav_status nav_traj_eval(nav_traj *traj, double t_s, nav_traj_state *out) {
+  if (!traj || !out || !isfinite(t_s)) return NAV_ERR_INVALID_ARG;
+  return eval_state(traj, t_s, NULL, out);
 }
 
 nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2, nav_vec3 *w_ib_b_rps) {
@@ -415,7 +429,7 @@ static nav_vec3 chain_step(const nav_traj *tr, nav_vec3 r0, const nav_kin_nodes 
  * A sequential run costs one model position per CHAIN_BLOCK samples; a jump re-integrates at most
  * CHAIN_BLOCK - 1 intervals. Off the grid the model's position at t0 anchors the nodes.
  */
-NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
+NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io, double half, nav_vec3 *r0_out) {
   nav_vec3 r0;
   nav_status st = NAV_OK;
   if (io->k < 1) {
@@ -460,6 +474,14 @@ NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, dou
     tr->chain_j = io->k;
     tr->chain_r = r1;
   }
+  if (st == NAV_OK) *r0_out = r0;
+  return st;
+}
+
+/* chain_advance, then the positions at the nodes. */
+NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
+  nav_vec3 r0;
+  const nav_status st = chain_advance(tr, io, half, &r0);
   if (st != NAV_OK) return st;
   for (int i = 0; i < io->n; ++i) {
     nav_vec3 s = nav_vec3_zero();
@@ -508,11 +530,15 @@ NAV_CLONE_INLINE void ned_inertial(const nav_frame *fr, double inv_m_lat, double
   *w_ib_b = nav_vec3_add(w_nb_b, nav_mat3_tmul_vec(*C_b_n, nav_vec3_add(w_ie_n, w_en_n)));
 }
 
-NAV_HOT_CLONES nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
-                                       const double *w, nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad) {
-  if (!traj || !x || !w || !dv_b_mps || !dtheta_b_rad || n < 1 || n > NAV_KIN_MAX_NODES || !isfinite(t0_s) ||
-      !isfinite(t1_s))
-    return NAV_ERR_INVALID_ARG;
+/*
+ * The increment over [t0, t1] (k: its grid index or -1). With r_end (k >= 1), also the position
+ * chain's R(k) into *r_end, setting *has_r_end, when the model's positions come from the chain
+ * (a local model with a node evaluator and no node positions of its own, normal gravity on WGS-84
+ * or flat Earth); *has_r_end stays false otherwise. The increment is the same either way.
+ */
+NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t1_s, int64_t k, int n,
+                                           const double *x, const double *w, nav_vec3 *dv_b_mps,
+                                           nav_vec3 *dtheta_b_rad, nav_vec3 *r_end, bool *has_r_end) {
   const bool flat = traj->frame.model == NAV_EARTH_FLAT;
   if (!traj->nodes || (!flat && traj->gravity != NAV_GRAVITY_NORMAL))
     return increment_by_nodes(traj, t0_s, t1_s, n, x, w, dv_b_mps, dtheta_b_rad);
@@ -526,15 +552,25 @@ NAV_HOT_CLONES nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_
   nd.t1_s = t1_s;
   for (int i = 0; i < n; ++i)
     nd.t_s[i] = mid + half * x[i];
-  nd.k = grid_index(traj, t0_s, t1_s);
+  nd.k = k;
   nd.need_pos = !flat;
   nd.has_pos = false;
   nav_status st = traj->nodes(traj->m.self, &nd);
   if (st != NAV_OK) return st;
-  if (!flat && !nd.has_pos) {
+  if (!nd.has_pos && (!flat || (r_end && k >= 1))) {
     set_rule(traj, n, x, w);
-    st = chain_positions(traj, &nd, half);
+    if (flat) {
+      /* Only R(k) is wanted: flat-Earth forces do not depend on the position. */
+      nav_vec3 r0;
+      st = chain_advance(traj, &nd, half, &r0);
+    } else {
+      st = chain_positions(traj, &nd, half);
+    }
     if (st != NAV_OK) return st;
+    if (r_end && k >= 1) {
+      *r_end = traj->chain_r;
+      *has_r_end = true;
+    }
   }
   /* Latitudes of the nodes differ by micro-radians: sin/cos of the first, the others by angle
    * addition (nav_kin_sincos_near); likewise 1/sqrt(D), D = 1 - e^2 sin^2 lat: directly at the
@@ -579,6 +615,34 @@ NAV_HOT_CLONES nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_
     dv = nav_vec3_axpy(dv, wgt, f_b);
     dth = nav_vec3_axpy(dth, wgt, w_b);
   }
+  *dv_b_mps = dv;
+  *dtheta_b_rad = dth;
+  return NAV_OK;
+}
+
+NAV_HOT_CLONES nav_status nav_traj_inertial_increment(nav_traj *traj, double t0_s, double t1_s, int n, const double *x,
+                                                      const double *w, nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad) {
+  if (!traj || !x || !w || !dv_b_mps || !dtheta_b_rad || n < 1 || n > NAV_KIN_MAX_NODES || !isfinite(t0_s) ||
+      !isfinite(t1_s))
+    return NAV_ERR_INVALID_ARG;
+  return increment_core(traj, t0_s, t1_s, grid_index(traj, t0_s, t1_s), n, x, w, dv_b_mps, dtheta_b_rad, NULL,
+                        NULL);
+}
+
+NAV_HOT_CLONES nav_status nav_traj_sample(nav_traj *traj, int64_t k, int n, const double *x, const double *w,
+                                          nav_traj_state *state, nav_vec3 *dv_b_mps, nav_vec3 *dtheta_b_rad) {
+  if (!traj || !x || !w || !state || !dv_b_mps || !dtheta_b_rad || n < 1 || n > NAV_KIN_MAX_NODES || k < 1 ||
+      k > (int64_t)9.0e15)
+    return NAV_ERR_INVALID_ARG;
+  const double t0_s = (double)(k - 1) * traj->dt_s, t1_s = (double)k * traj->dt_s;
+  nav_vec3 dv, dth, r_end;
+  bool has_r_end = false;
+  nav_status st = increment_core(traj, t0_s, t1_s, k, n, x, w, &dv, &dth, &r_end, &has_r_end);
+  if (st != NAV_OK) return st;
+  nav_traj_state s;
+  st = eval_state(traj, t1_s, has_r_end ? &r_end : NULL, &s);
+  if (st != NAV_OK) return st;
+  *state = s;
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;
   return NAV_OK;

@@ -52,6 +52,9 @@ typedef struct nav_traj_model {
   double duration_s;
   void *self;
   nav_status (*eval_local)(void *self, double t_s, nav_local_kin *out);
+  /* Optional: eval_local without the position (r_ned_m is set to zero), for a caller that has the
+   * position already (nav_traj_sample); every other field the same numbers as eval_local. */
+  nav_status (*eval_local_nopos)(void *self, double t_s, nav_local_kin *out);
   nav_status (*eval_geodetic)(void *self, double t_s, nav_geo_kin *out);
   /* ECEF state: fills r_fb_f_m .. dw_fb_b_rps2 of nav_traj_state with f = e. */
   nav_status (*eval_ecef)(void *self, double t_s, nav_traj_state *out);

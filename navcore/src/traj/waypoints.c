@@ -699,6 +699,10 @@ static nav_status wp_eval(void *self, double t_s, nav_local_kin *out) {
   return wp_kin(self, t_s, out, true);
 }
 
+static nav_status wp_eval_nopos(void *self, double t_s, nav_local_kin *out) {
+  return wp_kin(self, t_s, out, false);
+}
+
 /* find_piece through a cached index (the same piece; sequential times rarely search). */
 static const wp_piece *find_piece_hint(wp_model *m, double t) {
   const size_t h = m->piece_hint;
@@ -900,6 +904,7 @@ nav_status nav_traj_waypoints_create(const nav_scene *scene, double dt_s, nav_tr
   out->duration_s = m->end_s;
   out->self = m;
   out->eval_local = wp_eval;
+  out->eval_local_nopos = wp_eval_nopos;
   out->destroy = wp_destroy;
   for (int c = 0; c < 5; ++c)
     m->ch_hint[c] = -1;

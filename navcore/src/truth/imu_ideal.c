@@ -154,3 +154,29 @@ nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   *out = r;
   return NAV_OK;
 }
+
+nav_status nav_truth_sample(nav_truth *truth, int64_t k, nav_traj_state *state, nav_imu_increment *imu) {
+  if (!truth || !state || !imu || k < 1) return NAV_ERR_INVALID_ARG;
+  const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
+  nav_imu_increment r;
+  r.k = k;
+  r.t_s = t1;
+  r.dt_s = t1 - t0;
+  bool closed = false;
+  nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
+  if (st != NAV_OK) return st;
+  nav_vec3 dv, dth;
+  nav_traj_state s;
+  st = nav_traj_sample(truth->traj, k, truth->n_nodes, truth->nodes, truth->weights, &s, &dv, &dth);
+  if (st != NAV_OK) return st;
+  if (!closed) r.dtheta_b_rad = dth;
+  r.dv_b_mps = dv;
+  /* The guards of nav_truth_imu and nav_truth_state. */
+  if (!nav_vec3_isfinite(r.dtheta_b_rad) || !nav_vec3_isfinite(r.dv_b_mps)) return NAV_ERR_NUMERIC;
+  if (!isfinite(s.r_fb_f_m.x + s.r_fb_f_m.y + s.r_fb_f_m.z + s.v_fb_f_mps.x + s.v_fb_f_mps.y + s.v_fb_f_mps.z +
+                s.q_b_f.w + s.q_b_f.x + s.q_b_f.y + s.q_b_f.z))
+    return NAV_ERR_NUMERIC;
+  *state = s;
+  *imu = r;
+  return NAV_OK;
+}
