@@ -63,6 +63,10 @@ typedef struct seg_model {
    * each reused while its angle is unchanged. */
   double vel_ang[3], vel_sin[3], vel_cos[3];
   nav_mat3 vel_C;
+  /* sin and cos of the Euler angles at the first node of the node evaluator (yaw, pitch, roll) and
+   * of seg_kin's angles (roll, pitch, yaw and their halves): unchanged angles (a car's yaw on a
+   * straight, everything at rest) are not recomputed. */
+  nav_kin_sincos_cache nd_sc[3], st_sc[6];
 } seg_model;
 
 typedef struct planner {
@@ -735,12 +739,12 @@ static nav_status seg_kin(seg_model *m, double t_s, nav_local_kin *out, bool wit
    * sine and cosine computed once (and none for a zero angle): the same numbers. */
   const double roll = a.roll.d[0], pitch = a.pitch.d[0], yaw = a.yaw.d[0];
   double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
-  nav_kin_sincos(roll, &sr, &cr);
-  nav_kin_sincos(pitch, &sp, &cp);
-  nav_kin_sincos(yaw, &sy, &cy);
-  nav_kin_sincos(0.5 * roll, &shr, &chr);
-  nav_kin_sincos(0.5 * pitch, &shp, &chp);
-  nav_kin_sincos(0.5 * yaw, &shy, &chy);
+  nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
+  nav_kin_sincos_cached(&m->st_sc[1], pitch, &sp, &cp);
+  nav_kin_sincos_cached(&m->st_sc[2], yaw, &sy, &cy);
+  nav_kin_sincos_cached(&m->st_sc[3], 0.5 * roll, &shr, &chr);
+  nav_kin_sincos_cached(&m->st_sc[4], 0.5 * pitch, &shp, &chp);
+  nav_kin_sincos_cached(&m->st_sc[5], 0.5 * yaw, &shy, &chy);
   nav_local_kin k;
   k.q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
   nav_kin_euler_rates_sc(a.roll, a.pitch, a.yaw, sr, cr, sp, cp, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
@@ -758,8 +762,51 @@ static nav_status seg_eval(void *self, double t_s, nav_local_kin *out) {
   return seg_kin(self, t_s, out, true);
 }
 
+/*
+ * seg_kin without the position, to first order: the channels' values, rates and rate derivatives
+ * (nav_kin_channel_eval_rate: the numbers of the jets' first three orders) and the value and first
+ * derivative parts of nav_kin_euler_rates_sc, written out. Each part of a jet depends only on the
+ * same and lower orders of its operands (Leibniz and chain rules), so the values and first
+ * derivatives computed here are the jets' own, operation for operation. The coordinated bank
+ * (atan of a product of jets) takes the general path.
+ */
 static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
-  return seg_kin(self, t_s, out, false);
+  seg_model *m = self;
+  if (m->ch[CH_CYAW].n > 0) return seg_kin(m, t_s, out, false);
+  double x[CH_CYAW], r[CH_CYAW], r1[CH_CYAW];
+  for (int c = 0; c < CH_CYAW; ++c)
+    nav_kin_channel_eval_rate(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
+  const double roll = x[CH_ROLL], pitch = x[CH_PITCH], yaw = x[CH_YAW];
+  double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
+  nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
+  nav_kin_sincos_cached(&m->st_sc[1], pitch, &sp, &cp);
+  nav_kin_sincos_cached(&m->st_sc[2], yaw, &sy, &cy);
+  nav_kin_sincos_cached(&m->st_sc[3], 0.5 * roll, &shr, &chr);
+  nav_kin_sincos_cached(&m->st_sc[4], 0.5 * pitch, &shp, &chp);
+  nav_kin_sincos_cached(&m->st_sc[5], 0.5 * yaw, &shy, &chy);
+  nav_local_kin k;
+  k.q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
+  /* nav_kin_euler_rates_sc: dphi = (rr, rr1), dth = (pr, pr1), dpsi = (yr, yr1); sin/cos jets of
+   * pitch and roll (value, derivative) = (sp, cp pr), (cp, -sp pr), (sr, cr rr), (cr, -sr rr). */
+  const double rr = r[CH_ROLL], rr1 = r1[CH_ROLL], pr = r[CH_PITCH], pr1 = r1[CH_PITCH];
+  const double yr = r[CH_YAW], yr1 = r1[CH_YAW];
+  const double sth1 = cp * pr, cth1 = -sp * pr, sph1 = cr * rr, cph1 = -sr * rr;
+  /* mul(cth, sph) and mul(cth, cph) */
+  const double csd0 = cp * sr, csd1 = cth1 * sr + cp * sph1;
+  const double ccd0 = cp * cr, ccd1 = cth1 * cr + cp * cph1;
+  const double wx0 = rr - yr * sp, wx1 = rr1 - (yr1 * sp + yr * sth1);
+  const double wy0 = pr * cr + yr * csd0, wy1 = (pr1 * cr + pr * cph1) + (yr1 * csd0 + yr * csd1);
+  const double wz0 = yr * ccd0 - pr * sr, wz1 = (yr1 * ccd0 + yr * ccd1) - (pr1 * sr + pr * sph1);
+  k.w_nb_b_rps = nav_vec3_make(wx0, wy0, wz0);
+  k.dw_nb_b_rps2 = nav_vec3_make(wx1, wy1, wz1);
+  const nav_mat3 C = dcm_of(sr, cr, sp, cp, sy, cy);
+  const nav_vec3 vb = nav_vec3_make(x[CH_U], x[CH_V], x[CH_W]);
+  const nav_vec3 vb_dot = nav_vec3_make(r[CH_U], r[CH_V], r[CH_W]);
+  k.v_ned_mps = nav_mat3_mul_vec(C, vb);
+  k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
+  k.r_ned_m = nav_vec3_zero();
+  *out = k;
+  return NAV_OK;
 }
 
 /*
@@ -799,7 +846,8 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   double sn[3][NAV_KIN_MAX_NODES], cs[3][NAV_KIN_MAX_NODES];
   for (int c = 0; c < 3; ++c) {
     const double a0 = ang[c][0];
-    nav_kin_sincos(a0, &sn[c][0], &cs[c][0]); /* none for a zero angle (a car's pitch and roll) */
+    /* none for a zero angle (a car's pitch and roll) or one unchanged since the last interval */
+    nav_kin_sincos_cached(&m->nd_sc[c], a0, &sn[c][0], &cs[c][0]);
     for (int i = 1; i < n; ++i) {
       const double d = ang[c][i] - a0;
       if (d == 0.0) {
@@ -814,6 +862,23 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
     }
   }
   for (int i = 0; i < n; ++i) {
+    if (i > 0) {
+      /* Inputs of the same bits as the previous node's (every channel at rest or constant over the
+       * interval: a car on a straight, or standing): the same outputs. The sines and cosines follow
+       * from the angles (equal angles get equal ones above). */
+      bool same = true;
+      for (int c = 0; c < 3 && same; ++c)
+        same = nav_kin_same_bits(ang[c][i], ang[c][i - 1]) && nav_kin_same_bits(rate[c][i], rate[c][i - 1]) &&
+               nav_kin_same_bits(vb[c][i], vb[c][i - 1]) && nav_kin_same_bits(vbd[c][i], vbd[c][i - 1]);
+      if (same) {
+        io->C_b_n[i] = io->C_b_n[i - 1];
+        io->w_nb_b_rps[i] = io->w_nb_b_rps[i - 1];
+        io->v_ned_mps[i] = io->v_ned_mps[i - 1];
+        io->a_ned_mps2[i] = io->a_ned_mps2[i - 1];
+        io->same_kin[i] = true;
+        continue;
+      }
+    }
     const double sy = sn[0][i], cy = cs[0][i], sp = sn[1][i], cp = cs[1][i], sr = sn[2][i], cr = cs[2][i];
     /* C_b_n = R_z(yaw) R_y(pitch) R_x(roll) (nav_euler_to_dcm). */
     nav_mat3 *C = &io->C_b_n[i];
@@ -855,8 +920,12 @@ static seg_model *seg_alloc(void) {
   if (!m) return NULL;
   for (int c = 0; c < CH_N; ++c)
     m->hint[c] = m->st_hint[c] = m->vel_hint[c] = -1;
-  for (int i = 0; i < 3; ++i)
+  for (int i = 0; i < 3; ++i) {
     m->vel_ang[i] = NAN;
+    nav_kin_sincos_cache_init(&m->nd_sc[i]);
+  }
+  for (int i = 0; i < 6; ++i)
+    nav_kin_sincos_cache_init(&m->st_sc[i]);
   return m;
 }
 

@@ -10,6 +10,12 @@
 #include "traj/traj_kin_internal.h"
 #include "nav_clones.h"
 
+#if defined(__GNUC__)
+/* Four doubles for GCC's vector extensions: lane-wise IEEE arithmetic, the bits of the scalar
+ * operations (AVX2 in the AVX2 clone, two SSE2 halves in the baseline). */
+typedef double traj_v4d __attribute__((vector_size(32)));
+#endif
+
 /* Positions of the ideal IMU's position chain are re-anchored to the model's own (exact)
  * position every CHAIN_BLOCK samples; see chain_positions. */
 #define CHAIN_BLOCK 64
@@ -29,6 +35,10 @@ struct nav_traj {
   int q_n;
   double q_x[NAV_KIN_MAX_NODES], q_w[NAV_KIN_MAX_NODES];
   double q_A[NAV_KIN_MAX_NODES][NAV_KIN_MAX_NODES];
+  double q_At[NAV_KIN_MAX_NODES][NAV_KIN_MAX_NODES]; /* q_At[j][i] = q_A[i][j] (zero beyond n) */
+  /* sin and cos of the latitude and longitude of the last WGS-84 state, and of the latitude at the
+   * first node of the last increment (reused for the same bits: a vehicle at rest). */
+  nav_kin_sincos_cache st_lat_sc, st_lon_sc, nd_lat_sc;
   /* Position chain: R(chain_j) when chain_ok (a cache of a pure function of j). */
   bool chain_ok;
   int64_t chain_j;
@@ -125,14 +135,27 @@ static ned_kin geo_to_ned_kin(const nav_geo_kin *g) {
 /* E2M = 1 - e^2, as earth.c writes it (the same constant folding). */
 #define TRAJ_E2M (1.0 - NAV_WGS84_E2)
 
-static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+/* sin and cos of a, through the cache when there is one (the same numbers either way). */
+static inline void sincos_opt(nav_kin_sincos_cache *k, double a, double *s, double *c) {
+  if (k) {
+    nav_kin_sincos_cached(k, a, s, c);
+  } else {
+    *s = sin(a);
+    *c = cos(a);
+  }
+}
+
+/* lat_sc, lon_sc: caches of the sines and cosines, or NULL. */
+static void geo_to_ecef_state_c(const nav_geo_kin *g, nav_traj_state *s, nav_kin_sincos_cache *lat_sc,
+                                nav_kin_sincos_cache *lon_sc) {
   const double lat = g->pos.lat_rad, lon = g->pos.lon_rad, h = g->pos.h_m;
   /* One sine and cosine each of latitude and longitude and one square root, shared by what
    * nav_earth_radius_meridian_m, nav_earth_radius_prime_vertical_m, nav_earth_dcm_n_e and
    * nav_earth_geodetic_to_ecef would each compute again: their expressions, term for term
    * (Groves 2nd ed. eqs. 2.105, 2.106, 2.112), so the numbers are the same. */
-  const double sl = sin(lat), cl = cos(lat);
-  const double so = sin(lon), co = cos(lon);
+  double sl, cl, so, co;
+  sincos_opt(lat_sc, lat, &sl, &cl);
+  sincos_opt(lon_sc, lon, &so, &co);
   const double den2 = 1.0 - NAV_WGS84_E2 * sl * sl;
   const double sqrt_den = sqrt(den2);
   const double RM = NAV_WGS84_A_M * TRAJ_E2M / (den2 * sqrt_den);
@@ -149,6 +172,11 @@ static void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
   s->w_fb_b_rps = nav_vec3_add(g->w_nb_b_rps, w_en_b);
   s->dw_fb_b_rps2 = nav_vec3_sub(nav_vec3_add(g->dw_nb_b_rps2, nav_quat_rotate(nav_quat_conj(g->q_b_n), dw_en_n)),
                                  nav_vec3_cross(g->w_nb_b_rps, w_en_b));
+}
+
+/* Without caches (the white-box test compares it with the nav_earth functions). */
+static inline void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
+  geo_to_ecef_state_c(g, s, NULL, NULL);
 }
 
 /* Local curvilinear NED kinematics -> geodetic kinematics (affine map, exact derivatives). */
@@ -177,6 +205,9 @@ nav_status nav_traj_create_msg(const nav_scene *scene, double dt_s, nav_traj **o
   tr->dt_s = dt_s;
   tr->inv_m_lat = 1.0 / tr->frame.m_per_rad_lat;
   tr->inv_m_lon = tr->frame.m_per_rad_lon != 0.0 ? 1.0 / tr->frame.m_per_rad_lon : 0.0;
+  nav_kin_sincos_cache_init(&tr->st_lat_sc);
+  nav_kin_sincos_cache_init(&tr->st_lon_sc);
+  nav_kin_sincos_cache_init(&tr->nd_lat_sc);
   nav_status st = NAV_ERR_INVALID_ARG;
   switch (scene->trajectory.type) {
   case NAV_TRAJ_PARAMETRIC:
@@ -260,7 +291,7 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
     }
-    if (st == NAV_OK) geo_to_ecef_state(&g, &s);
+    if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
   }
   if (st != NAV_OK) return st;
   *out = s;
@@ -388,6 +419,9 @@ static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
       tr->q_A[i][j] = hl * sum;
     }
   }
+  for (int j = 0; j < NAV_KIN_MAX_NODES; ++j)
+    for (int i = 0; i < NAV_KIN_MAX_NODES; ++i)
+      tr->q_At[j][i] = i < n && j < n ? tr->q_A[i][j] : 0.0;
 }
 
 /* Sample index k with t0 = (k - 1) dt and t1 = k dt exactly, or -1. */
@@ -483,12 +517,28 @@ NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, dou
   nav_vec3 r0;
   const nav_status st = chain_advance(tr, io, half, &r0);
   if (st != NAV_OK) return st;
+#if defined(__GNUC__)
+  /* Four nodes at a time (lanes = nodes): each lane sums over j in the scalar loop's order. */
+  for (int i0 = 0; i0 < io->n; i0 += 4) {
+    traj_v4d sx = {0.0, 0.0, 0.0, 0.0}, sy = sx, sz = sx;
+    for (int j = 0; j < io->n; ++j) {
+      traj_v4d a;
+      memcpy(&a, &tr->q_At[j][i0], sizeof a);
+      sx = sx + a * io->v_ned_mps[j].x;
+      sy = sy + a * io->v_ned_mps[j].y;
+      sz = sz + a * io->v_ned_mps[j].z;
+    }
+    for (int l = 0; l < 4 && i0 + l < io->n; ++l)
+      io->r_ned_m[i0 + l] = nav_vec3_axpy(r0, half, nav_vec3_make(sx[l], sy[l], sz[l]));
+  }
+#else
   for (int i = 0; i < io->n; ++i) {
     nav_vec3 s = nav_vec3_zero();
     for (int j = 0; j < io->n; ++j)
       s = nav_vec3_axpy(s, tr->q_A[i][j], io->v_ned_mps[j]);
     io->r_ned_m[i] = nav_vec3_axpy(r0, half, s);
   }
+#endif
   io->has_pos = true;
   return NAV_OK;
 }
@@ -531,6 +581,98 @@ NAV_CLONE_INLINE void ned_inertial(const nav_frame *fr, double inv_m_lat, double
 }
 
 /*
+ * ned_inertial at the n nodes of nd (sines, cosines and 1/sqrt(D) of their latitudes in sl, cl,
+ * isq), into f_b[i] and w_b[i]. With GCC's vector extensions four nodes at a time: each lane
+ * performs the operations of ned_inertial, in its order (the same expressions, written for
+ * vectors; IEEE arithmetic lane by lane, no contraction), so every node gets the bits of the
+ * scalar function. Lanes beyond n repeat node 0 and are dropped.
+ */
+#if defined(__GNUC__)
+
+NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
+                                         const nav_kin_nodes *nd, int n, const double *sl_, const double *cl_,
+                                         const double *isq_, nav_vec3 *f_b, nav_vec3 *w_b) {
+  for (int i0 = 0; i0 < n; i0 += 4) {
+    int ix[4];
+    for (int l = 0; l < 4; ++l)
+      ix[l] = i0 + l < n ? i0 + l : 0;
+#define TRAJ_LANES(expr_of_j)                                                                                  \
+  (traj_v4d) {                                                                                                 \
+    expr_of_j(ix[0]), expr_of_j(ix[1]), expr_of_j(ix[2]), expr_of_j(ix[3])                                     \
+  }
+#define RZ(j) nd->r_ned_m[j].z
+#define VX(j) nd->v_ned_mps[j].x
+#define VY(j) nd->v_ned_mps[j].y
+#define VZ(j) nd->v_ned_mps[j].z
+#define AX(j) nd->a_ned_mps2[j].x
+#define AY(j) nd->a_ned_mps2[j].y
+#define AZ(j) nd->a_ned_mps2[j].z
+#define SL(j) sl_[j]
+#define CL(j) cl_[j]
+#define ISQ(j) isq_[j]
+    const traj_v4d rz = TRAJ_LANES(RZ), vx = TRAJ_LANES(VX), vy = TRAJ_LANES(VY), vz = TRAJ_LANES(VZ);
+    const traj_v4d ax = TRAJ_LANES(AX), ay = TRAJ_LANES(AY), az = TRAJ_LANES(AZ);
+    const traj_v4d sl = TRAJ_LANES(SL), cl = TRAJ_LANES(CL), inv_sq = TRAJ_LANES(ISQ);
+#undef RZ
+#undef VX
+#undef VY
+#undef VZ
+#undef AX
+#undef AY
+#undef AZ
+#undef SL
+#undef CL
+#undef ISQ
+    /* ned_inertial, term for term. */
+    const traj_v4d h = fr->origin.h_m - rz;
+    const traj_v4d dlat = vx * inv_m_lat, dlon = vy * inv_m_lon, dh = -vz;
+    const traj_v4d ddlat = ax * inv_m_lat, ddlon = ay * inv_m_lon, ddh = -az;
+    const traj_v4d s2 = sl * sl;
+    const traj_v4d inv_den = inv_sq * inv_sq;
+    const traj_v4d RN = NAV_WGS84_A_M * inv_sq, RM = NAV_WGS84_A_M * (1.0 - NAV_WGS84_E2) * inv_den * inv_sq;
+    const traj_v4d dRM = 3.0 * NAV_WGS84_E2 * RM * sl * cl * inv_den * dlat;
+    const traj_v4d dRN = NAV_WGS84_E2 * RN * sl * cl * inv_den * dlat;
+    const traj_v4d vnx = (RM + h) * dlat, vny = (RN + h) * cl * dlon, vnz = -dh;
+    const traj_v4d dvx = (dRM + dh) * dlat + (RM + h) * ddlat;
+    const traj_v4d dvy = (dRN + dh) * cl * dlon - (RN + h) * sl * dlat * dlon + (RN + h) * cl * ddlon;
+    const traj_v4d dvz = -ddh;
+    const traj_v4d wenx = dlon * cl, weny = -dlat, wenz = -dlon * sl;
+    const traj_v4d wiex = NAV_WGS84_OMEGA_IE_RPS * cl, wiez = -NAV_WGS84_OMEGA_IE_RPS * sl;
+    const double ea = NAV_WGS84_A_M;
+    const traj_v4d lin = (2.0 / ea) * (1.0 + NAV_WGS84_F + NAV_WGS84_M - 2.0 * NAV_WGS84_F * s2);
+    const double quad = 3.0 / (ea * ea);
+    const traj_v4d g =
+        NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) * inv_sq * (1.0 - lin * h + quad * h * h);
+    /* (2 w_ie + w_en) x v_n; w_ie_n.y = 0 enters as 0 * 2 + w_en.y, as in nav_vec3_scale / nav_vec3_add. */
+    const traj_v4d px = wiex * 2.0 + wenx, py = 0.0 * 2.0 + weny, pz = wiez * 2.0 + wenz;
+    const traj_v4d fx = (dvx + (py * vnz - pz * vny)) - 0.0;
+    const traj_v4d fy = (dvy + (pz * vnx - px * vnz)) - 0.0;
+    const traj_v4d fz = (dvz + (px * vny - py * vnx)) - g;
+    const traj_v4d qx = wiex + wenx, qy = 0.0 + weny, qz = wiez + wenz;
+    for (int l = 0; l < 4 && i0 + l < n; ++l) {
+      const nav_mat3 *C = &nd->C_b_n[i0 + l];
+      f_b[i0 + l] = nav_vec3_make(C->m[0][0] * fx[l] + C->m[1][0] * fy[l] + C->m[2][0] * fz[l],
+                                  C->m[0][1] * fx[l] + C->m[1][1] * fy[l] + C->m[2][1] * fz[l],
+                                  C->m[0][2] * fx[l] + C->m[1][2] * fy[l] + C->m[2][2] * fz[l]);
+      const nav_vec3 wt = nav_vec3_make(C->m[0][0] * qx[l] + C->m[1][0] * qy[l] + C->m[2][0] * qz[l],
+                                        C->m[0][1] * qx[l] + C->m[1][1] * qy[l] + C->m[2][1] * qz[l],
+                                        C->m[0][2] * qx[l] + C->m[1][2] * qy[l] + C->m[2][2] * qz[l]);
+      w_b[i0 + l] = nav_vec3_add(nd->w_nb_b_rps[i0 + l], wt);
+    }
+#undef TRAJ_LANES
+  }
+}
+#else
+NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
+                                         const nav_kin_nodes *nd, int n, const double *sl, const double *cl,
+                                         const double *isq, nav_vec3 *f_b, nav_vec3 *w_b) {
+  for (int i = 0; i < n; ++i)
+    ned_inertial(fr, inv_m_lat, inv_m_lon, nd->r_ned_m[i], nd->v_ned_mps[i], nd->a_ned_mps2[i], &nd->C_b_n[i],
+                 nd->w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b[i], &w_b[i]);
+}
+#endif
+
+/*
  * The increment over [t0, t1] (k: its grid index or -1). With r_end (k >= 1), also the position
  * chain's R(k) into *r_end, setting *has_r_end, when the model's positions come from the chain
  * (a local model with a node evaluator and no node positions of its own, normal gravity on WGS-84
@@ -555,6 +697,7 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   nd.k = k;
   nd.need_pos = !flat;
   nd.has_pos = false;
+  memset(nd.same_kin, 0, sizeof nd.same_kin);
   nav_status st = traj->nodes(traj->m.self, &nd);
   if (st != NAV_OK) return st;
   if (!nd.has_pos && (!flat || (r_end && k >= 1))) {
@@ -581,8 +724,7 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   const double inv_m_lat = traj->inv_m_lat, inv_m_lon = traj->inv_m_lon;
   if (!flat) {
     const double lat0 = fr->origin.lat_rad + nd.r_ned_m[0].x * inv_m_lat;
-    sl[0] = sin(lat0);
-    cl[0] = cos(lat0);
+    nav_kin_sincos_cached(&traj->nd_lat_sc, lat0, &sl[0], &cl[0]);
     const double den0 = 1.0 - NAV_WGS84_E2 * sl[0] * sl[0];
     isq[0] = 1.0 / sqrt(den0);
     const double inv_den0 = isq[0] * isq[0];
@@ -600,20 +742,41 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
                                : 1.0 / sqrt(1.0 - NAV_WGS84_E2 * sl[i] * sl[i]);
     }
   }
+  /* A node with the previous node's kinematics and position (at rest; on flat Earth any position)
+   * has its forces: they are not computed again (equal inputs, equal bits). */
+  bool reuse[NAV_KIN_MAX_NODES];
+  int fresh = 1;
+  reuse[0] = false;
+  for (int i = 1; i < n; ++i) {
+    reuse[i] = nd.same_kin[i] && (flat || (nav_kin_same_bits(nd.r_ned_m[i].x, nd.r_ned_m[i - 1].x) &&
+                                           nav_kin_same_bits(nd.r_ned_m[i].y, nd.r_ned_m[i - 1].y) &&
+                                           nav_kin_same_bits(nd.r_ned_m[i].z, nd.r_ned_m[i - 1].z)));
+    fresh += !reuse[i];
+  }
+  nav_vec3 f_b[NAV_KIN_MAX_NODES], w_b[NAV_KIN_MAX_NODES];
+  if (!flat && fresh > 1) {
+    /* All nodes at once (a reused node gets the bits it would be given anyway). */
+    ned_inertial_nodes(fr, inv_m_lat, inv_m_lon, &nd, n, sl, cl, isq, f_b, w_b);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if (reuse[i]) {
+        f_b[i] = f_b[i - 1];
+        w_b[i] = w_b[i - 1];
+      } else if (flat) {
+        /* Flat, non-rotating l with uniform gravity (E3.3). */
+        f_b[i] = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
+        w_b[i] = nd.w_nb_b_rps[i];
+      } else {
+        ned_inertial(fr, inv_m_lat, inv_m_lon, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i],
+                     nd.w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b[i], &w_b[i]);
+      }
+    }
+  }
   nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
   for (int i = 0; i < n; ++i) {
-    nav_vec3 f_b, w_b;
-    if (flat) {
-      /* Flat, non-rotating l with uniform gravity (E3.3). */
-      f_b = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
-      w_b = nd.w_nb_b_rps[i];
-    } else {
-      ned_inertial(fr, inv_m_lat, inv_m_lon, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i],
-                   nd.w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b, &w_b);
-    }
     const double wgt = w[i] * half;
-    dv = nav_vec3_axpy(dv, wgt, f_b);
-    dth = nav_vec3_axpy(dth, wgt, w_b);
+    dv = nav_vec3_axpy(dv, wgt, f_b[i]);
+    dth = nav_vec3_axpy(dth, wgt, w_b[i]);
   }
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;

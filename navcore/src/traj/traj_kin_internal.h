@@ -33,6 +33,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "navcore/nav_math.h"
 #include "navcore/nav_scene.h"
@@ -120,6 +121,36 @@ static inline void nav_kin_sincos(double a, double *s, double *c) {
     *s = sin(a);
     *c = cos(a);
   }
+}
+
+/** a and b have the same bits (unlike ==, tells +0 from -0; NaN with the same payload matches).
+ *  The caches of the truth generation reuse a result only for inputs of the same bits. */
+static inline bool nav_kin_same_bits(double a, double b) {
+  uint64_t x, y;
+  memcpy(&x, &a, sizeof x);
+  memcpy(&y, &b, sizeof y);
+  return x == y;
+}
+
+/** A one-entry cache of nav_kin_sincos: sin and cos of the last angle asked for. */
+typedef struct nav_kin_sincos_cache {
+  double a, s, c;
+} nav_kin_sincos_cache;
+
+/** Empty (a NaN angle is never taken from the cache). */
+static inline void nav_kin_sincos_cache_init(nav_kin_sincos_cache *k) {
+  k->a = NAN;
+  k->s = k->c = NAN;
+}
+
+/** nav_kin_sincos(a) through the cache: the same numbers (reused only for the same bits of a). */
+static inline void nav_kin_sincos_cached(nav_kin_sincos_cache *k, double a, double *s, double *c) {
+  if (!nav_kin_same_bits(a, k->a) || isnan(a)) {
+    nav_kin_sincos(a, &k->s, &k->c);
+    k->a = a;
+  }
+  *s = k->s;
+  *c = k->c;
 }
 
 /**
@@ -290,6 +321,9 @@ typedef struct nav_kin_nodes {
   nav_vec3 a_ned_mps2[NAV_KIN_MAX_NODES]; /* as nav_local_kin */
   nav_vec3 w_nb_b_rps[NAV_KIN_MAX_NODES]; /* as nav_local_kin */
   nav_mat3 C_b_n[NAV_KIN_MAX_NODES];      /* the attitude q_b_n of nav_local_kin as a DCM */
+  /* same_kin[i] (i >= 1): v, a, w and C of node i are those of node i - 1, bit for bit (the caller
+   * clears these flags; an evaluator may set them so that work on equal inputs is skipped). */
+  bool same_kin[NAV_KIN_MAX_NODES];
 } nav_kin_nodes;
 
 /** Node evaluators of the models (self as created by the matching nav_traj_*_create). */
