@@ -67,6 +67,11 @@ typedef struct seg_model {
    * of seg_kin's angles (roll, pitch, yaw and their halves): unchanged angles (a car's yaw on a
    * straight, everything at rest) are not recomputed. */
   nav_kin_sincos_cache nd_sc[3], st_sc[6];
+  /* seg_eval_nopos: the channels' (value, rate, rate derivative) of the last call and its result,
+   * reused for inputs of the same bits (at rest, on a straight). */
+  bool st_ok;
+  double st_in[3 * CH_CYAW];
+  nav_local_kin st_out;
 } seg_model;
 
 typedef struct planner {
@@ -776,6 +781,14 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   double x[CH_CYAW], r[CH_CYAW], r1[CH_CYAW];
   for (int c = 0; c < CH_CYAW; ++c)
     nav_kin_channel_eval_rate(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
+  double in[3 * CH_CYAW];
+  memcpy(in, x, sizeof x);
+  memcpy(in + CH_CYAW, r, sizeof r);
+  memcpy(in + 2 * CH_CYAW, r1, sizeof r1);
+  if (m->st_ok && memcmp(in, m->st_in, sizeof in) == 0) {
+    *out = m->st_out;
+    return NAV_OK;
+  }
   const double roll = x[CH_ROLL], pitch = x[CH_PITCH], yaw = x[CH_YAW];
   double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
   nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
@@ -805,6 +818,9 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
   k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
   k.r_ned_m = nav_vec3_zero();
+  memcpy(m->st_in, in, sizeof in);
+  m->st_out = k;
+  m->st_ok = true;
   *out = k;
   return NAV_OK;
 }

@@ -39,6 +39,11 @@ struct nav_traj {
   /* sin and cos of the latitude and longitude of the last WGS-84 state, and of the latitude at the
    * first node of the last increment (reused for the same bits: a vehicle at rest). */
   nav_kin_sincos_cache st_lat_sc, st_lon_sc, nd_lat_sc;
+  /* eval_state on WGS-84 from local kinematics: the last input and its state, reused for an input of
+   * the same bits (a vehicle at rest). */
+  bool es_ok;
+  nav_local_kin es_in;
+  nav_traj_state es_out;
   /* Position chain: R(chain_j) when chain_ok (a cache of a pure function of j). */
   bool chain_ok;
   int64_t chain_j;
@@ -287,11 +292,22 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
     if (traj->m.eval_local) {
       nav_local_kin k;
       st = local_kin(traj, t_s, r_ned, &k);
+      if (st != NAV_OK) return st;
+      if (traj->es_ok && memcmp(&k, &traj->es_in, sizeof k) == 0) {
+        s = traj->es_out;
+        s.t_s = t_s;
+        *out = s;
+        return NAV_OK;
+      }
       g = local_to_geo(&traj->frame, &k);
+      geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
+      traj->es_in = k;
+      traj->es_out = s;
+      traj->es_ok = true;
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
+      if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
     }
-    if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
   }
   if (st != NAV_OK) return st;
   *out = s;
