@@ -72,6 +72,12 @@ typedef struct seg_model {
   bool st_ok;
   double st_in[3 * CH_CYAW];
   nav_local_kin st_out;
+  /* The node evaluator's last interval with every channel at rest: its channel values and node
+   * outputs (nav_traj_segments_nodes). */
+  bool rest_ok;
+  double rest_in[12];
+  nav_mat3 rest_C;
+  nav_vec3 rest_w, rest_v, rest_a;
 } seg_model;
 
 typedef struct planner {
@@ -841,9 +847,33 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   double ang[3][NAV_KIN_MAX_NODES], rate[3][NAV_KIN_MAX_NODES], vb[3][NAV_KIN_MAX_NODES],
       vbd[3][NAV_KIN_MAX_NODES];
   double r1[NAV_KIN_MAX_NODES];
+  bool at_rest = m->ch[CH_CYAW].n == 0;
   for (int c = 0; c < 3; ++c) {
-    nav_kin_channel_eval_rate_n(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
-    nav_kin_channel_eval_rate_n(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+    at_rest &= nav_kin_channel_eval_rate_n(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
+    at_rest &= nav_kin_channel_eval_rate_n(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+  }
+  /* Every channel at rest over the interval (each node has the first node's channel values): when
+   * those have the bits of the last such interval's, so have the outputs (a car on a straight or
+   * standing still). */
+  double rest_in[12];
+  if (at_rest) {
+    for (int c = 0; c < 3; ++c) {
+      rest_in[c] = ang[c][0];
+      rest_in[3 + c] = rate[c][0];
+      rest_in[6 + c] = vb[c][0];
+      rest_in[9 + c] = vbd[c][0];
+    }
+    if (m->rest_ok && memcmp(rest_in, m->rest_in, sizeof rest_in) == 0) {
+      for (int i = 0; i < n; ++i) {
+        io->C_b_n[i] = m->rest_C;
+        io->w_nb_b_rps[i] = m->rest_w;
+        io->v_ned_mps[i] = m->rest_v;
+        io->a_ned_mps2[i] = m->rest_a;
+        io->same_kin[i] = i > 0;
+      }
+      io->has_pos = false;
+      return NAV_OK;
+    }
   }
   if (m->ch[CH_CYAW].n > 0) {
     /* Bank atan(z), z = u psi_dot_c / g, and its rate z' / (1 + z^2). */
@@ -921,6 +951,14 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
     io->a_ned_mps2[i] = nav_vec3_make(C->m[0][0] * ax + C->m[0][1] * ay + C->m[0][2] * az,
                                       C->m[1][0] * ax + C->m[1][1] * ay + C->m[1][2] * az,
                                       C->m[2][0] * ax + C->m[2][1] * ay + C->m[2][2] * az);
+  }
+  if (at_rest) {
+    memcpy(m->rest_in, rest_in, sizeof rest_in);
+    m->rest_C = io->C_b_n[0];
+    m->rest_w = io->w_nb_b_rps[0];
+    m->rest_v = io->v_ned_mps[0];
+    m->rest_a = io->a_ned_mps2[0];
+    m->rest_ok = true;
   }
   io->has_pos = false;
   return NAV_OK;

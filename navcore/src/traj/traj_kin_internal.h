@@ -212,8 +212,8 @@ double nav_kin_channel_eval_value(const nav_kin_channel *c, double t_s, ptrdiff_
 void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
                                double *r1);
 /** nav_kin_channel_eval_rate at the ascending times t_s[0..n-1] (a channel at rest over the
- *  whole span is evaluated once). */
-void nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
+ *  whole span is evaluated once: then it returns true, and every entry has the first one's bits). */
+bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
                                  double *x, double *r, double *r1);
 /** Rate after the last ramp. */
 double nav_kin_channel_final_rate(const nav_kin_channel *c);
