@@ -187,6 +187,17 @@ void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *
 
 NAV_HOT_CLONES bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n,
                                                 ptrdiff_t *hint, double *x, double *r, double *r1) {
+  if (!nav_kin_channel_eval_rate_n0(c, t_s, n, hint, x, r, r1)) return false;
+  for (int i = 1; i < n; ++i) {
+    x[i] = x[0];
+    r[i] = r[0];
+    r1[i] = r1[0];
+  }
+  return true;
+}
+
+NAV_HOT_CLONES bool nav_kin_channel_eval_rate_n0(const nav_kin_channel *c, const double *t_s, int n,
+                                                 ptrdiff_t *hint, double *x, double *r, double *r1) {
   if (n < 1) return false;
   /* A channel at rest over the whole span (after its ramps, at zero rate: the usual case for
    * most channels) is evaluated once; its value is constant there, up to the rounding of
@@ -202,14 +213,7 @@ NAV_HOT_CLONES bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const 
                ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s);
   }
   rate_state(c, k0, t_s[0], &x[0], &r[0], &r1[0]);
-  if (constant) {
-    for (int i = 1; i < n; ++i) {
-      x[i] = x[0];
-      r[i] = r[0];
-      r1[i] = r1[0];
-    }
-    return true;
-  }
+  if (constant) return true;
   /* All times in the step of the first (ascending times before the next step's start): the index
    * find_step would return for each. */
   const bool one_step = (k0 < 0 ? (c->n == 0 || t_last < c->steps[0].t0_s)

@@ -791,7 +791,7 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   memcpy(in, x, sizeof x);
   memcpy(in + CH_CYAW, r, sizeof r);
   memcpy(in + 2 * CH_CYAW, r1, sizeof r1);
-  if (m->st_ok && memcmp(in, m->st_in, sizeof in) == 0) {
+  if (m->st_ok && nav_kin_same_bits_n(in, m->st_in, 3 * CH_CYAW)) {
     *out = m->st_out;
     return NAV_OK;
   }
@@ -848,9 +848,11 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       vbd[3][NAV_KIN_MAX_NODES];
   double r1[NAV_KIN_MAX_NODES];
   bool at_rest = m->ch[CH_CYAW].n == 0;
+  bool rest[6];
   for (int c = 0; c < 3; ++c) {
-    at_rest &= nav_kin_channel_eval_rate_n(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
-    at_rest &= nav_kin_channel_eval_rate_n(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+    rest[c] = nav_kin_channel_eval_rate_n0(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
+    rest[3 + c] = nav_kin_channel_eval_rate_n0(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+    at_rest &= rest[c] & rest[3 + c];
   }
   /* Every channel at rest over the interval (each node has the first node's channel values): when
    * those have the bits of the last such interval's, so have the outputs (a car on a straight or
@@ -863,7 +865,7 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       rest_in[6 + c] = vb[c][0];
       rest_in[9 + c] = vbd[c][0];
     }
-    if (m->rest_ok && memcmp(rest_in, m->rest_in, sizeof rest_in) == 0) {
+    if (m->rest_ok && nav_kin_same_bits_n(rest_in, m->rest_in, 12)) {
       for (int i = 0; i < n; ++i) {
         io->C_b_n[i] = m->rest_C;
         io->w_nb_b_rps[i] = m->rest_w;
@@ -875,6 +877,18 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       return NAV_OK;
     }
   }
+  /* The channels at rest: their first node's values at every node (as nav_kin_channel_eval_rate_n). */
+  for (int c = 0; c < 3; ++c)
+    for (int i = 1; i < n; ++i) {
+      if (rest[c]) {
+        ang[c][i] = ang[c][0];
+        rate[c][i] = rate[c][0];
+      }
+      if (rest[3 + c]) {
+        vb[c][i] = vb[c][0];
+        vbd[c][i] = vbd[c][0];
+      }
+    }
   if (m->ch[CH_CYAW].n > 0) {
     /* Bank atan(z), z = u psi_dot_c / g, and its rate z' / (1 + z^2). */
     double cx[NAV_KIN_MAX_NODES], cr[NAV_KIN_MAX_NODES], cr1[NAV_KIN_MAX_NODES];

@@ -293,7 +293,7 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
       nav_local_kin k;
       st = local_kin(traj, t_s, r_ned, &k);
       if (st != NAV_OK) return st;
-      if (traj->es_ok && memcmp(&k, &traj->es_in, sizeof k) == 0) {
+      if (traj->es_ok && nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double))) {
         s = traj->es_out;
         s.t_s = t_s;
         *out = s;
@@ -411,8 +411,7 @@ static nav_status increment_by_nodes(nav_traj *traj, double t0_s, double t1_s, i
 
 /* Make (x, w) the rule of the position chain: the integration matrix, and a new chain. */
 static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
-  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 &&
-      memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
+  if (tr->q_n == n && nav_kin_same_bits_n(tr->q_x, x, (size_t)n) && nav_kin_same_bits_n(tr->q_w, w, (size_t)n))
     return;
   tr->q_n = n;
   memcpy(tr->q_x, x, (size_t)n * sizeof *x);

@@ -132,6 +132,20 @@ static inline bool nav_kin_same_bits(double a, double b) {
   return x == y;
 }
 
+/** The n doubles at a and b have the same bits (memcmp's answer, inlined for the short arrays of
+ *  the caches below; a and b may point to structs made of doubles only). */
+static inline bool nav_kin_same_bits_n(const void *a, const void *b, size_t n) {
+  const unsigned char *p = a, *q = b;
+  uint64_t diff = 0;
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t x, y;
+    memcpy(&x, p + 8 * i, sizeof x);
+    memcpy(&y, q + 8 * i, sizeof y);
+    diff |= x ^ y;
+  }
+  return diff == 0;
+}
+
 /** A one-entry cache of nav_kin_sincos: sin and cos of the last angle asked for. */
 typedef struct nav_kin_sincos_cache {
   double a, s, c;
@@ -215,6 +229,10 @@ void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *
  *  whole span is evaluated once: then it returns true, and every entry has the first one's bits). */
 bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
                                  double *x, double *r, double *r1);
+/** nav_kin_channel_eval_rate_n, but for a channel at rest over the span (returning true) only the
+ *  first entries are written: the caller copies them where it needs them. */
+bool nav_kin_channel_eval_rate_n0(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
+                                  double *x, double *r, double *r1);
 /** Rate after the last ramp. */
 double nav_kin_channel_final_rate(const nav_kin_channel *c);
 /** Time the last ramp ends (0 if none). */
