@@ -69,15 +69,21 @@ typedef struct seg_model {
   nav_kin_sincos_cache nd_sc[3], st_sc[6];
   /* seg_eval_nopos: the channels' (value, rate, rate derivative) of the last call and its result,
    * reused for inputs of the same bits (at rest, on a straight). */
-  bool st_ok;
-  double st_in[3 * CH_CYAW];
-  nav_local_kin st_out;
+  struct {
+    bool ok;
+    double in[3 * CH_CYAW];
+    nav_local_kin out;
+  } st[NAV_KIN_SC_WAYS];
+  int st_next;
   /* The node evaluator's last interval with every channel at rest: its channel values and node
    * outputs (nav_traj_segments_nodes). */
-  bool rest_ok;
-  double rest_in[12];
-  nav_mat3 rest_C;
-  nav_vec3 rest_w, rest_v, rest_a;
+  struct {
+    bool ok;
+    double in[12];
+    nav_mat3 C;
+    nav_vec3 w, v, a;
+  } rest[NAV_KIN_SC_WAYS]; /* several: a value at rest may alternate between neighbouring doubles */
+  int rest_next;
 } seg_model;
 
 typedef struct planner {
@@ -791,10 +797,11 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   memcpy(in, x, sizeof x);
   memcpy(in + CH_CYAW, r, sizeof r);
   memcpy(in + 2 * CH_CYAW, r1, sizeof r1);
-  if (m->st_ok && nav_kin_same_bits_n(in, m->st_in, 3 * CH_CYAW)) {
-    *out = m->st_out;
-    return NAV_OK;
-  }
+  for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
+    if (m->st[e].ok && nav_kin_same_bits_n(in, m->st[e].in, 3 * CH_CYAW)) {
+      *out = m->st[e].out;
+      return NAV_OK;
+    }
   const double roll = x[CH_ROLL], pitch = x[CH_PITCH], yaw = x[CH_YAW];
   double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
   nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
@@ -824,9 +831,11 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
   k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
   k.r_ned_m = nav_vec3_zero();
-  memcpy(m->st_in, in, sizeof in);
-  m->st_out = k;
-  m->st_ok = true;
+  const int e = m->st_next;
+  m->st_next = (e + 1) % NAV_KIN_SC_WAYS;
+  memcpy(m->st[e].in, in, sizeof in);
+  m->st[e].out = k;
+  m->st[e].ok = true;
   *out = k;
   return NAV_OK;
 }
@@ -865,17 +874,18 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       rest_in[6 + c] = vb[c][0];
       rest_in[9 + c] = vbd[c][0];
     }
-    if (m->rest_ok && nav_kin_same_bits_n(rest_in, m->rest_in, 12)) {
-      for (int i = 0; i < n; ++i) {
-        io->C_b_n[i] = m->rest_C;
-        io->w_nb_b_rps[i] = m->rest_w;
-        io->v_ned_mps[i] = m->rest_v;
-        io->a_ned_mps2[i] = m->rest_a;
-        io->same_kin[i] = i > 0;
+    for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
+      if (m->rest[e].ok && nav_kin_same_bits_n(rest_in, m->rest[e].in, 12)) {
+        for (int i = 0; i < n; ++i) {
+          io->C_b_n[i] = m->rest[e].C;
+          io->w_nb_b_rps[i] = m->rest[e].w;
+          io->v_ned_mps[i] = m->rest[e].v;
+          io->a_ned_mps2[i] = m->rest[e].a;
+          io->same_kin[i] = i > 0;
+        }
+        io->has_pos = false;
+        return NAV_OK;
       }
-      io->has_pos = false;
-      return NAV_OK;
-    }
   }
   /* The channels at rest: their first node's values at every node (as nav_kin_channel_eval_rate_n). */
   for (int c = 0; c < 3; ++c)
@@ -967,12 +977,14 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
                                       C->m[2][0] * ax + C->m[2][1] * ay + C->m[2][2] * az);
   }
   if (at_rest) {
-    memcpy(m->rest_in, rest_in, sizeof rest_in);
-    m->rest_C = io->C_b_n[0];
-    m->rest_w = io->w_nb_b_rps[0];
-    m->rest_v = io->v_ned_mps[0];
-    m->rest_a = io->a_ned_mps2[0];
-    m->rest_ok = true;
+    const int e = m->rest_next;
+    m->rest_next = (e + 1) % NAV_KIN_SC_WAYS;
+    memcpy(m->rest[e].in, rest_in, sizeof rest_in);
+    m->rest[e].C = io->C_b_n[0];
+    m->rest[e].w = io->w_nb_b_rps[0];
+    m->rest[e].v = io->v_ned_mps[0];
+    m->rest[e].a = io->a_ned_mps2[0];
+    m->rest[e].ok = true;
   }
   io->has_pos = false;
   return NAV_OK;

@@ -146,25 +146,38 @@ static inline bool nav_kin_same_bits_n(const void *a, const void *b, size_t n) {
   return diff == 0;
 }
 
-/** A one-entry cache of nav_kin_sincos: sin and cos of the last angle asked for. */
+/** A small cache of nav_kin_sincos: sin and cos of the last NAV_KIN_SC_WAYS angles asked for. An
+ *  angle held constant by a channel at rest is recomputed from its step each time and may alternate
+ *  between neighbouring doubles (the rounding of x0 + r0 d + dr (d - T/2) with r0 = -dr), hence
+ *  more than one entry. */
+#define NAV_KIN_SC_WAYS 4
 typedef struct nav_kin_sincos_cache {
-  double a, s, c;
+  double a[NAV_KIN_SC_WAYS], s[NAV_KIN_SC_WAYS], c[NAV_KIN_SC_WAYS];
+  int next;
 } nav_kin_sincos_cache;
 
 /** Empty (a NaN angle is never taken from the cache). */
 static inline void nav_kin_sincos_cache_init(nav_kin_sincos_cache *k) {
-  k->a = NAN;
-  k->s = k->c = NAN;
+  for (int i = 0; i < NAV_KIN_SC_WAYS; ++i)
+    k->a[i] = k->s[i] = k->c[i] = NAN;
+  k->next = 0;
 }
 
 /** nav_kin_sincos(a) through the cache: the same numbers (reused only for the same bits of a). */
 static inline void nav_kin_sincos_cached(nav_kin_sincos_cache *k, double a, double *s, double *c) {
-  if (!nav_kin_same_bits(a, k->a) || isnan(a)) {
-    nav_kin_sincos(a, &k->s, &k->c);
-    k->a = a;
-  }
-  *s = k->s;
-  *c = k->c;
+  if (!isnan(a))
+    for (int i = 0; i < NAV_KIN_SC_WAYS; ++i)
+      if (nav_kin_same_bits(a, k->a[i])) {
+        *s = k->s[i];
+        *c = k->c[i];
+        return;
+      }
+  const int i = k->next;
+  k->next = (i + 1) % NAV_KIN_SC_WAYS;
+  nav_kin_sincos(a, &k->s[i], &k->c[i]);
+  k->a[i] = a;
+  *s = k->s[i];
+  *c = k->c[i];
 }
 
 /**
