@@ -132,6 +132,7 @@ static void check_scene(const char *path, const char *name) {
   free(walk);
   nav_truth_destroy(ra);
   nav_truth_destroy(seq);
+  nav_scene_release(sc);
   free(sc);
 }
 
@@ -184,6 +185,7 @@ static void test_bad_arguments(void **state) {
   assert_int_equal(nav_truth_sample(t, 1, &s, NULL), NAV_ERR_INVALID_ARG);
   assert_memory_equal(&s, &s_before, sizeof s);
   nav_truth_destroy(t);
+  nav_scene_release(sc);
   free(sc);
 }
 
