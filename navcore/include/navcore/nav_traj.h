@@ -102,8 +102,8 @@ NAV_API NAV_NODISCARD nav_status nav_traj_inertial_increment(nav_traj *traj, dou
  * is the integral of their velocity (segment scripts, waypoints) the position of the state is the
  * position chain R(k) that the increment computes anyway, R(k) = R(k-1) + the rule's integral of
  * the velocity over the interval, restarted from the model's own position at every 64th sample
- * (docs/truth-generation-speed.md gives the difference from nav_traj_eval's position: at most
- * about 1e-9 m); every other field, and the whole state of other models, has the numbers of
+ * (it differs from nav_traj_eval's position by rounding: at most 3.5e-9 m, a few ulp of an ECEF
+ * coordinate, over the library's scenes; docs/truth-generation-speed.md); every other field, and the whole state of other models, has the numbers of
  * nav_traj_eval(t_k). The results depend only on k and the rule, never on earlier calls; walking
  * k = 1, 2, ... is the fast case.
  * @return as nav_traj_inertial_increment (NAV_ERR_INVALID_ARG also for k < 1).

@@ -55,7 +55,8 @@ NAV_API NAV_NODISCARD nav_status nav_truth_state(nav_truth *truth, double t_s, n
  * increment has the same numbers; the state's position, for segment-script and waypoint
  * trajectories, is the chain of interval quadratures of the velocity restarted every 64 samples
  * from the exact position, which differs from nav_truth_state's by rounding-level amounts (at most
- * about 1e-9 m; docs/truth-generation-speed.md). The state at t_0 is nav_truth_state(0).
+ * 3.5e-9 m over the library's scenes; docs/truth-generation-speed.md). The state at t_0 is
+ * nav_truth_state(0).
  * Results depend only on k, never on earlier calls; walking k = 1, 2, ... is the fast case.
  * NAV_ERR_NUMERIC as the two functions it replaces (outputs untouched).
  */
