@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "navcore/nav_rng.h"
+#include "nav_clones.h"
 #include "rng/rng_internal.h"
 
 /* ------------------------------------------------------------------ bias instability -> GM */
@@ -214,7 +215,9 @@ typedef struct triad {
   /* dt-dependent coefficients, valid for dt_cached */
   pair_coef gm_c[3], rw_c[3];
   double n_sd[3]; /* N sqrt(dt) */
-  nav_rng rng_noise[3], rng_gm[3], rng_rw[3];
+  /* The three axes' streams of each term side by side (rng_internal.h): one vector step draws a
+   * deviate for every axis, the same values as one nav_rng_gauss() per axis and deviate. */
+  nav_rng_lanes rng_noise, rng_gm, rng_rw;
 } triad;
 
 struct nav_imu_model {
@@ -381,21 +384,25 @@ static void triad_init(triad *t, const triad_params *p, const triad_kinds *k, ui
   if (t->terms & NAV_IMU_TERM_BIAS_TURN_ON)
     for (unsigned i = 0; i < 3; ++i)
       t->b0[i] = draw_const(seed, run, k->turn_on, i, b0_fixed[i], b0_sd[i]);
+  nav_rng r[3];
   if (t->terms & NAV_IMU_TERM_BIAS_GM) {
     vec_to_arr(t->gm_sd, p->gm_sd);
     vec_to_arr(t->gm_tau, p->gm_tau);
-    rng_triplet(t->rng_gm, seed, run, k->gm);
+    rng_triplet(r, seed, run, k->gm);
     /* Stationary start (E2.5): the first draw of each axis' GM stream. */
     for (int i = 0; i < 3; ++i)
-      t->gm_b[i] = t->gm_sd[i] * nav_rng_gauss(&t->rng_gm[i]);
+      t->gm_b[i] = t->gm_sd[i] * nav_rng_gauss(&r[i]);
+    nav_rng_lanes_pack(&t->rng_gm, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_BIAS_RW) {
     vec_to_arr(t->rw_k, p->rw_k);
-    rng_triplet(t->rng_rw, seed, run, k->rw);
+    rng_triplet(r, seed, run, k->rw);
+    nav_rng_lanes_pack(&t->rng_rw, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_NOISE) {
     vec_to_arr(t->n_density, p->n);
-    rng_triplet(t->rng_noise, seed, run, k->noise);
+    rng_triplet(r, seed, run, k->noise);
+    nav_rng_lanes_pack(&t->rng_noise, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_SCALE_FACTOR)
     for (unsigned i = 0; i < 3; ++i)
@@ -493,10 +500,16 @@ void nav_imu_model_destroy(nav_imu_model *model) {
  * One triad, one interval. x: ideal increment; extra: added before noise (gyro: G_g dv), NULL if
  * none. Writes the measured increment into y, the bias integral / dt into mean, the saturation
  * flags (bits 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
+ *
+ * Inlined into nav_imu_model_apply, with every intermediate in a local array that does not escape
+ * (so in registers) and each output written once: values that went through memory with scalar
+ * stores and came back as 16-byte pairs (or the reverse) could not be forwarded from the store
+ * buffer, a stall of ~10 cycles per such read at every sample.
  */
-static void triad_apply(triad *t, const double x[3], const double *extra, double dt, double y[3],
-                        double mean[3], unsigned *sat) {
+NAV_CLONE_INLINE void triad_apply(triad *t, const double x[3], const double *extra, double dt, double y_out[3],
+                                  double mean[3], unsigned *sat) {
   const unsigned terms = t->terms;
+  double y[3];
   if (t->apply_m) {
     /* (I + M) x, written as x + M x so that M = 0 reproduces x bit for bit. */
     for (int i = 0; i < 3; ++i)
@@ -510,26 +523,28 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
   if (terms & NAV_IMU_TERM_BIAS_TURN_ON)
     for (int i = 0; i < 3; ++i)
       ib[i] += t->b0[i] * dt;
-  /* Draws: one batch per term and triad (rng_internal.h), the same values as one
-   * nav_rng_gauss() per deviate. */
-  double u[6];
+  /* Draws: one vector step per term, triad and draw (rng_internal.h) gives one deviate per axis,
+   * the same values as one nav_rng_gauss() per axis and deviate. Per axis the order is fixed: u1
+   * (bias step), then u2 (integral). */
+  double u1s[4], u2s[4];
   if (terms & NAV_IMU_TERM_BIAS_GM) {
-    /* Draw order per axis is fixed: u1 (bias step), then u2 (integral). */
-    nav_rng_gauss_streams(t->rng_gm, 3, 2, u);
+    nav_rng_lanes_gauss(&t->rng_gm, 3, u1s);
+    nav_rng_lanes_gauss(&t->rng_gm, 3, u2s);
     for (int i = 0; i < 3; ++i) {
       const pair_coef *c = &t->gm_c[i];
-      const double u1 = u[2 * i], u2 = u[2 * i + 1];
-      ib[i] += c->c_int * t->gm_b[i] + c->l21 * u1 + c->l22 * u2;
-      t->gm_b[i] = c->phi * t->gm_b[i] + c->l11 * u1;
+      const double u1 = u1s[i], u2 = u2s[i], b = t->gm_b[i];
+      ib[i] += c->c_int * b + c->l21 * u1 + c->l22 * u2;
+      t->gm_b[i] = c->phi * b + c->l11 * u1;
     }
   }
   if (terms & NAV_IMU_TERM_BIAS_RW) {
-    nav_rng_gauss_streams(t->rng_rw, 3, 2, u);
+    nav_rng_lanes_gauss(&t->rng_rw, 3, u1s);
+    nav_rng_lanes_gauss(&t->rng_rw, 3, u2s);
     for (int i = 0; i < 3; ++i) {
       const pair_coef *c = &t->rw_c[i];
-      const double u1 = u[2 * i], u2 = u[2 * i + 1];
-      ib[i] += c->c_int * t->rw_b[i] + c->l21 * u1 + c->l22 * u2;
-      t->rw_b[i] += c->l11 * u1;
+      const double u1 = u1s[i], u2 = u2s[i], b = t->rw_b[i];
+      ib[i] += c->c_int * b + c->l21 * u1 + c->l22 * u2;
+      t->rw_b[i] = b + c->l11 * u1;
     }
   }
   if (t->any_bias)
@@ -541,22 +556,23 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
     for (int i = 0; i < 3; ++i)
       y[i] += extra[i];
   if (terms & NAV_IMU_TERM_NOISE) {
-    nav_rng_gauss_streams(t->rng_noise, 3, 1, u);
+    nav_rng_lanes_gauss(&t->rng_noise, 3, u1s);
     for (int i = 0; i < 3; ++i)
-      y[i] += t->n_sd[i] * u[i];
+      y[i] += t->n_sd[i] * u1s[i];
   }
-  *sat = 0;
+  unsigned flags = 0;
   if (terms & NAV_IMU_TERM_SATURATION)
     for (int i = 0; i < 3; ++i) {
       const double lim = t->range[i] * dt;
       if (y[i] > lim) {
         y[i] = lim;
-        *sat |= 1u << i;
+        flags |= 1u << i;
       } else if (y[i] < -lim) {
         y[i] = -lim;
-        *sat |= 1u << i;
+        flags |= 1u << i;
       }
     }
+  *sat = flags;
   if (terms & NAV_IMU_TERM_QUANTISATION)
     for (int i = 0; i < 3; ++i) {
       /* E2.8 with the residual r = S_k - Q_k carried instead of the running sums S and Q: the same
@@ -568,6 +584,9 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
       t->q_res[i] = v - q;
       y[i] = q;
     }
+  y_out[0] = y[0];
+  y_out[1] = y[1];
+  y_out[2] = y[2];
 }
 
 static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
@@ -578,8 +597,10 @@ static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
   return st;
 }
 
-nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *ideal,
-                               nav_imu_increment *measured) {
+/* Compiled for the baseline and for AVX2 (nav_clones.h; the same operations in the same order,
+ * bit-identical). */
+NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *ideal,
+                                              nav_imu_increment *measured) {
   assert(model != NULL && ideal != NULL && measured != NULL);
   if (model == NULL || ideal == NULL || measured == NULL) return NAV_ERR_INVALID_ARG;
   const double dt = ideal->dt_s;
@@ -620,8 +641,12 @@ nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *id
   measured->k = k;
   measured->t_s = t_s;
   measured->dt_s = dt;
-  measured->dtheta_b_rad = arr_to_vec(yg);
-  measured->dv_b_mps = arr_to_vec(ya);
+  measured->dtheta_b_rad.x = yg[0];
+  measured->dtheta_b_rad.y = yg[1];
+  measured->dtheta_b_rad.z = yg[2];
+  measured->dv_b_mps.x = ya[0];
+  measured->dv_b_mps.y = ya[1];
+  measured->dv_b_mps.z = ya[2];
 
   /* Bias bookkeeping only for triads that have a bias term: an ideal triad costs nothing here. */
   b->k = k;

@@ -688,9 +688,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       stop = true;
       break;
     }
-    nav_imu_increment ideal_imu, meas;
-    if (j->shared_imu) ideal_imu = j->shared_imu[k - 1];
-    else st = nav_truth_imu(truth, k, &ideal_imu);
+    /* The shared ideal record is read in place (no copy per step). */
+    nav_imu_increment own_imu, meas;
+    const nav_imu_increment *ideal = &own_imu;
+    if (j->shared_imu) ideal = &j->shared_imu[k - 1];
+    else st = nav_truth_imu(truth, k, &own_imu);
     if (st != NAV_OK) {
       job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
                 (double)k * dt);
@@ -704,15 +706,16 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         goto cleanup;
       }
     } else if (imu_model) {
-      st = nav_imu_model_apply(imu_model, &ideal_imu, &meas);
+      st = nav_imu_model_apply(imu_model, ideal, &meas);
       if (st != NAV_OK) {
-        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal_imu.t_s);
+        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal->t_s);
         goto cleanup;
       }
     } else {
-      meas = ideal_imu;
+      meas = *ideal;
     }
-    const nav_imu_increment meas_raw = meas;
+    /* meas is the raw measured record from here on: every consumer below takes it as const (no
+     * copy of it is kept for the record callback). */
     if (integrated) {
       st = nav_ins_gnss_step(aid_kf.x, &meas);
       if (st != NAV_OK) {
@@ -780,7 +783,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       store_sm(j, run, slot, true, &err);
     }
     if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw, NULL, NULL};
+      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, ideal, &meas, NULL, NULL};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
     }
     if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
