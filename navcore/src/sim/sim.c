@@ -312,6 +312,11 @@ typedef struct aiding {
   nav_ins_gnss *x;
   nav_sim_gyrofree *gf; /* gyro_free_gnss: the fixes go to the array INS's filter (borrowed) */
   int64_t next_epoch;
+  /* The time of receiver epoch t_epoch (a division), kept while the epoch waits: aiding_fixes
+   * asks for the next epoch's time at every IMU step. */
+  bool t_known;
+  int64_t t_epoch;
+  double t_fix_s;
 } aiding;
 
 static void aiding_destroy(aiding *a) {
@@ -396,7 +401,12 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
   const nav_scene *sc = &j->sim->scene;
   if (j->sim->fixes) return recorded_fixes(j, a, imu, run);
   for (;;) {
-    const double t_fix = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
+    if (!a->t_known || a->t_epoch != a->next_epoch) {
+      a->t_fix_s = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
+      a->t_epoch = a->next_epoch;
+      a->t_known = true;
+    }
+    const double t_fix = a->t_fix_s;
     if (!(t_fix <= imu->t_s + 0.5 * imu->dt_s)) break;
     const int64_t epoch = a->next_epoch++;
     if (t_fix < imu->t_s - 0.5 * imu->dt_s) continue; /* before the run's first interval */
