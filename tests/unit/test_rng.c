@@ -615,6 +615,52 @@ static void test_stream_ids(void **state) {
                    nav_rng_stream_id(NAV_RNG_STREAM_GYRO_BIAS_TURN_ON, 0));
 }
 
+/* nav_rng_lanes_gauss (rng_internal.h: the sensor models' draws, several streams in vector
+ * lanes) returns for every used lane exactly the value of one nav_rng_gauss() call on that
+ * lane's stream, bit for bit, and leaves each stream where those calls would: 2e5 draws per lane
+ * pass the wedge and tail paths many times (the slow path continues the lane's own stream). An
+ * unused lane stays all zero and returns +0.0. Checked with 1, 3 and 4 lanes in use. */
+static void test_lanes_gauss_equal_single_draws(void **state) {
+  (void)state;
+  const size_t used[] = {1, 3, 4};
+  for (size_t c = 0; c < sizeof used / sizeof used[0]; ++c) {
+    const size_t n = used[c];
+    nav_rng r[4], ref[4];
+    for (unsigned s = 0; s < 4; ++s) {
+      nav_rng_init(&r[s], test_seed, test_run + c, nav_rng_stream_id(NAV_RNG_STREAM_GYRO_NOISE, s));
+      ref[s] = r[s];
+    }
+    nav_rng_lanes lanes;
+    nav_rng_lanes_pack(&lanes, r, n);
+    long diverged = 0, tails = 0;
+    for (long it = 0; it < 200000; ++it) {
+      double out[4];
+      nav_rng_lanes_gauss(&lanes, n, out);
+      for (size_t s = 0; s < 4; ++s) {
+        if (s >= n) {
+          assert_int_equal(bits_of(out[s]), 0);
+          continue;
+        }
+        const double v = nav_rng_gauss(&ref[s]);
+        if (bits_of(v) != bits_of(out[s]))
+          fail_msg("lanes %zu, draw %ld, lane %zu: %.17g vs %.17g (nav_rng_gauss)", n, it, s, out[s], v);
+        tails += fabs(v) > zig_x[1];
+      }
+      diverged += nav_rng_lanes_get(&lanes, 0).s[0] != ref[0].s[0]; /* lane 0's state after every draw */
+    }
+    for (size_t s = 0; s < 4; ++s) {
+      const nav_rng got = nav_rng_lanes_get(&lanes, s);
+      if (s < n)
+        assert_memory_equal(got.s, ref[s].s, sizeof got.s);
+      else
+        for (int w = 0; w < 4; ++w)
+          assert_int_equal(got.s[w], 0);
+    }
+    assert_int_equal(diverged, 0);
+    assert_true(tails > 10); /* the tail (and so the slow path) was taken */
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_xoshiro256ss_reference_vector),
@@ -634,6 +680,7 @@ int main(void) {
       cmocka_unit_test(test_neighbour_streams_uncorrelated),
       cmocka_unit_test(test_lag1_autocorrelation),
       cmocka_unit_test(test_stream_ids),
+      cmocka_unit_test(test_lanes_gauss_equal_single_draws),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

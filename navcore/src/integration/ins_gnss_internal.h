@@ -16,7 +16,10 @@ struct nav_ins_gnss {
   nav_vec3 b_g_rps, b_a_mps2; /* estimated biases, subtracted from the raw increments */
   nav_vec3 s_g, s_a;          /* estimated scale factors: compensated = (raw - b dt) / (1 + s) */
   nav_imu_increment last;     /* compensated increment of the last step */
-  nav_vec3 w_prev_rps;        /* mean rate of the step before it */
+  /* The compensated angle increment and interval of the step before it: its mean rate is needed
+   * only at a fix epoch (nav_ins_gnss_epoch_nav), so the division is done there, not per step. */
+  nav_vec3 prev_dtheta_b_rad;
+  double prev_dt_s;
   bool have_step, have_prev;
   bool sf_on; /* the filter estimates scale factors */
   long updates;

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "navcore/nav_rng.h"
+#include "nav_clones.h"
 #include "rng/rng_internal.h"
 
 /* ------------------------------------------------------------------ bias instability -> GM */
@@ -211,11 +212,17 @@ typedef struct triad {
   nav_mat3 m;          /* M: scale factor on the diagonal, misalignment off it */
   double q_step[3], q_res[3];
   double range[3];
-  /* dt-dependent coefficients, valid for dt_cached */
-  pair_coef gm_c[3], rw_c[3];
-  double n_sd[3]; /* N sqrt(dt) */
-  nav_rng rng_noise[3], rng_gm[3], rng_rw[3];
+  /* The three axes' streams of each term side by side (rng_internal.h): one vector step draws a
+   * deviate for every axis, the same values as one nav_rng_gauss() per axis and deviate. */
+  nav_rng_lanes rng_noise, rng_gm, rng_rw;
 } triad;
+
+/* The dt-dependent coefficients of both triads (0: gyro, 1: accelerometer) for one interval. */
+typedef struct dt_slot {
+  double dt; /* 0: empty */
+  pair_coef gm_c[2][3], rw_c[2][3];
+  double n_sd[2][3]; /* N sqrt(dt) */
+} dt_slot;
 
 struct nav_imu_model {
   triad gyro, accel;
@@ -226,12 +233,11 @@ struct nav_imu_model {
   /* Coefficients of recently seen intervals. The increments' dt = t_k - t_(k-1) of a uniform
    * grid differs from sample to sample in its last bits (t_k = k dt rounded), which made
    * set_dt (two exp/expm1 per GM axis) run at nearly every sample; the few distinct values
-   * are cached by their exact bits, so the coefficients are exactly those set_dt computes. */
-  struct dt_slot {
-    double dt; /* 0: empty */
-    pair_coef gm_c[2][3], rw_c[2][3];
-    double n_sd[2][3];
-  } dt_cache[DT_CACHE_SLOTS];
+   * are cached by their exact bits, so the coefficients are exactly those set_dt computes.
+   * The samples read them through cur (the slot of dt_cached): a change of dt, at about every
+   * other sample early in a run, is a pointer switch, not a copy of the coefficients. */
+  dt_slot dt_cache[DT_CACHE_SLOTS];
+  const dt_slot *cur;
   nav_imu_run_constants consts;
   nav_imu_bias_state bias;
   char last_error[256];
@@ -294,45 +300,30 @@ static pair_coef rw_pair(double k, double dt) {
   return c;
 }
 
-static void set_dt_compute(nav_imu_model *m, double dt);
+/* The coefficients of both triads for interval dt, into slot e. */
+static void slot_fill(const nav_imu_model *m, dt_slot *e, double dt) {
+  const triad *t[2] = {&m->gyro, &m->accel};
+  for (int s = 0; s < 2; ++s) {
+    const double sdt = sqrt(dt);
+    for (int i = 0; i < 3; ++i) {
+      if (t[s]->terms & NAV_IMU_TERM_BIAS_GM) e->gm_c[s][i] = gm_pair(t[s]->gm_sd[i], t[s]->gm_tau[i], dt);
+      if (t[s]->terms & NAV_IMU_TERM_BIAS_RW) e->rw_c[s][i] = rw_pair(t[s]->rw_k[i], dt);
+      e->n_sd[s][i] = t[s]->n_density[i] * sdt;
+    }
+  }
+  e->dt = dt;
+}
 
-/* The coefficients for interval dt: from the cache when this exact dt was seen, else computed
- * and cached (the slot from the bits of dt). */
+/* Make the coefficients for interval dt current: from the cache when this exact dt was seen,
+ * else computed into its slot (the slot from the bits of dt). */
 static void set_dt(nav_imu_model *m, double dt) {
   uint64_t bits;
   memcpy(&bits, &dt, sizeof bits);
   bits ^= bits >> 29;
   bits *= 0x9E3779B97F4A7C15ull;
-  struct dt_slot *e = &m->dt_cache[bits >> 60 & (DT_CACHE_SLOTS - 1)];
-  triad *t[2] = {&m->gyro, &m->accel};
-  if (e->dt == dt) {
-    for (int s = 0; s < 2; ++s) {
-      memcpy(t[s]->gm_c, e->gm_c[s], sizeof e->gm_c[s]);
-      memcpy(t[s]->rw_c, e->rw_c[s], sizeof e->rw_c[s]);
-      memcpy(t[s]->n_sd, e->n_sd[s], sizeof e->n_sd[s]);
-    }
-    m->dt_cached = dt;
-    return;
-  }
-  set_dt_compute(m, dt);
-  e->dt = dt;
-  for (int s = 0; s < 2; ++s) {
-    memcpy(e->gm_c[s], t[s]->gm_c, sizeof e->gm_c[s]);
-    memcpy(e->rw_c[s], t[s]->rw_c, sizeof e->rw_c[s]);
-    memcpy(e->n_sd[s], t[s]->n_sd, sizeof e->n_sd[s]);
-  }
-}
-
-static void set_dt_compute(nav_imu_model *m, double dt) {
-  triad *t[2] = {&m->gyro, &m->accel};
-  for (int s = 0; s < 2; ++s) {
-    const double sdt = sqrt(dt);
-    for (int i = 0; i < 3; ++i) {
-      if (t[s]->terms & NAV_IMU_TERM_BIAS_GM) t[s]->gm_c[i] = gm_pair(t[s]->gm_sd[i], t[s]->gm_tau[i], dt);
-      if (t[s]->terms & NAV_IMU_TERM_BIAS_RW) t[s]->rw_c[i] = rw_pair(t[s]->rw_k[i], dt);
-      t[s]->n_sd[i] = t[s]->n_density[i] * sdt;
-    }
-  }
+  dt_slot *e = &m->dt_cache[bits >> 60 & (DT_CACHE_SLOTS - 1)];
+  if (e->dt != dt) slot_fill(m, e, dt);
+  m->cur = e;
   m->dt_cached = dt;
 }
 
@@ -381,21 +372,25 @@ static void triad_init(triad *t, const triad_params *p, const triad_kinds *k, ui
   if (t->terms & NAV_IMU_TERM_BIAS_TURN_ON)
     for (unsigned i = 0; i < 3; ++i)
       t->b0[i] = draw_const(seed, run, k->turn_on, i, b0_fixed[i], b0_sd[i]);
+  nav_rng r[3];
   if (t->terms & NAV_IMU_TERM_BIAS_GM) {
     vec_to_arr(t->gm_sd, p->gm_sd);
     vec_to_arr(t->gm_tau, p->gm_tau);
-    rng_triplet(t->rng_gm, seed, run, k->gm);
+    rng_triplet(r, seed, run, k->gm);
     /* Stationary start (E2.5): the first draw of each axis' GM stream. */
     for (int i = 0; i < 3; ++i)
-      t->gm_b[i] = t->gm_sd[i] * nav_rng_gauss(&t->rng_gm[i]);
+      t->gm_b[i] = t->gm_sd[i] * nav_rng_gauss(&r[i]);
+    nav_rng_lanes_pack(&t->rng_gm, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_BIAS_RW) {
     vec_to_arr(t->rw_k, p->rw_k);
-    rng_triplet(t->rng_rw, seed, run, k->rw);
+    rng_triplet(r, seed, run, k->rw);
+    nav_rng_lanes_pack(&t->rng_rw, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_NOISE) {
     vec_to_arr(t->n_density, p->n);
-    rng_triplet(t->rng_noise, seed, run, k->noise);
+    rng_triplet(r, seed, run, k->noise);
+    nav_rng_lanes_pack(&t->rng_noise, r, 3);
   }
   if (t->terms & NAV_IMU_TERM_SCALE_FACTOR)
     for (unsigned i = 0; i < 3; ++i)
@@ -490,13 +485,20 @@ void nav_imu_model_destroy(nav_imu_model *model) {
 }
 
 /*
- * One triad, one interval. x: ideal increment; extra: added before noise (gyro: G_g dv), NULL if
- * none. Writes the measured increment into y, the bias integral / dt into mean, the saturation
+ * One triad, one interval, with the triad's coefficients for dt (gm_c, rw_c, n_sd). x: ideal
+ * increment; extra: added before noise (gyro: G_g dv), NULL if none. Writes the measured increment into y, the bias integral / dt into mean, the saturation
  * flags (bits 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
+ *
+ * Inlined into nav_imu_model_apply, with every intermediate in a local array that does not escape
+ * (so in registers) and each output written once: values that went through memory with scalar
+ * stores and came back as 16-byte pairs (or the reverse) could not be forwarded from the store
+ * buffer, a stall of ~10 cycles per such read at every sample.
  */
-static void triad_apply(triad *t, const double x[3], const double *extra, double dt, double y[3],
-                        double mean[3], unsigned *sat) {
+NAV_CLONE_INLINE void triad_apply(triad *t, const pair_coef *gm_c, const pair_coef *rw_c, const double *n_sd,
+                                  const double x[3], const double *extra, double dt, double y_out[3], double mean[3],
+                                  unsigned *sat) {
   const unsigned terms = t->terms;
+  double y[3];
   if (t->apply_m) {
     /* (I + M) x, written as x + M x so that M = 0 reproduces x bit for bit. */
     for (int i = 0; i < 3; ++i)
@@ -510,26 +512,28 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
   if (terms & NAV_IMU_TERM_BIAS_TURN_ON)
     for (int i = 0; i < 3; ++i)
       ib[i] += t->b0[i] * dt;
-  /* Draws: one batch per term and triad (rng_internal.h), the same values as one
-   * nav_rng_gauss() per deviate. */
-  double u[6];
+  /* Draws: one vector step per term, triad and draw (rng_internal.h) gives one deviate per axis,
+   * the same values as one nav_rng_gauss() per axis and deviate. Per axis the order is fixed: u1
+   * (bias step), then u2 (integral). */
+  double u1s[4], u2s[4];
   if (terms & NAV_IMU_TERM_BIAS_GM) {
-    /* Draw order per axis is fixed: u1 (bias step), then u2 (integral). */
-    nav_rng_gauss_streams(t->rng_gm, 3, 2, u);
+    nav_rng_lanes_gauss(&t->rng_gm, 3, u1s);
+    nav_rng_lanes_gauss(&t->rng_gm, 3, u2s);
     for (int i = 0; i < 3; ++i) {
-      const pair_coef *c = &t->gm_c[i];
-      const double u1 = u[2 * i], u2 = u[2 * i + 1];
-      ib[i] += c->c_int * t->gm_b[i] + c->l21 * u1 + c->l22 * u2;
-      t->gm_b[i] = c->phi * t->gm_b[i] + c->l11 * u1;
+      const pair_coef *c = &gm_c[i];
+      const double u1 = u1s[i], u2 = u2s[i], b = t->gm_b[i];
+      ib[i] += c->c_int * b + c->l21 * u1 + c->l22 * u2;
+      t->gm_b[i] = c->phi * b + c->l11 * u1;
     }
   }
   if (terms & NAV_IMU_TERM_BIAS_RW) {
-    nav_rng_gauss_streams(t->rng_rw, 3, 2, u);
+    nav_rng_lanes_gauss(&t->rng_rw, 3, u1s);
+    nav_rng_lanes_gauss(&t->rng_rw, 3, u2s);
     for (int i = 0; i < 3; ++i) {
-      const pair_coef *c = &t->rw_c[i];
-      const double u1 = u[2 * i], u2 = u[2 * i + 1];
-      ib[i] += c->c_int * t->rw_b[i] + c->l21 * u1 + c->l22 * u2;
-      t->rw_b[i] += c->l11 * u1;
+      const pair_coef *c = &rw_c[i];
+      const double u1 = u1s[i], u2 = u2s[i], b = t->rw_b[i];
+      ib[i] += c->c_int * b + c->l21 * u1 + c->l22 * u2;
+      t->rw_b[i] = b + c->l11 * u1;
     }
   }
   if (t->any_bias)
@@ -541,22 +545,23 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
     for (int i = 0; i < 3; ++i)
       y[i] += extra[i];
   if (terms & NAV_IMU_TERM_NOISE) {
-    nav_rng_gauss_streams(t->rng_noise, 3, 1, u);
+    nav_rng_lanes_gauss(&t->rng_noise, 3, u1s);
     for (int i = 0; i < 3; ++i)
-      y[i] += t->n_sd[i] * u[i];
+      y[i] += n_sd[i] * u1s[i];
   }
-  *sat = 0;
+  unsigned flags = 0;
   if (terms & NAV_IMU_TERM_SATURATION)
     for (int i = 0; i < 3; ++i) {
       const double lim = t->range[i] * dt;
       if (y[i] > lim) {
         y[i] = lim;
-        *sat |= 1u << i;
+        flags |= 1u << i;
       } else if (y[i] < -lim) {
         y[i] = -lim;
-        *sat |= 1u << i;
+        flags |= 1u << i;
       }
     }
+  *sat = flags;
   if (terms & NAV_IMU_TERM_QUANTISATION)
     for (int i = 0; i < 3; ++i) {
       /* E2.8 with the residual r = S_k - Q_k carried instead of the running sums S and Q: the same
@@ -568,6 +573,9 @@ static void triad_apply(triad *t, const double x[3], const double *extra, double
       t->q_res[i] = v - q;
       y[i] = q;
     }
+  y_out[0] = y[0];
+  y_out[1] = y[1];
+  y_out[2] = y[2];
 }
 
 static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
@@ -578,8 +586,10 @@ static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
   return st;
 }
 
-nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *ideal,
-                               nav_imu_increment *measured) {
+/* Compiled for the baseline and for AVX2 (nav_clones.h; the same operations in the same order,
+ * bit-identical). */
+NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *ideal,
+                                              nav_imu_increment *measured) {
   assert(model != NULL && ideal != NULL && measured != NULL);
   if (model == NULL || ideal == NULL || measured == NULL) return NAV_ERR_INVALID_ARG;
   const double dt = ideal->dt_s;
@@ -605,7 +615,8 @@ nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *id
   unsigned sat_g = 0, sat_a = 0;
   /* Accelerometer first, then gyro: the order only fixes which stream is read when; streams are
    * independent, so it does not affect values. G_g acts on the true dv (E2.2: G_g f). */
-  triad_apply(&model->accel, dv, NULL, dt, ya, ma, &sat_a);
+  const dt_slot *c = model->cur;
+  triad_apply(&model->accel, c->gm_c[1], c->rw_c[1], c->n_sd[1], dv, NULL, dt, ya, ma, &sat_a);
   double gdv[3];
   const double *extra = NULL;
   if (model->apply_g) {
@@ -613,15 +624,19 @@ nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *id
       gdv[i] = model->g_sens.m[i][0] * dv[0] + model->g_sens.m[i][1] * dv[1] + model->g_sens.m[i][2] * dv[2];
     extra = gdv;
   }
-  triad_apply(&model->gyro, dth, extra, dt, yg, mg, &sat_g);
+  triad_apply(&model->gyro, c->gm_c[0], c->rw_c[0], c->n_sd[0], dth, extra, dt, yg, mg, &sat_g);
 
   const int64_t k = ideal->k;
   const double t_s = ideal->t_s;
   measured->k = k;
   measured->t_s = t_s;
   measured->dt_s = dt;
-  measured->dtheta_b_rad = arr_to_vec(yg);
-  measured->dv_b_mps = arr_to_vec(ya);
+  measured->dtheta_b_rad.x = yg[0];
+  measured->dtheta_b_rad.y = yg[1];
+  measured->dtheta_b_rad.z = yg[2];
+  measured->dv_b_mps.x = ya[0];
+  measured->dv_b_mps.y = ya[1];
+  measured->dv_b_mps.z = ya[2];
 
   /* Bias bookkeeping only for triads that have a bias term: an ideal triad costs nothing here. */
   b->k = k;

@@ -312,6 +312,11 @@ typedef struct aiding {
   nav_ins_gnss *x;
   nav_sim_gyrofree *gf; /* gyro_free_gnss: the fixes go to the array INS's filter (borrowed) */
   int64_t next_epoch;
+  /* The time of receiver epoch t_epoch (a division), kept while the epoch waits: aiding_fixes
+   * asks for the next epoch's time at every IMU step. */
+  bool t_known;
+  int64_t t_epoch;
+  double t_fix_s;
 } aiding;
 
 static void aiding_destroy(aiding *a) {
@@ -396,7 +401,12 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
   const nav_scene *sc = &j->sim->scene;
   if (j->sim->fixes) return recorded_fixes(j, a, imu, run);
   for (;;) {
-    const double t_fix = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
+    if (!a->t_known || a->t_epoch != a->next_epoch) {
+      a->t_fix_s = nav_gnss_model_epoch_time_s(a->gnss, a->next_epoch);
+      a->t_epoch = a->next_epoch;
+      a->t_known = true;
+    }
+    const double t_fix = a->t_fix_s;
     if (!(t_fix <= imu->t_s + 0.5 * imu->dt_s)) break;
     const int64_t epoch = a->next_epoch++;
     if (t_fix < imu->t_s - 0.5 * imu->dt_s) continue; /* before the run's first interval */
@@ -688,9 +698,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       stop = true;
       break;
     }
-    nav_imu_increment ideal_imu, meas;
-    if (j->shared_imu) ideal_imu = j->shared_imu[k - 1];
-    else st = nav_truth_imu(truth, k, &ideal_imu);
+    /* The shared ideal record is read in place (no copy per step). */
+    nav_imu_increment own_imu, meas;
+    const nav_imu_increment *ideal = &own_imu;
+    if (j->shared_imu) ideal = &j->shared_imu[k - 1];
+    else st = nav_truth_imu(truth, k, &own_imu);
     if (st != NAV_OK) {
       job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
                 (double)k * dt);
@@ -704,15 +716,16 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         goto cleanup;
       }
     } else if (imu_model) {
-      st = nav_imu_model_apply(imu_model, &ideal_imu, &meas);
+      st = nav_imu_model_apply(imu_model, ideal, &meas);
       if (st != NAV_OK) {
-        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal_imu.t_s);
+        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal->t_s);
         goto cleanup;
       }
     } else {
-      meas = ideal_imu;
+      meas = *ideal;
     }
-    const nav_imu_increment meas_raw = meas;
+    /* meas is the raw measured record from here on: every consumer below takes it as const (no
+     * copy of it is kept for the record callback). */
     if (integrated) {
       st = nav_ins_gnss_step(aid_kf.x, &meas);
       if (st != NAV_OK) {
@@ -780,7 +793,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       store_sm(j, run, slot, true, &err);
     }
     if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, &ideal_imu, &meas_raw, NULL, NULL};
+      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, ideal, &meas, NULL, NULL};
       if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
     }
     if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
