@@ -30,15 +30,10 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 #define MAX_PEERS 8
 
-/* IMU files up to this size are read on a thread of their own while the run starts on their
- * first records (nav_rec_imu_stream). The bound keeps the stride of the "stats" block at 1 for any
- * file of this size (even one of shortest record lines, 14 bytes), as for the record count the run
- * finds; the statistics' accumulators are sized by the count once it is known. Larger files are
- * checked before the run, as below. */
-#define REPLAY_IMU_STREAM_BYTES ((size_t)14 * (size_t)(NAV_SIM_METRIC_MAX_VALUES - 2) - 1)
-
-/* IMU files up to this size are held in memory between the check and the run (about 0.55 bytes of
- * records per byte of text: 256 MiB is some 2 million records, 2.8 h at 200 Hz). */
+/* IMU files up to this size are read into memory on a thread of their own while the run starts on
+ * their first records (nav_rec_imu_stream; about 0.55 bytes of records per byte of text: 256 MiB
+ * is some 2 million records, 2.8 h at 200 Hz). Larger files are checked before the run and read
+ * again by it, so memory stays bounded. */
 #define REPLAY_IMU_IN_MEMORY_BYTES ((size_t)256 * 1024 * 1024)
 
 static const char *k_usage_replay =
@@ -1095,8 +1090,6 @@ int navsim_replay(int argc, char **argv) {
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;
   size_t imu_count = 0; /* IMU records (nav_rec_check_file): bounds the scored epochs */
-  nav_rec_imu_array imu_arr; /* the IMU records, read once: checked here, replayed below */
-  memset(&imu_arr, 0, sizeof imu_arr);
   nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
   int rc_exit = EXIT_FAIL;
   nav_status st = NAV_OK;
@@ -1120,20 +1113,10 @@ int navsim_replay(int argc, char **argv) {
       memset(&d, 0, sizeof d);
       nav_status cs = NAV_ERR_OUT_OF_RANGE;
       if (i == 0) {
-        cs = nav_rec_imu_stream_start(paths[i], REPLAY_IMU_STREAM_BYTES, &imu_stream, &d);
+        cs = nav_rec_imu_stream_start(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &d);
         if (cs == NAV_OK) {
           rc.imu_stream = imu_stream;
           continue;
-        }
-        /* Up to REPLAY_IMU_IN_MEMORY_BYTES the check keeps the records for the run (no second
-           parse of the largest input); a larger file is checked here and streamed by the run. */
-        if (cs == NAV_ERR_OUT_OF_RANGE) {
-          memset(&d, 0, sizeof d);
-          cs = nav_rec_imu_array_load(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_arr, &d);
-        }
-        if (cs == NAV_OK) {
-          imu_count = imu_arr.count;
-          rc.imu = &imu_arr;
         }
       }
       if (i != 0 || cs == NAV_ERR_OUT_OF_RANGE) {
@@ -1481,7 +1464,6 @@ cleanup:
     free(o.buf[i]);
     free(o.mem[i]);
   }
-  nav_rec_imu_array_free(&imu_arr);
   nav_rec_imu_stream_destroy(imu_stream);
   nav_resultdir_abort(o.rd);
   smooth_out_destroy(o.so);
