@@ -888,6 +888,206 @@ cleanup:
   return st;
 }
 
+/* ---------------------------------------------------------------- IMU file as a stream */
+
+/* Records per block of the stream (72 bytes each: about 0.6 MB per block). Blocks are never moved,
+ * so a record handed out stays where it is while the parser goes on. */
+#define STREAM_BLOCK 8192u
+/* Records parsed between two hand-overs to the consumer (a lock and a broadcast each). */
+#define STREAM_PUBLISH 1024u
+/* The consumer looks at the parser's state at least every this many records, so that a bad
+ * record late in the file stops it soon after it is found. */
+#define STREAM_LOOK 4096u
+/* The shortest IMU record line: seven one-character fields, six separators and a line end. */
+#define STREAM_MIN_LINE_BYTES 14u
+
+struct nav_rec_imu_stream {
+  nav_rec_reader *r;
+  size_t file_bytes;
+  nav_imu_increment **blocks; /* block table, sized for the most records the file can hold */
+  size_t nblocks;
+  bool threaded;
+  pthread_t th;
+  pthread_mutex_t m;
+  pthread_cond_t cv;
+  atomic_bool stop; /* destroy: the parser stops at its next block */
+  /* Under m: records handed over, their byte fraction of the file, the end and its status. */
+  size_t avail;
+  double frac;
+  bool done;
+  nav_status st;
+  /* Written by the parser before it sets done (read after seeing done under m). */
+  long cut_line, last_line;
+  nav_diag diag;
+  /* The consumer's copy of the state above (nav_rec_imu_stream_at() and the replay only). */
+  size_t c_avail;
+  double c_frac;
+  bool c_done;
+  nav_status c_st;
+};
+
+static void stream_publish(nav_rec_imu_stream *s, size_t n, bool done, nav_status st) {
+  pthread_mutex_lock(&s->m);
+  s->avail = n;
+  s->frac = nav_rec_reader_fraction(s->r);
+  if (done) {
+    s->done = true;
+    s->st = st;
+  }
+  pthread_cond_broadcast(&s->cv);
+  pthread_mutex_unlock(&s->m);
+}
+
+static void *stream_main(void *arg) {
+  nav_rec_imu_stream *s = arg;
+  size_t n = 0;
+  nav_status st = NAV_OK;
+  for (;;) {
+    if (n % STREAM_BLOCK == 0) {
+      if (atomic_load_explicit(&s->stop, memory_order_relaxed)) {
+        st = NAV_ERR_CANCELLED;
+        break;
+      }
+      const size_t b = n / STREAM_BLOCK;
+      /* (The table holds the records of the shortest possible lines: never reached.) */
+      if (b >= s->nblocks) {
+        st = NAV_ERR_NO_MEMORY;
+        break;
+      }
+      if (!s->blocks[b]) s->blocks[b] = malloc(STREAM_BLOCK * sizeof **s->blocks);
+      if (!s->blocks[b]) {
+        st = NAV_ERR_NO_MEMORY;
+        break;
+      }
+    }
+    bool got = false;
+    st = nav_rec_read_imu(s->r, &s->blocks[n / STREAM_BLOCK][n % STREAM_BLOCK], &got);
+    if (st != NAV_OK) {
+      s->diag = s->r->diag;
+      break;
+    }
+    if (!got) break;
+    ++n;
+    if (n % STREAM_PUBLISH == 0) stream_publish(s, n, false, NAV_OK);
+  }
+  s->cut_line = s->r->cut_line;
+  s->last_line = s->r->rec_line;
+  stream_publish(s, n, true, st);
+  return NULL;
+}
+
+nav_status nav_rec_imu_stream_start(const char *path, size_t max_bytes, nav_rec_imu_stream **out,
+                                    nav_diag *diag) {
+  if (!path || !out) return NAV_ERR_INVALID_ARG;
+  nav_rec_reader *r = NULL;
+  nav_status st = nav_rec_reader_open(path, NAV_REC_IMU, &r, diag);
+  if (st != NAV_OK) return st;
+  const size_t size = r->total > 0.0 ? (size_t)r->total : 0u;
+  if (size > max_bytes) {
+    nav_rec_reader_destroy(r);
+    diag_set(diag, path, 0, 0, "", "the IMU file has %zu bytes, more than the %zu to hold in memory", size,
+             max_bytes);
+    return NAV_ERR_OUT_OF_RANGE;
+  }
+  nav_rec_imu_stream *s = calloc(1, sizeof *s);
+  const size_t most = (size + 1) / STREAM_MIN_LINE_BYTES + 1;
+  const size_t nblocks = most / STREAM_BLOCK + 1;
+  nav_imu_increment **blocks = calloc(nblocks, sizeof *blocks);
+  if (!s || !blocks) {
+    free(s);
+    free(blocks);
+    nav_rec_reader_destroy(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  s->r = r;
+  s->file_bytes = size;
+  s->blocks = blocks;
+  s->nblocks = nblocks;
+  s->st = NAV_OK;
+  atomic_init(&s->stop, false);
+  if (pthread_mutex_init(&s->m, NULL) != 0) {
+    free(blocks);
+    free(s);
+    nav_rec_reader_destroy(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  if (pthread_cond_init(&s->cv, NULL) != 0) {
+    pthread_mutex_destroy(&s->m);
+    free(blocks);
+    free(s);
+    nav_rec_reader_destroy(r);
+    return NAV_ERR_NO_MEMORY;
+  }
+  /* POSIX threads (as the other threads here): ThreadSanitizer follows them. Without a thread the
+   * whole file is read now. */
+  s->threaded = pthread_create(&s->th, NULL, stream_main, s) == 0;
+  if (!s->threaded) (void)stream_main(s);
+  *out = s;
+  return NAV_OK;
+}
+
+size_t nav_rec_imu_stream_file_bytes(const nav_rec_imu_stream *s) { return s ? s->file_bytes : 0u; }
+
+/* The consumer's view of the parser's state, waiting until record @p i is parsed or the file
+ * ended when @p wait_for is true. */
+static void stream_look(nav_rec_imu_stream *s, size_t i, bool wait_for) {
+  pthread_mutex_lock(&s->m);
+  while (wait_for && s->avail <= i && !s->done)
+    pthread_cond_wait(&s->cv, &s->m);
+  s->c_avail = s->avail;
+  s->c_frac = s->frac;
+  s->c_done = s->done;
+  s->c_st = s->st;
+  pthread_mutex_unlock(&s->m);
+}
+
+nav_status nav_rec_imu_stream_at(nav_rec_imu_stream *s, size_t i, const nav_imu_increment **rec) {
+  if (!s || !rec) return NAV_ERR_INVALID_ARG;
+  if (i >= s->c_avail || i % STREAM_LOOK == 0) stream_look(s, i, true);
+  if (s->c_done && s->c_st != NAV_OK) return s->c_st;
+  *rec = i < s->c_avail ? &s->blocks[i / STREAM_BLOCK][i % STREAM_BLOCK] : NULL;
+  return NAV_OK;
+}
+
+bool nav_rec_imu_stream_poll(nav_rec_imu_stream *s, nav_status *st, size_t *count) {
+  if (!s) return false;
+  pthread_mutex_lock(&s->m);
+  const bool done = s->done;
+  if (done && st) *st = s->st;
+  if (done && count) *count = s->avail;
+  pthread_mutex_unlock(&s->m);
+  return done;
+}
+
+nav_status nav_rec_imu_stream_finish(nav_rec_imu_stream *s, size_t *count, long *cut_line, long *last_line,
+                                     nav_diag *diag) {
+  if (!s) return NAV_ERR_INVALID_ARG;
+  stream_look(s, SIZE_MAX, true);
+  if (s->c_st != NAV_OK) {
+    if (diag) *diag = s->diag;
+    return s->c_st;
+  }
+  if (count) *count = s->c_avail;
+  if (cut_line) *cut_line = s->cut_line;
+  if (last_line) *last_line = s->last_line;
+  return NAV_OK;
+}
+
+void nav_rec_imu_stream_destroy(nav_rec_imu_stream *s) {
+  if (!s) return;
+  if (s->threaded) {
+    atomic_store_explicit(&s->stop, true, memory_order_relaxed);
+    (void)pthread_join(s->th, NULL);
+  }
+  pthread_cond_destroy(&s->cv);
+  pthread_mutex_destroy(&s->m);
+  for (size_t b = 0; b < s->nblocks; ++b)
+    free(s->blocks[b]);
+  free(s->blocks);
+  nav_rec_reader_destroy(s->r);
+  free(s);
+}
+
 nav_traj_state nav_rec_pva_to_state(const nav_rec_pva *row) {
   nav_traj_state s;
   memset(&s, 0, sizeof s);
@@ -1237,8 +1437,29 @@ static nav_status ref_next(replay *p) {
   return NAV_OK;
 }
 
-/* The next IMU record: from the caller's array, or the (read-ahead) reader. */
+/* The next IMU record: from the caller's array or stream, or the (read-ahead) reader. */
 static nav_status imu_next(replay *p, nav_imu_increment *inc, bool *got) {
+  nav_rec_imu_stream *s = p->cfg->imu_stream;
+  if (s) {
+    const nav_imu_increment *rec = NULL;
+    *got = false;
+    const nav_status st = nav_rec_imu_stream_at(s, p->imu_idx, &rec);
+    if (st != NAV_OK) return st;
+    *got = rec != NULL;
+    if (*got) {
+      *inc = *rec;
+      p->imu_idx++;
+    } else {
+      p->imu_end_seen = true;
+    }
+    /* Records handed out against the records the file holds (known once it is read), or the
+     * parser's byte fraction scaled to the records handed out (an estimate, for progress only). */
+    if (s->c_done)
+      p->imu_fraction = s->c_avail ? (double)p->imu_idx / (double)s->c_avail : 1.0;
+    else
+      p->imu_fraction = s->c_avail ? fmin(1.0, s->c_frac * (double)p->imu_idx / (double)s->c_avail) : 0.0;
+    return NAV_OK;
+  }
   const nav_rec_imu_array *a = p->cfg->imu;
   if (a) {
     *got = p->imu_idx < a->count;
@@ -1314,6 +1535,8 @@ static nav_status check_config(const nav_replay_config *c, nav_diag *diag) {
     bad = "the end time must be after the start time";
   else if (c->outage_count > NAV_GNSS_MAX_OUTAGES)
     bad = "too many outages";
+  else if (c->imu && c->imu_stream)
+    bad = "IMU records in memory and an IMU stream are exclusive";
   else if (c->raw && c->gnss_path)
     bad = "raw measurements and a GNSS fix file are exclusive";
   else if (c->raw && !(c->nav.filter.states & NAV_FILTER_STATE_RX_CLOCK))
@@ -1545,7 +1768,7 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->free_ins = cfg->gnss_path == NULL && cfg->raw == NULL;
   const bool aided = !sum->free_ins;
 
-  if (!cfg->imu) st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
+  if (!cfg->imu && !cfg->imu_stream) st = nav_rec_reader_open(cfg->imu_path, NAV_REC_IMU, &p.imu, diag);
   if (st == NAV_OK) st = nav_rec_reader_open(cfg->ref_path, NAV_REC_PVA, &p.ref, diag);
   if (st == NAV_OK && cfg->gnss_path) st = nav_rec_reader_open(cfg->gnss_path, NAV_REC_GNSS, &p.gnss, diag);
   if (st != NAV_OK) goto cleanup;
@@ -1776,6 +1999,17 @@ nav_status nav_replay_run(const nav_replay_config *cfg, nav_replay_summary *out,
   sum->stats_output = nav_replay_stats_result(&sc.acc_out);
   if (nav.x) nav_ins_gnss_biases(nav.x, &sum->b_g_rps, &sum->b_a_mps2);
   sum->partial = stop;
+  if (cfg->imu_stream) {
+    /* As for records in memory (imu_next()): the streaming reader has read the last line once it
+     * returned the record on it or was asked past the last record. The file is read to its end
+     * long before the navigation gets there; waiting here only matters for a short window. */
+    nav_rec_imu_stream *s = cfg->imu_stream;
+    size_t count = 0;
+    long cut = 0, last = 0;
+    if (nav_rec_imu_stream_finish(s, &count, &cut, &last, NULL) == NAV_OK && cut &&
+        (p.imu_end_seen || (p.imu_idx == count && cut == last)))
+      p.imu_cut_line = cut;
+  }
   sum->imu_cut_line = p.imu_cut_line;
   sum->gnss_cut_line = nav_rec_reader_cut_line(p.gnss);
   sum->ref_cut_line = p.ref_cut_line;

@@ -12,6 +12,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,8 +31,10 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_INVALID = 2 };
 
 #define MAX_PEERS 8
 
-/* IMU files up to this size are held in memory between the check and the run (about 0.55 bytes of
- * records per byte of text: 256 MiB is some 2 million records, 2.8 h at 200 Hz). */
+/* IMU files up to this size are read into memory on a thread of their own while the run starts on
+ * their first records (nav_rec_imu_stream; about 0.55 bytes of records per byte of text: 256 MiB
+ * is some 2 million records, 2.8 h at 200 Hz). Larger files are checked before the run and read
+ * again by it, so memory stays bounded. */
 #define REPLAY_IMU_IN_MEMORY_BYTES ((size_t)256 * 1024 * 1024)
 
 static const char *k_usage_replay =
@@ -233,6 +236,15 @@ typedef struct run_stats {
   nav_stat_acc *acc[RUN_STATS_METRICS];
   long long stride, seen, kept;
   nav_status st;
+  /* While the IMU file is still being read, its record count (which sets the stride) is not
+   * known: the values of the scored epochs wait here, in order, and are fed to the accumulators
+   * once it is (run_stats_settle), as if they had been added then. */
+  bool pending;
+  double *pend; /* RUN_STATS_METRICS values per epoch */
+  size_t pend_n, pend_cap;
+  /* The results, once run_stats_finish() has computed them. */
+  bool have_result;
+  nav_stat result[RUN_STATS_METRICS];
 } run_stats;
 
 static void run_stats_on_scored(void *user, const nav_epoch_errors *e);
@@ -252,14 +264,68 @@ static nav_status run_stats_create(run_stats *rs, size_t epochs_max) {
 
 static void run_stats_destroy(run_stats *rs) {
   for (int m = 0; m < RUN_STATS_METRICS; ++m) nav_stat_acc_destroy(rs->acc[m]);
+  free(rs->pend);
+  rs->pend = NULL;
+}
+
+static void run_stats_add_values(run_stats *rs, const double v[RUN_STATS_METRICS]) {
+  if (rs->st != NAV_OK || rs->seen++ % rs->stride != 0) return;
+  for (int m = 0; m < RUN_STATS_METRICS && rs->st == NAV_OK; ++m) rs->st = nav_stat_acc_add(rs->acc[m], v[m]);
+  rs->kept++;
 }
 
 static void run_stats_add(run_stats *rs, const nav_epoch_errors *e) {
-  if (rs->st != NAV_OK || rs->seen++ % rs->stride != 0) return;
   const double v[RUN_STATS_METRICS] = {e->pos_err_h_m, e->pos_err_v_m, e->vel_err_mps, e->att_err_rad,
                                        fabs(e->euler_err.yaw_rad)};
-  for (int m = 0; m < RUN_STATS_METRICS && rs->st == NAV_OK; ++m) rs->st = nav_stat_acc_add(rs->acc[m], v[m]);
-  rs->kept++;
+  if (!rs->pending) {
+    run_stats_add_values(rs, v);
+    return;
+  }
+  if (rs->st != NAV_OK) return;
+  if (rs->pend_n == rs->pend_cap) {
+    const size_t cap = rs->pend_cap ? 2 * rs->pend_cap : 8192;
+    double *g = realloc(rs->pend, cap * RUN_STATS_METRICS * sizeof *g);
+    if (!g) {
+      rs->st = NAV_ERR_NO_MEMORY;
+      return;
+    }
+    rs->pend = g;
+    rs->pend_cap = cap;
+  }
+  memcpy(rs->pend + rs->pend_n++ * RUN_STATS_METRICS, v, sizeof v);
+}
+
+/* The statistics of a run whose IMU file (being read) turned out to hold @p epochs_max records:
+ * the accumulators of run_stats_create(), fed with the values that waited. */
+static void run_stats_settle(run_stats *rs, size_t epochs_max) {
+  if (!rs->pending) return;
+  double *pend = rs->pend;
+  const size_t n = rs->pend_n;
+  const nav_status pst = rs->st;
+  nav_status st = run_stats_create(rs, epochs_max); /* (clears rs) */
+  if (st == NAV_OK) st = pst;
+  rs->st = st;
+  for (size_t k = 0; k < n && rs->st == NAV_OK; ++k) run_stats_add_values(rs, pend + k * RUN_STATS_METRICS);
+  free(pend);
+}
+
+static void *run_stats_result_first(void *arg) {
+  run_stats *rs = arg;
+  for (int m = 0; m < 2; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
+  return NULL;
+}
+
+/* The results of every metric. Each p95 is a selection over all the values of its metric (some
+ * 3 ms for the five metrics of the long drive, after the run, on the critical path): the first two
+ * on a second thread, the other three here. The values do not depend on the thread. */
+static void run_stats_finish(run_stats *rs) {
+  if (rs->pending || rs->kept == 0 || rs->st != NAV_OK) return;
+  pthread_t th;
+  const bool threaded = pthread_create(&th, NULL, run_stats_result_first, rs) == 0;
+  if (!threaded) (void)run_stats_result_first(rs);
+  for (int m = 2; m < RUN_STATS_METRICS; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
+  if (threaded) (void)pthread_join(th, NULL);
+  rs->have_result = true;
 }
 
 /* ---------------------------------------------------------------- result files */
@@ -272,9 +338,22 @@ static void run_stats_add(run_stats *rs, const nav_epoch_errors *e) {
  * is renamed into place finds little left to write. */
 #define CSV_WRITEBACK_RECORDS 1024
 
+static const char *const k_csv_names[3] = {"truth.csv", "nav.csv", "errors.csv"};
+
 typedef struct out_files {
-  FILE *f[3]; /* truth.csv, nav.csv, errors.csv */
-  char *buf[3]; /* their stdio buffers, CSV_BUFFER_BYTES each */
+  /* truth.csv, nav.csv, errors.csv: in memory (open_memstream) until the IMU file being read has
+   * passed its checks, then the files of the result directory (live), which then get what was
+   * written to memory. Nothing is written to disk before every input record is checked. */
+  FILE *f[3];
+  char *buf[3]; /* the files' stdio buffers, CSV_BUFFER_BYTES each */
+  char *mem[3]; /* the memory streams' text */
+  size_t mem_len[3];
+  bool live;
+  int live_exit;              /* exit code of a failure to make the result directory live */
+  nav_rec_imu_stream *stream; /* the IMU file being read, or NULL (checked before the run) */
+  const char *out_dir;
+  bool force;
+  nav_resultdir *rd;
   long long records; /* output records written */
   nav_status st;
   bool show_progress;
@@ -295,9 +374,49 @@ static void start_writeback(FILE *f) {
 #endif
 }
 
+/* The result directory and its CSV files, which get the rows formatted in memory so far. */
+static int out_go_live(out_files *o) {
+  const int orc = navsim_out_begin("replay", o->out_dir, o->force, &o->rd);
+  if (orc != EXIT_OK) return orc;
+  for (int i = 0; i < 3; ++i) {
+    const char *file = nav_resultdir_file(o->rd, k_csv_names[i]);
+    FILE *f = file ? fopen(file, "w") : NULL;
+    /* 256 KiB buffers: a few write calls per file instead of one per 4 KiB. */
+    char *buf = f ? malloc(CSV_BUFFER_BYTES) : NULL;
+    if (buf) (void)setvbuf(f, buf, _IOFBF, CSV_BUFFER_BYTES);
+    bool ok = f != NULL && fflush(o->f[i]) == 0;
+    if (ok && o->mem_len[i] > 0) ok = fwrite(o->mem[i], 1, o->mem_len[i], f) == o->mem_len[i];
+    fclose(o->f[i]);
+    free(o->mem[i]);
+    o->mem[i] = NULL;
+    o->f[i] = f;
+    o->buf[i] = buf;
+    if (!ok) {
+      fprintf(stderr, "navsim replay: cannot write %s in \"%s\"\n", k_csv_names[i], o->out_dir);
+      return EXIT_FAIL;
+    }
+  }
+  o->live = true;
+  return EXIT_OK;
+}
+
+/* Live once the IMU file being read has passed its checks (asked without waiting). */
+static int out_maybe_live(out_files *o) {
+  nav_status st = NAV_ERR_STATE;
+  if (o->live || (o->stream && !(nav_rec_imu_stream_poll(o->stream, &st, NULL) && st == NAV_OK))) return EXIT_OK;
+  return out_go_live(o);
+}
+
 static nav_callback_result on_record(void *user, const nav_replay_record *r) {
   out_files *o = user;
-  if (++o->records % CSV_WRITEBACK_RECORDS == 0)
+  if (!o->live) {
+    o->live_exit = out_maybe_live(o);
+    if (o->live_exit != EXIT_OK) {
+      o->st = NAV_ERR_IO;
+      return NAV_STOP;
+    }
+  }
+  if (++o->records % CSV_WRITEBACK_RECORDS == 0 && o->live)
     for (int i = 0; i < 3; ++i) start_writeback(o->f[i]);
   /* Field by field: the simulator's record may grow fields the replay does not have. */
   nav_sim_record rec;
@@ -321,6 +440,11 @@ static nav_callback_result on_record(void *user, const nav_replay_record *r) {
 
 static void run_stats_on_scored(void *user, const nav_epoch_errors *e) {
   out_files *o = user;
+  if (o->rstats.pending && o->rstats.pend_n % 1024 == 0) {
+    nav_status st = NAV_ERR_STATE;
+    size_t count = 0;
+    if (nav_rec_imu_stream_poll(o->stream, &st, &count) && st == NAV_OK) run_stats_settle(&o->rstats, count);
+  }
   run_stats_add(&o->rstats, e);
 }
 
@@ -345,7 +469,7 @@ static void json_run_stats(FILE *f, run_stats *rs) {
   fprintf(f, "  \"stats\": {\n    \"epochs\": %lld,\n    \"stride\": %lld,\n", rs->kept, rs->stride);
   for (int m = 0; m < RUN_STATS_METRICS; ++m) {
     nav_stat s = {NAN, NAN, NAN};
-    if (rs->kept > 0) s = nav_stat_acc_result(rs->acc[m]);
+    if (rs->kept > 0) s = rs->have_result ? rs->result[m] : nav_stat_acc_result(rs->acc[m]);
     fprintf(f, "    \"%s\": {\"rms\": ", names[m]);
     json_number(f, s.rms);
     fputs(", \"max\": ", f);
@@ -750,6 +874,20 @@ static bool is_regular_file(const char *path) {
   return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
 }
 
+/* An error found before the run while the IMU file is still being read: as when the IMU file was
+ * checked first, its own error is reported instead when it has one. Returns its exit code, else
+ * 0 (the IMU file is good; the caller reports its error). */
+static int imu_error_first(nav_rec_imu_stream *s, const char *imu) {
+  if (!s) return 0;
+  nav_diag d;
+  memset(&d, 0, sizeof d);
+  const nav_status st = nav_rec_imu_stream_finish(s, NULL, NULL, NULL, &d);
+  if (st == NAV_OK) return 0;
+  if (d.message[0]) navsim_print_diag(NULL, &d);
+  else fprintf(stderr, "%s: error: %s\n", imu, nav_status_str(st));
+  return st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+}
+
 /* nav_replay_raw_fn over a nav_rinex_source. */
 static nav_status rinex_next(void *user, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag) {
   return nav_rinex_source_next(user, ep, got, diag);
@@ -975,15 +1113,20 @@ int navsim_replay(int argc, char **argv) {
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;
   size_t imu_count = 0; /* IMU records (nav_rec_check_file): bounds the scored epochs */
-  nav_rec_imu_array imu_arr; /* the IMU records, read once: checked here, replayed below */
-  memset(&imu_arr, 0, sizeof imu_arr);
+  nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
+  int rc_exit = EXIT_FAIL;
+  nav_status st = NAV_OK;
+  out_files o;
+  memset(&o, 0, sizeof o);
   rc.imu_path = imu;
   rc.gnss_path = gnss;
   rc.ref_path = truth;
   {
-    /* Every IMU and GNSS record is checked before the run, wherever it is in the file: a value
-       that would make the filter non-finite is reported at FILE:LINE:COL (exit 2), not as a
-       failure of the run. */
+    /* Every IMU and GNSS record is checked before the results are written, wherever it is in the
+       file: a value that would make the filter non-finite is reported at FILE:LINE:COL (exit 2),
+       not as a failure of the run, and nothing is written. The IMU file is read on a thread of
+       its own while the navigation starts on its first records (rc.imu_stream); the verdict on
+       the whole file comes before anything reaches the disk, and a bad record stops the run. */
     const char *paths[2] = {imu, gnss};
     const nav_rec_format fmts[2] = {NAV_REC_IMU, NAV_REC_GNSS};
     imu_count = 0;
@@ -993,12 +1136,10 @@ int navsim_replay(int argc, char **argv) {
       memset(&d, 0, sizeof d);
       nav_status cs = NAV_ERR_OUT_OF_RANGE;
       if (i == 0) {
-        /* Up to REPLAY_IMU_IN_MEMORY_BYTES the check keeps the records for the run (no second
-           parse of the largest input); a larger file is checked here and streamed by the run. */
-        cs = nav_rec_imu_array_load(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_arr, &d);
+        cs = nav_rec_imu_stream_start(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &d);
         if (cs == NAV_OK) {
-          imu_count = imu_arr.count;
-          rc.imu = &imu_arr;
+          rc.imu_stream = imu_stream;
+          continue;
         }
       }
       if (i != 0 || cs == NAV_ERR_OUT_OF_RANGE) {
@@ -1006,12 +1147,12 @@ int navsim_replay(int argc, char **argv) {
         cs = nav_rec_check_file(paths[i], fmts[i], i == 0 ? &imu_count : NULL, &d);
       }
       if (cs != NAV_OK) {
+        rc_exit = imu_error_first(imu_stream, imu);
+        if (rc_exit) goto cleanup;
         if (d.message[0]) navsim_print_diag(NULL, &d);
         else fprintf(stderr, "%s: error: %s\n", paths[i], nav_status_str(cs));
-        free(reqs);
-        free(verdicts);
-        nav_rec_imu_array_free(&imu_arr);
-        return cs == NAV_ERR_PARSE || cs == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+        rc_exit = cs == NAV_ERR_PARSE || cs == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+        goto cleanup;
       }
     }
   }
@@ -1045,21 +1186,21 @@ int navsim_replay(int argc, char **argv) {
       if (is != NAV_OK) d = *nav_rec_reader_diag(ir);
     }
     nav_rec_reader_destroy(ir);
+    if (is != NAV_OK || !got) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
+    }
     if (is == NAV_OK && !got) {
       fprintf(stderr, "%s:1:1: error: --init: the file holds no row; expected one .nav row (week, t, lat, lon, h, "
                       "vN vE vD, roll pitch yaw [deg]) at the initial epoch\n", init);
-      free(reqs);
-      free(verdicts);
-      nav_rec_imu_array_free(&imu_arr);
-      return EXIT_INVALID;
+      rc_exit = EXIT_INVALID;
+      goto cleanup;
     }
     if (is != NAV_OK) {
       if (d.message[0]) navsim_print_diag(NULL, &d);
       else fprintf(stderr, "%s: error: %s\n", init, nav_status_str(is));
-      free(reqs);
-      free(verdicts);
-      nav_rec_imu_array_free(&imu_arr);
-      return is == NAV_ERR_PARSE || is == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+      rc_exit = is == NAV_ERR_PARSE || is == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
+      goto cleanup;
     }
     rc.has_initial = true;
   }
@@ -1097,32 +1238,32 @@ int navsim_replay(int argc, char **argv) {
     nav_rinex_source_destroy(rsrc);
     rsrc = NULL;
     if (rs == NAV_OK && n_epochs == 0) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
       fprintf(stderr, "%s: error: the observation file holds no epoch; expected '>' epoch records after the header\n",
               rinex_obs);
-      free(reqs);
-      free(verdicts);
-      nav_rec_imu_array_free(&imu_arr);
-      return EXIT_INVALID;
+      rc_exit = EXIT_INVALID;
+      goto cleanup;
     }
     if (rs == NAV_OK) rs = nav_rinex_source_create(&rsc, &rsrc, &d);
     if (rs != NAV_OK) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
       if (d.message[0]) navsim_print_diag(NULL, &d);
       else fprintf(stderr, "navsim replay: %s\n", nav_status_str(rs));
-      free(reqs);
-      free(verdicts);
-      nav_rec_imu_array_free(&imu_arr);
-      return rs == NAV_ERR_PARSE || rs == NAV_ERR_INVALID_ARG || rs == NAV_ERR_OUT_OF_RANGE ? EXIT_INVALID : EXIT_FAIL;
+      rc_exit = rs == NAV_ERR_PARSE || rs == NAV_ERR_INVALID_ARG || rs == NAV_ERR_OUT_OF_RANGE ? EXIT_INVALID : EXIT_FAIL;
+      goto cleanup;
     }
     rc.raw = rinex_next;
     rc.raw_user = rsrc;
   }
-  int rc_exit = EXIT_FAIL;
-  nav_status st = NAV_OK;
-  nav_resultdir *rd = NULL;
-  out_files o;
-  memset(&o, 0, sizeof o);
   o.show_progress = !quiet && isatty(STDERR_FILENO);
+  o.stream = imu_stream;
+  o.out_dir = out_dir;
+  o.force = force;
   if (smooth && rinex_obs) {
+    rc_exit = imu_error_first(imu_stream, imu);
+    if (rc_exit) goto cleanup;
     fprintf(stderr, "navsim replay: --smooth is not supported with --rinex-obs (the smoother does not carry the "
                     "receiver-clock states yet)\n");
     rc_exit = EXIT_INVALID;
@@ -1131,35 +1272,35 @@ int navsim_replay(int argc, char **argv) {
   if (smooth && gnss) {
     st = smooth_out_create(&rc.nav.filter, smooth_group, &o.so, &rc.nav.smoother);
     if (st != NAV_OK) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
       fprintf(stderr, "navsim replay: --smooth: cannot set up the smoother: %s\n", nav_status_str(st));
+      rc_exit = EXIT_FAIL;
       goto cleanup;
     }
   } else if (smooth) {
     fprintf(stderr, "navsim replay: warning: --smooth has no effect without --gnss\n");
   }
-  static const char *names[3] = {"truth.csv", "nav.csv", "errors.csv"};
-  {
-    const int orc = navsim_out_begin("replay", out_dir, force, &rd);
-    if (orc != EXIT_OK) {
-      rc_exit = orc;
-      goto cleanup;
-    }
-  }
+  /* The CSV rows go to memory until the result directory is made (out_go_live): at once when the
+     IMU file has been checked already, else once it has been read to its end without an error. */
   for (int i = 0; i < 3; ++i) {
-    const char *file = nav_resultdir_file(rd, names[i]);
-    o.f[i] = file ? fopen(file, "w") : NULL;
-    /* 256 KiB buffers: a few write calls per file instead of one per 4 KiB. */
-    o.buf[i] = o.f[i] ? malloc(CSV_BUFFER_BYTES) : NULL;
-    if (o.buf[i]) (void)setvbuf(o.f[i], o.buf[i], _IOFBF, CSV_BUFFER_BYTES);
+    o.f[i] = open_memstream(&o.mem[i], &o.mem_len[i]);
     if (!o.f[i] || nav_csv_write_header(o.f[i], (nav_csv_table)i) != NAV_OK) {
-      fprintf(stderr, "navsim replay: cannot write %s in \"%s\"\n", names[i], out_dir);
+      fprintf(stderr, "navsim replay: %s\n", nav_status_str(NAV_ERR_NO_MEMORY));
       goto cleanup;
     }
   }
-  st = run_stats_create(&o.rstats, imu_count);
-  if (st != NAV_OK) {
-    fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
-    goto cleanup;
+  if (!imu_stream) {
+    rc_exit = out_go_live(&o);
+    if (rc_exit != EXIT_OK) goto cleanup;
+    rc_exit = EXIT_FAIL;
+    st = run_stats_create(&o.rstats, imu_count);
+    if (st != NAV_OK) {
+      fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
+      goto cleanup;
+    }
+  } else {
+    o.rstats.pending = true;
   }
   rc.record = on_record;
   rc.progress = on_progress;
@@ -1170,13 +1311,27 @@ int navsim_replay(int argc, char **argv) {
      nothing with on_record and run_stats_on_scored. */
   rc.callbacks_on_worker = o.so == NULL;
   if (n_reqs > 0) o.req = &req_buf;
-
   nav_replay_summary sum;
   nav_diag d;
   memset(&d, 0, sizeof d);
   const double t0 = navsim_now_s();
   st = nav_replay_run(&rc, &sum, &d);
   const double wall = navsim_now_s() - t0;
+  if (imu_stream) {
+    /* The verdict on the whole IMU file comes first, as when it was checked before the run: a bad
+       record anywhere is reported as such (and the run, stopped or not, is discarded). */
+    rc_exit = imu_error_first(imu_stream, imu);
+    if (rc_exit) goto cleanup;
+    rc_exit = EXIT_FAIL;
+    const nav_status cs = nav_rec_imu_stream_finish(imu_stream, &imu_count, NULL, NULL, NULL);
+    if (cs != NAV_OK) goto cleanup; /* (not reached: the verdict above) */
+    run_stats_settle(&o.rstats, imu_count);
+  }
+  if (st == NAV_OK) run_stats_finish(&o.rstats);
+  if (o.live_exit != EXIT_OK) {
+    rc_exit = o.live_exit; /* the result directory could not be made (said by out_go_live) */
+    goto cleanup;
+  }
   if (st != NAV_OK) {
     if (o.st != NAV_OK)
       fprintf(stderr, "navsim replay: writing results failed: %s\n", nav_status_str(o.st));
@@ -1214,6 +1369,12 @@ int navsim_replay(int argc, char **argv) {
             "%s: warning: no observation epoch fell on the IMU's time span %.3f .. %.3f s (IMU time = GPS time - "
             "%.17g s, see --t0-gps); the replay ran without GNSS\n",
             rinex_obs, sum.t_first_s, sum.t_last_s, t0_gps);
+  if (!o.live) {
+    /* No output record came after the IMU file's verdict: the result directory is made now. */
+    rc_exit = out_go_live(&o);
+    if (rc_exit != EXIT_OK) goto cleanup;
+    rc_exit = EXIT_FAIL;
+  }
   for (int i = 0; i < 3; ++i) {
     const bool bad = fflush(o.f[i]) != 0 || ferror(o.f[i]) != 0;
     if (!bad) start_writeback(o.f[i]);
@@ -1222,12 +1383,12 @@ int navsim_replay(int argc, char **argv) {
     free(o.buf[i]);
     o.buf[i] = NULL;
     if (bad || cl != 0) {
-      fprintf(stderr, "navsim replay: writing %s failed\n", names[i]);
+      fprintf(stderr, "navsim replay: writing %s failed\n", k_csv_names[i]);
       goto cleanup;
     }
   }
   if (o.so) {
-    st = smooth_out_finish(o.so, &sum, nav_resultdir_file(rd, "nav_smoothed.csv"));
+    st = smooth_out_finish(o.so, &sum, nav_resultdir_file(o.rd, "nav_smoothed.csv"));
     if (st != NAV_OK) {
       fprintf(stderr, "navsim replay: --smooth: %s\n", nav_status_str(st));
       rc_exit = EXIT_FAIL;
@@ -1290,14 +1451,14 @@ int navsim_replay(int argc, char **argv) {
     job.verdicts = verdicts;
     job.n_verdicts = n_reqs;
   }
-  st = write_summary(nav_resultdir_file(rd, "summary.json"), &job);
+  st = write_summary(nav_resultdir_file(o.rd, "summary.json"), &job);
   if (st != NAV_OK) {
     fprintf(stderr, "navsim replay: writing summary.json failed\n");
     goto cleanup;
   }
   {
-    const int orc = navsim_out_commit("replay", rd);
-    rd = NULL;
+    const int orc = navsim_out_commit("replay", o.rd);
+    o.rd = NULL;
     if (orc != EXIT_OK) {
       rc_exit = orc;
       goto cleanup;
@@ -1325,9 +1486,10 @@ cleanup:
   for (int i = 0; i < 3; ++i) {
     if (o.f[i]) fclose(o.f[i]);
     free(o.buf[i]);
+    free(o.mem[i]);
   }
-  nav_rec_imu_array_free(&imu_arr);
-  nav_resultdir_abort(rd);
+  nav_rec_imu_stream_destroy(imu_stream);
+  nav_resultdir_abort(o.rd);
   smooth_out_destroy(o.so);
   run_stats_destroy(&o.rstats);
   navsim_req_buffer_free(&req_buf);

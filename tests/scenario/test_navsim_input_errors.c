@@ -158,6 +158,52 @@ static void test_issue_25_replay_values_checked_before_the_run(void **state) {
   assert_false(exists("rp"));
 }
 
+/* Issue 23: the IMU file is read while the navigation already runs on its first records. A bad
+   record in its last line still gives the report of the check before the run - FILE:LINE:COL,
+   exit 2 - and nothing reaches the disk: no result directory, not even the missing parents of
+   --out. With the GNSS file bad as well, the IMU file's error is the one reported, as when the IMU
+   file was checked first. A good run into the same --out then works. */
+static void test_issue_23_replay_imu_read_during_the_run(void **state) {
+  (void)state;
+  char *good = nav_test_slurp_alloc(NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt");
+  assert_non_null(good);
+  int lines = 0;
+  for (const char *p = good; *p; ++p) lines += *p == '\n';
+  const size_t n = strlen(good);
+  char *text = malloc(n + 256);
+  assert_non_null(text);
+  snprintf(text, n + 256, "%s100300.000000 1e-6 2e-6 3e-6 0.1 0.2 9.8e\n", good);
+  nav_test_write_file(WORK, "imu-late-bad.txt", text);
+  free(text);
+  free(good);
+  char pattern[256];
+  snprintf(pattern, sizeof pattern,
+           "^imu-late-bad\\.txt:%d:38: error: column 7 \\(dvel_z_mps\\): expected a number, found \"9\\.8e\"", lines + 1);
+  nav_cli_result *r = navsim("replay --imu imu-late-bad.txt --gnss '%s/replay/GNSS-100195-100245.txt' "
+                             "--truth '%s/replay/truth-100195-100245-20Hz.nav' --out late/deeper/rp --quiet",
+                             NAV_TEST_DATA_DIR, NAV_TEST_DATA_DIR);
+  if (r->code != 2) fail_msg("exit %d, expected 2; stderr:\n%s", r->code, r->err);
+  nav_test_assert_matches(r->err, pattern);
+  assert_false(exists("late"));
+  /* GNSS file bad too (a sigma of 1e300 in its first record): the IMU file's error comes first. */
+  nav_test_write_file(WORK, "gnss-bad-first.txt",
+                      "100195.000 31.50818332870 120.40198876855 -0.0488 1e300 0.020 0.050\n");
+  r = navsim("replay --imu imu-late-bad.txt --gnss gnss-bad-first.txt "
+             "--truth '%s/replay/truth-100195-100245-20Hz.nav' --out late/deeper/rp --quiet",
+             NAV_TEST_DATA_DIR);
+  if (r->code != 2) fail_msg("exit %d, expected 2; stderr:\n%s", r->code, r->err);
+  nav_test_assert_matches(r->err, pattern);
+  if (strstr(r->err, "gnss-bad-first")) fail_msg("the GNSS error was reported first:\n%s", r->err);
+  assert_false(exists("late"));
+  /* The good file: the result directory appears, with its files. */
+  r = navsim("replay --imu '%s/replay/IMU-100195-100245.txt' --gnss '%s/replay/GNSS-100195-100245.txt' "
+             "--truth '%s/replay/truth-100195-100245-20Hz.nav' --out late/deeper/rp --quiet",
+             NAV_TEST_DATA_DIR, NAV_TEST_DATA_DIR, NAV_TEST_DATA_DIR);
+  if (r->code != 0) fail_msg("exit %d, expected 0; stderr:\n%s", r->code, r->err);
+  assert_true(exists("late/deeper/rp/nav.csv"));
+  assert_true(exists("late/deeper/rp/summary.json"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_sweep_grid_value_named_before_work),
@@ -165,6 +211,7 @@ int main(void) {
       cmocka_unit_test(test_issue_25_sweep_duplicate_param),
       cmocka_unit_test(test_issue_25_import_never_replaces_a_valid_scene),
       cmocka_unit_test(test_issue_25_replay_values_checked_before_the_run),
+      cmocka_unit_test(test_issue_23_replay_imu_read_during_the_run),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -184,6 +184,42 @@ static void test_edges(void **state) {
   }
 }
 
+/* The whole-word path of printf's "%.12e" shape (d.dddddddddddde[+-]dd) at its edges: the
+ * exponents where the scale 10^(e-12) leaves +-22 (e-10 is in, e-11 out; e+34 in, e+35 out), both
+ * exponent letters and signs, a sign in front, zero, the largest significand, and near misses of
+ * the shape (three exponent digits, one, a comma for the point, a missing sign) that the general
+ * scan or strtod must read instead - every accepted value identical to strtod's. Then 200 000
+ * random %.12e renderings across the whole double range. */
+static void test_sci12_shape(void **state) {
+  (void)state;
+  tally t = {0, 0};
+  static const char *const must[] = {
+      "3.550682422333e-06", "-4.911053131454e-02", "+9.999999999999e+34", "9.999999999999e-10",
+      "1.000000000000e-10", "1.000000000000E+00", "0.000000000000e+00", "-0.000000000000e-99",
+      "7.000000000001e+22", "5.000000000000e-01", "1.234567890123e+05"};
+  for (size_t i = 0; i < sizeof must / sizeof must[0]; ++i)
+    if (!check_one(must[i], &t)) fail_msg("\"%s\" should be accepted", must[i]);
+  static const char *const other[] = {"9.999999999999e-11", "2.220446049250e-16", "1.000000000000e+35", "1.000000000000e-100",
+                                      "1.000000000000e-5",  "1,000000000000e-05", "1.000000000000e05",
+                                      "1.00000000000e-05",  "1.0000000000000e-05", "1.000000000000x-05",
+                                      "1.000000000000e--5", "1.0000000000a0e-05", "11000000000000e-05"};
+  for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i)
+    check_one(other[i], &t); /* accepted or declined: if accepted, strtod's value */
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 23u, 0u);
+  char s[64];
+  long accepted = 0;
+  for (int it = 0; it < 200000; ++it) {
+    const double mag = pow(10.0, -40.0 + 80.0 * nav_rng_uniform(&r));
+    const double v = (nav_rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * mag * nav_rng_uniform(&r);
+    snprintf(s, sizeof s, it % 7 == 0 ? "%+.12E" : "%.12e", v);
+    accepted += check_one(s, &t);
+  }
+  print_message("[ fastnum  ] %%.12e shape: %ld fast (%ld of the random ones), %ld declined\n", t.fast, accepted,
+                t.declined);
+  assert_true(accepted > 40000);
+}
+
 /* Every field of the first lines of the shared long-drive files: all on the fast path and
  * identical to strtod. Skipped when the shared data is not there. */
 static void test_shared_files(void **state) {
@@ -239,6 +275,7 @@ int main(void) {
       cmocka_unit_test(test_random_digit_strings),
       cmocka_unit_test(test_random_printf_values),
       cmocka_unit_test(test_edges),
+      cmocka_unit_test(test_sci12_shape),
       cmocka_unit_test(test_shared_files),
       cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),

@@ -262,6 +262,136 @@ static void test_imu_array_errors_match_check(void **state) {
   free(base);
 }
 
+static void assert_same_stream(nav_rec_imu_stream *st, const seq_read *s) {
+  for (size_t i = 0; i < s->n; ++i) {
+    const nav_imu_increment *a = NULL;
+    assert_int_equal(nav_rec_imu_stream_at(st, i, &a), NAV_OK);
+    assert_non_null(a);
+    nav_rec_imu_array one;
+    memset(&one, 0, sizeof one);
+    one.part[0] = (nav_imu_increment *)a;
+    one.part_count[0] = 1;
+    one.count = 1;
+    assert_same_records(&one, &s->rec[i], 1);
+  }
+  const nav_imu_increment *past = (const nav_imu_increment *)&past;
+  assert_int_equal(nav_rec_imu_stream_at(st, s->n, &past), NAV_OK);
+  assert_null(past);
+}
+
+/* The IMU stream hands out the streaming reader's records, indices, intervals, count and cut line
+ * while it reads the file on its thread (consumed at once, as the replay does, or after a wait). */
+static void test_imu_stream_matches_reader(void **state) {
+  (void)state;
+  const int sizes[3] = {BIG_LINES, BIG_LINES + 1, 300};
+  for (int c = 0; c < 3; ++c) {
+    const bool last_nl = c != 1;
+    size_t len = 0;
+    char *text = make_imu_text(sizes[c], last_nl, &len);
+    char path[256];
+    temp_path(path, sizeof path, "imu-stream.txt");
+    write_text(path, text, len);
+    const seq_read s = read_sequential(path, (size_t)sizes[c] + 1);
+    for (int wait = 0; wait < 2; ++wait) {
+      nav_rec_imu_stream *st = NULL;
+      nav_diag d;
+      memset(&d, 0, sizeof d);
+      assert_int_equal(nav_rec_imu_stream_start(path, (size_t)1 << 30, &st, &d), NAV_OK);
+      assert_int_equal(nav_rec_imu_stream_file_bytes(st), len);
+      size_t count = 0;
+      long cut = -1, last = -1;
+      if (wait) assert_int_equal(nav_rec_imu_stream_finish(st, &count, &cut, &last, &d), NAV_OK);
+      assert_same_stream(st, &s);
+      nav_status ps = NAV_ERR_STATE;
+      size_t pc = 0;
+      assert_true(nav_rec_imu_stream_poll(st, &ps, &pc));
+      assert_int_equal(ps, NAV_OK);
+      assert_int_equal(pc, s.n);
+      assert_int_equal(nav_rec_imu_stream_finish(st, &count, &cut, &last, &d), NAV_OK);
+      assert_int_equal(count, s.n);
+      assert_int_equal(cut, s.cut_line);
+      assert_int_equal(last, s.last_line);
+      nav_rec_imu_stream_destroy(st);
+    }
+    print_message("  stream, %d lines: %zu records, cut line %ld, as the streaming reader\n", sizes[c], s.n,
+                  s.cut_line);
+    free(s.rec);
+    free(text);
+    unlink(path);
+  }
+  /* Destroyed while it still reads: the thread stops and everything is released (ASan, TSan). */
+  size_t len = 0;
+  char *text = make_imu_text(BIG_LINES, true, &len);
+  char path[256];
+  temp_path(path, sizeof path, "imu-stream-early.txt");
+  write_text(path, text, len);
+  nav_rec_imu_stream *st = NULL;
+  assert_int_equal(nav_rec_imu_stream_start(path, (size_t)1 << 30, &st, NULL), NAV_OK);
+  const nav_imu_increment *a = NULL;
+  assert_int_equal(nav_rec_imu_stream_at(st, 0, &a), NAV_OK);
+  assert_non_null(a);
+  nav_rec_imu_stream_destroy(st);
+  free(text);
+  unlink(path);
+  /* Larger than the limit: refused, as the array loader refuses it. */
+  nav_diag d;
+  memset(&d, 0, sizeof d);
+  st = NULL;
+  assert_int_equal(nav_rec_imu_stream_start(SLICE_IMU, 1000, &st, &d), NAV_ERR_OUT_OF_RANGE);
+  assert_null(st);
+  assert_non_null(strstr(d.message, "more than the 1000 to hold in memory"));
+}
+
+/* A bad record anywhere: the stream's verdict is nav_rec_check_file()'s (status, FILE:LINE:COL,
+ * column, message), every later nav_rec_imu_stream_at() returns the status, and a replay on the
+ * stream stops with it. */
+static void test_imu_stream_errors_match_check(void **state) {
+  (void)state;
+  size_t len = 0;
+  char *base = make_imu_text(BIG_LINES, true, &len);
+  char path[256];
+  temp_path(path, sizeof path, "imu-stream-bad.txt");
+  const double where[3] = {0.1, 0.5, 0.97};
+  for (int c = 0; c < 4; ++c) {
+    char *t = malloc(len + 1);
+    assert_non_null(t);
+    memcpy(t, base, len + 1);
+    if (c < 3) {
+      char *p = strchr(t + (size_t)(where[c] * (double)len), '\n') + 1;
+      p = strchr(p, ' ') + 3;
+      *p = 'x';
+    } else {
+      /* The last record repeats the time of the one before. */
+      char *e = t + len - 1;
+      char *l1 = e;
+      while (l1[-1] != '\n')
+        --l1;
+      char *l0 = l1 - 1;
+      while (l0[-1] != '\n')
+        --l0;
+      memcpy(l1, l0, 13);
+    }
+    write_text(path, t, len);
+    nav_diag dc, ds;
+    memset(&dc, 0, sizeof dc);
+    memset(&ds, 0, sizeof ds);
+    const nav_status sc = nav_rec_check_file(path, NAV_REC_IMU, NULL, &dc);
+    assert_int_equal(sc, NAV_ERR_PARSE);
+    nav_rec_imu_stream *st = NULL;
+    assert_int_equal(nav_rec_imu_stream_start(path, (size_t)1 << 30, &st, NULL), NAV_OK);
+    assert_int_equal(nav_rec_imu_stream_finish(st, NULL, NULL, NULL, &ds), sc);
+    assert_same_diag(&ds, &dc);
+    const nav_imu_increment *a = NULL;
+    assert_int_equal(nav_rec_imu_stream_at(st, 0, &a), sc);
+    assert_true(nav_rec_imu_stream_poll(st, NULL, NULL));
+    nav_rec_imu_stream_destroy(st);
+    print_message("  stream: %s:%d:%d %s: %s\n", dc.file, dc.line, dc.col, dc.path, dc.message);
+    free(t);
+  }
+  unlink(path);
+  free(base);
+}
+
 /* A file above the limit is refused before any record is read (the caller streams it). */
 static void test_imu_array_size_limit(void **state) {
   (void)state;
@@ -375,14 +505,17 @@ static uint64_t hash_summary(const nav_replay_summary *s) {
 
 typedef struct mode {
   const char *name;
-  bool array, read_ahead, worker;
+  bool array, read_ahead, worker, stream;
 } mode;
 
-static const mode k_modes[5] = {{"calling thread only", false, false, false},
-                                {"read-ahead", false, true, false},
-                                {"IMU array", true, false, false},
-                                {"scoring thread", false, false, true},
-                                {"all (navsim replay)", true, true, true}};
+enum { N_MODES = 7 };
+static const mode k_modes[N_MODES] = {{"calling thread only", false, false, false, false},
+                                      {"read-ahead", false, true, false, false},
+                                      {"IMU array", true, false, false, false},
+                                      {"scoring thread", false, false, true, false},
+                                      {"all, IMU array", true, true, true, false},
+                                      {"IMU stream", false, false, false, true},
+                                      {"all (navsim replay)", false, true, true, true}};
 
 typedef struct outcome {
   nav_status st;
@@ -422,6 +555,11 @@ static outcome run_mode(const mode *m, const char *imu, const char *truth, bool 
     assert_int_equal(nav_rec_imu_array_load(imu, (size_t)1 << 30, &a, NULL), NAV_OK);
     c.imu = &a;
   }
+  nav_rec_imu_stream *is = NULL;
+  if (m->stream) {
+    assert_int_equal(nav_rec_imu_stream_start(imu, (size_t)1 << 30, &is, NULL), NAV_OK);
+    c.imu_stream = is;
+  }
   outcome o;
   memset(&o, 0, sizeof o);
   o.tr.h_rec = o.tr.h_scored = 14695981039346656037ull;
@@ -434,6 +572,7 @@ static outcome run_mode(const mode *m, const char *imu, const char *truth, bool 
   o.st = nav_replay_run(&c, &o.sum, &d);
   if (o.st == NAV_OK || o.st == NAV_ERR_CANCELLED) o.h_sum = hash_summary(&o.sum);
   nav_rec_imu_array_free(&a);
+  nav_rec_imu_stream_destroy(is);
   return o;
 }
 
@@ -461,7 +600,7 @@ static void test_replay_modes_identical(void **state) {
       /* The cut line counts only when the replay reads it. */
       if (f == 1 && w == 0) assert_true(ref.sum.imu_cut_line > 0);
       if (f == 1 && w == 1) assert_int_equal(ref.sum.imu_cut_line, 0);
-      for (int m = 1; m < 5; ++m) {
+      for (int m = 1; m < N_MODES; ++m) {
         const outcome o = run_mode(&k_modes[m], imus[f], SLICE_TRUTH, true, w == 1, 0);
         print_message("  %-22s %s%s: %ld records, %ld scored, gaps %ld, cut line %ld\n", k_modes[m].name,
                       f ? "cut IMU file" : "IMU file", w ? ", --end" : "", o.tr.records, o.tr.scored,
@@ -481,7 +620,7 @@ static void test_replay_modes_identical(void **state) {
  * calling thread it stops at once; on the scoring thread the callbacks stop at the same record. */
 static void test_replay_stop_from_record(void **state) {
   (void)state;
-  for (int m = 0; m < 5; ++m) {
+  for (int m = 0; m < N_MODES; ++m) {
     const outcome o = run_mode(&k_modes[m], SLICE_IMU, SLICE_TRUTH, false, false, 40);
     assert_int_equal(o.st, NAV_ERR_CANCELLED);
     assert_true(o.sum.partial);
@@ -489,6 +628,60 @@ static void test_replay_stop_from_record(void **state) {
     if (!k_modes[m].worker) assert_true(o.sum.t_last_s < 100199.0);
     print_message("  %-22s stopped at record 40: %ld IMU steps\n", k_modes[m].name, o.sum.imu_steps);
   }
+}
+
+/* A replay on an IMU stream whose file turns out bad stops with the parse status, also when the
+ * bad record is far beyond the run's window (--end), which the run never reaches. */
+static void test_replay_stream_stops_on_bad_record(void **state) {
+  (void)state;
+  char *imu = slurp(SLICE_IMU);
+  assert_non_null(imu);
+  const size_t n = strlen(imu);
+  char *t = malloc(n + 128);
+  assert_non_null(t);
+  memcpy(t, imu, n);
+  /* One more record after the last, with a letter in it. */
+  const int k = snprintf(t + n, 128, "100300.000000 1e-6 2e-6 3e-6 0.1 0.2q 9.8\n");
+  char path[256];
+  temp_path(path, sizeof path, "imu-late-bad.txt");
+  write_text(path, t, n + (size_t)k);
+  free(t);
+  free(imu);
+  for (int w = 0; w < 2; ++w) {
+    nav_scene *sc = malloc(sizeof *sc);
+    assert_non_null(sc);
+    assert_int_equal(nav_scene_read_file(SLICE_SCENE, sc, NULL, NULL), NAV_OK);
+    nav_replay_config c = nav_replay_config_default();
+    c.nav = nav_ins_gnss_config_from_scene(sc);
+    free(sc);
+    c.imu_path = path;
+    c.gnss_path = SLICE_GNSS;
+    c.ref_path = SLICE_TRUTH;
+    c.callbacks_on_worker = true;
+    if (w == 1) {
+      c.has_end = true;
+      c.t_end_s = 100200.0;
+    }
+    nav_rec_imu_stream *is = NULL;
+    assert_int_equal(nav_rec_imu_stream_start(path, (size_t)1 << 30, &is, NULL), NAV_OK);
+    c.imu_stream = is;
+    nav_replay_summary s;
+    nav_diag d;
+    memset(&d, 0, sizeof d);
+    const nav_status st = nav_replay_run(&c, &s, &d);
+    nav_diag ds;
+    memset(&ds, 0, sizeof ds);
+    const nav_status ss = nav_rec_imu_stream_finish(is, NULL, NULL, NULL, &ds);
+    assert_int_equal(ss, NAV_ERR_PARSE);
+    assert_non_null(strstr(ds.message, "0.2q"));
+    /* Whole file: the run meets the bad record and stops with its status. With --end the run may
+       be over before the parser gets there (it ends normally) or not (it stops): either way the
+       caller's verdict is the stream's (ss). */
+    if (w == 0) assert_int_equal(st, NAV_ERR_PARSE);
+    else assert_true(st == NAV_OK || st == NAV_ERR_PARSE);
+    nav_rec_imu_stream_destroy(is);
+  }
+  unlink(path);
 }
 
 /* A malformed reference row is reported the same way with the read-ahead thread as without. */
@@ -508,7 +701,7 @@ static void test_replay_reference_error_read_ahead(void **state) {
   free(truth);
   nav_diag d0;
   memset(&d0, 0, sizeof d0);
-  for (int m = 0; m < 5; ++m) {
+  for (int m = 0; m < N_MODES; ++m) {
     nav_scene *sc = malloc(sizeof *sc);
     assert_non_null(sc);
     assert_int_equal(nav_scene_read_file(SLICE_SCENE, sc, NULL, NULL), NAV_OK);
@@ -520,10 +713,16 @@ static void test_replay_reference_error_read_ahead(void **state) {
     c.ref_path = path;
     c.read_ahead = k_modes[m].read_ahead;
     c.callbacks_on_worker = k_modes[m].worker;
+    nav_rec_imu_stream *is = NULL;
+    if (k_modes[m].stream) {
+      assert_int_equal(nav_rec_imu_stream_start(SLICE_IMU, (size_t)1 << 30, &is, NULL), NAV_OK);
+      c.imu_stream = is;
+    }
     nav_replay_summary s;
     nav_diag d;
     memset(&d, 0, sizeof d);
     assert_int_equal(nav_replay_run(&c, &s, &d), NAV_ERR_PARSE);
+    nav_rec_imu_stream_destroy(is);
     if (m == 0) {
       d0 = d;
       print_message("  %s:%d:%d %s: %s\n", d.file, d.line, d.col, d.path, d.message);
@@ -540,6 +739,9 @@ int main(void) {
       cmocka_unit_test(test_imu_array_matches_reader),
       cmocka_unit_test(test_imu_array_errors_match_check),
       cmocka_unit_test(test_imu_array_size_limit),
+      cmocka_unit_test(test_imu_stream_matches_reader),
+      cmocka_unit_test(test_imu_stream_errors_match_check),
+      cmocka_unit_test(test_replay_stream_stops_on_bad_record),
       cmocka_unit_test(test_replay_modes_identical),
       cmocka_unit_test(test_replay_stop_from_record),
       cmocka_unit_test(test_replay_reference_error_read_ahead),

@@ -212,6 +212,65 @@ NAV_API NAV_NODISCARD nav_status nav_rec_imu_array_load(const char *path, size_t
 NAV_API void nav_rec_imu_array_free(nav_rec_imu_array *a);
 
 /**
+ * An IMU file read and checked on a thread of its own while its records are consumed: the
+ * records of nav_rec_imu_array_load() (same checks, values, indices and intervals, same message
+ * for the first bad record, worded by the sequential reader), handed over as they are parsed so
+ * that a replay can start on the first ones (nav_replay_config.imu_stream). Made by
+ * nav_rec_imu_stream_start(), released by nav_rec_imu_stream_destroy(). The consumer calls
+ * (nav_rec_imu_stream_at(), _poll(), _finish()) are for one thread at a time, but not
+ * necessarily the same one; the parsing thread is internal.
+ */
+typedef struct nav_rec_imu_stream nav_rec_imu_stream;
+
+/**
+ * Open an IMU file and start reading it on a second thread (on the calling thread, before the
+ * return, when no thread can be made).
+ * @param[in]  path      IMU file (KF-GINS text)
+ * @param[in]  max_bytes larger files are refused with NAV_ERR_OUT_OF_RANGE and nothing read
+ * @param[out] out       the stream (release with nav_rec_imu_stream_destroy())
+ * @param[out] diag      when the file cannot be opened, why (may be NULL); parse errors come
+ *                       from nav_rec_imu_stream_finish()
+ * @return NAV_OK; NAV_ERR_OUT_OF_RANGE; NAV_ERR_NO_MEMORY; the open statuses of
+ *         nav_rec_reader_open() (with its message).
+ */
+NAV_API NAV_NODISCARD nav_status nav_rec_imu_stream_start(const char *path, size_t max_bytes,
+                                                          nav_rec_imu_stream **out, nav_diag *diag);
+
+/** Size of the file in bytes (known at the start). */
+NAV_API size_t nav_rec_imu_stream_file_bytes(const nav_rec_imu_stream *s);
+
+/**
+ * Record @p i, waiting until it has been parsed.
+ * @param[out] rec the record (borrowed, valid until nav_rec_imu_stream_destroy()), or NULL when
+ *                 the file has fewer than i + 1 records
+ * @return NAV_OK; the parse status once the file has turned out bad (for any @p i: the records
+ *         before the bad one are not handed out any more, so that a consumer stops at once).
+ */
+NAV_API NAV_NODISCARD nav_status nav_rec_imu_stream_at(nav_rec_imu_stream *s, size_t i,
+                                                       const nav_imu_increment **rec);
+
+/**
+ * Has the whole file been read? Without waiting, from any thread (also while another one is in
+ * nav_rec_imu_stream_at()); when it has, @p st gets its status and @p count its records (each may
+ * be NULL).
+ */
+NAV_API bool nav_rec_imu_stream_poll(nav_rec_imu_stream *s, nav_status *st, size_t *count);
+
+/**
+ * Wait until the whole file has been read and return its verdict, as nav_rec_check_file() would:
+ * the status, the record count and, on failure, the message of the first bad record.
+ * @param[out] count       records of the file (on NAV_OK; may be NULL)
+ * @param[out] cut_line    nav_rec_reader_cut_line() after the whole file (may be NULL)
+ * @param[out] last_line   1-based line of the last record, 0 without records (may be NULL)
+ * @param[out] diag        on failure, what and where (may be NULL)
+ */
+NAV_API NAV_NODISCARD nav_status nav_rec_imu_stream_finish(nav_rec_imu_stream *s, size_t *count,
+                                                           long *cut_line, long *last_line, nav_diag *diag);
+
+/** Stop the reading (if it still goes on), release everything; accepts NULL. */
+NAV_API void nav_rec_imu_stream_destroy(nav_rec_imu_stream *s);
+
+/**
  * A .nav row as a reference state in ECEF (F = e of nav_frames.h): r_eb_e from the geodetic
  * position, v_eb_e = C_n_e v_n, q_b_e = q_n_e (x) q_b_n; accelerations and rates are zero (not
  * in the format). Leaf function.
@@ -400,6 +459,14 @@ typedef struct nav_replay_config {
    * NULL: imu_path is streamed.
    */
   const nav_rec_imu_array *imu;
+  /**
+   * The IMU records of imu_path as a stream being read (nav_rec_imu_stream_start(); not kept,
+   * must outlive the call): the navigation starts on the first records while the rest is read.
+   * The records and results are those of the file read by the replay itself; if the stream
+   * turns out bad, the run stops at once with its status (the caller reports the stream's
+   * message from nav_rec_imu_stream_finish()). Exclusive with @p imu. Default NULL.
+   */
+  nav_rec_imu_stream *imu_stream;
   /**
    * Read the reference (and a streamed IMU file) on a second thread, ahead of the navigation,
    * through a bounded queue: the same records in the same order, so the same results and
