@@ -127,7 +127,7 @@ struct nav_filter {
 
   /* Scratch, sized for the largest state; nothing is allocated after create. */
   double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], Pn[NN], L[NN], A[NN], Wt[NN];
-  double H[MMAX * NMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
+  double H[MMAX * NMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
   double xn[NMAX];
   double vl_work[VL_WORK];
 
@@ -1023,11 +1023,12 @@ nav_status nav_filter_flush(nav_filter *f) {
 
 /* The arithmetic of an update (do_update): y, S and its Cholesky factor Ls, K, x+ into xn and the
  * Joseph-form P+ into Pn. Always inlined, so that do_update instantiates it for the GNSS cases
- * (n = 15 or 18, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
+ * (n = 15, 18 or 21, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
  * generically; the same operations in the same order either way, so the values are identical.
  * Returns false when S is not positive definite. */
 static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const size_t m, const double *H,
                                           const double *z, const double *R, double *y, double *S, double *Ls) {
+  const double *P = f->P;
   /* Innovation y = z - H x_minus (x_minus = 0 in closed loop except the GNSS states). */
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r) {
@@ -1047,15 +1048,30 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
       nz = nz || H[r * n + j] != 0.0;
     if (nz) hc[nhc++] = j;
   }
-  /* P H^T (n x m). */
+  /* Every n x m product below is kept transposed (m x n, as PHtT, Kt, BHtT, WT), so that each
+   * sum runs over the rows r or the columns hc of H for a whole row of n entries at a time
+   * (vectorised), with, entry by entry, the operations and the order of the textbook loops: each
+   * sum from +0.0 over r or q ascending, the products with their operands as before (a b = b a
+   * exactly). */
+  /* (P H^T)^T: PHtT_ri = sum_q P_i,hc_q H_r,hc_q; P is exactly symmetric (mirrored or
+   * symmetrised wherever it is written), so P_i,c is P_c,i and the sum runs over rows of P. */
+#ifndef NDEBUG
   for (size_t i = 0; i < n; ++i)
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += f->P[i * n + hc[q]] * H[r * n + hc[q]];
-      f->PHt[i * m + r] = sum;
+    for (size_t j = 0; j < i; ++j)
+      assert(memcmp(&P[i * n + j], &P[j * n + i], sizeof *P) == 0);
+#endif
+  double *PHtT = f->PHt;
+  for (size_t r = 0; r < m; ++r) {
+    double *o = PHtT + r * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    for (size_t q = 0; q < nhc; ++q) {
+      const double h = H[r * n + hc[q]];
+      const double *pc = P + hc[q] * n;
+      for (size_t i = 0; i < n; ++i)
+        o[i] += pc[i] * h;
     }
+  }
   /* S = H P H^T + R, symmetrised. */
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r)
@@ -1063,79 +1079,92 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
     for (size_t c = 0; c < m; ++c) {
       double sum = 0.0;
       for (size_t j = 0; j < n; ++j)
-        sum += H[r * n + j] * f->PHt[j * m + c];
+        sum += H[r * n + j] * PHtT[c * n + j];
       S[r * m + c] = sum + R[r * m + c];
     }
   nav_matn_symmetrize(S, m);
   if (nav_matn_cholesky(Ls, S, m) != NAV_OK) return false;
   /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
+  double *Kt = f->Kt;
+  memcpy(Kt, PHtT, m * n * sizeof *Kt);
+  nav_matn_chol_solve(Kt, Ls, Kt, m, n);
+
+  /* x+ = x- + K y */
+  for (size_t j = 0; j < n; ++j)
+    f->xn[j] = f->x[j];
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r)
     for (size_t j = 0; j < n; ++j)
-      f->Kt[r * n + j] = f->PHt[j * m + r];
-  nav_matn_chol_solve(f->Kt, Ls, f->Kt, m, n);
-  for (size_t j = 0; j < n; ++j)
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r)
-      f->K[j * m + r] = f->Kt[r * n + j];
-
-  /* x+ = x- + K y */
-  for (size_t j = 0; j < n; ++j) {
-    double sum = f->x[j];
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r)
-      sum += f->K[j * m + r] * y[r];
-    f->xn[j] = sum;
-  }
+      f->xn[j] += Kt[r * n + j] * y[r];
   /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T, evaluated as (A P) A^T with
    * A = I - K H without forming A: A P = P - K (H P) with H P = (P H^T)^T, then
    * (A P) A^T = A P - ((A P) H^T) K^T over the non-zero columns of H. The same product in
-   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, (A P) H^T to PHt's
-   * companion Kt (both n x m or larger scratch). */
-  double *B = f->Phi, *BHt = f->S;
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * f->PHt[j * m + r];
-      B[i * n + j] = f->P[i * n + j] - sum;
-    }
-  for (size_t i = 0; i < n; ++i)
+   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, ((A P) H^T)^T to S
+   * (both scratch here). */
+  double *B = f->Phi, *BHtT = f->S;
+  double tmp[NMAX];
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      tmp[j] = 0.0;
     NAV_UNROLL
     for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
-      BHt[i * m + r] = sum;
+      const double k = Kt[r * n + i];
+      for (size_t j = 0; j < n; ++j)
+        tmp[j] += k * PHtT[r * n + j];
     }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += BHt[i * m + r] * f->K[j * m + r];
-      f->Pn[i * n + j] = B[i * n + j] - sum;
+    for (size_t j = 0; j < n; ++j)
+      B[i * n + j] = P[i * n + j] - tmp[j];
+  }
+  for (size_t r = 0; r < m; ++r) {
+    double *o = BHtT + r * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    for (size_t q = 0; q < nhc; ++q) {
+      const double h = H[r * n + hc[q]];
+      for (size_t i = 0; i < n; ++i)
+        o[i] += B[i * n + hc[q]] * h;
     }
-  /* K R K^T: W = K R (n x m), then the upper triangle of W K^T mirrored. */
-  for (size_t i = 0; i < n; ++i)
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      tmp[j] = 0.0;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      const double b = BHtT[r * n + i];
+      for (size_t j = 0; j < n; ++j)
+        tmp[j] += b * Kt[r * n + j];
+    }
+    for (size_t j = 0; j < n; ++j)
+      f->Pn[i * n + j] = B[i * n + j] - tmp[j];
+  }
+  /* K R K^T: (K R)^T = WT (m x n), then the upper triangle of W K^T, added to both triangles. */
+  double *WT = f->W;
+  NAV_UNROLL
+  for (size_t c = 0; c < m; ++c) {
+    double *o = WT + c * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      const double rr = R[r * m + c];
+      for (size_t i = 0; i < n; ++i)
+        o[i] += Kt[r * n + i] * rr;
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i; j < n; ++j)
+      tmp[j] = 0.0;
     NAV_UNROLL
     for (size_t c = 0; c < m; ++c) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * R[r * m + c];
-      f->W[i * m + c] = sum;
+      const double w = WT[c * n + i];
+      for (size_t j = i; j < n; ++j)
+        tmp[j] += w * Kt[c * n + j];
     }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t c = 0; c < m; ++c)
-        sum += f->W[i * m + c] * f->K[j * m + c];
-      f->Pn[i * n + j] += sum;
-      if (j != i) f->Pn[j * n + i] += sum;
-    }
+    for (size_t j = i; j < n; ++j)
+      f->Pn[i * n + j] += tmp[j];
+    for (size_t j = i + 1; j < n; ++j)
+      f->Pn[j * n + i] += tmp[j];
+  }
   return true;
 }
 
@@ -1164,6 +1193,8 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
     s_ok = update_core(f, 15, 3, H, z, R, y, S, Ls);
   else if (n == 18 && m == 3)
     s_ok = update_core(f, 18, 3, H, z, R, y, S, Ls);
+  else if (n == 21 && m == 3)
+    s_ok = update_core(f, 21, 3, H, z, R, y, S, Ls);
   else
     s_ok = update_core(f, n, m, H, z, R, y, S, Ls);
   if (!s_ok) {
