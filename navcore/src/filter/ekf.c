@@ -666,13 +666,18 @@ static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const r
     }
   }
   /* The lower triangle of U: the blocks left of the diagonal by 4 x 4 transposes of the blocks
-   * above it, the diagonal blocks entry by entry. */
+   * above it, the diagonal blocks entry by entry (their rows and columns past n are scratch
+   * inside the padding). */
   for (size_t i0 = 0; i0 < n; i0 += 4) {
     for (size_t j0 = i0 + 4; j0 < n; j0 += 4)
       transpose4(U, U, i0, j0, LD);
-    for (size_t a = i0; a < i0 + 4 && a < n; ++a)
-      for (size_t b = a + 1; b < i0 + 4 && b < n; ++b)
-        U[b * LD + a] = U[a * LD + b];
+    double *u = U + i0 * LD + i0;
+    u[1 * LD + 0] = u[0 * LD + 1];
+    u[2 * LD + 0] = u[0 * LD + 2];
+    u[3 * LD + 0] = u[0 * LD + 3];
+    u[2 * LD + 1] = u[1 * LD + 2];
+    u[3 * LD + 1] = u[1 * LD + 3];
+    u[3 * LD + 2] = u[2 * LD + 3];
   }
   for (size_t i = 0; i < n; ++i)
     for (size_t q = 0; q < n; q += 4)
@@ -940,7 +945,8 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
     m.v_eb_n_mps = nav_vec3_scale(pd->v_T, 1.0 / T);
   }
   const nav_filter_earth_terms earth = nav_filter_earth_terms_wgs84(m.lat_rad, m.h_m);
-  nav_filter_build_F(f->F, &f->lay, &m, &earth, f->proc_diag);
+  /* f->F holds the build of init_patterns or of the last step: the same entries are rewritten. */
+  nav_filter_build_F_nonzero(f->F, &f->lay, &m, &earth, f->proc_diag);
   /* F T over the structural pattern of F only (fixed at create, init_patterns). Outside it F is
    * exactly zero, and FT and QT keep the zeros of calloc: both are written only here, always at
    * the same positions (the pattern, the blocks below, the diagonal), so the values are those of
