@@ -794,6 +794,18 @@ static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *F
   for (size_t k = 0; k < n * n; ++k)
     assert(memcmp(&f->Qd[k], &(double){0.5 * QT[k]}, sizeof(double)) == 0);
 #endif
+  if (ld - n < 4) {
+    /* Four entries at a time up to column ld of each row (P and Qd are read past the row end,
+     * into the next row or the rest of their NMAX^2 buffers), then the padding set to zero. */
+    for (size_t i = 0; i < n; ++i) {
+      NAV_UNROLL
+      for (size_t q = 0; q < ld; q += 4)
+        v4_store(f->S + i * ld + q, v4_add(v4_load(f->P + i * n + q), v4_load(f->Qd + i * n + q)));
+      for (size_t c = n; c < ld; ++c)
+        f->S[i * ld + c] = 0.0;
+    }
+    return;
+  }
   for (size_t i = 0; i < n; ++i) {
     NAV_UNROLL
     for (size_t j = 0; j < n; ++j)
