@@ -532,6 +532,36 @@ static void test_predict_guard_reports_lost_definiteness(void **state) {
   }
 }
 
+/* check_nav tests the 20 numbers of a nav_filter_nav at once: NaN or an infinity at any one of
+ * them is refused (NAV_ERR_NUMERIC, the predict leaves the filter as it was), finite extremes
+ * are accepted. */
+static void test_check_nav_every_position(void **state) {
+  (void)state;
+  nav_filter_config c = nav_filter_config_default();
+  nav_filter *f = NULL;
+  assert_int_equal(nav_filter_create(&c, &f), NAV_OK);
+  nav_filter_nav g;
+  g.lat_rad = 0.7;
+  g.h_m = -12.0;
+  g.v_eb_n_mps = nav_vec3_make(DBL_MAX, -0.0, 4.9e-324);
+  g.C_b_n = nav_euler_to_dcm((nav_euler){0.1, 0.2, 0.3});
+  g.f_ib_b_mps2 = nav_vec3_make(0.1, -0.2, -9.8);
+  g.w_ib_b_rps = nav_vec3_make(-DBL_MAX, 0.0, 1e-300);
+  assert_int_equal(check_nav(f, &g, "test"), NAV_OK);
+  const double bad[] = {NAN, INFINITY, -INFINITY};
+  for (size_t pos = 0; pos < 20; ++pos)
+    for (size_t b = 0; b < 3; ++b) {
+      double v[20];
+      memcpy(v, &g, sizeof v);
+      v[pos] = bad[b];
+      nav_filter_nav h;
+      memcpy(&h, v, sizeof h);
+      if (check_nav(f, &h, "test") != NAV_ERR_NUMERIC) fail_msg("number %zu = %g of the navigation state accepted", pos, bad[b]);
+      assert_non_null(strstr(nav_filter_last_error(f), "not finite"));
+    }
+  nav_filter_destroy(f);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chol_ok_matches_reference),
@@ -543,6 +573,7 @@ int main(void) {
       cmocka_unit_test(test_all_finite_every_position),
       cmocka_unit_test(test_sandwich_matches_plain),
       cmocka_unit_test(test_predict_guard_reports_lost_definiteness),
+      cmocka_unit_test(test_check_nav_every_position),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

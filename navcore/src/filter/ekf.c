@@ -859,20 +859,20 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
   return NAV_OK;
 }
 
-static bool mat3_isfinite(const nav_mat3 *m) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (!isfinite(m->m[i][j])) return false;
-  return true;
-}
-
 /* |lat| below this has cos(lat) > 0.07, far from the MIN_COS_LAT limit: no cos needed. */
 #define LAT_SAFE_RAD 1.5
 
+/* Every number of a nav_filter_nav finite, by the test of all_finite_nn (x - x is +0.0 exactly
+ * for finite x): the per-IMU-step check without a branch per number. */
+_Static_assert(sizeof(nav_filter_nav) == 20 * sizeof(double), "nav_filter_nav is 20 doubles");
+static bool nav_all_finite(const nav_filter_nav *nav) {
+  double v[20];
+  memcpy(v, nav, sizeof v);
+  return all_finite_nn(v, 20);
+}
+
 static nav_status check_nav(nav_filter *f, const nav_filter_nav *nav, const char *what) {
-  if (!isfinite(nav->lat_rad) || !isfinite(nav->h_m) || !nav_vec3_isfinite(nav->v_eb_n_mps) ||
-      !mat3_isfinite(&nav->C_b_n) || !nav_vec3_isfinite(nav->f_ib_b_mps2) ||
-      !nav_vec3_isfinite(nav->w_ib_b_rps)) {
+  if (!nav_all_finite(nav)) {
     set_error(f, "%s: the navigation state (lat, h, v, C_b_n, f_b or w_ib_b) is not finite", what);
     return NAV_ERR_NUMERIC;
   }
