@@ -298,25 +298,112 @@ static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
 #define NAV_UNROLL
 #endif
 
-/* y -= a x over len elements, len a multiple of 4 known at compile time after inlining (the loop
- * is then unrolled and vectorised; elementwise y_c - a x_c, so the values are those of a plain
- * loop whatever the vector width). */
-static NAV_ALWAYS_INLINE void axmy_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
-  NAV_UNROLL
-  for (size_t c = 0; c < len; c += 4) {
-    y[c] -= a * x[c];
-    y[c + 1] -= a * x[c + 1];
-    y[c + 2] -= a * x[c + 2];
-    y[c + 3] -= a * x[c + 3];
+/* Four doubles as one value: GCC/Clang vector extensions (elementwise IEEE operations, no FMA
+ * under -ffp-contract=off, two SSE2 operations each in the baseline clone), else a plain struct.
+ * The row kernels below keep their running sums in such values, i.e. in registers, for the
+ * whole of a row instead of loading and storing the row once per term. */
+#if defined(__GNUC__)
+#if !defined(__clang__)
+/* These helpers are always inlined, so the note that a 32-byte vector return changes the ABI
+ * where AVX is off (the baseline clone) does not apply. */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double nav_v4 __attribute__((vector_size(32)));
+static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
+  nav_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
+  return (nav_v4){a, b, c, d};
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
+  return (nav_v4){a, a, a, a};
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
+  return a + b;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_sub(nav_v4 a, nav_v4 b) {
+  return a - b;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
+  return a * b;
+}
+#else
+typedef struct nav_v4 {
+  double e[4];
+} nav_v4;
+static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
+  nav_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
+  const nav_v4 v = {{a, b, c, d}};
+  return v;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
+  return v4_make(a, a, a, a);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] += b.e[c];
+  return a;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_sub(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] -= b.e[c];
+  return a;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] *= b.e[c];
+  return a;
+}
+#endif
+
+/* The widest row any kernel handles: NMAX rounded up to four doubles. */
+#define NV_MAX ((NMAX + 3) / 4)
+
+/* Call body(NV) with NV a compile-time constant 1..6 (the row widths 4..24 in doubles). */
+#define NV_DISPATCH(nv, body)                                                                                    \
+  switch (nv) {                                                                                                  \
+  case 6: body(6); break;                                                                                        \
+  case 5: body(5); break;                                                                                        \
+  case 4: body(4); break;                                                                                        \
+  case 3: body(3); break;                                                                                        \
+  case 2: body(2); break;                                                                                        \
+  default: body(1); break;                                                                                       \
+  }
+
+/* Row i of the elimination from column c0 = LD - 4 NV on: a_i -= (a_ki / a_kk) a_k. */
+static NAV_ALWAYS_INLINE void chol_rows(double *a, size_t k, size_t n, double inv, const size_t LD, const size_t NV) {
+  const double *ak = a + k * LD;
+  const size_t c0 = LD - 4 * NV;
+  nav_v4 x[NV_MAX];
+  for (size_t q = 0; q < NV; ++q)
+    x[q] = v4_load(ak + c0 + 4 * q);
+  for (size_t i = k + 1; i < n; ++i) {
+    const nav_v4 f = v4_splat(ak[i] * inv);
+    double *ai = a + i * LD + c0;
+    for (size_t q = 0; q < NV; ++q)
+      v4_store(ai + 4 * q, v4_sub(v4_load(ai + 4 * q), v4_mul(f, x[q])));
   }
 }
 
 /* Is the symmetric n x n matrix p positive definite? Right-looking Cholesky (as Gaussian
  * elimination, pivots a_kk = L_kk^2) on a zero-padded copy (row stride LD): the outer-product
- * updates of the trailing rows are independent of each other, and each runs over a whole padded
- * row at a compile-time width (unrolled, vectorised) instead of the variable tail j >= i. The
- * entries j >= i get exactly the operations a_ij -= (a_ki / a_kk) a_kj of the textbook loop; the
- * others (j < i and the padding) are computed but never read. A strictly positive, finite pivot
+ * updates of the trailing rows are independent of each other, and each runs from column k + 1
+ * rounded down to a multiple of 4 to the end of the padded row, at one of the compile-time widths
+ * (unrolled, vectorised; the multiplied row of step k held in registers) instead of the variable
+ * tail j >= i. The entries j >= i get exactly the operations a_ij -= (a_ki / a_kk) a_kj of the
+ * textbook loop; the others (j < i and the padding) are computed or left stale, never read. A strictly positive, finite pivot
  * at every step is the criterion (numerics.md 6.5); the factor itself is not kept. NaN fails (the
  * comparisons are false).
  *
@@ -326,14 +413,28 @@ static NAV_ALWAYS_INLINE void axmy_fixed(double *restrict y, double a, const dou
  * fails at once, and a non-finite a_kj (j > k) makes the multiplier f_j = a_kj / a_kk non-finite
  * and the later pivot a_jj - f_j a_kj infinite or NaN, which fails at step j. */
 static NAV_ALWAYS_INLINE bool chol_ok_ld(const double *p, size_t n, double *a, const size_t LD) {
-  pad_copy(a, p, n, LD);
+  if (LD - n < 4) {
+    /* The padded copy four entries at a time (p read past each row end, into the next row or
+     * the rest of its NMAX^2 buffer), the padding then set to zero. */
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t q = 0; q < LD; q += 4)
+        v4_store(a + i * LD + q, v4_load(p + i * n + q));
+      for (size_t c = n; c < LD; ++c)
+        a[i * LD + c] = 0.0;
+    }
+  } else {
+    pad_copy(a, p, n, LD);
+  }
   for (size_t k = 0; k < n; ++k) {
-    const double *restrict ak = a + k * LD;
-    const double d = ak[k];
+    const double d = a[k * LD + k];
     if (!(d > 0.0) || !(d < INFINITY)) return false;
     const double inv = 1.0 / d;
-    for (size_t i = k + 1; i < n; ++i)
-      axmy_fixed(a + i * LD, ak[i] * inv, ak, LD);
+    /* Only the columns from k + 1 rounded down to a multiple of 4: every entry j >= i > k still
+     * gets each of its operations; the entries left of them are never read again. */
+    const size_t nv = (LD - ((k + 1) & ~(size_t)3)) / 4;
+#define CHOL_ROWS(NV) chol_rows(a, k, n, inv, LD, NV)
+    NV_DISPATCH(nv, CHOL_ROWS)
+#undef CHOL_ROWS
   }
   return true;
 }
@@ -442,71 +543,6 @@ static nav_status check_cov_predict(nav_filter *f, const double *p) {
   return st;
 }
 
-/* Four doubles as one value: GCC/Clang vector extensions (elementwise IEEE operations, no FMA
- * under -ffp-contract=off, two SSE2 operations each in the baseline clone), else a plain struct.
- * The row kernels below keep their running sums in such values, i.e. in registers, for the
- * whole of a row instead of loading and storing the row once per term. */
-#if defined(__GNUC__)
-#if !defined(__clang__)
-/* These helpers are always inlined, so the note that a 32-byte vector return changes the ABI
- * where AVX is off (the baseline clone) does not apply. */
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef double nav_v4 __attribute__((vector_size(32)));
-static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
-  nav_v4 v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
-static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
-  memcpy(p, &v, sizeof v);
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
-  return (nav_v4){a, b, c, d};
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
-  return (nav_v4){a, a, a, a};
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
-  return a + b;
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
-  return a * b;
-}
-#else
-typedef struct nav_v4 {
-  double e[4];
-} nav_v4;
-static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
-  nav_v4 v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
-static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
-  memcpy(p, &v, sizeof v);
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
-  const nav_v4 v = {{a, b, c, d}};
-  return v;
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
-  return v4_make(a, a, a, a);
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
-  for (int c = 0; c < 4; ++c)
-    a.e[c] += b.e[c];
-  return a;
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
-  for (int c = 0; c < 4; ++c)
-    a.e[c] *= b.e[c];
-  return a;
-}
-#endif
-
-/* The widest row any kernel handles: NMAX rounded up to four doubles. */
-#define NV_MAX ((NMAX + 3) / 4)
-
 /*
  * acc[0..NV) = sum over p < cnt of a_p x_p, x_p = rows + col[p] * stride + c0 (4 NV doubles),
  * a_p = coef[col[p]] (times 0.5 when half): the first term a product, each further one a
@@ -531,17 +567,6 @@ static NAV_ALWAYS_INLINE void combo(nav_v4 *acc, const double *coef, bool half, 
       acc[q] = v4_add(acc[q], v4_mul(a, v4_load(x + 4 * q)));
   }
 }
-
-/* Call body(NV) with NV a compile-time constant 1..6 (the row widths 4..24 in doubles). */
-#define NV_DISPATCH(nv, body)                                                                                    \
-  switch (nv) {                                                                                                  \
-  case 6: body(6); break;                                                                                        \
-  case 5: body(5); break;                                                                                        \
-  case 4: body(4); break;                                                                                        \
-  case 3: body(3); break;                                                                                        \
-  case 2: body(2); break;                                                                                        \
-  default: body(1); break;                                                                                       \
-  }
 
 /* W row j, columns 0 .. 4 NV - 1: sum over the pattern of Phi_jk (row k of S). */
 static NAV_ALWAYS_INLINE void w_row(double *wj, const double *phi_j, const unsigned char *col, unsigned cnt,
