@@ -825,18 +825,6 @@ static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *F
   for (size_t k = 0; k < n * n; ++k)
     assert(memcmp(&f->Qd[k], &(double){0.5 * QT[k]}, sizeof(double)) == 0);
 #endif
-  if (ld - n < 4) {
-    /* Four entries at a time up to column ld of each row (P and Qd are read past the row end,
-     * into the next row or the rest of their NMAX^2 buffers), then the padding set to zero. */
-    for (size_t i = 0; i < n; ++i) {
-      NAV_UNROLL
-      for (size_t q = 0; q < ld; q += 4)
-        v4_store(f->S + i * ld + q, v4_add(v4_load(f->P + i * n + q), v4_load(f->Qd + i * n + q)));
-      for (size_t c = n; c < ld; ++c)
-        f->S[i * ld + c] = 0.0;
-    }
-    return;
-  }
   for (size_t i = 0; i < n; ++i) {
     NAV_UNROLL
     for (size_t j = 0; j < n; ++j)
@@ -949,27 +937,16 @@ static void pending_add(const nav_filter *f, pending *pd, const nav_filter_nav *
   pd->last_h = nav->h_m;
   pd->last_v = nav->v_eb_n_mps;
   pd->fn_T = nav_vec3_axpy(pd->fn_T, dt, nav_mat3_mul_vec(C, nav->f_ib_b_mps2));
-  /* The 3 x 3 sums as 9 consecutive doubles, 4 + 4 + 1 at a time, each entry with the operations
-   * of the entry-by-entry loops: C_T += dt C, Cf_T += (C_ij f_j) dt, Cw_T += (C_ij w_j) dt. */
-  const nav_v4 dtv = v4_splat(dt);
-  const double *c = &C.m[0][0];
-  const nav_v4 c0 = v4_load(c), c1 = v4_load(c + 4);
-  double *ct = &pd->C_T.m[0][0];
-  v4_store(ct, v4_add(v4_load(ct), v4_mul(dtv, c0)));
-  v4_store(ct + 4, v4_add(v4_load(ct + 4), v4_mul(dtv, c1)));
-  ct[8] += dt * c[8];
-  if (f->lay.has_scale_factors) {
-    const nav_vec3 fb = nav->f_ib_b_mps2, wb = nav->w_ib_b_rps;
-    const nav_v4 f0 = v4_make(fb.x, fb.y, fb.z, fb.x), f1 = v4_make(fb.y, fb.z, fb.x, fb.y);
-    const nav_v4 w0 = v4_make(wb.x, wb.y, wb.z, wb.x), w1 = v4_make(wb.y, wb.z, wb.x, wb.y);
-    double *cf = &pd->Cf_T.m[0][0], *cw = &pd->Cw_T.m[0][0];
-    v4_store(cf, v4_add(v4_load(cf), v4_mul(v4_mul(c0, f0), dtv)));
-    v4_store(cf + 4, v4_add(v4_load(cf + 4), v4_mul(v4_mul(c1, f1), dtv)));
-    cf[8] += c[8] * fb.z * dt;
-    v4_store(cw, v4_add(v4_load(cw), v4_mul(v4_mul(c0, w0), dtv)));
-    v4_store(cw + 4, v4_add(v4_load(cw + 4), v4_mul(v4_mul(c1, w1), dtv)));
-    cw[8] += c[8] * wb.z * dt;
-  }
+  pd->C_T = mat3_axpy(pd->C_T, dt, C);
+  if (f->lay.has_scale_factors)
+    for (int i = 0; i < 3; ++i) {
+      pd->Cf_T.m[i][0] += C.m[i][0] * nav->f_ib_b_mps2.x * dt;
+      pd->Cf_T.m[i][1] += C.m[i][1] * nav->f_ib_b_mps2.y * dt;
+      pd->Cf_T.m[i][2] += C.m[i][2] * nav->f_ib_b_mps2.z * dt;
+      pd->Cw_T.m[i][0] += C.m[i][0] * nav->w_ib_b_rps.x * dt;
+      pd->Cw_T.m[i][1] += C.m[i][1] * nav->w_ib_b_rps.y * dt;
+      pd->Cw_T.m[i][2] += C.m[i][2] * nav->w_ib_b_rps.z * dt;
+    }
   if (!f->q_isotropic) {
     pd->Qa_T = mat3_axpy(pd->Qa_T, dt, cqct(C, f->qc + NAV_FILTER_IDX_DV));
     pd->Qg_T = mat3_axpy(pd->Qg_T, dt, cqct(C, f->qc + NAV_FILTER_IDX_PHI));
