@@ -112,11 +112,11 @@ static void test_transpose_matches_plain(void **state) {
       wt[i] = NAN;
     }
     if (ld == 16)
-      transpose_ld(wt, w, n, 16);
+      transpose_ld(wt, w, n, n, 16);
     else if (ld == 20)
-      transpose_ld(wt, w, n, 20);
+      transpose_ld(wt, w, n, n, 20);
     else
-      transpose_ld(wt, w, n, 24);
+      transpose_ld(wt, w, n, n, 24);
     for (size_t i = 0; i < n; ++i)
       for (size_t j = 0; j < n; ++j)
         if (memcmp(&wt[j * ld + i], &w[i * ld + j], sizeof *w) != 0)
@@ -124,7 +124,94 @@ static void test_transpose_matches_plain(void **state) {
   }
 }
 
-/* The measurement update instantiated with compile-time sizes (n = 15 or 18, m = 3) gives the
+/* The update's arithmetic written as the textbook loops (row-major n x m products, every sum
+ * from +0.0 in index order over the non-zero columns of H where update_core uses them): P+ (Joseph
+ * form, symmetrised by the caller), x+ and S. */
+static void reference_update(const double *P, const double *x, const double *H, const double *z, const double *R,
+                             size_t n, size_t m, double *Pn, double *xn, double *S) {
+  static double PHt[NMAX * MMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], B[NN], BHt[NMAX * MMAX], W[NMAX * MMAX];
+  double y[MMAX], Ls[MMAX * MMAX];
+  size_t hc[NMAX], nhc = 0;
+  for (size_t r = 0; r < m; ++r) {
+    double hx = 0.0;
+    for (size_t j = 0; j < n; ++j)
+      hx += H[r * n + j] * x[j];
+    y[r] = z[r] - hx;
+  }
+  for (size_t j = 0; j < n; ++j) {
+    bool nz = false;
+    for (size_t r = 0; r < m; ++r)
+      nz = nz || H[r * n + j] != 0.0;
+    if (nz) hc[nhc++] = j;
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t r = 0; r < m; ++r) {
+      double sum = 0.0;
+      for (size_t q = 0; q < nhc; ++q)
+        sum += P[i * n + hc[q]] * H[r * n + hc[q]];
+      PHt[i * m + r] = sum;
+    }
+  for (size_t r = 0; r < m; ++r)
+    for (size_t c = 0; c < m; ++c) {
+      double sum = 0.0;
+      for (size_t j = 0; j < n; ++j)
+        sum += H[r * n + j] * PHt[j * m + c];
+      S[r * m + c] = sum + R[r * m + c];
+    }
+  nav_matn_symmetrize(S, m);
+  assert_int_equal(nav_matn_cholesky(Ls, S, m), NAV_OK);
+  for (size_t r = 0; r < m; ++r)
+    for (size_t j = 0; j < n; ++j)
+      Kt[r * n + j] = PHt[j * m + r];
+  nav_matn_chol_solve(Kt, Ls, Kt, m, n);
+  for (size_t j = 0; j < n; ++j)
+    for (size_t r = 0; r < m; ++r)
+      K[j * m + r] = Kt[r * n + j];
+  for (size_t j = 0; j < n; ++j) {
+    double sum = x[j];
+    for (size_t r = 0; r < m; ++r)
+      sum += K[j * m + r] * y[r];
+    xn[j] = sum;
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (size_t r = 0; r < m; ++r)
+        sum += K[i * m + r] * PHt[j * m + r];
+      B[i * n + j] = P[i * n + j] - sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t r = 0; r < m; ++r) {
+      double sum = 0.0;
+      for (size_t q = 0; q < nhc; ++q)
+        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
+      BHt[i * m + r] = sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (size_t r = 0; r < m; ++r)
+        sum += BHt[i * m + r] * K[j * m + r];
+      Pn[i * n + j] = B[i * n + j] - sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t c = 0; c < m; ++c) {
+      double sum = 0.0;
+      for (size_t r = 0; r < m; ++r)
+        sum += K[i * m + r] * R[r * m + c];
+      W[i * m + c] = sum;
+    }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i; j < n; ++j) {
+      double sum = 0.0;
+      for (size_t c = 0; c < m; ++c)
+        sum += W[i * m + c] * K[j * m + c];
+      Pn[i * n + j] += sum;
+      if (j != i) Pn[j * n + i] += sum;
+    }
+}
+
+/* The measurement update instantiated with compile-time sizes (n = 15, 18 or 21, m = 3) gives the
  * values of the generic code bit for bit: x+, P+, S and the innovation. */
 static void check_update_instantiation(size_t n, uint64_t stream) {
   nav_filter *f = calloc(1, sizeof *f);
@@ -153,7 +240,9 @@ static void check_update_instantiation(size_t n, uint64_t stream) {
   *g = *f;
   double yf[MMAX], Sf[MMAX * MMAX], Lf[MMAX * MMAX], yg[MMAX], Sg[MMAX * MMAX], Lg[MMAX * MMAX];
   /* The specialised instance, then the generic one (sizes the compiler cannot see). */
-  const bool ok_f = n == 15 ? update_core(f, 15, 3, H, z, R, yf, Sf, Lf) : update_core(f, 18, 3, H, z, R, yf, Sf, Lf);
+  const bool ok_f = n == 15   ? update_core(f, 15, 3, H, z, R, yf, Sf, Lf)
+                    : n == 18 ? update_core(f, 18, 3, H, z, R, yf, Sf, Lf)
+                              : update_core(f, 21, 3, H, z, R, yf, Sf, Lf);
   volatile size_t n_rt = n, m_rt = 3;
   const bool ok_g = update_core(g, n_rt, m_rt, H, z, R, yg, Sg, Lg);
   assert_true(ok_f);
@@ -162,6 +251,13 @@ static void check_update_instantiation(size_t n, uint64_t stream) {
   assert_memory_equal(f->xn, g->xn, n * sizeof *f->xn);
   assert_memory_equal(Sf, Sg, 9 * sizeof *Sf);
   assert_memory_equal(yf, yg, 3 * sizeof *yf);
+  /* And both are the textbook loops' values (the transposed layouts change no operation). */
+  static double Pr[NN];
+  double xr[NMAX], Sr[MMAX * MMAX];
+  reference_update(g->P, g->x, H, z, R, n, 3, Pr, xr, Sr);
+  assert_memory_equal(f->Pn, Pr, n * n * sizeof *Pr);
+  assert_memory_equal(f->xn, xr, n * sizeof *xr);
+  assert_memory_equal(Sf, Sr, 9 * sizeof *Sr);
   free(f);
   free(g);
 }
@@ -171,6 +267,7 @@ static void test_update_instantiations_bit_identical(void **state) {
   for (uint64_t s = 0; s < 20; ++s) {
     check_update_instantiation(15, 10 + s);
     check_update_instantiation(18, 100 + s);
+    check_update_instantiation(21, 200 + s);
   }
 }
 
@@ -319,11 +416,14 @@ static void test_sandwich_matches_plain(void **state) {
     for (size_t rep = 0; rep < 20; ++rep) {
       memset(phi, 0, sizeof phi);
       memset(sp, 0, sizeof sp);
-      /* A sparse Phi with its diagonal, about a third of the entries non-zero. */
+      /* A sparse Phi with its diagonal, about a third of the entries non-zero; in every other
+       * repetition the rows from a random diag_tail on hold their diagonal alone (the sensor and
+       * GNSS states of the filter), which the sandwich computes by its shorter path. */
+      const size_t diag_tail = rep % 2 == 0 ? n : (size_t)(nav_rng_uniform(&r) * (double)n);
       for (size_t i = 0; i < n; ++i) {
         unsigned char c = 0;
         for (size_t j = 0; j < n; ++j)
-          if (i == j || nav_rng_uniform(&r) < 0.33) {
+          if (i == j || (i < diag_tail && nav_rng_uniform(&r) < 0.33)) {
             phi[i * ld + j] = nav_rng_gauss(&r);
             pt.col[i][c++] = (unsigned char)j;
           }
@@ -337,7 +437,8 @@ static void test_sandwich_matches_plain(void **state) {
           sp[i * ld + j] = tmp[i * n + j];
       for (size_t i = 0; i < NN; ++i)
         pn[i] = NAN;
-      pattern_sandwich(pn, phi, &pt, sp, qh, n, ld, w, wt);
+      pattern_finish(&pt, n, ld);
+      pattern_sandwich(pn, phi, &pt, sp, qh, n, ld, w, wt, w);
       for (size_t i = 0; i < n; ++i)
         for (size_t c = 0; c < n; ++c) {
           double v = phi[i * ld + pt.col[i][0]] * sp[pt.col[i][0] * ld + c];
@@ -431,6 +532,36 @@ static void test_predict_guard_reports_lost_definiteness(void **state) {
   }
 }
 
+/* check_nav tests the 20 numbers of a nav_filter_nav at once: NaN or an infinity at any one of
+ * them is refused (NAV_ERR_NUMERIC, the predict leaves the filter as it was), finite extremes
+ * are accepted. */
+static void test_check_nav_every_position(void **state) {
+  (void)state;
+  nav_filter_config c = nav_filter_config_default();
+  nav_filter *f = NULL;
+  assert_int_equal(nav_filter_create(&c, &f), NAV_OK);
+  nav_filter_nav g;
+  g.lat_rad = 0.7;
+  g.h_m = -12.0;
+  g.v_eb_n_mps = nav_vec3_make(DBL_MAX, -0.0, 4.9e-324);
+  g.C_b_n = nav_euler_to_dcm((nav_euler){0.1, 0.2, 0.3});
+  g.f_ib_b_mps2 = nav_vec3_make(0.1, -0.2, -9.8);
+  g.w_ib_b_rps = nav_vec3_make(-DBL_MAX, 0.0, 1e-300);
+  assert_int_equal(check_nav(f, &g, "test"), NAV_OK);
+  const double bad[] = {NAN, INFINITY, -INFINITY};
+  for (size_t pos = 0; pos < 20; ++pos)
+    for (size_t b = 0; b < 3; ++b) {
+      double v[20];
+      memcpy(v, &g, sizeof v);
+      v[pos] = bad[b];
+      nav_filter_nav h;
+      memcpy(&h, v, sizeof h);
+      if (check_nav(f, &h, "test") != NAV_ERR_NUMERIC) fail_msg("number %zu = %g of the navigation state accepted", pos, bad[b]);
+      assert_non_null(strstr(nav_filter_last_error(f), "not finite"));
+    }
+  nav_filter_destroy(f);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_chol_ok_matches_reference),
@@ -442,6 +573,7 @@ int main(void) {
       cmocka_unit_test(test_all_finite_every_position),
       cmocka_unit_test(test_sandwich_matches_plain),
       cmocka_unit_test(test_predict_guard_reports_lost_definiteness),
+      cmocka_unit_test(test_check_nav_every_position),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -51,7 +51,42 @@
 typedef struct row_pattern {
   unsigned char cnt[NMAX];
   unsigned char col[NMAX][NMAX];
+  uint32_t mask[NMAX];     /* the same columns as bits */
+  unsigned char diag_from; /* rows diag_from .. n-1 hold their diagonal entry alone */
+  unsigned char width;     /* the columns of rows 0 .. diag_from-1 lie below this multiple of 4 */
 } row_pattern;
+
+/* The derived fields of a pattern whose cnt and col are set. */
+static void pattern_finish(row_pattern *pt, size_t n, size_t ld) {
+  size_t s0 = n;
+  while (s0 > 0 && pt->cnt[s0 - 1] == 1 && pt->col[s0 - 1][0] == s0 - 1)
+    --s0;
+  size_t w = 0;
+  for (size_t i = 0; i < n; ++i) {
+    pt->mask[i] = 0;
+    for (unsigned p = 0; p < pt->cnt[i]; ++p) {
+      pt->mask[i] |= UINT32_C(1) << pt->col[i][p];
+      if (i < s0 && pt->col[i][p] + 1u > w) w = pt->col[i][p] + 1u;
+    }
+  }
+  w = (w + 3) & ~(size_t)3;
+  pt->diag_from = (unsigned char)s0;
+  pt->width = (unsigned char)(w < 4 ? 4 : (w > ld ? ld : w));
+}
+
+/* Index of the lowest set bit of m != 0. */
+static inline unsigned nav_ctz32(uint32_t m) {
+#if defined(__GNUC__)
+  return (unsigned)__builtin_ctz(m);
+#else
+  unsigned k = 0;
+  while ((m & 1u) == 0) {
+    m >>= 1;
+    ++k;
+  }
+  return k;
+#endif
+}
 
 /*
  * Sums over a decimated covariance interval (numerics.md 6.3 with cov_decimation > 1). The
@@ -92,7 +127,7 @@ struct nav_filter {
 
   /* Scratch, sized for the largest state; nothing is allocated after create. */
   double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], Pn[NN], L[NN], A[NN], Wt[NN];
-  double H[MMAX * NMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
+  double H[MMAX * NMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
   double xn[NMAX];
   double vl_work[VL_WORK];
 
@@ -239,6 +274,8 @@ static void init_patterns(nav_filter *f) {
   /* The three instantiations of the padded kernels: 16 (the 15-state core), 20 (18 states: the
    * core with GNSS error states) and 24 (the rest). */
   f->ld = n <= 16 ? 16 : (n <= 20 ? 20 : 24);
+  pattern_finish(&f->a_pat, n, f->ld);
+  pattern_finish(&f->phi_pat, n, f->ld);
 }
 
 /* Copy an n x n matrix into a zero-padded one of row stride ld. */
@@ -250,9 +287,6 @@ static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
   }
 }
 
-/* y += a x over LD elements, LD a multiple of 4 known at compile time after inlining (the
- * loop is then unrolled and vectorised; elementwise y_c + a x_c, so the values are those of a
- * plain loop whatever the vector width). */
 #if defined(__GNUC__) || defined(__clang__)
 #define NAV_ALWAYS_INLINE __attribute__((always_inline)) inline
 #else
@@ -263,53 +297,113 @@ static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
 #else
 #define NAV_UNROLL
 #endif
-static NAV_ALWAYS_INLINE void axpy_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
-  NAV_UNROLL
-  for (size_t c = 0; c < len; c += 4) {
-    y[c] += a * x[c];
-    y[c + 1] += a * x[c + 1];
-    y[c + 2] += a * x[c + 2];
-    y[c + 3] += a * x[c + 3];
-  }
-}
 
-/*
- * Pn = Phi S Phi^T + Qh for a symmetric S (numerics.md 6.3), Phi given padded (stride LD) with
- * the row pattern @p pt. W = Phi S row by row (rows of S scaled by the non-zeros of Phi: each
- * an LD-wide multiply-add), then the upper triangle of Phi W^T the same way from the rows of
- * W^T, mirrored. Bias rows of Phi (a single diagonal entry) cost one row scaling each. Pn is
- * n x n (not padded); S, W, Wt are padded scratch. LD is a compile-time constant in the
- * instantiations below.
- */
-/* y = a x over len elements (the first term of a row: no zeroing pass, which the compiler turns
- * into a rep stos with a large start-up cost at these sizes). */
-static NAV_ALWAYS_INLINE void scal_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
-  NAV_UNROLL
-  for (size_t c = 0; c < len; c += 4) {
-    y[c] = a * x[c];
-    y[c + 1] = a * x[c + 1];
-    y[c + 2] = a * x[c + 2];
-    y[c + 3] = a * x[c + 3];
-  }
+/* Four doubles as one value: GCC/Clang vector extensions (elementwise IEEE operations, no FMA
+ * under -ffp-contract=off, two SSE2 operations each in the baseline clone), else a plain struct.
+ * The row kernels below keep their running sums in such values, i.e. in registers, for the
+ * whole of a row instead of loading and storing the row once per term. */
+#if defined(__GNUC__)
+#if !defined(__clang__)
+/* These helpers are always inlined, so the note that a 32-byte vector return changes the ABI
+ * where AVX is off (the baseline clone) does not apply. */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double nav_v4 __attribute__((vector_size(32)));
+static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
+  nav_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
 }
+static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
+  return (nav_v4){a, b, c, d};
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
+  return (nav_v4){a, a, a, a};
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
+  return a + b;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_sub(nav_v4 a, nav_v4 b) {
+  return a - b;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
+  return a * b;
+}
+#else
+typedef struct nav_v4 {
+  double e[4];
+} nav_v4;
+static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
+  nav_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
+  const nav_v4 v = {{a, b, c, d}};
+  return v;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
+  return v4_make(a, a, a, a);
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] += b.e[c];
+  return a;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_sub(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] -= b.e[c];
+  return a;
+}
+static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
+  for (int c = 0; c < 4; ++c)
+    a.e[c] *= b.e[c];
+  return a;
+}
+#endif
 
-/* y -= a x over LD elements (as axpy_fixed: elementwise, the values of a plain loop). */
-static NAV_ALWAYS_INLINE void axmy_fixed(double *restrict y, double a, const double *restrict x, size_t len) {
-  NAV_UNROLL
-  for (size_t c = 0; c < len; c += 4) {
-    y[c] -= a * x[c];
-    y[c + 1] -= a * x[c + 1];
-    y[c + 2] -= a * x[c + 2];
-    y[c + 3] -= a * x[c + 3];
+/* The widest row any kernel handles: NMAX rounded up to four doubles. */
+#define NV_MAX ((NMAX + 3) / 4)
+
+/* Call body(NV) with NV a compile-time constant 1..6 (the row widths 4..24 in doubles). */
+#define NV_DISPATCH(nv, body)                                                                                    \
+  switch (nv) {                                                                                                  \
+  case 6: body(6); break;                                                                                        \
+  case 5: body(5); break;                                                                                        \
+  case 4: body(4); break;                                                                                        \
+  case 3: body(3); break;                                                                                        \
+  case 2: body(2); break;                                                                                        \
+  default: body(1); break;                                                                                       \
+  }
+
+/* Row i of the elimination from column c0 = LD - 4 NV on: a_i -= (a_ki / a_kk) a_k. */
+static NAV_ALWAYS_INLINE void chol_rows(double *a, size_t k, size_t n, double inv, const size_t LD, const size_t NV) {
+  const double *ak = a + k * LD;
+  const size_t c0 = LD - 4 * NV;
+  nav_v4 x[NV_MAX];
+  for (size_t q = 0; q < NV; ++q)
+    x[q] = v4_load(ak + c0 + 4 * q);
+  for (size_t i = k + 1; i < n; ++i) {
+    const nav_v4 f = v4_splat(ak[i] * inv);
+    double *ai = a + i * LD + c0;
+    for (size_t q = 0; q < NV; ++q)
+      v4_store(ai + 4 * q, v4_sub(v4_load(ai + 4 * q), v4_mul(f, x[q])));
   }
 }
 
 /* Is the symmetric n x n matrix p positive definite? Right-looking Cholesky (as Gaussian
  * elimination, pivots a_kk = L_kk^2) on a zero-padded copy (row stride LD): the outer-product
- * updates of the trailing rows are independent of each other, and each runs over a whole padded
- * row at a compile-time width (unrolled, vectorised) instead of the variable tail j >= i. The
- * entries j >= i get exactly the operations a_ij -= (a_ki / a_kk) a_kj of the textbook loop; the
- * others (j < i and the padding) are computed but never read. A strictly positive, finite pivot
+ * updates of the trailing rows are independent of each other, and each runs from column k + 1
+ * rounded down to a multiple of 4 to the end of the padded row, at one of the compile-time widths
+ * (unrolled, vectorised; the multiplied row of step k held in registers) instead of the variable
+ * tail j >= i. The entries j >= i get exactly the operations a_ij -= (a_ki / a_kk) a_kj of the
+ * textbook loop; the others (j < i and the padding) are computed or left stale, never read. A strictly positive, finite pivot
  * at every step is the criterion (numerics.md 6.5); the factor itself is not kept. NaN fails (the
  * comparisons are false).
  *
@@ -319,14 +413,28 @@ static NAV_ALWAYS_INLINE void axmy_fixed(double *restrict y, double a, const dou
  * fails at once, and a non-finite a_kj (j > k) makes the multiplier f_j = a_kj / a_kk non-finite
  * and the later pivot a_jj - f_j a_kj infinite or NaN, which fails at step j. */
 static NAV_ALWAYS_INLINE bool chol_ok_ld(const double *p, size_t n, double *a, const size_t LD) {
-  pad_copy(a, p, n, LD);
+  if (LD - n < 4) {
+    /* The padded copy four entries at a time (p read past each row end, into the next row or
+     * the rest of its NMAX^2 buffer), the padding then set to zero. */
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t q = 0; q < LD; q += 4)
+        v4_store(a + i * LD + q, v4_load(p + i * n + q));
+      for (size_t c = n; c < LD; ++c)
+        a[i * LD + c] = 0.0;
+    }
+  } else {
+    pad_copy(a, p, n, LD);
+  }
   for (size_t k = 0; k < n; ++k) {
-    const double *restrict ak = a + k * LD;
-    const double d = ak[k];
+    const double d = a[k * LD + k];
     if (!(d > 0.0) || !(d < INFINITY)) return false;
     const double inv = 1.0 / d;
-    for (size_t i = k + 1; i < n; ++i)
-      axmy_fixed(a + i * LD, ak[i] * inv, ak, LD);
+    /* Only the columns from k + 1 rounded down to a multiple of 4: every entry j >= i > k still
+     * gets each of its operations; the entries left of them are never read again. */
+    const size_t nv = (LD - ((k + 1) & ~(size_t)3)) / 4;
+#define CHOL_ROWS(NV) chol_rows(a, k, n, inv, LD, NV)
+    NV_DISPATCH(nv, CHOL_ROWS)
+#undef CHOL_ROWS
   }
   return true;
 }
@@ -402,6 +510,7 @@ static NAV_ALWAYS_INLINE bool all_finite_nn(const double *p, const size_t count)
 NAV_KERNEL_CLONES static bool all_finite(const double *p, size_t n) {
   if (n == 15) return all_finite_nn(p, 225);
   if (n == 18) return all_finite_nn(p, 324);
+  if (n == 21) return all_finite_nn(p, 441);
   return all_finite_nn(p, n * n);
 }
 
@@ -434,112 +543,194 @@ static nav_status check_cov_predict(nav_filter *f, const double *p) {
   return st;
 }
 
-/* Wt = W^T for the n x n part of padded matrices (stride LD). With GCC vector extensions: 4 x 4
- * blocks, each loaded as four rows and stored as four columns with register shuffles. The scalar
- * transpose (one load and one strided store per entry, the loads right behind the vector stores
- * that wrote W) took a quarter of the sandwich. Blocks reach up to row and column
- * round_up(n, 4) <= LD: the extra rows of W are scratch (stale values), which land in padding
- * columns of Wt that are never read. Only values are moved, so the result is bit for bit the
- * plain loop's. */
+/*
+ * acc[0..NV) = sum over p < cnt of a_p x_p, x_p = rows + col[p] * stride + c0 (4 NV doubles),
+ * a_p = coef[col[p]] (times 0.5 when half): the first term a product, each further one a
+ * multiply and an add, in pattern order. Entry by entry these are the operations of the
+ * former full-row loops y = a x, y += a x (the values do not depend on how many columns are
+ * computed).
+ */
+static NAV_ALWAYS_INLINE void combo(nav_v4 *acc, const double *coef, bool half, const unsigned char *col,
+                                    unsigned cnt, const double *rows, size_t stride, size_t c0, const size_t NV) {
+  {
+    const size_t k = col[0];
+    const nav_v4 a = v4_splat(half ? 0.5 * coef[k] : coef[k]);
+    const double *x = rows + k * stride + c0;
+    for (size_t q = 0; q < NV; ++q)
+      acc[q] = v4_mul(a, v4_load(x + 4 * q));
+  }
+  for (unsigned p = 1; p < cnt; ++p) {
+    const size_t k = col[p];
+    const nav_v4 a = v4_splat(half ? 0.5 * coef[k] : coef[k]);
+    const double *x = rows + k * stride + c0;
+    for (size_t q = 0; q < NV; ++q)
+      acc[q] = v4_add(acc[q], v4_mul(a, v4_load(x + 4 * q)));
+  }
+}
+
+/* W row j, columns 0 .. 4 NV - 1: sum over the pattern of Phi_jk (row k of S). */
+static NAV_ALWAYS_INLINE void w_row(double *wj, const double *phi_j, const unsigned char *col, unsigned cnt,
+                                    const double *S, size_t LD, const size_t NV) {
+  nav_v4 acc[NV_MAX];
+  combo(acc, phi_j, false, col, cnt, S, LD, 0, NV);
+  for (size_t q = 0; q < NV; ++q)
+    v4_store(wj + 4 * q, acc[q]);
+}
+
+/* Row i of Phi W^T + Qh from column c0 = LD - 4 NV on: sum over the pattern of Phi_ik (row k of
+ * W^T), then + Qh_ij (Qh unpadded, stride n: the columns past n read the next row or the rest
+ * of the buffer, and land in columns that are never read). */
+static NAV_ALWAYS_INLINE void upper_row(double *ui, const double *phi_i, const unsigned char *col, unsigned cnt,
+                                        const double *Wt, const double *qh_i, size_t LD, const size_t NV) {
+  const size_t c0 = LD - 4 * NV;
+  nav_v4 acc[NV_MAX];
+  combo(acc, phi_i, false, col, cnt, Wt, LD, c0, NV);
+  for (size_t q = 0; q < NV; ++q)
+    v4_store(ui + c0 + 4 * q, v4_add(acc[q], v4_load(qh_i + c0 + 4 * q)));
+}
+
+/* Row i of the second-order Phi, columns 0 .. 4 NV - 1: sum over the pattern of A of
+ * (0.5 a_ik) (row k of A), then + 1.0 a_i (the axpy with 1.0 of before), then + 1 on the
+ * diagonal. */
+static NAV_ALWAYS_INLINE void phi2_row(double *phi_i, const double *ai, const unsigned char *col, unsigned cnt,
+                                       const double *A, size_t LD, size_t i, const size_t NV) {
+  nav_v4 acc[NV_MAX];
+  combo(acc, ai, true, col, cnt, A, LD, 0, NV);
+  const nav_v4 one = v4_splat(1.0);
+  for (size_t q = 0; q < NV; ++q)
+    v4_store(phi_i + 4 * q, v4_add(acc[q], v4_mul(one, v4_load(ai + 4 * q))));
+  phi_i[i] += 1.0;
+}
+
+/* 4 x 4 block transpose: Wt[(j0 + c) LD + i0 + r] = W[(i0 + r) LD + j0 + c]. With GCC vector
+ * extensions as four row loads, register shuffles and four column stores (the scalar transpose
+ * took a quarter of the sandwich); only values move, so the result is the plain loop's. The
+ * block is read before it is written: the two may be blocks of the same matrix (not the same
+ * block). */
 #if defined(__GNUC__) && !defined(__clang__)
-typedef double nav_v4d __attribute__((vector_size(32)));
 typedef long long nav_v4i __attribute__((vector_size(32)));
-static NAV_ALWAYS_INLINE void transpose_ld(double *restrict Wt, const double *restrict W, size_t n, const size_t LD) {
-  for (size_t i0 = 0; i0 < n; i0 += 4)
-    for (size_t j0 = 0; j0 < n; j0 += 4) {
-      nav_v4d r0, r1, r2, r3;
-      memcpy(&r0, W + (i0 + 0) * LD + j0, sizeof r0);
-      memcpy(&r1, W + (i0 + 1) * LD + j0, sizeof r1);
-      memcpy(&r2, W + (i0 + 2) * LD + j0, sizeof r2);
-      memcpy(&r3, W + (i0 + 3) * LD + j0, sizeof r3);
-      const nav_v4d t0 = __builtin_shuffle(r0, r1, (nav_v4i){0, 4, 2, 6});
-      const nav_v4d t1 = __builtin_shuffle(r0, r1, (nav_v4i){1, 5, 3, 7});
-      const nav_v4d t2 = __builtin_shuffle(r2, r3, (nav_v4i){0, 4, 2, 6});
-      const nav_v4d t3 = __builtin_shuffle(r2, r3, (nav_v4i){1, 5, 3, 7});
-      const nav_v4d c0 = __builtin_shuffle(t0, t2, (nav_v4i){0, 1, 4, 5});
-      const nav_v4d c1 = __builtin_shuffle(t1, t3, (nav_v4i){0, 1, 4, 5});
-      const nav_v4d c2 = __builtin_shuffle(t0, t2, (nav_v4i){2, 3, 6, 7});
-      const nav_v4d c3 = __builtin_shuffle(t1, t3, (nav_v4i){2, 3, 6, 7});
-      memcpy(Wt + (j0 + 0) * LD + i0, &c0, sizeof c0);
-      memcpy(Wt + (j0 + 1) * LD + i0, &c1, sizeof c1);
-      memcpy(Wt + (j0 + 2) * LD + i0, &c2, sizeof c2);
-      memcpy(Wt + (j0 + 3) * LD + i0, &c3, sizeof c3);
-    }
+static NAV_ALWAYS_INLINE void transpose4(double *Wt, const double *W, size_t i0, size_t j0, const size_t LD) {
+  const nav_v4 r0 = v4_load(W + (i0 + 0) * LD + j0);
+  const nav_v4 r1 = v4_load(W + (i0 + 1) * LD + j0);
+  const nav_v4 r2 = v4_load(W + (i0 + 2) * LD + j0);
+  const nav_v4 r3 = v4_load(W + (i0 + 3) * LD + j0);
+  const nav_v4 t0 = __builtin_shuffle(r0, r1, (nav_v4i){0, 4, 2, 6});
+  const nav_v4 t1 = __builtin_shuffle(r0, r1, (nav_v4i){1, 5, 3, 7});
+  const nav_v4 t2 = __builtin_shuffle(r2, r3, (nav_v4i){0, 4, 2, 6});
+  const nav_v4 t3 = __builtin_shuffle(r2, r3, (nav_v4i){1, 5, 3, 7});
+  v4_store(Wt + (j0 + 0) * LD + i0, __builtin_shuffle(t0, t2, (nav_v4i){0, 1, 4, 5}));
+  v4_store(Wt + (j0 + 1) * LD + i0, __builtin_shuffle(t1, t3, (nav_v4i){0, 1, 4, 5}));
+  v4_store(Wt + (j0 + 2) * LD + i0, __builtin_shuffle(t0, t2, (nav_v4i){2, 3, 6, 7}));
+  v4_store(Wt + (j0 + 3) * LD + i0, __builtin_shuffle(t1, t3, (nav_v4i){2, 3, 6, 7}));
 }
 #else
-static NAV_ALWAYS_INLINE void transpose_ld(double *restrict Wt, const double *restrict W, size_t n, const size_t LD) {
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j)
-      Wt[j * LD + i] = W[i * LD + j];
+static NAV_ALWAYS_INLINE void transpose4(double *Wt, const double *W, size_t i0, size_t j0, const size_t LD) {
+  for (size_t r = 0; r < 4; ++r)
+    for (size_t c = 0; c < 4; ++c)
+      Wt[(j0 + c) * LD + i0 + r] = W[(i0 + r) * LD + j0 + c];
 }
 #endif
 
-/* Columns c0 .. c0 + len - 1 of row i of Phi W^T (len = LD - c0, a compile-time constant in
- * every call): row = sum over the pattern of Phi_ik (row k of W^T), in pattern order. */
-static NAV_ALWAYS_INLINE void upper_row(double *row, const double *phi_i, const unsigned char *col, unsigned cnt,
-                                        const double *Wt, size_t c0, const size_t LD, const size_t len) {
-  scal_fixed(row + c0, phi_i[col[0]], Wt + col[0] * LD + c0, len);
-  for (unsigned p = 1; p < cnt; ++p) {
-    const size_t k = col[p];
-    axpy_fixed(row + c0, phi_i[k], Wt + k * LD + c0, len);
-  }
+/* Wt = W^T for rows 0 .. n - 1 and columns 0 .. cols - 1 of a padded W (stride LD), cols a
+ * (rounded up to a multiple of 4). Blocks reach up to row round_up(n, 4) <= LD: the extra rows of W are scratch
+ * (stale values), which land in padding columns of Wt that are never read. */
+static NAV_ALWAYS_INLINE void transpose_ld(double *Wt, const double *W, size_t n, size_t cols, const size_t LD) {
+  for (size_t i0 = 0; i0 < n; i0 += 4)
+    for (size_t j0 = 0; j0 < cols; j0 += 4)
+      transpose4(Wt, W, i0, j0, LD);
 }
 
+/*
+ * Pn = Phi S Phi^T + Qh for a symmetric S (numerics.md 6.3), Phi given padded (stride LD) with
+ * the row pattern pt. Every entry of the upper triangle gets the operations of the plain loops
+ * W_jk = sum_p Phi_jp S_pk and (Phi W^T)_ij = sum_k Phi_ik W_jk over the pattern, in pattern
+ * order, then + Qh_ij; the lower triangle is its mirror. What is not computed any more is only
+ * what was computed and never read:
+ *  - rows i >= pt->diag_from have the single entry Phi_ii = d_i (the sensor and GNSS states:
+ *    Phi = [[Phi_nn, Phi_ns], [0, D]]). There W_jk = d_j S_jk, and for j >= i >= diag_from the
+ *    entry is d_i W_ji = d_i (d_j S_ji) = d_i (d_j S_ij) (S is exactly symmetric: P is mirrored
+ *    and Qh symmetric): a row of S times the diagonal of Phi, times d_i.
+ *  - the other rows have their pattern in columns 0 .. pt->width - 1, so W is needed in those
+ *    columns only (and its transpose in those rows);
+ *  - a row of the upper triangle from column i rounded down to a multiple of 4 (one of the
+ *    compile-time widths LD - c0).
+ * The upper triangle goes into the padded scratch U, which is then mirrored block by block (4 x 4
+ * transposes) and copied to Pn (n x n, not padded), four entries at a time (the last group of a
+ * row runs into the next row, rewritten after, or into the rest of the NMAX^2 buffer). S, W, Wt
+ * and U are padded scratch; U may be W.
+ */
 static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
-                                          const double *Qh, size_t n, double *W, double *Wt, const size_t LD) {
+                                          const double *Qh, size_t n, double *W, double *Wt, double *U,
+                                          const size_t LD) {
+  const size_t s0 = pt->diag_from, nvw = pt->width / 4;
+  double d[NMAX + 4];
+  for (size_t j = 0; j < n; ++j)
+    d[j] = Phi[j * LD + j];
+  for (size_t j = n; j < LD; ++j)
+    d[j] = 0.0;
+  if (s0 > 0) {
+    for (size_t j = 0; j < s0; ++j) {
+#define W_ROW(NV) w_row(W + j * LD, Phi + j * LD, pt->col[j], pt->cnt[j], S, LD, NV)
+      NV_DISPATCH(nvw, W_ROW)
+#undef W_ROW
+    }
+    for (size_t j = s0; j < n; ++j) {
+      const nav_v4 dj = v4_splat(d[j]);
+      for (size_t q = 0; q < nvw; ++q)
+        v4_store(W + j * LD + 4 * q, v4_mul(dj, v4_load(S + j * LD + 4 * q)));
+    }
+    transpose_ld(Wt, W, n, pt->width, LD);
+  }
+  /* W is not read after this point: U may be W. */
   for (size_t i = 0; i < n; ++i) {
-    double *wi = W + i * LD;
-    const double *phi_i = Phi + i * LD;
-    /* Every row has its diagonal in the pattern, so cnt >= 1. */
-    scal_fixed(wi, phi_i[pt->col[i][0]], S + pt->col[i][0] * LD, LD);
-    for (unsigned p = 1; p < pt->cnt[i]; ++p) {
-      const size_t k = pt->col[i][p];
-      axpy_fixed(wi, phi_i[k], S + k * LD, LD);
+    const size_t c0 = i & ~(size_t)3, nv = (LD - c0) / 4;
+    if (i < s0) {
+#define U_ROW(NV) upper_row(U + i * LD, Phi + i * LD, pt->col[i], pt->cnt[i], Wt, Qh + i * n, LD, NV)
+      NV_DISPATCH(nv, U_ROW)
+#undef U_ROW
+    } else {
+      const nav_v4 di = v4_splat(d[i]);
+      for (size_t q = c0 / 4; q < LD / 4; ++q) {
+        const nav_v4 dsd = v4_mul(di, v4_mul(v4_load(d + 4 * q), v4_load(S + i * LD + 4 * q)));
+        v4_store(U + i * LD + 4 * q, v4_add(dsd, v4_load(Qh + i * n + 4 * q)));
+      }
     }
   }
-  transpose_ld(Wt, W, n, LD);
-  double row[NMAX + 4];
-  for (size_t i = 0; i < n; ++i) {
-    /* Only j >= i is used: the row from column c0 = i rounded down to a multiple of 4, at one of
-     * the compile-time widths LD - c0 (unrolled completely; the columns below c0 were computed
-     * and discarded before). Each entry gets the same operations either way. */
-    const double *phi_i = Phi + i * LD;
-    const size_t c0 = i & ~(size_t)3;
-    switch (LD - c0) {
-    /* LD >= 24 / 20: the wider cases cannot occur in the narrower instantiations (LD - c0 <= LD);
-     * the guard folds them away there, so that no compiler sees a row start of LD - 20 < 0. */
-    case 24:
-      if (LD >= 24) upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, 0, LD, 24);
-      break;
-    case 20:
-      if (LD >= 20) upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 20, LD, 20);
-      break;
-    case 16: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 16, LD, 16); break;
-    case 12: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 12, LD, 12); break;
-    case 8: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 8, LD, 8); break;
-    default: upper_row(row, phi_i, pt->col[i], pt->cnt[i], Wt, LD - 4, LD, 4); break;
-    }
-    for (size_t j = i; j < n; ++j) {
-      const double v = row[j] + Qh[i * n + j];
-      Pn[i * n + j] = v;
-      Pn[j * n + i] = v;
-    }
+  /* The lower triangle of U: the blocks left of the diagonal by 4 x 4 transposes of the blocks
+   * above it, the diagonal blocks entry by entry (their rows and columns past n are scratch
+   * inside the padding). */
+  for (size_t i0 = 0; i0 < n; i0 += 4) {
+    for (size_t j0 = i0 + 4; j0 < n; j0 += 4)
+      transpose4(U, U, i0, j0, LD);
+    double *u = U + i0 * LD + i0;
+    u[1 * LD + 0] = u[0 * LD + 1];
+    u[2 * LD + 0] = u[0 * LD + 2];
+    u[3 * LD + 0] = u[0 * LD + 3];
+    u[2 * LD + 1] = u[1 * LD + 2];
+    u[3 * LD + 1] = u[1 * LD + 3];
+    u[3 * LD + 2] = u[2 * LD + 3];
   }
+  for (size_t i = 0; i < n; ++i)
+    for (size_t q = 0; q < n; q += 4)
+      v4_store(Pn + i * n + q, v4_load(U + i * LD + q));
 }
 
-/* Phi = I + A + A^2/2 over the pattern of A (padded, stride LD). */
-static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pattern *ap, size_t n,
-                                      const size_t LD) {
-  for (size_t i = 0; i < n; ++i) {
-    double *phi_i = Phi + i * LD;
-    const double *ai = A + i * LD;
-    scal_fixed(phi_i, 0.5 * ai[ap->col[i][0]], A + ap->col[i][0] * LD, LD);
-    for (unsigned p = 1; p < ap->cnt[i]; ++p) {
-      const size_t k = ap->col[i][p];
-      axpy_fixed(phi_i, 0.5 * ai[k], A + k * LD, LD);
-    }
-    axpy_fixed(phi_i, 1.0, ai, LD);
-    phi_i[i] += 1.0;
+/* Phi = I + A + A^2/2 over the pattern of A (padded, stride LD), in the entries the sandwich and
+ * pattern_mul_vec read (the pattern of Phi, pt): rows below pt->diag_from in columns 0 ..
+ * pt->width - 1, the others (whose A row is the diagonal entry alone) on the diagonal only,
+ * ((0.5 a_ii) a_ii + 1.0 a_ii) + 1 as the full-row code computed it. The other entries of Phi
+ * are not written (the update uses Phi as scratch). */
+static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pattern *ap, const row_pattern *pt,
+                                      size_t n, const size_t LD) {
+  const size_t s0 = pt->diag_from, nvw = pt->width / 4;
+  for (size_t i = 0; i < s0; ++i) {
+#define PHI_ROW(NV) phi2_row(Phi + i * LD, A + i * LD, ap->col[i], ap->cnt[i], A, LD, i, NV)
+    NV_DISPATCH(nvw, PHI_ROW)
+#undef PHI_ROW
+  }
+  for (size_t i = s0; i < n; ++i) {
+    const double a = A[i * LD + i];
+    Phi[i * LD + i] = ((0.5 * a) * a + 1.0 * a) + 1.0;
   }
 }
 
@@ -548,31 +739,42 @@ static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pa
  * padding only adds products of zeros to entries that are never read, so the values do not
  * depend on LD. */
 NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
-                             const double *Qh, size_t n, size_t ld, double *W, double *Wt) {
+                                               const double *Qh, size_t n, size_t ld, double *W, double *Wt,
+                                               double *U) {
   if (ld == 16)
-    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 16);
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, U, 16);
   else if (ld == 20)
-    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 20);
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, U, 20);
   else
-    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, 24);
+    sandwich_ld(Pn, Phi, pt, S, Qh, n, W, Wt, U, 24);
 }
 
-NAV_KERNEL_CLONES static void phi_second_order(double *Phi, const double *A, const row_pattern *ap, size_t n, size_t ld) {
+NAV_KERNEL_CLONES static void phi_second_order(double *Phi, const double *A, const row_pattern *ap,
+                                               const row_pattern *pt, size_t n, size_t ld) {
   if (ld == 16)
-    phi2_ld(Phi, A, ap, n, 16);
+    phi2_ld(Phi, A, ap, pt, n, 16);
   else if (ld == 20)
-    phi2_ld(Phi, A, ap, n, 20);
+    phi2_ld(Phi, A, ap, pt, n, 20);
   else
-    phi2_ld(Phi, A, ap, n, 24);
+    phi2_ld(Phi, A, ap, pt, n, 24);
 }
 
-/* y = Phi x over the pattern. */
+/* y = Phi x over the pattern, skipping the terms whose x_k is zero: each sum starts at +0.0 and
+ * so is never -0.0 (a round-to-nearest sum is -0.0 only from two negative zeros), and adding a
+ * signed zero to a sum that is not -0.0 leaves it unchanged; so the result is bit for bit the
+ * sum over the whole pattern (x is finite: every committed x is checked). In closed loop the INS
+ * error states are reset to zero after each update, so only the GNSS states are left. */
 static void pattern_mul_vec(double *y, const double *Phi, const row_pattern *pt, const double *x, size_t ld,
                             size_t n) {
+  uint32_t xnz = 0;
+  for (size_t k = 0; k < n; ++k)
+    if (x[k] != 0.0) xnz |= UINT32_C(1) << k;
   for (size_t i = 0; i < n; ++i) {
     double sum = 0.0;
-    for (unsigned p = 0; p < pt->cnt[i]; ++p) {
-      const size_t k = pt->col[i][p];
+    uint32_t m = pt->mask[i] & xnz;
+    while (m != 0) {
+      const size_t k = (size_t)nav_ctz32(m);
+      m &= m - 1;
       sum += Phi[i * ld + k] * x[k];
     }
     y[i] = sum;
@@ -587,6 +789,7 @@ static void pattern_of_values(row_pattern *pt, const double *a, size_t n, size_t
       if (a[i * ld + j] != 0.0) pt->col[i][c++] = (unsigned char)j;
     pt->cnt[i] = c;
   }
+  pattern_finish(pt, n, ld);
 }
 
 /* The inputs of the second-order step: A = F T over the pattern of A (zeros elsewhere),
@@ -655,6 +858,8 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
       second_order_inputs(f, FT, QT, 15, 16);
     else if (n == 18)
       second_order_inputs(f, FT, QT, 18, 20);
+    else if (n == 21)
+      second_order_inputs(f, FT, QT, 21, 24);
     else
       second_order_inputs(f, FT, QT, n, ld);
 #ifndef NDEBUG
@@ -662,9 +867,9 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
       for (size_t k = 0; k < n; ++k)
         assert(FT[i * n + k] == f->A[i * ld + k]);
 #endif
-    phi_second_order(f->Phi, f->A, &f->a_pat, n, ld);
+    phi_second_order(f->Phi, f->A, &f->a_pat, &f->phi_pat, n, ld);
   }
-  pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt);
+  pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt, f->W);
   const nav_status st = check_cov_predict(f, f->Pn);
   if (st != NAV_OK) return st;
   pattern_mul_vec(f->xn, f->Phi, pt, f->x, ld, n);
@@ -673,20 +878,20 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
   return NAV_OK;
 }
 
-static bool mat3_isfinite(const nav_mat3 *m) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (!isfinite(m->m[i][j])) return false;
-  return true;
-}
-
 /* |lat| below this has cos(lat) > 0.07, far from the MIN_COS_LAT limit: no cos needed. */
 #define LAT_SAFE_RAD 1.5
 
+/* Every number of a nav_filter_nav finite, by the test of all_finite_nn (x - x is +0.0 exactly
+ * for finite x): the per-IMU-step check without a branch per number. */
+_Static_assert(sizeof(nav_filter_nav) == 20 * sizeof(double), "nav_filter_nav is 20 doubles");
+static bool nav_all_finite(const nav_filter_nav *nav) {
+  double v[20];
+  memcpy(v, nav, sizeof v);
+  return all_finite_nn(v, 20);
+}
+
 static nav_status check_nav(nav_filter *f, const nav_filter_nav *nav, const char *what) {
-  if (!isfinite(nav->lat_rad) || !isfinite(nav->h_m) || !nav_vec3_isfinite(nav->v_eb_n_mps) ||
-      !mat3_isfinite(&nav->C_b_n) || !nav_vec3_isfinite(nav->f_ib_b_mps2) ||
-      !nav_vec3_isfinite(nav->w_ib_b_rps)) {
+  if (!nav_all_finite(nav)) {
     set_error(f, "%s: the navigation state (lat, h, v, C_b_n, f_b or w_ib_b) is not finite", what);
     return NAV_ERR_NUMERIC;
   }
@@ -771,7 +976,8 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
     m.v_eb_n_mps = nav_vec3_scale(pd->v_T, 1.0 / T);
   }
   const nav_filter_earth_terms earth = nav_filter_earth_terms_wgs84(m.lat_rad, m.h_m);
-  nav_filter_build_F(f->F, &f->lay, &m, &earth, f->proc_diag);
+  /* f->F holds the build of init_patterns or of the last step: the same entries are rewritten. */
+  nav_filter_build_F_nonzero(f->F, &f->lay, &m, &earth, f->proc_diag);
   /* F T over the structural pattern of F only (fixed at create, init_patterns). Outside it F is
    * exactly zero, and FT and QT keep the zeros of calloc: both are written only here, always at
    * the same positions (the pattern, the blocks below, the diagonal), so the values are those of
@@ -854,11 +1060,12 @@ nav_status nav_filter_flush(nav_filter *f) {
 
 /* The arithmetic of an update (do_update): y, S and its Cholesky factor Ls, K, x+ into xn and the
  * Joseph-form P+ into Pn. Always inlined, so that do_update instantiates it for the GNSS cases
- * (n = 15 or 18, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
+ * (n = 15, 18 or 21, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
  * generically; the same operations in the same order either way, so the values are identical.
  * Returns false when S is not positive definite. */
 static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const size_t m, const double *H,
                                           const double *z, const double *R, double *y, double *S, double *Ls) {
+  const double *P = f->P;
   /* Innovation y = z - H x_minus (x_minus = 0 in closed loop except the GNSS states). */
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r) {
@@ -878,15 +1085,30 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
       nz = nz || H[r * n + j] != 0.0;
     if (nz) hc[nhc++] = j;
   }
-  /* P H^T (n x m). */
+  /* Every n x m product below is kept transposed (m x n, as PHtT, Kt, BHtT, WT), so that each
+   * sum runs over the rows r or the columns hc of H for a whole row of n entries at a time
+   * (vectorised), with, entry by entry, the operations and the order of the textbook loops: each
+   * sum from +0.0 over r or q ascending, the products with their operands as before (a b = b a
+   * exactly). */
+  /* (P H^T)^T: PHtT_ri = sum_q P_i,hc_q H_r,hc_q; P is exactly symmetric (mirrored or
+   * symmetrised wherever it is written), so P_i,c is P_c,i and the sum runs over rows of P. */
+#ifndef NDEBUG
   for (size_t i = 0; i < n; ++i)
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += f->P[i * n + hc[q]] * H[r * n + hc[q]];
-      f->PHt[i * m + r] = sum;
+    for (size_t j = 0; j < i; ++j)
+      assert(memcmp(&P[i * n + j], &P[j * n + i], sizeof *P) == 0);
+#endif
+  double *PHtT = f->PHt;
+  for (size_t r = 0; r < m; ++r) {
+    double *o = PHtT + r * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    for (size_t q = 0; q < nhc; ++q) {
+      const double h = H[r * n + hc[q]];
+      const double *pc = P + hc[q] * n;
+      for (size_t i = 0; i < n; ++i)
+        o[i] += pc[i] * h;
     }
+  }
   /* S = H P H^T + R, symmetrised. */
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r)
@@ -894,79 +1116,92 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
     for (size_t c = 0; c < m; ++c) {
       double sum = 0.0;
       for (size_t j = 0; j < n; ++j)
-        sum += H[r * n + j] * f->PHt[j * m + c];
+        sum += H[r * n + j] * PHtT[c * n + j];
       S[r * m + c] = sum + R[r * m + c];
     }
   nav_matn_symmetrize(S, m);
   if (nav_matn_cholesky(Ls, S, m) != NAV_OK) return false;
   /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
+  double *Kt = f->Kt;
+  memcpy(Kt, PHtT, m * n * sizeof *Kt);
+  nav_matn_chol_solve(Kt, Ls, Kt, m, n);
+
+  /* x+ = x- + K y */
+  for (size_t j = 0; j < n; ++j)
+    f->xn[j] = f->x[j];
   NAV_UNROLL
   for (size_t r = 0; r < m; ++r)
     for (size_t j = 0; j < n; ++j)
-      f->Kt[r * n + j] = f->PHt[j * m + r];
-  nav_matn_chol_solve(f->Kt, Ls, f->Kt, m, n);
-  for (size_t j = 0; j < n; ++j)
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r)
-      f->K[j * m + r] = f->Kt[r * n + j];
-
-  /* x+ = x- + K y */
-  for (size_t j = 0; j < n; ++j) {
-    double sum = f->x[j];
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r)
-      sum += f->K[j * m + r] * y[r];
-    f->xn[j] = sum;
-  }
+      f->xn[j] += Kt[r * n + j] * y[r];
   /* Joseph form (E6.5): P+ = (I - K H) P (I - K H)^T + K R K^T, evaluated as (A P) A^T with
    * A = I - K H without forming A: A P = P - K (H P) with H P = (P H^T)^T, then
    * (A P) A^T = A P - ((A P) H^T) K^T over the non-zero columns of H. The same product in
-   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, (A P) H^T to PHt's
-   * companion Kt (both n x m or larger scratch). */
-  double *B = f->Phi, *BHt = f->S;
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * f->PHt[j * m + r];
-      B[i * n + j] = f->P[i * n + j] - sum;
-    }
-  for (size_t i = 0; i < n; ++i)
+   * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, ((A P) H^T)^T to S
+   * (both scratch here). */
+  double *B = f->Phi, *BHtT = f->S;
+  double tmp[NMAX];
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      tmp[j] = 0.0;
     NAV_UNROLL
     for (size_t r = 0; r < m; ++r) {
-      double sum = 0.0;
-      for (size_t q = 0; q < nhc; ++q)
-        sum += B[i * n + hc[q]] * H[r * n + hc[q]];
-      BHt[i * m + r] = sum;
+      const double k = Kt[r * n + i];
+      for (size_t j = 0; j < n; ++j)
+        tmp[j] += k * PHtT[r * n + j];
     }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += BHt[i * m + r] * f->K[j * m + r];
-      f->Pn[i * n + j] = B[i * n + j] - sum;
+    for (size_t j = 0; j < n; ++j)
+      B[i * n + j] = P[i * n + j] - tmp[j];
+  }
+  for (size_t r = 0; r < m; ++r) {
+    double *o = BHtT + r * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    for (size_t q = 0; q < nhc; ++q) {
+      const double h = H[r * n + hc[q]];
+      for (size_t i = 0; i < n; ++i)
+        o[i] += B[i * n + hc[q]] * h;
     }
-  /* K R K^T: W = K R (n x m), then the upper triangle of W K^T mirrored. */
-  for (size_t i = 0; i < n; ++i)
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      tmp[j] = 0.0;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      const double b = BHtT[r * n + i];
+      for (size_t j = 0; j < n; ++j)
+        tmp[j] += b * Kt[r * n + j];
+    }
+    for (size_t j = 0; j < n; ++j)
+      f->Pn[i * n + j] = B[i * n + j] - tmp[j];
+  }
+  /* K R K^T: (K R)^T = WT (m x n), then the upper triangle of W K^T, added to both triangles. */
+  double *WT = f->W;
+  NAV_UNROLL
+  for (size_t c = 0; c < m; ++c) {
+    double *o = WT + c * n;
+    for (size_t i = 0; i < n; ++i)
+      o[i] = 0.0;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      const double rr = R[r * m + c];
+      for (size_t i = 0; i < n; ++i)
+        o[i] += Kt[r * n + i] * rr;
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i; j < n; ++j)
+      tmp[j] = 0.0;
     NAV_UNROLL
     for (size_t c = 0; c < m; ++c) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t r = 0; r < m; ++r)
-        sum += f->K[i * m + r] * R[r * m + c];
-      f->W[i * m + c] = sum;
+      const double w = WT[c * n + i];
+      for (size_t j = i; j < n; ++j)
+        tmp[j] += w * Kt[c * n + j];
     }
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i; j < n; ++j) {
-      double sum = 0.0;
-      NAV_UNROLL
-      for (size_t c = 0; c < m; ++c)
-        sum += f->W[i * m + c] * f->K[j * m + c];
-      f->Pn[i * n + j] += sum;
-      if (j != i) f->Pn[j * n + i] += sum;
-    }
+    for (size_t j = i; j < n; ++j)
+      f->Pn[i * n + j] += tmp[j];
+    for (size_t j = i + 1; j < n; ++j)
+      f->Pn[j * n + i] += tmp[j];
+  }
   return true;
 }
 
@@ -995,6 +1230,8 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
     s_ok = update_core(f, 15, 3, H, z, R, y, S, Ls);
   else if (n == 18 && m == 3)
     s_ok = update_core(f, 18, 3, H, z, R, y, S, Ls);
+  else if (n == 21 && m == 3)
+    s_ok = update_core(f, 21, 3, H, z, R, y, S, Ls);
   else
     s_ok = update_core(f, n, m, H, z, R, y, S, Ls);
   if (!s_ok) {

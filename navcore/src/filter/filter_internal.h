@@ -89,6 +89,15 @@ void nav_filter_build_F(double *F, const nav_filter_layout *lay, const nav_filte
                         const nav_filter_earth_terms *earth, const double *proc_diag);
 
 /**
+ * nav_filter_build_F without clearing F first: writes the same fixed set of entries (fixed by
+ * the layout, whatever the navigation state), so on an F that holds the result of an earlier
+ * build of the same layout (or zeros) the result is that of nav_filter_build_F. For the
+ * filter's per-step build, where clearing the n x n matrix cost as much as the rest.
+ */
+void nav_filter_build_F_nonzero(double *F, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                                const nav_filter_earth_terms *earth, const double *proc_diag);
+
+/**
  * G Q_c G^T (n x n, row-major, fully written): C diag(q_a) C^T on dv, C diag(q_g) C^T on phi,
  * diag(q) on the sensor/GNSS blocks (numerics.md 6.2).
  * @param qc n spectral densities: entries DV..DV+2 are N_a^2 and PHI..PHI+2 N_g^2 per body axis,

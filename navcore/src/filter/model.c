@@ -276,6 +276,12 @@ void nav_filter_build_F(double *F, const nav_filter_layout *lay, const nav_filte
                         const nav_filter_earth_terms *earth, const double *proc_diag) {
   const size_t n = lay->n_states;
   memset(F, 0, n * n * sizeof *F);
+  nav_filter_build_F_nonzero(F, lay, nav, earth, proc_diag);
+}
+
+void nav_filter_build_F_nonzero(double *F, const nav_filter_layout *lay, const nav_filter_nav *nav,
+                                const nav_filter_earth_terms *earth, const double *proc_diag) {
+  const size_t n = lay->n_states;
 
   /* numerics.md 6.1, identical to [SHIN] ch. 3 and KF-GINS gi_engine.cpp (StateID order
    * P, V, PHI, BG, BA, SG, SA). R_m = R_M + h, R_n = R_N + h. */
