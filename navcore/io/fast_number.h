@@ -105,7 +105,7 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
    * files, six of their seven columns), checked and converted in whole-word steps without a loop
    * per character; any other text goes on to the general scan below, which gives the same value
    * for this shape too. */
-  if (end - p >= 18 && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u)) {
+  if (end - p >= 18 && p[1] == '.' && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u)) {
     uint64_t a, b;
     memcpy(&a, p, 8);     /* d . d d d d d d */
     memcpy(&b, p + 8, 8); /* d d d d d d e +- */
