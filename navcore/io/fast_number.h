@@ -29,6 +29,61 @@ static const double nav_fast_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e
                                           1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                           1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/* Up to eight bytes of [s, end) in a word, the first in the lowest byte; missing bytes are 0,
+ * which is not a digit. */
+static inline uint64_t nav_fast_load8(const char *s, const char *end) {
+  uint64_t w = 0;
+  if (end - s >= 8)
+    memcpy(&w, s, 8);
+  else
+    memcpy(&w, s, (size_t)(end - s));
+  return w;
+}
+
+/* The number of leading ASCII digits of the word (8 when all are). */
+static inline unsigned nav_fast_digit_run(uint64_t w) {
+  /* A byte b is a digit iff its high nibble and that of b + 6 are both 3; a carry of b + 6 only
+   * reaches bytes above the first non-digit, so the bytes up to it are judged right. */
+  const uint64_t z = ((w & 0xF0F0F0F0F0F0F0F0ull) | (((w + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ^
+                     0x3333333333333333ull;
+  return z ? (unsigned)__builtin_ctzll(z) >> 3 : 8u;
+}
+
+/* The value of the first n (1..8) ASCII digits of the word: they are moved to the top bytes (the
+ * bytes below become leading zeros) and combined by the usual multiply-shift steps. */
+static inline uint64_t nav_fast_digits_value(uint64_t w, unsigned n) {
+  uint64_t d = (w - 0x3030303030303030ull) << (8u * (8u - n));
+  d = (d * 10u) + (d >> 8);
+  d = (((d & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
+       (((d >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
+      32;
+  return d & 0xFFFFFFFFu;
+}
+
+/* 10^0 .. 10^19 as integers. */
+static const uint64_t nav_fast_pow10_u[20] = {1ull,
+                                              10ull,
+                                              100ull,
+                                              1000ull,
+                                              10000ull,
+                                              100000ull,
+                                              1000000ull,
+                                              10000000ull,
+                                              100000000ull,
+                                              1000000000ull,
+                                              10000000000ull,
+                                              100000000000ull,
+                                              1000000000000ull,
+                                              10000000000000ull,
+                                              100000000000000ull,
+                                              1000000000000000ull,
+                                              10000000000000000ull,
+                                              100000000000000000ull,
+                                              1000000000000000000ull,
+                                              10000000000000000000ull};
+#endif
+
 /**
  * Parse a number [+-]digits[.digits][(e|E)[+-]digits] (at least one significand digit) at the
  * start of [s, end) when the exact fast path applies, stopping at the first character that
@@ -50,7 +105,7 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
    * files, six of their seven columns), checked and converted in whole-word steps without a loop
    * per character; any other text goes on to the general scan below, which gives the same value
    * for this shape too. */
-  if (end - p >= 18 && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u)) {
+  if (end - p >= 18 && p[1] == '.' && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u)) {
     uint64_t a, b;
     memcpy(&a, p, 8);     /* d . d d d d d d */
     memcpy(&b, p + 8, 8); /* d d d d d d e +- */
@@ -81,6 +136,51 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
         if (m != 0) v = q < 0 ? v / nav_fast_pow10[-q] : v * nav_fast_pow10[q];
         *out = neg ? -v : v;
         return p + 18;
+      }
+    }
+  }
+  /* Fixed-point text, printf's "%.Nf" (the columns of reference and GNSS files): 1-7 integer
+   * digits, optionally a point and up to 15 fraction digits, at most 19 digits in all, no
+   * exponent. The digit runs are found and converted a word at a time; the significand and the
+   * scale are those of the general scan below (leading zeros only add nothing to M), so the value
+   * is the same single division. Anything else goes on to the general scan. */
+  {
+    const uint64_t wi = nav_fast_load8(p, end);
+    const unsigned li = nav_fast_digit_run(wi);
+    if (li >= 1u && li <= 7u) {
+      const uint64_t vi = nav_fast_digits_value(wi, li);
+      const char *f = p + li;
+      if (f == end || (*f != '.' && *f != 'e' && *f != 'E')) {
+        *out = neg ? -(double)vi : (double)vi; /* exact: vi < 10^7 */
+        return f;
+      }
+      if (*f == '.') {
+        ++f;
+        const uint64_t w1 = nav_fast_load8(f, end);
+        unsigned nf = nav_fast_digit_run(w1);
+        uint64_t m = 0;
+        bool ok = nf >= 1u;
+        if (nf >= 1u && nf <= 7u) {
+          m = vi * nav_fast_pow10_u[nf] + nav_fast_digits_value(w1, nf);
+        } else if (nf == 8u) {
+          const uint64_t w2 = nav_fast_load8(f + 8, end);
+          const unsigned n2 = nav_fast_digit_run(w2);
+          ok = n2 <= 7u && li + 8u + n2 <= 19u;
+          if (ok) {
+            m = vi * nav_fast_pow10_u[8] + nav_fast_digits_value(w1, 8u);
+            if (n2 > 0u) m = m * nav_fast_pow10_u[n2] + nav_fast_digits_value(w2, n2);
+            nf = 8u + n2;
+          }
+        }
+        if (ok && m <= ((uint64_t)1 << 53)) {
+          const char *q = f + nf;
+          if (q == end || (*q != 'e' && *q != 'E')) {
+            double v = (double)m; /* exact */
+            if (m != 0) v = v / nav_fast_pow10[nf];
+            *out = neg ? -v : v;
+            return q;
+          }
+        }
       }
     }
   }

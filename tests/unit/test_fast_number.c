@@ -220,6 +220,71 @@ static void test_sci12_shape(void **state) {
   assert_true(accepted > 40000);
 }
 
+/* printf's "%.Nf" shape (1-7 integer digits, up to 15 fraction digits), which the reference and
+ * GNSS columns use and the word-at-a-time fixed-point path converts: its edges, every prefix of
+ * a longer text (the bytes after the end must not matter), what the scan returns when a field
+ * is followed by other text, and random renderings, all against strtod. */
+static void test_fixed_shape(void **state) {
+  (void)state;
+  tally t = {0, 0};
+  static const char *const must[] = {
+      "0",          "-0",          "7",          "1234567",        "-0.000000",       "100000.005000",
+      "31.50818300000", "120.40198900000", "-177.000000", "0.1",         "9999999.99999999", "1.00000000",
+      "1.000000001", "1.123456789012345", "0.000000000000001", "9007199254.740992", "+5.25"};
+  for (size_t i = 0; i < sizeof must / sizeof must[0]; ++i)
+    if (!check_one(must[i], &t)) fail_msg("\"%s\" should be accepted", must[i]);
+  static const char *const other[] = {"5.",         "12345678.5",   "1.5e3",         "1.5E-3",
+                                      "123.1234567890123456", "9007199254.740993", "1234567.1234567890123",
+                                      ".5",         "1..5",         "00000001.5",    "0.0000000000000000000001"};
+  for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i)
+    check_one(other[i], &t); /* accepted or declined: if accepted, strtod's value */
+  /* Every prefix of a long field, the rest of the text still in memory after the end. */
+  static const char *const longs[] = {"1234567.123456789012345678", "-31.508183000001234567", "0.00000000012345678"};
+  for (size_t i = 0; i < sizeof longs / sizeof longs[0]; ++i) {
+    const size_t n = strlen(longs[i]);
+    for (size_t k = 1; k <= n; ++k) {
+      char cut[64];
+      memcpy(cut, longs[i], k);
+      cut[k] = '\0';
+      double v = 0.0;
+      if (nav_fast_number(longs[i], longs[i] + k, &v)) {
+        char *end = NULL;
+        const double ref = strtod(cut, &end);
+        if (end != cut + k || memcmp(&v, &ref, sizeof v) != 0)
+          fail_msg("prefix \"%s\": fast path %.17g, strtod %.17g", cut, v, ref);
+      }
+    }
+  }
+  /* The end of the scan: at the first character that cannot continue the number. */
+  static const struct {
+    const char *s;
+    size_t end;
+  } stops[] = {{"100000.005000 31.5", 13}, {"0 100000.0", 1}, {"-177.000000\r", 11}, {"12.5x", 4}, {"12x", 2}};
+  for (size_t i = 0; i < sizeof stops / sizeof stops[0]; ++i) {
+    double v = 0.0;
+    const char *s = stops[i].s;
+    const char *q = nav_fast_number_scan(s, s + strlen(s), &v);
+    assert_non_null(q);
+    assert_int_equal((long)(q - s), (long)stops[i].end);
+    const double ref = strtod(s, NULL);
+    assert_memory_equal(&v, &ref, sizeof v);
+  }
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 31u, 0u);
+  char s[64];
+  long accepted = 0;
+  for (int it = 0; it < 300000; ++it) {
+    const int idigits = 1 + (int)next_u(&r, 7);
+    const int prec = (int)next_u(&r, 16);
+    const double v = (nav_rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * nav_rng_uniform(&r) * pow(10.0, idigits);
+    snprintf(s, sizeof s, "%.*f", prec, v);
+    accepted += check_one(s, &t);
+  }
+  print_message("[ fastnum  ] %%.Nf shape: %ld fast (%ld of the random ones), %ld declined\n", t.fast, accepted,
+                t.declined);
+  assert_true(accepted > 200000);
+}
+
 /* Every field of the first lines of the shared long-drive files: all on the fast path and
  * identical to strtod. Skipped when the shared data is not there. */
 static void test_shared_files(void **state) {
@@ -276,6 +341,7 @@ int main(void) {
       cmocka_unit_test(test_random_printf_values),
       cmocka_unit_test(test_edges),
       cmocka_unit_test(test_sci12_shape),
+      cmocka_unit_test(test_fixed_shape),
       cmocka_unit_test(test_shared_files),
       cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),
