@@ -22,13 +22,6 @@
  * much: velocities of up to 300 m/s by 5e-13 m/s (VEL_TOL), accelerations of up to 50 m/s^2 by
  * 1e-13 (ACC_TOL), unit quaternions by 2e-15 (QUAT_TOL); the body rates see the Earth and transport
  * rates (< 1e-3 rad/s) rotated by it, far below RATE_TOL = 1e-15 rad/s (and rad/s^2).
- * On WGS-84 the walk also carries the sines and cosines of the latitude and longitude from sample
- * to sample by angle addition (restarted from the library every 64 samples); each is within
- * eps = 2.3e-16 of the exact value (derivation: docs/truth-generation-speed.md, third pass), which
- * adds at most: to the position 2 (R_N + h) eps in x and y and (R_N + h) eps in z, 4.4e-9 m
- * together; to each element of the DCM C_n_e 2 eps, so 2 sqrt(3) eps |v| = 2.4e-13 m/s at 300 m/s
- * and 4e-14 m/s^2 at 50 m/s^2; to the quaternion 6 eps = 1.4e-15; to the rates eps times the
- * transport rate (< 1e-4 rad/s), nothing visible. The tolerances are the sums.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -46,10 +39,10 @@
 #include "navcore/nav_io.h"
 #include "navcore/nav_truth.h"
 
-#define POS_TOL_M (1e-8 + 4.4e-9)
-#define VEL_TOL_MPS (5e-13 + 2.4e-13)
-#define ACC_TOL_MPS2 (1e-13 + 4e-14)
-#define QUAT_TOL (2e-15 + 1.4e-15)
+#define POS_TOL_M 1e-8
+#define VEL_TOL_MPS 5e-13
+#define ACC_TOL_MPS2 1e-13
+#define QUAT_TOL 2e-15
 #define RATE_TOL_RPS 1e-15
 
 static double dist(nav_vec3 a, nav_vec3 b) {

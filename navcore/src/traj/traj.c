@@ -44,20 +44,10 @@ struct nav_traj {
   bool es_ok;
   nav_local_kin es_in;
   nav_traj_state es_out;
-  bool es_seq;     /* es_out was computed with the sines and cosines es_sc of the sequential walk */
-  double es_sc[4];
   /* Position chain: R(chain_j) when chain_ok (a cache of a pure function of j). */
   bool chain_ok;
   int64_t chain_j;
   nav_vec3 chain_r;
-  /* Sines and cosines of the latitude and longitude of R(geo_j) on WGS-84 (geo_ok), carried from
-   * sample to sample with the chain (see geo_sc_step): angles geo_a = {lat, lon}, and each sine and
-   * cosine as an unevaluated sum hi + lo (geo_hi/geo_lo[angle][0 = sin, 1 = cos]). */
-  bool geo_ok;
-  int64_t geo_j;
-  nav_vec3 geo_r;   /* R(geo_j) */
-  nav_geodetic geo_p; /* its geodetic position (nav_frame_local_to_geodetic) */
-  double geo_a[2], geo_hi[2][2], geo_lo[2][2];
 };
 
 /* ------------------------------------------------------------------ frames */
@@ -162,23 +152,15 @@ static inline void sincos_opt(nav_kin_sincos_cache *k, double a, double *s, doub
 
 /* lat_sc, lon_sc: caches of the sines and cosines, or NULL. */
 static void geo_to_ecef_state_c(const nav_geo_kin *g, nav_traj_state *s, nav_kin_sincos_cache *lat_sc,
-                                nav_kin_sincos_cache *lon_sc, const double *sc4) {
+                                nav_kin_sincos_cache *lon_sc) {
   const double lat = g->pos.lat_rad, lon = g->pos.lon_rad, h = g->pos.h_m;
   /* One sine and cosine each of latitude and longitude and one square root, shared by what
    * nav_earth_radius_meridian_m, nav_earth_radius_prime_vertical_m, nav_earth_dcm_n_e and
    * nav_earth_geodetic_to_ecef would each compute again: their expressions, term for term
    * (Groves 2nd ed. eqs. 2.105, 2.106, 2.112), so the numbers are the same. */
   double sl, cl, so, co;
-  if (sc4) {
-    /* Given (the sequential walk's sines and cosines of these angles, geo_sc_step). */
-    sl = sc4[0];
-    cl = sc4[1];
-    so = sc4[2];
-    co = sc4[3];
-  } else {
-    sincos_opt(lat_sc, lat, &sl, &cl);
-    sincos_opt(lon_sc, lon, &so, &co);
-  }
+  sincos_opt(lat_sc, lat, &sl, &cl);
+  sincos_opt(lon_sc, lon, &so, &co);
   const double den2 = 1.0 - NAV_WGS84_E2 * sl * sl;
   const double sqrt_den = sqrt(den2);
   const double RM = NAV_WGS84_A_M * TRAJ_E2M / (den2 * sqrt_den);
@@ -199,13 +181,13 @@ static void geo_to_ecef_state_c(const nav_geo_kin *g, nav_traj_state *s, nav_kin
 
 /* Without caches (the white-box test compares it with the nav_earth functions). */
 static inline void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
-  geo_to_ecef_state_c(g, s, NULL, NULL, NULL);
+  geo_to_ecef_state_c(g, s, NULL, NULL);
 }
 
 /* Local curvilinear NED kinematics -> geodetic kinematics (affine map, exact derivatives). */
-static nav_geo_kin local_to_geo_p(const nav_frame *fr, const nav_local_kin *k, const nav_geodetic *pos) {
+static nav_geo_kin local_to_geo(const nav_frame *fr, const nav_local_kin *k) {
   nav_geo_kin g;
-  g.pos = pos ? *pos : nav_frame_local_to_geodetic(fr, k->r_ned_m);
+  g.pos = nav_frame_local_to_geodetic(fr, k->r_ned_m);
   const double sy = fr->m_per_rad_lon != 0.0 ? 1.0 / fr->m_per_rad_lon : 0.0;
   g.dpos = nav_vec3_make(k->v_ned_mps.x / fr->m_per_rad_lat, k->v_ned_mps.y * sy, -k->v_ned_mps.z);
   g.ddpos = nav_vec3_make(k->a_ned_mps2.x / fr->m_per_rad_lat, k->a_ned_mps2.y * sy, -k->a_ned_mps2.z);
@@ -213,10 +195,6 @@ static nav_geo_kin local_to_geo_p(const nav_frame *fr, const nav_local_kin *k, c
   g.w_nb_b_rps = k->w_nb_b_rps;
   g.dw_nb_b_rps2 = k->dw_nb_b_rps2;
   return g;
-}
-
-static inline nav_geo_kin local_to_geo(const nav_frame *fr, const nav_local_kin *k) {
-  return local_to_geo_p(fr, k, NULL);
 }
 
 /* ------------------------------------------------------------------ front end */
@@ -292,81 +270,6 @@ static nav_status local_kin(nav_traj *traj, double t_s, const nav_vec3 *r_ned, n
   return st;
 }
 
-/*
- * Sines and cosines of the latitude and longitude of the chain positions R(j) (WGS-84), carried
- * along the chain so that the sequential walk needs no library sin/cos per sample (derivation and
- * error bound: docs/truth-generation-speed.md, "Third pass"). At every j that is a multiple of
- * CHAIN_BLOCK (where the chain takes the model's own position) and wherever an angle moved by
- * |d| >= GEO_NEAR_RAD since R(j - 1) (a longitude wrapping at +-pi, or a large step), sin and cos
- * come from the library (both angles); otherwise by angle addition from R(j - 1)'s:
- *   sin(a + d) = sin a + (sin a (cos d - 1) + cos a sin d),
- *   cos(a + d) = cos a + (cos a (cos d - 1) - sin a sin d),
- * with d = a_j - a_(j-1) (exact: two neighbouring angles), sin d = d - d^3/6 and cos d - 1 =
- * -d^2/2 (omitted terms below d^4/24 = 4.2e-22 at |d| = 1e-5, i.e. 64 m per sample), and the sum
- * carried as hi + lo with an error-free addition (Knuth's two-sum), so that rounding does not
- * accumulate over the block: hi is within about one ulp of the library's value. A position that
- * did not change keeps its values.
- * Like the chain, the values are a pure function of j: the chain visits every j of a block from
- * its anchor, in order, whichever sample the caller asks for.
- */
-#define GEO_NEAR_RAD 1e-5
-
-static inline void geo_two_sum(double a, double b, double *hi, double *lo) {
-  const double s = a + b, bb = s - a;
-  *hi = s;
-  *lo = (a - (s - bb)) + (b - bb);
-}
-
-static void geo_sc_step(nav_traj *tr, int64_t j, nav_vec3 r) {
-  if (tr->frame.model == NAV_EARTH_FLAT) return;
-  const bool from_prev = j % CHAIN_BLOCK != 0 && tr->geo_ok && tr->geo_j == j - 1;
-  if (from_prev && nav_kin_same_bits_n(&r, &tr->geo_r, 3)) {
-    /* The same position (a vehicle at rest): the same angles, whose values carry over. */
-    tr->geo_j = j;
-    return;
-  }
-  const nav_geodetic p = nav_frame_local_to_geodetic(&tr->frame, r);
-  const double d0 = p.lat_rad - tr->geo_a[0], d1 = p.lon_rad - tr->geo_a[1];
-  if (from_prev && fabs(d0) < GEO_NEAR_RAD && fabs(d1) < GEO_NEAR_RAD) {
-    /* Both angles at once: v = {sin lat, cos lat, sin lon, cos lon}, w = {cos lat, -sin lat, ...}
-     * so that sin(a + d) - sin a = s (cos d - 1) + c sin d and cos(a + d) - cos a = c (cos d - 1)
-     * - s sin d are v cm1 + w sd lane by lane (the scalar expressions' operations, in order). */
-    const double sd0 = d0 - d0 * (d0 * d0) * (1.0 / 6.0), sd1 = d1 - d1 * (d1 * d1) * (1.0 / 6.0);
-    const double cm0 = -0.5 * (d0 * d0), cm1 = -0.5 * (d1 * d1);
-    double *hi = &tr->geo_hi[0][0], *lo = &tr->geo_lo[0][0];
-    const double s0 = hi[0], c0 = hi[1], s1 = hi[2], c1 = hi[3];
-    const double dv[4] = {s0 * cm0 + c0 * sd0, c0 * cm0 - s0 * sd0, s1 * cm1 + c1 * sd1, c1 * cm1 - s1 * sd1};
-    for (int i = 0; i < 4; ++i)
-      geo_two_sum(hi[i], lo[i] + dv[i], &hi[i], &lo[i]);
-  } else {
-    tr->geo_hi[0][0] = sin(p.lat_rad);
-    tr->geo_hi[0][1] = cos(p.lat_rad);
-    tr->geo_hi[1][0] = sin(p.lon_rad);
-    tr->geo_hi[1][1] = cos(p.lon_rad);
-    memset(tr->geo_lo, 0, sizeof tr->geo_lo);
-  }
-  tr->geo_a[0] = p.lat_rad;
-  tr->geo_a[1] = p.lon_rad;
-  /* A step that is neither an anchor nor a successor cannot happen (the chain walks in order);
-   * should it, the values are not used (geo_ok false until the next anchor). */
-  tr->geo_ok = j % CHAIN_BLOCK == 0 || (tr->geo_ok && tr->geo_j == j - 1);
-  tr->geo_j = j;
-  tr->geo_r = r;
-  tr->geo_p = p;
-}
-
-/* For the local position r when it is R(geo_j), bit for bit: its geodetic position and the carried
- * sin/cos of its latitude and longitude. */
-static bool geo_sc_get(const nav_traj *tr, const nav_vec3 *r, nav_geodetic *p, double sc4[4]) {
-  if (!tr->geo_ok || !nav_kin_same_bits_n(r, &tr->geo_r, 3)) return false;
-  *p = tr->geo_p;
-  sc4[0] = tr->geo_hi[0][0];
-  sc4[1] = tr->geo_hi[0][1];
-  sc4[2] = tr->geo_hi[1][0];
-  sc4[3] = tr->geo_hi[1][1];
-  return true;
-}
-
 /* nav_traj_eval, with the local position r_ned instead of the model's when given (see local_kin). */
 static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, nav_traj_state *out) {
   nav_traj_state s;
@@ -390,28 +293,20 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
       nav_local_kin k;
       st = local_kin(traj, t_s, r_ned, &k);
       if (st != NAV_OK) return st;
-      /* The sequential walk (r_ned: the chain's R(k)) takes the carried sines and cosines of its
-       * latitude and longitude (geo_sc_step); the random-access path calls the library. */
-      double sc4[4] = {0.0, 0.0, 0.0, 0.0};
-      nav_geodetic p;
-      const bool seq = r_ned && geo_sc_get(traj, r_ned, &p, sc4);
-      g = local_to_geo_p(&traj->frame, &k, seq ? &p : NULL);
-      if (traj->es_ok && traj->es_seq == seq && nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double)) &&
-          (!seq || nav_kin_same_bits_n(sc4, traj->es_sc, 4))) {
+      if (traj->es_ok && nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double))) {
         s = traj->es_out;
         s.t_s = t_s;
         *out = s;
         return NAV_OK;
       }
-      geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc, seq ? sc4 : NULL);
+      g = local_to_geo(&traj->frame, &k);
+      geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
       traj->es_in = k;
       traj->es_out = s;
-      traj->es_seq = seq;
-      memcpy(traj->es_sc, sc4, sizeof sc4);
       traj->es_ok = true;
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
-      if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc, NULL);
+      if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
     }
   }
   if (st != NAV_OK) return st;
@@ -590,20 +485,16 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
     st = model_position(tr, io->t0_s, &r0);
   } else {
     const int64_t j = io->k - 1;
-    /* The carried sines and cosines belong to the cached R(chain_j) (not so only after an error). */
-    const bool chain_ok =
-        tr->chain_ok && (tr->frame.model == NAV_EARTH_FLAT || (tr->geo_ok && tr->geo_j == tr->chain_j));
-    if (chain_ok && tr->chain_j == j) {
+    if (tr->chain_ok && tr->chain_j == j) {
       r0 = tr->chain_r;
     } else {
       /* Anchor of the block, or the cached value when it lies between the anchor and j. */
       int64_t i = j - j % CHAIN_BLOCK;
-      if (chain_ok && tr->chain_j > i && tr->chain_j < j) {
+      if (tr->chain_ok && tr->chain_j > i && tr->chain_j < j) {
         i = tr->chain_j;
         r0 = tr->chain_r;
       } else {
         st = model_position(tr, (double)i * tr->dt_s, &r0);
-        if (st == NAV_OK) geo_sc_step(tr, i, r0);
       }
       nav_kin_nodes tmp;
       tmp.n = io->n;
@@ -617,10 +508,7 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
         for (int q = 0; q < io->n; ++q)
           tmp.t_s[q] = m + h * io->x[q];
         st = tr->nodes(tr->m.self, &tmp);
-        if (st == NAV_OK) {
-          r0 = chain_step(tr, r0, &tmp, h);
-          geo_sc_step(tr, i + 1, r0);
-        }
+        if (st == NAV_OK) r0 = chain_step(tr, r0, &tmp, h);
       }
     }
     if (st != NAV_OK) return st;
@@ -631,7 +519,6 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
     else
       r1 = chain_step(tr, r0, io, half);
     if (st != NAV_OK) return st;
-    geo_sc_step(tr, io->k, r1);
     tr->chain_ok = true;
     tr->chain_j = io->k;
     tr->chain_r = r1;
