@@ -185,10 +185,12 @@ static inline void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
 }
 
 /* Local curvilinear NED kinematics -> geodetic kinematics (affine map, exact derivatives). */
-static nav_geo_kin local_to_geo(const nav_frame *fr, const nav_local_kin *k) {
+static nav_geo_kin local_to_geo(const nav_traj *tr, const nav_local_kin *k) {
+  const nav_frame *fr = &tr->frame;
   nav_geo_kin g;
   g.pos = nav_frame_local_to_geodetic(fr, k->r_ned_m);
-  const double sy = fr->m_per_rad_lon != 0.0 ? 1.0 / fr->m_per_rad_lon : 0.0;
+  /* 1 / m_per_rad_lon (0 for 0), computed once at creation by the same expression. */
+  const double sy = tr->inv_m_lon;
   g.dpos = nav_vec3_make(k->v_ned_mps.x / fr->m_per_rad_lat, k->v_ned_mps.y * sy, -k->v_ned_mps.z);
   g.ddpos = nav_vec3_make(k->a_ned_mps2.x / fr->m_per_rad_lat, k->a_ned_mps2.y * sy, -k->a_ned_mps2.z);
   g.q_b_n = k->q_b_n;
@@ -299,7 +301,7 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
         *out = s;
         return NAV_OK;
       }
-      g = local_to_geo(&traj->frame, &k);
+      g = local_to_geo(traj, &k);
       geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
       traj->es_in = k;
       traj->es_out = s;
@@ -353,7 +355,7 @@ nav_status nav_traj_inertial(nav_traj *traj, double t_s, nav_vec3 *f_ib_b_mps2, 
     nav_local_kin k;
     st = traj->m.eval_local(traj->m.self, t_s, &k);
     if (st != NAV_OK) return st;
-    g = local_to_geo(&traj->frame, &k);
+    g = local_to_geo(traj, &k);
   } else {
     st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
     if (st != NAV_OK) return st;
