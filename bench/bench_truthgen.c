@@ -52,13 +52,13 @@
 #define TG_TARGET 100.0
 
 /* gnss-ins-sim @ 966ff271 on the long drive (193 036 samples), Debian 12 python3 3.11.2,
- * python3-numpy 1.24.2, on this project's 2-core AMD EPYC machine,
+ * python3-numpy 1.24.2, on this project's 2-core machine,
  * 2026-11-27 07:10 UTC, load average 5.0-5.3 (other engineers' builds): CPU seconds of path_gen
  * (truth + ideal IMU) and of the whole Sim.run (+ IMU errors, GPS, derived data). */
 #define TG_PUBLISHED_SAMPLES 193036.0
 #define TG_PUBLISHED_PATHGEN_CPU_S 8.290
 #define TG_PUBLISHED_RUN_CPU_S 9.928
-#define TG_PUBLISHED_SOURCE "measured on this project's 2-core AMD EPYC, 2026-11-27 07:10 UTC, load 5.0-5.3"
+#define TG_PUBLISHED_SOURCE "measured on this project's 2-core machine, 2026-11-27 07:10 UTC, load 5.0-5.3"
 #define TG_PUBLISHED_SHORT "earlier figure (this machine, 2026-11-27, load 5.0-5.3)"
 
 /* The timing script run for --peer-gnss-ins-sim (argv: gnss-ins-sim checkout, motion file). */

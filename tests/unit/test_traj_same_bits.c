@@ -152,7 +152,7 @@ static void test_fused_wgs84_embedding(void **state) {
     g.dw_nb_b_rps2 = nav_vec3_make(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
     nav_traj_state s;
     memset(&s, 0, sizeof s);
-    geo_to_ecef_state(&g, &s);
+    geo_to_ecef_state_c(&g, &s, NULL, NULL); /* without the caches */
     /* The composition the fused form replaced (earth.c's functions, geo_to_ned_kin with the radii). */
     const ned_kin nk = geo_to_ned_kin(&g);
     const nav_mat3 C_n_e = nav_earth_dcm_n_e(g.pos.lat_rad, g.pos.lon_rad);

@@ -179,11 +179,6 @@ static void geo_to_ecef_state_c(const nav_geo_kin *g, nav_traj_state *s, nav_kin
                                  nav_vec3_cross(g->w_nb_b_rps, w_en_b));
 }
 
-/* Without caches (the white-box test compares it with the nav_earth functions). */
-static inline void geo_to_ecef_state(const nav_geo_kin *g, nav_traj_state *s) {
-  geo_to_ecef_state_c(g, s, NULL, NULL);
-}
-
 /* Local curvilinear NED kinematics -> geodetic kinematics (affine map, exact derivatives). */
 static nav_geo_kin local_to_geo(const nav_traj *tr, const nav_local_kin *k) {
   const nav_frame *fr = &tr->frame;
