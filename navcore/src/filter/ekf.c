@@ -1074,6 +1074,26 @@ nav_status nav_filter_flush(nav_filter *f) {
  * (n = 15, 18 or 21, m = 3) with compile-time bounds (loops unrolled, no loop control per product) and once
  * generically; the same operations in the same order either way, so the values are identical.
  * Returns false when S is not positive definite. */
+/* out = base - X^T Y for n x n out and base and m x n X and Y (rows of n): row i of X^T Y is
+ * sum_r X_ri Y_r, accumulated from +0.0 over r ascending, a whole row of n at a time. out must not
+ * be X or Y (base may not be out either: it is read row by row after the sums). */
+static NAV_ALWAYS_INLINE void sub_xty(double *restrict out, const double *base, const double *X, const double *Y,
+                                      const size_t n, const size_t m) {
+  double tmp[NMAX];
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      tmp[j] = 0.0;
+    NAV_UNROLL
+    for (size_t r = 0; r < m; ++r) {
+      const double x = X[r * n + i];
+      for (size_t j = 0; j < n; ++j)
+        tmp[j] += x * Y[r * n + j];
+    }
+    for (size_t j = 0; j < n; ++j)
+      out[i * n + j] = base[i * n + j] - tmp[j];
+  }
+}
+
 static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const size_t m, const double *H,
                                           const double *z, const double *R, double *y, double *S, double *Ls) {
   const double *P = f->P;
@@ -1150,19 +1170,7 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
    * O(n^2 m) instead of the 2 n^3 of a dense sandwich. A P goes to Phi, ((A P) H^T)^T to S
    * (both scratch here). */
   double *B = f->Phi, *BHtT = f->S;
-  double tmp[NMAX];
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = 0; j < n; ++j)
-      tmp[j] = 0.0;
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r) {
-      const double k = Kt[r * n + i];
-      for (size_t j = 0; j < n; ++j)
-        tmp[j] += k * PHtT[r * n + j];
-    }
-    for (size_t j = 0; j < n; ++j)
-      B[i * n + j] = P[i * n + j] - tmp[j];
-  }
+  sub_xty(B, P, Kt, PHtT, n, m);
   for (size_t r = 0; r < m; ++r) {
     double *o = BHtT + r * n;
     for (size_t i = 0; i < n; ++i)
@@ -1173,18 +1181,7 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
         o[i] += B[i * n + hc[q]] * h;
     }
   }
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = 0; j < n; ++j)
-      tmp[j] = 0.0;
-    NAV_UNROLL
-    for (size_t r = 0; r < m; ++r) {
-      const double b = BHtT[r * n + i];
-      for (size_t j = 0; j < n; ++j)
-        tmp[j] += b * Kt[r * n + j];
-    }
-    for (size_t j = 0; j < n; ++j)
-      f->Pn[i * n + j] = B[i * n + j] - tmp[j];
-  }
+  sub_xty(f->Pn, B, BHtT, Kt, n, m);
   /* K R K^T: (K R)^T = WT (m x n), then the upper triangle of W K^T, added to both triangles. */
   double *WT = f->W;
   NAV_UNROLL
@@ -1199,6 +1196,7 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
         o[i] += Kt[r * n + i] * rr;
     }
   }
+  double tmp[NMAX];
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i; j < n; ++j)
       tmp[j] = 0.0;

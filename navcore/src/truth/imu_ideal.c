@@ -122,35 +122,51 @@ double nav_truth_dt(const nav_truth *truth) { return truth ? truth->dt_s : 0.0; 
 int64_t nav_truth_sample_count(const nav_truth *truth) { return truth ? truth->n_samples : 0; }
 nav_frame nav_truth_frame(const nav_truth *truth) { return truth->frame; }
 
+/* Numerical guard of a state (one test for all: any NaN or infinity propagates into the sum). */
+static bool state_finite(const nav_traj_state *s) {
+  return isfinite(s->r_fb_f_m.x + s->r_fb_f_m.y + s->r_fb_f_m.z + s->v_fb_f_mps.x + s->v_fb_f_mps.y +
+                  s->v_fb_f_mps.z + s->q_b_f.w + s->q_b_f.x + s->q_b_f.y + s->q_b_f.z);
+}
+
+/* The increment over [t0, t1] ending at sample k without its node sums: the time stamps and, where
+ * the trajectory integrates the rate in closed form, the rotation vector (*closed). */
+static nav_status increment_start(nav_truth *truth, int64_t k, double t0, double t1, nav_imu_increment *r,
+                                  bool *closed) {
+  r->k = k;
+  r->t_s = t1;
+  r->dt_s = t1 - t0;
+  *closed = false;
+  return nav_traj_rate_integral(truth->traj, t0, t1, &r->dtheta_b_rad, closed);
+}
+
+/* The increment with the node sums dv and dth (dth only where the rate has no closed form). */
+static nav_status increment_finish(nav_imu_increment *r, bool closed, nav_vec3 dv, nav_vec3 dth) {
+  if (!closed) r->dtheta_b_rad = dth;
+  r->dv_b_mps = dv;
+  return nav_vec3_isfinite(r->dtheta_b_rad) && nav_vec3_isfinite(r->dv_b_mps) ? NAV_OK : NAV_ERR_NUMERIC;
+}
+
 nav_status nav_truth_state(nav_truth *truth, double t_s, nav_traj_state *out) {
   if (!truth) return NAV_ERR_INVALID_ARG;
   const nav_status st = nav_traj_eval(truth->traj, t_s, out);
   if (st != NAV_OK) return st;
-  /* Numerical guard (one test for all: any NaN or infinity propagates into the sum). */
-  if (!isfinite(out->r_fb_f_m.x + out->r_fb_f_m.y + out->r_fb_f_m.z + out->v_fb_f_mps.x + out->v_fb_f_mps.y +
-                out->v_fb_f_mps.z + out->q_b_f.w + out->q_b_f.x + out->q_b_f.y + out->q_b_f.z))
-    return NAV_ERR_NUMERIC;
-  return NAV_OK;
+  return state_finite(out) ? NAV_OK : NAV_ERR_NUMERIC;
 }
 
 nav_status nav_truth_imu(nav_truth *truth, int64_t k, nav_imu_increment *out) {
   if (!truth || !out || k < 1) return NAV_ERR_INVALID_ARG;
   const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
   nav_imu_increment r;
-  r.k = k;
-  r.t_s = t1;
-  r.dt_s = t1 - t0;
-  bool closed = false;
-  nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
+  bool closed;
+  nav_status st = increment_start(truth, k, t0, t1, &r, &closed);
   if (st != NAV_OK) return st;
   /* Gauss-Legendre over the interval, all nodes at once (nav_traj_inertial_increment). */
   nav_vec3 dv, dth;
   st = nav_traj_inertial_increment(truth->traj, t0, t1, truth->n_nodes, truth->nodes, truth->weights, &dv,
                                    &dth);
   if (st != NAV_OK) return st;
-  if (!closed) r.dtheta_b_rad = dth;
-  r.dv_b_mps = dv;
-  if (!nav_vec3_isfinite(r.dtheta_b_rad) || !nav_vec3_isfinite(r.dv_b_mps)) return NAV_ERR_NUMERIC;
+  st = increment_finish(&r, closed, dv, dth);
+  if (st != NAV_OK) return st;
   *out = r;
   return NAV_OK;
 }
@@ -159,23 +175,17 @@ nav_status nav_truth_sample(nav_truth *truth, int64_t k, nav_traj_state *state, 
   if (!truth || !state || !imu || k < 1) return NAV_ERR_INVALID_ARG;
   const double t0 = (double)(k - 1) * truth->dt_s, t1 = (double)k * truth->dt_s;
   nav_imu_increment r;
-  r.k = k;
-  r.t_s = t1;
-  r.dt_s = t1 - t0;
-  bool closed = false;
-  nav_status st = nav_traj_rate_integral(truth->traj, t0, t1, &r.dtheta_b_rad, &closed);
+  bool closed;
+  nav_status st = increment_start(truth, k, t0, t1, &r, &closed);
   if (st != NAV_OK) return st;
   nav_vec3 dv, dth;
   nav_traj_state s;
   st = nav_traj_sample(truth->traj, k, truth->n_nodes, truth->nodes, truth->weights, &s, &dv, &dth);
   if (st != NAV_OK) return st;
-  if (!closed) r.dtheta_b_rad = dth;
-  r.dv_b_mps = dv;
   /* The guards of nav_truth_imu and nav_truth_state. */
-  if (!nav_vec3_isfinite(r.dtheta_b_rad) || !nav_vec3_isfinite(r.dv_b_mps)) return NAV_ERR_NUMERIC;
-  if (!isfinite(s.r_fb_f_m.x + s.r_fb_f_m.y + s.r_fb_f_m.z + s.v_fb_f_mps.x + s.v_fb_f_mps.y + s.v_fb_f_mps.z +
-                s.q_b_f.w + s.q_b_f.x + s.q_b_f.y + s.q_b_f.z))
-    return NAV_ERR_NUMERIC;
+  st = increment_finish(&r, closed, dv, dth);
+  if (st != NAV_OK) return st;
+  if (!state_finite(&s)) return NAV_ERR_NUMERIC;
   *state = s;
   *imu = r;
   return NAV_OK;
