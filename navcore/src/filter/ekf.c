@@ -314,11 +314,9 @@ static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
  * The row kernels below keep their running sums in such values, i.e. in registers, for the
  * whole of a row instead of loading and storing the row once per term. */
 #if defined(__GNUC__)
-#if !defined(__clang__)
 /* These helpers are always inlined, so the note that a 32-byte vector return changes the ABI
- * where AVX is off (the baseline clone) does not apply. */
+ * where AVX is off (the baseline clone) does not apply (GCC and clang both raise it). */
 #pragma GCC diagnostic ignored "-Wpsabi"
-#endif
 typedef double nav_v4 __attribute__((vector_size(32)));
 static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
   nav_v4 v;
@@ -327,9 +325,6 @@ static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
 }
 static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
   memcpy(p, &v, sizeof v);
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
-  return (nav_v4){a, b, c, d};
 }
 static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
   return (nav_v4){a, a, a, a};
