@@ -318,14 +318,6 @@ static void pad_copy(double *dst, const double *src, size_t n, size_t ld) {
  * where AVX is off (the baseline clone) does not apply (GCC and clang both raise it). */
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double nav_v4 __attribute__((vector_size(32)));
-static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
-  nav_v4 v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
-static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
-  memcpy(p, &v, sizeof v);
-}
 static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
   return (nav_v4){a, a, a, a};
 }
@@ -342,20 +334,9 @@ static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
 typedef struct nav_v4 {
   double e[4];
 } nav_v4;
-static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
-  nav_v4 v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
-static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
-  memcpy(p, &v, sizeof v);
-}
-static NAV_ALWAYS_INLINE nav_v4 v4_make(double a, double b, double c, double d) {
-  const nav_v4 v = {{a, b, c, d}};
-  return v;
-}
 static NAV_ALWAYS_INLINE nav_v4 v4_splat(double a) {
-  return v4_make(a, a, a, a);
+  const nav_v4 v = {{a, a, a, a}};
+  return v;
 }
 static NAV_ALWAYS_INLINE nav_v4 v4_add(nav_v4 a, nav_v4 b) {
   for (int c = 0; c < 4; ++c)
@@ -373,6 +354,15 @@ static NAV_ALWAYS_INLINE nav_v4 v4_mul(nav_v4 a, nav_v4 b) {
   return a;
 }
 #endif
+/* Loads and stores through memcpy: any alignment, either representation. */
+static NAV_ALWAYS_INLINE nav_v4 v4_load(const double *p) {
+  nav_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+static NAV_ALWAYS_INLINE void v4_store(double *p, nav_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
 
 /* The widest row any kernel handles: NMAX rounded up to four doubles. */
 #define NV_MAX ((NMAX + 3) / 4)

@@ -750,20 +750,28 @@ static double seg_step(void *self, double ta, double tb) {
   return w > 1.0 ? 0.5 / w : 0.5;
 }
 
+/* The sines and cosines of the Euler angles, each computed once (none for a zero angle, the
+ * model's caches st_sc), and q_b_n from those of the half angles (nav_euler_to_quat's numbers). */
+static inline void euler_trig(seg_model *m, double roll, double pitch, double yaw, double *sr, double *cr,
+                              double *sp, double *cp, double *sy, double *cy, nav_quat *q_b_n) {
+  double shr, chr, shp, chp, shy, chy;
+  nav_kin_sincos_cached(&m->st_sc[0], roll, sr, cr);
+  nav_kin_sincos_cached(&m->st_sc[1], pitch, sp, cp);
+  nav_kin_sincos_cached(&m->st_sc[2], yaw, sy, cy);
+  nav_kin_sincos_cached(&m->st_sc[3], 0.5 * roll, &shr, &chr);
+  nav_kin_sincos_cached(&m->st_sc[4], 0.5 * pitch, &shp, &chp);
+  nav_kin_sincos_cached(&m->st_sc[5], 0.5 * yaw, &shy, &chy);
+  *q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
+}
+
 static nav_status seg_kin(seg_model *m, double t_s, nav_local_kin *out, bool with_pos) {
   const seg_att a = seg_state(m, t_s);
   /* nav_euler_to_quat, nav_kin_euler_rates and nav_euler_to_dcm of the Euler angles, with each
    * sine and cosine computed once (and none for a zero angle): the same numbers. */
   const double roll = a.roll.d[0], pitch = a.pitch.d[0], yaw = a.yaw.d[0];
-  double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
-  nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
-  nav_kin_sincos_cached(&m->st_sc[1], pitch, &sp, &cp);
-  nav_kin_sincos_cached(&m->st_sc[2], yaw, &sy, &cy);
-  nav_kin_sincos_cached(&m->st_sc[3], 0.5 * roll, &shr, &chr);
-  nav_kin_sincos_cached(&m->st_sc[4], 0.5 * pitch, &shp, &chp);
-  nav_kin_sincos_cached(&m->st_sc[5], 0.5 * yaw, &shy, &chy);
+  double sr, cr, sp, cp, sy, cy;
   nav_local_kin k;
-  k.q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
+  euler_trig(m, roll, pitch, yaw, &sr, &cr, &sp, &cp, &sy, &cy, &k.q_b_n);
   nav_kin_euler_rates_sc(a.roll, a.pitch, a.yaw, sr, cr, sp, cp, &k.w_nb_b_rps, &k.dw_nb_b_rps2);
   const nav_mat3 C = dcm_of(sr, cr, sp, cp, sy, cy);
   const nav_vec3 vb = nav_vec3_make(a.u.d[0], a.v.d[0], a.w.d[0]);
@@ -803,15 +811,9 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
       return NAV_OK;
     }
   const double roll = x[CH_ROLL], pitch = x[CH_PITCH], yaw = x[CH_YAW];
-  double sr, cr, sp, cp, sy, cy, shr, chr, shp, chp, shy, chy;
-  nav_kin_sincos_cached(&m->st_sc[0], roll, &sr, &cr);
-  nav_kin_sincos_cached(&m->st_sc[1], pitch, &sp, &cp);
-  nav_kin_sincos_cached(&m->st_sc[2], yaw, &sy, &cy);
-  nav_kin_sincos_cached(&m->st_sc[3], 0.5 * roll, &shr, &chr);
-  nav_kin_sincos_cached(&m->st_sc[4], 0.5 * pitch, &shp, &chp);
-  nav_kin_sincos_cached(&m->st_sc[5], 0.5 * yaw, &shy, &chy);
+  double sr, cr, sp, cp, sy, cy;
   nav_local_kin k;
-  k.q_b_n = quat_of(shr, chr, shp, chp, shy, chy);
+  euler_trig(m, roll, pitch, yaw, &sr, &cr, &sp, &cp, &sy, &cy, &k.q_b_n);
   /* nav_kin_euler_rates_sc: dphi = (rr, rr1), dth = (pr, pr1), dpsi = (yr, yr1); sin/cos jets of
    * pitch and roll (value, derivative) = (sp, cp pr), (cp, -sp pr), (sr, cr rr), (cr, -sr rr). */
   const double rr = r[CH_ROLL], rr1 = r1[CH_ROLL], pr = r[CH_PITCH], pr1 = r1[CH_PITCH];
