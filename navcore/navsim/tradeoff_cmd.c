@@ -553,9 +553,21 @@ static void json_text(FILE *f, const char *s) {
   fputc('"', f);
 }
 
+/* A figure of tradeoff.csv: the shortest text that reads back to the same double. The pareto,
+   within_tolerance and recommended columns are decided on these doubles, so a reader who recomputes
+   them from the file gets the same answers; with 9 digits, two variants whose errors differ in the
+   10th digit printed equal and a front point looked dominated. */
 static void csv_num(FILE *f, double v) {
-  if (isfinite(v)) fprintf(f, ",%.9g", v);
-  else fputs(",", f);
+  if (!isfinite(v)) {
+    fputs(",", f);
+    return;
+  }
+  char b[40];
+  for (int prec = 9; prec <= 17; ++prec) {
+    snprintf(b, sizeof b, "%.*g", prec, v);
+    if (strtod(b, NULL) == v) break;
+  }
+  fprintf(f, ",%s", b);
 }
 
 int navsim_tradeoff(int argc, char **argv) {
