@@ -290,6 +290,59 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
   return p;
 }
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/**
+ * The fixed-point shape of nav_fast_number_scan() alone (printf's "%.Nf": [+-], 1-7 integer
+ * digits, optionally a point and 1-15 fraction digits, at most 19 digits, no exponent), for text
+ * in a padded buffer: the text ends at a byte that is not a digit (a line's terminating NUL),
+ * after which at least 8 more bytes are readable, so every word is loaded without a length check.
+ * The significand and the scale are those of nav_fast_number_scan(), so the value is the same
+ * single correctly rounded division (strtod's value).
+ * @return the end of the number and *out; NULL when the text at @p p has another shape (an
+ *         exponent, more digits, no digit, ...), *out untouched.
+ */
+static inline const char *nav_fast_fixed_scan_padded(const char *p, double *out) {
+  const bool neg = *p == '-';
+  if (*p == '-' || *p == '+') ++p;
+  uint64_t wi;
+  memcpy(&wi, p, 8);
+  const unsigned li = nav_fast_digit_run(wi);
+  if (li < 1u || li > 7u) return NULL;
+  const uint64_t vi = nav_fast_digits_value(wi, li);
+  const char *f = p + li;
+  if (*f != '.') {
+    if (*f == 'e' || *f == 'E') return NULL;
+    *out = neg ? -(double)vi : (double)vi; /* exact: vi < 10^7 */
+    return f;
+  }
+  ++f;
+  uint64_t w1;
+  memcpy(&w1, f, 8);
+  unsigned nf = nav_fast_digit_run(w1);
+  uint64_t m;
+  if (nf >= 1u && nf <= 7u) {
+    m = vi * nav_fast_pow10_u[nf] + nav_fast_digits_value(w1, nf);
+  } else if (nf == 8u) {
+    uint64_t w2;
+    memcpy(&w2, f + 8, 8); /* f + 8 is at most the terminating byte */
+    const unsigned n2 = nav_fast_digit_run(w2);
+    if (n2 > 7u || li + 8u + n2 > 19u) return NULL;
+    m = vi * nav_fast_pow10_u[8] + nav_fast_digits_value(w1, 8u);
+    if (n2 > 0u) m = m * nav_fast_pow10_u[n2] + nav_fast_digits_value(w2, n2);
+    nf = 8u + n2;
+  } else {
+    return NULL; /* "5." without fraction digits: the general scan */
+  }
+  if (m > ((uint64_t)1 << 53)) return NULL;
+  const char *q = f + nf;
+  if (*q == 'e' || *q == 'E') return NULL;
+  double v = (double)m; /* exact */
+  if (m != 0) v = v / nav_fast_pow10[nf];
+  *out = neg ? -v : v;
+  return q;
+}
+#endif
+
 /**
  * Parse the whole of [s, end) as one number when the exact fast path applies.
  * @return true and *out = the correctly rounded value; false when the text is not exactly one

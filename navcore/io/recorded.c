@@ -23,6 +23,9 @@
 /* Buffer of a streaming reader. Larger than the longest line, so a full buffer always holds a
  * complete line; 256 KiB amortises fread and keeps memory flat for any file size. */
 #define BUF_CAP (256u * 1024u)
+/* Zero bytes after the buffer's spare byte: a word loaded at any point of a line stays inside
+ * the allocation (split_fixed, nav_fast_fixed_scan_padded). */
+#define BUF_PAD 16u
 #define MAX_COLS 13
 
 struct nav_rec_reader {
@@ -30,7 +33,7 @@ struct nav_rec_reader {
   FILE *f;         /* NULL for a memory source */
   const char *mem; /* memory source */
   size_t mem_len, mem_pos;
-  char *buf;       /* BUF_CAP + 1 bytes: room for a terminating NUL after the last line */
+  char *buf;       /* BUF_CAP + 1 + BUF_PAD bytes: room for a terminating NUL after the last line */
   size_t len, pos; /* unread data is buf[pos, len) */
   bool src_eof;
   long line;              /* lines consumed */
@@ -144,7 +147,7 @@ static nav_status reader_new(nav_rec_format fmt, const char *name, nav_rec_reade
   if (fmt != NAV_REC_IMU && fmt != NAV_REC_GNSS && fmt != NAV_REC_PVA) return NAV_ERR_INVALID_ARG;
   nav_rec_reader *r = calloc(1, sizeof *r);
   if (!r) return NAV_ERR_NO_MEMORY;
-  r->buf = malloc(BUF_CAP + 1);
+  r->buf = calloc(BUF_CAP + 1 + BUF_PAD, 1);
   if (!r->buf) {
     free(r);
     return NAV_ERR_NO_MEMORY;
@@ -317,6 +320,11 @@ typedef struct fields {
   double v[MAX_COLS];
   int col[MAX_COLS + 1]; /* 1-based column of each field (and of the first extra one) */
   int end_col;           /* column just after the last field */
+  /* Read by split_fixed(): col and end_col not filled yet; the line (valid until the next line is
+   * read) is split again by with_cols() when a message needs a column. */
+  bool fast;
+  char *line;
+  size_t n;
 } fields;
 
 static bool is_blank(char c) {
@@ -426,6 +434,51 @@ static nav_status split(nav_rec_reader *r, char *line, size_t n, fields *fl) {
   return NAV_OK;
 }
 
+/*
+ * Line-level fast path of split() for lines of exactly @p want fixed-point fields (the rows of
+ * .nav reference files, printf's "%.Nf"): each field converted by nav_fast_fixed_scan_padded(),
+ * which gives the value split() gives, and the blanks between them skipped, in one pass without
+ * the per-field bookkeeping of split(). The line is NUL-terminated in the padded buffer of the
+ * reader. @return false for any other line (leading blank, comment, other shape or count,
+ * anything after the last field), which split() then reads as before; nothing is reported here.
+ */
+static bool split_fixed(char *line, size_t n, int want, fields *fl) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  const char *p = line, *const end = line + n;
+  for (int k = 0;; ++k) {
+    const char *q = nav_fast_fixed_scan_padded(p, &fl->v[k]);
+    if (!q) return false;
+    if (k + 1 == want) {
+      if (q != end) return false;
+      break;
+    }
+    if (!is_blank(*q)) return false; /* (the terminating NUL is not a blank) */
+    do
+      ++q;
+    while (is_blank(*q));
+    p = q;
+  }
+  fl->count = want;
+  fl->fast = true;
+  fl->line = line;
+  fl->n = n;
+  return true;
+#else
+  (void)line;
+  (void)n;
+  (void)want;
+  (void)fl;
+  return false;
+#endif
+}
+
+/* The columns of a line read by split_fixed(), for a message (split() gives the same values). */
+static void with_cols(nav_rec_reader *r, fields *fl) {
+  if (!fl->fast) return;
+  fl->fast = false;
+  (void)split(r, fl->line, fl->n, fl);
+}
+
 static nav_status column_count_error(nav_rec_reader *r, const fields *fl, const char *expect) {
   char msg[320];
   snprintf(msg, sizeof msg, "expected %s, found %d", expect, fl->count);
@@ -437,7 +490,8 @@ static nav_status column_count_error(nav_rec_reader *r, const fields *fl, const 
   return fail(r, NAV_ERR_PARSE, (int)r->line, col, "", msg);
 }
 
-static nav_status range_error(nav_rec_reader *r, const fields *fl, int i, const char *fmt_msg, double v) {
+static nav_status range_error(nav_rec_reader *r, fields *fl, int i, const char *fmt_msg, double v) {
+  with_cols(r, fl);
   char msg[200];
   snprintf(msg, sizeof msg, fmt_msg, v);
   return field_error(r, i, fl->col[i], msg);
@@ -453,6 +507,8 @@ static nav_status next_record(nav_rec_reader *r, fields *fl, bool *got) {
     nav_status st = next_line(r, &line, &n);
     if (st != NAV_OK) return st;
     if (!line) return NAV_OK;
+    fl->fast = false;
+    if (r->fmt == NAV_REC_PVA && split_fixed(line, n, 11, fl)) break;
     st = split(r, line, n, fl);
     if (st != NAV_OK) return st;
     if (fl->count > 0) break;
@@ -478,6 +534,7 @@ static nav_status next_record(nav_rec_reader *r, fields *fl, bool *got) {
   const int it = r->fmt == NAV_REC_PVA ? 1 : 0;
   const double t = fl->v[it];
   if (r->have_prev && !(t > r->t_prev)) {
+    with_cols(r, fl);
     char msg[200];
     snprintf(msg, sizeof msg,
              "time must increase from record to record: %.6f s is not after %.6f s (line %ld)", t, r->t_prev,
@@ -546,7 +603,7 @@ nav_status nav_rec_read_imu(nav_rec_reader *r, nav_imu_increment *out, bool *got
 }
 
 /* Common geodetic checks of GNSS and .nav rows; i is the latitude column. */
-static nav_status check_position(nav_rec_reader *r, const fields *fl, int i) {
+static nav_status check_position(nav_rec_reader *r, fields *fl, int i) {
   if (!(fabs(fl->v[i]) <= 90.0))
     return range_error(r, fl, i, "latitude %.9g deg outside [-90, 90]", fl->v[i]);
   if (!(fl->v[i + 1] >= -180.0 && fl->v[i + 1] <= 360.0))

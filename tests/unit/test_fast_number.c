@@ -285,6 +285,157 @@ static void test_fixed_shape(void **state) {
   assert_true(accepted > 200000);
 }
 
+/* nav_fast_fixed_scan_padded (the reference reader's line-level path): on text followed by its
+ * terminating byte and more bytes, it accepts only what nav_fast_number_scan accepts, with the
+ * same end and the same bits (strtod's); digits after the terminating byte are never read in. */
+static void check_padded(const char *s, const char *after, tally *t) {
+  char buf[128];
+  const size_t n = strlen(s);
+  assert_true(n + 1 + 24 < sizeof buf);
+  memset(buf, 0, sizeof buf);
+  memcpy(buf, s, n);
+  buf[n] = '\0';
+  memcpy(buf + n + 1, after, strlen(after));
+  double v = 0.0, g = 0.0;
+  const char *q = nav_fast_fixed_scan_padded(buf, &v);
+  const char *qg = nav_fast_number_scan(buf, buf + n, &g);
+  if (!q) {
+    t->declined++;
+    return;
+  }
+  if (!qg || q != qg) fail_msg("\"%s\": the padded scan accepted up to %ld, the general scan %ld", s, (long)(q - buf),
+                               qg ? (long)(qg - buf) : -1L);
+  if (memcmp(&v, &g, sizeof v) != 0) fail_msg("\"%s\": padded %.17g, general %.17g", s, v, g);
+  char *end = NULL;
+  const double ref = strtod(buf, &end);
+  if (end != q || memcmp(&v, &ref, sizeof v) != 0) fail_msg("\"%s\": padded %.17g, strtod %.17g", s, v, ref);
+  t->fast++;
+}
+
+static void test_fixed_padded(void **state) {
+  (void)state;
+  tally t = {0, 0};
+  static const char *const must[] = {"0",           "-0",          "7",         "1234567",      "-0.000000",
+                                     "100000.005000", "31.50818300000", "120.40198900000", "-177.000000", "0.1",
+                                     "9999999.99999999", "1.00000000", "1.000000001", "1.123456789012345",
+                                     "0.000000000000001", "9007199254.740992", "+5.25", "12345678"};
+  static const char *const afters[] = {"", "99999999", "0123456789012345", "e5", ".5"};
+  for (size_t i = 0; i < sizeof must / sizeof must[0]; ++i)
+    for (size_t a = 0; a < sizeof afters / sizeof afters[0]; ++a) check_padded(must[i], afters[a], &t);
+  /* Must be declined (other shapes: the general scan or strtod read them). */
+  static const char *const other[] = {"5.",  "12345678.5", "1.5e3", "1.5E-3", "123.1234567890123456",
+                                      ".5",  "1..5",       "-",     "+",      "",
+                                      " 5",  "1e5",        "9007199254.740993", "00000001.5", "-.5"};
+  for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
+    char buf[64] = {0};
+    memcpy(buf, other[i], strlen(other[i]));
+    double v = 0.0;
+    const char *q = nav_fast_fixed_scan_padded(buf, &v);
+    if (q && *q != '\0') continue; /* stopped early ("12345678.5" is not read as one number) */
+    if (q) fail_msg("\"%s\" should be declined by the padded scan", other[i]);
+  }
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 41u, 0u);
+  char s[64];
+  long accepted = 0;
+  for (int it = 0; it < 400000; ++it) {
+    const int idigits = 1 + (int)next_u(&r, 7);
+    const int prec = (int)next_u(&r, 17);
+    const double v = (nav_rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * nav_rng_uniform(&r) * pow(10.0, idigits);
+    snprintf(s, sizeof s, "%.*f", prec, v);
+    const long before = t.fast;
+    check_padded(s, (it & 1) ? "987654321" : "", &t);
+    accepted += t.fast - before;
+  }
+  print_message("[ fastnum  ] padded %%.Nf scan: %ld fast (%ld of the random ones), %ld declined\n", t.fast, accepted,
+                t.declined);
+  assert_true(accepted > 300000);
+}
+
+/* A .nav reference read by the line-level path gives the values of the field-by-field path and
+ * the same messages: the same rows written with blanks and tabs that only the field-by-field path
+ * reads, and errors at their columns. */
+static void read_all_pva(const char *text, nav_rec_pva *rows, int cap, int *n, nav_status *st, nav_diag *d) {
+  nav_rec_reader *r = NULL;
+  assert_int_equal(nav_rec_reader_open_memory(text, strlen(text), "ref.nav", NAV_REC_PVA, &r), NAV_OK);
+  *n = 0;
+  *st = NAV_OK;
+  for (;;) {
+    bool got = false;
+    nav_rec_pva row;
+    *st = nav_rec_read_pva(r, &row, &got);
+    if (*st != NAV_OK || !got) break;
+    if (*n < cap) rows[(*n)++] = row;
+  }
+  *d = *nav_rec_reader_diag(r);
+  nav_rec_reader_destroy(r);
+}
+
+static void test_pva_line_path(void **state) {
+  (void)state;
+  static const char fast[] = "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 "
+                             "0.000000 0.000000 -177.000000\n"
+                             "2179 100000.010000 -31.508183123 -120.40198900000 -12.5000 1.250000 -2.500000 "
+                             "0.125000 -10.000000 45.000000 359.500000\n"
+                             "2179 100000.015000 89.99999999999 359.99999999999 100000.0000 9999.999999 0 -0 "
+                             "180.000000 -90.000000 -180.000000";
+  static const char slow[] = "  0\t100000.005000 31.50818300000  120.40198900000 0.0000 0.000000 0.000000 0.000000 "
+                             "0.000000 0.000000 -177.000000\r\n"
+                             "# a comment\n\n"
+                             "2179 100000.010000 -31.508183123 -120.40198900000 -12.5000 1.250000 -2.500000 "
+                             "0.125000 -10.000000 45.000000 359.500000 \n"
+                             "2179 1.00000015e5 89.99999999999 359.99999999999 1e5 9999.999999 0 -0 "
+                             "180.000000 -90.000000 -180.000000\n";
+  nav_rec_pva a[4], b[4];
+  int na = 0, nb = 0;
+  nav_status sa, sb;
+  nav_diag da, db;
+  read_all_pva(fast, a, 4, &na, &sa, &da);
+  read_all_pva(slow, b, 4, &nb, &sb, &db);
+  assert_int_equal(sa, NAV_OK);
+  assert_int_equal(sb, NAV_OK);
+  assert_int_equal(na, 3);
+  assert_int_equal(nb, 3);
+  for (int i = 0; i < 3; ++i) {
+    assert_int_equal(a[i].week, b[i].week);
+    const double va[10] = {a[i].t_s, a[i].pos.lat_rad, a[i].pos.lon_rad, a[i].pos.h_m, a[i].v_n_mps.x,
+                           a[i].v_n_mps.y, a[i].v_n_mps.z, a[i].att.roll_rad, a[i].att.pitch_rad, a[i].att.yaw_rad};
+    const double vb[10] = {b[i].t_s, b[i].pos.lat_rad, b[i].pos.lon_rad, b[i].pos.h_m, b[i].v_n_mps.x,
+                           b[i].v_n_mps.y, b[i].v_n_mps.z, b[i].att.roll_rad, b[i].att.pitch_rad, b[i].att.yaw_rad};
+    assert_memory_equal(va, vb, sizeof va);
+  }
+  assert_true(signbit(a[2].v_n_mps.z) && signbit(b[2].v_n_mps.z));
+  /* Errors on lines the line-level path reads: the column of the field, as before. */
+  static const struct {
+    const char *text;
+    int line, col;
+    const char *words;
+  } bad[] = {
+      {"0 100000.005000 95.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0\n", 1,
+       17, "latitude 95.508183 deg outside [-90, 90]"},
+      {"0 100000.005000  31.5   400.0 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0\n", 1, 25,
+       "longitude 400 deg outside [-180, 360]"},
+      {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0\n0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 "
+       "1.0\n",
+       2, 3, "time must increase"},
+      {"1.5 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0\n", 1, 1, "GPS week 1.5"},
+      {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0 7\n", 1, 56, "expected 11 columns"},
+      {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 95.0 1.0\n", 1, 48, "pitch 95 deg outside [-90, 90]"},
+      {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0x\n", 1, 52, "expected a number, found \"1.0x\""},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    nav_rec_pva rows[2];
+    int n = 0;
+    nav_status st;
+    nav_diag d;
+    read_all_pva(bad[i].text, rows, 2, &n, &st, &d);
+    assert_int_equal(st, NAV_ERR_PARSE);
+    if (d.line != bad[i].line || d.col != bad[i].col || !strstr(d.message, bad[i].words))
+      fail_msg("case %zu: %d:%d %s; expected %d:%d and \"%s\"", i, d.line, d.col, d.message, bad[i].line, bad[i].col,
+               bad[i].words);
+  }
+}
+
 /* Every field of the first lines of the shared long-drive files: all on the fast path and
  * identical to strtod. Skipped when the shared data is not there. */
 static void test_shared_files(void **state) {
@@ -342,6 +493,8 @@ int main(void) {
       cmocka_unit_test(test_edges),
       cmocka_unit_test(test_sci12_shape),
       cmocka_unit_test(test_fixed_shape),
+      cmocka_unit_test(test_fixed_padded),
+      cmocka_unit_test(test_pva_line_path),
       cmocka_unit_test(test_shared_files),
       cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),
