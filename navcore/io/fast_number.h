@@ -24,6 +24,13 @@
 #include <stdint.h>
 #include <string.h>
 
+/* The padded scans are called once per field of every line: inlined into the line loop. */
+#if defined(__GNUC__)
+#define NAV_FAST_INLINE static inline __attribute__((always_inline))
+#else
+#define NAV_FAST_INLINE static inline
+#endif
+
 /* 10^0 .. 10^22: all exactly representable as doubles (5^22 < 2^53). */
 static const double nav_fast_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                           1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
@@ -84,6 +91,46 @@ static const uint64_t nav_fast_pow10_u[20] = {1ull,
                                               10000000000000000000ull};
 #endif
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/* The value of the 18 characters at @p p when they are printf's "%.12e" shape,
+ * d.dddddddddddde[+-]dd, with a scale 10^q, |q| <= 22 (Clinger's exact case): *out = the
+ * correctly rounded value (negated when @p neg) and true; false for any other text. Reads
+ * p[0..17] only; the caller checks what follows. */
+NAV_FAST_INLINE bool nav_fast_sci12_words(const char *p, bool neg, double *out) {
+  uint64_t a, b;
+  memcpy(&a, p, 8);     /* d . d d d d d d */
+  memcpy(&b, p + 8, 8); /* d d d d d d e +- */
+  const uint64_t ad = (a & ~0xFF00ull) | 0x3000ull;                     /* the point as a '0' */
+  const uint64_t bd = (b & 0x0000FFFFFFFFFFFFull) | 0x3030000000000000ull; /* e and sign as '0's */
+  const unsigned c6 = (unsigned)(b >> 48) & 0xFFu, c7 = (unsigned)(b >> 56);
+  if (!(((ad & 0xF0F0F0F0F0F0F0F0ull) | (((ad + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ==
+            0x3333333333333333ull &&
+        ((bd & 0xF0F0F0F0F0F0F0F0ull) | (((bd + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ==
+            0x3333333333333333ull &&
+        ((a >> 8) & 0xFFu) == '.' && (c6 | 0x20u) == 'e' && (c7 == '+' || c7 == '-') &&
+        (unsigned)(p[16] - '0') < 10u && (unsigned)(p[17] - '0') < 10u))
+    return false;
+  const int e = (c7 == '-' ? -1 : 1) * ((p[16] - '0') * 10 + (p[17] - '0'));
+  const int q = e - 12;
+  if (q < -22 || q > 22) return false;
+  /* Fraction digits 1-8 (bytes 2-7 of a, 0-1 of b) and 9-12 (bytes 2-5 of b), combined as in the
+   * eight- and four-digit steps of the general scan. */
+  uint64_t w = ((a >> 16) | (b << 48)) - 0x3030303030303030ull;
+  w = (w * 10u) + (w >> 8);
+  w = (((w & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
+       (((w >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
+      32;
+  uint32_t w4 = (uint32_t)(b >> 16) - 0x30303030u;
+  w4 = (w4 * 10u) + (w4 >> 8);
+  w4 = ((w4 & 0x000000FFu) * 100u) + ((w4 >> 16) & 0x000000FFu);
+  const uint64_t m = ((a & 0xFFu) - '0') * 1000000000000ull + (w & 0xFFFFFFFFu) * 10000u + w4;
+  double v = (double)m; /* exact: m < 10^13 < 2^53 */
+  if (m != 0) v = q < 0 ? v / nav_fast_pow10[-q] : v * nav_fast_pow10[q];
+  *out = neg ? -v : v;
+  return true;
+}
+#endif
+
 /**
  * Parse a number [+-]digits[.digits][(e|E)[+-]digits] (at least one significand digit) at the
  * start of [s, end) when the exact fast path applies, stopping at the first character that
@@ -105,40 +152,9 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
    * files, six of their seven columns), checked and converted in whole-word steps without a loop
    * per character; any other text goes on to the general scan below, which gives the same value
    * for this shape too. */
-  if (end - p >= 18 && p[1] == '.' && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u)) {
-    uint64_t a, b;
-    memcpy(&a, p, 8);     /* d . d d d d d d */
-    memcpy(&b, p + 8, 8); /* d d d d d d e +- */
-    const uint64_t ad = (a & ~0xFF00ull) | 0x3000ull;                     /* the point as a '0' */
-    const uint64_t bd = (b & 0x0000FFFFFFFFFFFFull) | 0x3030000000000000ull; /* e and sign as '0's */
-    const unsigned c6 = (unsigned)(b >> 48) & 0xFFu, c7 = (unsigned)(b >> 56);
-    if (((ad & 0xF0F0F0F0F0F0F0F0ull) | (((ad + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ==
-            0x3333333333333333ull &&
-        ((bd & 0xF0F0F0F0F0F0F0F0ull) | (((bd + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ==
-            0x3333333333333333ull &&
-        ((a >> 8) & 0xFFu) == '.' && (c6 | 0x20u) == 'e' && (c7 == '+' || c7 == '-') &&
-        (unsigned)(p[16] - '0') < 10u && (unsigned)(p[17] - '0') < 10u) {
-      const int e = (c7 == '-' ? -1 : 1) * ((p[16] - '0') * 10 + (p[17] - '0'));
-      const int q = e - 12;
-      if (q >= -22 && q <= 22) {
-        /* Fraction digits 1-8 (bytes 2-7 of a, 0-1 of b) and 9-12 (bytes 2-5 of b), combined
-         * as in the eight- and four-digit steps below. */
-        uint64_t w = ((a >> 16) | (b << 48)) - 0x3030303030303030ull;
-        w = (w * 10u) + (w >> 8);
-        w = (((w & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
-             (((w >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
-            32;
-        uint32_t w4 = (uint32_t)(b >> 16) - 0x30303030u;
-        w4 = (w4 * 10u) + (w4 >> 8);
-        w4 = ((w4 & 0x000000FFu) * 100u) + ((w4 >> 16) & 0x000000FFu);
-        const uint64_t m = ((a & 0xFFu) - '0') * 1000000000000ull + (w & 0xFFFFFFFFu) * 10000u + w4;
-        double v = (double)m; /* exact: m < 10^13 < 2^53 */
-        if (m != 0) v = q < 0 ? v / nav_fast_pow10[-q] : v * nav_fast_pow10[q];
-        *out = neg ? -v : v;
-        return p + 18;
-      }
-    }
-  }
+  if (end - p >= 18 && p[1] == '.' && (end - p == 18 || (unsigned)(p[18] - '0') >= 10u) &&
+      nav_fast_sci12_words(p, neg, out))
+    return p + 18;
   /* Fixed-point text, printf's "%.Nf" (the columns of reference and GNSS files): 1-7 integer
    * digits, optionally a point and up to 15 fraction digits, at most 19 digits in all, no
    * exponent. The digit runs are found and converted a word at a time; the significand and the
@@ -301,7 +317,7 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
  * @return the end of the number and *out; NULL when the text at @p p has another shape (an
  *         exponent, more digits, no digit, ...), *out untouched.
  */
-static inline const char *nav_fast_fixed_scan_padded(const char *p, double *out) {
+NAV_FAST_INLINE const char *nav_fast_fixed_scan_padded(const char *p, double *out) {
   const bool neg = *p == '-';
   if (*p == '-' || *p == '+') ++p;
   uint64_t wi;
@@ -340,6 +356,22 @@ static inline const char *nav_fast_fixed_scan_padded(const char *p, double *out)
   if (m != 0) v = v / nav_fast_pow10[nf];
   *out = neg ? -v : v;
   return q;
+}
+#endif
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/**
+ * The "%.12e" shape of nav_fast_number_scan() alone ([+-]d.dddddddddddde[+-]dd, |q| <= 22) for
+ * text in a padded buffer: the text ends at a byte that is not a digit, after which at least 19
+ * more bytes are readable (every byte of the shape is checked, so a shorter text fails at its
+ * terminating byte). @return the end of the number and *out (nav_fast_number_scan()'s value);
+ * NULL for any other text, *out untouched.
+ */
+NAV_FAST_INLINE const char *nav_fast_sci12_scan_padded(const char *p, double *out) {
+  const bool neg = *p == '-';
+  if (*p == '-' || *p == '+') ++p;
+  if (p[1] != '.' || (unsigned)(p[18] - '0') < 10u || !nav_fast_sci12_words(p, neg, out)) return NULL;
+  return p + 18;
 }
 #endif
 

@@ -25,7 +25,7 @@
 #define BUF_CAP (256u * 1024u)
 /* Zero bytes after the buffer's spare byte: a word loaded at any point of a line stays inside
  * the allocation (split_fixed, nav_fast_fixed_scan_padded). */
-#define BUF_PAD 16u
+#define BUF_PAD 32u
 #define MAX_COLS 13
 
 struct nav_rec_reader {
@@ -435,18 +435,22 @@ static nav_status split(nav_rec_reader *r, char *line, size_t n, fields *fl) {
 }
 
 /*
- * Line-level fast path of split() for lines of exactly @p want fixed-point fields (the rows of
- * .nav reference files, printf's "%.Nf"): each field converted by nav_fast_fixed_scan_padded(),
- * which gives the value split() gives, and the blanks between them skipped, in one pass without
- * the per-field bookkeeping of split(). The line is NUL-terminated in the padded buffer of the
- * reader. @return false for any other line (leading blank, comment, other shape or count,
- * anything after the last field), which split() then reads as before; nothing is reported here.
+ * Line-level fast path of split() for lines of exactly @p want fields in the shapes printf writes
+ * them in our data files: fixed-point "%.Nf" (the rows of .nav reference files, the time of IMU
+ * records) and, where @p sci is set, "%.12e" first (the increments of KF-GINS IMU files). Each
+ * field is converted by nav_fast_sci12_scan_padded() or nav_fast_fixed_scan_padded(), which give
+ * the value split() gives, and the blanks between fields are skipped, in one pass without the
+ * per-field bookkeeping of split(). The line is NUL-terminated in the padded buffer of the reader.
+ * @return false for any other line (leading blank, comment, other shape or count, anything after
+ * the last field), which split() then reads as before; nothing is reported here.
  */
-static bool split_fixed(char *line, size_t n, int want, fields *fl) {
+static inline __attribute__((always_inline)) bool split_fixed(char *line, size_t n, int want, bool sci,
+                                                             fields *fl) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   const char *p = line, *const end = line + n;
   for (int k = 0;; ++k) {
-    const char *q = nav_fast_fixed_scan_padded(p, &fl->v[k]);
+    const char *q = sci && k > 0 ? nav_fast_sci12_scan_padded(p, &fl->v[k]) : NULL;
+    if (!q) q = nav_fast_fixed_scan_padded(p, &fl->v[k]);
     if (!q) return false;
     if (k + 1 == want) {
       if (q != end) return false;
@@ -467,9 +471,18 @@ static bool split_fixed(char *line, size_t n, int want, fields *fl) {
   (void)line;
   (void)n;
   (void)want;
+  (void)sci;
   (void)fl;
   return false;
 #endif
+}
+
+/* split_fixed() for the two formats (separate functions: each loop is compiled for its shapes). */
+static __attribute__((noinline)) bool split_pva_line(char *line, size_t n, fields *fl) {
+  return split_fixed(line, n, 11, false, fl);
+}
+static __attribute__((noinline)) bool split_imu_line(char *line, size_t n, fields *fl) {
+  return split_fixed(line, n, 7, true, fl);
 }
 
 /* The columns of a line read by split_fixed(), for a message (split() gives the same values). */
@@ -508,7 +521,8 @@ static nav_status next_record(nav_rec_reader *r, fields *fl, bool *got) {
     if (st != NAV_OK) return st;
     if (!line) return NAV_OK;
     fl->fast = false;
-    if (r->fmt == NAV_REC_PVA && split_fixed(line, n, 11, fl)) break;
+    if (r->fmt == NAV_REC_PVA ? split_pva_line(line, n, fl) : r->fmt == NAV_REC_IMU && split_imu_line(line, n, fl))
+      break;
     st = split(r, line, n, fl);
     if (st != NAV_OK) return st;
     if (fl->count > 0) break;

@@ -436,6 +436,141 @@ static void test_pva_line_path(void **state) {
   }
 }
 
+/* nav_fast_sci12_scan_padded (the IMU reader's line-level path): the same acceptance, end and bits
+ * as nav_fast_number_scan on "%.12e" text, whatever follows the terminating byte. */
+static void check_sci_padded(const char *s, const char *after, tally *t) {
+  char buf[128];
+  const size_t n = strlen(s);
+  assert_true(n + 1 + 40 < sizeof buf);
+  memset(buf, 0, sizeof buf);
+  memcpy(buf, s, n);
+  memcpy(buf + n + 1, after, strlen(after));
+  double v = 0.0, g = 0.0;
+  const char *q = nav_fast_sci12_scan_padded(buf, &v);
+  if (!q) {
+    t->declined++;
+    return;
+  }
+  const char *qg = nav_fast_number_scan(buf, buf + n, &g);
+  if (!qg || q != qg) fail_msg("\"%s\": the padded scan accepted up to %ld, the general scan %ld", s, (long)(q - buf),
+                               qg ? (long)(qg - buf) : -1L);
+  char *end = NULL;
+  const double ref = strtod(buf, &end);
+  if (end != q || memcmp(&v, &g, sizeof v) != 0 || memcmp(&v, &ref, sizeof v) != 0)
+    fail_msg("\"%s\": padded %.17g, general %.17g, strtod %.17g", s, v, g, ref);
+  t->fast++;
+}
+
+static void test_sci_padded(void **state) {
+  (void)state;
+  tally t = {0, 0};
+  static const char *const must[] = {"3.550682422333e-06", "-1.757083616415e-06", "-4.911053131454e-02",
+                                     "0.000000000000e+00", "-0.000000000000e+00", "9.999999999999e+22",
+                                     "1.000000000000e-10", "+5.000000000000e+00"};
+  static const char *const afters[] = {"", "5", "12345678901234567890", "e+05"};
+  for (size_t i = 0; i < sizeof must / sizeof must[0]; ++i)
+    for (size_t a = 0; a < sizeof afters / sizeof afters[0]; ++a) {
+      const long before = t.fast;
+      check_sci_padded(must[i], afters[a], &t);
+      if (t.fast == before) fail_msg("\"%s\" should be accepted", must[i]);
+    }
+  /* Declined: cut short (the rest of a longer number after the terminating byte must not be
+   * read as its digits), a 13th digit, a 3-digit exponent, other shapes, |q| > 22. */
+  static const char *const other[] = {"3.550682422333e-0", "3.550682422333e", "3.55068242233e-06",
+                                      "3.5506824223330e-06", "3.550682422333e-106", "35.50682422333e-06",
+                                      "3.550682422333x-06", "1.000000000000e-11", "", "-", "3.5"};
+  for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
+    char buf[80] = {0};
+    memcpy(buf, other[i], strlen(other[i]));
+    memcpy(buf + strlen(other[i]) + 1, "0123456789e+01", 14);
+    double v = 0.0;
+    const char *q = nav_fast_sci12_scan_padded(buf, &v);
+    if (q && *q == '\0') fail_msg("\"%s\" should be declined by the padded %%.12e scan", other[i]);
+  }
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 43u, 0u);
+  char s[64];
+  for (int it = 0; it < 300000; ++it) {
+    const double v = (nav_rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * nav_rng_uniform(&r) *
+                     pow(10.0, (double)((int)next_u(&r, 30) - 15));
+    snprintf(s, sizeof s, "%.12e", v);
+    const long before = t.fast;
+    check_sci_padded(s, (it & 1) ? "98765432109876543210" : "", &t);
+    /* Declined only outside Clinger's case: exponents below -10 (10^(e-12) beyond 10^-22). */
+    if (t.fast == before && atoi(s + strlen(s) - 3) >= -10) fail_msg("\"%s\" should be accepted", s);
+  }
+  print_message("[ fastnum  ] padded %%.12e scan: %ld fast, %ld declined\n", t.fast, t.declined);
+  assert_true(t.fast > 200000);
+}
+
+/* IMU records read by the line-level path give the values and messages of the field-by-field
+ * path (the same records written so that only the latter reads them). */
+static void test_imu_line_path(void **state) {
+  (void)state;
+  static const char fast[] =
+      "100000.005000 3.550682422333e-06 -1.757083616415e-06 -2.985800620171e-07 -9.093064074826e-05 "
+      "8.384128995745e-05 -4.911053131454e-02\n"
+      "100000.010000 -1.555077539977e-06 0.001 2.811151415522e-06 9.432643236281e-05 -2.609348822230e-05 "
+      "-4.896167903435e-02\n"
+      "100000.015 0 -0.000000000000e+00 1.0e-3 1 -2 3";
+  static const char slow[] =
+      "100000.005000\t3.550682422333e-06 -1.757083616415e-06 -2.985800620171e-07 -9.093064074826e-05 "
+      "8.384128995745e-05 -4.911053131454e-02\r\n"
+      "# comment\n"
+      " 100000.010000 -1.555077539977e-06 1e-3 2.811151415522e-06 9.432643236281e-05 -2.609348822230e-05 "
+      "-4.896167903435e-02\n"
+      "100000.015 0 -0.0 0.001 1 -2 3 \n";
+  nav_imu_increment a[3], b[3];
+  for (int pass = 0; pass < 2; ++pass) {
+    const char *text = pass ? slow : fast;
+    nav_imu_increment *out = pass ? b : a;
+    nav_rec_reader *r = NULL;
+    assert_int_equal(nav_rec_reader_open_memory(text, strlen(text), "imu.txt", NAV_REC_IMU, &r), NAV_OK);
+    for (int i = 0; i < 3; ++i) {
+      bool got = false;
+      assert_int_equal(nav_rec_read_imu(r, &out[i], &got), NAV_OK);
+      assert_true(got);
+    }
+    nav_rec_reader_destroy(r);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double va[8] = {a[i].t_s, a[i].dt_s, a[i].dtheta_b_rad.x, a[i].dtheta_b_rad.y, a[i].dtheta_b_rad.z,
+                          a[i].dv_b_mps.x, a[i].dv_b_mps.y, a[i].dv_b_mps.z};
+    const double vb[8] = {b[i].t_s, b[i].dt_s, b[i].dtheta_b_rad.x, b[i].dtheta_b_rad.y, b[i].dtheta_b_rad.z,
+                          b[i].dv_b_mps.x, b[i].dv_b_mps.y, b[i].dv_b_mps.z};
+    assert_memory_equal(va, vb, sizeof va);
+  }
+  static const struct {
+    const char *text;
+    int line, col;
+    const char *words;
+  } bad[] = {
+      {"100.0 1e-6 2e-6 3e-6 0.1 0.2 9.8\n100.005 4.000000000000e+00 2e-6 3e-6 0.1 0.2 9.8\n", 2, 9,
+       "angle increment 4 rad exceeds pi"},
+      {"100.0 1.000000000000e-06 2e-6 3e-6 0.1 0.2 2.000000000000e+04\n", 1, 44, "velocity increment 20000 m/s"},
+      {"100.0 1e-6 2e-6 3e-6 0.1 0.2 9.8\n100.0 1.000000000000e-06 2e-6 3e-6 0.1 0.2 9.8\n", 2, 1,
+       "time must increase"},
+      {"100.0 1.000000000000e-06 2e-6 3e-6 0.1 0.2\n", 1, 43, "expected 7 columns"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    nav_rec_reader *r = NULL;
+    assert_int_equal(nav_rec_reader_open_memory(bad[i].text, strlen(bad[i].text), "imu.txt", NAV_REC_IMU, &r), NAV_OK);
+    nav_status st = NAV_OK;
+    for (int k = 0; k < 3 && st == NAV_OK; ++k) {
+      nav_imu_increment inc;
+      bool got = false;
+      st = nav_rec_read_imu(r, &inc, &got);
+      if (st == NAV_OK && !got) break;
+    }
+    const nav_diag *d = nav_rec_reader_diag(r);
+    assert_int_equal(st, NAV_ERR_PARSE);
+    if (d->line != bad[i].line || d->col != bad[i].col || !strstr(d->message, bad[i].words))
+      fail_msg("case %zu: %d:%d %s; expected %d:%d and \"%s\"", i, d->line, d->col, d->message, bad[i].line,
+               bad[i].col, bad[i].words);
+    nav_rec_reader_destroy(r);
+  }
+}
+
 /* Every field of the first lines of the shared long-drive files: all on the fast path and
  * identical to strtod. Skipped when the shared data is not there. */
 static void test_shared_files(void **state) {
@@ -495,6 +630,8 @@ int main(void) {
       cmocka_unit_test(test_fixed_shape),
       cmocka_unit_test(test_fixed_padded),
       cmocka_unit_test(test_pva_line_path),
+      cmocka_unit_test(test_sci_padded),
+      cmocka_unit_test(test_imu_line_path),
       cmocka_unit_test(test_shared_files),
       cmocka_unit_test(test_leading_zero_fractions),
       cmocka_unit_test(test_malformed_reported),
