@@ -9,11 +9,14 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "nav_test.h"
 #include "navcore/nav_errors.h"
 #include "navcore/nav_ins.h"
+#include "navcore/nav_rng.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_truth.h"
 
@@ -231,6 +234,63 @@ static void test_stats(void **state) {
   nav_stat_acc_destroy(acc);
 }
 
+/* The p95 of nav_stat_acc_result (a radix selection) against the order statistics of a sort, bit
+ * for bit, on many random sets: spread and clustered values (one binade, one value repeated),
+ * negatives, zeros of both signs, sizes from 1 to 200 000. */
+static int cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+static void test_stats_p95_exact(void **state) {
+  (void)state;
+  nav_rng r;
+  nav_rng_init(&r, 20261127u, 95u, 0u);
+  static const size_t sizes[] = {1, 2, 3, 20, 21, 49, 50, 100, 1001, 4097, 65536, 200000};
+  double *v = malloc(200000 * sizeof *v), *sorted = malloc(200000 * sizeof *sorted);
+  assert_non_null(v);
+  assert_non_null(sorted);
+  int cases = 0;
+  for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; ++si)
+    for (int kind = 0; kind < 7; ++kind) {
+      const size_t n = sizes[si];
+      nav_stat_acc *acc = NULL;
+      assert_int_equal(nav_stat_acc_create(n, &acc), NAV_OK);
+      for (size_t i = 0; i < n; ++i) {
+        const double u = nav_rng_uniform(&r);
+        double x;
+        switch (kind) {
+        case 0: x = u * 10.0; break;                                   /* spread */
+        case 1: x = 0.015 + 0.001 * u; break;                          /* one binade, 16 buckets of it */
+        case 2: x = 0.25; break;                                       /* all equal */
+        case 3: x = (u < 0.5 ? -1.0 : 1.0) * exp(40.0 * (nav_rng_uniform(&r) - 0.5)); break; /* signs, scales */
+        case 4: x = u < 0.3 ? 0.0 : (u < 0.6 ? -0.0 : u - 0.8); break; /* zeros of both signs */
+        case 5: x = (double)(nav_rng_next_u64(&r) % 7u) * 1e-3; break; /* few distinct values */
+        default: x = 1.0 + ldexp(u, -45); break;                       /* differ in the last bits only */
+        }
+        v[i] = x;
+        assert_int_equal(nav_stat_acc_add(acc, x), NAV_OK);
+      }
+      memcpy(sorted, v, n * sizeof *v);
+      qsort(sorted, n, sizeof *sorted, cmp_double);
+      const double h = (double)(n - 1) * 0.95;
+      const size_t lo = (size_t)floor(h);
+      const double x_lo = sorted[lo], x_hi = lo + 1 < n ? sorted[lo + 1] : sorted[lo];
+      const double want = x_lo + (h - (double)lo) * (x_hi - x_lo);
+      const nav_stat s = nav_stat_acc_result(acc);
+      if (memcmp(&s.p95, &want, sizeof want) != 0)
+        fail_msg("n %zu kind %d: p95 %.17g (%a), from the sort %.17g (%a)", n, kind, s.p95, s.p95, want, want);
+      /* A second call gives the same (the values are left as they were). */
+      const nav_stat s2 = nav_stat_acc_result(acc);
+      assert_memory_equal(&s.p95, &s2.p95, sizeof s.p95);
+      nav_stat_acc_destroy(acc);
+      ++cases;
+    }
+  free(v);
+  free(sorted);
+  assert_int_equal(cases, 12 * 7);
+}
+
 /* nav_sim end to end on the default scene: summary consistent with the direct closure. */
 typedef struct rec_count {
   int n;
@@ -293,6 +353,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_gauss_legendre),
       cmocka_unit_test(test_stats),
+      cmocka_unit_test(test_stats_p95_exact),
       cmocka_unit_test(test_parametric_derivatives),
       cmocka_unit_test(test_rate_integral),
       cmocka_unit_test(test_t32_quadrature_convergence),
