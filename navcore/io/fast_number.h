@@ -31,6 +31,17 @@
 #define NAV_FAST_INLINE static inline
 #endif
 
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+/* -v when @p neg, else v (IEEE negation: the sign bit flipped), without a branch on the data. */
+NAV_FAST_INLINE double nav_fast_negate_if(double v, bool neg) {
+  uint64_t b;
+  memcpy(&b, &v, sizeof b);
+  b ^= (uint64_t)neg << 63;
+  memcpy(&v, &b, sizeof v);
+  return v;
+}
+#endif
+
 /* 10^0 .. 10^22: all exactly representable as doubles (5^22 < 2^53). */
 static const double nav_fast_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                           1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
@@ -54,7 +65,8 @@ static inline unsigned nav_fast_digit_run(uint64_t w) {
    * reaches bytes above the first non-digit, so the bytes up to it are judged right. */
   const uint64_t z = ((w & 0xF0F0F0F0F0F0F0F0ull) | (((w + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) >> 4)) ^
                      0x3333333333333333ull;
-  return z ? (unsigned)__builtin_ctzll(z) >> 3 : 8u;
+  /* Without a branch on the data: the top bit set aside, z = 0 gives 63 + 1 = 64, i.e. 8. */
+  return (unsigned)(__builtin_ctzll(z | 0x8000000000000000ull) + (z == 0)) >> 3;
 }
 
 /* The value of the first n (1..8) ASCII digits of the word: they are moved to the top bytes (the
@@ -124,9 +136,9 @@ NAV_FAST_INLINE bool nav_fast_sci12_words(const char *p, bool neg, double *out) 
   w4 = (w4 * 10u) + (w4 >> 8);
   w4 = ((w4 & 0x000000FFu) * 100u) + ((w4 >> 16) & 0x000000FFu);
   const uint64_t m = ((a & 0xFFu) - '0') * 1000000000000ull + (w & 0xFFFFFFFFu) * 10000u + w4;
-  double v = (double)m; /* exact: m < 10^13 < 2^53 */
-  if (m != 0) v = q < 0 ? v / nav_fast_pow10[-q] : v * nav_fast_pow10[q];
-  *out = neg ? -v : v;
+  /* m < 10^13 < 2^53 is exact; 0 gives +0 either way, as the general scan's 0 */
+  const double v = q < 0 ? (double)m / nav_fast_pow10[-q] : (double)m * nav_fast_pow10[q];
+  *out = nav_fast_negate_if(v, neg);
   return true;
 }
 #endif
@@ -319,7 +331,7 @@ static inline const char *nav_fast_number_scan(const char *s, const char *end, d
  */
 NAV_FAST_INLINE const char *nav_fast_fixed_scan_padded(const char *p, double *out) {
   const bool neg = *p == '-';
-  if (*p == '-' || *p == '+') ++p;
+  p += neg | (*p == '+'); /* (no branch on the sign: it changes from field to field) */
   uint64_t wi;
   memcpy(&wi, p, 8);
   const unsigned li = nav_fast_digit_run(wi);
@@ -328,7 +340,7 @@ NAV_FAST_INLINE const char *nav_fast_fixed_scan_padded(const char *p, double *ou
   const char *f = p + li;
   if (*f != '.') {
     if (*f == 'e' || *f == 'E') return NULL;
-    *out = neg ? -(double)vi : (double)vi; /* exact: vi < 10^7 */
+    *out = nav_fast_negate_if((double)vi, neg); /* exact: vi < 10^7 */
     return f;
   }
   ++f;
@@ -352,9 +364,8 @@ NAV_FAST_INLINE const char *nav_fast_fixed_scan_padded(const char *p, double *ou
   if (m > ((uint64_t)1 << 53)) return NULL;
   const char *q = f + nf;
   if (*q == 'e' || *q == 'E') return NULL;
-  double v = (double)m; /* exact */
-  if (m != 0) v = v / nav_fast_pow10[nf];
-  *out = neg ? -v : v;
+  /* m exact as a double; 0 / 10^nf is +0 as the general scan's 0 (no branch on the data) */
+  *out = nav_fast_negate_if((double)m / nav_fast_pow10[nf], neg);
   return q;
 }
 #endif
@@ -369,7 +380,7 @@ NAV_FAST_INLINE const char *nav_fast_fixed_scan_padded(const char *p, double *ou
  */
 NAV_FAST_INLINE const char *nav_fast_sci12_scan_padded(const char *p, double *out) {
   const bool neg = *p == '-';
-  if (*p == '-' || *p == '+') ++p;
+  p += neg | (*p == '+');
   if (p[1] != '.' || (unsigned)(p[18] - '0') < 10u || !nav_fast_sci12_words(p, neg, out)) return NULL;
   return p + 18;
 }
