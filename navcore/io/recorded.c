@@ -448,18 +448,21 @@ static inline __attribute__((always_inline)) bool split_fixed(char *line, size_t
                                                              fields *fl) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   const char *p = line, *const end = line + n;
-  for (int k = 0;; ++k) {
+  /* (Unrolled: the field count is a constant of each caller, and the loop's exit is then no
+   * branch to predict.) */
+#pragma GCC unroll 16
+  for (int k = 0; k < want; ++k) {
     const char *q = sci && k > 0 ? nav_fast_sci12_scan_padded(p, &fl->v[k]) : NULL;
     if (!q) q = nav_fast_fixed_scan_padded(p, &fl->v[k]);
     if (!q) return false;
     if (k + 1 == want) {
       if (q != end) return false;
-      break;
+    } else {
+      if (!is_blank(*q)) return false; /* (the terminating NUL is not a blank) */
+      do
+        ++q;
+      while (is_blank(*q));
     }
-    if (!is_blank(*q)) return false; /* (the terminating NUL is not a blank) */
-    do
-      ++q;
-    while (is_blank(*q));
     p = q;
   }
   fl->count = want;
