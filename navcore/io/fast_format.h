@@ -136,7 +136,7 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
     nav_fmt_u128 q = p >> sh;
     const nav_fmt_u128 rem = p - (q << sh);
     const nav_fmt_u128 half = (nav_fmt_u128)1 << (sh - 1);
-    if (rem > half || (rem == half && (q & 1u))) ++q;
+    q += (unsigned)((rem > half) | ((rem == half) & (unsigned)(q & 1u))); /* (no branch: the bits are random) */
     return q >> 63 ? UINT64_MAX : (uint64_t)q;
   }
   const nav_fmt_u128 p = (nav_fmt_u128)m * nav_fmt_pow5[k];
@@ -149,7 +149,8 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
   nav_fmt_u128 q = p >> sh;
   const nav_fmt_u128 rem = p - (q << sh);
   const nav_fmt_u128 half = (nav_fmt_u128)1 << (sh - 1);
-  if (rem > half || (rem == half && (q & 1u))) ++q;
+  /* Round half to even, without a branch on the discarded bits (they are random). */
+  q += (unsigned)((rem > half) | ((rem == half) & (unsigned)(q & 1u)));
   return q >> 63 ? UINT64_MAX : (uint64_t)q;
 }
 
@@ -216,7 +217,8 @@ static inline int nav_fmt_g17(char *buf, double x) {
   char t[64];
   memset(t, 0, NAV_FMT_G17_SIZE);
   char *p = t;
-  if (neg) *p++ = '-';
+  *p = '-';
+  p += neg; /* (the sign without a branch: it changes from value to value) */
   if (x10 < -4 || x10 >= 17) {
     p[0] = dig[0];
     p[1] = '.';
