@@ -82,8 +82,10 @@ typedef struct seg_model {
     double in[12];
     nav_mat3 C;
     nav_vec3 w, v, a;
+    uint64_t id; /* nav_kin_nodes.rest_id of this content */
   } rest[NAV_KIN_SC_WAYS]; /* several: a value at rest may alternate between neighbouring doubles */
   int rest_next;
+  uint64_t rest_ids; /* ids handed out so far */
 } seg_model;
 
 typedef struct planner {
@@ -885,6 +887,7 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
           io->a_ned_mps2[i] = m->rest[e].a;
           io->same_kin[i] = i > 0;
         }
+        io->rest_id = m->rest[e].id;
         io->has_pos = false;
         return NAV_OK;
       }
@@ -987,6 +990,9 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
     m->rest[e].v = io->v_ned_mps[0];
     m->rest[e].a = io->a_ned_mps2[0];
     m->rest[e].ok = true;
+    /* Every node has node 0's outputs here (all channels at rest: equal inputs at every node). */
+    m->rest[e].id = ++m->rest_ids;
+    io->rest_id = m->rest[e].id;
   }
   io->has_pos = false;
   return NAV_OK;

@@ -19,6 +19,8 @@ typedef double traj_v4d __attribute__((vector_size(32)));
 /* Positions of the ideal IMU's position chain are re-anchored to the model's own (exact)
  * position every CHAIN_BLOCK samples; see chain_positions. */
 #define CHAIN_BLOCK 64
+/* Entries of the cache of increments at rest (nav_traj.rep). */
+#define REP_WAYS 8
 
 struct nav_traj {
   nav_traj_model m;
@@ -48,6 +50,18 @@ struct nav_traj {
   bool chain_ok;
   int64_t chain_j;
   nav_vec3 chain_r;
+  /* Increments of the last intervals whose nodes were a rest entry of the node evaluator
+   * (nav_kin_nodes.rest_id; 0: none), with what else they depend on: the rule (q_gen: set_rule's
+   * count of rule changes), the half length of the interval and the chain position at its start.
+   * An interval with the same of all these has the same node positions, forces and sums. Several
+   * entries: the half length (k dt - (k - 1) dt) / 2 takes about 17 neighbouring values. */
+  uint64_t q_gen;
+  struct {
+    uint64_t id, gen;
+    double half;
+    nav_vec3 r0, dv, dth;
+  } rep[REP_WAYS];
+  int rep_next;
 };
 
 /* ------------------------------------------------------------------ frames */
@@ -411,6 +425,7 @@ static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
   if (tr->q_n == n && nav_kin_same_bits_n(tr->q_x, x, (size_t)n) && nav_kin_same_bits_n(tr->q_w, w, (size_t)n))
     return;
   tr->q_n = n;
+  tr->q_gen++;
   memcpy(tr->q_x, x, (size_t)n * sizeof *x);
   memcpy(tr->q_w, w, (size_t)n * sizeof *w);
   tr->chain_ok = false;
@@ -497,6 +512,7 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
       tmp.n = io->n;
       tmp.x = io->x;
       tmp.need_pos = false;
+      tmp.rest_id = 0;
       for (; st == NAV_OK && i < j; ++i) {
         tmp.k = i + 1;
         tmp.t0_s = (double)i * tr->dt_s;
@@ -524,11 +540,8 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
   return st;
 }
 
-/* chain_advance, then the positions at the nodes. */
-NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
-  nav_vec3 r0;
-  const nav_status st = chain_advance(tr, io, half, &r0);
-  if (st != NAV_OK) return st;
+/* The positions at the nodes from the chain's r0 = R(k - 1) (chain_advance). */
+NAV_CLONE_INLINE void chain_positions(const nav_traj *tr, nav_kin_nodes *io, double half, nav_vec3 r0) {
 #if defined(__GNUC__)
   /* Four nodes at a time (lanes = nodes): each lane sums over j in the scalar loop's order. */
   for (int i0 = 0; i0 < io->n; i0 += 4) {
@@ -552,7 +565,6 @@ NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, dou
   }
 #endif
   io->has_pos = true;
-  return NAV_OK;
 }
 
 /*
@@ -710,22 +722,33 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   nd.need_pos = !flat;
   nd.has_pos = false;
   memset(nd.same_kin, 0, sizeof nd.same_kin);
+  nd.rest_id = 0;
   nav_status st = traj->nodes(traj->m.self, &nd);
   if (st != NAV_OK) return st;
+  bool chained = false; /* the chain and the rule (x, w) were set up: r0 = R(k - 1) */
+  nav_vec3 r0 = nav_vec3_zero();
   if (!nd.has_pos && (!flat || (r_end && k >= 1))) {
     set_rule(traj, n, x, w);
-    if (flat) {
-      /* Only R(k) is wanted: flat-Earth forces do not depend on the position. */
-      nav_vec3 r0;
-      st = chain_advance(traj, &nd, half, &r0);
-    } else {
-      st = chain_positions(traj, &nd, half);
-    }
+    st = chain_advance(traj, &nd, half, &r0);
     if (st != NAV_OK) return st;
+    chained = true;
     if (r_end && k >= 1) {
       *r_end = traj->chain_r;
       *has_r_end = true;
     }
+    /* The nodes of the last rest interval again (a vehicle standing still), on the same rule, the
+     * same interval length and from the same position: the same increment (every later step below
+     * is a function of these inputs). */
+    if (nd.rest_id != 0)
+      for (int e = 0; e < REP_WAYS; ++e)
+        if (nav_kin_same_bits_n(&r0, &traj->rep[e].r0, 3) && nav_kin_same_bits(half, traj->rep[e].half) &&
+            nd.rest_id == traj->rep[e].id && traj->rep[e].gen == traj->q_gen) {
+          *dv_b_mps = traj->rep[e].dv;
+          *dtheta_b_rad = traj->rep[e].dth;
+          return NAV_OK;
+        }
+    /* Flat-Earth forces do not depend on the position: there only R(k) was wanted. */
+    if (!flat) chain_positions(traj, &nd, half, r0);
   }
   /* Latitudes of the nodes differ by micro-radians: sin/cos of the first, the others by angle
    * addition (nav_kin_sincos_near); likewise 1/sqrt(D), D = 1 - e^2 sin^2 lat: directly at the
@@ -789,6 +812,16 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
     const double wgt = w[i] * half;
     dv = nav_vec3_axpy(dv, wgt, f_b[i]);
     dth = nav_vec3_axpy(dth, wgt, w_b[i]);
+  }
+  if (chained && nd.rest_id != 0) {
+    const int e = traj->rep_next;
+    traj->rep_next = (e + 1) % REP_WAYS;
+    traj->rep[e].id = nd.rest_id;
+    traj->rep[e].gen = traj->q_gen;
+    traj->rep[e].half = half;
+    traj->rep[e].r0 = r0;
+    traj->rep[e].dv = dv;
+    traj->rep[e].dth = dth;
   }
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;

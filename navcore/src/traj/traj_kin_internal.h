@@ -355,6 +355,10 @@ typedef struct nav_kin_nodes {
   /* same_kin[i] (i >= 1): v, a, w and C of node i are those of node i - 1, bit for bit (the caller
    * clears these flags; an evaluator may set them so that work on equal inputs is skipped). */
   bool same_kin[NAV_KIN_MAX_NODES];
+  /* Nonzero (the caller sets 0): every node's v, a, w and C are the evaluator's cached outputs of an
+   * interval with every channel at rest, whose content this id names (ids are never reused within a
+   * model, so the same id means the same bits). */
+  uint64_t rest_id;
 } nav_kin_nodes;
 
 /** Node evaluators of the models (self as created by the matching nav_traj_*_create). */
