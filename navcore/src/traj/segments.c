@@ -807,8 +807,10 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   memcpy(in, x, sizeof x);
   memcpy(in + CH_CYAW, r, sizeof r);
   memcpy(in + 2 * CH_CYAW, r1, sizeof r1);
+  /* The yaw and the speed first: while turning or accelerating they change every call. */
   for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
-    if (m->st[e].ok && nav_kin_same_bits_n(in, m->st[e].in, 3 * CH_CYAW)) {
+    if (m->st[e].ok && nav_kin_same_bits(in[CH_YAW], m->st[e].in[CH_YAW]) &&
+        nav_kin_same_bits(in[CH_U], m->st[e].in[CH_U]) && nav_kin_same_bits_n(in, m->st[e].in, 3 * CH_CYAW)) {
       *out = m->st[e].out;
       return NAV_OK;
     }
