@@ -802,7 +802,7 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   if (m->ch[CH_CYAW].n > 0) return seg_kin(m, t_s, out, false);
   double x[CH_CYAW], r[CH_CYAW], r1[CH_CYAW];
   for (int c = 0; c < CH_CYAW; ++c)
-    nav_kin_channel_eval_rate(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
+    nav_kin_channel_eval_rate_inline(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
   double in[3 * CH_CYAW];
   memcpy(in, x, sizeof x);
   memcpy(in + CH_CYAW, r, sizeof r);
@@ -865,8 +865,8 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   bool at_rest = m->ch[CH_CYAW].n == 0;
   bool rest[6];
   for (int c = 0; c < 3; ++c) {
-    rest[c] = nav_kin_channel_eval_rate_n0(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
-    rest[3 + c] = nav_kin_channel_eval_rate_n0(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+    rest[c] = nav_kin_channel_eval_rate_n0_inline(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
+    rest[3 + c] = nav_kin_channel_eval_rate_n0_inline(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
     at_rest &= rest[c] & rest[3 + c];
   }
   /* Every channel at rest over the interval (each node has the first node's channel values): when
