@@ -424,7 +424,8 @@ static nav_status increment_by_nodes(nav_traj *traj, double t0_s, double t1_s, i
 
 /* Make (x, w) the rule of the position chain: the integration matrix, and a new chain. */
 static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
-  if (tr->q_n == n && nav_kin_same_bits_n(tr->q_x, x, (size_t)n) && nav_kin_same_bits_n(tr->q_w, w, (size_t)n))
+  /* memcmp: the same answer as comparing the bits of each double (called for every increment). */
+  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 && memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
     return;
   tr->q_n = n;
   tr->q_gen++;
@@ -621,15 +622,17 @@ NAV_CLONE_INLINE void ned_inertial(const nav_frame *fr, double inv_m_lat, double
 
 NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
                                          const nav_kin_nodes *nd, int n, const double *sl_, const double *cl_,
-                                         const double *isq_, double fb[3][NODE_PAD], double wb[3][NODE_PAD]) {
+                                         const double *isq_, bool same, double fb[3][NODE_PAD],
+                                         double wb[3][NODE_PAD]) {
   for (int i0 = 0; i0 < n; i0 += 4) {
     int ix[4];
     for (int l = 0; l < 4; ++l)
       ix[l] = i0 + l < n ? i0 + l : 0;
+    /* The kinematics of the four nodes, or node 0's in every lane when every node has its bits
+     * (same: a vehicle at rest or on a straight at constant speed). */
 #define TRAJ_LANES(expr_of_j)                                                                                  \
-  (traj_v4d) {                                                                                                 \
-    expr_of_j(ix[0]), expr_of_j(ix[1]), expr_of_j(ix[2]), expr_of_j(ix[3])                                     \
-  }
+  (same ? (traj_v4d){expr_of_j(0), expr_of_j(0), expr_of_j(0), expr_of_j(0)}                                  \
+        : (traj_v4d){expr_of_j(ix[0]), expr_of_j(ix[1]), expr_of_j(ix[2]), expr_of_j(ix[3])})
 #define RZ(j) nd->r_ned_m[j].z
 #define VX(j) nd->v_ned_mps[j].x
 #define VY(j) nd->v_ned_mps[j].y
@@ -637,7 +640,8 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
 #define AX(j) nd->a_ned_mps2[j].x
 #define AY(j) nd->a_ned_mps2[j].y
 #define AZ(j) nd->a_ned_mps2[j].z
-    const traj_v4d rz = TRAJ_LANES(RZ), vx = TRAJ_LANES(VX), vy = TRAJ_LANES(VY), vz = TRAJ_LANES(VZ);
+    const traj_v4d rz = {RZ(ix[0]), RZ(ix[1]), RZ(ix[2]), RZ(ix[3])};
+    const traj_v4d vx = TRAJ_LANES(VX), vy = TRAJ_LANES(VY), vz = TRAJ_LANES(VZ);
     const traj_v4d ax = TRAJ_LANES(AX), ay = TRAJ_LANES(AY), az = TRAJ_LANES(AZ);
 #undef RZ
 #undef VX
@@ -722,7 +726,9 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
 #else
 NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
                                          const nav_kin_nodes *nd, int n, const double *sl, const double *cl,
-                                         const double *isq, double fb[3][NODE_PAD], double wb[3][NODE_PAD]) {
+                                         const double *isq, bool same, double fb[3][NODE_PAD],
+                                         double wb[3][NODE_PAD]) {
+  (void)same;
   for (int i = 0; i < n; ++i) {
     nav_vec3 f, w;
     ned_inertial(fr, inv_m_lat, inv_m_lon, nd->r_ned_m[i], nd->v_ned_mps[i], nd->a_ned_mps2[i], &nd->C_b_n[i],
@@ -828,8 +834,10 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
    * has its forces: they are not computed again (equal inputs, equal bits). */
   bool reuse[NAV_KIN_MAX_NODES];
   int fresh = 1;
+  bool same_kin = true; /* every node has node 0's kinematics */
   reuse[0] = false;
   for (int i = 1; i < n; ++i) {
+    same_kin &= nd.same_kin[i];
     reuse[i] = nd.same_kin[i] && (flat || (nav_kin_same_bits(nd.r_ned_m[i].x, nd.r_ned_m[i - 1].x) &&
                                            nav_kin_same_bits(nd.r_ned_m[i].y, nd.r_ned_m[i - 1].y) &&
                                            nav_kin_same_bits(nd.r_ned_m[i].z, nd.r_ned_m[i - 1].z)));
@@ -839,7 +847,7 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   double fb[3][NODE_PAD], wb[3][NODE_PAD];
   if (!flat && fresh > 1) {
     /* All nodes at once (a reused node gets the bits it would be given anyway). */
-    ned_inertial_nodes(fr, inv_m_lat, inv_m_lon, &nd, n, sl, cl, isq, fb, wb);
+    ned_inertial_nodes(fr, inv_m_lat, inv_m_lon, &nd, n, sl, cl, isq, same_kin, fb, wb);
   } else {
     for (int i = 0; i < n; ++i) {
       nav_vec3 f_b, w_b;
