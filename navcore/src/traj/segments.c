@@ -881,7 +881,8 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       rest_in[9 + c] = vbd[c][0];
     }
     for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
-      if (m->rest[e].ok && nav_kin_same_bits_n(rest_in, m->rest[e].in, 12)) {
+      if (m->rest[e].ok && nav_kin_same_bits(rest_in[0], m->rest[e].in[0]) &&
+          nav_kin_same_bits_n(rest_in, m->rest[e].in, 12)) {
         for (int i = 0; i < n; ++i) {
           io->C_b_n[i] = m->rest[e].C;
           io->w_nb_b_rps[i] = m->rest[e].w;

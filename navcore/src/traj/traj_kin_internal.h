@@ -270,6 +270,13 @@ ptrdiff_t nav_kin_find_step(const nav_kin_channel *c, double t);
  *  moves to the next one, so the binary search is rarely needed. The result is the same index. */
 NAV_CLONE_INLINE ptrdiff_t nav_kin_find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
   const ptrdiff_t n = (ptrdiff_t)c->n;
+  /* The hint itself (the loop's first candidate, tested the same way). */
+  const ptrdiff_t h = *hint;
+  if (h >= 0 && h < n) {
+    if (c->steps[h].t0_s <= t && (h + 1 >= n || t < c->steps[h + 1].t0_s)) return h;
+  } else if (h == -1 && (n == 0 || t < c->steps[0].t0_s)) {
+    return h;
+  }
   for (ptrdiff_t k = *hint; k <= *hint + 1 && k < n; ++k) {
     if (k < -1) break;
     const bool lo_ok = k < 0 ? (n == 0 || t < c->steps[0].t0_s) : c->steps[k].t0_s <= t;
