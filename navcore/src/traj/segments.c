@@ -837,11 +837,18 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
   k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
   k.r_ned_m = nav_vec3_zero();
-  const int e = m->st_next;
-  m->st_next = (e + 1) % NAV_KIN_SC_WAYS;
-  memcpy(m->st[e].in, in, sizeof in);
-  m->st[e].out = k;
-  m->st[e].ok = true;
+  /* Kept when every channel is at a constant rate of zero (at rest, on a straight at constant
+   * speed): otherwise the values move with t and do not repeat. */
+  bool level = true;
+  for (int c = 0; c < CH_CYAW; ++c)
+    level &= r[c] == 0.0 && r1[c] == 0.0;
+  if (level) {
+    const int e = m->st_next;
+    m->st_next = (e + 1) % NAV_KIN_SC_WAYS;
+    memcpy(m->st[e].in, in, sizeof in);
+    m->st[e].out = k;
+    m->st[e].ok = true;
+  }
   *out = k;
   return NAV_OK;
 }

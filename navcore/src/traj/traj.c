@@ -314,9 +314,12 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
       }
       g = local_to_geo(traj, &k);
       geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
-      traj->es_in = k;
-      traj->es_out = s;
-      traj->es_ok = true;
+      /* Kept for a vehicle at rest only: a moving one does not come back to the same inputs. */
+      if (k.v_ned_mps.x == 0.0 && k.v_ned_mps.y == 0.0 && k.v_ned_mps.z == 0.0) {
+        traj->es_in = k;
+        traj->es_out = s;
+        traj->es_ok = true;
+      }
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
       if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
