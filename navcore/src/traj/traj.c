@@ -776,6 +776,7 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   nav_status st = traj->nodes(traj->m.self, &nd);
   if (st != NAV_OK) return st;
   bool chained = false; /* the chain and the rule (x, w) were set up: r0 = R(k - 1) */
+  bool standing = false; /* and the nodes are a rest entry with zero velocity */
   nav_vec3 r0 = nav_vec3_zero();
   if (!nd.has_pos && (!flat || (r_end && k >= 1))) {
     set_rule(traj, n, x, w);
@@ -789,7 +790,9 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
     /* The nodes of the last rest interval again (a vehicle standing still), on the same rule, the
      * same interval length and from the same position: the same increment (every later step below
      * is a function of these inputs). */
-    if (nd.rest_id != 0)
+    /* Only at rest (zero velocity at the nodes) can the chain come back to the same r0. */
+    standing = nd.rest_id != 0 && nd.v_ned_mps[0].x == 0.0 && nd.v_ned_mps[0].y == 0.0 && nd.v_ned_mps[0].z == 0.0;
+    if (standing)
       for (int e = 0; e < REP_WAYS; ++e)
         if (nav_kin_same_bits_n(&r0, &traj->rep[e].r0, 3) && nav_kin_same_bits(half, traj->rep[e].half) &&
             nd.rest_id == traj->rep[e].id && traj->rep[e].gen == traj->q_gen) {
@@ -880,7 +883,7 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
     dv = nav_vec3_make(dv.x + wgt * fb[0][i], dv.y + wgt * fb[1][i], dv.z + wgt * fb[2][i]);
     dth = nav_vec3_make(dth.x + wgt * wb[0][i], dth.y + wgt * wb[1][i], dth.z + wgt * wb[2][i]);
   }
-  if (chained && nd.rest_id != 0) {
+  if (chained && standing) {
     const int e = traj->rep_next;
     traj->rep_next = (e + 1) % REP_WAYS;
     traj->rep[e].id = nd.rest_id;
