@@ -307,19 +307,21 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
       /* The north position first: it changes every call while the vehicle moves north or south. */
       if (traj->es_ok && nav_kin_same_bits(k.r_ned_m.x, traj->es_in.r_ned_m.x) &&
           nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double))) {
-        s = traj->es_out;
-        s.t_s = t_s;
-        *out = s;
+        *out = traj->es_out;
+        out->t_s = t_s;
         return NAV_OK;
       }
+      /* Nothing can fail from here: the state is built in place. */
       g = local_to_geo(traj, &k);
-      geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
+      out->t_s = t_s;
+      geo_to_ecef_state_c(&g, out, &traj->st_lat_sc, &traj->st_lon_sc);
       /* Kept for a vehicle at rest only: a moving one does not come back to the same inputs. */
       if (k.v_ned_mps.x == 0.0 && k.v_ned_mps.y == 0.0 && k.v_ned_mps.z == 0.0) {
         traj->es_in = k;
-        traj->es_out = s;
+        traj->es_out = *out;
         traj->es_ok = true;
       }
+      return NAV_OK;
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
       if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
@@ -917,10 +919,9 @@ NAV_HOT_CLONES nav_status nav_traj_sample(nav_traj *traj, int64_t k, int n, cons
   bool has_r_end = false;
   nav_status st = increment_core(traj, t0_s, t1_s, k, n, x, w, &dv, &dth, &r_end, &has_r_end);
   if (st != NAV_OK) return st;
-  nav_traj_state s;
-  st = eval_state(traj, t1_s, has_r_end ? &r_end : NULL, &s);
+  /* eval_state writes *state only on success, and nothing fails after it. */
+  st = eval_state(traj, t1_s, has_r_end ? &r_end : NULL, state);
   if (st != NAV_OK) return st;
-  *state = s;
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;
   return NAV_OK;
