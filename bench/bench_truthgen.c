@@ -107,19 +107,31 @@ static double cpu_now_s(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* One generation of the whole drive: states and increments into the caller's arrays (the
- * products must be stored, as gnss-ins-sim stores them), with the sensor models when asked.
- * Returns false with a message on failure. */
-static bool generate(const nav_scene *sc, bool sensors, nav_traj_state *ts, nav_imu_increment *ideal,
-                     nav_imu_increment *meas, int64_t n, double *cpu_s, double *wall_s, char *msg, size_t msg_size) {
+/* One generation of the whole drive: states and increments into arrays of its own (the products
+ * must be stored, as gnss-ins-sim stores them), with the sensor models when asked. Returns false
+ * with a message on failure. */
+static bool generate(const nav_scene *sc, bool sensors, int64_t n, double *cpu_s, double *wall_s, char *msg,
+                     size_t msg_size) {
   nav_truth *truth = NULL;
   nav_imu_model *im = NULL;
   nav_gnss_model *gm = NULL;
   nav_gnss_model_config gcfg;
+  nav_traj_state *ts = NULL;
+  nav_imu_increment *ideal = NULL, *meas = NULL;
   bool ok = false;
   /* Set-up (planning, position checkpoints, catalog models) is timed too: gnss-ins-sim's figure
-   * includes its own parsing of the motion file. */
+   * includes its own parsing of the motion file. So is the allocation of the output arrays and
+   * the first writes to their pages, in every repetition: gnss-ins-sim creates its arrays inside
+   * the timed call, and arrays reused from an earlier repetition would leave the page faults of
+   * 39 MB (the long drive's states and increments) out of the median. */
   const double c0 = cpu_now_s(), w0 = bench_now_s();
+  ts = malloc((size_t)(n + 1) * sizeof *ts);
+  ideal = malloc((size_t)n * sizeof *ideal);
+  meas = sensors ? malloc((size_t)n * sizeof *meas) : NULL;
+  if (!ts || !ideal || (sensors && !meas)) {
+    snprintf(msg, msg_size, "out of memory");
+    goto cleanup;
+  }
   nav_status st = nav_truth_create_msg(sc, &truth, msg, msg_size);
   if (st != NAV_OK) goto cleanup;
   if (nav_truth_sample_count(truth) != n) {
@@ -166,6 +178,9 @@ cleanup:
   nav_gnss_model_destroy(gm);
   nav_imu_model_destroy(im);
   nav_truth_destroy(truth);
+  free(meas);
+  free(ideal);
+  free(ts);
   return ok;
 }
 
@@ -223,8 +238,6 @@ static bool run_peer(const char *gis_dir, const char *out_dir, char *msg, size_t
 void bench_case_truthgen(bool full, const char *out_dir, const char *gis_dir, bench_row *rows, int *n, int cap) {
   if (*n + 3 > cap) return;
   nav_scene *sc = malloc(sizeof *sc);
-  nav_traj_state *ts = NULL;
-  nav_imu_increment *ideal = NULL, *meas = NULL;
   /* No commas: variants are bench.csv fields. */
   const char *variants[2] = {"truth + ideal IMU at every sample", "+ IMU errors + GNSS (as Sim.run)"};
   bench_row *r[2] = {&rows[*n], &rows[*n + 1]};
@@ -254,20 +267,13 @@ void bench_case_truthgen(bool full, const char *out_dir, const char *gis_dir, be
   const double dur = (double)ns * nav_truth_dt(probe);
   s_planned_s = dur;
   nav_truth_destroy(probe);
-  ts = malloc((size_t)(ns + 1) * sizeof *ts);
-  ideal = malloc((size_t)ns * sizeof *ideal);
-  meas = malloc((size_t)ns * sizeof *meas);
-  if (!ts || !ideal || !meas) {
-    for (int v = 0; v < 2; ++v) snprintf(r[v]->error, sizeof r[v]->error, "out of memory");
-    goto peer;
-  }
   const int reps = full ? 9 : 5;
   for (int v = 0; v < 2; ++v) {
     double cpu[9], wall[9];
     int k = 0;
     for (; k < reps; ++k) {
       msg[0] = '\0';
-      if (!generate(sc, v == 1, ts, ideal, meas, ns, &cpu[k], &wall[k], msg, sizeof msg)) break;
+      if (!generate(sc, v == 1, ns, &cpu[k], &wall[k], msg, sizeof msg)) break;
     }
     if (k < reps) {
       snprintf(r[v]->error, sizeof r[v]->error, "%.200s", msg);
@@ -316,9 +322,6 @@ peer:;
            1e6 * s_peer.pathgen_cpu_s / s_peer.samples, 1e6 * s_peer.run_cpu_s / s_peer.samples,
            pmsg[0] ? "; not run here: " : "", pmsg);
   snprintf(p->note, sizeof p->note, "%.159s", note);
-  free(meas);
-  free(ideal);
-  free(ts);
   free(sc);
 }
 

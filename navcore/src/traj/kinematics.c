@@ -34,24 +34,17 @@ void nav_kin_euler_rates_sc(nav_jet roll, nav_jet pitch, nav_jet yaw, double sr,
 
 /* ================================================================ septic smoothstep */
 
-/* S(u) = 35u^4 - 84u^5 + 70u^6 - 20u^7 and its derivatives; I = int_0^u S, J = int_0^u I. */
-static double ss_S(double u) {
-  return u * u * u * u * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)));
-}
-static double ss_S1(double u) {
-  const double v = u * (1.0 - u);
-  return 140.0 * v * v * v;
-}
+/* S(u) = 35u^4 - 84u^5 + 70u^6 - 20u^7 and its derivatives; I = int_0^u S, J = int_0^u I (S, S'
+ * and I in traj_kin_internal.h, inlined into the node evaluators). */
+#define ss_S nav_kin_ss_S
+#define ss_S1 nav_kin_ss_S1
+#define ss_I nav_kin_ss_I
 static double ss_S2(double u) {
   const double v = u * (1.0 - u);
   return 420.0 * v * v * (1.0 - 2.0 * u);
 }
 static double ss_S3(double u) {
   return 840.0 * u * (1.0 + u * (-6.0 + u * (10.0 - 5.0 * u)));
-}
-static double ss_I(double u) {
-  const double u2 = u * u;
-  return u2 * u2 * u * (7.0 + u * (-14.0 + u * (10.0 - 2.5 * u)));
 }
 static double ss_J(double u) {
   const double u3 = u * u * u;
@@ -126,8 +119,7 @@ nav_status nav_kin_channel_add_step(nav_kin_channel *c, double t0_s, double len_
   return NAV_OK;
 }
 
-/* Index of the last step starting at or before t, -1 if none. */
-static ptrdiff_t find_step(const nav_kin_channel *c, double t) {
+ptrdiff_t nav_kin_find_step(const nav_kin_channel *c, double t) {
   if (c->n == 0 || t < c->steps[0].t0_s) return -1;
   size_t lo = 0, hi = c->n; /* steps[lo].t0 <= t < steps[hi].t0 */
   while (hi - lo > 1) {
@@ -140,45 +132,9 @@ static ptrdiff_t find_step(const nav_kin_channel *c, double t) {
   return (ptrdiff_t)lo;
 }
 
-/* find_step through a cached index: sequential evaluation stays in the same step or moves to
- * the next one, so the binary search is rarely needed. The result is the same index. */
-NAV_CLONE_INLINE ptrdiff_t find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
-  const ptrdiff_t n = (ptrdiff_t)c->n;
-  for (ptrdiff_t k = *hint; k <= *hint + 1 && k < n; ++k) {
-    if (k < -1) break;
-    const bool lo_ok = k < 0 ? (n == 0 || t < c->steps[0].t0_s) : c->steps[k].t0_s <= t;
-    const bool hi_ok = k + 1 >= n || t < c->steps[k + 1].t0_s;
-    if (lo_ok && hi_ok) {
-      *hint = k;
-      return k;
-    }
-  }
-  *hint = find_step(c, t);
-  return *hint;
-}
-
-/* x, r and r' of channel_state in step k (the same expressions, hence the same numbers),
- * without y and the higher rate derivatives. */
-static inline void rate_state(const nav_kin_channel *c, ptrdiff_t k, double t_s, double *x, double *r,
-                              double *r1) {
-  if (k >= 0) {
-    const nav_kin_step *s = &c->steps[k];
-    const double d = t_s - s->t0_s;
-    if (d < s->len_s) {
-      const double T = s->len_s, u = d / T;
-      *x = s->x0 + s->r0 * d + s->dr * T * ss_I(u);
-      *r = s->r0 + s->dr * ss_S(u);
-      *r1 = s->dr * ss_S1(u) / T;
-      return;
-    }
-    *x = s->x0 + s->r0 * d + s->dr * (d - 0.5 * s->len_s);
-    *r = s->r0 + s->dr;
-  } else {
-    *x = c->x_init + c->r_init * t_s;
-    *r = c->r_init;
-  }
-  *r1 = 0.0;
-}
+#define find_step nav_kin_find_step
+#define find_step_hint nav_kin_find_step_hint
+#define rate_state nav_kin_rate_state
 
 void nav_kin_channel_eval_rate(const nav_kin_channel *c, double t_s, ptrdiff_t *hint, double *x, double *r,
                                double *r1) {
@@ -198,29 +154,7 @@ NAV_HOT_CLONES bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const 
 
 NAV_HOT_CLONES bool nav_kin_channel_eval_rate_n0(const nav_kin_channel *c, const double *t_s, int n,
                                                  ptrdiff_t *hint, double *x, double *r, double *r1) {
-  if (n < 1) return false;
-  /* A channel at rest over the whole span (after its ramps, at zero rate: the usual case for
-   * most channels) is evaluated once; its value is constant there, up to the rounding of
-   * x0 + r0 d + dr (d - len/2) with r0 + dr = 0. */
-  const ptrdiff_t k0 = find_step_hint(c, t_s[0], hint);
-  const double t_last = t_s[n - 1];
-  bool constant;
-  if (k0 < 0) {
-    constant = c->r_init == 0.0 && (c->n == 0 || t_last < c->steps[0].t0_s);
-  } else {
-    const nav_kin_step *s = &c->steps[k0];
-    constant = s->r0 + s->dr == 0.0 && !(t_s[0] - s->t0_s < s->len_s) &&
-               ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s);
-  }
-  rate_state(c, k0, t_s[0], &x[0], &r[0], &r1[0]);
-  if (constant) return true;
-  /* All times in the step of the first (ascending times before the next step's start): the index
-   * find_step would return for each. */
-  const bool one_step = (k0 < 0 ? (c->n == 0 || t_last < c->steps[0].t0_s)
-                                : ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s));
-  for (int i = 1; i < n; ++i)
-    rate_state(c, one_step ? k0 : find_step_hint(c, t_s[i], hint), t_s[i], &x[i], &r[i], &r1[i]);
-  return false;
+  return nav_kin_channel_eval_rate_n0_inline(c, t_s, n, hint, x, r, r1);
 }
 
 /* Full state at t: x, y and rate jets (r, r', r'', r'''). */

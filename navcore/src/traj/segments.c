@@ -82,8 +82,10 @@ typedef struct seg_model {
     double in[12];
     nav_mat3 C;
     nav_vec3 w, v, a;
+    uint64_t id; /* nav_kin_nodes.rest_id of this content */
   } rest[NAV_KIN_SC_WAYS]; /* several: a value at rest may alternate between neighbouring doubles */
   int rest_next;
+  uint64_t rest_ids; /* ids handed out so far */
 } seg_model;
 
 typedef struct planner {
@@ -800,13 +802,15 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   if (m->ch[CH_CYAW].n > 0) return seg_kin(m, t_s, out, false);
   double x[CH_CYAW], r[CH_CYAW], r1[CH_CYAW];
   for (int c = 0; c < CH_CYAW; ++c)
-    nav_kin_channel_eval_rate(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
+    nav_kin_channel_eval_rate_inline(&m->ch[c], t_s, &m->st_hint[c], &x[c], &r[c], &r1[c]);
   double in[3 * CH_CYAW];
   memcpy(in, x, sizeof x);
   memcpy(in + CH_CYAW, r, sizeof r);
   memcpy(in + 2 * CH_CYAW, r1, sizeof r1);
+  /* The yaw and the speed first: while turning or accelerating they change every call. */
   for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
-    if (m->st[e].ok && nav_kin_same_bits_n(in, m->st[e].in, 3 * CH_CYAW)) {
+    if (m->st[e].ok && nav_kin_same_bits(in[CH_YAW], m->st[e].in[CH_YAW]) &&
+        nav_kin_same_bits(in[CH_U], m->st[e].in[CH_U]) && nav_kin_same_bits_n(in, m->st[e].in, 3 * CH_CYAW)) {
       *out = m->st[e].out;
       return NAV_OK;
     }
@@ -833,11 +837,18 @@ static nav_status seg_eval_nopos(void *self, double t_s, nav_local_kin *out) {
   k.v_ned_mps = nav_mat3_mul_vec(C, vb);
   k.a_ned_mps2 = nav_mat3_mul_vec(C, nav_vec3_add(vb_dot, nav_vec3_cross(k.w_nb_b_rps, vb)));
   k.r_ned_m = nav_vec3_zero();
-  const int e = m->st_next;
-  m->st_next = (e + 1) % NAV_KIN_SC_WAYS;
-  memcpy(m->st[e].in, in, sizeof in);
-  m->st[e].out = k;
-  m->st[e].ok = true;
+  /* Kept when every channel is at a constant rate of zero (at rest, on a straight at constant
+   * speed): otherwise the values move with t and do not repeat. */
+  bool level = true;
+  for (int c = 0; c < CH_CYAW; ++c)
+    level &= r[c] == 0.0 && r1[c] == 0.0;
+  if (level) {
+    const int e = m->st_next;
+    m->st_next = (e + 1) % NAV_KIN_SC_WAYS;
+    memcpy(m->st[e].in, in, sizeof in);
+    m->st[e].out = k;
+    m->st[e].ok = true;
+  }
   *out = k;
   return NAV_OK;
 }
@@ -861,8 +872,8 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
   bool at_rest = m->ch[CH_CYAW].n == 0;
   bool rest[6];
   for (int c = 0; c < 3; ++c) {
-    rest[c] = nav_kin_channel_eval_rate_n0(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
-    rest[3 + c] = nav_kin_channel_eval_rate_n0(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
+    rest[c] = nav_kin_channel_eval_rate_n0_inline(&m->ch[c], io->t_s, n, &m->hint[c], ang[c], rate[c], r1);
+    rest[3 + c] = nav_kin_channel_eval_rate_n0_inline(&m->ch[CH_U + c], io->t_s, n, &m->hint[CH_U + c], vb[c], vbd[c], r1);
     at_rest &= rest[c] & rest[3 + c];
   }
   /* Every channel at rest over the interval (each node has the first node's channel values): when
@@ -877,7 +888,8 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
       rest_in[9 + c] = vbd[c][0];
     }
     for (int e = 0; e < NAV_KIN_SC_WAYS; ++e)
-      if (m->rest[e].ok && nav_kin_same_bits_n(rest_in, m->rest[e].in, 12)) {
+      if (m->rest[e].ok && nav_kin_same_bits(rest_in[0], m->rest[e].in[0]) &&
+          nav_kin_same_bits_n(rest_in, m->rest[e].in, 12)) {
         for (int i = 0; i < n; ++i) {
           io->C_b_n[i] = m->rest[e].C;
           io->w_nb_b_rps[i] = m->rest[e].w;
@@ -885,6 +897,7 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
           io->a_ned_mps2[i] = m->rest[e].a;
           io->same_kin[i] = i > 0;
         }
+        io->rest_id = m->rest[e].id;
         io->has_pos = false;
         return NAV_OK;
       }
@@ -987,6 +1000,9 @@ NAV_HOT_CLONES nav_status nav_traj_segments_nodes(void *self, nav_kin_nodes *io)
     m->rest[e].v = io->v_ned_mps[0];
     m->rest[e].a = io->a_ned_mps2[0];
     m->rest[e].ok = true;
+    /* Every node has node 0's outputs here (all channels at rest: equal inputs at every node). */
+    m->rest[e].id = ++m->rest_ids;
+    io->rest_id = m->rest[e].id;
   }
   io->has_pos = false;
   return NAV_OK;

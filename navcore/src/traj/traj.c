@@ -19,6 +19,8 @@ typedef double traj_v4d __attribute__((vector_size(32)));
 /* Positions of the ideal IMU's position chain are re-anchored to the model's own (exact)
  * position every CHAIN_BLOCK samples; see chain_positions. */
 #define CHAIN_BLOCK 64
+/* Entries of the cache of increments at rest (nav_traj.rep). */
+#define REP_WAYS 8
 
 struct nav_traj {
   nav_traj_model m;
@@ -48,6 +50,18 @@ struct nav_traj {
   bool chain_ok;
   int64_t chain_j;
   nav_vec3 chain_r;
+  /* Increments of the last intervals whose nodes were a rest entry of the node evaluator
+   * (nav_kin_nodes.rest_id; 0: none), with what else they depend on: the rule (q_gen: set_rule's
+   * count of rule changes), the half length of the interval and the chain position at its start.
+   * An interval with the same of all these has the same node positions, forces and sums. Several
+   * entries: the half length (k dt - (k - 1) dt) / 2 takes about 17 neighbouring values. */
+  uint64_t q_gen;
+  struct {
+    uint64_t id, gen;
+    double half;
+    nav_vec3 r0, dv, dth;
+  } rep[REP_WAYS];
+  int rep_next;
 };
 
 /* ------------------------------------------------------------------ frames */
@@ -290,17 +304,24 @@ static nav_status eval_state(nav_traj *traj, double t_s, const nav_vec3 *r_ned, 
       nav_local_kin k;
       st = local_kin(traj, t_s, r_ned, &k);
       if (st != NAV_OK) return st;
-      if (traj->es_ok && nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double))) {
-        s = traj->es_out;
-        s.t_s = t_s;
-        *out = s;
+      /* The north position first: it changes every call while the vehicle moves north or south. */
+      if (traj->es_ok && nav_kin_same_bits(k.r_ned_m.x, traj->es_in.r_ned_m.x) &&
+          nav_kin_same_bits_n(&k, &traj->es_in, sizeof k / sizeof(double))) {
+        *out = traj->es_out;
+        out->t_s = t_s;
         return NAV_OK;
       }
+      /* Nothing can fail from here: the state is built in place. */
       g = local_to_geo(traj, &k);
-      geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
-      traj->es_in = k;
-      traj->es_out = s;
-      traj->es_ok = true;
+      out->t_s = t_s;
+      geo_to_ecef_state_c(&g, out, &traj->st_lat_sc, &traj->st_lon_sc);
+      /* Kept for a vehicle at rest only: a moving one does not come back to the same inputs. */
+      if (k.v_ned_mps.x == 0.0 && k.v_ned_mps.y == 0.0 && k.v_ned_mps.z == 0.0) {
+        traj->es_in = k;
+        traj->es_out = *out;
+        traj->es_ok = true;
+      }
+      return NAV_OK;
     } else {
       st = traj->m.eval_geodetic(traj->m.self, t_s, &g);
       if (st == NAV_OK) geo_to_ecef_state_c(&g, &s, &traj->st_lat_sc, &traj->st_lon_sc);
@@ -408,9 +429,11 @@ static nav_status increment_by_nodes(nav_traj *traj, double t0_s, double t1_s, i
 
 /* Make (x, w) the rule of the position chain: the integration matrix, and a new chain. */
 static void set_rule(nav_traj *tr, int n, const double *x, const double *w) {
-  if (tr->q_n == n && nav_kin_same_bits_n(tr->q_x, x, (size_t)n) && nav_kin_same_bits_n(tr->q_w, w, (size_t)n))
+  /* memcmp: the same answer as comparing the bits of each double (called for every increment). */
+  if (tr->q_n == n && memcmp(tr->q_x, x, (size_t)n * sizeof *x) == 0 && memcmp(tr->q_w, w, (size_t)n * sizeof *w) == 0)
     return;
   tr->q_n = n;
+  tr->q_gen++;
   memcpy(tr->q_x, x, (size_t)n * sizeof *x);
   memcpy(tr->q_w, w, (size_t)n * sizeof *w);
   tr->chain_ok = false;
@@ -497,6 +520,7 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
       tmp.n = io->n;
       tmp.x = io->x;
       tmp.need_pos = false;
+      tmp.rest_id = 0;
       for (; st == NAV_OK && i < j; ++i) {
         tmp.k = i + 1;
         tmp.t0_s = (double)i * tr->dt_s;
@@ -524,11 +548,8 @@ NAV_CLONE_INLINE nav_status chain_advance(nav_traj *tr, const nav_kin_nodes *io,
   return st;
 }
 
-/* chain_advance, then the positions at the nodes. */
-NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, double half) {
-  nav_vec3 r0;
-  const nav_status st = chain_advance(tr, io, half, &r0);
-  if (st != NAV_OK) return st;
+/* The positions at the nodes from the chain's r0 = R(k - 1) (chain_advance). */
+NAV_CLONE_INLINE void chain_positions(const nav_traj *tr, nav_kin_nodes *io, double half, nav_vec3 r0) {
 #if defined(__GNUC__)
   /* Four nodes at a time (lanes = nodes): each lane sums over j in the scalar loop's order. */
   for (int i0 = 0; i0 < io->n; i0 += 4) {
@@ -552,7 +573,6 @@ NAV_CLONE_INLINE nav_status chain_positions(nav_traj *tr, nav_kin_nodes *io, dou
   }
 #endif
   io->has_pos = true;
-  return NAV_OK;
 }
 
 /*
@@ -592,26 +612,32 @@ NAV_CLONE_INLINE void ned_inertial(const nav_frame *fr, double inv_m_lat, double
   *w_ib_b = nav_vec3_add(w_nb_b, nav_mat3_tmul_vec(*C_b_n, nav_vec3_add(w_ie_n, w_en_n)));
 }
 
+/* Node arrays with room for the lanes of a last group of four beyond NAV_KIN_MAX_NODES. */
+#define NODE_PAD (NAV_KIN_MAX_NODES + 3)
+
 /*
  * ned_inertial at the n nodes of nd (sines, cosines and 1/sqrt(D) of their latitudes in sl, cl,
- * isq), into f_b[i] and w_b[i]. With GCC's vector extensions four nodes at a time: each lane
- * performs the operations of ned_inertial, in its order (the same expressions, written for
- * vectors; IEEE arithmetic lane by lane, no contraction), so every node gets the bits of the
- * scalar function. Lanes beyond n repeat node 0 and are dropped.
+ * isq, each padded to a multiple of four entries with node 0's values), into fb[c][i] and wb[c][i]
+ * (component c of f_b and w_b at node i). With GCC's vector extensions four nodes at a time: each
+ * lane performs the operations of ned_inertial, in its order (the same expressions, written for
+ * vectors, C_n_b f_n as nav_mat3_tmul_vec forms it; IEEE arithmetic lane by lane, no
+ * contraction), so every node gets the bits of the scalar function. Lanes beyond n repeat node 0.
  */
 #if defined(__GNUC__)
 
 NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
                                          const nav_kin_nodes *nd, int n, const double *sl_, const double *cl_,
-                                         const double *isq_, nav_vec3 *f_b, nav_vec3 *w_b) {
+                                         const double *isq_, bool same, double fb[3][NODE_PAD],
+                                         double wb[3][NODE_PAD]) {
   for (int i0 = 0; i0 < n; i0 += 4) {
     int ix[4];
     for (int l = 0; l < 4; ++l)
       ix[l] = i0 + l < n ? i0 + l : 0;
+    /* The kinematics of the four nodes, or node 0's in every lane when every node has its bits
+     * (same: a vehicle at rest or on a straight at constant speed). */
 #define TRAJ_LANES(expr_of_j)                                                                                  \
-  (traj_v4d) {                                                                                                 \
-    expr_of_j(ix[0]), expr_of_j(ix[1]), expr_of_j(ix[2]), expr_of_j(ix[3])                                     \
-  }
+  (same ? (traj_v4d){expr_of_j(0), expr_of_j(0), expr_of_j(0), expr_of_j(0)}                                  \
+        : (traj_v4d){expr_of_j(ix[0]), expr_of_j(ix[1]), expr_of_j(ix[2]), expr_of_j(ix[3])})
 #define RZ(j) nd->r_ned_m[j].z
 #define VX(j) nd->v_ned_mps[j].x
 #define VY(j) nd->v_ned_mps[j].y
@@ -619,12 +645,9 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
 #define AX(j) nd->a_ned_mps2[j].x
 #define AY(j) nd->a_ned_mps2[j].y
 #define AZ(j) nd->a_ned_mps2[j].z
-#define SL(j) sl_[j]
-#define CL(j) cl_[j]
-#define ISQ(j) isq_[j]
-    const traj_v4d rz = TRAJ_LANES(RZ), vx = TRAJ_LANES(VX), vy = TRAJ_LANES(VY), vz = TRAJ_LANES(VZ);
+    const traj_v4d rz = {RZ(ix[0]), RZ(ix[1]), RZ(ix[2]), RZ(ix[3])};
+    const traj_v4d vx = TRAJ_LANES(VX), vy = TRAJ_LANES(VY), vz = TRAJ_LANES(VZ);
     const traj_v4d ax = TRAJ_LANES(AX), ay = TRAJ_LANES(AY), az = TRAJ_LANES(AZ);
-    const traj_v4d sl = TRAJ_LANES(SL), cl = TRAJ_LANES(CL), inv_sq = TRAJ_LANES(ISQ);
 #undef RZ
 #undef VX
 #undef VY
@@ -632,9 +655,10 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
 #undef AX
 #undef AY
 #undef AZ
-#undef SL
-#undef CL
-#undef ISQ
+    traj_v4d sl, cl, inv_sq;
+    memcpy(&sl, &sl_[i0], sizeof sl);
+    memcpy(&cl, &cl_[i0], sizeof cl);
+    memcpy(&inv_sq, &isq_[i0], sizeof inv_sq);
     /* ned_inertial, term for term. */
     const traj_v4d h = fr->origin.h_m - rz;
     const traj_v4d dlat = vx * inv_m_lat, dlon = vy * inv_m_lon, dh = -vz;
@@ -661,15 +685,45 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
     const traj_v4d fy = (dvy + (pz * vnx - px * vnz)) - 0.0;
     const traj_v4d fz = (dvz + (px * vny - py * vnx)) - g;
     const traj_v4d qx = wiex + wenx, qy = 0.0 + weny, qz = wiez + wenz;
-    for (int l = 0; l < 4 && i0 + l < n; ++l) {
-      const nav_mat3 *C = &nd->C_b_n[i0 + l];
-      f_b[i0 + l] = nav_vec3_make(C->m[0][0] * fx[l] + C->m[1][0] * fy[l] + C->m[2][0] * fz[l],
-                                  C->m[0][1] * fx[l] + C->m[1][1] * fy[l] + C->m[2][1] * fz[l],
-                                  C->m[0][2] * fx[l] + C->m[1][2] * fy[l] + C->m[2][2] * fz[l]);
-      const nav_vec3 wt = nav_vec3_make(C->m[0][0] * qx[l] + C->m[1][0] * qy[l] + C->m[2][0] * qz[l],
-                                        C->m[0][1] * qx[l] + C->m[1][1] * qy[l] + C->m[2][1] * qz[l],
-                                        C->m[0][2] * qx[l] + C->m[1][2] * qy[l] + C->m[2][2] * qz[l]);
-      w_b[i0 + l] = nav_vec3_add(nd->w_nb_b_rps[i0 + l], wt);
+    /* C_n_b f_n and w_nb_b + C_n_b (w_ie_n + w_en_n) (nav_mat3_tmul_vec, nav_vec3_add). */
+#define CM(r, c) TRAJ_LANES(CM_##r##c)
+#define CM_00(j) nd->C_b_n[j].m[0][0]
+#define CM_01(j) nd->C_b_n[j].m[0][1]
+#define CM_02(j) nd->C_b_n[j].m[0][2]
+#define CM_10(j) nd->C_b_n[j].m[1][0]
+#define CM_11(j) nd->C_b_n[j].m[1][1]
+#define CM_12(j) nd->C_b_n[j].m[1][2]
+#define CM_20(j) nd->C_b_n[j].m[2][0]
+#define CM_21(j) nd->C_b_n[j].m[2][1]
+#define CM_22(j) nd->C_b_n[j].m[2][2]
+#define WX(j) nd->w_nb_b_rps[j].x
+#define WY(j) nd->w_nb_b_rps[j].y
+#define WZ(j) nd->w_nb_b_rps[j].z
+    const traj_v4d c00 = CM(0, 0), c01 = CM(0, 1), c02 = CM(0, 2), c10 = CM(1, 0), c11 = CM(1, 1);
+    const traj_v4d c12 = CM(1, 2), c20 = CM(2, 0), c21 = CM(2, 1), c22 = CM(2, 2);
+    const traj_v4d wnx = TRAJ_LANES(WX), wny = TRAJ_LANES(WY), wnz = TRAJ_LANES(WZ);
+#undef CM
+#undef CM_00
+#undef CM_01
+#undef CM_02
+#undef CM_10
+#undef CM_11
+#undef CM_12
+#undef CM_20
+#undef CM_21
+#undef CM_22
+#undef WX
+#undef WY
+#undef WZ
+    const traj_v4d out[6] = {c00 * fx + c10 * fy + c20 * fz,
+                             c01 * fx + c11 * fy + c21 * fz,
+                             c02 * fx + c12 * fy + c22 * fz,
+                             wnx + (c00 * qx + c10 * qy + c20 * qz),
+                             wny + (c01 * qx + c11 * qy + c21 * qz),
+                             wnz + (c02 * qx + c12 * qy + c22 * qz)};
+    for (int c = 0; c < 3; ++c) {
+      memcpy(&fb[c][i0], &out[c], sizeof out[c]);
+      memcpy(&wb[c][i0], &out[3 + c], sizeof out[c]);
     }
 #undef TRAJ_LANES
   }
@@ -677,10 +731,20 @@ NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, 
 #else
 NAV_CLONE_INLINE void ned_inertial_nodes(const nav_frame *fr, double inv_m_lat, double inv_m_lon,
                                          const nav_kin_nodes *nd, int n, const double *sl, const double *cl,
-                                         const double *isq, nav_vec3 *f_b, nav_vec3 *w_b) {
-  for (int i = 0; i < n; ++i)
+                                         const double *isq, bool same, double fb[3][NODE_PAD],
+                                         double wb[3][NODE_PAD]) {
+  (void)same;
+  for (int i = 0; i < n; ++i) {
+    nav_vec3 f, w;
     ned_inertial(fr, inv_m_lat, inv_m_lon, nd->r_ned_m[i], nd->v_ned_mps[i], nd->a_ned_mps2[i], &nd->C_b_n[i],
-                 nd->w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b[i], &w_b[i]);
+                 nd->w_nb_b_rps[i], sl[i], cl[i], isq[i], &f, &w);
+    fb[0][i] = f.x;
+    fb[1][i] = f.y;
+    fb[2][i] = f.z;
+    wb[0][i] = w.x;
+    wb[1][i] = w.y;
+    wb[2][i] = w.z;
+  }
 }
 #endif
 
@@ -710,28 +774,42 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
   nd.need_pos = !flat;
   nd.has_pos = false;
   memset(nd.same_kin, 0, sizeof nd.same_kin);
+  nd.rest_id = 0;
   nav_status st = traj->nodes(traj->m.self, &nd);
   if (st != NAV_OK) return st;
+  bool chained = false; /* the chain and the rule (x, w) were set up: r0 = R(k - 1) */
+  bool standing = false; /* and the nodes are a rest entry with zero velocity */
+  nav_vec3 r0 = nav_vec3_zero();
   if (!nd.has_pos && (!flat || (r_end && k >= 1))) {
     set_rule(traj, n, x, w);
-    if (flat) {
-      /* Only R(k) is wanted: flat-Earth forces do not depend on the position. */
-      nav_vec3 r0;
-      st = chain_advance(traj, &nd, half, &r0);
-    } else {
-      st = chain_positions(traj, &nd, half);
-    }
+    st = chain_advance(traj, &nd, half, &r0);
     if (st != NAV_OK) return st;
+    chained = true;
     if (r_end && k >= 1) {
       *r_end = traj->chain_r;
       *has_r_end = true;
     }
+    /* The nodes of the last rest interval again (a vehicle standing still), on the same rule, the
+     * same interval length and from the same position: the same increment (every later step below
+     * is a function of these inputs). */
+    /* Only at rest (zero velocity at the nodes) can the chain come back to the same r0. */
+    standing = nd.rest_id != 0 && nd.v_ned_mps[0].x == 0.0 && nd.v_ned_mps[0].y == 0.0 && nd.v_ned_mps[0].z == 0.0;
+    if (standing)
+      for (int e = 0; e < REP_WAYS; ++e)
+        if (nav_kin_same_bits_n(&r0, &traj->rep[e].r0, 3) && nav_kin_same_bits(half, traj->rep[e].half) &&
+            nd.rest_id == traj->rep[e].id && traj->rep[e].gen == traj->q_gen) {
+          *dv_b_mps = traj->rep[e].dv;
+          *dtheta_b_rad = traj->rep[e].dth;
+          return NAV_OK;
+        }
+    /* Flat-Earth forces do not depend on the position: there only R(k) was wanted. */
+    if (!flat) chain_positions(traj, &nd, half, r0);
   }
   /* Latitudes of the nodes differ by micro-radians: sin/cos of the first, the others by angle
    * addition (nav_kin_sincos_near); likewise 1/sqrt(D), D = 1 - e^2 sin^2 lat: directly at the
    * first node, at the others as (1/sqrt(D0)) (1 + e)^(-1/2), e = (D - D0)/D0, by its series
    * 1 - e/2 + 3e^2/8 while |e| <= 1e-6 (omitted 5e^3/16 < 4e-19; e is ~1e-10 at vehicle speeds). */
-  double sl[NAV_KIN_MAX_NODES], cl[NAV_KIN_MAX_NODES], isq[NAV_KIN_MAX_NODES];
+  double sl[NODE_PAD], cl[NODE_PAD], isq[NODE_PAD];
   const nav_frame *fr = &traj->frame;
   const double inv_m_lat = traj->inv_m_lat, inv_m_lon = traj->inv_m_lon;
   if (!flat) {
@@ -753,42 +831,69 @@ NAV_CLONE_INLINE nav_status increment_core(nav_traj *traj, double t0_s, double t
       isq[i] = fabs(e) <= 1e-6 ? isq[0] * (1.0 - 0.5 * e + 0.375 * e * e)
                                : 1.0 / sqrt(1.0 - NAV_WGS84_E2 * sl[i] * sl[i]);
     }
+    /* The lanes of ned_inertial_nodes beyond n. */
+    for (int i = n; i % 4 != 0; ++i) {
+      sl[i] = sl[0];
+      cl[i] = cl[0];
+      isq[i] = isq[0];
+    }
   }
   /* A node with the previous node's kinematics and position (at rest; on flat Earth any position)
    * has its forces: they are not computed again (equal inputs, equal bits). */
   bool reuse[NAV_KIN_MAX_NODES];
   int fresh = 1;
+  bool same_kin = true; /* every node has node 0's kinematics */
   reuse[0] = false;
   for (int i = 1; i < n; ++i) {
+    same_kin &= nd.same_kin[i];
     reuse[i] = nd.same_kin[i] && (flat || (nav_kin_same_bits(nd.r_ned_m[i].x, nd.r_ned_m[i - 1].x) &&
                                            nav_kin_same_bits(nd.r_ned_m[i].y, nd.r_ned_m[i - 1].y) &&
                                            nav_kin_same_bits(nd.r_ned_m[i].z, nd.r_ned_m[i - 1].z)));
     fresh += !reuse[i];
   }
-  nav_vec3 f_b[NAV_KIN_MAX_NODES], w_b[NAV_KIN_MAX_NODES];
+  /* f_b and w_b of the nodes, component by component: fb[c][i], wb[c][i]. */
+  double fb[3][NODE_PAD], wb[3][NODE_PAD];
   if (!flat && fresh > 1) {
     /* All nodes at once (a reused node gets the bits it would be given anyway). */
-    ned_inertial_nodes(fr, inv_m_lat, inv_m_lon, &nd, n, sl, cl, isq, f_b, w_b);
+    ned_inertial_nodes(fr, inv_m_lat, inv_m_lon, &nd, n, sl, cl, isq, same_kin, fb, wb);
   } else {
     for (int i = 0; i < n; ++i) {
+      nav_vec3 f_b, w_b;
       if (reuse[i]) {
-        f_b[i] = f_b[i - 1];
-        w_b[i] = w_b[i - 1];
+        f_b = nav_vec3_make(fb[0][i - 1], fb[1][i - 1], fb[2][i - 1]);
+        w_b = nav_vec3_make(wb[0][i - 1], wb[1][i - 1], wb[2][i - 1]);
       } else if (flat) {
         /* Flat, non-rotating l with uniform gravity (E3.3). */
-        f_b[i] = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
-        w_b[i] = nd.w_nb_b_rps[i];
+        f_b = nav_mat3_tmul_vec(nd.C_b_n[i], nav_vec3_sub(nd.a_ned_mps2[i], traj->g_l_mps2));
+        w_b = nd.w_nb_b_rps[i];
       } else {
         ned_inertial(fr, inv_m_lat, inv_m_lon, nd.r_ned_m[i], nd.v_ned_mps[i], nd.a_ned_mps2[i], &nd.C_b_n[i],
-                     nd.w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b[i], &w_b[i]);
+                     nd.w_nb_b_rps[i], sl[i], cl[i], isq[i], &f_b, &w_b);
       }
+      fb[0][i] = f_b.x;
+      fb[1][i] = f_b.y;
+      fb[2][i] = f_b.z;
+      wb[0][i] = w_b.x;
+      wb[1][i] = w_b.y;
+      wb[2][i] = w_b.z;
     }
   }
+  /* nav_vec3_axpy over the nodes in order. */
   nav_vec3 dv = nav_vec3_zero(), dth = nav_vec3_zero();
   for (int i = 0; i < n; ++i) {
     const double wgt = w[i] * half;
-    dv = nav_vec3_axpy(dv, wgt, f_b[i]);
-    dth = nav_vec3_axpy(dth, wgt, w_b[i]);
+    dv = nav_vec3_make(dv.x + wgt * fb[0][i], dv.y + wgt * fb[1][i], dv.z + wgt * fb[2][i]);
+    dth = nav_vec3_make(dth.x + wgt * wb[0][i], dth.y + wgt * wb[1][i], dth.z + wgt * wb[2][i]);
+  }
+  if (chained && standing) {
+    const int e = traj->rep_next;
+    traj->rep_next = (e + 1) % REP_WAYS;
+    traj->rep[e].id = nd.rest_id;
+    traj->rep[e].gen = traj->q_gen;
+    traj->rep[e].half = half;
+    traj->rep[e].r0 = r0;
+    traj->rep[e].dv = dv;
+    traj->rep[e].dth = dth;
   }
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;
@@ -814,10 +919,9 @@ NAV_HOT_CLONES nav_status nav_traj_sample(nav_traj *traj, int64_t k, int n, cons
   bool has_r_end = false;
   nav_status st = increment_core(traj, t0_s, t1_s, k, n, x, w, &dv, &dth, &r_end, &has_r_end);
   if (st != NAV_OK) return st;
-  nav_traj_state s;
-  st = eval_state(traj, t1_s, has_r_end ? &r_end : NULL, &s);
+  /* eval_state writes *state only on success, and nothing fails after it. */
+  st = eval_state(traj, t1_s, has_r_end ? &r_end : NULL, state);
   if (st != NAV_OK) return st;
-  *state = s;
   *dv_b_mps = dv;
   *dtheta_b_rad = dth;
   return NAV_OK;

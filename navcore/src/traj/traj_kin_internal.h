@@ -39,6 +39,7 @@
 #include "navcore/nav_scene.h"
 #include "navcore/nav_status.h"
 #include "traj/traj_internal.h"
+#include "nav_clones.h"
 
 /* ================================================================ jets */
 
@@ -246,6 +247,107 @@ bool nav_kin_channel_eval_rate_n(const nav_kin_channel *c, const double *t_s, in
  *  first entries are written: the caller copies them where it needs them. */
 bool nav_kin_channel_eval_rate_n0(const nav_kin_channel *c, const double *t_s, int n, ptrdiff_t *hint,
                                   double *x, double *r, double *r1);
+/* Inline forms of the channel evaluation, for the node evaluators' hot loops (no call through the
+ * clone dispatch per channel; kinematics.c's functions are these). */
+
+/** The septic smoothstep S(u), its derivative S'(u) and its integral I(u) = int_0^u S. */
+static inline double nav_kin_ss_S(double u) {
+  return u * u * u * u * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)));
+}
+static inline double nav_kin_ss_S1(double u) {
+  const double v = u * (1.0 - u);
+  return 140.0 * v * v * v;
+}
+static inline double nav_kin_ss_I(double u) {
+  const double u2 = u * u;
+  return u2 * u2 * u * (7.0 + u * (-14.0 + u * (10.0 - 2.5 * u)));
+}
+
+/** Index of the last step starting at or before t, -1 if none (binary search). */
+ptrdiff_t nav_kin_find_step(const nav_kin_channel *c, double t);
+
+/** nav_kin_find_step through a cached index: sequential evaluation stays in the same step or
+ *  moves to the next one, so the binary search is rarely needed. The result is the same index. */
+NAV_CLONE_INLINE ptrdiff_t nav_kin_find_step_hint(const nav_kin_channel *c, double t, ptrdiff_t *hint) {
+  const ptrdiff_t n = (ptrdiff_t)c->n;
+  /* The hint itself (the loop's first candidate, tested the same way). */
+  const ptrdiff_t h = *hint;
+  if (h >= 0 && h < n) {
+    if (c->steps[h].t0_s <= t && (h + 1 >= n || t < c->steps[h + 1].t0_s)) return h;
+  } else if (h == -1 && (n == 0 || t < c->steps[0].t0_s)) {
+    return h;
+  }
+  for (ptrdiff_t k = *hint; k <= *hint + 1 && k < n; ++k) {
+    if (k < -1) break;
+    const bool lo_ok = k < 0 ? (n == 0 || t < c->steps[0].t0_s) : c->steps[k].t0_s <= t;
+    const bool hi_ok = k + 1 >= n || t < c->steps[k + 1].t0_s;
+    if (lo_ok && hi_ok) {
+      *hint = k;
+      return k;
+    }
+  }
+  *hint = nav_kin_find_step(c, t);
+  return *hint;
+}
+
+/** x, r and r' of the channel in step k (-1: before the first) at t: the expressions of the full
+ *  state (kinematics.c channel_state_k), hence the same numbers, without y and the higher rate
+ *  derivatives. */
+NAV_CLONE_INLINE void nav_kin_rate_state(const nav_kin_channel *c, ptrdiff_t k, double t_s, double *x, double *r,
+                                         double *r1) {
+  if (k >= 0) {
+    const nav_kin_step *s = &c->steps[k];
+    const double d = t_s - s->t0_s;
+    if (d < s->len_s) {
+      const double T = s->len_s, u = d / T;
+      *x = s->x0 + s->r0 * d + s->dr * T * nav_kin_ss_I(u);
+      *r = s->r0 + s->dr * nav_kin_ss_S(u);
+      *r1 = s->dr * nav_kin_ss_S1(u) / T;
+      return;
+    }
+    *x = s->x0 + s->r0 * d + s->dr * (d - 0.5 * s->len_s);
+    *r = s->r0 + s->dr;
+  } else {
+    *x = c->x_init + c->r_init * t_s;
+    *r = c->r_init;
+  }
+  *r1 = 0.0;
+}
+
+/** nav_kin_channel_eval_rate, inline. */
+NAV_CLONE_INLINE void nav_kin_channel_eval_rate_inline(const nav_kin_channel *c, double t_s, ptrdiff_t *hint,
+                                                       double *x, double *r, double *r1) {
+  nav_kin_rate_state(c, nav_kin_find_step_hint(c, t_s, hint), t_s, x, r, r1);
+}
+
+/** nav_kin_channel_eval_rate_n0, inline. */
+NAV_CLONE_INLINE bool nav_kin_channel_eval_rate_n0_inline(const nav_kin_channel *c, const double *t_s, int n,
+                                                          ptrdiff_t *hint, double *x, double *r, double *r1) {
+  if (n < 1) return false;
+  /* A channel at rest over the whole span (after its ramps, at zero rate: the usual case for
+   * most channels) is evaluated once; its value is constant there, up to the rounding of
+   * x0 + r0 d + dr (d - len/2) with r0 + dr = 0. */
+  const ptrdiff_t k0 = nav_kin_find_step_hint(c, t_s[0], hint);
+  const double t_last = t_s[n - 1];
+  bool constant;
+  if (k0 < 0) {
+    constant = c->r_init == 0.0 && (c->n == 0 || t_last < c->steps[0].t0_s);
+  } else {
+    const nav_kin_step *s = &c->steps[k0];
+    constant = s->r0 + s->dr == 0.0 && !(t_s[0] - s->t0_s < s->len_s) &&
+               ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s);
+  }
+  nav_kin_rate_state(c, k0, t_s[0], &x[0], &r[0], &r1[0]);
+  if (constant) return true;
+  /* All times in the step of the first (ascending times before the next step's start): the index
+   * nav_kin_find_step would return for each. */
+  const bool one_step = (k0 < 0 ? (c->n == 0 || t_last < c->steps[0].t0_s)
+                                : ((size_t)k0 + 1 >= c->n || t_last < c->steps[k0 + 1].t0_s));
+  for (int i = 1; i < n; ++i)
+    nav_kin_rate_state(c, one_step ? k0 : nav_kin_find_step_hint(c, t_s[i], hint), t_s[i], &x[i], &r[i], &r1[i]);
+  return false;
+}
+
 /** Rate after the last ramp. */
 double nav_kin_channel_final_rate(const nav_kin_channel *c);
 /** Time the last ramp ends (0 if none). */
@@ -355,6 +457,10 @@ typedef struct nav_kin_nodes {
   /* same_kin[i] (i >= 1): v, a, w and C of node i are those of node i - 1, bit for bit (the caller
    * clears these flags; an evaluator may set them so that work on equal inputs is skipped). */
   bool same_kin[NAV_KIN_MAX_NODES];
+  /* Nonzero (the caller sets 0): every node's v, a, w and C are the evaluator's cached outputs of an
+   * interval with every channel at rest, whose content this id names (ids are never reused within a
+   * model, so the same id means the same bits). */
+  uint64_t rest_id;
 } nav_kin_nodes;
 
 /** Node evaluators of the models (self as created by the matching nav_traj_*_create). */

@@ -130,17 +130,20 @@ static bool state_finite(const nav_traj_state *s) {
 
 /* The increment over [t0, t1] ending at sample k without its node sums: the time stamps and, where
  * the trajectory integrates the rate in closed form, the rotation vector (*closed). */
-static nav_status increment_start(nav_truth *truth, int64_t k, double t0, double t1, nav_imu_increment *r,
-                                  bool *closed) {
+static inline nav_status increment_start(nav_truth *truth, int64_t k, double t0, double t1, nav_imu_increment *r,
+                                         bool *closed) {
   r->k = k;
   r->t_s = t1;
   r->dt_s = t1 - t0;
   *closed = false;
+  /* On WGS-84 nav_traj_rate_integral has no closed form: its answer (the argument check, then no
+   * closed form) without the call. */
+  if (truth->frame.model != NAV_EARTH_FLAT) return isfinite(t0) && isfinite(t1) ? NAV_OK : NAV_ERR_INVALID_ARG;
   return nav_traj_rate_integral(truth->traj, t0, t1, &r->dtheta_b_rad, closed);
 }
 
 /* The increment with the node sums dv and dth (dth only where the rate has no closed form). */
-static nav_status increment_finish(nav_imu_increment *r, bool closed, nav_vec3 dv, nav_vec3 dth) {
+static inline nav_status increment_finish(nav_imu_increment *r, bool closed, nav_vec3 dv, nav_vec3 dth) {
   if (!closed) r->dtheta_b_rad = dth;
   r->dv_b_mps = dv;
   return nav_vec3_isfinite(r->dtheta_b_rad) && nav_vec3_isfinite(r->dv_b_mps) ? NAV_OK : NAV_ERR_NUMERIC;
