@@ -192,6 +192,14 @@ typedef struct job {
   nav_traj_state *shared_ts; /* the states of the samples that need one (ts_map), compact */
   int32_t *ts_map;           /* [n + 1]: index into shared_ts, or -1 (state not kept) */
   nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
+  /* With shared truth and a simulated receiver: the reference at receiver epoch e (its time of
+   * validity gnss_t[e], NaN when not kept), e < gnss_epochs, evaluated once for every run (see
+   * epoch_state). */
+  nav_traj_state *gnss_ts;
+  double *gnss_t;
+  int64_t gnss_epochs;
+  nav_frame frame; /* the reference's frame and IMU interval (a run creates its own reference */
+  double dt;       /* object only when it needs one: run_truth) */
   /* navigation.smoother (INS/GNSS): per-run RTS smoothing over the output and GNSS epochs. */
   bool smooth;
   int64_t sm_stride;  /* every sm_stride-th output slot enters the smoothed statistics */
@@ -214,6 +222,14 @@ static const nav_traj_state *shared_state(const job *j, int64_t k) {
   return i >= 0 ? &j->shared_ts[i] : NULL;
 }
 
+/* The shared reference at receiver epoch `epoch` when it was kept for time t_s exactly, else NULL:
+ * the state the run's own reference object would compute at t_s (the same numbers, as for
+ * shared_state), without the per-run evaluation at every receiver epoch. */
+static const nav_traj_state *epoch_state(const job *j, int64_t epoch, double t_s) {
+  if (epoch < 0 || epoch >= j->gnss_epochs || !(j->gnss_t[epoch] == t_s)) return NULL;
+  return &j->gnss_ts[epoch];
+}
+
 /* Keep the first failure's message (of any run) for nav_sim_last_error. */
 #if defined(__GNUC__)
 __attribute__((format(printf, 2, 3)))
@@ -228,6 +244,17 @@ static void job_error(job *j, const char *fmt, ...) {
     j->err_set = true;
   }
   nav_mutex_unlock(&j->err_lock);
+}
+
+/* The run's own reference object, created at its first use: with shared truth a run of a Monte
+ * Carlo job reads every ideal increment and every reference state it needs from the job
+ * (shared_imu, shared_state, epoch_state) and never needs one. */
+static nav_status run_truth(job *j, long run, nav_truth **truth) {
+  if (*truth) return NAV_OK;
+  char msg[200];
+  const nav_status st = nav_truth_create_msg(&j->sim->scene, truth, msg, sizeof msg);
+  if (st != NAV_OK) job_error(j, "run %ld: reference trajectory: %s", run, msg[0] ? msg : nav_status_str(st));
+  return st;
 }
 
 /*
@@ -397,7 +424,7 @@ static nav_status pvt_fix(const nav_ins_gnss_raw_epoch *ep, nav_ins_gnss_fix *f,
  * t_k (numerics.md 6.5: the residual offset is below dt/2; with rates that divide the IMU rate
  * it is zero). Each fix is made by the receiver model from the truth at its own time of validity.
  */
-static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_imu_increment *imu, long run) {
+static nav_status aiding_fixes(job *j, aiding *a, nav_truth **truth, const nav_imu_increment *imu, long run) {
   const nav_scene *sc = &j->sim->scene;
   if (j->sim->fixes) return recorded_fixes(j, a, imu, run);
   for (;;) {
@@ -416,8 +443,10 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     const int64_t kk = (int64_t)llround(kf);
     const bool on_grid = j->shared_ts && fabs(kf - (double)kk) < 1e-9 && kk >= 0 && kk <= j->n;
     const nav_traj_state *sh = on_grid ? shared_state(j, kk) : NULL;
+    const double t_eval = on_grid ? (double)kk * j->dt : t_fix;
+    if (!sh) sh = epoch_state(j, epoch, t_eval);
     if (sh) ts = *sh;
-    else st = nav_truth_state(truth, on_grid ? (double)kk * nav_truth_dt(truth) : t_fix, &ts);
+    else if ((st = run_truth(j, run, truth)) == NAV_OK) st = nav_truth_state(*truth, t_eval, &ts);
     if (st != NAV_OK) return st;
     nav_gnss_fix fix;
     bool has_fix = false;
@@ -430,7 +459,7 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     if (a->raw && a->pvt) {
       /* Loosely coupled on the least-squares PVT of the same raw measurements. */
       nav_ins_gnss_raw_epoch ep;
-      const nav_frame fr = nav_truth_frame(truth);
+      const nav_frame fr = j->frame;
       st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
       nav_ins_gnss_fix f;
       double pos_cov[9], vel_cov[9];
@@ -446,7 +475,7 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     if (a->raw) {
       /* Tightly coupled: the receiver's epochs and outages, the satellites' raw measurements. */
       nav_ins_gnss_raw_epoch ep;
-      const nav_frame fr = nav_truth_frame(truth);
+      const nav_frame fr = j->frame;
       st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
       if (st == NAV_OK) st = nav_ins_gnss_update_raw(a->x, &ep, NULL);
       if (st != NAV_OK) {
@@ -598,13 +627,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const nav_run_observer *obs = j->opts->observer; /* requirements (nav_requirements.h) */
   void *obs_ctx = obs && obs->begin ? obs->begin(obs->user, run) : NULL;
   char msg[200];
-  nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
-  if (st != NAV_OK) {
-    job_error(j, "run %ld: reference trajectory: %s", run, msg[0] ? msg : nav_status_str(st));
-    goto cleanup;
-  }
-  const nav_frame frame = nav_truth_frame(truth);
-  const double dt = nav_truth_dt(truth);
+  nav_status st = j->shared_imu ? NAV_OK : run_truth(j, run, &truth);
+  if (st != NAV_OK) goto cleanup;
+  const nav_frame frame = j->frame;
+  const double dt = j->dt;
   const bool gf_gnss = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || gf_gnss;
   if (!j->ideal && !gyro_free) {
@@ -616,7 +642,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   nav_traj_state ts;
   if (shared_state(j, 0)) ts = *shared_state(j, 0);
-  else st = nav_truth_state(truth, 0.0, &ts);
+  else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
   const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
   const nav_ins_config icfg = nav_ins_config_from_scene(sc);
@@ -702,7 +728,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     nav_imu_increment own_imu, meas;
     const nav_imu_increment *ideal = &own_imu;
     if (j->shared_imu) ideal = &j->shared_imu[k - 1];
-    else st = nav_truth_imu(truth, k, &own_imu);
+    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_imu(truth, k, &own_imu);
     if (st != NAV_OK) {
       job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
                 (double)k * dt);
@@ -732,10 +758,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(aid_kf.x));
         goto cleanup;
       }
-      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
+      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
     } else if (gf_gnss) {
-      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
+      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
     } else if (!gf) {
       st = nav_ins_step(ins, &meas);
@@ -766,7 +792,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
                                               : nav_ins_get_state(ins);
     const nav_traj_state *sh = shared_state(j, k);
     if (sh) ts = *sh;
-    else st = nav_truth_state(truth, meas.t_s, &ts);
+    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
     if (aid && !integrated) {
       /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
@@ -850,6 +876,48 @@ static nav_status add_values(const double *v, int64_t count, nav_stat_acc *acc) 
   return st;
 }
 
+/*
+ * The reference at every receiver epoch of the run's time span (epoch_state), evaluated once by
+ * the job's reference object for a Monte Carlo job with shared truth and a simulated receiver
+ * (ins_gnss, ins_gnss_tight, gyro_free_gnss; not recorded fixes). Each run needs these states at
+ * every epoch, outages included, and most epochs fall between the shared IMU-grid states (the
+ * increment's interval, a difference of two times, is not exactly 1 / rate). An epoch whose state
+ * cannot be evaluated is not kept (the run evaluates it and reports the failure as before).
+ */
+static nav_status shared_epoch_states(job *j, nav_truth *probe) {
+  const nav_scene *sc = &j->sim->scene;
+  const bool receiver = sc->navigation.scheme == NAV_SCHEME_INS_GNSS ||
+                        sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT ||
+                        sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  if (!receiver || j->sim->fixes || !(j->gnss_cfg.update_rate_hz > 0.0)) return NAV_OK;
+  nav_gnss_model *gm = NULL;
+  nav_status st = nav_gnss_model_create(&j->gnss_cfg, &j->frame, sc->simulation.seed, 0, &gm);
+  if (st != NAV_OK) return st;
+  const double t_end = (double)j->n * j->dt;
+  int64_t count = 0;
+  while (nav_gnss_model_epoch_time_s(gm, count) <= t_end && count <= j->n)
+    ++count;
+  if (count > 0) {
+    j->gnss_ts = malloc((size_t)count * sizeof *j->gnss_ts);
+    j->gnss_t = malloc((size_t)count * sizeof *j->gnss_t);
+  }
+  if (j->gnss_ts && j->gnss_t) {
+    for (int64_t e = 0; e < count; ++e) {
+      const double t = nav_gnss_model_epoch_time_s(gm, e);
+      j->gnss_t[e] = nav_truth_state(probe, t, &j->gnss_ts[e]) == NAV_OK ? t : NAN;
+    }
+    j->gnss_epochs = count;
+  } else {
+    /* Not kept (no memory): every run evaluates its epochs itself. */
+    free(j->gnss_ts);
+    free(j->gnss_t);
+    j->gnss_ts = NULL;
+    j->gnss_t = NULL;
+  }
+  nav_gnss_model_destroy(gm);
+  return NAV_OK;
+}
+
 nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out) {
   job j;
   nav_status st = NAV_OK;
@@ -897,6 +965,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   }
   j.n = nav_truth_sample_count(probe);
   const double dt = nav_truth_dt(probe);
+  j.frame = nav_truth_frame(probe);
+  j.dt = dt;
   /* Range hook: runs [r0, r1) only (a merge runs none). */
   const long r0 = sim->hook.active ? (sim->hook.r0 < j.runs ? sim->hook.r0 : j.runs) : 0;
   j.run_end = sim->hook.active ? (sim->hook.r1 < j.runs ? sim->hook.r1 : j.runs) : j.runs;
@@ -938,6 +1008,12 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
         snprintf(sim->last_error, sizeof sim->last_error,
                  "reference trajectory (shared truth): %s in the state or ideal increment at t = %.6f s (sample %lld)",
                  nav_status_str(st), (double)k_fail * dt, (long long)k_fail);
+        nav_truth_destroy(probe);
+        goto cleanup;
+      }
+      st = shared_epoch_states(&j, probe);
+      if (st != NAV_OK) {
+        snprintf(sim->last_error, sizeof sim->last_error, "GNSS receiver model: %s", nav_status_str(st));
         nav_truth_destroy(probe);
         goto cleanup;
       }
@@ -1189,6 +1265,8 @@ cleanup:
   free(j.shared_imu);
   free(j.shared_ts);
   free(j.ts_map);
+  free(j.gnss_ts);
+  free(j.gnss_t);
   nav_sim_gyrofree_truth_destroy(j.gf_truth);
   free(j.final);
   free(j.samples_done);
