@@ -191,6 +191,7 @@ typedef struct job {
   nav_imu_increment *shared_imu;
   nav_traj_state *shared_ts; /* the states of the samples that need one (ts_map), compact */
   int32_t *ts_map;           /* [n + 1]: index into shared_ts, or -1 (state not kept) */
+  nav_errors_ref *shared_ref; /* beside shared_ts: the reference part of the errors, or NULL */
   nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
   /* With shared truth and a simulated receiver: the reference at receiver epoch e (its time of
    * validity gnss_t[e], NaN when not kept), e < gnss_epochs, evaluated once for every run (see
@@ -208,6 +209,10 @@ typedef struct job {
   int64_t *sm_bytes;  /* [runs]: smoother memory of the run (records + results) */
 } job;
 
+/* Largest memory for the shared reference parts of the errors (nav_errors_ref, ~0.2 KB per kept
+ * state; the free INS with vertical aiding keeps every sample's). */
+#define SHARED_REF_MAX_BYTES ((size_t)64 << 20)
+
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
 #define SHARED_TRUTH_MAX_SAMPLES 4000000LL
 
@@ -220,6 +225,14 @@ static const nav_traj_state *shared_state(const job *j, int64_t k) {
   if (!j->shared_ts || k < 0 || k > j->n) return NULL;
   const int32_t i = j->ts_map[k];
   return i >= 0 ? &j->shared_ts[i] : NULL;
+}
+
+/* The reference part of the errors (nav_errors_ref) at sample k: the shared one beside
+ * shared_state(j, k) when kept, else computed into *own from ts (the run's reference at k). */
+static const nav_errors_ref *errors_ref(const job *j, int64_t k, const nav_traj_state *ts, nav_errors_ref *own) {
+  if (j->shared_ref && shared_state(j, k)) return &j->shared_ref[j->ts_map[k]];
+  *own = nav_errors_ref_compute(&j->frame, ts);
+  return own;
 }
 
 /* The shared reference at receiver epoch `epoch` when it was kept for time t_s exactly, else NULL:
@@ -567,14 +580,13 @@ static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t
  * e = (dr_n, dv_n, phi) with phi from C_true C_est^T = I + [phi x] (E0.1), resolved in n.
  * Returns NAN when the block is not positive definite.
  */
-static double nees9(const double *P, size_t n, const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s,
-                    const nav_epoch_errors *e) {
+static double nees9(const double *P, size_t n, const nav_errors_ref *ref, const nav_traj_state *ts,
+                    const nav_ins_state *s, const nav_epoch_errors *e) {
   double B[81], L[81], x[9];
   for (size_t i = 0; i < 9; ++i)
     for (size_t q = 0; q < 9; ++q) B[i * 9 + q] = P[i * n + q];
-  const nav_local_view vt = nav_frame_view(fr, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f);
   const nav_vec3 phi_f = nav_quat_to_rotvec(nav_quat_mul(ts->q_b_f, nav_quat_conj(s->q_b_f)));
-  const nav_vec3 phi_n = nav_mat3_mul_vec(vt.C_f_n, phi_f);
+  const nav_vec3 phi_n = nav_mat3_mul_vec(ref->view.C_f_n, phi_f);
   const double err[9] = {e->pos_err_n_m.x,   e->pos_err_n_m.y,   e->pos_err_n_m.z, e->vel_err_n_mps.x, e->vel_err_n_mps.y,
                          e->vel_err_n_mps.z, phi_n.x, phi_n.y, phi_n.z};
   if (nav_matn_cholesky(L, B, 9) != NAV_OK) return NAN;
@@ -596,7 +608,7 @@ static const double *run_cov(const nav_ins_gnss *x, const nav_sim_gyrofree *gf, 
 }
 
 static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, const double *P, size_t n,
-                      const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s) {
+                      const nav_errors_ref *ref, const nav_traj_state *ts, const nav_ins_state *s) {
   const int64_t slot = out_slot(j, k);
   if (!j->env || slot < 0 || slot >= j->n_out) return;
   double *v = j->env + ((int64_t)run * j->n_out + slot) * ENV_VALUES;
@@ -608,7 +620,7 @@ static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, co
   v[5] = v[6] = v[7] = v[8] = 0.0;
   if (P) {
     for (int i = 0; i < 3; ++i) v[5 + i] = sqrt(P[(size_t)i * n + (size_t)i]);
-    v[8] = nees9(P, n, fr, ts, s, e);
+    v[8] = nees9(P, n, ref, ts, s, e);
   }
 }
 
@@ -701,10 +713,12 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const bool record = caller_thread && run == 0 && j->opts->record;
   bool stop = false;
 
-  nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
+  nav_errors_ref own_ref;
+  const nav_errors_ref *ref = errors_ref(j, 0, &ts, &own_ref);
+  nav_epoch_errors err = nav_errors_compute_ref(&frame, &ts, ref, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
   const double *cov0 = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-  store_env(j, run, 0, &err, cov0, cov_n, &frame, &ts, nav_ins_get_state(ins));
+  store_env(j, run, 0, &err, cov0, cov_n, ref, &ts, nav_ins_get_state(ins));
   if (obs_ctx) obs->epoch(obs_ctx, &err);
   if (sm) {
     sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
@@ -801,10 +815,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       st = nav_ins_aid_vertical(ins, h, v.v_n_mps.z);
       if (st != NAV_OK) goto cleanup;
     }
-    err = nav_errors_compute(&frame, &ts, nav_now);
+    ref = errors_ref(j, k, &ts, &own_ref);
+    err = nav_errors_compute_ref(&frame, &ts, ref, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     const double *cov = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-    store_env(j, run, k, &err, cov, cov_n, &frame, &ts, nav_now);
+    store_env(j, run, k, &err, cov, cov_n, ref, &ts, nav_now);
     if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
     if (sm && out_k) {
       /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
@@ -992,13 +1007,20 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       }
     j.shared_imu = malloc((size_t)j.n * sizeof *j.shared_imu);
     j.shared_ts = j.ts_map ? malloc((size_t)n_ts * sizeof *j.shared_ts) : NULL;
+    /* The reference part of the errors beside each kept state, within SHARED_REF_MAX_BYTES (else
+     * every run computes it at each of its error epochs, as a job without shared truth does). */
+    if (j.shared_ts && (size_t)n_ts * sizeof *j.shared_ref <= SHARED_REF_MAX_BYTES)
+      j.shared_ref = malloc((size_t)n_ts * sizeof *j.shared_ref);
     if (j.shared_imu && j.shared_ts) {
       st = nav_truth_state(probe, 0.0, &j.shared_ts[0]);
+      if (st == NAV_OK && j.shared_ref) j.shared_ref[0] = nav_errors_ref_compute(&j.frame, &j.shared_ts[0]);
       int64_t k_fail = 0;
       for (int64_t k = 1; k <= j.n && st == NAV_OK; ++k) {
         k_fail = k;
         st = nav_truth_imu(probe, k, &j.shared_imu[k - 1]);
         if (st == NAV_OK && j.ts_map[k] >= 0) st = nav_truth_state(probe, (double)k * dt, &j.shared_ts[j.ts_map[k]]);
+        if (st == NAV_OK && j.ts_map[k] >= 0 && j.shared_ref)
+          j.shared_ref[j.ts_map[k]] = nav_errors_ref_compute(&j.frame, &j.shared_ts[j.ts_map[k]]);
         if (opts->progress && k % PROGRESS_EVERY == 0) {
           nav_progress p = {"truth", 0, 0.0, (double)k * dt};
           if (opts->progress(opts->user, &p) == NAV_STOP) st = NAV_ERR_CANCELLED;
@@ -1021,6 +1043,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       free(j.shared_imu);
       free(j.shared_ts);
       free(j.ts_map);
+      free(j.shared_ref);
+      j.shared_ref = NULL;
       j.shared_imu = NULL;
       j.shared_ts = NULL;
       j.ts_map = NULL;
@@ -1265,6 +1289,7 @@ cleanup:
   free(j.shared_imu);
   free(j.shared_ts);
   free(j.ts_map);
+  free(j.shared_ref);
   free(j.gnss_ts);
   free(j.gnss_t);
   nav_sim_gyrofree_truth_destroy(j.gf_truth);
