@@ -36,6 +36,10 @@
  * 21.9k per 3-component update (72.7k -> 28.3k, now instantiated for 21 states). Every one of
  * these transformations keeps the values bit for bit (test_filter_kernels checks each kernel
  * against its plain loops; scripts/compare-outputs over every scene and replay).
+ * Then (issue 23, bench scene): the INS/GNSS step's prediction without the input check of the
+ * numbers the NED INS vouches for (nav_filter_predict_ins: 64 -> 0 per IMU step), and the update
+ * with P+ symmetrised in its K R K^T pass and S^-1 solved inline: 22.8k -> 20.0k per position
+ * update, 22.4k -> 19.6k per velocity update (docs/campaign-speed.md has the whole budget).
  */
 #include <assert.h>
 #include <math.h>
