@@ -211,7 +211,7 @@ typedef struct job {
 
 /* Largest memory for the shared reference parts of the errors (nav_errors_ref, ~0.2 KB per kept
  * state; the free INS with vertical aiding keeps every sample's). */
-#define SHARED_REF_MAX_BYTES ((size_t)64 << 20)
+#define SHARED_REF_MAX_BYTES NAV_SIM_SHARED_REF_MAX_BYTES
 
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
 #define SHARED_TRUTH_MAX_SAMPLES 4000000LL
