@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "navcore/nav_errors.h"
 #include "navcore/nav_results.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_traj.h"
@@ -114,6 +115,11 @@ void nav_predict_run(const nav_scene *sc, bool ideal, long threads, bool kml, na
     const bool every = sc->navigation.aid_vertical && sc->navigation.scheme != NAV_SCHEME_INS_GNSS;
     mem += (double)n_imu * (double)sizeof(nav_imu_increment) +
            (every ? (double)n_imu + 1.0 : 2.0 * rows) * (double)sizeof(nav_traj_state) + (double)n_imu * 4.0;
+    /* The reference part of the errors beside those states (kept only within
+     * NAV_SIM_SHARED_REF_MAX_BYTES), and the reference at each receiver epoch with its time. */
+    const double ref_bytes = (every ? (double)n_imu + 1.0 : 2.0 * rows) * (double)sizeof(nav_errors_ref);
+    mem += (ref_bytes <= (double)NAV_SIM_SHARED_REF_MAX_BYTES ? ref_bytes : 0.0) +
+           n_gnss * ((double)sizeof(nav_traj_state) + 8.0);
     strncat(out->memory, ", shared reference", sizeof out->memory - strlen(out->memory) - 1);
   }
   if (sc->navigation.smoother && gnss) {

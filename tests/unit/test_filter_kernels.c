@@ -126,7 +126,7 @@ static void test_transpose_matches_plain(void **state) {
 
 /* The update's arithmetic written as the textbook loops (row-major n x m products, every sum
  * from +0.0 in index order over the non-zero columns of H where update_core uses them): P+ (Joseph
- * form, symmetrised by the caller), x+ and S. */
+ * form, then symmetrised by nav_matn_symmetrize: the P+ of do_update), x+ and S. */
 static void reference_update(const double *P, const double *x, const double *H, const double *z, const double *R,
                              size_t n, size_t m, double *Pn, double *xn, double *S) {
   static double PHt[NMAX * MMAX], K[NMAX * MMAX], Kt[MMAX * NMAX], B[NN], BHt[NMAX * MMAX], W[NMAX * MMAX];
@@ -209,6 +209,8 @@ static void reference_update(const double *P, const double *x, const double *H, 
       Pn[i * n + j] += sum;
       if (j != i) Pn[j * n + i] += sum;
     }
+  /* do_update's symmetrisation of P+ (update_core does it as it adds K R K^T). */
+  nav_matn_symmetrize(Pn, n);
 }
 
 /* The measurement update instantiated with compile-time sizes (n = 15, 18 or 21, m = 3) gives the

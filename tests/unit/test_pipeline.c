@@ -349,6 +349,39 @@ static void test_sim_stop(void **state) {
   assert_int_equal(nav_sim_create(&sc, &sim), NAV_ERR_INVALID_ARG);
 }
 
+/* nav_errors_compute_ref with the reference part of nav_errors_ref_compute (shared by the runs of
+ * a Monte Carlo job) gives the errors of nav_errors_compute bit for bit, on the flat and the
+ * WGS-84 frame, for estimates off the reference in position, velocity and attitude. */
+static void test_errors_ref_same_bits(void **state) {
+  (void)state;
+  for (int model = 0; model < 2; ++model) {
+    nav_scene sc = nav_scene_default();
+    if (model == 1) {
+      sc.earth.model = NAV_EARTH_WGS84;
+      sc.earth.origin_lat_rad = 0.84;
+      sc.earth.origin_lon_rad = 0.2;
+      sc.earth.origin_h_m = 520.0;
+    }
+    nav_truth *truth = NULL;
+    assert_int_equal(nav_truth_create(&sc, &truth), NAV_OK);
+    const nav_frame fr = nav_truth_frame(truth);
+    for (int i = 0; i < 8; ++i) {
+      nav_traj_state ts;
+      assert_int_equal(nav_truth_state(truth, 2.5 * i, &ts), NAV_OK);
+      const double d = 0.3 + 0.7 * i;
+      const nav_ins_state est = {ts.t_s, nav_vec3_add(ts.r_fb_f_m, nav_vec3_make(d, -2.0 * d, 0.5 * d)),
+                                 nav_vec3_add(ts.v_fb_f_mps, nav_vec3_make(0.01 * d, 0.02, -0.03 * d)),
+                                 nav_quat_mul(ts.q_b_f, nav_quat_from_rotvec(nav_vec3_make(1e-3 * d, -2e-3, 0.05 * d)))};
+      const nav_epoch_errors a = nav_errors_compute(&fr, &ts, &est);
+      const nav_errors_ref ref = nav_errors_ref_compute(&fr, &ts);
+      const nav_epoch_errors b = nav_errors_compute_ref(&fr, &ts, &ref, &est);
+      assert_true(a.pos_err_h_m > 0.0 && a.att_err_rad > 0.0);
+      assert_memory_equal(&a, &b, sizeof a);
+    }
+    nav_truth_destroy(truth);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_gauss_legendre),
@@ -361,6 +394,7 @@ int main(void) {
       cmocka_unit_test(test_t31_high_order),
       cmocka_unit_test(test_sim_run),
       cmocka_unit_test(test_sim_stop),
+      cmocka_unit_test(test_errors_ref_same_bits),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

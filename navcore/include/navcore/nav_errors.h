@@ -39,6 +39,22 @@ typedef struct nav_epoch_errors {
 NAV_API nav_epoch_errors nav_errors_compute(const nav_frame *fr, const nav_traj_state *truth,
                                             const nav_ins_state *est);
 
+/** The reference's part of nav_errors_compute, which depends on the reference state alone: its
+ *  local-level view and Euler angles. A Monte Carlo job computes it once per reference epoch for
+ *  every run. */
+typedef struct nav_errors_ref {
+  nav_local_view view; /**< nav_frame_view of the reference state */
+  nav_euler euler;     /**< its local-level Euler angles */
+} nav_errors_ref;
+
+/** The reference part of the errors at @p truth (frame @p fr). Leaf function: cannot fail. */
+NAV_API nav_errors_ref nav_errors_ref_compute(const nav_frame *fr, const nav_traj_state *truth);
+
+/** nav_errors_compute with the reference part @p ref of @p truth given (from
+ *  nav_errors_ref_compute of the same @p fr and @p truth): the same values, bit for bit. */
+NAV_API nav_epoch_errors nav_errors_compute_ref(const nav_frame *fr, const nav_traj_state *truth,
+                                                const nav_errors_ref *ref, const nav_ins_state *est);
+
 /** RMS, maximum and 95th percentile of a non-negative metric over epochs (and runs). */
 typedef struct nav_stat {
   double rms;

@@ -130,6 +130,9 @@ typedef struct nav_sim_summary {
  *  the per-epoch envelopes (runs x output epochs x 9; no envelopes beyond this). */
 #define NAV_SIM_METRIC_MAX_VALUES 2000000LL
 #define NAV_SIM_ENV_MAX_VALUES 4000000LL
+/** Bytes kept at most for the reference's part of the errors (nav_errors_ref) beside the
+ *  reference states a Monte Carlo job shares between its runs. */
+#define NAV_SIM_SHARED_REF_MAX_BYTES ((size_t)64 << 20)
 
 /** Monte Carlo envelope at one output epoch: statistics over runs (numerics.md T6.6). */
 typedef struct nav_sim_envelope_point {

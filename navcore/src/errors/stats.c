@@ -3,24 +3,37 @@
 
 #include "navcore/nav_errors.h"
 
-nav_epoch_errors nav_errors_compute(const nav_frame *fr, const nav_traj_state *truth, const nav_ins_state *est) {
+nav_errors_ref nav_errors_ref_compute(const nav_frame *fr, const nav_traj_state *truth) {
+  nav_errors_ref r;
+  r.view = nav_frame_view(fr, truth->r_fb_f_m, truth->v_fb_f_mps, truth->q_b_f);
+  r.euler = nav_quat_to_euler(r.view.q_b_n, NULL);
+  return r;
+}
+
+nav_epoch_errors nav_errors_compute_ref(const nav_frame *fr, const nav_traj_state *truth, const nav_errors_ref *ref,
+                                        const nav_ins_state *est) {
   nav_epoch_errors e;
-  const nav_local_view vt = nav_frame_view(fr, truth->r_fb_f_m, truth->v_fb_f_mps, truth->q_b_f);
+  const nav_local_view *vt = &ref->view;
   const nav_local_view ve = nav_frame_view(fr, est->r_fb_f_m, est->v_fb_f_mps, est->q_b_f);
   e.t_s = truth->t_s;
   /* Resolve the F-frame differences in n at the true position. */
-  e.pos_err_n_m = nav_mat3_mul_vec(vt.C_f_n, nav_vec3_sub(est->r_fb_f_m, truth->r_fb_f_m));
+  e.pos_err_n_m = nav_mat3_mul_vec(vt->C_f_n, nav_vec3_sub(est->r_fb_f_m, truth->r_fb_f_m));
   e.pos_err_h_m = hypot(e.pos_err_n_m.x, e.pos_err_n_m.y);
   e.pos_err_v_m = fabs(e.pos_err_n_m.z);
-  e.vel_err_n_mps = nav_mat3_mul_vec(vt.C_f_n, nav_vec3_sub(est->v_fb_f_mps, truth->v_fb_f_mps));
+  e.vel_err_n_mps = nav_mat3_mul_vec(vt->C_f_n, nav_vec3_sub(est->v_fb_f_mps, truth->v_fb_f_mps));
   e.vel_err_mps = nav_vec3_norm(e.vel_err_n_mps);
   e.att_err_rad = nav_quat_angle_between(truth->q_b_f, est->q_b_f);
-  const nav_euler et = nav_quat_to_euler(vt.q_b_n, NULL);
+  const nav_euler et = ref->euler;
   const nav_euler ee = nav_quat_to_euler(ve.q_b_n, NULL);
   e.euler_err.roll_rad = nav_wrap_pi(ee.roll_rad - et.roll_rad);
   e.euler_err.pitch_rad = nav_wrap_pi(ee.pitch_rad - et.pitch_rad);
   e.euler_err.yaw_rad = nav_wrap_pi(ee.yaw_rad - et.yaw_rad);
   return e;
+}
+
+nav_epoch_errors nav_errors_compute(const nav_frame *fr, const nav_traj_state *truth, const nav_ins_state *est) {
+  const nav_errors_ref ref = nav_errors_ref_compute(fr, truth);
+  return nav_errors_compute_ref(fr, truth, &ref, est);
 }
 
 struct nav_stat_acc {

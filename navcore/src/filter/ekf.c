@@ -36,6 +36,10 @@
  * 21.9k per 3-component update (72.7k -> 28.3k, now instantiated for 21 states). Every one of
  * these transformations keeps the values bit for bit (test_filter_kernels checks each kernel
  * against its plain loops; scripts/compare-outputs over every scene and replay).
+ * Then (issue 23, bench scene): the INS/GNSS step's prediction without the input check of the
+ * numbers the NED INS vouches for (nav_filter_predict_ins: 64 -> 0 per IMU step), and the update
+ * with P+ symmetrised in its K R K^T pass and S^-1 solved inline: 22.8k -> 20.0k per position
+ * update, 22.4k -> 19.6k per velocity update (docs/campaign-speed.md has the whole budget).
  */
 #include <assert.h>
 #include <math.h>
@@ -1014,6 +1018,23 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
     f->QT[i * (n + 1)] = f->qc[i] * T;
 }
 
+/* nav_filter_predict after its checks of nav and dt_s. */
+static nav_status predict_checked(nav_filter *f, const nav_filter_nav *nav, double dt_s) {
+  /* Between covariance steps, accumulate in place. */
+  if (f->pend.count + 1 < f->cfg.cov_decimation) {
+    pending_add(f, &f->pend, nav, dt_s);
+    return NAV_OK;
+  }
+  /* A covariance step: accumulate into a copy, so that a failing step leaves the pending sums
+   * untouched. */
+  pending pd = f->pend;
+  pending_add(f, &pd, nav, dt_s);
+  pending_integrals(f, &pd);
+  const nav_status st = cov_step(f, f->FT, f->QT);
+  if (st == NAV_OK) memset(&f->pend, 0, sizeof f->pend);
+  return st;
+}
+
 nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double dt_s) {
   assert(f != NULL && nav != NULL);
   if (f == NULL || nav == NULL) return NAV_ERR_INVALID_ARG;
@@ -1025,21 +1046,20 @@ nav_status nav_filter_predict(nav_filter *f, const nav_filter_nav *nav, double d
     set_error(f, "predict: dt_s = %g must be > 0", dt_s);
     return NAV_ERR_INVALID_ARG;
   }
-  nav_status st = check_nav(f, nav, "predict");
+  const nav_status st = check_nav(f, nav, "predict");
   if (st != NAV_OK) return st;
-  /* Between covariance steps, accumulate in place. */
-  if (f->pend.count + 1 < f->cfg.cov_decimation) {
-    pending_add(f, &f->pend, nav, dt_s);
-    return NAV_OK;
-  }
-  /* A covariance step: accumulate into a copy, so that a failing step leaves the pending sums
-   * untouched. */
-  pending pd = f->pend;
-  pending_add(f, &pd, nav, dt_s);
-  pending_integrals(f, &pd);
-  st = cov_step(f, f->FT, f->QT);
-  if (st == NAV_OK) memset(&f->pend, 0, sizeof f->pend);
-  return st;
+  return predict_checked(f, nav, dt_s);
+}
+
+nav_status nav_filter_predict_ins(nav_filter *f, const nav_filter_nav *nav, double dt_s) {
+  assert(f != NULL && nav != NULL);
+  /* x - x is +0.0 for a finite x and NaN otherwise, so the sum is +0.0 exactly when the six
+   * numbers are finite. */
+  const nav_vec3 a = nav->f_ib_b_mps2, w = nav->w_ib_b_rps;
+  const double z = (a.x - a.x) + (a.y - a.y) + (a.z - a.z) + (w.x - w.x) + (w.y - w.y) + (w.z - w.z);
+  if (!(z == 0.0) || !(dt_s > 0.0) || isinf(dt_s) || !(fabs(nav->lat_rad) <= LAT_SAFE_RAD))
+    return nav_filter_predict(f, nav, dt_s); /* its checks decide and word the failure */
+  return predict_checked(f, nav, dt_s);
 }
 
 nav_status nav_filter_flush(nav_filter *f) {
@@ -1076,6 +1096,37 @@ static NAV_ALWAYS_INLINE void sub_xty(double *restrict out, const double *base, 
     }
     for (size_t j = 0; j < n; ++j)
       out[i * n + j] = base[i * n + j] - tmp[j];
+  }
+}
+
+/* x := S^-1 x for the m x n x (rows of n) by the m x m Cholesky factor l of S: the operations and
+ * the order of nav_matn_chol_solve(x, l, x, m, n) (forward substitution, then back substitution,
+ * row by row), inlined with the compile-time m and n of update_core, so each row operation runs
+ * over the n columns at once. */
+static NAV_ALWAYS_INLINE void chol_solve_rows(double *x, const double *l, const size_t m, const size_t n) {
+  NAV_UNROLL
+  for (size_t i = 0; i < m; ++i) {
+    NAV_UNROLL
+    for (size_t k = 0; k < i; ++k) {
+      const double lik = l[i * m + k];
+      for (size_t c = 0; c < n; ++c)
+        x[i * n + c] -= lik * x[k * n + c];
+    }
+    const double lii = l[i * m + i];
+    for (size_t c = 0; c < n; ++c)
+      x[i * n + c] /= lii;
+  }
+  NAV_UNROLL
+  for (size_t ii = m; ii-- > 0;) {
+    NAV_UNROLL
+    for (size_t k = ii + 1; k < m; ++k) {
+      const double lki = l[k * m + ii];
+      for (size_t c = 0; c < n; ++c)
+        x[ii * n + c] -= lki * x[k * n + c];
+    }
+    const double lii = l[ii * m + ii];
+    for (size_t c = 0; c < n; ++c)
+      x[ii * n + c] /= lii;
   }
 }
 
@@ -1135,12 +1186,20 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
         sum += H[r * n + j] * PHtT[c * n + j];
       S[r * m + c] = sum + R[r * m + c];
     }
-  nav_matn_symmetrize(S, m);
+  /* Symmetrised as nav_matn_symmetrize, with the compile-time m. */
+  NAV_UNROLL
+  for (size_t r = 0; r < m; ++r)
+    NAV_UNROLL
+    for (size_t c = r + 1; c < m; ++c) {
+      const double v = 0.5 * (S[r * m + c] + S[c * m + r]);
+      S[r * m + c] = v;
+      S[c * m + r] = v;
+    }
   if (nav_matn_cholesky(Ls, S, m) != NAV_OK) return false;
   /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
   double *Kt = f->Kt;
   memcpy(Kt, PHtT, m * n * sizeof *Kt);
-  nav_matn_chol_solve(Kt, Ls, Kt, m, n);
+  chol_solve_rows(Kt, Ls, m, n);
 
   /* x+ = x- + K y */
   for (size_t j = 0; j < n; ++j)
@@ -1191,10 +1250,15 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
       for (size_t j = i; j < n; ++j)
         tmp[j] += w * Kt[c * n + j];
     }
-    for (size_t j = i; j < n; ++j)
-      f->Pn[i * n + j] += tmp[j];
-    for (size_t j = i + 1; j < n; ++j)
-      f->Pn[j * n + i] += tmp[j];
+    /* Added to both triangles and symmetrised as nav_matn_symmetrize would (v = (P_ij + P_ji) / 2
+     * on both), in the same pass: the pair (i, j > i) is final once row i has added its term. */
+    f->Pn[i * n + i] += tmp[i];
+    for (size_t j = i + 1; j < n; ++j) {
+      const double a = f->Pn[i * n + j] + tmp[j], b = f->Pn[j * n + i] + tmp[j];
+      const double v = 0.5 * (a + b);
+      f->Pn[i * n + j] = v;
+      f->Pn[j * n + i] = v;
+    }
   }
   return true;
 }
@@ -1232,7 +1296,7 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
     set_error(f, "%s: innovation covariance S = H P H^T + R is not positive definite", what);
     return NAV_ERR_NUMERIC;
   }
-  nav_matn_symmetrize(f->Pn, n);
+  /* Pn is symmetric already (update_core symmetrises it as it adds K R K^T). */
   for (size_t j = 0; j < n; ++j)
     if (!isfinite(f->xn[j])) {
       set_error(f, "%s: updated state x[%zu] is not finite", what, j);

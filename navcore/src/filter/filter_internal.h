@@ -122,4 +122,15 @@ nav_filter_layout nav_filter_layout_of(unsigned states);
  */
 double *nav_filter_internal_state(nav_filter *f);
 
+/*
+ * nav_filter_predict for a caller whose lat, h, v_eb_n and C_b_n come from a running strapdown
+ * INS in NED form (nav_ins_gnss_step, nav_ins_get_ned): the INS keeps those finite (it refuses a
+ * step or a state that is not, and C_b_n is the DCM of its unit quaternion), so only f_ib_b,
+ * w_ib_b, dt_s and the latitude's distance from the poles are checked here; when any of these is
+ * in doubt the call is nav_filter_predict's, whose checks decide and word the failure. The same
+ * values and the same errors as nav_filter_predict, without the finiteness test of all 20
+ * numbers at every IMU step.
+ */
+nav_status nav_filter_predict_ins(nav_filter *f, const nav_filter_nav *nav, double dt_s);
+
 #endif /* NAV_FILTER_INTERNAL_H */

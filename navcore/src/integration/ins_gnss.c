@@ -193,10 +193,11 @@ static nav_filter_ins_state nominal_of(const nav_ins_gnss *x) {
  * whole-struct copy moves 16-byte pairs at the struct's alignment, and reading a vector member
  * (at offset 24) back from such a copy as a pair straddles two stores, which the CPU cannot
  * forward (a stall of some 10 cycles per read at every IMU step). */
-static inline void filter_nav_fill(nav_filter_nav *n, const nav_frame *fr, const nav_ins *ins,
+static inline bool filter_nav_fill(nav_filter_nav *n, const nav_frame *fr, const nav_ins *ins,
                                    const nav_imu_increment *imu) {
   nav_ins_ned ned;
-  if (nav_ins_get_ned(ins, &ned)) {
+  const bool from_ned = nav_ins_get_ned(ins, &ned);
+  if (from_ned) {
     n->lat_rad = ned.pos.lat_rad;
     n->h_m = ned.pos.h_m;
     n->v_eb_n_mps = ned.v_n_mps;
@@ -212,6 +213,7 @@ static inline void filter_nav_fill(nav_filter_nav *n, const nav_frame *fr, const
   const double idt = 1.0 / imu->dt_s;
   n->f_ib_b_mps2 = nav_vec3_make(imu->dv_b_mps.x * idt, imu->dv_b_mps.y * idt, imu->dv_b_mps.z * idt);
   n->w_ib_b_rps = nav_vec3_make(imu->dtheta_b_rad.x * idt, imu->dtheta_b_rad.y * idt, imu->dtheta_b_rad.z * idt);
+  return from_ned;
 }
 
 nav_filter_nav nav_ins_gnss_filter_nav(const nav_frame *fr, const nav_ins *ins, const nav_imu_increment *imu) {
@@ -252,8 +254,9 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
     return st;
   }
   nav_filter_nav n; /* filled in place: no copy of the returned struct per step */
-  filter_nav_fill(&n, &x->frame, x->ins, &m);
-  st = nav_filter_predict(x->kf, &n, dt);
+  /* From the NED state the INS vouches for lat, h, v and C_b_n (nav_filter_predict_ins). */
+  st = filter_nav_fill(&n, &x->frame, x->ins, &m) ? nav_filter_predict_ins(x->kf, &n, dt)
+                                                  : nav_filter_predict(x->kf, &n, dt);
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m.t_s, nav_filter_last_error(x->kf));
     return st;

@@ -191,7 +191,16 @@ typedef struct job {
   nav_imu_increment *shared_imu;
   nav_traj_state *shared_ts; /* the states of the samples that need one (ts_map), compact */
   int32_t *ts_map;           /* [n + 1]: index into shared_ts, or -1 (state not kept) */
+  nav_errors_ref *shared_ref; /* beside shared_ts: the reference part of the errors, or NULL */
   nav_sim_gyrofree_truth *gf_truth; /* gyro-free scheme: shared ideal array increments, or NULL */
+  /* With shared truth and a simulated receiver: the reference at receiver epoch e (its time of
+   * validity gnss_t[e], NaN when not kept), e < gnss_epochs, evaluated once for every run (see
+   * epoch_state). */
+  nav_traj_state *gnss_ts;
+  double *gnss_t;
+  int64_t gnss_epochs;
+  nav_frame frame; /* the reference's frame and IMU interval (a run creates its own reference */
+  double dt;       /* object only when it needs one: run_truth) */
   /* navigation.smoother (INS/GNSS): per-run RTS smoothing over the output and GNSS epochs. */
   bool smooth;
   int64_t sm_stride;  /* every sm_stride-th output slot enters the smoothed statistics */
@@ -199,6 +208,10 @@ typedef struct job {
   double *sm_metrics; /* [2 N_METRICS][runs][sm_per_run]: smoothed planes, then forward planes */
   int64_t *sm_bytes;  /* [runs]: smoother memory of the run (records + results) */
 } job;
+
+/* Largest memory for the shared reference parts of the errors (nav_errors_ref, ~0.2 KB per kept
+ * state; the free INS with vertical aiding keeps every sample's). */
+#define SHARED_REF_MAX_BYTES NAV_SIM_SHARED_REF_MAX_BYTES
 
 /* Largest number of samples whose truth is shared between runs (~0.2 KB per sample). */
 #define SHARED_TRUTH_MAX_SAMPLES 4000000LL
@@ -212,6 +225,22 @@ static const nav_traj_state *shared_state(const job *j, int64_t k) {
   if (!j->shared_ts || k < 0 || k > j->n) return NULL;
   const int32_t i = j->ts_map[k];
   return i >= 0 ? &j->shared_ts[i] : NULL;
+}
+
+/* The reference part of the errors (nav_errors_ref) at sample k: the shared one beside
+ * shared_state(j, k) when kept, else computed into *own from ts (the run's reference at k). */
+static const nav_errors_ref *errors_ref(const job *j, int64_t k, const nav_traj_state *ts, nav_errors_ref *own) {
+  if (j->shared_ref && shared_state(j, k)) return &j->shared_ref[j->ts_map[k]];
+  *own = nav_errors_ref_compute(&j->frame, ts);
+  return own;
+}
+
+/* The shared reference at receiver epoch `epoch` when it was kept for time t_s exactly, else NULL:
+ * the state the run's own reference object would compute at t_s (the same numbers, as for
+ * shared_state), without the per-run evaluation at every receiver epoch. */
+static const nav_traj_state *epoch_state(const job *j, int64_t epoch, double t_s) {
+  if (epoch < 0 || epoch >= j->gnss_epochs || !(j->gnss_t[epoch] == t_s)) return NULL;
+  return &j->gnss_ts[epoch];
 }
 
 /* Keep the first failure's message (of any run) for nav_sim_last_error. */
@@ -228,6 +257,17 @@ static void job_error(job *j, const char *fmt, ...) {
     j->err_set = true;
   }
   nav_mutex_unlock(&j->err_lock);
+}
+
+/* The run's own reference object, created at its first use: with shared truth a run of a Monte
+ * Carlo job reads every ideal increment and every reference state it needs from the job
+ * (shared_imu, shared_state, epoch_state) and never needs one. */
+static nav_status run_truth(job *j, long run, nav_truth **truth) {
+  if (*truth) return NAV_OK;
+  char msg[200];
+  const nav_status st = nav_truth_create_msg(&j->sim->scene, truth, msg, sizeof msg);
+  if (st != NAV_OK) job_error(j, "run %ld: reference trajectory: %s", run, msg[0] ? msg : nav_status_str(st));
+  return st;
 }
 
 /*
@@ -397,7 +437,7 @@ static nav_status pvt_fix(const nav_ins_gnss_raw_epoch *ep, nav_ins_gnss_fix *f,
  * t_k (numerics.md 6.5: the residual offset is below dt/2; with rates that divide the IMU rate
  * it is zero). Each fix is made by the receiver model from the truth at its own time of validity.
  */
-static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_imu_increment *imu, long run) {
+static nav_status aiding_fixes(job *j, aiding *a, nav_truth **truth, const nav_imu_increment *imu, long run) {
   const nav_scene *sc = &j->sim->scene;
   if (j->sim->fixes) return recorded_fixes(j, a, imu, run);
   for (;;) {
@@ -416,8 +456,10 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     const int64_t kk = (int64_t)llround(kf);
     const bool on_grid = j->shared_ts && fabs(kf - (double)kk) < 1e-9 && kk >= 0 && kk <= j->n;
     const nav_traj_state *sh = on_grid ? shared_state(j, kk) : NULL;
+    const double t_eval = on_grid ? (double)kk * j->dt : t_fix;
+    if (!sh) sh = epoch_state(j, epoch, t_eval);
     if (sh) ts = *sh;
-    else st = nav_truth_state(truth, on_grid ? (double)kk * nav_truth_dt(truth) : t_fix, &ts);
+    else if ((st = run_truth(j, run, truth)) == NAV_OK) st = nav_truth_state(*truth, t_eval, &ts);
     if (st != NAV_OK) return st;
     nav_gnss_fix fix;
     bool has_fix = false;
@@ -430,7 +472,7 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     if (a->raw && a->pvt) {
       /* Loosely coupled on the least-squares PVT of the same raw measurements. */
       nav_ins_gnss_raw_epoch ep;
-      const nav_frame fr = nav_truth_frame(truth);
+      const nav_frame fr = j->frame;
       st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
       nav_ins_gnss_fix f;
       double pos_cov[9], vel_cov[9];
@@ -446,7 +488,7 @@ static nav_status aiding_fixes(job *j, aiding *a, nav_truth *truth, const nav_im
     if (a->raw) {
       /* Tightly coupled: the receiver's epochs and outages, the satellites' raw measurements. */
       nav_ins_gnss_raw_epoch ep;
-      const nav_frame fr = nav_truth_frame(truth);
+      const nav_frame fr = j->frame;
       st = nav_sim_gnss_raw_measure(a->raw, &fr, &ts, &ep);
       if (st == NAV_OK) st = nav_ins_gnss_update_raw(a->x, &ep, NULL);
       if (st != NAV_OK) {
@@ -538,14 +580,13 @@ static nav_status smooth_finish(job *j, long run, nav_smoother *sm, const size_t
  * e = (dr_n, dv_n, phi) with phi from C_true C_est^T = I + [phi x] (E0.1), resolved in n.
  * Returns NAN when the block is not positive definite.
  */
-static double nees9(const double *P, size_t n, const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s,
-                    const nav_epoch_errors *e) {
+static double nees9(const double *P, size_t n, const nav_errors_ref *ref, const nav_traj_state *ts,
+                    const nav_ins_state *s, const nav_epoch_errors *e) {
   double B[81], L[81], x[9];
   for (size_t i = 0; i < 9; ++i)
     for (size_t q = 0; q < 9; ++q) B[i * 9 + q] = P[i * n + q];
-  const nav_local_view vt = nav_frame_view(fr, ts->r_fb_f_m, ts->v_fb_f_mps, ts->q_b_f);
   const nav_vec3 phi_f = nav_quat_to_rotvec(nav_quat_mul(ts->q_b_f, nav_quat_conj(s->q_b_f)));
-  const nav_vec3 phi_n = nav_mat3_mul_vec(vt.C_f_n, phi_f);
+  const nav_vec3 phi_n = nav_mat3_mul_vec(ref->view.C_f_n, phi_f);
   const double err[9] = {e->pos_err_n_m.x,   e->pos_err_n_m.y,   e->pos_err_n_m.z, e->vel_err_n_mps.x, e->vel_err_n_mps.y,
                          e->vel_err_n_mps.z, phi_n.x, phi_n.y, phi_n.z};
   if (nav_matn_cholesky(L, B, 9) != NAV_OK) return NAN;
@@ -567,7 +608,7 @@ static const double *run_cov(const nav_ins_gnss *x, const nav_sim_gyrofree *gf, 
 }
 
 static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, const double *P, size_t n,
-                      const nav_frame *fr, const nav_traj_state *ts, const nav_ins_state *s) {
+                      const nav_errors_ref *ref, const nav_traj_state *ts, const nav_ins_state *s) {
   const int64_t slot = out_slot(j, k);
   if (!j->env || slot < 0 || slot >= j->n_out) return;
   double *v = j->env + ((int64_t)run * j->n_out + slot) * ENV_VALUES;
@@ -579,7 +620,7 @@ static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, co
   v[5] = v[6] = v[7] = v[8] = 0.0;
   if (P) {
     for (int i = 0; i < 3; ++i) v[5 + i] = sqrt(P[(size_t)i * n + (size_t)i]);
-    v[8] = nees9(P, n, fr, ts, s, e);
+    v[8] = nees9(P, n, ref, ts, s, e);
   }
 }
 
@@ -598,13 +639,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const nav_run_observer *obs = j->opts->observer; /* requirements (nav_requirements.h) */
   void *obs_ctx = obs && obs->begin ? obs->begin(obs->user, run) : NULL;
   char msg[200];
-  nav_status st = nav_truth_create_msg(sc, &truth, msg, sizeof msg);
-  if (st != NAV_OK) {
-    job_error(j, "run %ld: reference trajectory: %s", run, msg[0] ? msg : nav_status_str(st));
-    goto cleanup;
-  }
-  const nav_frame frame = nav_truth_frame(truth);
-  const double dt = nav_truth_dt(truth);
+  nav_status st = j->shared_imu ? NAV_OK : run_truth(j, run, &truth);
+  if (st != NAV_OK) goto cleanup;
+  const nav_frame frame = j->frame;
+  const double dt = j->dt;
   const bool gf_gnss = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
   const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || gf_gnss;
   if (!j->ideal && !gyro_free) {
@@ -616,7 +654,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   }
   nav_traj_state ts;
   if (shared_state(j, 0)) ts = *shared_state(j, 0);
-  else st = nav_truth_state(truth, 0.0, &ts);
+  else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, 0.0, &ts);
   if (st != NAV_OK) goto cleanup;
   const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
   const nav_ins_config icfg = nav_ins_config_from_scene(sc);
@@ -675,10 +713,12 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
   const bool record = caller_thread && run == 0 && j->opts->record;
   bool stop = false;
 
-  nav_epoch_errors err = nav_errors_compute(&frame, &ts, nav_ins_get_state(ins));
+  nav_errors_ref own_ref;
+  const nav_errors_ref *ref = errors_ref(j, 0, &ts, &own_ref);
+  nav_epoch_errors err = nav_errors_compute_ref(&frame, &ts, ref, nav_ins_get_state(ins));
   store_metrics(j, run, 0, &err);
   const double *cov0 = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-  store_env(j, run, 0, &err, cov0, cov_n, &frame, &ts, nav_ins_get_state(ins));
+  store_env(j, run, 0, &err, cov0, cov_n, ref, &ts, nav_ins_get_state(ins));
   if (obs_ctx) obs->epoch(obs_ctx, &err);
   if (sm) {
     sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
@@ -702,7 +742,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
     nav_imu_increment own_imu, meas;
     const nav_imu_increment *ideal = &own_imu;
     if (j->shared_imu) ideal = &j->shared_imu[k - 1];
-    else st = nav_truth_imu(truth, k, &own_imu);
+    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_imu(truth, k, &own_imu);
     if (st != NAV_OK) {
       job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
                 (double)k * dt);
@@ -732,10 +772,10 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
         job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(aid_kf.x));
         goto cleanup;
       }
-      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
+      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
     } else if (gf_gnss) {
-      st = aiding_fixes(j, &aid_kf, truth, &meas, run);
+      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
       if (st != NAV_OK) goto cleanup;
     } else if (!gf) {
       st = nav_ins_step(ins, &meas);
@@ -766,7 +806,7 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
                                               : nav_ins_get_state(ins);
     const nav_traj_state *sh = shared_state(j, k);
     if (sh) ts = *sh;
-    else st = nav_truth_state(truth, meas.t_s, &ts);
+    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, meas.t_s, &ts);
     if (st != NAV_OK) goto cleanup;
     if (aid && !integrated) {
       /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
@@ -775,10 +815,11 @@ static nav_status run_one(job *j, long run, bool caller_thread) {
       st = nav_ins_aid_vertical(ins, h, v.v_n_mps.z);
       if (st != NAV_OK) goto cleanup;
     }
-    err = nav_errors_compute(&frame, &ts, nav_now);
+    ref = errors_ref(j, k, &ts, &own_ref);
+    err = nav_errors_compute_ref(&frame, &ts, ref, nav_now);
     if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
     const double *cov = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-    store_env(j, run, k, &err, cov, cov_n, &frame, &ts, nav_now);
+    store_env(j, run, k, &err, cov, cov_n, ref, &ts, nav_now);
     if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
     if (sm && out_k) {
       /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
@@ -850,6 +891,48 @@ static nav_status add_values(const double *v, int64_t count, nav_stat_acc *acc) 
   return st;
 }
 
+/*
+ * The reference at every receiver epoch of the run's time span (epoch_state), evaluated once by
+ * the job's reference object for a Monte Carlo job with shared truth and a simulated receiver
+ * (ins_gnss, ins_gnss_tight, gyro_free_gnss; not recorded fixes). Each run needs these states at
+ * every epoch, outages included, and most epochs fall between the shared IMU-grid states (the
+ * increment's interval, a difference of two times, is not exactly 1 / rate). An epoch whose state
+ * cannot be evaluated is not kept (the run evaluates it and reports the failure as before).
+ */
+static nav_status shared_epoch_states(job *j, nav_truth *probe) {
+  const nav_scene *sc = &j->sim->scene;
+  const bool receiver = sc->navigation.scheme == NAV_SCHEME_INS_GNSS ||
+                        sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT ||
+                        sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  if (!receiver || j->sim->fixes || !(j->gnss_cfg.update_rate_hz > 0.0)) return NAV_OK;
+  nav_gnss_model *gm = NULL;
+  nav_status st = nav_gnss_model_create(&j->gnss_cfg, &j->frame, sc->simulation.seed, 0, &gm);
+  if (st != NAV_OK) return st;
+  const double t_end = (double)j->n * j->dt;
+  int64_t count = 0;
+  while (nav_gnss_model_epoch_time_s(gm, count) <= t_end && count <= j->n)
+    ++count;
+  if (count > 0) {
+    j->gnss_ts = malloc((size_t)count * sizeof *j->gnss_ts);
+    j->gnss_t = malloc((size_t)count * sizeof *j->gnss_t);
+  }
+  if (j->gnss_ts && j->gnss_t) {
+    for (int64_t e = 0; e < count; ++e) {
+      const double t = nav_gnss_model_epoch_time_s(gm, e);
+      j->gnss_t[e] = nav_truth_state(probe, t, &j->gnss_ts[e]) == NAV_OK ? t : NAN;
+    }
+    j->gnss_epochs = count;
+  } else {
+    /* Not kept (no memory): every run evaluates its epochs itself. */
+    free(j->gnss_ts);
+    free(j->gnss_t);
+    j->gnss_ts = NULL;
+    j->gnss_t = NULL;
+  }
+  nav_gnss_model_destroy(gm);
+  return NAV_OK;
+}
+
 nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summary *out) {
   job j;
   nav_status st = NAV_OK;
@@ -897,6 +980,8 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   }
   j.n = nav_truth_sample_count(probe);
   const double dt = nav_truth_dt(probe);
+  j.frame = nav_truth_frame(probe);
+  j.dt = dt;
   /* Range hook: runs [r0, r1) only (a merge runs none). */
   const long r0 = sim->hook.active ? (sim->hook.r0 < j.runs ? sim->hook.r0 : j.runs) : 0;
   j.run_end = sim->hook.active ? (sim->hook.r1 < j.runs ? sim->hook.r1 : j.runs) : j.runs;
@@ -922,13 +1007,20 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
       }
     j.shared_imu = malloc((size_t)j.n * sizeof *j.shared_imu);
     j.shared_ts = j.ts_map ? malloc((size_t)n_ts * sizeof *j.shared_ts) : NULL;
+    /* The reference part of the errors beside each kept state, within SHARED_REF_MAX_BYTES (else
+     * every run computes it at each of its error epochs, as a job without shared truth does). */
+    if (j.shared_ts && (size_t)n_ts * sizeof *j.shared_ref <= SHARED_REF_MAX_BYTES)
+      j.shared_ref = malloc((size_t)n_ts * sizeof *j.shared_ref);
     if (j.shared_imu && j.shared_ts) {
       st = nav_truth_state(probe, 0.0, &j.shared_ts[0]);
+      if (st == NAV_OK && j.shared_ref) j.shared_ref[0] = nav_errors_ref_compute(&j.frame, &j.shared_ts[0]);
       int64_t k_fail = 0;
       for (int64_t k = 1; k <= j.n && st == NAV_OK; ++k) {
         k_fail = k;
         st = nav_truth_imu(probe, k, &j.shared_imu[k - 1]);
         if (st == NAV_OK && j.ts_map[k] >= 0) st = nav_truth_state(probe, (double)k * dt, &j.shared_ts[j.ts_map[k]]);
+        if (st == NAV_OK && j.ts_map[k] >= 0 && j.shared_ref)
+          j.shared_ref[j.ts_map[k]] = nav_errors_ref_compute(&j.frame, &j.shared_ts[j.ts_map[k]]);
         if (opts->progress && k % PROGRESS_EVERY == 0) {
           nav_progress p = {"truth", 0, 0.0, (double)k * dt};
           if (opts->progress(opts->user, &p) == NAV_STOP) st = NAV_ERR_CANCELLED;
@@ -941,10 +1033,18 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
         nav_truth_destroy(probe);
         goto cleanup;
       }
+      st = shared_epoch_states(&j, probe);
+      if (st != NAV_OK) {
+        snprintf(sim->last_error, sizeof sim->last_error, "GNSS receiver model: %s", nav_status_str(st));
+        nav_truth_destroy(probe);
+        goto cleanup;
+      }
     } else {
       free(j.shared_imu);
       free(j.shared_ts);
       free(j.ts_map);
+      free(j.shared_ref);
+      j.shared_ref = NULL;
       j.shared_imu = NULL;
       j.shared_ts = NULL;
       j.ts_map = NULL;
@@ -1189,6 +1289,9 @@ cleanup:
   free(j.shared_imu);
   free(j.shared_ts);
   free(j.ts_map);
+  free(j.shared_ref);
+  free(j.gnss_ts);
+  free(j.gnss_t);
   nav_sim_gyrofree_truth_destroy(j.gf_truth);
   free(j.final);
   free(j.samples_done);
