@@ -23,6 +23,9 @@ set_target_properties(navcore_shared PROPERTIES OUTPUT_NAME navcore EXPORT_NAME 
   VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR})
 set_target_properties(navcore_io_shared PROPERTIES OUTPUT_NAME navcore_io EXPORT_NAME io
   VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR})
+# Build RUNPATH as installed (none): see navsim in navcore/CMakeLists.txt. Nothing in the build tree
+# loads these two; they are used once installed (tests/install).
+set_target_properties(navcore_shared navcore_io_shared PROPERTIES BUILD_WITH_INSTALL_RPATH ON)
 set_target_properties(navcore PROPERTIES EXPORT_NAME navcore_static)
 set_target_properties(navcore_io PROPERTIES EXPORT_NAME io_static)
 # A symbol the shared libraries use but do not find (e.g. a hidden one) fails the link here, not

@@ -56,6 +56,23 @@ tree)
       [ -e "$prefix/$f" ] || fail "not installed: $f"
     done
   fi
+  # No program or library, built or installed, may name a search directory the loader reads as
+  # relative to the current one: an empty RUNPATH/RPATH entry (CMake leaves a trailing ':' in the
+  # build tree for installed targets unless they are linked with their install RUNPATH) or a
+  # relative path. A build-tree navsim started in a user's data folder would otherwise load a
+  # libexpat.so.1 lying there.
+  for f in "$build/navcore/navsim" "$build/viewer/navview" "$build/editor/navstudio" \
+    "$build"/navcore/libnavcore*.so.* "$prefix"/bin/* "$prefix/$libdir"/libnavcore*.so.*; do
+    [ -f "$f" ] || continue
+    rp=$(readelf -d "$f" | sed -n 's/.*(R[UN]*PATH).*\[\(.*\)\]/\1/p')
+    [ -z "$rp" ] && continue
+    case ":$rp:" in *::*) fail "$f: RUNPATH '$rp' has an empty entry (the current directory)" ;; esac
+    old_ifs=$IFS; IFS=:
+    for d in $rp; do
+      case "$d" in /*|'$ORIGIN'*) ;; *) IFS=$old_ifs; fail "$f: RUNPATH '$rp' has a relative entry '$d'" ;; esac
+    done
+    IFS=$old_ifs
+  done
   # SONAME follows the version: libnavcore.so.MAJOR.
   major=${version%%.*}
   for l in navcore navcore_io; do
