@@ -50,6 +50,7 @@
 #include <string.h>
 
 #include "filter/filter_internal.h"
+#include "math/chol_solve_inline.h"
 #include "navcore/nav_earth.h"
 
 #define NMAX NAV_FILTER_MAX_STATES
@@ -1099,37 +1100,6 @@ static NAV_ALWAYS_INLINE void sub_xty(double *restrict out, const double *base, 
   }
 }
 
-/* x := S^-1 x for the m x n x (rows of n) by the m x m Cholesky factor l of S: the operations and
- * the order of nav_matn_chol_solve(x, l, x, m, n) (forward substitution, then back substitution,
- * row by row), inlined with the compile-time m and n of update_core, so each row operation runs
- * over the n columns at once. */
-static NAV_ALWAYS_INLINE void chol_solve_rows(double *x, const double *l, const size_t m, const size_t n) {
-  NAV_UNROLL
-  for (size_t i = 0; i < m; ++i) {
-    NAV_UNROLL
-    for (size_t k = 0; k < i; ++k) {
-      const double lik = l[i * m + k];
-      for (size_t c = 0; c < n; ++c)
-        x[i * n + c] -= lik * x[k * n + c];
-    }
-    const double lii = l[i * m + i];
-    for (size_t c = 0; c < n; ++c)
-      x[i * n + c] /= lii;
-  }
-  NAV_UNROLL
-  for (size_t ii = m; ii-- > 0;) {
-    NAV_UNROLL
-    for (size_t k = ii + 1; k < m; ++k) {
-      const double lki = l[k * m + ii];
-      for (size_t c = 0; c < n; ++c)
-        x[ii * n + c] -= lki * x[k * n + c];
-    }
-    const double lii = l[ii * m + ii];
-    for (size_t c = 0; c < n; ++c)
-      x[ii * n + c] /= lii;
-  }
-}
-
 static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const size_t m, const double *H,
                                           const double *z, const double *R, double *y, double *S, double *Ls) {
   const double *P = f->P;
@@ -1199,7 +1169,9 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
   /* K^T = S^-1 (P H^T)^T by the Cholesky factor (never an explicit inverse). */
   double *Kt = f->Kt;
   memcpy(Kt, PHtT, m * n * sizeof *Kt);
-  chol_solve_rows(Kt, Ls, m, n);
+  /* Kt := S^-1 Kt by the Cholesky factor of S: the operations and order of
+     nav_matn_chol_solve(Kt, Ls, Kt, m, n), inlined with the compile-time m and n of update_core. */
+  nav_chol_solve_rows_inline(Kt, Ls, m, n);
 
   /* x+ = x- + K y */
   for (size_t j = 0; j < n; ++j)

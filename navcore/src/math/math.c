@@ -21,6 +21,7 @@
  * [NUM] docs/numerics.md (project), sections 0.2, 4.1, 4.4.
  */
 #include "navcore/nav_math.h"
+#include "math/chol_solve_inline.h"
 #include "math/quat_dcm_inline.h"
 
 #include <assert.h>
@@ -458,26 +459,7 @@ void nav_matn_chol_solve(double *x, const double *l, const double *b, size_t n, 
   if (x == NULL || l == NULL || b == NULL) return;
   if (x != b) memmove(x, b, n * m * sizeof *x);
   /* L Y = B by forward substitution, then L^T X = Y by back substitution, in place in x. */
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t k = 0; k < i; ++k) {
-      const double lik = l[i * n + k];
-      for (size_t c = 0; c < m; ++c)
-        x[i * m + c] -= lik * x[k * m + c];
-    }
-    const double lii = l[i * n + i];
-    for (size_t c = 0; c < m; ++c)
-      x[i * m + c] /= lii;
-  }
-  for (size_t ii = n; ii-- > 0;) {
-    for (size_t k = ii + 1; k < n; ++k) {
-      const double lki = l[k * n + ii]; /* (L^T)_ik */
-      for (size_t c = 0; c < m; ++c)
-        x[ii * m + c] -= lki * x[k * m + c];
-    }
-    const double lii = l[ii * n + ii];
-    for (size_t c = 0; c < m; ++c)
-      x[ii * m + c] /= lii;
-  }
+  nav_chol_solve_rows_inline(x, l, n, m);
 }
 
 void nav_matn_mul(double *c, const double *a, const double *b, size_t n, size_t k, size_t m) {
