@@ -10,6 +10,7 @@
 
 #include "navcore/nav_io.h"
 #include "navcore/nav_sim.h"
+#include "navcore/nav_size_limits.h"
 #include "navcore/nav_traj.h"
 #include "navcore/nav_truth.h"
 
@@ -32,6 +33,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static nav_scene scene;
   if (nav_scene_read_string((const char *)data, size, "fuzz.yaml", &scene, NULL, NULL) != NAV_OK) return 0;
   if (nav_scene_validate(&scene, ignore_issue, NULL) != NAV_OK) __builtin_trap(); /* the reader accepted it */
+
+  /* navsim run, estimate and render refuse a scene above the documented output and memory limits
+   * before building anything (nav_size_check, without --allow-large); so does this target. Such a
+   * scene's trajectory takes time in proportion to its length: a walking-pace waypoint moved 49
+   * degrees of latitude away (tests/fuzz/corpus/fuzz_check/long-walk-leg.yaml, 750 million IMU
+   * samples) took 4 s to plan natively and 50 s under the fuzzer, past its 10 s per-input bound. */
+  nav_size_prediction pred;
+  nav_predict_run(&scene, false, 1, false, &pred);
+  if (!(pred.output_bytes <= NAV_MAX_OUTPUT_BYTES) || !(pred.memory_bytes <= NAV_MAX_MEMORY_BYTES)) {
+    nav_scene_release(&scene);
+    return 0;
+  }
 
   /* Trajectory over its whole duration: a few evaluations and increments. */
   const double dt = 1.0 / scene.imu.rate_hz;
