@@ -85,6 +85,10 @@ typedef struct nav_sim_options {
    *  final errors and the output epochs (navstudio's live preview) passes the output stride and
    *  skips the reference state and the errors at the other IMU epochs. */
   int64_t stats_stride_min;
+  /** Runs stepped together: 0 (the default) lets a Monte Carlo job of the loosely coupled
+   *  INS/GNSS scheme step four runs at once with their strapdown in vector lanes; 1 steps one run
+   *  at a time. The results are the same bits either way (as for any thread count). */
+  int lanes;
 } nav_sim_options;
 
 NAV_API nav_sim_options nav_sim_options_default(void);

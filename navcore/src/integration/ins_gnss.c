@@ -11,6 +11,7 @@
 #include "navcore/nav_sensors.h"
 #include "filter/filter_internal.h"
 #include "integration/ins_gnss_internal.h"
+#include "nav/strapdown_lanes.h"
 #include "math/quat_dcm_inline.h"
 
 static nav_filter_ins_state nominal_of(const nav_ins_gnss *x);
@@ -222,10 +223,10 @@ nav_filter_nav nav_ins_gnss_filter_nav(const nav_frame *fr, const nav_ins *ins, 
   return n;
 }
 
-nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
-  if (!x || !raw || !(raw->dt_s > 0.0)) return NAV_ERR_INVALID_ARG;
+/* Compensation of a raw increment: (raw - b dt) / (1 + s), written member by member (see
+ * nav_ins_gnss_filter_nav). */
+static inline void compensate(const nav_ins_gnss *x, const nav_imu_increment *raw, nav_imu_increment *m) {
   const double dt = raw->dt_s;
-  /* Compensation: (raw - b dt) / (1 + s), written member by member (see nav_ins_gnss_filter_nav). */
   double gx = raw->dtheta_b_rad.x + -dt * x->b_g_rps.x, gy = raw->dtheta_b_rad.y + -dt * x->b_g_rps.y,
          gz = raw->dtheta_b_rad.z + -dt * x->b_g_rps.z;
   double ax = raw->dv_b_mps.x + -dt * x->b_a_mps2.x, ay = raw->dv_b_mps.y + -dt * x->b_a_mps2.y,
@@ -238,32 +239,37 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
     ay /= 1.0 + x->s_a.y;
     az /= 1.0 + x->s_a.z;
   }
-  nav_imu_increment m;
-  m.k = raw->k;
-  m.t_s = raw->t_s;
-  m.dt_s = dt;
-  m.dtheta_b_rad.x = gx;
-  m.dtheta_b_rad.y = gy;
-  m.dtheta_b_rad.z = gz;
-  m.dv_b_mps.x = ax;
-  m.dv_b_mps.y = ay;
-  m.dv_b_mps.z = az;
-  nav_status st = nav_ins_step(x->ins, &m);
-  if (st != NAV_OK) {
-    snprintf(x->err, sizeof x->err, "strapdown navigation stopped at t = %.6f s: %s", m.t_s, nav_ins_last_error(x->ins));
-    return st;
-  }
+  m->k = raw->k;
+  m->t_s = raw->t_s;
+  m->dt_s = dt;
+  m->dtheta_b_rad.x = gx;
+  m->dtheta_b_rad.y = gy;
+  m->dtheta_b_rad.z = gz;
+  m->dv_b_mps.x = ax;
+  m->dv_b_mps.y = ay;
+  m->dv_b_mps.z = az;
+}
+
+static nav_status strapdown_failed(nav_ins_gnss *x, const nav_imu_increment *m, nav_status st) {
+  snprintf(x->err, sizeof x->err, "strapdown navigation stopped at t = %.6f s: %s", m->t_s, nav_ins_last_error(x->ins));
+  return st;
+}
+
+/* The step after the strapdown: the filter prediction (and the smoother's record) with the
+ * compensated increment m the INS was just stepped with. */
+static inline nav_status after_strapdown(nav_ins_gnss *x, const nav_imu_increment *m) {
+  const double dt = m->dt_s;
   nav_filter_nav n; /* filled in place: no copy of the returned struct per step */
   /* From the NED state the INS vouches for lat, h, v and C_b_n (nav_filter_predict_ins). */
-  st = filter_nav_fill(&n, &x->frame, x->ins, &m) ? nav_filter_predict_ins(x->kf, &n, dt)
-                                                  : nav_filter_predict(x->kf, &n, dt);
+  nav_status st = filter_nav_fill(&n, &x->frame, x->ins, m) ? nav_filter_predict_ins(x->kf, &n, dt)
+                                                            : nav_filter_predict(x->kf, &n, dt);
   if (st != NAV_OK) {
-    snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m.t_s, nav_filter_last_error(x->kf));
+    snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m->t_s, nav_filter_last_error(x->kf));
     return st;
   }
   if (x->cfg.smoother) {
     const nav_filter_ins_state nom = nominal_of(x);
-    st = nav_smoother_step(x->cfg.smoother, m.t_s, &n, dt, &nom);
+    st = nav_smoother_step(x->cfg.smoother, m->t_s, &n, dt, &nom);
     if (st != NAV_OK) {
       snprintf(x->err, sizeof x->err, "%s", nav_smoother_last_error(x->cfg.smoother));
       return st;
@@ -276,13 +282,45 @@ nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
     x->prev_dt_s = x->last.dt_s;
     x->have_prev = true;
   }
-  x->last.k = m.k;
-  x->last.t_s = m.t_s;
+  x->last.k = m->k;
+  x->last.t_s = m->t_s;
   x->last.dt_s = dt;
-  x->last.dtheta_b_rad = nav_vec3_make(gx, gy, gz);
-  x->last.dv_b_mps = nav_vec3_make(ax, ay, az);
+  x->last.dtheta_b_rad = nav_vec3_make(m->dtheta_b_rad.x, m->dtheta_b_rad.y, m->dtheta_b_rad.z);
+  x->last.dv_b_mps = nav_vec3_make(m->dv_b_mps.x, m->dv_b_mps.y, m->dv_b_mps.z);
   x->have_step = true;
   return NAV_OK;
+}
+
+nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
+  if (!x || !raw || !(raw->dt_s > 0.0)) return NAV_ERR_INVALID_ARG;
+  nav_imu_increment m;
+  compensate(x, raw, &m);
+  const nav_status st = nav_ins_step(x->ins, &m);
+  if (st != NAV_OK) return strapdown_failed(x, &m, st);
+  return after_strapdown(x, &m);
+}
+
+void nav_ins_gnss_step_lanes(nav_ins_gnss *const x[NAV_LANES], const nav_imu_increment *const raw[NAV_LANES],
+                             nav_status st[NAV_LANES]) {
+  for (int l = 0; l < NAV_LANES; ++l)
+    if (!x[l] || !raw[l] || !(raw[l]->dt_s > 0.0)) {
+      for (int i = 0; i < NAV_LANES; ++i)
+        st[i] = nav_ins_gnss_step(x[i], raw[i]);
+      return;
+    }
+  nav_imu_increment m[NAV_LANES];
+  nav_ins *ins[NAV_LANES];
+  const nav_imu_increment *mp[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    compensate(x[l], raw[l], &m[l]);
+    ins[l] = x[l]->ins;
+    mp[l] = &m[l];
+  }
+  const bool lockstep = nav_ins_step_lanes(ins, mp);
+  for (int l = 0; l < NAV_LANES; ++l) {
+    st[l] = lockstep ? NAV_OK : nav_ins_step(ins[l], &m[l]);
+    st[l] = st[l] != NAV_OK ? strapdown_failed(x[l], &m[l], st[l]) : after_strapdown(x[l], &m[l]);
+  }
 }
 
 /* The filter's linearisation point at the current epoch: the INS state (view), the filter inputs of

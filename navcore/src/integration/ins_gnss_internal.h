@@ -27,6 +27,11 @@ struct nav_ins_gnss {
   char err[256];
 };
 
+/** nav_ins_gnss_step(x[l], raw[l]) for l = 0..3, st[l] its status, with the four strapdown steps
+ *  in lockstep where they can be (nav_ins_step_lanes()): the same results and messages as four
+ *  calls. */
+void nav_ins_gnss_step_lanes(nav_ins_gnss *const x[4], const nav_imu_increment *const raw[4], nav_status st[4]);
+
 /** Filter inputs from the INS and the compensated increment of the step just taken. */
 nav_filter_nav nav_ins_gnss_filter_nav(const nav_frame *fr, const nav_ins *ins, const nav_imu_increment *imu);
 

@@ -34,6 +34,7 @@
  * 860 per ECEF step (its normal gravity without trigonometry, nav/ecef_gravity.h), 890 flat
  * (high order, 200 Hz; 1360, 2290 and 970 before).
  */
+#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,6 +44,7 @@
 #include "nav/ecef_gravity.h"
 #include "nav_clones.h"
 #include "math/quat_dcm_inline.h"
+#include "nav/strapdown_lanes.h"
 
 /* 1 - e^2 = (b/a)^2. */
 #define E2M (1.0 - NAV_WGS84_E2)
@@ -788,4 +790,223 @@ NAV_HOT_CLONES nav_status nav_ins_step(nav_ins *ins, const nav_imu_increment *im
   ins->prev_dv_b_mps = imu->dv_b_mps;
   ins->have_prev = true;
   return NAV_OK;
+}
+
+/* ------------------------------------------------------------------ four INS in lockstep */
+
+/* The Earth terms of ned_terms_fill() (normal gravity) in four lanes, from a nearby point's terms.
+ * The two Newton steps are taken lane by lane where the scalar code takes them, the exact 1/sqrt
+ * and division elsewhere: both are computed and the lane's own choice kept. */
+typedef struct ned_terms4 {
+  nav_l4 sl, cl, icl, RM, RN, iRMh, iRNh, isq, inv, gz;
+} ned_terms4;
+
+NAV_CLONE_INLINE void ned_terms_fill4(nav_l4 sl, nav_l4 cl, nav_l4 h, const ned_terms4 *near, ned_terms4 *t) {
+  const nav_l4 one = l4_splat(1.0);
+  const nav_l4 s2 = sl * sl;
+  const nav_l4 den2 = one - l4_splat(NAV_WGS84_E2) * s2;
+  const nav_l4 e_sq = one - den2 * near->isq * near->isq;
+  const nav_m4 newton_sq = l4_abs(e_sq) < l4_splat(NEWTON_REL);
+  nav_l4 isq = near->isq * (one + l4_splat(0.5) * e_sq);
+  if (!l4_all(newton_sq))
+    for (int l = 0; l < NAV_LANES; ++l)
+      if (!newton_sq[l]) isq[l] = 1.0 / sqrt(den2[l]);
+  t->sl = sl;
+  t->cl = cl;
+  t->isq = isq;
+  t->RN = l4_splat(NAV_WGS84_A_M) * isq;
+  t->RM = l4_splat(NAV_WGS84_A_M * E2M) * isq * isq * isq;
+  const nav_l4 A = t->RM + h, B = t->RN + h, P = A * B, x = P * cl;
+  const nav_l4 e_inv = one - x * near->inv;
+  t->inv = l4_sel(l4_abs(e_inv) < l4_splat(NEWTON_REL), near->inv * (one + e_inv), one / x);
+  t->iRMh = t->inv * B * cl;
+  t->iRNh = t->inv * A * cl;
+  t->icl = t->inv * P;
+  const double a = NAV_WGS84_A_M;
+  const nav_l4 gamma0 =
+      l4_splat(NAV_WGS84_GAMMA_E_MPS2) * (one + l4_splat(NAV_WGS84_SOMIGLIANA_K) * s2) * isq;
+  const nav_l4 lin = l4_splat(2.0 / a) * (l4_splat(1.0 + NAV_WGS84_F + NAV_WGS84_M) - l4_splat(2.0 * NAV_WGS84_F) * s2);
+  const nav_l4 quad = l4_splat(3.0 / (a * a));
+  t->gz = gamma0 * (one - lin * h + quad * h * h);
+}
+
+/* ned_rates() and ned_force() in lanes (g_n = (0, 0, gz) with normal gravity). */
+NAV_CLONE_INLINE void ned_rates4(const ned_terms4 *t, nav_l4v3 v, nav_l4v3 *w_in, nav_l4v3 *w_cor) {
+  const nav_l4 w = l4_splat(NAV_WGS84_OMEGA_IE_RPS);
+  const nav_l4 east = v.y * t->iRNh;
+  const nav_l4v3 w_ie = l4v3(w * t->cl, l4_splat(0.0), -w * t->sl);
+  const nav_l4v3 w_en = l4v3(east, -v.x * t->iRMh, -east * t->sl * t->icl);
+  *w_in = l4v3_add(w_ie, w_en);
+  *w_cor = l4v3_add(*w_in, w_ie);
+}
+NAV_CLONE_INLINE nav_l4v3 ned_force4(const ned_terms4 *t, nav_l4v3 w_cor, nav_l4v3 v) {
+  return l4v3_sub(l4v3(l4_splat(0.0), l4_splat(0.0), t->gz), l4v3_cross(w_cor, v));
+}
+
+/* The series of quat_of_rotvec() / body_terms() below ROT_SERIES_RAD (the caller checks a2). */
+NAV_CLONE_INLINE nav_l4q quat_series4(nav_l4v3 v, nav_l4 a2) {
+  const nav_l4 w = l4_splat(1.0) - a2 * (l4_splat(1.0 / 8.0) - a2 * (l4_splat(1.0 / 384.0) - a2 * l4_splat(1.0 / 46080.0)));
+  const nav_l4 s = l4_splat(0.5) - a2 * (l4_splat(1.0 / 48.0) - a2 * (l4_splat(1.0 / 3840.0) - a2 * l4_splat(1.0 / 645120.0)));
+  nav_l4q q = {w, s * v.x, s * v.y, s * v.z};
+  return q;
+}
+
+/* Does this INS step on the lockstep path: WGS-84 in NED, the high-order algorithm with the
+ * predictor-corrector gravity step and normal gravity, no vertical hold. */
+static bool lanes_config(const nav_ins *ins) {
+  const nav_ins_config *c = &ins->cfg;
+  return c->earth_model == NAV_EARTH_WGS84 && c->mech_frame == NAV_MECH_NED && c->algorithm == NAV_MECH_HIGH_ORDER &&
+         c->gravity_step == NAV_INS_GRAVITY_PREDICTOR_CORRECTOR && c->gravity_model == NAV_GRAVITY_NORMAL &&
+         !c->clamp_vertical;
+}
+
+/*
+ * step_ned_impl(high, predictor-corrector) of four INS at once, lane l being ins[l] with imu[l]:
+ * the same operations in the same order in every lane. Where the scalar step branches on the
+ * data, the lanes go on only when every lane takes the branch taken here (the rotation series,
+ * the series of the latitude step, no pole, no longitude wrap, renormalisation by the Newton
+ * step, a finite state); otherwise nothing is written and false is returned, and the caller
+ * steps each INS with nav_ins_step(), which also words any error.
+ */
+NAV_HOT_CLONES bool nav_ins_step_lanes(nav_ins *const ins[NAV_LANES], const nav_imu_increment *const imu[NAV_LANES]) {
+  nav_l4 dt, lat0, lon0, h0;
+  nav_l4v3 dth, dv, pdth, pdv, v0;
+  nav_l4q q0;
+  ned_terms4 t0;
+  for (int l = 0; l < NAV_LANES; ++l) {
+    const nav_ins *s = ins[l];
+    const nav_imu_increment *u = imu[l];
+    if (!lanes_config(s) || !(u->dt_s > 0.0) || !nav_vec3_isfinite(u->dtheta_b_rad) ||
+        !nav_vec3_isfinite(u->dv_b_mps) || !isfinite(u->dt_s))
+      return false;
+    dt[l] = u->dt_s;
+    l4v3_set_lane(&dth, l, u->dtheta_b_rad);
+    l4v3_set_lane(&dv, l, u->dv_b_mps);
+    l4v3_set_lane(&pdth, l, s->have_prev ? s->prev_dtheta_b_rad : nav_vec3_zero());
+    l4v3_set_lane(&pdv, l, s->have_prev ? s->prev_dv_b_mps : nav_vec3_zero());
+    lat0[l] = s->lat_rad;
+    lon0[l] = s->lon_rad;
+    h0[l] = s->h_m;
+    l4v3_set_lane(&v0, l, s->v_n_mps);
+    l4q_set_lane(&q0, l, s->q_b_n);
+    const ned_terms *e = &s->et;
+    t0.sl[l] = e->sl;
+    t0.cl[l] = e->cl;
+    t0.icl[l] = e->icl;
+    t0.RM[l] = e->RM;
+    t0.RN[l] = e->RN;
+    t0.iRMh[l] = e->iRMh;
+    t0.iRNh[l] = e->iRNh;
+    t0.isq[l] = e->isq;
+    t0.inv[l] = e->inv;
+    t0.gz[l] = e->g_n.z;
+  }
+  const nav_l4 hdt = l4_splat(0.5) * dt;
+  const nav_l4 one = l4_splat(1.0);
+
+  /* body_terms(high) */
+  const nav_l4v3 phi = l4v3_add(dth, l4v3_scale(l4v3_cross(pdth, dth), l4_splat(1.0 / 12.0)));
+  const nav_l4 a2 = l4v3_dot(phi, phi);
+  if (!l4_all(a2 < l4_splat(ROT_SERIES_RAD * ROT_SERIES_RAD))) return false;
+  const nav_l4q q_phi = quat_series4(phi, a2);
+  const nav_l4 b1 =
+      l4_splat(0.5) - a2 * (l4_splat(1.0 / 24.0) - a2 * (l4_splat(1.0 / 720.0) - a2 * l4_splat(1.0 / 40320.0)));
+  const nav_l4 b2 = l4_splat(1.0 / 6.0) -
+                    a2 * (l4_splat(1.0 / 120.0) - a2 * (l4_splat(1.0 / 5040.0) - a2 * l4_splat(1.0 / 362880.0)));
+  const nav_l4v3 pxdv = l4v3_cross(phi, dv);
+  const nav_l4v3 dv_rot = l4v3_add(l4v3_axpy(dv, b1, pxdv), l4v3_scale(l4v3_cross(phi, pxdv), b2));
+  const nav_l4v3 dv_scul =
+      l4v3_scale(l4v3_add(l4v3_cross(pdth, dv), l4v3_cross(pdv, dth)), l4_splat(1.0 / 12.0));
+  const nav_l4v3 dv_body = l4v3_add(dv_rot, dv_scul);
+
+  const nav_l4m3 C_b_n = l4q_to_dcm(q0);
+  const nav_l4v3 dv_f = l4m3_mul_vec(&C_b_n, dv_body);
+  const nav_l4v3 cdv = l4m3_mul_vec(&C_b_n, dv);
+  const nav_l4v3 cphi = l4m3_mul_vec(&C_b_n, phi);
+  const nav_l4v3 base = l4v3_add(v0, dv_f);
+
+  nav_l4v3 w_in0, w_cor0;
+  ned_rates4(&t0, v0, &w_in0, &w_cor0);
+  const nav_l4v3 F0 = ned_force4(&t0, w_cor0, v0);
+  const nav_l4 lat_rate0 = v0.x * t0.iRMh;
+  const nav_l4 lon_rate0 = v0.y * t0.iRNh * t0.icl;
+
+  /* Predictor */
+  nav_l4v3 zeta = l4v3_scale(w_in0, dt);
+  nav_l4v3 v1 =
+      l4v3_add(l4v3_add(base, l4v3_scale(l4v3_cross(zeta, cdv), l4_splat(-0.5))), l4v3_scale(F0, dt));
+  const nav_l4 lat_p = lat0 + dt * lat_rate0, h_p = h0 - dt * v0.z;
+  /* sincos_shift(), series branch */
+  const nav_l4 d = lat_p - lat0;
+  if (!l4_all(l4_abs(d) < l4_splat(LAT_STEP_SERIES_RAD))) return false;
+  const nav_l4 d2 = d * d;
+  const nav_l4 cd = one - d2 * (l4_splat(0.5) - d2 / l4_splat(24.0));
+  const nav_l4 sd = d * (one - d2 * (l4_splat(1.0 / 6.0) - d2 / l4_splat(120.0)));
+  const nav_l4 sp = t0.sl * cd + t0.cl * sd, cp = t0.cl * cd - t0.sl * sd;
+  if (!l4_all(cp >= l4_splat(NAV_INS_NED_MIN_COS_LAT))) return false;
+  ned_terms4 tp;
+  ned_terms_fill4(sp, cp, h_p, &t0, &tp);
+  nav_l4v3 w_inp, w_corp;
+  ned_rates4(&tp, v1, &w_inp, &w_corp);
+  const nav_l4v3 Fp = ned_force4(&tp, w_corp, v1);
+  /* Corrector, with frame_rotation_term(high) */
+  zeta = l4v3_scale(l4v3_add(w_in0, w_inp), hdt);
+  const nav_l4v3 k = l4v3_sub(l4v3_scale(zeta, l4_splat(1.0 / 6.0)), l4v3_scale(cphi, l4_splat(1.0 / 3.0)));
+  const nav_l4v3 rot = l4v3_cross(zeta, l4v3_add(l4v3_scale(cdv, l4_splat(-0.5)), l4v3_cross(k, cdv)));
+  v1 = l4v3_add(l4v3_add(base, rot), l4v3_scale(l4v3_add(F0, Fp), hdt));
+  const nav_l4 h1 = h0 - hdt * (v0.z + v1.z);
+  const nav_l4 lat1 = lat0 + hdt * (lat_rate0 + v1.x * tp.iRMh);
+  /* ned_half_lat(): glibc's sin and cos, lane by lane */
+  const nav_l4 hl = l4_splat(0.5) * lat1;
+  nav_l4 sh1, ch1;
+  for (int l = 0; l < NAV_LANES; ++l) {
+    sh1[l] = sin(hl[l]);
+    ch1[l] = cos(hl[l]);
+  }
+  const nav_l4 sl1 = l4_splat(2.0) * sh1 * ch1, cl1 = (ch1 - sh1) * (ch1 + sh1);
+  if (!l4_all(cl1 >= l4_splat(NAV_INS_NED_MIN_COS_LAT))) return false;
+  const nav_l4 lon_fac1 = tp.iRNh * tp.icl;
+  const nav_l4 lon1 = lon0 + hdt * (lon_rate0 + v1.y * lon_fac1);
+  if (!l4_all((lon1 <= l4_splat(NAV_PI)) & (lon1 > l4_splat(-NAV_PI)))) return false;
+  /* Attitude: q(-zeta) (x) q (x) q(phi), renormalised by the Newton step */
+  const nav_l4v3 mz = l4v3_scale(zeta, l4_splat(-1.0));
+  const nav_l4 z2 = l4v3_dot(mz, mz);
+  if (!l4_all(z2 < l4_splat(ROT_SERIES_RAD * ROT_SERIES_RAD))) return false;
+  const nav_l4q qq = l4q_mul(quat_series4(mz, z2), l4q_mul(q0, q_phi));
+  const nav_l4 n2 = qq.w * qq.w + qq.x * qq.x + qq.y * qq.y + qq.z * qq.z;
+  if (!l4_all(l4_abs(n2 - one) < l4_splat(1e-8))) return false;
+  const nav_l4 sc = l4_splat(0.5) * (l4_splat(3.0) - n2);
+  const nav_l4q q1 = {qq.w * sc, qq.x * sc, qq.y * sc, qq.z * sc};
+  /* The finiteness test of step_ned_impl, lane by lane. */
+  const nav_l4 sum = v1.x + v1.y + v1.z + h1 + lat1 + lon1 + q1.w + q1.x + q1.y + q1.z;
+  if (!l4_all(l4_abs(sum) <= l4_splat(DBL_MAX))) return false;
+  ned_terms4 t1;
+  ned_terms_fill4(sl1, cl1, h1, &tp, &t1);
+  for (int l = 0; l < NAV_LANES; ++l) {
+    nav_ins *s = ins[l];
+    s->lat_rad = lat1[l];
+    s->lon_rad = lon1[l];
+    s->h_m = h1[l];
+    s->v_n_mps = l4v3_lane(v1, l);
+    s->q_b_n = l4q_lane(q1, l);
+    ned_terms *e = &s->et;
+    e->sl = t1.sl[l];
+    e->cl = t1.cl[l];
+    e->icl = t1.icl[l];
+    e->RM = t1.RM[l];
+    e->RN = t1.RN[l];
+    e->iRMh = t1.iRMh[l];
+    e->iRNh = t1.iRNh[l];
+    e->isq = t1.isq[l];
+    e->inv = t1.inv[l];
+    e->g_n = nav_vec3_make(0.0, 0.0, t1.gz[l]);
+    s->view_sh = sh1[l];
+    s->view_ch = ch1[l];
+    s->view_stale = true;
+    s->s.t_s = imu[l]->t_s;
+    s->prev_dtheta_b_rad = imu[l]->dtheta_b_rad;
+    s->prev_dv_b_mps = imu[l]->dv_b_mps;
+    s->have_prev = true;
+  }
+  return true;
 }

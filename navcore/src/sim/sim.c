@@ -33,6 +33,8 @@
 #include "navcore/nav_sim.h"
 #include "navcore/nav_smoother.h"
 #include "navcore/nav_truth.h"
+#include "integration/ins_gnss_internal.h"
+#include "math/lanes4.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
 #include "sim/sim_partial_internal.h"
@@ -624,261 +626,423 @@ static void store_env(job *j, long run, int64_t k, const nav_epoch_errors *e, co
   }
 }
 
-static nav_status run_one(job *j, long run, bool caller_thread) {
+/* One run's state between its steps: run_one() runs one run through run_open(), its steps
+ * (run_measure(), run_navigate(), run_after()) and run_close(); run_group() runs four runs whose
+ * strapdown steps go in lockstep (nav_ins_gnss_step_lanes()), each run with the same calls in
+ * the same order as alone, so with the same results. */
+typedef struct run_ctx {
+  job *j;
+  long run;
+  bool caller_thread;
+  nav_truth *truth;
+  nav_ins *ins;
+  nav_imu_model *imu_model;
+  nav_sim_gyrofree *gf; /* gyro-free scheme (sim_gyrofree.c): replaces the IMU */
+  nav_smoother *sm;     /* navigation.smoother: the run's RTS smoother */
+  size_t *sm_rec;       /* [n_out]: smoother record of each output slot */
+  nav_traj_state *sm_ts; /* [n_out]: reference at each output slot (no shared truth) */
+  aiding aid_kf;
+  const nav_run_observer *obs; /* requirements (nav_requirements.h) */
+  void *obs_ctx;
+  bool aid, tight, integrated, gf_gnss, gyro_free, record, stop;
+  nav_traj_state ts;
+  nav_errors_ref own_ref;
+  nav_epoch_errors err;
+  size_t cov_n;
+  int64_t k;
+  /* Steps left to the next statistics sample and output epoch: k % stride == 0 exactly when a
+   * countdown started at stride (k = 1) reaches 0, without two 64-bit divisions per step. */
+  int64_t stats_left, out_left;
+  /* The step's ideal record (the shared one is read in place: no copy per step) and the raw
+   * measured record: every consumer takes meas as const (no copy of it is kept for the record
+   * callback). */
+  nav_imu_increment own_imu, meas;
+  const nav_imu_increment *ideal;
+} run_ctx;
+
+/* Set-up of a run and its epoch 0; on failure the run is closed by run_close() all the same. */
+static nav_status run_open(run_ctx *c, job *j, long run, bool caller_thread) {
+  memset(c, 0, sizeof *c);
+  c->j = j;
+  c->run = run;
+  c->caller_thread = caller_thread;
   nav_sim *sim = j->sim;
   const nav_scene *sc = &sim->scene;
-  nav_truth *truth = NULL;
-  nav_ins *ins = NULL;
-  nav_imu_model *imu_model = NULL;
-  nav_sim_gyrofree *gf = NULL; /* gyro-free scheme (sim_gyrofree.c): replaces the IMU */
-  nav_smoother *sm = NULL;        /* navigation.smoother: the run's RTS smoother */
-  size_t *sm_rec = NULL;          /* [n_out]: smoother record of each output slot */
-  nav_traj_state *sm_ts = NULL;   /* [n_out]: reference at each output slot (no shared truth) */
-  aiding aid_kf;
-  memset(&aid_kf, 0, sizeof aid_kf);
-  const nav_run_observer *obs = j->opts->observer; /* requirements (nav_requirements.h) */
-  void *obs_ctx = obs && obs->begin ? obs->begin(obs->user, run) : NULL;
+  c->obs = j->opts->observer;
+  c->obs_ctx = c->obs && c->obs->begin ? c->obs->begin(c->obs->user, run) : NULL;
   char msg[200];
-  nav_status st = j->shared_imu ? NAV_OK : run_truth(j, run, &truth);
-  if (st != NAV_OK) goto cleanup;
+  nav_status st = j->shared_imu ? NAV_OK : run_truth(j, run, &c->truth);
+  if (st != NAV_OK) return st;
   const nav_frame frame = j->frame;
-  const double dt = j->dt;
-  const bool gf_gnss = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
-  const bool gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || gf_gnss;
-  if (!j->ideal && !gyro_free) {
-    st = nav_imu_model_create(&sc->imu.model, sc->simulation.seed, (uint64_t)run, &imu_model);
+  c->gf_gnss = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE_GNSS;
+  c->gyro_free = sc->navigation.scheme == NAV_SCHEME_GYRO_FREE || c->gf_gnss;
+  if (!j->ideal && !c->gyro_free) {
+    st = nav_imu_model_create(&sc->imu.model, sc->simulation.seed, (uint64_t)run, &c->imu_model);
     if (st != NAV_OK) {
       job_error(j, "run %ld: IMU error model: %s", run, nav_status_str(st));
-      goto cleanup;
+      return st;
     }
   }
-  nav_traj_state ts;
-  if (shared_state(j, 0)) ts = *shared_state(j, 0);
-  else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, 0.0, &ts);
-  if (st != NAV_OK) goto cleanup;
-  const nav_ins_state s0 = initial_state(sc, &frame, &ts, run, j->ideal);
+  if (shared_state(j, 0)) c->ts = *shared_state(j, 0);
+  else if ((st = run_truth(j, run, &c->truth)) == NAV_OK) st = nav_truth_state(c->truth, 0.0, &c->ts);
+  if (st != NAV_OK) return st;
+  const nav_ins_state s0 = initial_state(sc, &frame, &c->ts, run, j->ideal);
   const nav_ins_config icfg = nav_ins_config_from_scene(sc);
-  st = nav_ins_create(&icfg, &s0, &ins);
+  st = nav_ins_create(&icfg, &s0, &c->ins);
   if (st != NAV_OK) {
     job_error(j, "run %ld: navigation set-up: %s", run, nav_status_str(st));
-    goto cleanup;
+    return st;
   }
-  const bool aid = sc->navigation.aid_vertical;
-  const bool tight = sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
-  const bool integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || tight;
-  if (integrated || gf_gnss) {
+  c->aid = sc->navigation.aid_vertical;
+  c->tight = sc->navigation.scheme == NAV_SCHEME_INS_GNSS_TIGHT;
+  c->integrated = sc->navigation.scheme == NAV_SCHEME_INS_GNSS || c->tight;
+  if (c->integrated || c->gf_gnss) {
     /* --ideal: the receiver is perfect too (same epochs and outages, no error terms). */
     nav_gnss_model_config gcfg = j->gnss_cfg;
     if (j->ideal) gcfg.terms = 0;
-    st = nav_gnss_model_create(&gcfg, &frame, sc->simulation.seed, (uint64_t)run, &aid_kf.gnss);
+    st = nav_gnss_model_create(&gcfg, &frame, sc->simulation.seed, (uint64_t)run, &c->aid_kf.gnss);
     if (st != NAV_OK) {
       job_error(j, "run %ld: GNSS receiver model: %s", run, nav_status_str(st));
-      goto cleanup;
+      return st;
     }
   }
-  if (integrated) {
+  if (c->integrated) {
     nav_ins_gnss_config xc = nav_ins_gnss_config_from_scene(sc);
     if (j->smooth) {
       /* Records at the output and GNSS epochs only (nav_smoother.h: ~4.3 KiB each at 15 states). */
       nav_smoother_config scfg = nav_smoother_config_default();
       scfg.filter = xc.filter;
       scfg.group_steps = SMOOTH_GROUP_STEPS;
-      st = nav_smoother_create(&scfg, &sm);
-      sm_rec = st == NAV_OK ? malloc((size_t)j->n_out * sizeof *sm_rec) : NULL;
-      sm_ts = st == NAV_OK && !j->shared_ts ? malloc((size_t)j->n_out * sizeof *sm_ts) : NULL;
-      if (st == NAV_OK && (!sm_rec || (!j->shared_ts && !sm_ts))) st = NAV_ERR_NO_MEMORY;
+      st = nav_smoother_create(&scfg, &c->sm);
+      c->sm_rec = st == NAV_OK ? malloc((size_t)j->n_out * sizeof *c->sm_rec) : NULL;
+      c->sm_ts = st == NAV_OK && !j->shared_ts ? malloc((size_t)j->n_out * sizeof *c->sm_ts) : NULL;
+      if (st == NAV_OK && (!c->sm_rec || (!j->shared_ts && !c->sm_ts))) st = NAV_ERR_NO_MEMORY;
       if (st != NAV_OK) {
         job_error(j, "run %ld: RTS smoother set-up: %s", run, nav_status_str(st));
-        goto cleanup;
+        return st;
       }
-      xc.smoother = sm;
+      xc.smoother = c->sm;
     }
-    st = nav_ins_gnss_create(&xc, &s0, &aid_kf.x);
-    aid_kf.pvt = !tight && nav_scene_gnss_pvt_fixes(sc);
-    if (st == NAV_OK && (tight || aid_kf.pvt)) st = nav_sim_gnss_raw_create(sc, (uint64_t)run, j->ideal, &aid_kf.raw);
+    st = nav_ins_gnss_create(&xc, &s0, &c->aid_kf.x);
+    c->aid_kf.pvt = !c->tight && nav_scene_gnss_pvt_fixes(sc);
+    if (st == NAV_OK && (c->tight || c->aid_kf.pvt))
+      st = nav_sim_gnss_raw_create(sc, (uint64_t)run, j->ideal, &c->aid_kf.raw);
     if (st != NAV_OK) {
       job_error(j, "run %ld: INS/GNSS set-up: %s", run, nav_status_str(st));
-      goto cleanup;
+      return st;
     }
   }
-  if (gyro_free) {
-    st = nav_sim_gyrofree_create(sc, j->gf_truth, run, j->ideal, &icfg, &s0, &gf, msg, sizeof msg);
+  if (c->gyro_free) {
+    st = nav_sim_gyrofree_create(sc, j->gf_truth, run, j->ideal, &icfg, &s0, &c->gf, msg, sizeof msg);
     if (st != NAV_OK) {
       job_error(j, "run %ld: gyro-free INS: %s", run, msg[0] ? msg : nav_status_str(st));
-      goto cleanup;
+      return st;
     }
-    aid_kf.gf = gf_gnss ? gf : NULL;
+    c->aid_kf.gf = c->gf_gnss ? c->gf : NULL;
   }
-  size_t cov_n = 0;
-  const bool record = caller_thread && run == 0 && j->opts->record;
-  bool stop = false;
+  c->record = caller_thread && run == 0 && j->opts->record;
 
-  nav_errors_ref own_ref;
-  const nav_errors_ref *ref = errors_ref(j, 0, &ts, &own_ref);
-  nav_epoch_errors err = nav_errors_compute_ref(&frame, &ts, ref, nav_ins_get_state(ins));
-  store_metrics(j, run, 0, &err);
-  const double *cov0 = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-  store_env(j, run, 0, &err, cov0, cov_n, ref, &ts, nav_ins_get_state(ins));
-  if (obs_ctx) obs->epoch(obs_ctx, &err);
-  if (sm) {
-    sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
-    if (sm_ts) sm_ts[0] = ts;
-    store_sm(j, run, 0, true, &err);
+  const nav_errors_ref *ref = errors_ref(j, 0, &c->ts, &c->own_ref);
+  c->err = nav_errors_compute_ref(&frame, &c->ts, ref, nav_ins_get_state(c->ins));
+  store_metrics(j, run, 0, &c->err);
+  const double *cov0 = run_cov(c->aid_kf.x, c->aid_kf.gf, &c->cov_n);
+  store_env(j, run, 0, &c->err, cov0, c->cov_n, ref, &c->ts, nav_ins_get_state(c->ins));
+  if (c->obs_ctx) c->obs->epoch(c->obs_ctx, &c->err);
+  if (c->sm) {
+    c->sm_rec[0] = 0; /* nav_ins_gnss_create recorded epoch 0 */
+    if (c->sm_ts) c->sm_ts[0] = c->ts;
+    store_sm(j, run, 0, true, &c->err);
   }
-  if (record) {
-    nav_sim_record rec = {run, &frame, &ts, nav_ins_get_state(ins), &err, NULL, NULL, NULL, NULL};
-    if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
+  if (c->record) {
+    nav_sim_record rec = {run, &frame, &c->ts, nav_ins_get_state(c->ins), &c->err, NULL, NULL, NULL, NULL};
+    if (j->opts->record(j->opts->user, &rec) == NAV_STOP) c->stop = true;
   }
-  int64_t k = 1;
-  /* Steps left to the next statistics sample and output epoch: k % stride == 0 exactly when a
-   * countdown started at stride (k = 1) reaches 0, without two 64-bit divisions per step. */
-  int64_t stats_left = j->stats_stride, out_left = j->out_stride;
-  for (; k <= j->n && !stop; ++k) {
-    if (atomic_load_explicit(&sim->cancel, memory_order_relaxed)) {
-      stop = true;
-      break;
-    }
-    /* The shared ideal record is read in place (no copy per step). */
-    nav_imu_increment own_imu, meas;
-    const nav_imu_increment *ideal = &own_imu;
-    if (j->shared_imu) ideal = &j->shared_imu[k - 1];
-    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_imu(truth, k, &own_imu);
-    if (st != NAV_OK) {
-      job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
-                (double)k * dt);
-      goto cleanup;
-    }
-    if (gf) {
-      /* Gyro-free: the array replaces the IMU; meas is the INS's equivalent (dtheta, dv). */
-      st = nav_sim_gyrofree_step(gf, k, &meas);
-      if (st != NAV_OK) {
-        job_error(j, "run %ld: %s", run, nav_sim_gyrofree_last_error(gf));
-        goto cleanup;
-      }
-    } else if (imu_model) {
-      st = nav_imu_model_apply(imu_model, ideal, &meas);
-      if (st != NAV_OK) {
-        job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), ideal->t_s);
-        goto cleanup;
-      }
-    } else {
-      meas = *ideal;
-    }
-    /* meas is the raw measured record from here on: every consumer below takes it as const (no
-     * copy of it is kept for the record callback). */
-    if (integrated) {
-      st = nav_ins_gnss_step(aid_kf.x, &meas);
-      if (st != NAV_OK) {
-        job_error(j, "run %ld: %s", run, nav_ins_gnss_last_error(aid_kf.x));
-        goto cleanup;
-      }
-      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
-      if (st != NAV_OK) goto cleanup;
-    } else if (gf_gnss) {
-      st = aiding_fixes(j, &aid_kf, &truth, &meas, run);
-      if (st != NAV_OK) goto cleanup;
-    } else if (!gf) {
-      st = nav_ins_step(ins, &meas);
-      if (st != NAV_OK) {
-        job_error(j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", run, nav_ins_last_error(ins),
-                  meas.t_s);
-        goto cleanup;
-      }
-    }
-    /* The errors are needed only at the statistics samples, the output epochs and the end: the
-     * reference state, the navigation state's e-frame view and the errors (together more than
-     * the navigation step itself) are not computed in between. */
-    const bool stats_tick = --stats_left == 0, out_tick = --out_left == 0;
-    if (stats_tick) stats_left = j->stats_stride;
-    if (out_tick) out_left = j->out_stride;
-    const bool stats_k = stats_tick && k / j->stats_stride < j->stats_per_run;
-    const bool out_k = out_tick || k == j->n;
-    if (!stats_k && !out_k && !(aid && !integrated)) {
-      if (caller_thread && j->opts->progress && k % PROGRESS_EVERY == 0) {
-        const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
-        nav_progress p = {"run", run, done / (double)j->runs, meas.t_s};
-        if (j->opts->progress(j->opts->user, &p) == NAV_STOP) stop = true;
-      }
-      continue;
-    }
-    const nav_ins_state *nav_now = integrated ? nav_ins_gnss_state(aid_kf.x)
-                                   : gf       ? nav_sim_gyrofree_state(gf)
-                                              : nav_ins_get_state(ins);
-    const nav_traj_state *sh = shared_state(j, k);
-    if (sh) ts = *sh;
-    else if ((st = run_truth(j, run, &truth)) == NAV_OK) st = nav_truth_state(truth, meas.t_s, &ts);
-    if (st != NAV_OK) goto cleanup;
-    if (aid && !integrated) {
-      /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
-      const nav_local_view v = nav_frame_view(&frame, ts.r_fb_f_m, ts.v_fb_f_mps, ts.q_b_f);
-      const double h = frame.model == NAV_EARTH_FLAT ? -ts.r_fb_f_m.z : v.pos.h_m;
-      st = nav_ins_aid_vertical(ins, h, v.v_n_mps.z);
-      if (st != NAV_OK) goto cleanup;
-    }
-    ref = errors_ref(j, k, &ts, &own_ref);
-    err = nav_errors_compute_ref(&frame, &ts, ref, nav_now);
-    if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run) store_metrics(j, run, k / j->stats_stride, &err);
-    const double *cov = run_cov(aid_kf.x, aid_kf.gf, &cov_n);
-    store_env(j, run, k, &err, cov, cov_n, ref, &ts, nav_now);
-    if (obs_ctx && (k % j->out_stride == 0 || k == j->n)) obs->epoch(obs_ctx, &err);
-    if (sm && out_k) {
-      /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
-      st = nav_smoother_mark(sm);
-      if (st != NAV_OK) {
-        job_error(j, "run %ld: RTS smoother record at t = %.6f s: %s", run, meas.t_s, nav_smoother_last_error(sm));
-        goto cleanup;
-      }
-      const int64_t slot = out_slot(j, k);
-      sm_rec[slot] = nav_smoother_count(sm) - 1;
-      if (sm_ts) sm_ts[slot] = ts;
-      store_sm(j, run, slot, true, &err);
-    }
-    if (record && (k % j->out_stride == 0 || k == j->n)) {
-      nav_sim_record rec = {run, &frame, &ts, nav_now, &err, ideal, &meas, NULL, NULL};
-      if (j->opts->record(j->opts->user, &rec) == NAV_STOP) stop = true;
-    }
-    if (caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
+  c->k = 1;
+  c->stats_left = j->stats_stride;
+  c->out_left = j->out_stride;
+  return NAV_OK;
+}
+
+/* Step k's measured record c->meas: the ideal increment with the IMU's errors (or the gyro-free
+ * array's equivalent). A cancelled job sets c->stop instead. */
+static nav_status run_measure(run_ctx *c) {
+  job *j = c->j;
+  const long run = c->run;
+  const int64_t k = c->k;
+  if (atomic_load_explicit(&j->sim->cancel, memory_order_relaxed)) {
+    c->stop = true;
+    return NAV_OK;
+  }
+  nav_status st = NAV_OK;
+  c->ideal = &c->own_imu;
+  if (j->shared_imu) c->ideal = &j->shared_imu[k - 1];
+  else if ((st = run_truth(j, run, &c->truth)) == NAV_OK) st = nav_truth_imu(c->truth, k, &c->own_imu);
+  if (st != NAV_OK) {
+    job_error(j, "run %ld: ideal IMU generation failed (%s) at t = %.6f s", run, nav_status_str(st),
+              (double)k * j->dt);
+    return st;
+  }
+  if (c->gf) {
+    /* Gyro-free: the array replaces the IMU; meas is the INS's equivalent (dtheta, dv). */
+    st = nav_sim_gyrofree_step(c->gf, k, &c->meas);
+    if (st != NAV_OK) job_error(j, "run %ld: %s", run, nav_sim_gyrofree_last_error(c->gf));
+  } else if (c->imu_model) {
+    st = nav_imu_model_apply(c->imu_model, c->ideal, &c->meas);
+    if (st != NAV_OK)
+      job_error(j, "run %ld: IMU error model failed (%s) at t = %.6f s", run, nav_status_str(st), c->ideal->t_s);
+  } else {
+    c->meas = *c->ideal;
+  }
+  return st;
+}
+
+/* The INS/GNSS step's failure, worded for the job. */
+static nav_status ins_gnss_failed(run_ctx *c, nav_status st) {
+  job_error(c->j, "run %ld: %s", c->run, nav_ins_gnss_last_error(c->aid_kf.x));
+  return st;
+}
+
+/* The navigation step with c->meas: the INS/GNSS step (strapdown and prediction) or the free
+ * INS's strapdown (the gyro-free schemes stepped in run_measure). */
+static nav_status run_navigate(run_ctx *c) {
+  if (c->integrated) {
+    const nav_status st = nav_ins_gnss_step(c->aid_kf.x, &c->meas);
+    return st != NAV_OK ? ins_gnss_failed(c, st) : NAV_OK;
+  }
+  if (!c->gf_gnss && !c->gf) {
+    const nav_status st = nav_ins_step(c->ins, &c->meas);
+    if (st != NAV_OK)
+      job_error(c->j, "run %ld: strapdown navigation stopped (%s) at t = %.6f s", c->run, nav_ins_last_error(c->ins),
+                c->meas.t_s);
+    return st;
+  }
+  return NAV_OK;
+}
+
+/* The rest of step k: the receiver epochs of the step, then the errors, statistics, outputs and
+ * callbacks where step k has any. */
+static nav_status run_after(run_ctx *c) {
+  job *j = c->j;
+  const long run = c->run;
+  const int64_t k = c->k;
+  const nav_frame frame = j->frame;
+  nav_status st = NAV_OK;
+  if (c->integrated || c->gf_gnss) {
+    st = aiding_fixes(j, &c->aid_kf, &c->truth, &c->meas, run);
+    if (st != NAV_OK) return st;
+  }
+  /* The errors are needed only at the statistics samples, the output epochs and the end: the
+   * reference state, the navigation state's e-frame view and the errors (together more than
+   * the navigation step itself) are not computed in between. */
+  const bool stats_tick = --c->stats_left == 0, out_tick = --c->out_left == 0;
+  if (stats_tick) c->stats_left = j->stats_stride;
+  if (out_tick) c->out_left = j->out_stride;
+  const bool stats_k = stats_tick && k / j->stats_stride < j->stats_per_run;
+  const bool out_k = out_tick || k == j->n;
+  if (!stats_k && !out_k && !(c->aid && !c->integrated)) {
+    if (c->caller_thread && j->opts->progress && k % PROGRESS_EVERY == 0) {
       const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
-      nav_progress p = {"run", run, done / (double)j->runs, meas.t_s};
-      if (j->opts->progress(j->opts->user, &p) == NAV_STOP) stop = true;
+      nav_progress p = {"run", run, done / (double)j->runs, c->meas.t_s};
+      if (j->opts->progress(j->opts->user, &p) == NAV_STOP) c->stop = true;
+    }
+    return NAV_OK;
+  }
+  const nav_ins_state *nav_now = c->integrated ? nav_ins_gnss_state(c->aid_kf.x)
+                                 : c->gf       ? nav_sim_gyrofree_state(c->gf)
+                                               : nav_ins_get_state(c->ins);
+  const nav_traj_state *sh = shared_state(j, k);
+  if (sh) c->ts = *sh;
+  else if ((st = run_truth(j, run, &c->truth)) == NAV_OK) st = nav_truth_state(c->truth, c->meas.t_s, &c->ts);
+  if (st != NAV_OK) return st;
+  if (c->aid && !c->integrated) {
+    /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
+    const nav_local_view v = nav_frame_view(&frame, c->ts.r_fb_f_m, c->ts.v_fb_f_mps, c->ts.q_b_f);
+    const double h = frame.model == NAV_EARTH_FLAT ? -c->ts.r_fb_f_m.z : v.pos.h_m;
+    st = nav_ins_aid_vertical(c->ins, h, v.v_n_mps.z);
+    if (st != NAV_OK) return st;
+  }
+  const nav_errors_ref *ref = errors_ref(j, k, &c->ts, &c->own_ref);
+  c->err = nav_errors_compute_ref(&frame, &c->ts, ref, nav_now);
+  if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run)
+    store_metrics(j, run, k / j->stats_stride, &c->err);
+  const double *cov = run_cov(c->aid_kf.x, c->aid_kf.gf, &c->cov_n);
+  store_env(j, run, k, &c->err, cov, c->cov_n, ref, &c->ts, nav_now);
+  if (c->obs_ctx && (k % j->out_stride == 0 || k == j->n)) c->obs->epoch(c->obs_ctx, &c->err);
+  if (c->sm && out_k) {
+    /* An output epoch: a smoother record (a no-op when a GNSS update made one at this step). */
+    st = nav_smoother_mark(c->sm);
+    if (st != NAV_OK) {
+      job_error(j, "run %ld: RTS smoother record at t = %.6f s: %s", run, c->meas.t_s, nav_smoother_last_error(c->sm));
+      return st;
+    }
+    const int64_t slot = out_slot(j, k);
+    c->sm_rec[slot] = nav_smoother_count(c->sm) - 1;
+    if (c->sm_ts) c->sm_ts[slot] = c->ts;
+    store_sm(j, run, slot, true, &c->err);
+  }
+  if (c->record && (k % j->out_stride == 0 || k == j->n)) {
+    nav_sim_record rec = {run, &frame, &c->ts, nav_now, &c->err, c->ideal, &c->meas, NULL, NULL};
+    if (j->opts->record(j->opts->user, &rec) == NAV_STOP) c->stop = true;
+  }
+  if (c->caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
+    const double done = (double)atomic_load(&j->runs_done) + (double)k / (double)j->n;
+    nav_progress p = {"run", run, done / (double)j->runs, c->meas.t_s};
+    if (j->opts->progress(j->opts->user, &p) == NAV_STOP) c->stop = true;
+  }
+  return NAV_OK;
+}
+
+/* The end of a run: after its steps (st == NAV_OK) the final errors and the smoother; then, in
+ * any case, its status and the release of what it holds. */
+static nav_status run_close(run_ctx *c, nav_status st) {
+  job *j = c->j;
+  const long run = c->run;
+  if (st == NAV_OK) {
+    j->final[run] = c->err;
+    j->samples_done[run] = c->k - 1;
+    if (c->sm && !c->stop) {
+      const nav_frame frame = j->frame;
+      const bool sm_record = c->caller_thread && run == 0 && j->opts->smoothed_record;
+      st = smooth_finish(j, run, c->sm, c->sm_rec, c->sm_ts, &frame, sm_record);
+      if (st == NAV_ERR_CANCELLED) c->stop = true;
+    }
+    if (st == NAV_OK || st == NAV_ERR_CANCELLED) {
+      st = c->stop ? NAV_ERR_CANCELLED : NAV_OK;
+      if (c->stop) atomic_store(&j->sim->cancel, true); /* a stop in run 0 stops the whole job */
     }
   }
-  j->final[run] = err;
-  j->samples_done[run] = k - 1;
-  if (sm && !stop) {
-    const bool sm_record = caller_thread && run == 0 && j->opts->smoothed_record;
-    st = smooth_finish(j, run, sm, sm_rec, sm_ts, &frame, sm_record);
-    if (st == NAV_ERR_CANCELLED) stop = true;
-    else if (st != NAV_OK) goto cleanup;
-  }
-  st = stop ? NAV_ERR_CANCELLED : NAV_OK;
-  if (stop) atomic_store(&sim->cancel, true); /* a stop in run 0 stops the whole job */
-
-cleanup:
-  if (obs_ctx) obs->end(obs->user, obs_ctx, st == NAV_OK);
-  aiding_destroy(&aid_kf);
-  nav_smoother_destroy(sm); /* after the nav_ins_gnss that borrowed it */
-  free(sm_rec);
-  free(sm_ts);
-  nav_sim_gyrofree_destroy(gf);
-  nav_imu_model_destroy(imu_model);
-  nav_ins_destroy(ins);
-  nav_truth_destroy(truth);
+  if (c->obs_ctx) c->obs->end(c->obs->user, c->obs_ctx, st == NAV_OK);
+  aiding_destroy(&c->aid_kf);
+  nav_smoother_destroy(c->sm); /* after the nav_ins_gnss that borrowed it */
+  free(c->sm_rec);
+  free(c->sm_ts);
+  nav_sim_gyrofree_destroy(c->gf);
+  nav_imu_model_destroy(c->imu_model);
+  nav_ins_destroy(c->ins);
+  nav_truth_destroy(c->truth);
   j->status[run] = st;
   atomic_fetch_add(&j->runs_done, 1);
   return st;
 }
 
+static nav_status run_one(job *j, long run, bool caller_thread) {
+  run_ctx c;
+  nav_status st = run_open(&c, j, run, caller_thread);
+  for (; st == NAV_OK && c.k <= j->n && !c.stop; ++c.k) {
+    st = run_measure(&c);
+    if (st != NAV_OK || c.stop) break;
+    st = run_navigate(&c);
+    if (st == NAV_OK) st = run_after(&c);
+  }
+  return run_close(&c, st);
+}
+
+/* Can the runs of this job go in groups of NAV_LANES (run_group)? The loosely coupled INS/GNSS
+ * scheme on simulated fixes with the IMU's errors and the shared truth; not the first run on the
+ * caller's thread (records, progress), which run_one() keeps. */
+static bool group_job(const job *j) {
+  const nav_scene *sc = &j->sim->scene;
+  return j->opts->lanes != 1 && j->shared_imu && !j->ideal && !j->smooth && sc->navigation.scheme == NAV_SCHEME_INS_GNSS &&
+         !nav_scene_gnss_pvt_fixes(sc);
+}
+
+/*
+ * Runs r0 .. r0 + NAV_LANES - 1 together: every run makes the calls of run_one() in the same order
+ * (so the same values), and at each step the four strapdown steps go in lockstep
+ * (nav_ins_gnss_step_lanes()) when all four runs are still going. A run that stops or fails leaves
+ * the group; the others go on with their own steps.
+ */
+static void run_group(job *j, long r0) {
+  run_ctx c[NAV_LANES];
+  nav_status st[NAV_LANES];
+  bool going[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    st[l] = run_open(&c[l], j, r0 + l, false);
+    going[l] = st[l] == NAV_OK && c[l].integrated && c[l].imu_model && !c[l].stop;
+  }
+  for (int64_t k = 1; k <= j->n; ++k) {
+    int n_going = 0;
+    for (int l = 0; l < NAV_LANES; ++l) {
+      if (!going[l]) continue;
+      st[l] = run_measure(&c[l]);
+      if (st[l] != NAV_OK || c[l].stop) going[l] = false;
+      else ++n_going;
+    }
+    if (n_going == 0) break;
+    if (n_going == NAV_LANES) {
+      nav_ins_gnss *x[NAV_LANES];
+      const nav_imu_increment *m[NAV_LANES];
+      for (int l = 0; l < NAV_LANES; ++l) {
+        x[l] = c[l].aid_kf.x;
+        m[l] = &c[l].meas;
+      }
+      nav_ins_gnss_step_lanes(x, m, st);
+      for (int l = 0; l < NAV_LANES; ++l)
+        if (st[l] != NAV_OK) st[l] = ins_gnss_failed(&c[l], st[l]);
+    } else {
+      for (int l = 0; l < NAV_LANES; ++l)
+        if (going[l]) st[l] = run_navigate(&c[l]);
+    }
+    for (int l = 0; l < NAV_LANES; ++l) {
+      if (!going[l]) continue;
+      if (st[l] == NAV_OK) st[l] = run_after(&c[l]);
+      if (st[l] != NAV_OK) {
+        going[l] = false;
+        continue;
+      }
+      ++c[l].k;
+      if (c[l].stop) going[l] = false;
+    }
+  }
+  for (int l = 0; l < NAV_LANES; ++l) {
+    /* A run set up but not on the lockstep path (not expected from group_job) goes alone. */
+    if (st[l] == NAV_OK && !c[l].stop && c[l].k == 1 && !(c[l].integrated && c[l].imu_model)) {
+      for (; st[l] == NAV_OK && c[l].k <= j->n && !c[l].stop; ++c[l].k) {
+        st[l] = run_measure(&c[l]);
+        if (st[l] != NAV_OK || c[l].stop) break;
+        st[l] = run_navigate(&c[l]);
+        if (st[l] == NAV_OK) st[l] = run_after(&c[l]);
+      }
+    }
+    (void)run_close(&c[l], st[l]);
+  }
+}
+
+/* Runs [run, end) of the job: in groups of NAV_LANES where the job allows, the rest one by one. */
+static void run_some(job *j, long run, long end) {
+  if (group_job(j) && end - run == NAV_LANES) {
+    for (long r = run; r < end; ++r)
+      if (atomic_load(&j->sim->cancel)) {
+        for (long q = run; q < end; ++q) j->status[q] = NAV_ERR_CANCELLED;
+        return;
+      }
+    run_group(j, run);
+    return;
+  }
+  for (long r = run; r < end; ++r) {
+    if (atomic_load(&j->sim->cancel)) {
+      j->status[r] = NAV_ERR_CANCELLED;
+      continue;
+    }
+    (void)run_one(j, r, false);
+  }
+}
+
+/* The next runs to take from the job: a group of NAV_LANES when the job runs groups. */
+static long take_runs(job *j, long *end) {
+  const long w = group_job(j) ? NAV_LANES : 1;
+  const long run = atomic_fetch_add(&j->next_run, w);
+  *end = run + w < j->run_end ? run + w : j->run_end;
+  return run;
+}
+
 static int worker(void *arg) {
   job *j = arg;
   for (;;) {
-    const long run = atomic_fetch_add(&j->next_run, 1);
+    long end;
+    const long run = take_runs(j, &end);
     if (run >= j->run_end) break;
-    if (atomic_load(&j->sim->cancel)) {
-      j->status[run] = NAV_ERR_CANCELLED;
-      continue;
-    }
-    (void)run_one(j, run, false);
+    run_some(j, run, end);
   }
   return 0;
 }
@@ -1120,13 +1284,10 @@ nav_status nav_sim_run(nav_sim *sim, const nav_sim_options *opts, nav_sim_summar
   if (j.runs > 1) {
     /* This thread works too, reporting progress between runs. */
     for (;;) {
-      const long run = atomic_fetch_add(&j.next_run, 1);
+      long end;
+      const long run = take_runs(&j, &end);
       if (run >= j.run_end) break;
-      if (atomic_load(&sim->cancel)) {
-        j.status[run] = NAV_ERR_CANCELLED;
-        continue;
-      }
-      (void)run_one(&j, run, false);
+      run_some(&j, run, end);
       if (opts->progress) {
         nav_progress p = {"monte_carlo", run, (double)atomic_load(&j.runs_done) / (double)j.runs, j.n * dt};
         if (opts->progress(opts->user, &p) == NAV_STOP) atomic_store(&sim->cancel, true);

@@ -1,0 +1,22 @@
+/*
+ * Four INS stepped in lockstep (the Monte Carlo runs of sim.c that step together): internal to
+ * navcore. See nav_ins_step_lanes() in strapdown.c and docs/campaign-speed.md.
+ */
+#ifndef NAV_STRAPDOWN_LANES_H
+#define NAV_STRAPDOWN_LANES_H
+
+#include <stdbool.h>
+
+#include "math/lanes4.h"
+#include "navcore/nav_ins.h"
+
+/**
+ * nav_ins_step(ins[l], imu[l]) for l = 0..3 at once, with the bits of the four separate calls.
+ * @return true when all four were stepped; false when any INS or increment is outside the
+ *         lockstep path (configuration, a branch of the step that differs from lane to lane, a
+ *         refused or non-finite step): then no INS was changed and the caller steps each one with
+ *         nav_ins_step(), which gives the same results and words any error.
+ */
+bool nav_ins_step_lanes(nav_ins *const ins[NAV_LANES], const nav_imu_increment *const imu[NAV_LANES]);
+
+#endif /* NAV_STRAPDOWN_LANES_H */
