@@ -49,15 +49,15 @@
 /* One field of d = li + nf digits (li integer, nf fraction digits) starting at offset off. Its
  * first min(d, 8) digits form word A: the 8 bytes at off, with the bytes from the point on taken
  * from the 8 bytes at off + 1 (merge: the bytes kept from the first load), so that the point drops
- * out; the other d - 8 digits (fraction digits only, since li <= 7) form word B at off + li + 9.
- * Each word's digits are moved to its top by a shift (B is cleared by its mask when it has none),
- * and M = A * mul + B (mul = 10^(d - 8), or 1), value = M / div (div = 10^nf). */
+ * out; the other d - 8 digits, if any (fraction digits only, since li <= 7), form word B at
+ * off + li + 9. Each word's digits are moved to its top by a shift, and M = A, or A * mul + B
+ * (mul = 10^(d - 8)); value = M / div (div = 10^nf). */
 typedef struct nav_layout_field {
-  uint64_t merge, mask_b, mul;
+  uint64_t merge, mul;
   double div;
   uint16_t off, off_b;
   uint8_t shift_a, shift_b;
-  bool neg;
+  bool has_b, neg;
 } nav_layout_field;
 
 typedef struct nav_line_layout {
@@ -108,11 +108,11 @@ static inline bool nav_layout_learn(nav_line_layout *L, const char *line, size_t
     }
     const unsigned d = li + nf, na = d < 8u ? d : 8u, nb = d - na;
     fd->off = (uint16_t)si;
-    fd->off_b = (uint16_t)(nb ? si + 9u : si); /* (a readable place when B has no digits) */
+    fd->off_b = (uint16_t)(si + 9u);
     fd->merge = nf && li < 8u ? ((uint64_t)1 << (8u * li)) - 1u : ~(uint64_t)0;
     fd->shift_a = (uint8_t)(8u * (8u - na));
-    fd->shift_b = (uint8_t)(nb ? 8u * (8u - nb) : 56u); /* (a shift by 64 would be undefined) */
-    fd->mask_b = nb ? ~(uint64_t)0 : 0u;
+    fd->shift_b = (uint8_t)(nb ? 8u * (8u - nb) : 0u);
+    fd->has_b = nb > 0u;
     fd->mul = nav_fast_pow10_u[nb];
     fd->div = nav_fast_pow10[nf];
     if (k + 1 < want) {
@@ -174,10 +174,10 @@ static inline bool nav_layout_match(const nav_line_layout *L, const char *line, 
 
 #if NAV_LAYOUT_ENABLED
 /* The value of the digits of word w, moved to its top by @p shift (the bytes below become leading
- * zeros, those after the digits are shifted out) and kept by @p mask, combined by the
+ * zeros, those after the digits are shifted out), combined by the
  * multiply-shift steps of fast_number.h. */
-NAV_FAST_INLINE uint64_t nav_layout_digits(uint64_t w, unsigned shift, uint64_t mask) {
-  uint64_t d = ((w - 0x3030303030303030ull) << shift) & mask;
+NAV_FAST_INLINE uint64_t nav_layout_digits(uint64_t w, unsigned shift) {
+  uint64_t d = (w - 0x3030303030303030ull) << shift;
   d = (d * 10u) + (d >> 8);
   d = (((d & 0x000000FF000000FFull) * (100u + (1000000ull << 32))) +
        (((d >> 16) & 0x000000FF000000FFull) * (1u + (10000ull << 32)))) >>
@@ -195,12 +195,16 @@ NAV_FAST_INLINE void nav_layout_convert(const nav_line_layout *L, const char *li
 #if NAV_LAYOUT_ENABLED
   for (int k = 0; k < count; ++k) {
     const nav_layout_field *fd = &L->f[k];
-    uint64_t w0, w1, wb;
+    uint64_t w0, w1;
     memcpy(&w0, line + fd->off, 8);
     memcpy(&w1, line + fd->off + 1, 8);
-    memcpy(&wb, line + fd->off_b, 8);
-    const uint64_t a = nav_layout_digits((w0 & fd->merge) | (w1 & ~fd->merge), fd->shift_a, ~(uint64_t)0);
-    const uint64_t m = a * fd->mul + nav_layout_digits(wb, fd->shift_b, fd->mask_b);
+    uint64_t m = nav_layout_digits((w0 & fd->merge) | (w1 & ~fd->merge), fd->shift_a);
+    /* (a branch on the layout, not on the text: the same for every row that matches, so predicted) */
+    if (fd->has_b) {
+      uint64_t wb;
+      memcpy(&wb, line + fd->off_b, 8);
+      m = m * fd->mul + nav_layout_digits(wb, fd->shift_b);
+    }
     /* m < 10^15 < 2^53: exact (converted as a signed integer, one instruction) */
     v[k] = nav_fast_negate_if((double)(int64_t)m / fd->div, fd->neg);
   }
