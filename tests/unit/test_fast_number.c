@@ -504,12 +504,13 @@ static void rowgen_next(rowgen *g, bool mutate, char *s, size_t cap) {
   g->v[1] = 100000.0 + 0.005 * (double)g->i;
   int prec[11];
   memcpy(prec, g->prec, sizeof prec);
-  const int kind = mutate ? (int)next_u(r, 100) : -1; /* one row in ten changed */
+  const int kind = mutate ? (int)next_u(r, 100) : -1; /* one row in nine changed */
   const int at = 1 + (int)next_u(r, 10);
   /* other fraction digits (0: no point; the time keeps at least 3, so that it still increases) */
   if (kind == 0) prec[at] = at == 1 ? 3 + (int)next_u(r, 13) : (int)next_u(r, 16);
   if (kind == 1) prec[at] = 12 + (int)next_u(r, 4);           /* 16-19 digits, or > 15 fraction digits */
   if (kind == 2) for (int k = 2; k < 11; ++k) prec[k] = 15;   /* a line longer than a layout takes */
+  if (kind == 10) prec[at] = 40; /* a field longer than the reader's buffer padding (32 bytes) */
   size_t p = (size_t)snprintf(s, cap, "%s%d", kind == 3 ? " " : "", g->week);
   for (int k = 1; k < 11; ++k) {
     const char *sep = " ";
@@ -664,6 +665,7 @@ static void test_layout_changes(void **state) {
       "0 100000.005000 31.50818300000 120. 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
       "0 100000.005000 31.508183000000000 120.401989000000000 0.0000000000 0.000000000000 0.000000000000 "
       "0.000000000000 0.000000000000 0.000000000000 1.0",
+      "0 100000.005000 31.5081830000000000000000000000000000000000001 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0",
   };
   for (size_t i = 0; i < sizeof unlearned / sizeof unlearned[0]; ++i) {
     char buf[256] = {0};
