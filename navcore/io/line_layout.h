@@ -49,9 +49,10 @@
 /* One field of d = li + nf digits (li integer, nf fraction digits) starting at offset off. Its
  * first min(d, 8) digits form word A: the 8 bytes at off, with the bytes from the point on taken
  * from the 8 bytes at off + 1 (merge: the bytes kept from the first load), so that the point drops
- * out; the other d - 8 digits, if any (fraction digits only, since li <= 7), form word B at
- * off + li + 9. Each word's digits are moved to its top by a shift, and M = A, or A * mul + B
- * (mul = 10^(d - 8)); value = M / div (div = 10^nf). */
+ * out. The other d - 8 digits, if any, are fraction digits (li <= 7), the first of them at
+ * off + 9 (digit 8, one byte after its place without the point): word B. Each word's digits are
+ * moved to its top by a shift, and M = A, or A * mul + B (mul = 10^(d - 8)); value = M / div
+ * (div = 10^nf). */
 typedef struct nav_layout_field {
   uint64_t merge, mul;
   double div;
