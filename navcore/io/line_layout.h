@@ -67,9 +67,9 @@ typedef struct nav_line_layout {
   unsigned char digit[NAV_LAYOUT_MAX_LINE + 1];
   unsigned char byte[NAV_LAYOUT_MAX_LINE + 1];
   unsigned char any[NAV_LAYOUT_MAX_LINE + 1];
-  size_t n;      /* length of the learned line */
-  int chunks;    /* 16-byte chunks that cover [0, n] */
-  int count;     /* fields; 0: no layout */
+  size_t n;   /* length of the learned line */
+  int chunks; /* 16-byte chunks that cover [0, n] */
+  int count;  /* fields; 0: no layout */
   nav_layout_field f[NAV_LAYOUT_MAX_FIELDS];
 } nav_line_layout;
 

@@ -469,7 +469,8 @@ typedef struct rowgen {
   long i;
 } rowgen;
 
-static const double k_row_lo[11] = {0, 0, -89.9, -179.9, -999.0, -300.0, -300.0, -300.0, -179.0, -89.0, -179.0};
+static const double k_row_lo[11] = {0,      0,      -89.9,  -179.9, -999.0, -300.0,
+                                    -300.0, -300.0, -179.0, -89.0,  -179.0};
 static const double k_row_hi[11] = {0, 0, 89.9, 359.9, 99999.0, 300.0, 300.0, 300.0, 179.0, 89.0, 359.0};
 
 static void rowgen_init(rowgen *g, uint64_t seed) {
@@ -508,8 +509,10 @@ static void rowgen_next(rowgen *g, bool mutate, char *s, size_t cap) {
   const int at = 1 + (int)next_u(r, 10);
   /* other fraction digits (0: no point; the time keeps at least 3, so that it still increases) */
   if (kind == 0) prec[at] = at == 1 ? 3 + (int)next_u(r, 13) : (int)next_u(r, 16);
-  if (kind == 1) prec[at] = 12 + (int)next_u(r, 4);           /* 16-19 digits, or > 15 fraction digits */
-  if (kind == 2) for (int k = 2; k < 11; ++k) prec[k] = 15;   /* a line longer than a layout takes */
+  if (kind == 1) prec[at] = 12 + (int)next_u(r, 4); /* 16-19 digits, or > 15 fraction digits */
+  if (kind == 2)
+    for (int k = 2; k < 11; ++k)
+      prec[k] = 15;              /* a line longer than a layout takes */
   if (kind == 10) prec[at] = 40; /* a field longer than the reader's buffer padding (32 bytes) */
   size_t p = (size_t)snprintf(s, cap, "%s%d", kind == 3 ? " " : "", g->week);
   for (int k = 1; k < 11; ++k) {
@@ -571,7 +574,8 @@ static bool layout_check_line(nav_line_layout *L, const char *line, long *learne
     /* The learned line itself must match its layout and give strtod's values. */
     if (!nav_layout_match(L, buf, n)) fail_msg("\"%s\" does not match the layout learned from it", line);
     nav_layout_convert(L, buf, 11, v);
-    if (!strtod_row(line, ref)) fail_msg("a layout was learned from \"%s\", which is not 11 numeric fields", line);
+    if (!strtod_row(line, ref))
+      fail_msg("a layout was learned from \"%s\", which is not 11 numeric fields", line);
     for (int k = 0; k < 11; ++k)
       if (memcmp(&v[k], &ref[k], sizeof v[k]) != 0)
         fail_msg("\"%s\" field %d (learned): layout %.17g, strtod %.17g", line, k + 1, v[k], ref[k]);
@@ -583,8 +587,9 @@ static bool layout_check_line(nav_line_layout *L, const char *line, long *learne
  * alone match, and then give strtod's values. */
 static void test_layout_changes(void **state) {
   (void)state;
-  static const char base[] = "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 "
-                             "0.000000 0.000000 -177.000000";
+  static const char base[] =
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 "
+      "0.000000 0.000000 -177.000000";
   static const char *const same[] = {
       "9 199999.995999 89.99999999999 359.99999999999 9.9999 9.999999 9.999999 9.999999 9.999999 9.999999 "
       "-999.999999",
@@ -655,12 +660,14 @@ static void test_layout_changes(void **state) {
     assert_false(layout_check_line(&M, base, &l2));
     char buf[NAV_LAYOUT_MAX_LINE + 64] = {0};
     memcpy(buf, changed[i], strlen(changed[i]));
-    if (nav_layout_match(&M, buf, strlen(buf))) fail_msg("\"%s\" matched the layout of the base row", changed[i]);
+    if (nav_layout_match(&M, buf, strlen(buf)))
+      fail_msg("\"%s\" matched the layout of the base row", changed[i]);
   }
   /* What a layout does not take: fields of more than 15 digits, more than 7 integer digits, "5."
    * without fraction digits, lines longer than NAV_LAYOUT_MAX_LINE bytes. */
   static const char *const unlearned[] = {
-      "0 100000.0050001234 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
+      "0 100000.0050001234 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 "
+      "0.000000 1.0",
       "0 100000.005000 31.50818300000 12345678.0 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
       "0 100000.005000 31.50818300000 120. 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
       "0 100000.005000 31.508183000000000 120.401989000000000 0.0000000000 0.000000000000 0.000000000000 "
@@ -670,7 +677,8 @@ static void test_layout_changes(void **state) {
   for (size_t i = 0; i < sizeof unlearned / sizeof unlearned[0]; ++i) {
     char buf[256] = {0};
     memcpy(buf, unlearned[i], strlen(unlearned[i]));
-    if (nav_layout_learn(&L, buf, strlen(buf), 11)) fail_msg("a layout was learned from \"%s\"", unlearned[i]);
+    if (nav_layout_learn(&L, buf, strlen(buf), 11))
+      fail_msg("a layout was learned from \"%s\"", unlearned[i]);
     assert_false(nav_layout_match(&L, base, strlen(base)));
   }
 }
@@ -698,8 +706,9 @@ static void test_layout_random_rows(void **state) {
     else
       ++misses;
   }
-  print_message("[ fastnum  ] layout: %ld rows matched the layout of the row before, %ld did not (%ld relearned)\n",
-                hits, misses, learned);
+  print_message(
+      "[ fastnum  ] layout: %ld rows matched the layout of the row before, %ld did not (%ld relearned)\n",
+      hits, misses, learned);
   assert_true(hits > 100000);
   assert_true(misses > 20000);
   assert_true(learned > 10000);
@@ -717,9 +726,9 @@ static int read_pva_values(const char *text, double *v, int cap, nav_status *st,
     *st = nav_rec_read_pva(r, &row, &got);
     if (*st != NAV_OK || !got) break;
     if (n < cap) {
-      const double x[11] = {(double)row.week,  row.t_s,          row.pos.lat_rad,     row.pos.lon_rad,
-                            row.pos.h_m,       row.v_n_mps.x,    row.v_n_mps.y,       row.v_n_mps.z,
-                            row.att.roll_rad,  row.att.pitch_rad, row.att.yaw_rad};
+      const double x[11] = {(double)row.week, row.t_s,           row.pos.lat_rad, row.pos.lon_rad,
+                            row.pos.h_m,      row.v_n_mps.x,     row.v_n_mps.y,   row.v_n_mps.z,
+                            row.att.roll_rad, row.att.pitch_rad, row.att.yaw_rad};
       memcpy(v + 11 * n, x, sizeof x);
     }
     ++n;
