@@ -78,7 +78,7 @@ static inline bool nav_layout_is_digit(char c) {
 }
 
 /**
- * Learn the layout of @p line (@p n bytes, NUL-terminated, in a buffer readable to n + 24):
+ * Learn the layout of @p line (@p n bytes, NUL-terminated; reads line[0..n] only):
  * exactly @p want fields of printf's "%.Nf" shape ([+-], 1-7 integer digits, optionally a point
  * and 1-15 fraction digits, at most 15 digits in all), separated by blanks, none before the first
  * or after the last.
