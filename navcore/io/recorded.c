@@ -18,6 +18,7 @@
 #include "navcore/nav_io.h"
 #include "navcore/nav_recorded.h"
 #include "fast_number.h"
+#include "line_layout.h"
 #include "scene_bounds.h"
 
 /* Buffer of a streaming reader. Larger than the longest line, so a full buffer always holds a
@@ -49,6 +50,10 @@ struct nav_rec_reader {
   long cut_line;      /* a last line without a line end (the file may have been cut), else 0 */
   locale_t c_numeric; /* "C" numbers for strtod, whatever the process locale (a GUI may set one) */
   size_t file_left;   /* bytes of the file still to read (a stretch of it; SIZE_MAX: to its end) */
+  /* .nav rows: the layout of the last row read field by field (line_layout.h), and how many rows
+   * in a row did not match it (relearning backs off when the layout keeps changing). */
+  nav_line_layout pva_layout;
+  unsigned pva_layout_misses;
 };
 
 /* ---------------------------------------------------------------- diagnostics */
@@ -488,6 +493,27 @@ static __attribute__((noinline)) bool split_imu_line(char *line, size_t n, field
   return split_fixed(line, n, 7, true, fl);
 }
 
+/* A .nav row with the layout of the row learned last (line_layout.h): its 11 fields converted
+ * from their known places, with the values split_pva_line() gives. */
+static __attribute__((noinline)) bool pva_layout_line(const nav_line_layout *lay, char *line, size_t n,
+                                                      fields *fl) {
+  if (!nav_layout_match(lay, line, n)) return false;
+  nav_layout_convert(lay, line, 11, fl->v);
+  fl->count = 11;
+  fl->fast = true;
+  fl->line = line;
+  fl->n = n;
+  return true;
+}
+
+/* A .nav row that did not match the layout and that split_pva_line() read: learn its layout, at
+ * once for the first misses in a row (a sign or a digit count changed), then every 64th row only
+ * (a file whose layout changes from row to row pays little for the attempts). */
+static void pva_layout_missed(nav_rec_reader *r, const char *line, size_t n) {
+  const unsigned m = r->pva_layout_misses++;
+  if (m < 8u || (m & 63u) == 0u) (void)nav_layout_learn(&r->pva_layout, line, n, 11);
+}
+
 /* The columns of a line read by split_fixed(), for a message (split() gives the same values). */
 static void with_cols(nav_rec_reader *r, fields *fl) {
   if (!fl->fast) return;
@@ -524,8 +550,18 @@ static nav_status next_record(nav_rec_reader *r, fields *fl, bool *got) {
     if (st != NAV_OK) return st;
     if (!line) return NAV_OK;
     fl->fast = false;
-    if (r->fmt == NAV_REC_PVA ? split_pva_line(line, n, fl) : r->fmt == NAV_REC_IMU && split_imu_line(line, n, fl))
+    if (r->fmt == NAV_REC_PVA) {
+      if (pva_layout_line(&r->pva_layout, line, n, fl)) {
+        r->pva_layout_misses = 0;
+        break;
+      }
+      if (split_pva_line(line, n, fl)) {
+        pva_layout_missed(r, line, n);
+        break;
+      }
+    } else if (r->fmt == NAV_REC_IMU && split_imu_line(line, n, fl)) {
       break;
+    }
     st = split(r, line, n, fl);
     if (st != NAV_OK) return st;
     if (fl->count > 0) break;

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "fast_number.h"
+#include "line_layout.h"
 #include "nav_test.h"
 #include "navcore/nav_recorded.h"
 #include "navcore/nav_rng.h"
@@ -422,6 +423,23 @@ static void test_pva_line_path(void **state) {
       {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0 7\n", 1, 56, "expected 11 columns"},
       {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 95.0 1.0\n", 1, 48, "pitch 95 deg outside [-90, 90]"},
       {"0 100000.005000 31.5 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0x\n", 1, 52, "expected a number, found \"1.0x\""},
+      /* second rows with the layout of the first (read from the learned layout, line_layout.h) */
+      {"0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 10.000000 "
+       "1.000000\n0 100000.010000 95.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 "
+       "10.000000 1.000000\n",
+       2, 17, "latitude 95.508183 deg outside [-90, 90]"},
+      {"0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 10.000000 "
+       "1.000000\n0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 "
+       "10.000000 1.000000\n",
+       2, 3, "time must increase"},
+      {"0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 10.000000 "
+       "1.000000\n0 100000.010000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 "
+       "95.000000 1.000000\n",
+       2, 92, "pitch 95 deg outside [-90, 90]"},
+      {"0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 10.000000 "
+       "1.000000\n0 100000.010000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 10.000000 "
+       "10.000000 1.00000x\n",
+       2, 102, "expected a number, found \"1.00000x\""},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
     nav_rec_pva rows[2];
@@ -433,6 +451,340 @@ static void test_pva_line_path(void **state) {
     if (d.line != bad[i].line || d.col != bad[i].col || !strstr(d.message, bad[i].words))
       fail_msg("case %zu: %d:%d %s; expected %d:%d and \"%s\"", i, d.line, d.col, d.message, bad[i].line, bad[i].col,
                bad[i].words);
+  }
+}
+
+/* ------------------------------------------------------------ speculative layout (line_layout.h) */
+
+/* Random rows in the shape of a .nav reference (11 fields: week, time, lat, lon, h, velocity,
+ * attitude), most of them with the layout of the row before (only digits change), some with a
+ * changed layout: a sign appears or goes, a digit count changes (9.99 -> 10.00), other fraction
+ * digits, extra blanks, a tab, CR LF, a leading or trailing blank, a '+', fields of 16-19 digits,
+ * lines longer than a layout takes. */
+typedef struct rowgen {
+  nav_rng rng;
+  double v[11];
+  int prec[11];
+  int week;
+  long i;
+} rowgen;
+
+static const double k_row_lo[11] = {0,      0,      -89.9,  -179.9, -999.0, -300.0,
+                                    -300.0, -300.0, -179.0, -89.0,  -179.0};
+static const double k_row_hi[11] = {0, 0, 89.9, 359.9, 99999.0, 300.0, 300.0, 300.0, 179.0, 89.0, 359.0};
+
+static void rowgen_init(rowgen *g, uint64_t seed) {
+  nav_rng_init(&g->rng, seed, 7u, 0u);
+  static const int prec[11] = {0, 6, 11, 11, 4, 6, 6, 6, 6, 6, 6};
+  for (int k = 0; k < 11; ++k) {
+    g->prec[k] = prec[k];
+    g->v[k] = k_row_lo[k] + (k_row_hi[k] - k_row_lo[k]) * nav_rng_uniform(&g->rng);
+  }
+  g->week = 2179;
+  g->i = 0;
+}
+
+/* The next row into s (no line end); @p mutate: also the layout changes that only the
+ * field-by-field reader reads (blanks, tabs, CR, '+', long fields). Values stay in the ranges the
+ * .nav reader accepts and the time increases. */
+static void rowgen_next(rowgen *g, bool mutate, char *s, size_t cap) {
+  nav_rng *r = &g->rng;
+  for (int k = 2; k < 11; ++k) {
+    const double u = nav_rng_uniform(r);
+    if (u < 0.005) /* a jump: another sign or digit count, usually */
+      g->v[k] = k_row_lo[k] + (k_row_hi[k] - k_row_lo[k]) * nav_rng_uniform(r);
+    else if (u < 0.01) /* near a digit-count or sign boundary */
+      g->v[k] = (nav_rng_uniform(r) < 0.5 ? -1.0 : 1.0) * (pow(10.0, (double)next_u(r, 3)) - 1e-5) +
+                1e-5 * (nav_rng_uniform(r) - 0.5);
+    else /* the last digits only */
+      g->v[k] += 1e-4 * (nav_rng_uniform(r) - 0.5);
+    if (g->v[k] < k_row_lo[k] || g->v[k] > k_row_hi[k]) g->v[k] = 0.5 * (k_row_lo[k] + k_row_hi[k]);
+  }
+  if (next_u(r, 500) == 0) g->week++;
+  g->i++;
+  g->v[1] = 100000.0 + 0.005 * (double)g->i;
+  int prec[11];
+  memcpy(prec, g->prec, sizeof prec);
+  const int kind = mutate ? (int)next_u(r, 100) : -1; /* one row in nine changed */
+  const int at = 1 + (int)next_u(r, 10);
+  /* other fraction digits (0: no point; the time keeps at least 3, so that it still increases) */
+  if (kind == 0) prec[at] = at == 1 ? 3 + (int)next_u(r, 13) : (int)next_u(r, 16);
+  if (kind == 1) prec[at] = 12 + (int)next_u(r, 4); /* 16-19 digits, or > 15 fraction digits */
+  if (kind == 2)
+    for (int k = 2; k < 11; ++k)
+      prec[k] = 15;              /* a line longer than a layout takes */
+  if (kind == 10) prec[at] = 40; /* a field longer than the reader's buffer padding (32 bytes) */
+  size_t p = (size_t)snprintf(s, cap, "%s%d", kind == 3 ? " " : "", g->week);
+  for (int k = 1; k < 11; ++k) {
+    const char *sep = " ";
+    if (k == at && kind == 4) sep = "  ";
+    if (k == at && kind == 5) sep = "\t";
+    if (k == at && kind == 6 && g->v[k] >= 0.0) sep = " +";
+    if (k == at && kind == 7) sep = " \v";
+    p += (size_t)snprintf(s + p, cap - p, "%s%.*f", sep, prec[k], g->v[k]);
+  }
+  if (kind == 8) p += (size_t)snprintf(s + p, cap - p, "\r");
+  if (kind == 9) p += (size_t)snprintf(s + p, cap - p, " ");
+  assert_true(p < cap);
+}
+
+/* Fields of a line by strtod, blank-separated; false unless the line is exactly 11 fields of
+ * [+-.0-9] characters with blanks between them and none before or after. */
+static bool strtod_row(const char *line, double *v) {
+  const char *p = line;
+  for (int k = 0; k < 11; ++k) {
+    if (k > 0) {
+      if (!(*p == ' ' || *p == '\t' || *p == '\r' || *p == '\v' || *p == '\f')) return false;
+      while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\v' || *p == '\f')
+        ++p;
+    }
+    const char *q = p;
+    while ((*q >= '0' && *q <= '9') || *q == '+' || *q == '-' || *q == '.')
+      ++q;
+    if (q == p) return false;
+    char *end = NULL;
+    v[k] = strtod(p, &end);
+    if (end != q) return false;
+    p = q;
+  }
+  return *p == '\0';
+}
+
+/* Check a line against the layout as the reader does: a match must give strtod's bits for every
+ * field. The line sits in a buffer whose bytes after its terminating NUL are digits (so a word
+ * loaded past the end would show). Returns whether it matched. */
+static bool layout_check_line(nav_line_layout *L, const char *line, long *learned) {
+  char buf[640];
+  const size_t n = strlen(line);
+  assert_true(n + 1 + 32 <= sizeof buf);
+  for (size_t i = 0; i < sizeof buf; ++i)
+    buf[i] = (char)('0' + (i * 7u) % 10u);
+  memcpy(buf, line, n + 1);
+  double v[11], ref[11];
+  if (nav_layout_match(L, buf, n)) {
+    nav_layout_convert(L, buf, 11, v);
+    if (!strtod_row(line, ref)) fail_msg("the layout accepted \"%s\", which is not 11 numeric fields", line);
+    for (int k = 0; k < 11; ++k)
+      if (memcmp(&v[k], &ref[k], sizeof v[k]) != 0)
+        fail_msg("\"%s\" field %d: layout %.17g, strtod %.17g", line, k + 1, v[k], ref[k]);
+    return true;
+  }
+  if (nav_layout_learn(L, buf, n, 11)) {
+    ++*learned;
+    /* The learned line itself must match its layout and give strtod's values. */
+    if (!nav_layout_match(L, buf, n)) fail_msg("\"%s\" does not match the layout learned from it", line);
+    nav_layout_convert(L, buf, 11, v);
+    if (!strtod_row(line, ref))
+      fail_msg("a layout was learned from \"%s\", which is not 11 numeric fields", line);
+    for (int k = 0; k < 11; ++k)
+      if (memcmp(&v[k], &ref[k], sizeof v[k]) != 0)
+        fail_msg("\"%s\" field %d (learned): layout %.17g, strtod %.17g", line, k + 1, v[k], ref[k]);
+  }
+  return false;
+}
+
+/* A layout learned from one row and every way of changing it: only rows that differ in digits
+ * alone match, and then give strtod's values. */
+static void test_layout_changes(void **state) {
+  (void)state;
+  static const char base[] =
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 "
+      "0.000000 0.000000 -177.000000";
+  static const char *const same[] = {
+      "9 199999.995999 89.99999999999 359.99999999999 9.9999 9.999999 9.999999 9.999999 9.999999 9.999999 "
+      "-999.999999",
+      "0 100000.010000 31.50818312345 120.40198987654 0.0000 0.000001 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 000000.000000 00.00000000000 000.00000000000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-000.000000",
+  };
+  static const char *const changed[] = {
+      /* a sign appears (longer line), a sign moves (same length), a sign goes */
+      "0 100000.005000 -31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000 -31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "177.0000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "+177.000000",
+      /* integer digits: one more (9.99 -> 10.00) and one less with a fraction digit more */
+      "0 100000.005000 31.50818300000 120.40198900000 10.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 10.00000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-17.0000000",
+      /* the point moved within the same field width; an extra blank; a tab; CR; leading and trailing
+       * blanks; a character next to the digits ('/' and ':'), a letter, a high byte, an exponent */
+      "0 100000.005000 315.0818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000  31.5081830000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0\t100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.00000\r",
+      " 0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.00000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.00000 ",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000/00 0.000000 0.000000 "
+      "-177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.00:000 "
+      "-177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.00000x",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.0000\xb0"
+      "0 -177.000000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.0000e0 "
+      "-177.000000",
+      /* a field shorter or longer at the end: the line length differs */
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.00000",
+      "0 100000.005000 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 "
+      "-177.000000 1",
+  };
+  nav_line_layout L;
+  L.count = 0;
+  long learned = 0;
+  assert_false(layout_check_line(&L, base, &learned));
+  assert_int_equal(learned, 1);
+  assert_true(layout_check_line(&L, base, &learned));
+  for (size_t i = 0; i < sizeof same / sizeof same[0]; ++i)
+    if (!layout_check_line(&L, same[i], &learned)) fail_msg("\"%s\" should match the layout", same[i]);
+  for (size_t i = 0; i < sizeof changed / sizeof changed[0]; ++i) {
+    nav_line_layout M;
+    M.count = 0;
+    long l2 = 0;
+    assert_false(layout_check_line(&M, base, &l2));
+    char buf[NAV_LAYOUT_MAX_LINE + 64] = {0};
+    memcpy(buf, changed[i], strlen(changed[i]));
+    if (nav_layout_match(&M, buf, strlen(buf)))
+      fail_msg("\"%s\" matched the layout of the base row", changed[i]);
+  }
+  /* What a layout does not take: fields of more than 15 digits, more than 7 integer digits, "5."
+   * without fraction digits, lines longer than NAV_LAYOUT_MAX_LINE bytes. */
+  static const char *const unlearned[] = {
+      "0 100000.0050001234 31.50818300000 120.40198900000 0.0000 0.000000 0.000000 0.000000 0.000000 "
+      "0.000000 1.0",
+      "0 100000.005000 31.50818300000 12345678.0 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
+      "0 100000.005000 31.50818300000 120. 0.0000 0.000000 0.000000 0.000000 0.000000 0.000000 1.0",
+      "0 100000.005000 31.508183000000000 120.401989000000000 0.0000000000 0.000000000000 0.000000000000 "
+      "0.000000000000 0.000000000000 0.000000000000 1.0",
+      "0 100000.005000 31.5081830000000000000000000000000000000000001 120.4 0.0 0.0 0.0 0.0 0.0 0.0 1.0",
+  };
+  for (size_t i = 0; i < sizeof unlearned / sizeof unlearned[0]; ++i) {
+    char buf[256] = {0};
+    memcpy(buf, unlearned[i], strlen(unlearned[i]));
+    if (nav_layout_learn(&L, buf, strlen(buf), 11))
+      fail_msg("a layout was learned from \"%s\"", unlearned[i]);
+    assert_false(nav_layout_match(&L, base, strlen(base)));
+  }
+}
+
+/* Random rows against the layout of the row before, as the reader runs it: every match gives
+ * strtod's bits, and both the matches and the relearning are exercised. */
+static void test_layout_random_rows(void **state) {
+  (void)state;
+  rowgen g;
+  rowgen_init(&g, 20261127u);
+  nav_line_layout L;
+  L.count = 0;
+  long hits = 0, misses = 0, learned = 0;
+  char s[512];
+  for (int it = 0; it < 200000; ++it) {
+    rowgen_next(&g, true, s, sizeof s);
+    /* and now and then a digit replaced by a byte that is not one */
+    if (next_u(&g.rng, 100) == 0) {
+      static const char bad[] = {'/', ':', 'x', ' ', '.', '-', '\x80', '\xff'};
+      const size_t at = (size_t)next_u(&g.rng, strlen(s));
+      if (s[at] >= '0' && s[at] <= '9') s[at] = bad[next_u(&g.rng, sizeof bad)];
+    }
+    if (layout_check_line(&L, s, &learned))
+      ++hits;
+    else
+      ++misses;
+  }
+  print_message(
+      "[ fastnum  ] layout: %ld rows matched the layout of the row before, %ld did not (%ld relearned)\n",
+      hits, misses, learned);
+  assert_true(hits > 100000);
+  assert_true(misses > 20000);
+  assert_true(learned > 10000);
+}
+
+/* Read a .nav text with the reader; every row's values into v (11 per row, as the reader returns
+ * them) and the status and message at the end. */
+static int read_pva_values(const char *text, double *v, int cap, nav_status *st, nav_diag *d) {
+  nav_rec_reader *r = NULL;
+  assert_int_equal(nav_rec_reader_open_memory(text, strlen(text), "ref.nav", NAV_REC_PVA, &r), NAV_OK);
+  int n = 0;
+  for (;;) {
+    bool got = false;
+    nav_rec_pva row;
+    *st = nav_rec_read_pva(r, &row, &got);
+    if (*st != NAV_OK || !got) break;
+    if (n < cap) {
+      const double x[11] = {(double)row.week, row.t_s,           row.pos.lat_rad, row.pos.lon_rad,
+                            row.pos.h_m,      row.v_n_mps.x,     row.v_n_mps.y,   row.v_n_mps.z,
+                            row.att.roll_rad, row.att.pitch_rad, row.att.yaw_rad};
+      memcpy(v + 11 * n, x, sizeof x);
+    }
+    ++n;
+  }
+  *d = *nav_rec_reader_diag(r);
+  nav_rec_reader_destroy(r);
+  return n;
+}
+
+/* Random .nav files (several reader buffers long, rows whose layout changes in every way, comment
+ * and empty lines, CR LF, a last line without a line end) read by the reader give, value by value,
+ * what the reader gives for the same rows each with a leading blank (which only the field-by-field
+ * path reads). */
+static void test_layout_reader_files(void **state) {
+  (void)state;
+  enum { ROWS = 30000 };
+  for (int file = 0; file < 3; ++file) {
+    rowgen g;
+    rowgen_init(&g, 1000u + (uint64_t)file);
+    const size_t cap = (size_t)ROWS * 300u;
+    char *fast = malloc(cap), *slow = malloc(cap);
+    double *a = malloc(sizeof(double) * 11 * ROWS), *b = malloc(sizeof(double) * 11 * ROWS);
+    assert_non_null(fast);
+    assert_non_null(slow);
+    assert_non_null(a);
+    assert_non_null(b);
+    size_t pf = 0, ps = 0;
+    char s[512];
+    for (int i = 0; i < ROWS; ++i) {
+      rowgen_next(&g, file > 0, s, sizeof s);
+      const bool last = i + 1 == ROWS;
+      const char *end = last && file == 2 ? "" : "\n";
+      if (next_u(&g.rng, 1000) == 0) {
+        pf += (size_t)snprintf(fast + pf, cap - pf, "# comment\n\n");
+        ps += (size_t)snprintf(slow + ps, cap - ps, "# comment\n\n");
+      }
+      pf += (size_t)snprintf(fast + pf, cap - pf, "%s%s", s, end);
+      ps += (size_t)snprintf(slow + ps, cap - ps, " %s%s", s, end);
+    }
+    nav_status sa, sb;
+    nav_diag da, db;
+    const int na = read_pva_values(fast, a, ROWS, &sa, &da);
+    const int nb = read_pva_values(slow, b, ROWS, &sb, &db);
+    if (sa != NAV_OK) fail_msg("file %d: %s:%d:%d %s", file, da.file, da.line, da.col, da.message);
+    assert_int_equal(sb, NAV_OK);
+    assert_int_equal(na, ROWS);
+    assert_int_equal(nb, ROWS);
+    for (int i = 0; i < ROWS; ++i)
+      for (int k = 0; k < 11; ++k)
+        if (memcmp(&a[11 * i + k], &b[11 * i + k], sizeof(double)) != 0)
+          fail_msg("file %d row %d field %d: %.17g, field by field %.17g", file, i + 1, k + 1, a[11 * i + k],
+                   b[11 * i + k]);
+    free(fast);
+    free(slow);
+    free(a);
+    free(b);
   }
 }
 
@@ -630,6 +982,9 @@ int main(void) {
       cmocka_unit_test(test_fixed_shape),
       cmocka_unit_test(test_fixed_padded),
       cmocka_unit_test(test_pva_line_path),
+      cmocka_unit_test(test_layout_changes),
+      cmocka_unit_test(test_layout_random_rows),
+      cmocka_unit_test(test_layout_reader_files),
       cmocka_unit_test(test_sci_padded),
       cmocka_unit_test(test_imu_line_path),
       cmocka_unit_test(test_shared_files),
