@@ -1299,6 +1299,18 @@ int navsim_replay(int argc, char **argv) {
       fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
       goto cleanup;
     }
+  } else if ((long long)nav_rec_imu_stream_max_records(imu_stream) + 1 <= NAV_SIM_METRIC_MAX_VALUES) {
+    /* The most records the stream can hold already gives stride 1, so the record count, which is
+     * smaller, gives it too: the accumulators are made now, with room for that many values (only
+     * the pages the values reach are touched), and nothing waits in memory to be copied. */
+    st = run_stats_create(&o.rstats, nav_rec_imu_stream_max_records(imu_stream));
+    if (st != NAV_OK) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
+      rc_exit = EXIT_FAIL;
+      fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
+      goto cleanup;
+    }
   } else {
     o.rstats.pending = true;
   }
