@@ -1069,13 +1069,25 @@ int navsim_replay(int argc, char **argv) {
     const int orc = navsim_out_check("replay", out_dir, force);
     if (orc != EXIT_OK) return orc;
   }
+  /* The IMU file starts being read now, on its own thread, while this one reads the scene: the
+     second core would otherwise idle through the scene. Its verdict and any error opening it are
+     taken up below, where they were before (a bad scene is still reported alone, first). */
+  nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
+  nav_diag imu_start_diag;
+  memset(&imu_start_diag, 0, sizeof imu_start_diag);
+  const nav_status imu_start_st =
+      nav_rec_imu_stream_start(imu, REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &imu_start_diag);
 
   if (config) {
     /* nav_scene is large (segment scripts): keep it off the stack. */
     nav_scene *scene = malloc(sizeof *scene);
-    if (!scene) return EXIT_FAIL;
+    if (!scene) {
+      nav_rec_imu_stream_destroy(imu_stream);
+      return EXIT_FAIL;
+    }
     const nav_status st = nav_scene_read_file(config, scene, navsim_print_diag, NULL);
     if (st != NAV_OK) {
+      nav_rec_imu_stream_destroy(imu_stream);
       fprintf(stderr, "navsim replay: --scene %s: %s\n", config,
               st == NAV_ERR_PARSE ? "not a valid scene (errors above)" : nav_status_str(st));
       free(scene);
@@ -1104,6 +1116,7 @@ int navsim_replay(int argc, char **argv) {
         free(verdicts);
         nav_scene_release(scene);
         free(scene);
+        nav_rec_imu_stream_destroy(imu_stream);
         return EXIT_FAIL;
       }
       for (int k = 0; k < n_reqs; ++k) reqs[k] = scene->requirements[k];
@@ -1113,7 +1126,6 @@ int navsim_replay(int argc, char **argv) {
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;
   size_t imu_count = 0; /* IMU records (nav_rec_check_file): bounds the scored epochs */
-  nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
   int rc_exit = EXIT_FAIL;
   nav_status st = NAV_OK;
   out_files o;
@@ -1136,7 +1148,8 @@ int navsim_replay(int argc, char **argv) {
       memset(&d, 0, sizeof d);
       nav_status cs = NAV_ERR_OUT_OF_RANGE;
       if (i == 0) {
-        cs = nav_rec_imu_stream_start(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &d);
+        cs = imu_start_st; /* (started before the scene) */
+        d = imu_start_diag;
         if (cs == NAV_OK) {
           rc.imu_stream = imu_stream;
           continue;
