@@ -1138,6 +1138,8 @@ nav_status nav_rec_imu_stream_start(const char *path, size_t max_bytes, nav_rec_
 
 size_t nav_rec_imu_stream_file_bytes(const nav_rec_imu_stream *s) { return s ? s->file_bytes : 0u; }
 
+size_t nav_rec_imu_stream_max_records(const nav_rec_imu_stream *s) { return s ? s->nblocks * STREAM_BLOCK : 0u; }
+
 /* The consumer's view of the parser's state, waiting until record @p i is parsed or the file
  * ended when @p wait_for is true. */
 static void stream_look(nav_rec_imu_stream *s, size_t i, bool wait_for) {

@@ -242,9 +242,12 @@ typedef struct run_stats {
   bool pending;
   double *pend; /* RUN_STATS_METRICS values per epoch */
   size_t pend_n, pend_cap;
-  /* The results, once run_stats_finish() has computed them. */
+  /* The results, once run_stats_finish_join() has computed them; the first RUN_STATS_ON_HELPER of
+   * them on a second thread while it runs (run_stats_finish_start). */
   bool have_result;
   nav_stat result[RUN_STATS_METRICS];
+  bool helper_running;
+  pthread_t helper;
 } run_stats;
 
 static void run_stats_on_scored(void *user, const nav_epoch_errors *e);
@@ -262,7 +265,10 @@ static nav_status run_stats_create(run_stats *rs, size_t epochs_max) {
   return NAV_OK;
 }
 
+static void run_stats_finish_join(run_stats *rs);
+
 static void run_stats_destroy(run_stats *rs) {
+  if (rs->helper_running) run_stats_finish_join(rs); /* (an error after the selections started) */
   for (int m = 0; m < RUN_STATS_METRICS; ++m) nav_stat_acc_destroy(rs->acc[m]);
   free(rs->pend);
   rs->pend = NULL;
@@ -309,23 +315,32 @@ static void run_stats_settle(run_stats *rs, size_t epochs_max) {
   free(pend);
 }
 
+/* Metrics whose p95 is selected on the helper thread; the others on the thread that joins it. */
+enum { RUN_STATS_ON_HELPER = 3 };
+
 static void *run_stats_result_first(void *arg) {
   run_stats *rs = arg;
-  for (int m = 0; m < 2; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
+  for (int m = 0; m < RUN_STATS_ON_HELPER; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
   return NULL;
 }
 
-/* The results of every metric. Each p95 is a selection over all the values of its metric (some
- * 3 ms for the five metrics of the long drive, after the run, on the critical path): the first two
- * on a second thread, the other three here. The values do not depend on the thread. */
-static void run_stats_finish(run_stats *rs) {
+/* The results of every metric. Each p95 is a selection over all the values of its metric (1-2 ms
+ * for the five metrics of the long drive, after the run, on the critical path): the first three
+ * start on a second thread here, while the caller closes the CSV files and prepares the summary;
+ * run_stats_finish_join() selects the other two and waits for them. Each selection touches its
+ * own metric's values only, and the values do not depend on the thread. */
+static void run_stats_finish_start(run_stats *rs) {
   if (rs->pending || rs->kept == 0 || rs->st != NAV_OK) return;
-  pthread_t th;
-  const bool threaded = pthread_create(&th, NULL, run_stats_result_first, rs) == 0;
-  if (!threaded) (void)run_stats_result_first(rs);
-  for (int m = 2; m < RUN_STATS_METRICS; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
-  if (threaded) (void)pthread_join(th, NULL);
-  rs->have_result = true;
+  rs->helper_running = pthread_create(&rs->helper, NULL, run_stats_result_first, rs) == 0;
+  if (!rs->helper_running) (void)run_stats_result_first(rs);
+  rs->have_result = true; /* (once joined) */
+}
+
+static void run_stats_finish_join(run_stats *rs) {
+  if (!rs->have_result) return;
+  for (int m = RUN_STATS_ON_HELPER; m < RUN_STATS_METRICS; ++m) rs->result[m] = nav_stat_acc_result(rs->acc[m]);
+  if (rs->helper_running) (void)pthread_join(rs->helper, NULL);
+  rs->helper_running = false;
 }
 
 /* ---------------------------------------------------------------- result files */
@@ -888,6 +903,38 @@ static int imu_error_first(nav_rec_imu_stream *s, const char *imu) {
   return st == NAV_ERR_PARSE || st == NAV_ERR_INVALID_ARG ? EXIT_INVALID : EXIT_FAIL;
 }
 
+/* What is freed after summary.json is written, on a second thread while the result directory is
+ * committed (its fsyncs wait for the disk): the IMU records and the statistics' values. */
+typedef struct free_late {
+  nav_rec_imu_stream *stream;
+  run_stats rstats;
+  bool running;
+  pthread_t th;
+} free_late;
+
+static void *free_late_main(void *arg) {
+  free_late *fl = arg;
+  nav_rec_imu_stream_destroy(fl->stream);
+  fl->stream = NULL;
+  run_stats_destroy(&fl->rstats);
+  return NULL;
+}
+
+/* Takes @p stream and the contents of @p rs (which is left empty) and frees them; on one thread
+ * if a second cannot be started. */
+static void free_late_start(free_late *fl, nav_rec_imu_stream *stream, run_stats *rs) {
+  fl->stream = stream;
+  fl->rstats = *rs;
+  memset(rs, 0, sizeof *rs);
+  fl->running = pthread_create(&fl->th, NULL, free_late_main, fl) == 0;
+  if (!fl->running) (void)free_late_main(fl);
+}
+
+static void free_late_join(free_late *fl) {
+  if (fl->running) (void)pthread_join(fl->th, NULL);
+  fl->running = false;
+}
+
 /* nav_replay_raw_fn over a nav_rinex_source. */
 static nav_status rinex_next(void *user, nav_ins_gnss_raw_epoch *ep, bool *got, nav_diag *diag) {
   return nav_rinex_source_next(user, ep, got, diag);
@@ -1069,13 +1116,25 @@ int navsim_replay(int argc, char **argv) {
     const int orc = navsim_out_check("replay", out_dir, force);
     if (orc != EXIT_OK) return orc;
   }
+  /* The IMU file starts being read now, on its own thread, while this one reads the scene: the
+     second core would otherwise idle through the scene. Its verdict and any error opening it are
+     taken up below, where they were before (a bad scene is still reported alone, first). */
+  nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
+  nav_diag imu_start_diag;
+  memset(&imu_start_diag, 0, sizeof imu_start_diag);
+  const nav_status imu_start_st =
+      nav_rec_imu_stream_start(imu, REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &imu_start_diag);
 
   if (config) {
     /* nav_scene is large (segment scripts): keep it off the stack. */
     nav_scene *scene = malloc(sizeof *scene);
-    if (!scene) return EXIT_FAIL;
+    if (!scene) {
+      nav_rec_imu_stream_destroy(imu_stream);
+      return EXIT_FAIL;
+    }
     const nav_status st = nav_scene_read_file(config, scene, navsim_print_diag, NULL);
     if (st != NAV_OK) {
+      nav_rec_imu_stream_destroy(imu_stream);
       fprintf(stderr, "navsim replay: --scene %s: %s\n", config,
               st == NAV_ERR_PARSE ? "not a valid scene (errors above)" : nav_status_str(st));
       free(scene);
@@ -1104,6 +1163,7 @@ int navsim_replay(int argc, char **argv) {
         free(verdicts);
         nav_scene_release(scene);
         free(scene);
+        nav_rec_imu_stream_destroy(imu_stream);
         return EXIT_FAIL;
       }
       for (int k = 0; k < n_reqs; ++k) reqs[k] = scene->requirements[k];
@@ -1113,11 +1173,12 @@ int navsim_replay(int argc, char **argv) {
   }
   if (cov_decimation > 0u) rc.nav.filter.cov_decimation = cov_decimation;
   size_t imu_count = 0; /* IMU records (nav_rec_check_file): bounds the scored epochs */
-  nav_rec_imu_stream *imu_stream = NULL; /* or the IMU file being read while the run starts */
   int rc_exit = EXIT_FAIL;
   nav_status st = NAV_OK;
   out_files o;
   memset(&o, 0, sizeof o);
+  free_late late;
+  memset(&late, 0, sizeof late);
   rc.imu_path = imu;
   rc.gnss_path = gnss;
   rc.ref_path = truth;
@@ -1136,7 +1197,8 @@ int navsim_replay(int argc, char **argv) {
       memset(&d, 0, sizeof d);
       nav_status cs = NAV_ERR_OUT_OF_RANGE;
       if (i == 0) {
-        cs = nav_rec_imu_stream_start(paths[i], REPLAY_IMU_IN_MEMORY_BYTES, &imu_stream, &d);
+        cs = imu_start_st; /* (started before the scene) */
+        d = imu_start_diag;
         if (cs == NAV_OK) {
           rc.imu_stream = imu_stream;
           continue;
@@ -1299,6 +1361,18 @@ int navsim_replay(int argc, char **argv) {
       fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
       goto cleanup;
     }
+  } else if ((long long)nav_rec_imu_stream_max_records(imu_stream) + 1 <= NAV_SIM_METRIC_MAX_VALUES) {
+    /* The most records the stream can hold already gives stride 1, so the record count, which is
+     * smaller, gives it too: the accumulators are made now, with room for that many values (only
+     * the pages the values reach are touched), and nothing waits in memory to be copied. */
+    st = run_stats_create(&o.rstats, nav_rec_imu_stream_max_records(imu_stream));
+    if (st != NAV_OK) {
+      rc_exit = imu_error_first(imu_stream, imu);
+      if (rc_exit) goto cleanup;
+      rc_exit = EXIT_FAIL;
+      fprintf(stderr, "navsim replay: %s\n", nav_status_str(st));
+      goto cleanup;
+    }
   } else {
     o.rstats.pending = true;
   }
@@ -1327,7 +1401,7 @@ int navsim_replay(int argc, char **argv) {
     if (cs != NAV_OK) goto cleanup; /* (not reached: the verdict above) */
     run_stats_settle(&o.rstats, imu_count);
   }
-  if (st == NAV_OK) run_stats_finish(&o.rstats);
+  if (st == NAV_OK) run_stats_finish_start(&o.rstats);
   if (o.live_exit != EXIT_OK) {
     rc_exit = o.live_exit; /* the result directory could not be made (said by out_go_live) */
     goto cleanup;
@@ -1451,11 +1525,17 @@ int navsim_replay(int argc, char **argv) {
     job.verdicts = verdicts;
     job.n_verdicts = n_reqs;
   }
+  run_stats_finish_join(&o.rstats);
   st = write_summary(nav_resultdir_file(o.rd, "summary.json"), &job);
   if (st != NAV_OK) {
     fprintf(stderr, "navsim replay: writing summary.json failed\n");
     goto cleanup;
   }
+  /* Nothing reads the IMU records and the statistics' values any more: they are freed on a second
+     thread while this one waits for the commit's fsyncs (some 20 MB unmapped for the long drive). */
+  free_late_start(&late, imu_stream, &o.rstats);
+  imu_stream = NULL;
+  o.stream = NULL;
   {
     const int orc = navsim_out_commit("replay", o.rd);
     o.rd = NULL;
@@ -1491,6 +1571,7 @@ cleanup:
   nav_rec_imu_stream_destroy(imu_stream);
   nav_resultdir_abort(o.rd);
   smooth_out_destroy(o.so);
+  free_late_join(&late); /* (before run_stats_destroy: it may own the statistics) */
   run_stats_destroy(&o.rstats);
   navsim_req_buffer_free(&req_buf);
   nav_rinex_source_destroy(rsrc);

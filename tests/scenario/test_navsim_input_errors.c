@@ -162,7 +162,8 @@ static void test_issue_25_replay_values_checked_before_the_run(void **state) {
    record in its last line still gives the report of the check before the run - FILE:LINE:COL,
    exit 2 - and nothing reaches the disk: no result directory, not even the missing parents of
    --out. With the GNSS file bad as well, the IMU file's error is the one reported, as when the IMU
-   file was checked first. A good run into the same --out then works. */
+   file was checked first; a bad scene, read while the IMU file is, is reported alone. A good run into
+   the same --out then works. */
 static void test_issue_23_replay_imu_read_during_the_run(void **state) {
   (void)state;
   char *good = nav_test_slurp_alloc(NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt");
@@ -194,6 +195,28 @@ static void test_issue_23_replay_imu_read_during_the_run(void **state) {
   if (r->code != 2) fail_msg("exit %d, expected 2; stderr:\n%s", r->code, r->err);
   nav_test_assert_matches(r->err, pattern);
   if (strstr(r->err, "gnss-bad-first")) fail_msg("the GNSS error was reported first:\n%s", r->err);
+  assert_false(exists("late"));
+  /* The IMU file starts being read before the scene: a bad scene is still the error reported, alone
+     and first, whether the IMU file is bad or missing, and nothing is written. */
+  nav_test_write_file(WORK, "bad-scene.yaml", "format_version: 1\nnavigation:\n  algorithm: bogus\n");
+  const char *imus[2] = {"imu-late-bad.txt", "no-such-imu.txt"};
+  for (int k = 0; k < 2; ++k) {
+    r = navsim("replay --imu %s --gnss gnss-bad-first.txt --truth '%s/replay/truth-100195-100245-20Hz.nav' "
+               "--scene bad-scene.yaml --out late/deeper/rp --quiet",
+               imus[k], NAV_TEST_DATA_DIR);
+    if (r->code != 2) fail_msg("%s: exit %d, expected 2; stderr:\n%s", imus[k], r->code, r->err);
+    nav_test_assert_matches(r->err, "^bad-scene\\.yaml:3:14: error: navigation\\.algorithm: ");
+    if (strstr(r->err, "imu") || strstr(r->err, "gnss-bad-first"))
+      fail_msg("%s: an input other than the scene reported:\n%s", imus[k], r->err);
+    assert_false(exists("late"));
+  }
+  /* A good scene: the missing IMU file is reported then (before the bad GNSS file). */
+  r = navsim("replay --imu no-such-imu.txt --gnss gnss-bad-first.txt --truth '%s/replay/truth-100195-100245-20Hz.nav' "
+             "--out late/deeper/rp --quiet",
+             NAV_TEST_DATA_DIR);
+  if (r->code == 0) fail_msg("exit 0 with a missing IMU file; stderr:\n%s", r->err);
+  nav_test_assert_matches(r->err, "^no-such-imu\\.txt: error: cannot open the IMU file");
+  if (strstr(r->err, "gnss-bad-first")) fail_msg("the GNSS error was reported:\n%s", r->err);
   assert_false(exists("late"));
   /* The good file: the result directory appears, with its files. */
   r = navsim("replay --imu '%s/replay/IMU-100195-100245.txt' --gnss '%s/replay/GNSS-100195-100245.txt' "

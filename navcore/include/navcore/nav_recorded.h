@@ -239,6 +239,10 @@ NAV_API NAV_NODISCARD nav_status nav_rec_imu_stream_start(const char *path, size
 /** Size of the file in bytes (known at the start). */
 NAV_API size_t nav_rec_imu_stream_file_bytes(const nav_rec_imu_stream *s);
 
+/** The most records the stream can hold (set by the file's size at the start; a file with more
+ *  fails with NAV_ERR_NO_MEMORY): an upper bound of the record count known before the reading ends. */
+NAV_API size_t nav_rec_imu_stream_max_records(const nav_rec_imu_stream *s);
+
 /**
  * Record @p i, waiting until it has been parsed.
  * @param[out] rec the record (borrowed, valid until nav_rec_imu_stream_destroy()), or NULL when
