@@ -1236,25 +1236,35 @@ nav_replay_config nav_replay_config_default(void) {
 /* Running RMS / max of the metrics (streaming: memory does not grow with the epochs). */
 enum { N_M = 8 };
 
-void nav_replay_stats_add(nav_replay_stats_acc *a, const nav_epoch_errors *e) {
-  const double v[N_M] = {e->pos_err_h_m,
-                         e->pos_err_v_m,
-                         hypot(e->vel_err_n_mps.x, e->vel_err_n_mps.y),
-                         fabs(e->vel_err_n_mps.z),
-                         fabs(e->euler_err.roll_rad),
-                         fabs(e->euler_err.pitch_rad),
-                         fabs(e->euler_err.yaw_rad),
-                         e->att_err_rad};
+/* The metrics of an epoch (computed once when two accumulators take the same epoch). */
+static void stats_values(const nav_epoch_errors *e, double v[N_M]) {
+  v[0] = e->pos_err_h_m;
+  v[1] = e->pos_err_v_m;
+  v[2] = hypot(e->vel_err_n_mps.x, e->vel_err_n_mps.y);
+  v[3] = fabs(e->vel_err_n_mps.z);
+  v[4] = fabs(e->euler_err.roll_rad);
+  v[5] = fabs(e->euler_err.pitch_rad);
+  v[6] = fabs(e->euler_err.yaw_rad);
+  v[7] = e->att_err_rad;
+}
+
+static void stats_add_values(nav_replay_stats_acc *a, const double v[N_M], double t_s, const nav_epoch_errors *e) {
   for (int m = 0; m < N_M; ++m) {
     a->sum_sq[m] += v[m] * v[m];
     if (a->n == 0 || v[m] > a->max[m]) {
       a->max[m] = v[m];
-      a->t_max[m] = e->t_s;
+      a->t_max[m] = t_s;
     }
   }
   a->sum_pos = nav_vec3_add(a->sum_pos, e->pos_err_n_m);
   a->sum_vel = nav_vec3_add(a->sum_vel, e->vel_err_n_mps);
   a->n++;
+}
+
+void nav_replay_stats_add(nav_replay_stats_acc *a, const nav_epoch_errors *e) {
+  double v[N_M];
+  stats_values(e, v);
+  stats_add_values(a, v, e->t_s, e);
 }
 
 nav_replay_stats nav_replay_stats_result(const nav_replay_stats_acc *a) {
@@ -1698,6 +1708,24 @@ static nav_vec3 ecef_of(double sl, double cl, double so, double co, double h) {
  * Euler angles (the reference's straight from its row). The values agree with the general path
  * to rounding (a few 1e-10 m, 1e-14 rad: the same formulas without the geodetic inversions).
  */
+/* nav_wrap_pi() with its common case (an angle already in (-pi, pi], returned as is) inline. */
+static inline double wrap_pi(double a) { return a > -NAV_PI && a <= NAV_PI ? a : nav_wrap_pi(a); }
+
+/* nav_rec_pva_to_state() of a reference item from the sines and cosines of its latitude and
+ * longitude and the quaternion of its Euler angles, which the item has already (the same calls on
+ * the same angles): the same operations after those, so the same state bit for bit. */
+static nav_traj_state ref_item_state(const ref_item *it) {
+  const nav_rec_pva *row = &it->row;
+  nav_traj_state s;
+  memset(&s, 0, sizeof s);
+  s.t_s = row->t_s;
+  const nav_mat3 C_n_e = dcm_n_e(it->slt, it->clt, it->sot, it->cot);
+  s.r_fb_f_m = nav_earth_geodetic_to_ecef_sc(it->slt, it->clt, it->sot, it->cot, row->pos.h_m);
+  s.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, row->v_n_mps);
+  s.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), it->qt));
+  return s;
+}
+
 static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
   const nav_rec_pva *ref = &ri->row;
   nav_epoch_errors r;
@@ -1721,9 +1749,9 @@ static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
   const nav_quat qm = nav_quat_from_dcm(nav_mat3_mul(Ct_t, Ce));
   r.att_err_rad = nav_quat_angle_between(qt, nav_quat_mul(qm, e->q_b_n));
   const nav_euler ee = nav_quat_to_euler(e->q_b_n, NULL);
-  r.euler_err.roll_rad = nav_wrap_pi(ee.roll_rad - ref->att.roll_rad);
-  r.euler_err.pitch_rad = nav_wrap_pi(ee.pitch_rad - ref->att.pitch_rad);
-  r.euler_err.yaw_rad = nav_wrap_pi(ee.yaw_rad - ref->att.yaw_rad);
+  r.euler_err.roll_rad = wrap_pi(ee.roll_rad - ref->att.roll_rad);
+  r.euler_err.pitch_rad = wrap_pi(ee.pitch_rad - ref->att.pitch_rad);
+  r.euler_err.yaw_rad = wrap_pi(ee.yaw_rad - ref->att.yaw_rad);
   return r;
 }
 
@@ -1731,7 +1759,7 @@ static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
 static nav_epoch_errors errors_at(const nav_frame *frame, const ref_item *ref, const nav_side *n) {
   nav_ins_ned ned;
   if (nav_ned(n, &ned)) return ned_errors(ref, &ned);
-  const nav_traj_state ts = nav_rec_pva_to_state(&ref->row);
+  const nav_traj_state ts = ref_item_state(ref);
   return nav_errors_compute(frame, &ts, nav_state(n));
 }
 
@@ -1798,18 +1826,20 @@ static void score_one(scorer *sc, const sc_item *it) {
     if (it->has_ned) {
       err = ned_errors(&it->u.e.ref, &it->u.e.ned);
     } else {
-      const nav_traj_state ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+      const nav_traj_state ts = ref_item_state(&it->u.e.ref);
       err = nav_errors_compute(sc->frame, &ts, &it->u.e.nav);
     }
-    nav_replay_stats_add(&sc->acc, &err);
+    double v[N_M];
+    stats_values(&err, v);
+    stats_add_values(&sc->acc, v, err.t_s, &err);
     if (cfg->scored) cfg->scored(cfg->user, &err);
-    if (it->output) nav_replay_stats_add(&sc->acc_out, &err);
+    if (it->output) stats_add_values(&sc->acc_out, v, err.t_s, &err);
     sum->final = err;
     sc->gap_max_h = fmax(sc->gap_max_h, err.pos_err_h_m);
   }
   if (it->output && cfg->record) {
     nav_traj_state ts;
-    if (it->has_ref) ts = nav_rec_pva_to_state(&it->u.e.ref.row);
+    if (it->has_ref) ts = ref_item_state(&it->u.e.ref);
     const nav_replay_record rec = {sc->frame, &it->u.e.nav, it->has_ref ? &ts : NULL,
                                    it->has_ref ? &err : NULL, it->updated};
     if (cfg->record(cfg->user, &rec) == NAV_STOP)

@@ -275,8 +275,11 @@ static void run_stats_destroy(run_stats *rs) {
 }
 
 static void run_stats_add_values(run_stats *rs, const double v[RUN_STATS_METRICS]) {
-  if (rs->st != NAV_OK || rs->seen++ % rs->stride != 0) return;
-  for (int m = 0; m < RUN_STATS_METRICS && rs->st == NAV_OK; ++m) rs->st = nav_stat_acc_add(rs->acc[m], v[m]);
+  if (rs->st != NAV_OK) return;
+  const bool keep = rs->stride == 1 || rs->seen % rs->stride == 0; /* (no division at stride 1) */
+  rs->seen++;
+  if (!keep) return;
+  rs->st = nav_stat_acc_add_each(rs->acc, v, RUN_STATS_METRICS);
   rs->kept++;
 }
 

@@ -227,6 +227,70 @@ static void test_issue_23_replay_imu_read_during_the_run(void **state) {
   assert_true(exists("late/deeper/rp/summary.json"));
 }
 
+/* The "stats" block of replay's summary.json (from its key to the next top-level key). */
+static char *stats_block(const char *summary_path) {
+  char *js = nav_test_slurp_alloc(summary_path);
+  assert_non_null(js);
+  const char *a = strstr(js, "\n  \"stats\": {");
+  assert_non_null(a);
+  const char *b = strstr(a, "\n  \"final\": {");
+  assert_non_null(b);
+  char *out = malloc((size_t)(b - a) + 1);
+  assert_non_null(out);
+  memcpy(out, a, (size_t)(b - a));
+  out[b - a] = '\0';
+  free(js);
+  return out;
+}
+
+/* Issue 23: the "stats" accumulators are made before the run when the IMU file's size bounds its
+   record count below NAV_SIM_METRIC_MAX_VALUES (stride 1), else the values wait for the count at
+   the file's end. The same records with 30 MB of comment lines before them take the second path
+   (the size allows more than 2 million records) and must give the same block and the same rows. */
+static void test_issue_23_replay_stats_either_path(void **state) {
+  (void)state;
+  char *good = nav_test_slurp_alloc(NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt");
+  assert_non_null(good);
+  const size_t n = strlen(good);
+  const char pad[] = "# padding to make the file large without records (navsim replay's statistics path)\n";
+  const size_t pn = sizeof pad - 1, lines = (30u << 20) / pn + 1;
+  char *text = malloc(lines * pn + n + 1);
+  assert_non_null(text);
+  for (size_t i = 0; i < lines; ++i) memcpy(text + i * pn, pad, pn);
+  memcpy(text + lines * pn, good, n + 1);
+  nav_test_write_file(WORK, "imu-padded.txt", text);
+  free(text);
+  free(good);
+  const char *imus[2] = {"'" NAV_TEST_DATA_DIR "/replay/IMU-100195-100245.txt'", "imu-padded.txt"};
+  const char *outs[2] = {"stats-plain", "stats-padded"};
+  for (int k = 0; k < 2; ++k) {
+    nav_cli_result *r = navsim("replay --imu %s --gnss '%s/replay/GNSS-100195-100245.txt' "
+                               "--truth '%s/replay/truth-100195-100245-20Hz.nav' --init none --out %s --quiet",
+                               imus[k], NAV_TEST_DATA_DIR, NAV_TEST_DATA_DIR, outs[k]);
+    if (r->code != 0) fail_msg("%s: exit %d; stderr:\n%s", imus[k], r->code, r->err);
+  }
+  char *a = stats_block(WORK "/stats-plain/summary.json"), *b = stats_block(WORK "/stats-padded/summary.json");
+  if (strcmp(a, b) != 0) fail_msg("the stats blocks differ:\n%s\n---\n%s", a, b);
+  assert_non_null(strstr(a, "\"stride\": 1,"));
+  free(a);
+  free(b);
+  static const char *const files[3] = {"errors.csv", "nav.csv", "truth.csv"};
+  for (int i = 0; i < 3; ++i) {
+    char pa[1024], pb[1024];
+    snprintf(pa, sizeof pa, "%s/stats-plain/%s", WORK, files[i]);
+    snprintf(pb, sizeof pb, "%s/stats-padded/%s", WORK, files[i]);
+    char *ta = nav_test_slurp_alloc(pa), *tb = nav_test_slurp_alloc(pb);
+    assert_non_null(ta);
+    assert_non_null(tb);
+    if (strcmp(ta, tb) != 0) fail_msg("%s differs between the two paths", files[i]);
+    free(ta);
+    free(tb);
+  }
+  char big[1024];
+  snprintf(big, sizeof big, "%s/imu-padded.txt", WORK);
+  (void)remove(big);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_issue_25_sweep_grid_value_named_before_work),
@@ -235,6 +299,7 @@ int main(void) {
       cmocka_unit_test(test_issue_25_import_never_replaces_a_valid_scene),
       cmocka_unit_test(test_issue_25_replay_values_checked_before_the_run),
       cmocka_unit_test(test_issue_23_replay_imu_read_during_the_run),
+      cmocka_unit_test(test_issue_23_replay_stats_either_path),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
 }

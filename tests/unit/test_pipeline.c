@@ -234,6 +234,49 @@ static void test_stats(void **state) {
   nav_stat_acc_destroy(acc);
 }
 
+/* nav_stat_acc_add_each: the same accumulators, bit for bit, as nav_stat_acc_add one metric after
+ * the other; it stops at the first error and returns it. */
+static void test_stats_add_each(void **state) {
+  (void)state;
+  enum { M = 5, N = 1000 };
+  nav_stat_acc *a[M], *b[M];
+  for (int m = 0; m < M; ++m) {
+    assert_int_equal(nav_stat_acc_create(N, &a[m]), NAV_OK);
+    assert_int_equal(nav_stat_acc_create(N, &b[m]), NAV_OK);
+  }
+  unsigned long long x = 88172645463325252ull;
+  for (int i = 0; i < N; ++i) {
+    double v[M];
+    for (int m = 0; m < M; ++m) {
+      x ^= x << 13;
+      x ^= x >> 7;
+      x ^= x << 17;
+      v[m] = ((double)(x >> 11) * 0x1p-53 - 0.3) * (m + 1);
+      assert_int_equal(nav_stat_acc_add(a[m], v[m]), NAV_OK);
+    }
+    assert_int_equal(nav_stat_acc_add_each(b, v, M), NAV_OK);
+  }
+  for (int m = 0; m < M; ++m) {
+    const nav_stat sa = nav_stat_acc_result(a[m]), sb = nav_stat_acc_result(b[m]);
+    assert_memory_equal(&sa, &sb, sizeof sa);
+    assert_int_equal(nav_stat_acc_count(b[m]), N);
+  }
+  /* Full accumulators: the first one's error, nothing added to the others. */
+  const double one[M] = {1, 2, 3, 4, 5};
+  assert_int_equal(nav_stat_acc_add_each(b, one, M), NAV_ERR_OUT_OF_RANGE);
+  for (int m = 0; m < M; ++m) nav_stat_acc_reset(b[m]);
+  const double bad[M] = {1, 2, NAN, 4, 5};
+  assert_int_equal(nav_stat_acc_add_each(b, bad, M), NAV_ERR_NUMERIC);
+  assert_int_equal(nav_stat_acc_count(b[1]), 1);
+  assert_int_equal(nav_stat_acc_count(b[2]), 0);
+  assert_int_equal(nav_stat_acc_count(b[3]), 0);
+  assert_int_equal(nav_stat_acc_add_each(NULL, one, M), NAV_ERR_INVALID_ARG);
+  for (int m = 0; m < M; ++m) {
+    nav_stat_acc_destroy(a[m]);
+    nav_stat_acc_destroy(b[m]);
+  }
+}
+
 /* The p95 of nav_stat_acc_result (a radix selection) against the order statistics of a sort, bit
  * for bit, on many random sets: spread and clustered values (one binade, one value repeated),
  * negatives, zeros of both signs, sizes from 1 to 200 000. */
@@ -386,6 +429,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_gauss_legendre),
       cmocka_unit_test(test_stats),
+      cmocka_unit_test(test_stats_add_each),
       cmocka_unit_test(test_stats_p95_exact),
       cmocka_unit_test(test_parametric_derivatives),
       cmocka_unit_test(test_rate_integral),

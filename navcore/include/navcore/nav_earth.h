@@ -103,6 +103,14 @@ NAV_API double nav_earth_wrap_lon(double lon_rad);
 NAV_API nav_vec3 nav_earth_geodetic_to_ecef(nav_geodetic p);
 
 /**
+ * nav_earth_geodetic_to_ecef() for a caller that already has the sines and cosines of the
+ * latitude and longitude (sin() and cos() of them): the same operations after those, so the same
+ * result bit for bit.
+ */
+NAV_API nav_vec3 nav_earth_geodetic_to_ecef_sc(double sin_lat, double cos_lat, double sin_lon, double cos_lon,
+                                               double h_m);
+
+/**
  * ECEF to geodetic position: the nearest point on the ellipsoid and the height along its
  * normal. Robust for every finite input: at and near the poles, on the polar axis, in the
  * equatorial plane, inside the ellipsoid (including inside the evolute near the centre) and far

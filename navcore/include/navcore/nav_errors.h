@@ -70,6 +70,9 @@ NAV_API NAV_NODISCARD nav_status nav_stat_acc_create(size_t capacity, nav_stat_a
 NAV_API void nav_stat_acc_destroy(nav_stat_acc *acc);
 /** Add a value; NAV_ERR_OUT_OF_RANGE when full, NAV_ERR_NUMERIC when not finite. */
 NAV_API NAV_NODISCARD nav_status nav_stat_acc_add(nav_stat_acc *acc, double value);
+/** nav_stat_acc_add(acc[i], values[i]) for i = 0 .. n-1 in order, stopping at the first error
+ *  (returned); one call for the metrics of an epoch. */
+NAV_API NAV_NODISCARD nav_status nav_stat_acc_add_each(nav_stat_acc *const acc[], const double values[], int n);
 NAV_API size_t nav_stat_acc_count(const nav_stat_acc *acc);
 /** Forget every value added (keeps the capacity). */
 NAV_API void nav_stat_acc_reset(nav_stat_acc *acc);

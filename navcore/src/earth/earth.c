@@ -44,13 +44,15 @@ static double radius_den2(double sin_lat) {
 }
 
 nav_vec3 nav_earth_geodetic_to_ecef(nav_geodetic p) {
-  const double s = sin(p.lat_rad), c = cos(p.lat_rad);
-  const double sl = sin(p.lon_rad), cl = cos(p.lon_rad);
+  return nav_earth_geodetic_to_ecef_sc(sin(p.lat_rad), cos(p.lat_rad), sin(p.lon_rad), cos(p.lon_rad), p.h_m);
+}
+
+nav_vec3 nav_earth_geodetic_to_ecef_sc(double s, double c, double sl, double cl, double h_m) {
   /* Groves (2.112): R_N from (2.106); z uses R_N (1 - e^2) = a (1 - e^2)/sqrt(...). */
   const double sqrt_den = sqrt(radius_den2(s));
   const double R_N = NAV_WGS84_A_M / sqrt_den;
-  const double rho = (R_N + p.h_m) * c;
-  const double z = (NAV_WGS84_A_M * E2M / sqrt_den + p.h_m) * s;
+  const double rho = (R_N + h_m) * c;
+  const double z = (NAV_WGS84_A_M * E2M / sqrt_den + h_m) * s;
   return nav_vec3_make(rho * cl, rho * sl, z);
 }
 

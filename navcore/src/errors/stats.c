@@ -73,7 +73,9 @@ void nav_stat_acc_reset(nav_stat_acc *acc) {
   acc->max = 0.0;
 }
 
-nav_status nav_stat_acc_add(nav_stat_acc *acc, double value) {
+/* The body of nav_stat_acc_add(), inlined into nav_stat_acc_add_each() (an exported function of a
+ * shared library is not inlined into its callers by the compiler). */
+static inline nav_status acc_add(nav_stat_acc *acc, double value) {
   if (!acc) return NAV_ERR_INVALID_ARG;
   if (!isfinite(value)) return NAV_ERR_NUMERIC;
   if (acc->count >= acc->capacity) return NAV_ERR_OUT_OF_RANGE;
@@ -84,6 +86,17 @@ nav_status nav_stat_acc_add(nav_stat_acc *acc, double value) {
   acc->sum_sq = t;
   const double a = fabs(value);
   if (a > acc->max) acc->max = a;
+  return NAV_OK;
+}
+
+nav_status nav_stat_acc_add(nav_stat_acc *acc, double value) { return acc_add(acc, value); }
+
+nav_status nav_stat_acc_add_each(nav_stat_acc *const acc[], const double values[], int n) {
+  if (!acc || (!values && n > 0)) return NAV_ERR_INVALID_ARG;
+  for (int i = 0; i < n; ++i) {
+    const nav_status st = acc_add(acc[i], values[i]);
+    if (st != NAV_OK) return st;
+  }
   return NAV_OK;
 }
 
