@@ -825,7 +825,7 @@ static nav_status run_after(run_ctx *c) {
   job *j = c->j;
   const long run = c->run;
   const int64_t k = c->k;
-  const nav_frame frame = j->frame;
+  const nav_frame *frame = &j->frame;
   nav_status st = NAV_OK;
   if (c->integrated || c->gf_gnss) {
     st = aiding_fixes(j, &c->aid_kf, &c->truth, &c->meas, run);
@@ -856,13 +856,13 @@ static nav_status run_after(run_ctx *c) {
   if (st != NAV_OK) return st;
   if (c->aid && !c->integrated) {
     /* Height aiding from the reference (a baro-like sensor): flat Earth height is -D. */
-    const nav_local_view v = nav_frame_view(&frame, c->ts.r_fb_f_m, c->ts.v_fb_f_mps, c->ts.q_b_f);
-    const double h = frame.model == NAV_EARTH_FLAT ? -c->ts.r_fb_f_m.z : v.pos.h_m;
+    const nav_local_view v = nav_frame_view(frame, c->ts.r_fb_f_m, c->ts.v_fb_f_mps, c->ts.q_b_f);
+    const double h = frame->model == NAV_EARTH_FLAT ? -c->ts.r_fb_f_m.z : v.pos.h_m;
     st = nav_ins_aid_vertical(c->ins, h, v.v_n_mps.z);
     if (st != NAV_OK) return st;
   }
   const nav_errors_ref *ref = errors_ref(j, k, &c->ts, &c->own_ref);
-  c->err = nav_errors_compute_ref(&frame, &c->ts, ref, nav_now);
+  c->err = nav_errors_compute_ref(frame, &c->ts, ref, nav_now);
   if (k % j->stats_stride == 0 && k / j->stats_stride < j->stats_per_run)
     store_metrics(j, run, k / j->stats_stride, &c->err);
   const double *cov = run_cov(c->aid_kf.x, c->aid_kf.gf, &c->cov_n);
@@ -881,7 +881,7 @@ static nav_status run_after(run_ctx *c) {
     store_sm(j, run, slot, true, &c->err);
   }
   if (c->record && (k % j->out_stride == 0 || k == j->n)) {
-    nav_sim_record rec = {run, &frame, &c->ts, nav_now, &c->err, c->ideal, &c->meas, NULL, NULL};
+    nav_sim_record rec = {run, frame, &c->ts, nav_now, &c->err, c->ideal, &c->meas, NULL, NULL};
     if (j->opts->record(j->opts->user, &rec) == NAV_STOP) c->stop = true;
   }
   if (c->caller_thread && j->opts->progress && (k % PROGRESS_EVERY == 0 || k == j->n)) {
@@ -956,9 +956,11 @@ static void run_group(job *j, long r0) {
   run_ctx c[NAV_LANES];
   nav_status st[NAV_LANES];
   bool going[NAV_LANES];
+  bool integrated = true; /* every run has its INS/GNSS object (group_job's scheme) */
   for (int l = 0; l < NAV_LANES; ++l) {
     st[l] = run_open(&c[l], j, r0 + l, false);
-    going[l] = st[l] == NAV_OK && c[l].integrated && c[l].imu_model && !c[l].stop;
+    going[l] = st[l] == NAV_OK && !c[l].stop;
+    integrated = integrated && c[l].integrated;
   }
   for (int64_t k = 1; k <= j->n; ++k) {
     int n_going = 0;
@@ -969,7 +971,7 @@ static void run_group(job *j, long r0) {
       else ++n_going;
     }
     if (n_going == 0) break;
-    if (n_going == NAV_LANES) {
+    if (n_going == NAV_LANES && integrated) {
       nav_ins_gnss *x[NAV_LANES];
       const nav_imu_increment *m[NAV_LANES];
       for (int l = 0; l < NAV_LANES; ++l) {
@@ -994,28 +996,17 @@ static void run_group(job *j, long r0) {
       if (c[l].stop) going[l] = false;
     }
   }
-  for (int l = 0; l < NAV_LANES; ++l) {
-    /* A run set up but not on the lockstep path (not expected from group_job) goes alone. */
-    if (st[l] == NAV_OK && !c[l].stop && c[l].k == 1 && !(c[l].integrated && c[l].imu_model)) {
-      for (; st[l] == NAV_OK && c[l].k <= j->n && !c[l].stop; ++c[l].k) {
-        st[l] = run_measure(&c[l]);
-        if (st[l] != NAV_OK || c[l].stop) break;
-        st[l] = run_navigate(&c[l]);
-        if (st[l] == NAV_OK) st[l] = run_after(&c[l]);
-      }
-    }
+  for (int l = 0; l < NAV_LANES; ++l)
     (void)run_close(&c[l], st[l]);
-  }
 }
 
 /* Runs [run, end) of the job: in groups of NAV_LANES where the job allows, the rest one by one. */
 static void run_some(job *j, long run, long end) {
   if (group_job(j) && end - run == NAV_LANES) {
-    for (long r = run; r < end; ++r)
-      if (atomic_load(&j->sim->cancel)) {
-        for (long q = run; q < end; ++q) j->status[q] = NAV_ERR_CANCELLED;
-        return;
-      }
+    if (atomic_load(&j->sim->cancel)) {
+      for (long r = run; r < end; ++r) j->status[r] = NAV_ERR_CANCELLED;
+      return;
+    }
     run_group(j, run);
     return;
   }
