@@ -27,6 +27,7 @@
 #include "navcore/nav_ins.h"
 #include "navcore/nav_sim.h"
 #include "navcore/nav_sim_partial.h"
+#include "nav_sim_outcome.h"
 #include "nav/strapdown_lanes.h"
 
 /* ---------------------------------------------------------------- the strapdown in lanes */
@@ -190,114 +191,23 @@ static void test_strapdown_lanes_wrap_and_refusals(void **state) {
 
 /* ---------------------------------------------------------------- a whole job */
 
-typedef struct outcome {
-  nav_sim_summary sum;
-  nav_sim_envelope_point *env;
-  size_t n_env;
-  nav_sim_run_final *fin;
-  size_t n_fin;
-} outcome;
-
-static void keep(nav_sim *sim, const nav_sim_summary *sum, outcome *o) {
-  o->sum = *sum;
-  const nav_sim_envelope_point *e = nav_sim_envelope(sim, &o->n_env);
-  const nav_sim_run_final *f = nav_sim_finals(sim, &o->n_fin);
-  o->env = o->n_env ? malloc(o->n_env * sizeof *o->env) : NULL;
-  o->fin = o->n_fin ? malloc(o->n_fin * sizeof *o->fin) : NULL;
-  if (o->n_env) memcpy(o->env, e, o->n_env * sizeof *e);
-  if (o->n_fin) memcpy(o->fin, f, o->n_fin * sizeof *f);
-}
-
-static void release(outcome *o) {
-  free(o->env);
-  free(o->fin);
-}
-
-static void job(const nav_scene *sc, int threads, int lanes, outcome *o) {
-  nav_sim *sim = NULL;
-  assert_int_equal(nav_sim_create(sc, &sim), NAV_OK);
-  nav_sim_options opt = nav_sim_options_default();
-  opt.threads = threads;
-  opt.lanes = lanes;
-  nav_sim_summary sum;
-  const nav_status st = nav_sim_run(sim, &opt, &sum);
-  if (st != NAV_OK) fail_msg("nav_sim_run: %s: %s", nav_status_str(st), nav_sim_last_error(sim));
-  keep(sim, &sum, o);
-  nav_sim_destroy(sim);
-}
-
-/* Runs [r0, r1) and [r1, runs) on their own nav_sim (groups then start at other runs), merged. */
-static void split_job(const nav_scene *sc, long r1, outcome *o) {
-  const long bounds[3] = {0, r1, sc->simulation.runs};
-  nav_sim_partial *parts[2] = {NULL, NULL};
-  for (int q = 0; q < 2; ++q) {
-    nav_sim *sim = NULL;
-    assert_int_equal(nav_sim_create(sc, &sim), NAV_OK);
-    nav_sim_options opt = nav_sim_options_default();
-    opt.threads = 2;
-    assert_int_equal(nav_sim_run_partial(sim, &opt, bounds[q], bounds[q + 1], &parts[q]), NAV_OK);
-    nav_sim_destroy(sim);
-  }
-  nav_sim *sim = NULL;
-  assert_int_equal(nav_sim_create(sc, &sim), NAV_OK);
-  nav_sim_options opt = nav_sim_options_default();
-  nav_sim_summary sum;
-  assert_int_equal(nav_sim_merge(sim, &opt, (const nav_sim_partial *const *)parts, 2, &sum), NAV_OK);
-  keep(sim, &sum, o);
-  nav_sim_destroy(sim);
-  nav_sim_partial_destroy(parts[0]);
-  nav_sim_partial_destroy(parts[1]);
-}
-
-static void same_double(double a, double b, const char *what) {
-  if (memcmp(&a, &b, sizeof a) != 0) fail_msg("%s: %.17g != %.17g", what, a, b);
-}
-
-static void same_stat(nav_stat a, nav_stat b, const char *what) {
-  same_double(a.rms, b.rms, what);
-  same_double(a.max, b.max, what);
-  same_double(a.p95, b.p95, what);
-}
-
-static void assert_identical(const outcome *a, const outcome *b) {
-  assert_int_equal(a->sum.runs, b->sum.runs);
-  assert_int_equal(a->sum.imu_samples, b->sum.imu_samples);
-  assert_int_equal(a->sum.stats_epochs, b->sum.stats_epochs);
-  same_stat(a->sum.stats.pos_err_h_m, b->sum.stats.pos_err_h_m, "stats.pos_err_h_m");
-  same_stat(a->sum.stats.pos_err_v_m, b->sum.stats.pos_err_v_m, "stats.pos_err_v_m");
-  same_stat(a->sum.stats.vel_err_mps, b->sum.stats.vel_err_mps, "stats.vel_err_mps");
-  same_stat(a->sum.stats.att_err_rad, b->sum.stats.att_err_rad, "stats.att_err_rad");
-  same_stat(a->sum.stats.yaw_err_rad, b->sum.stats.yaw_err_rad, "stats.yaw_err_rad");
-  same_double(a->sum.final_rms.pos_err_h_m, b->sum.final_rms.pos_err_h_m, "final_rms.pos_err_h_m");
-  assert_int_equal(a->n_env, b->n_env);
-  assert_true(a->n_env > 0);
-  assert_memory_equal(a->env, b->env, a->n_env * sizeof *a->env);
-  assert_int_equal(a->n_fin, b->n_fin);
-  for (size_t i = 0; i < a->n_fin; ++i) {
-    assert_int_equal(a->fin[i].run, b->fin[i].run);
-    assert_memory_equal(&a->fin[i].err, &b->fin[i].err, sizeof a->fin[i].err);
-  }
-}
-
 static void test_job_lanes_same_bits(void **state) {
   (void)state;
-  char path[1024];
-  snprintf(path, sizeof path, "%s/scenes/urban-drive.yaml", NAV_SOURCE_DIR);
-  nav_scene sc;
-  assert_int_equal(nav_scene_read_file(path, &sc, NULL, NULL), NAV_OK);
-  sc.simulation.runs = 6;
-  outcome one, four, split;
-  job(&sc, 1, 1, &one);
-  job(&sc, 2, 0, &four);
-  split_job(&sc, 2, &split);
+  const nav_scene sc = load("urban-drive.yaml", 6);
+  outcome one, four, split_runs;
+  reference_lanes(&sc, 1, 1, &one);
+  reference_lanes(&sc, 2, 0, &four);
+  const long bounds[3] = {0, 2, 6};
+  const int threads[2] = {2, 2};
+  split(&sc, bounds, 2, threads, &split_runs);
   /* The runs differ (else equal results would say nothing). */
   assert_int_equal(one.n_fin, 6);
   assert_true(memcmp(&one.fin[1].err, &one.fin[2].err, sizeof one.fin[1].err) != 0);
   assert_identical(&four, &one);
-  assert_identical(&split, &one);
+  assert_identical(&split_runs, &one);
   release(&one);
   release(&four);
-  release(&split);
+  release(&split_runs);
 }
 
 int main(void) {
