@@ -8,7 +8,7 @@
  *   - viewer frames per second on the one-hour 200 Hz case (navview --bench);
  *   - peak resident memory of a Monte Carlo campaign (the full suite: 1000 runs of 1 h at 200 Hz),
  *     from the child's rusage.
- * Child processes are started with fork/exec and timed here; their output goes to DIR/logs/.
+ * Child processes are started and timed by bench_child.c; their output goes to DIR/logs/.
  */
 #define _POSIX_C_SOURCE 200809L
 #define _DEFAULT_SOURCE
@@ -33,54 +33,6 @@
 #include "navcore/nav_recorded.h"
 
 /* ------------------------------------------------------------------ child processes */
-
-/* Run argv with stdout+stderr into log_path; kill it after timeout_s (0: no limit). */
-child_result bench_run_child(char *const argv[], const char *log_path, double timeout_s) {
-  child_result r;
-  memset(&r, 0, sizeof r);
-  fflush(stdout);
-  fflush(stderr);
-  const double t0 = bench_now_s();
-  const pid_t pid = fork();
-  if (pid < 0) return r;
-  if (pid == 0) {
-    const int fd = open(log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      dup2(fd, STDOUT_FILENO);
-      dup2(fd, STDERR_FILENO);
-      close(fd);
-    }
-    execvp(argv[0], argv);
-    fprintf(stderr, "cannot start %s: %s\n", argv[0], strerror(errno));
-    _exit(127);
-  }
-  r.started = true;
-  int status = 0;
-  struct rusage ru;
-  memset(&ru, 0, sizeof ru);
-  for (;;) {
-    const pid_t w = wait4(pid, &status, WNOHANG, &ru);
-    if (w == pid) break;
-    if (w < 0 && errno != EINTR) {
-      r.started = false;
-      return r;
-    }
-    if (timeout_s > 0 && bench_now_s() - t0 > timeout_s && !r.timed_out) {
-      kill(pid, SIGKILL);
-      r.timed_out = true;
-    }
-    const struct timespec ts = {0, 20 * 1000 * 1000};
-    nanosleep(&ts, NULL);
-  }
-  r.wall_s = bench_now_s() - t0;
-  r.maxrss_mb = (double)ru.ru_maxrss / 1024.0; /* ru_maxrss is in KiB on Linux */
-  r.cpu_s = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-            1e-6 * (double)ru.ru_stime.tv_usec;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.exited_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  if (r.exit_code == 127) r.started = false;
-  return r;
-}
 
 /* This executable (for the child runs). */
 bool bench_self_exe(char *buf, size_t cap) {

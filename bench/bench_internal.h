@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "bench_child.h"
 #include "navcore/nav_scene.h"
 
 typedef struct bench_row {
@@ -37,16 +38,6 @@ double bench_now_s(void);
 #define BENCH_KFGINS_PUBLISHED_SOURCE                                                                          \
   "data set README: 2-core AMD EPYC, Debian 12, 2026-11-22; not this machine, not this load"
 
-/* Child processes (bench_cases2.c): stdout+stderr into log_path, killed after timeout_s (0: none). */
-typedef struct child_result {
-  bool started, exited_ok, timed_out;
-  int exit_code;
-  double wall_s;
-  double maxrss_mb; /* of the child itself (wait4) */
-  double cpu_s;     /* user + system CPU seconds of the child itself (wait4) */
-} child_result;
-
-child_result bench_run_child(char *const argv[], const char *log_path, double timeout_s);
 /* navview of this build, or NULL; whether an X display is set. */
 const char *bench_navview_exe(void);
 bool bench_have_display(void);
