@@ -23,6 +23,14 @@ strace -f -qq -o "$WORK/trace.txt" -e trace=openat,write,sync_file_range,fsync,r
   --truth "$D/truth-100195-100245-20Hz.nav" --scene "$SRC/tests/data/replay/long-drive.yaml" \
   --out "$WORK/out" --force --quiet
 test -s "$WORK/out/nav.csv" || { echo "FAIL: no nav.csv"; exit 1; }
+# strace -f splits a call that another thread interrupts into "PID call(args <unfinished ...>" and
+# later "PID <... call resumed>rest": join each pair into one line, at the place the call ended
+# (navsim fsyncs and unlinks a result's files on two threads).
+awk '
+  / <unfinished \.\.\.>$/        { l = $0; sub(/ <unfinished \.\.\.>$/, "", l); pend[$1] = l; next }
+  /^[0-9]+ +<\.\.\. [a-z0-9_]+ resumed>/ { r = $0; sub(/^[0-9]+ +<\.\.\. [a-z0-9_]+ resumed>/, "", r)
+                                    print pend[$1] r; delete pend[$1]; next }
+  { print }' "$WORK/trace.txt" > "$WORK/trace-joined.txt"
 # Per file (named by the path its descriptor was opened with): write calls, sync_file_range calls
 # and fsyncs; and whether any fsync came after the rename. The write counts go to writes.txt.
 awk '
@@ -44,7 +52,7 @@ awk '
     if (!renamed || late) { print "FAIL: an fsync after the rename, or no rename"; bad = 1 }
     for (c in lim) printf "%s %d\n", c, lim[c] > "/dev/stderr"
     exit bad
-  }' "$WORK/trace.txt" 2> "$WORK/writes.txt" || { echo "FAIL: see $WORK/trace.txt"; exit 1; }
+  }' "$WORK/trace-joined.txt" 2> "$WORK/writes.txt" || { echo "FAIL: see $WORK/trace.txt"; exit 1; }
 # The write calls against the file sizes.
 while read -r f n; do
   size=$(wc -c < "$WORK/out/$f")
