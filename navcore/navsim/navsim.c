@@ -3,6 +3,9 @@
  * command table and the dispatch; each command lives in the file named for it (check_cmd.c,
  * run_cmd.c, estimate_cmd.c, ...) and parses its own options with the helpers of cli_util.h.
  * The program's --help is printed from the table, so a command is added in one place.
+ * `serve`, and `run` under several MPI ranks, replace this process by a helper program
+ * (navsim-serve, navsim-mpi; exec_helper.h), so navsim itself links neither the server's
+ * libraries nor MPI. This file is also the main of navsim-mpi (NAVSIM_HAVE_MPI, no such exec).
  *
  * Exit codes: 0 success; 1 failure other than invalid input (I/O, numerical); 2 invalid scene
  * or invalid command line.
