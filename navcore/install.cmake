@@ -72,6 +72,12 @@ foreach(_pc navcore navcore-io)
 endforeach()
 
 install(TARGETS navsim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+# navsim's helper programs (navsim/exec_helper.h), found by navsim in ../libexec/navcore.
+foreach(_helper navsim_serve navsim_mpi)
+  if(TARGET ${_helper})
+    install(TARGETS ${_helper} RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/navcore COMPONENT tools)
+  endif()
+endforeach()
 
 # Man pages navsim.1 and navsim-COMMAND.1, generated with help2man from `navsim [COMMAND] --help`
 # each time navsim is linked (the test install_man checks that they agree with --help).

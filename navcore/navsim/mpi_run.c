@@ -7,6 +7,11 @@
  * `navsim run SCENE --runs N` on one machine with the same seed, for any K and thread count.
  * Only rank 0 writes the result directory (atomically, as always).
  *
+ * This file is compiled twice: into navsim without MPI (the functions below the #else), and into
+ * the helper navsim-mpi with it; navsim started with more than one rank replaces itself by
+ * navsim-mpi before anything else (navsim.c, exec_helper.h), so a process that is not part of a
+ * campaign never loads the MPI libraries.
+ *
  * Protocol: rank 0 broadcasts "go" (1) once its result directory is set up, or "stop" (0) when it
  * fails before; every other rank then sends rank 0 a message with the size of its packed partial
  * (or minus a status on failure), then the bytes in chunks of at most 1 GiB. Rank 0 receives every
@@ -27,6 +32,7 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "exec_helper.h"
 #include "navcore/nav_requirements.h"
 #include "navcore/nav_sim_partial.h"
 
@@ -41,19 +47,9 @@
 static bool g_active;   /* MPI initialised by us and not yet finalised */
 static int g_rank, g_size = 1;
 
-/* Started by mpirun/srun with more than one rank? (Open MPI, PMI/PMIx launchers.) */
-static bool launched_with_ranks(void) {
-  const char *vars[3] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"};
-  for (int i = 0; i < 3; ++i) {
-    const char *v = getenv(vars[i]);
-    if (v && atoi(v) > 1) return true;
-  }
-  return false;
-}
-
 static bool mpi_start(void) {
   if (g_active) return true;
-  if (!launched_with_ranks()) return false;
+  if (!navsim_launched_with_ranks()) return false;
   int provided = 0;
   if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
     fprintf(stderr, "navsim run: MPI_Init failed; running without MPI\n");

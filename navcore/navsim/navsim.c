@@ -3,6 +3,9 @@
  * command table and the dispatch; each command lives in the file named for it (check_cmd.c,
  * run_cmd.c, estimate_cmd.c, ...) and parses its own options with the helpers of cli_util.h.
  * The program's --help is printed from the table, so a command is added in one place.
+ * `serve`, and `run` under several MPI ranks, replace this process by a helper program
+ * (navsim-serve, navsim-mpi; exec_helper.h), so navsim itself links neither the server's
+ * libraries nor MPI. This file is also the main of navsim-mpi (NAVSIM_HAVE_MPI, no such exec).
  *
  * Exit codes: 0 success; 1 failure other than invalid input (I/O, numerical); 2 invalid scene
  * or invalid command line.
@@ -25,10 +28,8 @@
 #include "schema_cmd.h"
 #include "select_cmd.h"
 #include "tradeoff_cmd.h"
+#include "exec_helper.h"
 #include "navcore/nav_version.h"
-#ifdef NAVSIM_HAVE_SERVE
-#include "navserve.h"
-#endif
 
 enum { EXIT_OK = 0, EXIT_INVALID = 2 };
 
@@ -37,6 +38,18 @@ static int cmd_catalog(int argc, char **argv) {
   char res[4096];
   return navsim_catalog(argc, argv, navsim_find_resources_dir(res, sizeof res) ? res : NULL);
 }
+
+/* The whole command line, for the commands that hand it to a helper program (exec_helper.h). */
+static char **g_argv;
+
+#ifdef NAVSIM_HAVE_SERVE
+/* navsim serve: the server is the helper program navsim-serve (libmicrohttpd is loaded only there). */
+static int cmd_serve(int argc, char **argv) {
+  (void)argc;
+  (void)argv;
+  return navsim_exec_helper("navsim-serve", "navsim serve", g_argv);
+}
+#endif
 
 typedef struct navsim_command {
   const char *name;
@@ -70,7 +83,7 @@ static const navsim_command k_commands[] = {
     {"schema", "", "JSON Schema of scene files: keys, types, units, bounds, defaults", navsim_schema},
 #ifdef NAVSIM_HAVE_SERVE
     /* Listed only when built: the man pages and bash completion are made from this list. */
-    {"serve", "", "HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)", navserve_main},
+    {"serve", "", "HTTP server of the web variant: browser studio and JSON API (docs/web-server.md)", cmd_serve},
 #endif
 };
 enum { N_COMMANDS = sizeof k_commands / sizeof k_commands[0] };
@@ -110,6 +123,13 @@ int main(int argc, char **argv) {
     return EXIT_INVALID;
   }
   const char *cmd = argv[1];
+  g_argv = argv;
+#ifdef NAVSIM_MPI_HELPER
+  /* Under mpirun or srun with several ranks, `run` is navsim-mpi's (before any MPI call: the
+   * launcher's environment is all MPI_Init needs, and execv keeps the process). */
+  if (strcmp(cmd, "run") == 0 && navsim_launched_with_ranks())
+    return navsim_exec_helper("navsim-mpi", "navsim run", argv);
+#endif
   if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0) {
     printf("navsim %s\n", nav_version_string());
     return EXIT_OK;

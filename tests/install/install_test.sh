@@ -56,13 +56,21 @@ tree)
       [ -e "$prefix/$f" ] || fail "not installed: $f"
     done
   fi
+  # navsim's helper programs (navcore/navsim/exec_helper.h) in libexec/navcore, where navsim finds them.
+  helpers=""
+  for h in navsim-serve navsim-mpi; do
+    if [ -x "$build/navcore/$h" ]; then
+      [ -x "$prefix/libexec/navcore/$h" ] || fail "not installed: libexec/navcore/$h"
+      helpers="$helpers $h"
+    fi
+  done
   # No program or library, built or installed, may name a search directory the loader reads as
   # relative to the current one: an empty RUNPATH/RPATH entry (CMake leaves a trailing ':' in the
   # build tree for installed targets unless they are linked with their install RUNPATH) or a
   # relative path. A build-tree navsim started in a user's data folder would otherwise load a
   # libexpat.so.1 lying there.
-  for f in "$build/navcore/navsim" "$build/viewer/navview" "$build/editor/navstudio" \
-    "$build"/navcore/libnavcore*.so.* "$prefix"/bin/* "$prefix/$libdir"/libnavcore*.so.*; do
+  for f in "$build/navcore/navsim" "$build"/navcore/navsim-* "$build/viewer/navview" "$build/editor/navstudio" \
+    "$build"/navcore/libnavcore*.so.* "$prefix"/bin/* "$prefix"/libexec/navcore/* "$prefix/$libdir"/libnavcore*.so.*; do
     [ -f "$f" ] || continue
     rp=$(readelf -d "$f" | sed -n 's/.*(R[UN]*PATH).*\[\(.*\)\]/\1/p')
     [ -z "$rp" ] && continue
@@ -92,7 +100,7 @@ tree)
   comm -23 "$work/api.declared" "$work/api.exported" > "$work/api.missing"
   [ ! -s "$work/api.missing" ] || fail "declared but not exported: $(tr '\n' ' ' < "$work/api.missing")"
   # No compiled-in path of this machine's source or build tree in what runs.
-  for f in "$prefix"/bin/* "$prefix/$libdir"/lib*.so.*; do
+  for f in "$prefix"/bin/* "$prefix/$libdir"/lib*.so.* $(for h in $helpers; do echo "$prefix/libexec/navcore/$h"; done); do
     [ -L "$f" ] && continue
     if strings -a "$f" | grep -F -e "$build" -e "$src" > "$work/paths.txt"; then
       fail "$f contains a build-machine path: $(head -n 3 "$work/paths.txt")"
@@ -112,7 +120,13 @@ bin=$moved/usr/bin
 grep -q "$moved/usr/share/navcore/resources/imu_catalog.csv" catalog.txt
 \$bin/navsim run $moved/usr/share/navcore/scenes/$scene --out result --quiet
 test -s result/summary.json
-echo "installed navsim (moved to $moved/usr): check, catalog and run passed"
+if ldd \$bin/navsim | grep -E 'libmicrohttpd|libmpi'; then echo "navsim links the server or MPI"; exit 1; fi
+RUN
+  case " $helpers " in
+  *" navsim-serve "*) echo '$bin/navsim serve --help | grep -q "^usage: navsim serve "' >> "$moved/run.sh" ;;
+  esac
+  cat >> "$moved/run.sh" <<RUN
+echo "installed navsim (moved to $moved/usr): check, catalog, run and its helpers ($helpers ) passed"
 RUN
   if unshare -m --propagation private true 2>/dev/null; then
     unshare -m --propagation private sh -c "mount -t tmpfs none '$build' && mount -t tmpfs none '$src' && sh '$moved/run.sh'" ||

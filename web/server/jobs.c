@@ -1,6 +1,6 @@
 /*
  * Jobs of navsim serve: a bounded queue of simulations, each run by a worker thread as its own
- * process (this program again, `navsim run`, with a fixed argument list and no shell) in its own
+ * process (navsim again, `navsim run`, with a fixed argument list and no shell) in its own
  * directory <data_dir>/jobs/<id>/, with resource limits, no new privileges, its own process group
  * and a watchdog; results expire by age under a disk quota.
  *
@@ -9,6 +9,7 @@
  */
 #define _GNU_SOURCE
 #include "serve_internal.h"
+#include "navserve.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -83,7 +84,7 @@ static struct {
   char jobs_dir[SERVE_PATH_MAX], tmp_dir[SERVE_PATH_MAX];
   char *envp[12];
   char env_store[12][SERVE_PATH_MAX + 32];
-  char exe[SERVE_PATH_MAX]; /* this program's path, for Slurm batch scripts */
+  char exe[SERVE_PATH_MAX]; /* the jobs' navsim (job_program), for Slurm batch scripts */
 } g = {.mu = PTHREAD_MUTEX_INITIALIZER};
 
 const char *job_state_name(job_state s) {
@@ -186,9 +187,24 @@ static void confine_writes(void) {
   close(rs);
 }
 
+/* The navsim the jobs run: set by navserve_set_job_program (the helper program navsim-serve hosts
+ * the server), else this program. Written once before the server starts. */
+static char g_job_program[SERVE_PATH_MAX];
+
+void navserve_set_job_program(const char *path) {
+  if (path && strlen(path) < sizeof g_job_program) memcpy(g_job_program, path, strlen(path) + 1);
+}
+
+static bool job_program(char *buf, size_t size) {
+  if (g_job_program[0] == '\0') return nav_paths_executable(buf, size);
+  if (strlen(g_job_program) >= size) return false;
+  memcpy(buf, g_job_program, strlen(g_job_program) + 1);
+  return true;
+}
+
 pid_t serve_spawn(const char *dir, char *const argv[], int progress_fd, long cpu_s, const char *log_name) {
   char exe[SERVE_PATH_MAX];
-  if (!nav_paths_executable(exe, sizeof exe)) return -1;
+  if (!job_program(exe, sizeof exe)) return -1;
   return serve_spawn_prog(exe, dir, argv, progress_fd, cpu_s, log_name);
 }
 
@@ -770,7 +786,7 @@ bool serve_jobs_start(const serve_config *cfg, char *why, size_t why_size) {
   clear_dir(g.jobs_dir, true);
   clear_dir(g.tmp_dir, false);
   build_env();
-  if (!nav_paths_executable(g.exe, sizeof g.exe)) g.exe[0] = '\0';
+  if (!job_program(g.exe, sizeof g.exe)) g.exe[0] = '\0';
   g.stream_client = calloc((size_t)cfg->max_streams, sizeof *g.stream_client);
   g.workers = calloc((size_t)cfg->max_parallel_jobs, sizeof *g.workers);
   if (!g.stream_client || !g.workers) {
