@@ -94,10 +94,22 @@ static const uint64_t nav_fmt_pow5_wide[28][2] = {{0x0000000000000002ull, 0x04fc
                                                   {0xd0cf4b50cfe20765ull, 0xfff4b4e3f741cf6dull},
                                                   /* 5^55 */};
 
-/* "00" "01" ... "99": two decimal digits per entry. */
-static const char nav_fmt_digit_pairs[201] =
-    "0001020304050607080910111213141516171819202122232425262728293031323334353637383940414243444546474849"
-    "5051525354555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+/* The eight decimal digits of n < 10^8 as ASCII in one word, the first digit in the lowest byte
+ * (the order of a little-endian store): n is split into two groups of four digits, each group
+ * into two of two, each of those into two digits, every split done in all lanes at once by a
+ * multiplication by a scaled reciprocal (floor(v 10486 / 2^20) = floor(v / 100) for v < 10^4,
+ * floor(v 103 / 2^10) = floor(v / 10) for v < 100; no lane's product reaches the next lane). */
+static inline uint64_t nav_fmt_digits8(uint32_t n) {
+  uint64_t x = (uint64_t)(n / 10000u) | ((uint64_t)(n % 10000u) << 32);
+  const uint64_t y = ((x * 10486u) >> 20) & 0x0000007F0000007Full;
+  x = y | ((x - y * 100u) << 16);
+  const uint64_t z = ((x * 103u) >> 10) & 0x000F000F000F000Full;
+  x = z | ((x - z * 10u) << 8);
+  return x | 0x3030303030303030ull;
+}
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "fast_format.h stores the digits of nav_fmt_digits8 little-endian"
+#endif
 
 /* round(P / 2^sh) to nearest, ties to even, for P = p2 2^128 + p1 2^64 + p0 and 64 <= sh < 192;
  * UINT64_MAX when it does not fit below 2^63. */
@@ -154,12 +166,16 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
   return q >> 63 ? UINT64_MAX : (uint64_t)q;
 }
 
+/** Bytes nav_fmt_g17_wide() may overwrite at its destination. */
+#define NAV_FMT_G17_WIDE 64
+
 /**
- * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
- * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
- * digits). @return the length.
+ * Writes x as printf("%.17g", x) would at t, with a terminating NUL, using t[0 ..
+ * NAV_FMT_G17_WIDE) as scratch (the bytes after the NUL get whatever the fixed-size stores put
+ * there). The text is assembled from the digits in registers with 1-, 8- and 16-byte stores,
+ * without a scratch array of digits. @return the length.
  */
-static inline int nav_fmt_g17(char *buf, double x) {
+static inline int nav_fmt_g17_wide(char *t, double x) {
   uint64_t bits;
   memcpy(&bits, &x, sizeof bits);
   const int neg = (int)(bits >> 63);
@@ -167,13 +183,13 @@ static inline int nav_fmt_g17(char *buf, double x) {
   const uint64_t frac = bits & ((1ull << 52) - 1u);
   if (be == 0 && frac == 0) {
     if (neg) {
-      memcpy(buf, "-0", 3);
+      memcpy(t, "-0", 3);
       return 2;
     }
-    memcpy(buf, "0", 2);
+    memcpy(t, "0", 2);
     return 1;
   }
-  if (be == 0 || be == 0x7ff) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
+  if (be == 0 || be == 0x7ff) return snprintf(t, NAV_FMT_G17_SIZE, "%.17g", x);
   const uint64_t m = frac | (1ull << 52);
   const int e = be - 1075; /* x = m 2^e */
   /* Decimal exponent of the leading bit, floor((e + 52) log10 2), within one of floor(log10 |x|). */
@@ -183,7 +199,7 @@ static inline int nav_fmt_g17(char *buf, double x) {
   int tries = 0;
   for (;;) {
     const int k = 16 - x10;
-    if (k < 0 || k > 55 || ++tries > 4) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
+    if (k < 0 || k > 55 || ++tries > 4) return snprintf(t, NAV_FMT_G17_SIZE, "%.17g", x);
     d = nav_fmt_scaled(m, k, k + e);
     if (d >= 100000000000000000ull)
       ++x10;
@@ -192,37 +208,29 @@ static inline int nav_fmt_g17(char *buf, double x) {
     else
       break;
   }
-  /* The 17 digits: 9 + 8 in two 32-bit halves, two digits per step (short dependency chains of
-   * 32-bit divisions by constants instead of 17 64-bit ones). */
-  /* dig: the 17 digits, then '0' padding so that the fixed-size copies below stay inside it. */
-  char dig[40];
-  memset(dig + 17, '0', sizeof dig - 17);
-  uint32_t hi = (uint32_t)(d / 100000000u), lo = (uint32_t)(d % 100000000u);
-  for (int i = 16; i > 8; i -= 2) {
-    const uint32_t two = lo % 100u;
-    lo /= 100u;
-    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
-  }
-  for (int i = 8; i > 0; i -= 2) {
-    const uint32_t two = hi % 100u;
-    hi /= 100u;
-    memcpy(dig + i - 1, nav_fmt_digit_pairs + 2 * two, 2);
-  }
-  dig[0] = (char)('0' + hi);
-  int nd = 17; /* significant digits after removing trailing zeros */
-  while (nd > 1 && dig[nd - 1] == '0')
-    --nd;
-  /* The text is laid out in t with copies of fixed size (short variable-length copies cost more
-   * than the digits: rep movsb), then t's first NAV_FMT_G17_SIZE bytes go to buf. */
-  char t[64];
-  memset(t, 0, NAV_FMT_G17_SIZE);
+  /* The 17 digits: the first (c0), then digits 1 .. 16 in the bytes of D (digit 1 lowest), two
+   * groups of eight converted by nav_fmt_digits8. The significant digits end at the last one that
+   * is not '0'. */
+  const uint64_t rest = d % 10000000000000000ull;
+  const char c0 = (char)('0' + (int)(d / 10000000000000000ull));
+  const uint64_t wh = nav_fmt_digits8((uint32_t)(rest / 100000000u));
+  const uint64_t wl = nav_fmt_digits8((uint32_t)(rest % 100000000u));
+  const nav_fmt_u128 D = (nav_fmt_u128)wh | ((nav_fmt_u128)wl << 64);
+  const uint64_t zh = wh ^ 0x3030303030303030ull, zl = wl ^ 0x3030303030303030ull; /* '0' -> 0 */
+  int nd; /* significant digits after removing trailing zeros */
+  if (zl)
+    nd = 17 - (__builtin_clzll(zl) >> 3);
+  else if (zh)
+    nd = 9 - (__builtin_clzll(zh) >> 3);
+  else
+    nd = 1;
   char *p = t;
   *p = '-';
   p += neg; /* (the sign without a branch: it changes from value to value) */
   if (x10 < -4 || x10 >= 17) {
-    p[0] = dig[0];
+    p[0] = c0;
     p[1] = '.';
-    memcpy(p + 2, dig + 1, 16);
+    memcpy(p + 2, &D, 16);
     p += nd > 1 ? nd + 1 : 1;
     *p++ = 'e';
     int ex = x10;
@@ -233,24 +241,40 @@ static inline int nav_fmt_g17(char *buf, double x) {
     *p++ = (char)('0' + ex % 10);
   } else if (x10 >= 0) {
     const int ni = x10 + 1; /* integer digits, 1..17 */
-    memcpy(p, dig, 17);
+    p[0] = c0;
+    memcpy(p + 1, &D, 16);
     if (nd > ni) {
+      /* ni <= 16: the point, then digits ni .. 16 (bytes ni - 1 .. 15 of D) after it. */
+      const nav_fmt_u128 tail = D >> (8 * (ni - 1));
       p[ni] = '.';
-      memcpy(p + ni + 1, dig + ni, 16);
+      memcpy(p + ni + 1, &tail, 16);
       p += nd + 1;
     } else {
       p += ni;
     }
   } else {
     /* -4 <= x10 <= -1: "0." and -x10 - 1 zeros before the digits. */
-    memcpy(p, "0.000", 5);
+    memcpy(p, "0.000000", 8);
     p += 2 + (-x10 - 1);
-    memcpy(p, dig, 17);
+    p[0] = c0;
+    memcpy(p + 1, &D, 16);
     p += nd;
   }
   *p = '\0';
-  memcpy(buf, t, NAV_FMT_G17_SIZE);
   return (int)(p - t);
+}
+
+/**
+ * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
+ * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
+ * digits). @return the length.
+ */
+static inline int nav_fmt_g17(char *buf, double x) {
+  char t[NAV_FMT_G17_WIDE];
+  memset(t, 0, NAV_FMT_G17_SIZE);
+  const int n = nav_fmt_g17_wide(t, x);
+  memcpy(buf, t, NAV_FMT_G17_SIZE);
+  return n;
 }
 
 #endif /* NAV_IO_FAST_FORMAT_H */
