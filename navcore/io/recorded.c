@@ -19,6 +19,7 @@
 #include "navcore/nav_recorded.h"
 #include "fast_number.h"
 #include "line_layout.h"
+#include "replay_errors.h"
 #include "scene_bounds.h"
 
 /* Buffer of a streaming reader. Larger than the longest line, so a full buffer always holds a
@@ -1294,23 +1295,6 @@ static nav_frame frame_at(nav_geodetic p) {
   return f;
 }
 
-/* A reference row with the parts of its errors that depend on it alone (ned_errors()), which the
- * reading thread computes ahead of the navigation. */
-typedef struct ref_item {
-  nav_rec_pva row;
-  double slt, clt, sot, cot; /* sin and cos of its latitude and longitude */
-  nav_quat qt;               /* q_b_n of its Euler angles */
-} ref_item;
-
-static void ref_item_fill(ref_item *it) {
-  const nav_rec_pva *ref = &it->row;
-  it->slt = sin(ref->pos.lat_rad);
-  it->clt = cos(ref->pos.lat_rad);
-  it->sot = sin(ref->pos.lon_rad);
-  it->cot = cos(ref->pos.lon_rad);
-  it->qt = nav_euler_to_quat(ref->att);
-}
-
 /*
  * A single-producer single-consumer queue of fixed-size items between two threads: a ring of
  * RING_CAP slots handed over in batches under a mutex. Each side sleeps only when the ring is full
@@ -1416,6 +1400,19 @@ static const void *ring_next(ring *r) {
     if (r->c_tail == r->c_head) return NULL;
   }
   return r->buf + (r->c_tail++ % RING_CAP) * r->size;
+}
+
+/* Consumer: up to @p n next items at once, in order, valid until the next call (the items of a
+ * call are released together at a later one); 0 after the last. The first may wait; the others
+ * are those already at hand. */
+static int ring_next_n(ring *r, const void **items, int n) {
+  const void *first = ring_next(r);
+  if (!first) return 0;
+  items[0] = first;
+  int k = 1;
+  while (k < n && r->c_tail != r->c_head)
+    items[k++] = r->buf + (r->c_tail++ % RING_CAP) * r->size;
+  return k;
 }
 
 /* Consumer: want no more items (the producer's next ring_slot() returns NULL). */
@@ -1688,29 +1685,6 @@ static bool nav_ned(const nav_side *n, nav_ins_ned *out) {
   return nav_ins_get_ned(n->x ? nav_ins_gnss_ins(n->x) : n->ins, out);
 }
 
-/* C_n_e at (lat, lon) from their sines and cosines (rows of e, columns N, E, D). */
-static nav_mat3 dcm_n_e(double sl, double cl, double so, double co) {
-  const nav_mat3 c = {{{-sl * co, -so, -cl * co}, {-sl * so, co, -cl * so}, {cl, 0.0, -sl}}};
-  return c;
-}
-
-/* WGS-84 ECEF position from sin/cos of latitude and longitude (Groves eq. 2.112). */
-static nav_vec3 ecef_of(double sl, double cl, double so, double co, double h) {
-  const double rn = NAV_WGS84_A_M / sqrt(1.0 - NAV_WGS84_E2 * sl * sl);
-  return nav_vec3_make((rn + h) * cl * co, (rn + h) * cl * so, (rn * (1.0 - NAV_WGS84_E2) + h) * sl);
-}
-
-/*
- * The errors of nav_errors_compute() for a NED navigation state against a reference row,
- * without the ECEF round trips of the general path (which cost more than the whole navigation
- * step at 200 Hz): e-frame position and velocity differences resolved in the reference's NED,
- * the rotation angle between the two body-to-e attitudes, and differences of the local-level
- * Euler angles (the reference's straight from its row). The values agree with the general path
- * to rounding (a few 1e-10 m, 1e-14 rad: the same formulas without the geodetic inversions).
- */
-/* nav_wrap_pi() with its common case (an angle already in (-pi, pi], returned as is) inline. */
-static inline double wrap_pi(double a) { return a > -NAV_PI && a <= NAV_PI ? a : nav_wrap_pi(a); }
-
 /* nav_rec_pva_to_state() of a reference item from the sines and cosines of its latitude and
  * longitude and the quaternion of its Euler angles, which the item has already (the same calls on
  * the same angles): the same operations after those, so the same state bit for bit. */
@@ -1724,35 +1698,6 @@ static nav_traj_state ref_item_state(const ref_item *it) {
   s.v_fb_f_mps = nav_mat3_mul_vec(C_n_e, row->v_n_mps);
   s.q_b_f = nav_quat_normalize(nav_quat_mul(nav_quat_from_dcm(C_n_e), it->qt));
   return s;
-}
-
-static nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
-  const nav_rec_pva *ref = &ri->row;
-  nav_epoch_errors r;
-  r.t_s = ref->t_s;
-  const double slt = ri->slt, clt = ri->clt;
-  const double sot = ri->sot, cot = ri->cot;
-  const double sle = e->sin_lat, cle = e->cos_lat;
-  const double soe = sin(e->pos.lon_rad), coe = cos(e->pos.lon_rad);
-  const nav_mat3 Ct = dcm_n_e(slt, clt, sot, cot), Ce = dcm_n_e(sle, cle, soe, coe);
-  const nav_mat3 Ct_t = nav_mat3_transpose(Ct);
-  const nav_vec3 dr =
-      nav_vec3_sub(ecef_of(sle, cle, soe, coe, e->pos.h_m), ecef_of(slt, clt, sot, cot, ref->pos.h_m));
-  r.pos_err_n_m = nav_mat3_mul_vec(Ct_t, dr);
-  r.pos_err_h_m = hypot(r.pos_err_n_m.x, r.pos_err_n_m.y);
-  r.pos_err_v_m = fabs(r.pos_err_n_m.z);
-  const nav_vec3 dv = nav_vec3_sub(nav_mat3_mul_vec(Ce, e->v_n_mps), nav_mat3_mul_vec(Ct, ref->v_n_mps));
-  r.vel_err_n_mps = nav_mat3_mul_vec(Ct_t, dv);
-  r.vel_err_mps = nav_vec3_norm(r.vel_err_n_mps);
-  /* C_b_e(ref)^T C_b_e(est) = C_n_b(ref) M C_b_n(est) with M = C_e_n(ref) C_n_e(est) ~ I. */
-  const nav_quat qt = ri->qt;
-  const nav_quat qm = nav_quat_from_dcm(nav_mat3_mul(Ct_t, Ce));
-  r.att_err_rad = nav_quat_angle_between(qt, nav_quat_mul(qm, e->q_b_n));
-  const nav_euler ee = nav_quat_to_euler(e->q_b_n, NULL);
-  r.euler_err.roll_rad = wrap_pi(ee.roll_rad - ref->att.roll_rad);
-  r.euler_err.pitch_rad = wrap_pi(ee.pitch_rad - ref->att.pitch_rad);
-  r.euler_err.yaw_rad = wrap_pi(ee.yaw_rad - ref->att.yaw_rad);
-  return r;
 }
 
 /* The errors at a reference row: the NED path when the navigation has one, else the general. */
@@ -1804,7 +1749,12 @@ typedef struct scorer {
   sc_item one; /* on the calling thread: the item being filled */
 } scorer;
 
-static void score_one(scorer *sc, const sc_item *it) {
+/* score_one() of an epoch item with a reference row and a NED state, whose errors are given. */
+static void score_epoch(scorer *sc, const sc_item *it, const nav_epoch_errors *given);
+
+static void score_one(scorer *sc, const sc_item *it) { score_epoch(sc, it, NULL); }
+
+static void score_epoch(scorer *sc, const sc_item *it, const nav_epoch_errors *given) {
   /* After a NAV_STOP nothing more is scored or called back, as on the calling thread, where the
    * navigation stops at once. */
   if (atomic_load_explicit(&sc->stop, memory_order_relaxed)) return;
@@ -1823,7 +1773,9 @@ static void score_one(scorer *sc, const sc_item *it) {
   const nav_replay_config *cfg = sc->cfg;
   nav_epoch_errors err;
   if (it->has_ref) {
-    if (it->has_ned) {
+    if (given) {
+      err = *given;
+    } else if (it->has_ned) {
       err = ned_errors(&it->u.e.ref, &it->u.e.ned);
     } else {
       const nav_traj_state ts = ref_item_state(&it->u.e.ref);
@@ -1847,10 +1799,27 @@ static void score_one(scorer *sc, const sc_item *it) {
   }
 }
 
+/* An epoch whose errors ned_errors4() can compute. */
+static bool ned_epoch(const sc_item *it) { return it->kind == SC_EPOCH && it->has_ref && it->has_ned; }
+
 static void *scorer_main(void *arg) {
   scorer *sc = arg;
-  for (const sc_item *it = ring_next(&sc->q); it; it = ring_next(&sc->q))
-    score_one(sc, it);
+  const void *got[4];
+  for (int n = ring_next_n(&sc->q, got, 4); n > 0; n = ring_next_n(&sc->q, got, 4)) {
+    const sc_item *const *its = (const sc_item *const *)got;
+    if (n == 4 && ned_epoch(its[0]) && ned_epoch(its[1]) && ned_epoch(its[2]) && ned_epoch(its[3])) {
+      /* Four epochs' errors at once (the same values), then each item as score_one() would. */
+      const ref_item *const refs[4] = {&its[0]->u.e.ref, &its[1]->u.e.ref, &its[2]->u.e.ref, &its[3]->u.e.ref};
+      const nav_ins_ned *const neds[4] = {&its[0]->u.e.ned, &its[1]->u.e.ned, &its[2]->u.e.ned, &its[3]->u.e.ned};
+      nav_epoch_errors err[4];
+      ned_errors4_clones(refs, neds, err);
+      for (int k = 0; k < 4; ++k)
+        score_epoch(sc, its[k], &err[k]);
+    } else {
+      for (int k = 0; k < n; ++k)
+        score_one(sc, its[k]);
+    }
+  }
   return NULL;
 }
 
