@@ -101,3 +101,11 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
   return r;
 }
 
+
+int bench_settle_writes(const char *dir) {
+  const int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  const int rc = syncfs(fd);
+  close(fd);
+  return rc == 0 ? 0 : -1;
+}

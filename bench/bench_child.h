@@ -17,4 +17,10 @@ typedef struct child_result {
  * seen; started is false when the program could not be started. */
 child_result bench_run_child(char *const argv[], const char *log_path, double timeout_s);
 
+/* Write to disk what earlier runs left in the page cache on the file system of @p dir (syncfs),
+ * untimed, before a timed run: a run's own fsyncs then do not wait for another program's data
+ * (KF-GINS writes 137 MB per run of the long drive; the replay alternating with it fsyncs its
+ * result). @return 0, or -1 when @p dir cannot be opened or synced. */
+int bench_settle_writes(const char *dir);
+
 #endif

@@ -96,11 +96,18 @@ static void test_end_seen_when_it_happens(void **state) {
   assert_true(r.wall_s >= 0.05);
 }
 
+static void test_settle_writes(void **state) {
+  (void)state;
+  assert_int_equal(bench_settle_writes("/tmp"), 0);
+  assert_int_equal(bench_settle_writes("/nonexistent/navsim-no-such-dir"), -1);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_exit_codes_and_log, setup, teardown),
       cmocka_unit_test_setup_teardown(test_timeout, setup, teardown),
       cmocka_unit_test_setup_teardown(test_end_seen_when_it_happens, setup, teardown),
+      cmocka_unit_test(test_settle_writes),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
