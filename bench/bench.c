@@ -468,6 +468,7 @@ static const char *k_usage_bench =
     "              project's machine is shown, labelled with date and load\n"
     "Each row records the 1-minute load average when its case was timed (column load1).\n"
     "  --quiet     do not print the table\n"
+    "  --programs  print the programs the suite would run (navsim, navview, navstudio) and exit\n"
     "\n"
     "exit codes: 0 success (failed cases are reported in the table), 2 bad options, 1 I/O failure\n";
 
@@ -481,6 +482,13 @@ int navsim_bench(int argc, char **argv) {
       return 0;
     } else if (strcmp(a, "--quiet") == 0) {
       quiet = true;
+    } else if (strcmp(a, "--programs") == 0) {
+      static const char *const progs[] = {"navsim", "navview", "navstudio"};
+      for (size_t k = 0; k < sizeof progs / sizeof progs[0]; ++k) {
+        char path[4096];
+        printf("%s: %s\n", progs[k], bench_program(progs[k], path, sizeof path) ? path : "(not found)");
+      }
+      return 0;
     } else if (strcmp(a, "--peer-kfgins") == 0 && i + 1 < argc) {
       peer_kfgins = argv[++i];
       if (access(peer_kfgins, X_OK) != 0) {

@@ -39,13 +39,30 @@ bool bench_self_exe(char *buf, size_t cap) {
   return nav_paths_executable(buf, cap);
 }
 
+/* A program of this build or install: beside the navsim that started the bench (NAVSIM_PROGRAM,
+ * which `navsim bench` sets: an installed navsim-bench lives in libexec/navcore, the programs in
+ * bin), else where nav_paths_program finds it (beside this program, libexec, the build tree). */
+bool bench_program(const char *name, char *buf, size_t cap) {
+  const char *self = getenv("NAVSIM_PROGRAM");
+  if (self && self[0] == '/' && access(self, X_OK) == 0) {
+    const char *slash = strrchr(self, '/');
+    char cand[4400];
+    if (snprintf(cand, sizeof cand, "%.*s/%s", (int)(slash - self), self, name) < (int)sizeof cand &&
+        access(cand, X_OK) == 0 && strlen(cand) < cap) {
+      memcpy(buf, cand, strlen(cand) + 1);
+      return true;
+    }
+  }
+  return nav_paths_program(name, buf, cap);
+}
+
 bool bench_navsim_exe(char *buf, size_t cap) {
-  return nav_paths_program("navsim", buf, cap);
+  return bench_program("navsim", buf, cap);
 }
 
 const char *bench_navview_exe(void) {
   static char path[4096];
-  return nav_paths_program("navview", path, sizeof path) ? path : NULL;
+  return bench_program("navview", path, sizeof path) ? path : NULL;
 }
 
 double bench_log_field(const char *line, const char *key) {

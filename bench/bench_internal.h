@@ -40,6 +40,8 @@ double bench_now_s(void);
 
 /* navview of this build, or NULL; whether an X display is set. */
 const char *bench_navview_exe(void);
+/* The program @p name of this build or install (see bench_cases2.c); false when not found. */
+bool bench_program(const char *name, char *buf, size_t cap);
 bool bench_have_display(void);
 /* The number after @p key (e.g. " median=") in a child's log line; NAN when the key is absent. */
 double bench_log_field(const char *line, const char *key);

@@ -23,7 +23,7 @@
 
 static const char *navstudio_exe(void) {
   static char path[4096];
-  return nav_paths_program("navstudio", path, sizeof path) ? path : NULL;
+  return bench_program("navstudio", path, sizeof path) ? path : NULL;
 }
 
 void bench_case_studio_preview(bool full, const char *out_dir, bench_row *rows, int *n, int cap) {

@@ -13,6 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "exec_helper.h"
 #include "navcore/nav_paths.h"
 
 int navsim_bench(int argc, char **argv) {
@@ -28,6 +29,14 @@ int navsim_bench(int argc, char **argv) {
   }
   args[0] = exe;
   for (int i = 0; i < argc; ++i) args[i + 1] = argv[i];
+  /* The bench times this navsim (and the programs beside it): an installed navsim-bench in
+   * libexec/navcore would not find bin/navsim on its own. */
+  char self[4096];
+  if (nav_paths_executable(self, sizeof self) && setenv(NAVSIM_PROGRAM_ENV, self, 1) != 0) {
+    fprintf(stderr, "navsim bench: cannot set %s: %s\n", NAVSIM_PROGRAM_ENV, strerror(errno));
+    free(args);
+    return 1;
+  }
   fflush(NULL);
   execv(exe, args);
   fprintf(stderr, "navsim bench: cannot start %s: %s\n", exe, strerror(errno));

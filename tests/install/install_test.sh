@@ -125,6 +125,10 @@ RUN
   case " $helpers " in
   *" navsim-serve "*) echo '$bin/navsim serve --help | grep -q "^usage: navsim serve "' >> "$moved/run.sh" ;;
   esac
+  # navsim bench (libexec/navcore/navsim-bench) times the installed bin/navsim, not a build's.
+  if [ -x "$prefix/libexec/navcore/navsim-bench" ]; then
+    echo "\$bin/navsim bench --programs | grep -qx 'navsim: $moved/usr/bin/navsim'" >> "$moved/run.sh"
+  fi
   cat >> "$moved/run.sh" <<RUN
 echo "installed navsim (moved to $moved/usr): check, catalog, run and its helpers ($helpers ) passed"
 RUN
