@@ -166,16 +166,12 @@ static inline uint64_t nav_fmt_scaled(uint64_t m, int k, int s) {
   return q >> 63 ? UINT64_MAX : (uint64_t)q;
 }
 
-/** Bytes nav_fmt_g17_wide() may overwrite at its destination. */
-#define NAV_FMT_G17_WIDE 64
-
 /**
- * Writes x as printf("%.17g", x) would at t, with a terminating NUL, using t[0 ..
- * NAV_FMT_G17_WIDE) as scratch (the bytes after the NUL get whatever the fixed-size stores put
- * there). The text is assembled from the digits in registers with 1-, 8- and 16-byte stores,
- * without a scratch array of digits. @return the length.
+ * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
+ * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
+ * digits). @return the length.
  */
-static inline int nav_fmt_g17_wide(char *t, double x) {
+static inline int nav_fmt_g17(char *buf, double x) {
   uint64_t bits;
   memcpy(&bits, &x, sizeof bits);
   const int neg = (int)(bits >> 63);
@@ -183,13 +179,13 @@ static inline int nav_fmt_g17_wide(char *t, double x) {
   const uint64_t frac = bits & ((1ull << 52) - 1u);
   if (be == 0 && frac == 0) {
     if (neg) {
-      memcpy(t, "-0", 3);
+      memcpy(buf, "-0", 3);
       return 2;
     }
-    memcpy(t, "0", 2);
+    memcpy(buf, "0", 2);
     return 1;
   }
-  if (be == 0 || be == 0x7ff) return snprintf(t, NAV_FMT_G17_SIZE, "%.17g", x);
+  if (be == 0 || be == 0x7ff) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
   const uint64_t m = frac | (1ull << 52);
   const int e = be - 1075; /* x = m 2^e */
   /* Decimal exponent of the leading bit, floor((e + 52) log10 2), within one of floor(log10 |x|). */
@@ -199,7 +195,7 @@ static inline int nav_fmt_g17_wide(char *t, double x) {
   int tries = 0;
   for (;;) {
     const int k = 16 - x10;
-    if (k < 0 || k > 55 || ++tries > 4) return snprintf(t, NAV_FMT_G17_SIZE, "%.17g", x);
+    if (k < 0 || k > 55 || ++tries > 4) return snprintf(buf, NAV_FMT_G17_SIZE, "%.17g", x);
     d = nav_fmt_scaled(m, k, k + e);
     if (d >= 100000000000000000ull)
       ++x10;
@@ -224,6 +220,11 @@ static inline int nav_fmt_g17_wide(char *t, double x) {
     nd = 9 - (__builtin_clzll(zh) >> 3);
   else
     nd = 1;
+  /* The text is laid out in t from the digits in registers with 1-, 8- and 16-byte stores that may
+   * run past its end (copies of fixed size: short variable-length ones cost more than the
+   * digits), then t's first NAV_FMT_G17_SIZE bytes go to buf. */
+  char t[64];
+  memset(t, 0, NAV_FMT_G17_SIZE);
   char *p = t;
   *p = '-';
   p += neg; /* (the sign without a branch: it changes from value to value) */
@@ -261,20 +262,8 @@ static inline int nav_fmt_g17_wide(char *t, double x) {
     p += nd;
   }
   *p = '\0';
-  return (int)(p - t);
-}
-
-/**
- * Writes x as printf("%.17g", x) would into buf (at least NAV_FMT_G17_SIZE bytes), with a
- * terminating NUL (the bytes after it, up to NAV_FMT_G17_SIZE, are overwritten with zeros or
- * digits). @return the length.
- */
-static inline int nav_fmt_g17(char *buf, double x) {
-  char t[NAV_FMT_G17_WIDE];
-  memset(t, 0, NAV_FMT_G17_SIZE);
-  const int n = nav_fmt_g17_wide(t, x);
   memcpy(buf, t, NAV_FMT_G17_SIZE);
-  return n;
+  return (int)(p - t);
 }
 
 #endif /* NAV_IO_FAST_FORMAT_H */
