@@ -28,12 +28,6 @@
 #include "navcore/nav_ins.h"
 #include "navcore/nav_truth.h"
 
-double bench_now_s(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 bool bench_resources_dir(char *buf, size_t size) {
   if (buf == NULL || size == 0) return false;
   buf[0] = '\0';

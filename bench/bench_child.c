@@ -23,7 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 
-static double now_s(void) {
+double bench_now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -45,7 +45,7 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
   if (posix_spawn_file_actions_init(&fa) != 0) return r;
   (void)posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
   (void)posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
-  const double t0 = now_s();
+  const double t0 = bench_now_s();
   pid_t pid = 0;
   const int se = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
   posix_spawn_file_actions_destroy(&fa);
@@ -63,7 +63,7 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
     if (pfd >= 0) {
       int ms = -1; /* no limit: block until the child ends */
       if (timeout_s > 0 && !r.timed_out) {
-        const double left = timeout_s - (now_s() - t0);
+        const double left = timeout_s - (bench_now_s() - t0);
         ms = left <= 0 ? 0 : (int)fmin(ceil(left * 1000.0), 1e9);
       }
       struct pollfd pf = {pfd, POLLIN, 0};
@@ -79,12 +79,12 @@ child_result bench_run_child(char *const argv[], const char *log_path, double ti
       const struct timespec ts = {0, 1000 * 1000};
       nanosleep(&ts, NULL);
     }
-    if (timeout_s > 0 && !r.timed_out && now_s() - t0 > timeout_s) {
+    if (timeout_s > 0 && !r.timed_out && bench_now_s() - t0 > timeout_s) {
       kill(pid, SIGKILL);
       r.timed_out = true;
     }
   }
-  const double t_end = now_s();
+  const double t_end = bench_now_s();
   if (pfd >= 0) close(pfd);
   int status = 0;
   struct rusage ru;

@@ -12,6 +12,9 @@ typedef struct child_result {
   double cpu_s;     /* user + system CPU seconds of the child itself (wait4) */
 } child_result;
 
+/* Monotonic time [s], the clock of every figure of the bench. */
+double bench_now_s(void);
+
 /* Runs argv (argv[0] looked up in PATH) with stdout and stderr into log_path, killed after
  * timeout_s (0: no limit). wall_s runs from just before the spawn to the moment the exit is
  * seen; started is false when the program could not be started. */

@@ -32,7 +32,6 @@ typedef struct bench_row {
   char error[256];
 } bench_row;
 
-double bench_now_s(void);
 
 /* Where the published KF-GINS figures on the long drive come from. */
 #define BENCH_KFGINS_PUBLISHED_SOURCE                                                                          \
