@@ -1749,11 +1749,7 @@ typedef struct scorer {
   sc_item one; /* on the calling thread: the item being filled */
 } scorer;
 
-/* score_one() of an epoch item with a reference row and a NED state, whose errors are given. */
-static void score_epoch(scorer *sc, const sc_item *it, const nav_epoch_errors *given);
-
-static void score_one(scorer *sc, const sc_item *it) { score_epoch(sc, it, NULL); }
-
+/* Score one item; @p given: its errors when already computed (ned_errors4), else NULL. */
 static void score_epoch(scorer *sc, const sc_item *it, const nav_epoch_errors *given) {
   /* After a NAV_STOP nothing more is scored or called back, as on the calling thread, where the
    * navigation stops at once. */
@@ -1798,6 +1794,8 @@ static void score_epoch(scorer *sc, const sc_item *it, const nav_epoch_errors *g
       atomic_store_explicit(&sc->stop, true, memory_order_relaxed);
   }
 }
+
+static void score_one(scorer *sc, const sc_item *it) { score_epoch(sc, it, NULL); }
 
 /* An epoch whose errors ned_errors4() can compute. */
 static bool ned_epoch(const sc_item *it) { return it->kind == SC_EPOCH && it->has_ref && it->has_ned; }
