@@ -220,6 +220,9 @@ static void check_update_instantiation(size_t n, uint64_t stream) {
   nav_filter *g = calloc(1, sizeof *g);
   assert_non_null(f);
   assert_non_null(g);
+  /* P and Pn point into the filter's own cov buffers (as nav_filter_create sets them). */
+  f->P = f->cov[0];
+  f->Pn = f->cov[1];
   nav_rng r;
   nav_rng_init(&r, SEED, 1, stream);
   f->n = n;
@@ -240,6 +243,8 @@ static void check_update_instantiation(size_t n, uint64_t stream) {
     R[q * 3 + q] = 0.5 + fabs(nav_rng_gauss(&r));
   }
   *g = *f;
+  g->P = g->cov[0];
+  g->Pn = g->cov[1];
   double yf[MMAX], Sf[MMAX * MMAX], Lf[MMAX * MMAX], yg[MMAX], Sg[MMAX * MMAX], Lg[MMAX * MMAX];
   /* The specialised instance, then the generic one (sizes the compiler cannot see). */
   const bool ok_f = n == 15   ? update_core(f, 15, 3, H, z, R, yf, Sf, Lf)

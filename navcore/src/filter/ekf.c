@@ -130,7 +130,12 @@ struct nav_filter {
   double qc[NMAX];        /* spectral densities (see nav_filter_build_GQG) */
 
   double x[NMAX];
-  double P[NN];
+  /* The committed covariance P and the candidate Pn of a time or measurement update are the two
+   * halves of cov; a candidate that passes its checks becomes P by swapping the pointers (a copy
+   * of n^2 doubles less per covariance step and per update). nav_filter_get_cov()'s pointer is
+   * valid until the next non-const call, which allows the swap. */
+  double *P, *Pn;
+  double cov[2][NN];
 
   /* Pending (decimated) covariance step: the sums over the interval of everything F and
    * G Q_c G^T need (see pending_add). */
@@ -142,7 +147,7 @@ struct nav_filter {
   size_t ld; /* row stride of the padded work matrices: n rounded up to a multiple of 4 */
 
   /* Scratch, sized for the largest state; nothing is allocated after create. */
-  double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], Pn[NN], L[NN], A[NN], Wt[NN];
+  double F[NN], GQG[NN], FT[NN], QT[NN], Phi[NN], Qd[NN], S[NN], W[NN], L[NN], A[NN], Wt[NN];
   double H[MMAX * NMAX], Kt[MMAX * NMAX], PHt[NMAX * MMAX];
   double xn[NMAX];
   double vl_work[VL_WORK];
@@ -184,6 +189,8 @@ nav_status nav_filter_create(const nav_filter_config *cfg, nav_filter **out) {
   nav_filter *f = calloc(1, sizeof *f);
   if (f == NULL) return NAV_ERR_NO_MEMORY;
   f->cfg = *cfg;
+  f->P = f->cov[0];
+  f->Pn = f->cov[1];
   f->lay = nav_filter_layout_of(cfg->states);
   f->n = f->lay.n_states;
 
@@ -445,6 +452,13 @@ NAV_KERNEL_CLONES static bool chol_ok(const double *p, size_t n, size_t ld, doub
   if (ld == 16) return chol_ok_ld(p, n, a, 16);
   if (ld == 20) return chol_ok_ld(p, n, a, 20);
   return chol_ok_ld(p, n, a, 24);
+}
+
+/* The checked candidate Pn becomes P; the old P's buffer is the next candidate's. */
+static inline void commit_cov(nav_filter *f) {
+  double *const p = f->P;
+  f->P = f->Pn;
+  f->Pn = p;
 }
 
 /* Covariance steps between two full positive-definiteness proofs of a propagated P (see
@@ -814,7 +828,9 @@ static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *F
    * velocity and attitude blocks when the noise is not isotropic): elsewhere both keep the zeros
    * of calloc (a filter with the second-order discretisation never writes Qd otherwise), so this
    * is 0.5 QT everywhere without a pass over all n^2 entries. Then the padded rows of S
-   * (unrolled); S = P + Qd over every entry, as before, so that a -0.0 in P still becomes +0.0. */
+   * (unrolled); S = P + Qd, as before, so that a -0.0 in P still becomes +0.0: where Qd is the
+   * +0.0 of calloc this is P + 0.0 (the same bits without reading Qd), and the entries Qd can
+   * hold are then added again from P. */
   for (size_t i = 0; i < n; ++i)
     f->Qd[i * (n + 1)] = 0.5 * QT[i * (n + 1)];
   if (!f->q_isotropic)
@@ -829,10 +845,16 @@ static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *F
   for (size_t i = 0; i < n; ++i) {
     NAV_UNROLL
     for (size_t j = 0; j < n; ++j)
-      f->S[i * ld + j] = f->P[i * n + j] + f->Qd[i * n + j];
+      f->S[i * ld + j] = f->P[i * n + j] + 0.0;
     for (size_t c = n; c < ld; ++c)
       f->S[i * ld + c] = 0.0;
+    f->S[i * ld + i] = f->P[i * (n + 1)] + f->Qd[i * (n + 1)];
   }
+  if (!f->q_isotropic)
+    for (size_t b = NAV_FILTER_IDX_DV; b <= NAV_FILTER_IDX_PHI; b += NAV_FILTER_IDX_PHI - NAV_FILTER_IDX_DV)
+      for (size_t i = 0; i < 3; ++i)
+        for (size_t j = 0; j < 3; ++j)
+          f->S[(b + i) * ld + b + j] = f->P[(b + i) * n + b + j] + f->Qd[(b + i) * n + b + j];
 }
 
 /* One covariance step over the integrated FT = int F dt and QT = int G Q_c G^T dt. Commits x and
@@ -874,7 +896,7 @@ static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
   const nav_status st = check_cov_predict(f, f->Pn);
   if (st != NAV_OK) return st;
   pattern_mul_vec(f->xn, f->Phi, pt, f->x, ld, n);
-  memcpy(f->P, f->Pn, n * n * sizeof *f->P);
+  commit_cov(f);
   memcpy(f->x, f->xn, n * sizeof *f->x);
   return NAV_OK;
 }
@@ -1279,7 +1301,7 @@ static nav_status do_update(nav_filter *f, size_t m, const double *H, const doub
   f->cov_unproved = 0;
 
   /* Commit, and keep y, S and the NIS y^T S^-1 y for consistency tests (T6.5). */
-  memcpy(f->P, f->Pn, n * n * sizeof *f->P);
+  commit_cov(f);
   memcpy(f->x, f->xn, n * sizeof *f->x);
   nav_matn_chol_solve(u, Ls, y, m, 1);
   double nis = 0.0;
@@ -1461,7 +1483,7 @@ nav_status nav_filter_set_cov(nav_filter *f, const double *P) {
   st = check_cov(f, f->Pn, "set_cov");
   if (st != NAV_OK) return st;
   f->cov_unproved = 0;
-  memcpy(f->P, f->Pn, n * n * sizeof *P);
+  commit_cov(f);
   return NAV_OK;
 }
 
