@@ -445,7 +445,7 @@ static void test_sandwich_matches_plain(void **state) {
       for (size_t i = 0; i < NN; ++i)
         pn[i] = NAN;
       pattern_finish(&pt, n, ld);
-      pattern_sandwich(pn, phi, &pt, sp, qh, n, ld, w, wt, w);
+      pattern_sandwich(pn, phi, &pt, sp, qh, n, ld, w, wt);
       for (size_t i = 0; i < n; ++i)
         for (size_t c = 0; c < n; ++c) {
           double v = phi[i * ld + pt.col[i][0]] * sp[pt.col[i][0] * ld + c];
