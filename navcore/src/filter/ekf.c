@@ -865,7 +865,7 @@ static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *F
 
 /* One covariance step over the integrated FT = int F dt and QT = int G Q_c G^T dt. Commits x and
  * P only on success. */
-static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
+NAV_KERNEL_CLONES static nav_status cov_step(nav_filter *f, const double *FT, const double *QT) {
   const size_t n = f->n, ld = f->ld;
   const row_pattern *pt = &f->phi_pat;
   row_pattern dyn;
@@ -1265,7 +1265,7 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
 
 /* Update with an m x n H, m measurements z and the m x m noise R (already checked finite and
  * positive definite). numerics.md 6.5. */
-static nav_status do_update(nav_filter *f, size_t m, const double *H, const double *z, const double *R,
+NAV_KERNEL_CLONES static nav_status do_update(nav_filter *f, size_t m, const double *H, const double *z, const double *R,
                             const char *what) {
   const size_t n = f->n;
   for (size_t i = 0; i < m * n; ++i)
