@@ -38,6 +38,7 @@
 #include "navcore/nav_frames.h"
 #include "navcore/nav_rng.h"
 #include "navcore/nav_sensors.h"
+#include "sensors/imu_model_internal.h"
 
 static const uint64_t k_seed = 20240611;
 
@@ -826,6 +827,51 @@ static void test_bias_reporting(void **state) {
   assert_rel_near(sqrt(s2 / (3.0 * RUNS)), 1e-3, 0.05);
 }
 
+/* nav_imu_model_defer_bias (what a simulation run sets): the same measured increments bit for bit,
+ * and nav_imu_model_bias() after a sample gives the bias state of a model that forms it at every
+ * sample, bit for bit, whether it is asked after every sample or only now and then; both
+ * triads with every bias term, turn-on, GM and random walk, and noise. */
+static void test_deferred_bias_state(void **state) {
+  (void)state;
+  const double dt = 0.01;
+  nav_imu_model_config cfg = nav_imu_model_config_default();
+  const unsigned terms = NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_NOISE;
+  cfg.gyro.terms = cfg.accel.terms = terms;
+  cfg.gyro.bias_turn_on_sd_rps = v3(1e-4);
+  cfg.gyro.bias_gm_sd_rps = v3(1e-5);
+  cfg.gyro.bias_gm_tau_s = v3(100.0);
+  cfg.gyro.bias_rw_rps_per_sqrt_s = v3(1e-6);
+  cfg.gyro.arw_rad_per_sqrt_s = v3(1e-4);
+  cfg.accel.bias_turn_on_sd_mps2 = v3(1e-3);
+  cfg.accel.bias_gm_sd_mps2 = v3(1e-4);
+  cfg.accel.bias_gm_tau_s = v3(50.0);
+  cfg.accel.bias_rw_mps2_per_sqrt_s = v3(1e-5);
+  cfg.accel.vrw_mps_per_sqrt_s = v3(1e-3);
+  nav_imu_model *eager = NULL, *lazy = NULL;
+  assert_int_equal(nav_imu_model_create(&cfg, k_seed, 7, &eager), NAV_OK);
+  assert_int_equal(nav_imu_model_create(&cfg, k_seed, 7, &lazy), NAV_OK);
+  nav_imu_model_defer_bias(lazy);
+  assert_memory_equal(nav_imu_model_bias(eager), nav_imu_model_bias(lazy), sizeof(nav_imu_bias_state));
+  int asked = 0;
+  for (int64_t k = 1; k <= 2000; ++k) {
+    const nav_imu_increment ideal = increment(k, dt);
+    nav_imu_increment me, ml;
+    assert_int_equal(nav_imu_model_apply(eager, &ideal, &me), NAV_OK);
+    assert_int_equal(nav_imu_model_apply(lazy, &ideal, &ml), NAV_OK);
+    assert_memory_equal(&me, &ml, sizeof me);
+    /* Every sample at first, then every 97th. */
+    if (k <= 50 || k % 97 == 0) {
+      assert_memory_equal(nav_imu_model_bias(eager), nav_imu_model_bias(lazy), sizeof(nav_imu_bias_state));
+      ++asked;
+    }
+  }
+  assert_int_equal(asked, 50 + 20);
+  /* The values are not all zero (else the comparison would prove nothing). */
+  assert_true(nav_imu_model_bias(lazy)->gyro_mean_rps.x != 0.0 && nav_imu_model_bias(lazy)->accel_rw_mps2.z != 0.0);
+  nav_imu_model_destroy(eager);
+  nav_imu_model_destroy(lazy);
+}
+
 static void test_saturation(void **state) {
   (void)state;
   const double dt = 0.01;
@@ -1565,6 +1611,7 @@ int main(void) {
       cmocka_unit_test(test_t2_6_determinism_and_streams),
       cmocka_unit_test(test_t2_7_scale_factor_misalignment),
       cmocka_unit_test(test_bias_reporting),
+      cmocka_unit_test(test_deferred_bias_state),
       cmocka_unit_test(test_saturation),
       cmocka_unit_test(test_ideal_model_is_identity),
       cmocka_unit_test(test_config_validation_and_errors),

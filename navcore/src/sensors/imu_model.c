@@ -15,6 +15,7 @@
 #include "navcore/nav_rng.h"
 #include "nav_clones.h"
 #include "rng/rng_internal.h"
+#include "sensors/imu_model_internal.h"
 
 /* ------------------------------------------------------------------ bias instability -> GM */
 
@@ -208,6 +209,7 @@ typedef struct triad {
   double gm_sd[3], gm_tau[3];
   double rw_b[3]; /* random-walk state */
   double rw_k[3];
+  double ib[3]; /* the bias integral over the last interval (its mean is ib / dt) */
   double n_density[3]; /* white noise density N */
   nav_mat3 m;          /* M: scale factor on the diagonal, misalignment off it */
   double q_step[3], q_res[3];
@@ -240,6 +242,10 @@ struct nav_imu_model {
   const dt_slot *cur;
   nav_imu_run_constants consts;
   nav_imu_bias_state bias;
+  /* nav_imu_model_defer_bias(): the bias values of bias are formed by nav_imu_model_bias() when it
+   * is called after a sample (bias_stale) instead of at every sample; bias_dt is that sample's dt. */
+  bool defer_bias, bias_stale;
+  double bias_dt;
   char last_error[256];
 };
 
@@ -486,8 +492,8 @@ void nav_imu_model_destroy(nav_imu_model *model) {
 
 /*
  * One triad, one interval, with the triad's coefficients for dt (gm_c, rw_c, n_sd). x: ideal
- * increment; extra: added before noise (gyro: G_g dv), NULL if none. Writes the measured increment into y, the bias integral / dt into mean, the saturation
- * flags (bits 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
+ * increment; extra: added before noise (gyro: G_g dv), NULL if none. Writes the measured increment into y, the bias integral
+ * over the interval into t->ib (when the triad has a bias term), the saturation flags (bits 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
  *
  * Inlined into nav_imu_model_apply, with every intermediate in a local array that does not escape
  * (so in registers) and each output written once: values that went through memory with scalar
@@ -495,8 +501,7 @@ void nav_imu_model_destroy(nav_imu_model *model) {
  * buffer, a stall of ~10 cycles per such read at every sample.
  */
 NAV_CLONE_INLINE void triad_apply(triad *t, const pair_coef *gm_c, const pair_coef *rw_c, const double *n_sd,
-                                  const double x[3], const double *extra, double dt, double y_out[3], double mean[3],
-                                  unsigned *sat) {
+                                  const double x[3], const double *extra, double dt, double y_out[3], unsigned *sat) {
   const unsigned terms = t->terms;
   double y[3];
   if (t->apply_m) {
@@ -539,7 +544,7 @@ NAV_CLONE_INLINE void triad_apply(triad *t, const pair_coef *gm_c, const pair_co
   if (t->any_bias)
     for (int i = 0; i < 3; ++i) {
       y[i] += ib[i];
-      mean[i] = ib[i] / dt;
+      t->ib[i] = ib[i];
     }
   if (extra)
     for (int i = 0; i < 3; ++i)
@@ -586,6 +591,31 @@ static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
   return st;
 }
 
+/* The bias values of the last sample in the bias state: the states, the total b_0 + b_GM + b_RW
+ * and the interval mean (integral / dt), for the triads that have a bias term (the others keep
+ * their values from create). */
+static void form_bias_values(nav_imu_model *m) {
+  nav_imu_bias_state *b = &m->bias;
+  const double dt = m->bias_dt;
+  if (m->gyro.any_bias) {
+    b->gyro_gm_rps = arr_to_vec(m->gyro.gm_b);
+    b->gyro_rw_rps = arr_to_vec(m->gyro.rw_b);
+    b->gyro_rps = nav_vec3_add(nav_vec3_add(m->consts.gyro_bias_turn_on_rps, b->gyro_gm_rps), b->gyro_rw_rps);
+    b->gyro_mean_rps = nav_vec3_make(m->gyro.ib[0] / dt, m->gyro.ib[1] / dt, m->gyro.ib[2] / dt);
+  }
+  if (m->accel.any_bias) {
+    b->accel_gm_mps2 = arr_to_vec(m->accel.gm_b);
+    b->accel_rw_mps2 = arr_to_vec(m->accel.rw_b);
+    b->accel_mps2 = nav_vec3_add(nav_vec3_add(m->consts.accel_bias_turn_on_mps2, b->accel_gm_mps2), b->accel_rw_mps2);
+    b->accel_mean_mps2 = nav_vec3_make(m->accel.ib[0] / dt, m->accel.ib[1] / dt, m->accel.ib[2] / dt);
+  }
+  m->bias_stale = false;
+}
+
+void nav_imu_model_defer_bias(nav_imu_model *model) {
+  if (model) model->defer_bias = true;
+}
+
 /* Compiled for the baseline and for AVX2 (nav_clones.h; the same operations in the same order,
  * bit-identical). */
 NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_imu_increment *ideal,
@@ -611,12 +641,12 @@ NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_im
 
   const double dth[3] = {ideal->dtheta_b_rad.x, ideal->dtheta_b_rad.y, ideal->dtheta_b_rad.z};
   const double dv[3] = {ideal->dv_b_mps.x, ideal->dv_b_mps.y, ideal->dv_b_mps.z};
-  double yg[3], ya[3], mg[3] = {0.0, 0.0, 0.0}, ma[3] = {0.0, 0.0, 0.0};
+  double yg[3], ya[3];
   unsigned sat_g = 0, sat_a = 0;
   /* Accelerometer first, then gyro: the order only fixes which stream is read when; streams are
    * independent, so it does not affect values. G_g acts on the true dv (E2.2: G_g f). */
   const dt_slot *c = model->cur;
-  triad_apply(&model->accel, c->gm_c[1], c->rw_c[1], c->n_sd[1], dv, NULL, dt, ya, ma, &sat_a);
+  triad_apply(&model->accel, c->gm_c[1], c->rw_c[1], c->n_sd[1], dv, NULL, dt, ya, &sat_a);
   double gdv[3];
   const double *extra = NULL;
   if (model->apply_g) {
@@ -624,7 +654,7 @@ NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_im
       gdv[i] = model->g_sens.m[i][0] * dv[0] + model->g_sens.m[i][1] * dv[1] + model->g_sens.m[i][2] * dv[2];
     extra = gdv;
   }
-  triad_apply(&model->gyro, c->gm_c[0], c->rw_c[0], c->n_sd[0], dth, extra, dt, yg, mg, &sat_g);
+  triad_apply(&model->gyro, c->gm_c[0], c->rw_c[0], c->n_sd[0], dth, extra, dt, yg, &sat_g);
 
   const int64_t k = ideal->k;
   const double t_s = ideal->t_s;
@@ -641,20 +671,9 @@ NAV_HOT_CLONES nav_status nav_imu_model_apply(nav_imu_model *model, const nav_im
   /* Bias bookkeeping only for triads that have a bias term: an ideal triad costs nothing here. */
   b->k = k;
   b->t_s = t_s;
-  if (model->gyro.any_bias) {
-    b->gyro_gm_rps = arr_to_vec(model->gyro.gm_b);
-    b->gyro_rw_rps = arr_to_vec(model->gyro.rw_b);
-    b->gyro_rps =
-        nav_vec3_add(nav_vec3_add(model->consts.gyro_bias_turn_on_rps, b->gyro_gm_rps), b->gyro_rw_rps);
-    b->gyro_mean_rps = arr_to_vec(mg);
-  }
-  if (model->accel.any_bias) {
-    b->accel_gm_mps2 = arr_to_vec(model->accel.gm_b);
-    b->accel_rw_mps2 = arr_to_vec(model->accel.rw_b);
-    b->accel_mps2 =
-        nav_vec3_add(nav_vec3_add(model->consts.accel_bias_turn_on_mps2, b->accel_gm_mps2), b->accel_rw_mps2);
-    b->accel_mean_mps2 = arr_to_vec(ma);
-  }
+  model->bias_dt = dt;
+  model->bias_stale = true;
+  if (!model->defer_bias) form_bias_values(model);
   b->saturated = sat_g | (sat_a << 3);
   if (b->saturated) b->saturated_samples++;
   return NAV_OK;
@@ -664,8 +683,12 @@ const nav_imu_run_constants *nav_imu_model_constants(const nav_imu_model *model)
   return model ? &model->consts : NULL;
 }
 
+/* A deferring model (nav_imu_model_defer_bias) is written here, through a cast: every model is
+ * allocated by nav_imu_model_create, none is defined const. */
 const nav_imu_bias_state *nav_imu_model_bias(const nav_imu_model *model) {
-  return model ? &model->bias : NULL;
+  if (model == NULL) return NULL;
+  if (model->bias_stale) form_bias_values((nav_imu_model *)model);
+  return &model->bias;
 }
 
 const char *nav_imu_model_last_error(const nav_imu_model *model) {

@@ -37,6 +37,7 @@
 #include "math/lanes4.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
+#include "sensors/imu_model_internal.h"
 #include "sim/sim_partial_internal.h"
 #include "traj/traj_internal.h"
 
@@ -682,6 +683,7 @@ static nav_status run_open(run_ctx *c, job *j, long run, bool caller_thread) {
       job_error(j, "run %ld: IMU error model: %s", run, nav_status_str(st));
       return st;
     }
+    nav_imu_model_defer_bias(c->imu_model); /* no run reads the bias state */
   }
   if (shared_state(j, 0)) c->ts = *shared_state(j, 0);
   else if ((st = run_truth(j, run, &c->truth)) == NAV_OK) st = nav_truth_state(c->truth, 0.0, &c->ts);
