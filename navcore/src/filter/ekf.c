@@ -472,7 +472,7 @@ static inline void commit_cov(nav_filter *f) {
  * only, where it picks the message. On failure the message names the first non-finite entry, or
  * else the first leading block that is not positive definite (found by factorising growing
  * blocks). */
-static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
+NAV_KERNEL_CLONES static nav_status check_cov(nav_filter *f, const double *p, const char *what) {
   const size_t n = f->n;
 #ifndef NDEBUG
   for (size_t i = 0; i < n; ++i)

@@ -322,7 +322,7 @@ static void slot_fill(const nav_imu_model *m, dt_slot *e, double dt) {
 
 /* Make the coefficients for interval dt current: from the cache when this exact dt was seen,
  * else computed into its slot (the slot from the bits of dt). */
-static void set_dt(nav_imu_model *m, double dt) {
+NAV_CLONE_INLINE void set_dt(nav_imu_model *m, double dt) {
   uint64_t bits;
   memcpy(&bits, &dt, sizeof bits);
   bits ^= bits >> 29;
@@ -594,7 +594,7 @@ static nav_status fail(nav_imu_model *m, nav_status st, const char *fmt, ...) {
 /* The bias values of the last sample in the bias state: the states, the total b_0 + b_GM + b_RW
  * and the interval mean (integral / dt), for the triads that have a bias term (the others keep
  * their values from create). */
-static void form_bias_values(nav_imu_model *m) {
+NAV_CLONE_INLINE void form_bias_values(nav_imu_model *m) {
   nav_imu_bias_state *b = &m->bias;
   const double dt = m->bias_dt;
   if (m->gyro.any_bias) {
