@@ -835,7 +835,8 @@ static void test_deferred_bias_state(void **state) {
   (void)state;
   const double dt = 0.01;
   nav_imu_model_config cfg = nav_imu_model_config_default();
-  const unsigned terms = NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_NOISE;
+  const unsigned terms =
+      NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_NOISE;
   cfg.gyro.terms = cfg.accel.terms = terms;
   cfg.gyro.bias_turn_on_sd_rps = v3(1e-4);
   cfg.gyro.bias_gm_sd_rps = v3(1e-5);
@@ -867,7 +868,8 @@ static void test_deferred_bias_state(void **state) {
   }
   assert_int_equal(asked, 50 + 20);
   /* The values are not all zero (else the comparison would prove nothing). */
-  assert_true(nav_imu_model_bias(lazy)->gyro_mean_rps.x != 0.0 && nav_imu_model_bias(lazy)->accel_rw_mps2.z != 0.0);
+  assert_true(nav_imu_model_bias(lazy)->gyro_mean_rps.x != 0.0 &&
+              nav_imu_model_bias(lazy)->accel_rw_mps2.z != 0.0);
   nav_imu_model_destroy(eager);
   nav_imu_model_destroy(lazy);
 }

@@ -680,8 +680,9 @@ static NAV_ALWAYS_INLINE void transpose_ld(double *Wt, const double *W, size_t n
  * doubles per step at 18 states, an eighth of the sandwich's time.) S, W and Wt are padded
  * scratch. n is a compile-time constant in the instantiations for 15, 18 and 21 states.
  */
-static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
-                                          const double *Qh, const size_t n, double *W, double *Wt, const size_t LD) {
+static NAV_ALWAYS_INLINE void sandwich_ld(double *Pn, const double *Phi, const row_pattern *pt,
+                                          const double *S, const double *Qh, const size_t n, double *W,
+                                          double *Wt, const size_t LD) {
   const size_t s0 = pt->diag_from, nvw = pt->width / 4;
   double d[NMAX + 4];
   for (size_t j = 0; j < n; ++j)
@@ -754,8 +755,9 @@ static NAV_ALWAYS_INLINE void phi2_ld(double *Phi, const double *A, const row_pa
  * the GNSS error states) and 24 (the rest), each also as an AVX2 clone (NAV_KERNEL_CLONES). The
  * padding only adds products of zeros to entries that are never read, so the values do not
  * depend on LD. */
-NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, const row_pattern *pt, const double *S,
-                                               const double *Qh, size_t n, size_t ld, double *W, double *Wt) {
+NAV_KERNEL_CLONES static void pattern_sandwich(double *Pn, const double *Phi, const row_pattern *pt,
+                                               const double *S, const double *Qh, size_t n, size_t ld,
+                                               double *W, double *Wt) {
   if (n == 15 && ld == 16)
     sandwich_ld(Pn, Phi, pt, S, Qh, 15, W, Wt, 16);
   else if (n == 18 && ld == 20)
@@ -1265,8 +1267,8 @@ static NAV_ALWAYS_INLINE bool update_core(nav_filter *f, const size_t n, const s
 
 /* Update with an m x n H, m measurements z and the m x m noise R (already checked finite and
  * positive definite). numerics.md 6.5. */
-NAV_KERNEL_CLONES static nav_status do_update(nav_filter *f, size_t m, const double *H, const double *z, const double *R,
-                            const char *what) {
+NAV_KERNEL_CLONES static nav_status do_update(nav_filter *f, size_t m, const double *H, const double *z,
+                                              const double *R, const char *what) {
   const size_t n = f->n;
   for (size_t i = 0; i < m * n; ++i)
     if (!isfinite(H[i])) {

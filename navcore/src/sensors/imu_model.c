@@ -209,7 +209,7 @@ typedef struct triad {
   double gm_sd[3], gm_tau[3];
   double rw_b[3]; /* random-walk state */
   double rw_k[3];
-  double ib[3]; /* the bias integral over the last interval (its mean is ib / dt) */
+  double ib[3];        /* the bias integral over the last interval (its mean is ib / dt) */
   double n_density[3]; /* white noise density N */
   nav_mat3 m;          /* M: scale factor on the diagonal, misalignment off it */
   double q_step[3], q_res[3];
@@ -492,8 +492,9 @@ void nav_imu_model_destroy(nav_imu_model *model) {
 
 /*
  * One triad, one interval, with the triad's coefficients for dt (gm_c, rw_c, n_sd). x: ideal
- * increment; extra: added before noise (gyro: G_g dv), NULL if none. Writes the measured increment into y, the bias integral
- * over the interval into t->ib (when the triad has a bias term), the saturation flags (bits 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
+ * increment; extra: added before noise (gyro: G_g dv), NULL if none. Writes the measured increment into y,
+ * the bias integral over the interval into t->ib (when the triad has a bias term), the saturation flags (bits
+ * 0-2) into *sat. Each enabled term is one branch followed by straight per-axis code.
  *
  * Inlined into nav_imu_model_apply, with every intermediate in a local array that does not escape
  * (so in registers) and each output written once: values that went through memory with scalar
@@ -501,7 +502,8 @@ void nav_imu_model_destroy(nav_imu_model *model) {
  * buffer, a stall of ~10 cycles per such read at every sample.
  */
 NAV_CLONE_INLINE void triad_apply(triad *t, const pair_coef *gm_c, const pair_coef *rw_c, const double *n_sd,
-                                  const double x[3], const double *extra, double dt, double y_out[3], unsigned *sat) {
+                                  const double x[3], const double *extra, double dt, double y_out[3],
+                                  unsigned *sat) {
   const unsigned terms = t->terms;
   double y[3];
   if (t->apply_m) {
@@ -606,7 +608,8 @@ NAV_CLONE_INLINE void form_bias_values(nav_imu_model *m) {
   if (m->accel.any_bias) {
     b->accel_gm_mps2 = arr_to_vec(m->accel.gm_b);
     b->accel_rw_mps2 = arr_to_vec(m->accel.rw_b);
-    b->accel_mps2 = nav_vec3_add(nav_vec3_add(m->consts.accel_bias_turn_on_mps2, b->accel_gm_mps2), b->accel_rw_mps2);
+    b->accel_mps2 =
+        nav_vec3_add(nav_vec3_add(m->consts.accel_bias_turn_on_mps2, b->accel_gm_mps2), b->accel_rw_mps2);
     b->accel_mean_mps2 = nav_vec3_make(m->accel.ib[0] / dt, m->accel.ib[1] / dt, m->accel.ib[2] / dt);
   }
   m->bias_stale = false;

@@ -35,9 +35,9 @@
 #include "navcore/nav_truth.h"
 #include "integration/ins_gnss_internal.h"
 #include "math/lanes4.h"
+#include "sensors/imu_model_internal.h"
 #include "sim/nav_thread_internal.h"
 #include "sim/sim_internal.h"
-#include "sensors/imu_model_internal.h"
 #include "sim/sim_partial_internal.h"
 #include "traj/traj_internal.h"
 
