@@ -874,6 +874,128 @@ static void test_deferred_bias_state(void **state) {
   nav_imu_model_destroy(lazy);
 }
 
+/* A model with every term of both triads on (g-sensitivity included), for the lanes test. */
+static nav_imu_model_config every_term_config(void) {
+  nav_imu_model_config cfg = nav_imu_model_config_default();
+  cfg.gyro.terms = NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW |
+                   NAV_IMU_TERM_NOISE | NAV_IMU_TERM_SCALE_FACTOR | NAV_IMU_TERM_MISALIGNMENT |
+                   NAV_IMU_TERM_G_SENSITIVITY | NAV_IMU_TERM_QUANTISATION | NAV_IMU_TERM_SATURATION;
+  cfg.accel.terms = cfg.gyro.terms & ~(unsigned)NAV_IMU_TERM_G_SENSITIVITY;
+  cfg.gyro.bias_turn_on_sd_rps = v3(1e-4);
+  cfg.gyro.bias_gm_sd_rps = v3(1e-5);
+  cfg.gyro.bias_gm_tau_s = v3(100.0);
+  cfg.gyro.bias_rw_rps_per_sqrt_s = v3(1e-6);
+  cfg.gyro.arw_rad_per_sqrt_s = v3(1e-4);
+  cfg.gyro.scale_factor_sd = v3(1e-3);
+  cfg.accel.bias_turn_on_sd_mps2 = v3(1e-3);
+  cfg.accel.bias_gm_sd_mps2 = v3(1e-4);
+  cfg.accel.bias_gm_tau_s = v3(50.0);
+  cfg.accel.bias_rw_mps2_per_sqrt_s = v3(1e-5);
+  cfg.accel.vrw_mps_per_sqrt_s = v3(1e-3);
+  cfg.accel.scale_factor_sd = v3(1e-3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      if (i != j) cfg.gyro.misalignment_sd_rad.m[i][j] = cfg.accel.misalignment_sd_rad.m[i][j] = 1e-3;
+      cfg.gyro.g_sensitivity_sd_rps_per_mps2.m[i][j] = 1e-5;
+    }
+  cfg.gyro.quant_step_rad = v3(1e-7);
+  cfg.accel.quant_step_mps = v3(1e-5);
+  cfg.gyro.range_rps = v3(nav_unit_deg_per_s_to_rps(300.0));
+  cfg.accel.range_mps2 = v3(nav_unit_g_to_mps2(8.0));
+  return cfg;
+}
+
+/* Sample k of a made-up motion: a few rad/s and m/s^2 that change with k, above the sensors'
+ * ranges at every 41st sample (saturation), with the interval alternating between two values in
+ * runs of 100 samples (the interval cache). */
+static nav_imu_increment lanes_sample(int64_t k) {
+  const double dt = (k / 100) % 2 ? 0.005 : 0.01;
+  nav_imu_increment in = increment(k, dt);
+  const double big = k % 41 == 0 ? 30.0 : 1.0;
+  in.dtheta_b_rad = nav_vec3_make(big * 0.3 * sin(0.01 * (double)k) * dt, -big * 0.2 * dt, 0.1 * dt);
+  in.dv_b_mps = nav_vec3_make(big * 2.0 * cos(0.02 * (double)k) * dt, 0.5 * dt, -9.81 * big * dt);
+  return in;
+}
+
+/* Four models stepped in lanes (nav_imu_lanes_*) give, sample by sample, the bits of the same four
+ * models stepped alone: the measured increments, and after a close the whole bias state and
+ * every stream (the models go on alone and still agree); a refused sample changes nothing; the
+ * lanes refuse models of different configurations and models that form the bias at every
+ * sample. */
+static void test_imu_lanes_match_alone(void **state) {
+  (void)state;
+  const nav_imu_model_config cfg = every_term_config();
+  nav_imu_model *lane[4], *alone[4];
+  for (int l = 0; l < 4; ++l) {
+    assert_int_equal(nav_imu_model_create(&cfg, k_seed, 3 + (uint64_t)l, &lane[l]), NAV_OK);
+    assert_int_equal(nav_imu_model_create(&cfg, k_seed, 3 + (uint64_t)l, &alone[l]), NAV_OK);
+    nav_imu_model_defer_bias(alone[l]);
+  }
+  /* Not deferring: refused, models untouched. */
+  assert_null(nav_imu_lanes_open(lane));
+  for (int l = 0; l < 4; ++l)
+    nav_imu_model_defer_bias(lane[l]);
+  nav_imu_lanes *g = nav_imu_lanes_open(lane);
+  assert_non_null(g);
+  nav_imu_increment ml[4], ma;
+  nav_imu_increment *mp[4] = {&ml[0], &ml[1], &ml[2], &ml[3]};
+  int64_t k = 1;
+  for (int part = 0; part < 3; ++part) {
+    for (int i = 0; i < 1500; ++i, ++k) {
+      const nav_imu_increment in = lanes_sample(k);
+      assert_true(nav_imu_lanes_apply(g, &in, mp));
+      for (int l = 0; l < 4; ++l) {
+        assert_int_equal(nav_imu_model_apply(alone[l], &in, &ma), NAV_OK);
+        assert_memory_equal(&ml[l], &ma, sizeof ma);
+      }
+    }
+    /* A sample nav_imu_model_apply refuses: refused by the lanes too, with nothing changed. */
+    nav_imu_increment bad = lanes_sample(k);
+    bad.dt_s = 0.0;
+    assert_false(nav_imu_lanes_apply(g, &bad, mp));
+    bad = lanes_sample(k);
+    bad.dv_b_mps.y = NAN;
+    assert_false(nav_imu_lanes_apply(g, &bad, mp));
+    nav_imu_lanes_close(g);
+    for (int l = 0; l < 4; ++l)
+      assert_memory_equal(nav_imu_model_bias(lane[l]), nav_imu_model_bias(alone[l]),
+                          sizeof(nav_imu_bias_state));
+    /* Alone for a while (the streams and states written back), then in lanes again. */
+    for (int i = 0; i < 300; ++i, ++k) {
+      const nav_imu_increment in = lanes_sample(k);
+      for (int l = 0; l < 4; ++l) {
+        assert_int_equal(nav_imu_model_apply(lane[l], &in, &ml[l]), NAV_OK);
+        assert_int_equal(nav_imu_model_apply(alone[l], &in, &ma), NAV_OK);
+        assert_memory_equal(&ml[l], &ma, sizeof ma);
+      }
+    }
+    g = nav_imu_lanes_open(lane);
+    assert_non_null(g);
+  }
+  nav_imu_lanes_close(g);
+  /* The comparison covered what it should: saturated samples, four different runs. */
+  for (int l = 0; l < 4; ++l) {
+    const nav_imu_bias_state *b = nav_imu_model_bias(lane[l]);
+    assert_true(b->saturated_samples > 50);
+    assert_memory_equal(b, nav_imu_model_bias(alone[l]), sizeof *b);
+  }
+  assert_true(nav_imu_model_bias(lane[0])->gyro_gm_rps.x != nav_imu_model_bias(lane[1])->gyro_gm_rps.x);
+  /* Another configuration in one lane: refused. */
+  nav_imu_model_config other = cfg;
+  other.accel.bias_gm_tau_s.y = 51.0;
+  nav_imu_model *odd = NULL;
+  assert_int_equal(nav_imu_model_create(&other, k_seed, 9, &odd), NAV_OK);
+  nav_imu_model_defer_bias(odd);
+  nav_imu_model *mixed[4] = {lane[0], lane[1], odd, lane[3]};
+  assert_null(nav_imu_lanes_open(mixed));
+  nav_imu_lanes_close(NULL);
+  nav_imu_model_destroy(odd);
+  for (int l = 0; l < 4; ++l) {
+    nav_imu_model_destroy(lane[l]);
+    nav_imu_model_destroy(alone[l]);
+  }
+}
+
 static void test_saturation(void **state) {
   (void)state;
   const double dt = 0.01;
@@ -1614,6 +1736,7 @@ int main(void) {
       cmocka_unit_test(test_t2_7_scale_factor_misalignment),
       cmocka_unit_test(test_bias_reporting),
       cmocka_unit_test(test_deferred_bias_state),
+      cmocka_unit_test(test_imu_lanes_match_alone),
       cmocka_unit_test(test_saturation),
       cmocka_unit_test(test_ideal_model_is_identity),
       cmocka_unit_test(test_config_validation_and_errors),

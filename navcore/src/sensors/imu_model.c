@@ -15,6 +15,7 @@
 #include "navcore/nav_rng.h"
 #include "nav_clones.h"
 #include "rng/rng_internal.h"
+#include "math/lanes4.h"
 #include "sensors/imu_model_internal.h"
 
 /* ------------------------------------------------------------------ bias instability -> GM */
@@ -696,4 +697,278 @@ const nav_imu_bias_state *nav_imu_model_bias(const nav_imu_model *model) {
 
 const char *nav_imu_model_last_error(const nav_imu_model *model) {
   return model ? model->last_error : "";
+}
+
+/* ------------------------------------------------------ four models in lockstep (vector lanes) */
+
+/* One triad of four models: lane l of every value is model l's. The streams of a term are held
+ * per axis (rng_x[i], lane l: model l's stream of axis i), so one vector draw serves the four
+ * runs; each stream still yields its words in its own order (u1 then u2 per sample and axis). */
+typedef struct lanes_triad {
+  nav_l4 b0[3], gm_b[3], rw_b[3], ib[3], q_res[3];
+  nav_l4 m[3][3];
+  nav_rng_lanes rng_noise[3], rng_gm[3], rng_rw[3];
+} lanes_triad;
+
+struct nav_imu_lanes {
+  lanes_triad gyro, accel;
+  nav_l4 g_sens[3][3];
+  nav_imu_model *m[NAV_LANES];
+  bool applied; /* a sample went through the lanes: the bias state's fields below are the last one's */
+  int64_t k;
+  double t_s, dt;
+  unsigned sat_last[NAV_LANES];
+  uint64_t sat_count[NAV_LANES];
+};
+
+/* The parameters a triad's per-sample arithmetic reads from its model (not its per-run draws):
+ * the four models must agree on them bit for bit, since the lanes read model 0's coefficients. */
+static bool triad_same_config(const triad *a, const triad *b) {
+  return a->terms == b->terms && a->apply_m == b->apply_m && a->any_bias == b->any_bias &&
+         memcmp(a->gm_sd, b->gm_sd, sizeof a->gm_sd) == 0 &&
+         memcmp(a->gm_tau, b->gm_tau, sizeof a->gm_tau) == 0 &&
+         memcmp(a->rw_k, b->rw_k, sizeof a->rw_k) == 0 &&
+         memcmp(a->n_density, b->n_density, sizeof a->n_density) == 0 &&
+         memcmp(a->q_step, b->q_step, sizeof a->q_step) == 0 &&
+         memcmp(a->range, b->range, sizeof a->range) == 0;
+}
+
+/* Streams: lanes (model l, axis i) -> (axis i, model l), and back. */
+static void streams_to_lanes(nav_rng_lanes out[3], const nav_rng_lanes *in[NAV_LANES]) {
+  for (int i = 0; i < 3; ++i)
+    for (int w = 0; w < 4; ++w)
+      for (int l = 0; l < NAV_LANES; ++l)
+        out[i].s[w][l] = in[l]->s[w][i];
+}
+
+static void streams_from_lanes(const nav_rng_lanes in[3], nav_rng_lanes *out[NAV_LANES]) {
+  for (int i = 0; i < 3; ++i)
+    for (int w = 0; w < 4; ++w)
+      for (int l = 0; l < NAV_LANES; ++l)
+        out[l]->s[w][i] = in[i].s[w][l];
+}
+
+static void triad_to_lanes(lanes_triad *g, triad *const t[NAV_LANES]) {
+  for (int l = 0; l < NAV_LANES; ++l)
+    for (int i = 0; i < 3; ++i) {
+      g->b0[i][l] = t[l]->b0[i];
+      g->gm_b[i][l] = t[l]->gm_b[i];
+      g->rw_b[i][l] = t[l]->rw_b[i];
+      g->ib[i][l] = t[l]->ib[i];
+      g->q_res[i][l] = t[l]->q_res[i];
+      for (int j = 0; j < 3; ++j)
+        g->m[i][j][l] = t[l]->m.m[i][j];
+    }
+  const nav_rng_lanes *noise[NAV_LANES], *gm[NAV_LANES], *rw[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    noise[l] = &t[l]->rng_noise;
+    gm[l] = &t[l]->rng_gm;
+    rw[l] = &t[l]->rng_rw;
+  }
+  streams_to_lanes(g->rng_noise, noise);
+  streams_to_lanes(g->rng_gm, gm);
+  streams_to_lanes(g->rng_rw, rw);
+}
+
+/* The state a sample changes (the per-run constants b0 and M stay as they are in the models). */
+static void triad_from_lanes(const lanes_triad *g, triad *const t[NAV_LANES]) {
+  for (int l = 0; l < NAV_LANES; ++l)
+    for (int i = 0; i < 3; ++i) {
+      t[l]->gm_b[i] = g->gm_b[i][l];
+      t[l]->rw_b[i] = g->rw_b[i][l];
+      t[l]->ib[i] = g->ib[i][l];
+      t[l]->q_res[i] = g->q_res[i][l];
+    }
+  nav_rng_lanes *noise[NAV_LANES], *gm[NAV_LANES], *rw[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    noise[l] = &t[l]->rng_noise;
+    gm[l] = &t[l]->rng_gm;
+    rw[l] = &t[l]->rng_rw;
+  }
+  streams_from_lanes(g->rng_noise, noise);
+  streams_from_lanes(g->rng_gm, gm);
+  streams_from_lanes(g->rng_rw, rw);
+}
+
+nav_imu_lanes *nav_imu_lanes_open(nav_imu_model *const models[NAV_LANES]) {
+  for (int l = 0; l < NAV_LANES; ++l) {
+    const nav_imu_model *m = models[l], *m0 = models[0];
+    if (m == NULL || m->ideal || !m->defer_bias || m->apply_g != m0->apply_g ||
+        !triad_same_config(&m->gyro, &m0->gyro) || !triad_same_config(&m->accel, &m0->accel))
+      return NULL;
+  }
+  /* 32-byte lanes: aligned_alloc wants a size that is a multiple of the alignment. */
+  const size_t size = (sizeof(nav_imu_lanes) + 31u) / 32u * 32u;
+  nav_imu_lanes *g = aligned_alloc(32, size);
+  if (g == NULL) return NULL;
+  memset(g, 0, size);
+  triad *gy[NAV_LANES], *ac[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    g->m[l] = models[l];
+    gy[l] = &models[l]->gyro;
+    ac[l] = &models[l]->accel;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        g->g_sens[i][j][l] = models[l]->g_sens.m[i][j];
+  }
+  triad_to_lanes(&g->gyro, gy);
+  triad_to_lanes(&g->accel, ac);
+  return g;
+}
+
+void nav_imu_lanes_close(nav_imu_lanes *g) {
+  if (g == NULL) return;
+  triad *gy[NAV_LANES], *ac[NAV_LANES];
+  for (int l = 0; l < NAV_LANES; ++l) {
+    gy[l] = &g->m[l]->gyro;
+    ac[l] = &g->m[l]->accel;
+  }
+  triad_from_lanes(&g->gyro, gy);
+  triad_from_lanes(&g->accel, ac);
+  if (g->applied)
+    for (int l = 0; l < NAV_LANES; ++l) {
+      nav_imu_model *m = g->m[l];
+      /* What the last sample's nav_imu_model_apply() would have left (model 0's coefficients are
+       * already those of g->dt). */
+      m->last_error[0] = '\0';
+      if (m->dt_cached != g->dt) set_dt(m, g->dt);
+      m->bias.k = g->k;
+      m->bias.t_s = g->t_s;
+      m->bias_dt = g->dt;
+      m->bias_stale = true;
+      m->bias.saturated = g->sat_last[l];
+      m->bias.saturated_samples += g->sat_count[l];
+    }
+  free(g);
+}
+
+/* triad_apply() for the four lanes, the same operations in the same order in each lane. x is the
+ * shared ideal increment; extra as there (one value per lane), NULL if none; the saturation flags
+ * of lane l go into sat[l]. */
+NAV_CLONE_INLINE void lanes_triad_apply(lanes_triad *t, const triad *cfg, const pair_coef *gm_c,
+                                        const pair_coef *rw_c, const double *n_sd, const double x[3],
+                                        const nav_l4 *extra, double dt, nav_l4 y_out[3],
+                                        unsigned sat[NAV_LANES]) {
+  const unsigned terms = cfg->terms;
+  nav_l4 y[3];
+  const nav_l4 xs[3] = {l4_splat(x[0]), l4_splat(x[1]), l4_splat(x[2])};
+  if (cfg->apply_m) {
+    for (int i = 0; i < 3; ++i)
+      y[i] = xs[i] + (t->m[i][0] * xs[0] + t->m[i][1] * xs[1] + t->m[i][2] * xs[2]);
+  } else {
+    y[0] = xs[0];
+    y[1] = xs[1];
+    y[2] = xs[2];
+  }
+  const nav_l4 dts = l4_splat(dt);
+  nav_l4 ib[3] = {l4_splat(0.0), l4_splat(0.0), l4_splat(0.0)};
+  if (terms & NAV_IMU_TERM_BIAS_TURN_ON)
+    for (int i = 0; i < 3; ++i)
+      ib[i] += t->b0[i] * dts;
+  double u1s[4], u2s[4];
+  if (terms & NAV_IMU_TERM_BIAS_GM)
+    for (int i = 0; i < 3; ++i) {
+      nav_rng_lanes_gauss(&t->rng_gm[i], NAV_LANES, u1s);
+      nav_rng_lanes_gauss(&t->rng_gm[i], NAV_LANES, u2s);
+      const pair_coef *c = &gm_c[i];
+      const nav_l4 u1 = {u1s[0], u1s[1], u1s[2], u1s[3]}, u2 = {u2s[0], u2s[1], u2s[2], u2s[3]},
+                   b = t->gm_b[i];
+      ib[i] += l4_splat(c->c_int) * b + l4_splat(c->l21) * u1 + l4_splat(c->l22) * u2;
+      t->gm_b[i] = l4_splat(c->phi) * b + l4_splat(c->l11) * u1;
+    }
+  if (terms & NAV_IMU_TERM_BIAS_RW)
+    for (int i = 0; i < 3; ++i) {
+      nav_rng_lanes_gauss(&t->rng_rw[i], NAV_LANES, u1s);
+      nav_rng_lanes_gauss(&t->rng_rw[i], NAV_LANES, u2s);
+      const pair_coef *c = &rw_c[i];
+      const nav_l4 u1 = {u1s[0], u1s[1], u1s[2], u1s[3]}, u2 = {u2s[0], u2s[1], u2s[2], u2s[3]},
+                   b = t->rw_b[i];
+      ib[i] += l4_splat(c->c_int) * b + l4_splat(c->l21) * u1 + l4_splat(c->l22) * u2;
+      t->rw_b[i] = b + l4_splat(c->l11) * u1;
+    }
+  if (cfg->any_bias)
+    for (int i = 0; i < 3; ++i) {
+      y[i] += ib[i];
+      t->ib[i] = ib[i];
+    }
+  if (extra)
+    for (int i = 0; i < 3; ++i)
+      y[i] += extra[i];
+  if (terms & NAV_IMU_TERM_NOISE)
+    for (int i = 0; i < 3; ++i) {
+      nav_rng_lanes_gauss(&t->rng_noise[i], NAV_LANES, u1s);
+      const nav_l4 u = {u1s[0], u1s[1], u1s[2], u1s[3]};
+      y[i] += l4_splat(n_sd[i]) * u;
+    }
+  for (int l = 0; l < NAV_LANES; ++l)
+    sat[l] = 0;
+  if (terms & NAV_IMU_TERM_SATURATION)
+    for (int i = 0; i < 3; ++i) {
+      /* The scalar branches (clip above, else clip below) as masks on the unclipped value. */
+      const double lim = cfg->range[i] * dt;
+      const nav_m4 hi = y[i] > l4_splat(lim), lo = (y[i] < l4_splat(-lim)) & ~hi;
+      y[i] = l4_sel(hi, l4_splat(lim), l4_sel(lo, l4_splat(-lim), y[i]));
+      for (int l = 0; l < NAV_LANES; ++l)
+        if (hi[l] | lo[l]) sat[l] |= 1u << i;
+    }
+  if (terms & NAV_IMU_TERM_QUANTISATION)
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < NAV_LANES; ++l) {
+        /* As triad_apply (round() per lane: it rounds halves away from zero, which the vector
+         * rounding instruction does not). */
+        const double v = t->q_res[i][l] + y[i][l];
+        const double q = cfg->q_step[i] * round(v / cfg->q_step[i]);
+        t->q_res[i][l] = v - q;
+        y[i][l] = q;
+      }
+  y_out[0] = y[0];
+  y_out[1] = y[1];
+  y_out[2] = y[2];
+}
+
+NAV_HOT_CLONES bool nav_imu_lanes_apply(nav_imu_lanes *g, const nav_imu_increment *ideal,
+                                        nav_imu_increment *const measured[NAV_LANES]) {
+  const double dt = ideal->dt_s;
+  if (!(isfinite(dt) && dt > 0.0) || !nav_vec3_isfinite(ideal->dtheta_b_rad) ||
+      !nav_vec3_isfinite(ideal->dv_b_mps))
+    return false;
+  nav_imu_model *m0 = g->m[0];
+  if (dt != m0->dt_cached) set_dt(m0, dt);
+  const dt_slot *c = m0->cur;
+  const double dth[3] = {ideal->dtheta_b_rad.x, ideal->dtheta_b_rad.y, ideal->dtheta_b_rad.z};
+  const double dv[3] = {ideal->dv_b_mps.x, ideal->dv_b_mps.y, ideal->dv_b_mps.z};
+  nav_l4 yg[3], ya[3];
+  unsigned sat_g[NAV_LANES], sat_a[NAV_LANES];
+  lanes_triad_apply(&g->accel, &m0->accel, c->gm_c[1], c->rw_c[1], c->n_sd[1], dv, NULL, dt, ya, sat_a);
+  nav_l4 gdv[3];
+  const nav_l4 *extra = NULL;
+  if (m0->apply_g) {
+    const nav_l4 d0 = l4_splat(dv[0]), d1 = l4_splat(dv[1]), d2 = l4_splat(dv[2]);
+    for (int i = 0; i < 3; ++i)
+      gdv[i] = g->g_sens[i][0] * d0 + g->g_sens[i][1] * d1 + g->g_sens[i][2] * d2;
+    extra = gdv;
+  }
+  lanes_triad_apply(&g->gyro, &m0->gyro, c->gm_c[0], c->rw_c[0], c->n_sd[0], dth, extra, dt, yg, sat_g);
+  const int64_t k = ideal->k;
+  const double t_s = ideal->t_s;
+  for (int l = 0; l < NAV_LANES; ++l) {
+    nav_imu_increment *o = measured[l];
+    o->k = k;
+    o->t_s = t_s;
+    o->dt_s = dt;
+    o->dtheta_b_rad.x = yg[0][l];
+    o->dtheta_b_rad.y = yg[1][l];
+    o->dtheta_b_rad.z = yg[2][l];
+    o->dv_b_mps.x = ya[0][l];
+    o->dv_b_mps.y = ya[1][l];
+    o->dv_b_mps.z = ya[2][l];
+    const unsigned sat = sat_g[l] | (sat_a[l] << 3);
+    g->sat_last[l] = sat;
+    if (sat) g->sat_count[l]++;
+  }
+  g->applied = true;
+  g->k = k;
+  g->t_s = t_s;
+  g->dt = dt;
+  return true;
 }

@@ -964,13 +964,44 @@ static void run_group(job *j, long r0) {
     going[l] = st[l] == NAV_OK && !c[l].stop;
     integrated = integrated && c[l].integrated;
   }
+  /* The four IMU error models in lanes too, while all four runs go (their first sample to their
+   * last but one that fails or stops). */
+  nav_imu_model *models[NAV_LANES];
+  bool all_going = true;
+  for (int l = 0; l < NAV_LANES; ++l) {
+    models[l] = c[l].imu_model;
+    all_going = all_going && going[l];
+  }
+  nav_imu_lanes *imu = all_going ? nav_imu_lanes_open(models) : NULL;
   for (int64_t k = 1; k <= j->n; ++k) {
     int n_going = 0;
-    for (int l = 0; l < NAV_LANES; ++l) {
-      if (!going[l]) continue;
-      st[l] = run_measure(&c[l]);
-      if (st[l] != NAV_OK || c[l].stop) going[l] = false;
-      else ++n_going;
+    if (imu && !atomic_load_explicit(&j->sim->cancel, memory_order_relaxed)) {
+      /* run_measure() of the four runs: the same shared ideal record, the models in lanes. */
+      const nav_imu_increment *ideal = &j->shared_imu[k - 1];
+      __builtin_prefetch(ideal + 16);
+      nav_imu_increment *meas[NAV_LANES];
+      for (int l = 0; l < NAV_LANES; ++l)
+        meas[l] = &c[l].meas;
+      if (nav_imu_lanes_apply(imu, ideal, meas)) {
+        for (int l = 0; l < NAV_LANES; ++l) {
+          c[l].ideal = ideal;
+          st[l] = NAV_OK;
+        }
+        n_going = NAV_LANES;
+      }
+    }
+    if (n_going == 0) {
+      /* A cancel or a sample the lanes refuse: the models go on alone, run_measure() as in run_one(). */
+      nav_imu_lanes_close(imu);
+      imu = NULL;
+      for (int l = 0; l < NAV_LANES; ++l) {
+        if (!going[l]) continue;
+        st[l] = run_measure(&c[l]);
+        if (st[l] != NAV_OK || c[l].stop)
+          going[l] = false;
+        else
+          ++n_going;
+      }
     }
     if (n_going == 0) break;
     if (n_going == NAV_LANES && integrated) {
@@ -997,7 +1028,13 @@ static void run_group(job *j, long r0) {
       ++c[l].k;
       if (c[l].stop) going[l] = false;
     }
+    for (int l = 0; l < NAV_LANES && imu; ++l)
+      if (!going[l]) {
+        nav_imu_lanes_close(imu);
+        imu = NULL;
+      }
   }
+  nav_imu_lanes_close(imu); /* before run_close() destroys the models */
   for (int l = 0; l < NAV_LANES; ++l)
     (void)run_close(&c[l], st[l]);
 }
