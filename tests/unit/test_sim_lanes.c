@@ -28,6 +28,7 @@
 #include "navcore/nav_sim.h"
 #include "navcore/nav_sim_partial.h"
 #include "nav_sim_outcome.h"
+#include "math/quat_dcm_inline.h"
 #include "nav/strapdown_lanes.h"
 
 /* ---------------------------------------------------------------- the strapdown in lanes */
@@ -115,9 +116,25 @@ static long drive(nav_ins *ins[4], nav_ins *solo[4], long steps, double dt, int 
     }
     snap before[4];
     for (int l = 0; l < 4; ++l) before[l] = take(ins[l]);
-    const bool done = nav_ins_step_lanes(ins, ip);
+    /* Every other step through nav_ins_step_lanes_nav(), whose lanes must then hold each INS's
+     * new NED state and the DCM of its attitude. */
+    nav_ins_lanes_nav out;
+    const bool with_nav = k % 2 == 1;
+    const bool done = with_nav ? nav_ins_step_lanes_nav(ins, ip, &out) : nav_ins_step_lanes(ins, ip);
     nav_status st[4];
     for (int l = 0; l < 4; ++l) st[l] = nav_ins_step(solo[l], ip[l]);
+    if (done && with_nav)
+      for (int l = 0; l < 4; ++l) {
+        nav_ins_ned ned;
+        assert_true(nav_ins_get_ned(solo[l], &ned));
+        const double got[5] = {out.lat[l], out.h[l], out.v.x[l], out.v.y[l], out.v.z[l]};
+        const double want[5] = {ned.pos.lat_rad, ned.pos.h_m, ned.v_n_mps.x, ned.v_n_mps.y, ned.v_n_mps.z};
+        assert_memory_equal(got, want, sizeof got);
+        const nav_mat3 C = nav_quat_to_dcm_inline(ned.q_b_n);
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            assert_memory_equal(&out.C_b_n.m[i][j][l], &C.m[i][j], sizeof(double));
+      }
     if (!done) {
       ++refused;
       /* Nothing changed; then the scalar step of each lane, as nav_ins_gnss_step_lanes does. */

@@ -257,19 +257,18 @@ static nav_status strapdown_failed(nav_ins_gnss *x, const nav_imu_increment *m, 
 
 /* The step after the strapdown: the filter prediction (and the smoother's record) with the
  * compensated increment m the INS was just stepped with. */
-static inline nav_status after_strapdown(nav_ins_gnss *x, const nav_imu_increment *m) {
+static inline nav_status after_strapdown_nav(nav_ins_gnss *x, const nav_imu_increment *m,
+                                             const nav_filter_nav *np, bool from_ned) {
   const double dt = m->dt_s;
-  nav_filter_nav n; /* filled in place: no copy of the returned struct per step */
   /* From the NED state the INS vouches for lat, h, v and C_b_n (nav_filter_predict_ins). */
-  nav_status st = filter_nav_fill(&n, &x->frame, x->ins, m) ? nav_filter_predict_ins(x->kf, &n, dt)
-                                                            : nav_filter_predict(x->kf, &n, dt);
+  nav_status st = from_ned ? nav_filter_predict_ins(x->kf, np, dt) : nav_filter_predict(x->kf, np, dt);
   if (st != NAV_OK) {
     snprintf(x->err, sizeof x->err, "filter prediction failed at t = %.6f s: %s", m->t_s, nav_filter_last_error(x->kf));
     return st;
   }
   if (x->cfg.smoother) {
     const nav_filter_ins_state nom = nominal_of(x);
-    st = nav_smoother_step(x->cfg.smoother, m->t_s, &n, dt, &nom);
+    st = nav_smoother_step(x->cfg.smoother, m->t_s, np, dt, &nom);
     if (st != NAV_OK) {
       snprintf(x->err, sizeof x->err, "%s", nav_smoother_last_error(x->cfg.smoother));
       return st;
@@ -289,6 +288,12 @@ static inline nav_status after_strapdown(nav_ins_gnss *x, const nav_imu_incremen
   x->last.dv_b_mps = nav_vec3_make(m->dv_b_mps.x, m->dv_b_mps.y, m->dv_b_mps.z);
   x->have_step = true;
   return NAV_OK;
+}
+
+static inline nav_status after_strapdown(nav_ins_gnss *x, const nav_imu_increment *m) {
+  nav_filter_nav n; /* filled in place: no copy of the returned struct per step */
+  const bool from_ned = filter_nav_fill(&n, &x->frame, x->ins, m);
+  return after_strapdown_nav(x, m, &n, from_ned);
 }
 
 nav_status nav_ins_gnss_step(nav_ins_gnss *x, const nav_imu_increment *raw) {
@@ -316,9 +321,28 @@ void nav_ins_gnss_step_lanes(nav_ins_gnss *const x[NAV_LANES], const nav_imu_inc
     ins[l] = x[l]->ins;
     mp[l] = &m[l];
   }
-  const bool lockstep = nav_ins_step_lanes(ins, mp);
+  nav_ins_lanes_nav out;
+  if (nav_ins_step_lanes_nav(ins, mp, &out)) {
+    /* The filter's inputs from the lanes: filter_nav_fill() of each INS (its NED state, the DCM
+     * of its attitude, the increment's mean rates), the same values. */
+    for (int l = 0; l < NAV_LANES; ++l) {
+      nav_filter_nav n;
+      n.lat_rad = out.lat[l];
+      n.h_m = out.h[l];
+      n.v_eb_n_mps = l4v3_lane(out.v, l);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          n.C_b_n.m[i][j] = out.C_b_n.m[i][j][l];
+      const double idt = 1.0 / m[l].dt_s;
+      n.f_ib_b_mps2 = nav_vec3_make(m[l].dv_b_mps.x * idt, m[l].dv_b_mps.y * idt, m[l].dv_b_mps.z * idt);
+      n.w_ib_b_rps =
+          nav_vec3_make(m[l].dtheta_b_rad.x * idt, m[l].dtheta_b_rad.y * idt, m[l].dtheta_b_rad.z * idt);
+      st[l] = after_strapdown_nav(x[l], &m[l], &n, true);
+    }
+    return;
+  }
   for (int l = 0; l < NAV_LANES; ++l) {
-    st[l] = lockstep ? NAV_OK : nav_ins_step(ins[l], &m[l]);
+    st[l] = nav_ins_step(ins[l], &m[l]);
     st[l] = st[l] != NAV_OK ? strapdown_failed(x[l], &m[l], st[l]) : after_strapdown(x[l], &m[l]);
   }
 }

@@ -19,4 +19,17 @@
  */
 bool nav_ins_step_lanes(nav_ins *const ins[NAV_LANES], const nav_imu_increment *const imu[NAV_LANES]);
 
+/** The new NED state of four INS after a lockstep step, one run per lane: lane l of lat, h and v
+ *  is what nav_ins_get_ned(ins[l]) then gives, and C_b_n the DCM of its attitude, with the
+ *  operations of nav_quat_to_dcm_inline() (the filter's inputs, nav_ins_gnss_step_lanes()). */
+typedef struct nav_ins_lanes_nav {
+  nav_l4 lat, h;
+  nav_l4v3 v;
+  nav_l4m3 C_b_n;
+} nav_ins_lanes_nav;
+
+/** nav_ins_step_lanes(), and when it returns true the new state in @p out. */
+bool nav_ins_step_lanes_nav(nav_ins *const ins[NAV_LANES], const nav_imu_increment *const imu[NAV_LANES],
+                            nav_ins_lanes_nav *out);
+
 #endif /* NAV_STRAPDOWN_LANES_H */
