@@ -44,6 +44,7 @@
 #include "nav/ecef_gravity.h"
 #include "nav_clones.h"
 #include "math/quat_dcm_inline.h"
+#include "math/sincos_quarter.h"
 #include "nav/strapdown_lanes.h"
 
 /* 1 - e^2 = (b/a)^2. */
@@ -337,8 +338,14 @@ static void ned_output(nav_ins *ins, double sh, double ch) {
  * of lat itself there; one sin/cos pair serves the Earth terms and q_n_e. */
 static void ned_half_lat(double lat, double *sh, double *ch, double *sl, double *cl) {
   const double hl = 0.5 * lat;
-  *sh = sin(hl);
-  *ch = cos(hl);
+  /* navcore's kernel (math/sincos_quarter.h), which the lockstep step computes in lanes; libm's
+   * sin and cos only beyond a quarter turn (never for a latitude). */
+  if (fabs(hl) <= NAV_SINCOS_QUARTER_MAX) {
+    nav_sincos_quarter(hl, sh, ch);
+  } else {
+    *sh = sin(hl);
+    *ch = cos(hl);
+  }
   *sl = 2.0 * *sh * *ch;
   *cl = (*ch - *sh) * (*ch + *sh);
 }
@@ -957,13 +964,11 @@ NAV_CLONE_INLINE bool step_lanes_impl(nav_ins *const ins[NAV_LANES],
   v1 = l4v3_add(l4v3_add(base, rot), l4v3_scale(l4v3_add(F0, Fp), hdt));
   const nav_l4 h1 = h0 - hdt * (v0.z + v1.z);
   const nav_l4 lat1 = lat0 + hdt * (lat_rate0 + v1.x * tp.iRMh);
-  /* ned_half_lat(): glibc's sin and cos, lane by lane */
+  /* ned_half_lat(): navcore's sin and cos kernel in lanes */
   const nav_l4 hl = l4_splat(0.5) * lat1;
+  if (!l4_all(l4_abs(hl) <= l4_splat(NAV_SINCOS_QUARTER_MAX))) return false;
   nav_l4 sh1, ch1;
-  for (int l = 0; l < NAV_LANES; ++l) {
-    sh1[l] = sin(hl[l]);
-    ch1[l] = cos(hl[l]);
-  }
+  nav_sincos_quarter4(hl, &sh1, &ch1);
   const nav_l4 sl1 = l4_splat(2.0) * sh1 * ch1, cl1 = (ch1 - sh1) * (ch1 + sh1);
   if (!l4_all(cl1 >= l4_splat(NAV_INS_NED_MIN_COS_LAT))) return false;
   const nav_l4 lon_fac1 = tp.iRNh * tp.icl;
