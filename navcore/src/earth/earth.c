@@ -13,6 +13,8 @@
 #include <float.h>
 #include <math.h>
 
+#include "earth/earth_internal.h"
+
 /* 1 - e^2 = (b/a)^2. */
 #define E2M (1.0 - NAV_WGS84_E2)
 
@@ -179,32 +181,55 @@ nav_geodetic nav_earth_ecef_to_geodetic(nav_vec3 r_eb_e_m) {
   return g;
 }
 
-double nav_earth_radius_meridian_m(double lat_rad) {
+/* The radii and normal gravity from s = sin(lat): the public functions below call these with
+ * sin(lat_rad), and nav_earth_radii_gravity() with one sine for all three, the same values. */
+static double meridian_of_sin(double s) {
   /* Groves (2.105). */
-  const double den2 = radius_den2(sin(lat_rad));
+  const double den2 = radius_den2(s);
   return NAV_WGS84_A_M * E2M / (den2 * sqrt(den2));
 }
 
-double nav_earth_radius_prime_vertical_m(double lat_rad) {
+static double prime_vertical_of_sin(double s) {
   /* Groves (2.106). */
-  return NAV_WGS84_A_M / sqrt(radius_den2(sin(lat_rad)));
+  return NAV_WGS84_A_M / sqrt(radius_den2(s));
 }
 
-double nav_earth_gravity_normal_surface_mps2(double lat_rad) {
+static double gravity_surface_of_sin(double s) {
   /* Somigliana, TR8350.2 (4-1), numerics.md (E3.10). */
-  const double s = sin(lat_rad);
   const double s2 = s * s;
   return NAV_WGS84_GAMMA_E_MPS2 * (1.0 + NAV_WGS84_SOMIGLIANA_K * s2) / sqrt(1.0 - NAV_WGS84_E2 * s2);
 }
 
-double nav_earth_gravity_normal_mps2(double lat_rad, double h_m) {
+static double gravity_normal_of_sin(double s, double h_m) {
   /* TR8350.2 (4-3), numerics.md (E3.11). */
-  const double s = sin(lat_rad);
   const double s2 = s * s;
   const double a = NAV_WGS84_A_M;
   const double lin = (2.0 / a) * (1.0 + NAV_WGS84_F + NAV_WGS84_M - 2.0 * NAV_WGS84_F * s2);
   const double quad = 3.0 / (a * a);
-  return nav_earth_gravity_normal_surface_mps2(lat_rad) * (1.0 - lin * h_m + quad * h_m * h_m);
+  return gravity_surface_of_sin(s) * (1.0 - lin * h_m + quad * h_m * h_m);
+}
+
+double nav_earth_radius_meridian_m(double lat_rad) {
+  return meridian_of_sin(sin(lat_rad));
+}
+
+double nav_earth_radius_prime_vertical_m(double lat_rad) {
+  return prime_vertical_of_sin(sin(lat_rad));
+}
+
+double nav_earth_gravity_normal_surface_mps2(double lat_rad) {
+  return gravity_surface_of_sin(sin(lat_rad));
+}
+
+double nav_earth_gravity_normal_mps2(double lat_rad, double h_m) {
+  return gravity_normal_of_sin(sin(lat_rad), h_m);
+}
+
+void nav_earth_radii_gravity(double lat_rad, double h_m, double *R_M_m, double *R_N_m, double *g_mps2) {
+  const double s = sin(lat_rad);
+  *R_M_m = meridian_of_sin(s);
+  *R_N_m = prime_vertical_of_sin(s);
+  *g_mps2 = gravity_normal_of_sin(s, h_m);
 }
 
 nav_vec3 nav_earth_gravity_n_mps2(double lat_rad, double h_m) {

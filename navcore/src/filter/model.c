@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "earth/earth_internal.h"
 #include "filter/filter_internal.h"
 #include "navcore/nav_earth.h"
 
@@ -247,9 +248,7 @@ nav_filter_layout nav_filter_layout_of(unsigned states) {
 
 nav_filter_earth_terms nav_filter_earth_terms_wgs84(double lat_rad, double h_m) {
   nav_filter_earth_terms e;
-  e.R_M_m = nav_earth_radius_meridian_m(lat_rad);
-  e.R_N_m = nav_earth_radius_prime_vertical_m(lat_rad);
-  e.g_mps2 = nav_earth_gravity_normal_mps2(lat_rad, h_m);
+  nav_earth_radii_gravity(lat_rad, h_m, &e.R_M_m, &e.R_N_m, &e.g_mps2);
   e.w_ie_rps = NAV_WGS84_OMEGA_IE_RPS;
   return e;
 }
