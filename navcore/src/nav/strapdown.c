@@ -825,7 +825,10 @@ NAV_CLONE_INLINE void ned_terms_fill4(nav_l4 sl, nav_l4 cl, nav_l4 h, const ned_
   t->RM = l4_splat(NAV_WGS84_A_M * E2M) * isq * isq * isq;
   const nav_l4 A = t->RM + h, B = t->RN + h, P = A * B, x = P * cl;
   const nav_l4 e_inv = one - x * near->inv;
-  t->inv = l4_sel(l4_abs(e_inv) < l4_splat(NEWTON_REL), near->inv * (one + e_inv), one / x);
+  /* The division only when a lane needs it (a point that moved far), as the 1/sqrt above. */
+  const nav_m4 newton_inv = l4_abs(e_inv) < l4_splat(NEWTON_REL);
+  t->inv = near->inv * (one + e_inv);
+  if (!l4_all(newton_inv)) t->inv = l4_sel(newton_inv, t->inv, one / x);
   t->iRMh = t->inv * B * cl;
   t->iRNh = t->inv * A * cl;
   t->icl = t->inv * P;
