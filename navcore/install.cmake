@@ -32,6 +32,12 @@ set_target_properties(navcore_io PROPERTIES EXPORT_NAME io_static)
 # in a user's program.
 target_link_options(navcore_shared PRIVATE -Wl,--no-undefined)
 target_link_options(navcore_io_shared PRIVATE -Wl,--no-undefined)
+# With NAV_LTO the objects are fat LTO objects (navcore/CMakeLists.txt): the shared libraries link
+# their machine code, without LTO code generation.
+if(NAV_LTO_ACTIVE)
+  target_link_options(navcore_shared PRIVATE $<${_nav_lto_configs}:-fno-lto>)
+  target_link_options(navcore_io_shared PRIVATE $<${_nav_lto_configs}:-fno-lto>)
+endif()
 
 install(TARGETS navcore_shared navcore_io_shared EXPORT navcoreTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT lib NAMELINK_COMPONENT dev)
