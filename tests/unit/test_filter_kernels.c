@@ -305,9 +305,10 @@ static void test_gauss_streams_equal_single_draws(void **state) {
   assert_true(tails > 10);
 }
 
-/* The time update writes FT, QT and (second order) Qd only at fixed positions and relies on the
- * zeros of calloc elsewhere (pending_integrals, second_order_inputs). After covariance steps the
- * stored matrices must equal the full passes they replace, bit for bit: FT = F T outside the
+/* The time update writes F T (into the padded A of the second-order step), QT and Qd only at
+ * fixed positions and relies on the zeros of calloc elsewhere (pending_integrals,
+ * second_order_inputs). After covariance steps the stored matrices must equal the full passes
+ * they replace, bit for bit: A = F T outside the
  * blocks integrated from the sums, QT zero outside its diagonal and noise blocks, Qd = QT / 2
  * everywhere. Every layout, isotropic and per-axis noise. */
 static void check_time_update_buffers(unsigned states, bool isotropic) {
@@ -355,8 +356,10 @@ static void check_time_update_buffers(unsigned states, bool isotropic) {
           blk[(rows[b] + i) * n + cols[b] + j] = true;
     for (size_t k = 0; k < n * n; ++k) {
       const double ft = f->F[k] * T, qd = 0.5 * f->QT[k];
-      if (!blk[k] && memcmp(&f->FT[k], &ft, sizeof ft) != 0)
-        fail_msg("n = %zu: FT(%zu,%zu) = %g, F T = %g", n, k / n, k % n, f->FT[k], ft);
+      /* The second-order step's F T is the padded A (stride ld), written in place. */
+      const double a_k = f->A[(k / n) * f->ld + k % n];
+      if (!blk[k] && memcmp(&a_k, &ft, sizeof ft) != 0)
+        fail_msg("n = %zu: A(%zu,%zu) = %g, F T = %g", n, k / n, k % n, a_k, ft);
       if (memcmp(&f->Qd[k], &qd, sizeof qd) != 0)
         fail_msg("n = %zu: Qd(%zu,%zu) = %g, QT / 2 = %g", n, k / n, k % n, f->Qd[k], qd);
       const size_t i = k / n, j = k % n;
@@ -364,6 +367,11 @@ static void check_time_update_buffers(unsigned states, bool isotropic) {
       if (i != j && !noise_blk && memcmp(&f->QT[k], &(double){0.0}, sizeof(double)) != 0)
         fail_msg("n = %zu: QT(%zu,%zu) = %g outside the noise blocks", n, i, j, f->QT[k]);
     }
+    /* A's padding columns: the +0.0 of calloc (phi_second_order reads whole padded rows). */
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = n; j < f->ld; ++j)
+        if (memcmp(&f->A[i * f->ld + j], &(double){0.0}, sizeof(double)) != 0)
+          fail_msg("n = %zu: A(%zu,%zu) padding = %g", n, i, j, f->A[i * f->ld + j]);
     /* Move along so that the next step sees other values. */
     g.v_eb_n_mps.x += 0.3;
     g.w_ib_b_rps.z = -g.w_ib_b_rps.z;

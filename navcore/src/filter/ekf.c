@@ -815,23 +815,16 @@ static void pattern_of_values(row_pattern *pt, const double *a, size_t n, size_t
   pattern_finish(pt, n, ld);
 }
 
-/* The inputs of the second-order step: A = F T over the pattern of A (zeros elsewhere),
- * and for the fused E6.2, P+ = Phi (P + Q/2) Phi^T + Q/2, Qd = Q/2 and S = P + Q/2 padded. Always
+/* The inputs of the second-order step besides A = F T (pending_integrals writes it in place, over
+ * the pattern of A, zeros elsewhere): for the fused E6.2, P+ = Phi (P + Q/2) Phi^T + Q/2,
+ * Qd = Q/2 and S = P + Q/2 padded. Always
  * inlined: cov_step instantiates it for 15 and 18 states with compile-time bounds (unrolled
  * rows, no memset calls for the padding), and once generically; the same values either way. */
-static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *FT, const double *QT, const size_t n,
+static NAV_ALWAYS_INLINE void second_order_inputs(nav_filter *f, const double *QT, const size_t n,
                                                   const size_t ld) {
-  /* A is written only here and only over its pattern, which is fixed at create: every other
-   * entry (padding included) is still the zero of calloc, so the rows need no clearing (a
-   * rep stos per row cost a quarter of the step). */
-  double *A = f->A;
-  for (size_t i = 0; i < n; ++i) {
-    double *ai = A + i * ld;
-    for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
-      const size_t k = f->a_pat.col[i][p];
-      ai[k] = FT[i * n + k];
-    }
-  }
+  /* A = F T is already in place (pending_integrals): written only there and only over its
+   * pattern, which is fixed at create, so every other entry (padding included) is still the zero
+   * of calloc and the rows need no clearing (a rep stos per row cost a quarter of the step). */
   /* Qd = Q/2 only where QT can be non-zero (pending_integrals writes the diagonal, and the
    * velocity and attitude blocks when the noise is not isotropic): elsewhere both keep the zeros
    * of calloc (a filter with the second-order discretisation never writes Qd otherwise), so this
@@ -886,18 +879,13 @@ NAV_KERNEL_CLONES static nav_status cov_step(nav_filter *f, const double *FT, co
   } else {
     /* E6.2: Phi = I + A + A^2/2, A = F T, the square over the structural non-zeros of A. */
     if (n == 15)
-      second_order_inputs(f, FT, QT, 15, 16);
+      second_order_inputs(f, QT, 15, 16);
     else if (n == 18)
-      second_order_inputs(f, FT, QT, 18, 20);
+      second_order_inputs(f, QT, 18, 20);
     else if (n == 21)
-      second_order_inputs(f, FT, QT, 21, 24);
+      second_order_inputs(f, QT, 21, 24);
     else
-      second_order_inputs(f, FT, QT, n, ld);
-#ifndef NDEBUG
-    for (size_t i = 0; i < n; ++i)
-      for (size_t k = 0; k < n; ++k)
-        assert(FT[i * n + k] == f->A[i * ld + k]);
-#endif
+      second_order_inputs(f, QT, n, ld);
     phi_second_order(f->Phi, f->A, &f->a_pat, &f->phi_pat, n, ld);
   }
   pattern_sandwich(f->Pn, f->Phi, pt, f->S, f->Qd, n, ld, f->W, f->Wt);
@@ -991,9 +979,15 @@ static void put_block(double *a, size_t n, size_t r, size_t c, nav_mat3 b, doubl
       a[(r + i) * n + c + j] = s * b.m[i][j];
 }
 
-/* F T and G Q_c G^T T of the pending interval into f->FT, f->QT. */
+/* F T and G Q_c G^T T of the pending interval into f->QT and, for the Van Loan discretisation,
+ * f->FT; for the second-order one F T goes straight into the padded A = F T that cov_step's
+ * Phi = I + A + A^2/2 reads (stride ld), at the same positions and with the same values (it was
+ * written into FT and copied over the pattern, a scalar loop of a fifth of cov_step's own time). */
 static void pending_integrals(nav_filter *f, const pending *pd) {
   const size_t n = f->n;
+  const bool van_loan = f->cfg.discretisation == NAV_FILTER_DISC_VAN_LOAN;
+  double *const FT = van_loan ? f->FT : f->A;
+  const size_t ft_ld = van_loan ? n : f->ld;
   const double T = pd->T;
   nav_filter_nav m;
   memset(&m, 0, sizeof m);
@@ -1017,7 +1011,7 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
   for (size_t i = 0; i < n; ++i)
     for (unsigned p = 0; p < f->a_pat.cnt[i]; ++p) {
       const size_t k = f->a_pat.col[i][p];
-      f->FT[i * n + k] = f->F[i * n + k] * T;
+      FT[i * ft_ld + k] = f->F[i * n + k] * T;
     }
 #ifndef NDEBUG
   for (size_t i = 0; i < n; ++i)
@@ -1029,12 +1023,12 @@ static void pending_integrals(nav_filter *f, const pending *pd) {
     }
 #endif
   /* The blocks linear in C_b_n: their exact integrals. */
-  put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_PHI, nav_mat3_skew(pd->fn_T), 1.0);
-  put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_BA, pd->C_T, 1.0);
-  put_block(f->FT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_BG, pd->C_T, -1.0);
+  put_block(FT, ft_ld, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_PHI, nav_mat3_skew(pd->fn_T), 1.0);
+  put_block(FT, ft_ld, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_BA, pd->C_T, 1.0);
+  put_block(FT, ft_ld, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_BG, pd->C_T, -1.0);
   if (f->lay.has_scale_factors) {
-    put_block(f->FT, n, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_SA, pd->Cf_T, 1.0);
-    put_block(f->FT, n, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_SG, pd->Cw_T, -1.0);
+    put_block(FT, ft_ld, NAV_FILTER_IDX_DV, NAV_FILTER_IDX_SA, pd->Cf_T, 1.0);
+    put_block(FT, ft_ld, NAV_FILTER_IDX_PHI, NAV_FILTER_IDX_SG, pd->Cw_T, -1.0);
   }
   if (f->q_isotropic) {
     for (size_t i = 0; i < 3; ++i) {
