@@ -160,21 +160,10 @@ static inline void nav_rng_lanes_gauss(nav_rng_lanes *p, size_t n, double out[4]
   memcpy(&dlo, &lo, sizeof dlo);
   memcpy(&dhi, &hi, sizeof dhi);
   const nav_rng_f64x4 dv = (dhi - 0x1.0p84) + (dlo - 0x1.0p52);
-  /* A layer's edge and the next one are adjacent in the table: one 16-byte load per lane, then
-   * two shuffles make the vector of edges and the vector of next edges (only values move). */
-  nav_rng_f64x2 p0, p1, p2, p3;
-  memcpy(&p0, &nav_rng_zig_x[bits[0] & 0xffu], sizeof p0);
-  memcpy(&p1, &nav_rng_zig_x[bits[1] & 0xffu], sizeof p1);
-  memcpy(&p2, &nav_rng_zig_x[bits[2] & 0xffu], sizeof p2);
-  memcpy(&p3, &nav_rng_zig_x[bits[3] & 0xffu], sizeof p3);
-  const nav_rng_f64x4 a02 = {p0[0], p0[1], p2[0], p2[1]}, a13 = {p1[0], p1[1], p3[0], p3[1]};
-#if defined(__clang__)
-  const nav_rng_f64x4 edge = __builtin_shufflevector(a02, a13, 0, 4, 2, 6);
-  const nav_rng_f64x4 next = __builtin_shufflevector(a02, a13, 1, 5, 3, 7);
-#else
-  const nav_rng_f64x4 edge = __builtin_shuffle(a02, a13, (nav_rng_i64x4){0, 4, 2, 6});
-  const nav_rng_f64x4 next = __builtin_shuffle(a02, a13, (nav_rng_i64x4){1, 5, 3, 7});
-#endif
+  const nav_rng_f64x4 edge = {nav_rng_zig_x[bits[0] & 0xffu], nav_rng_zig_x[bits[1] & 0xffu],
+                              nav_rng_zig_x[bits[2] & 0xffu], nav_rng_zig_x[bits[3] & 0xffu]};
+  const nav_rng_f64x4 next = {nav_rng_zig_x[(bits[0] & 0xffu) + 1], nav_rng_zig_x[(bits[1] & 0xffu) + 1],
+                              nav_rng_zig_x[(bits[2] & 0xffu) + 1], nav_rng_zig_x[(bits[3] & 0xffu) + 1]};
   const nav_rng_f64x4 x = dv * 0x1.0p-53 * edge;
   const nav_rng_i64x4 ok = x < next;
   nav_rng_u64x4 xb;
