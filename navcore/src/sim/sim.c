@@ -978,7 +978,7 @@ static void run_group(job *j, long r0) {
     if (imu && !atomic_load_explicit(&j->sim->cancel, memory_order_relaxed)) {
       /* run_measure() of the four runs: the same shared ideal record, the models in lanes. */
       const nav_imu_increment *ideal = &j->shared_imu[k - 1];
-      __builtin_prefetch(ideal + 16);
+      if (k + 16 <= j->n) __builtin_prefetch(&j->shared_imu[k + 15]); /* 16 samples ahead, within the array */
       nav_imu_increment *meas[NAV_LANES];
       for (int l = 0; l < NAV_LANES; ++l)
         meas[l] = &c[l].meas;
