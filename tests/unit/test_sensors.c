@@ -831,9 +831,8 @@ static void test_bias_reporting(void **state) {
  * and nav_imu_model_bias() after a sample gives the bias state of a model that forms it at every
  * sample, bit for bit, whether it is asked after every sample or only now and then; both
  * triads with every bias term, turn-on, GM and random walk, and noise. */
-static void test_deferred_bias_state(void **state) {
-  (void)state;
-  const double dt = 0.01;
+/* Both triads with every bias term (turn-on, GM, random walk) and noise. */
+static nav_imu_model_config bias_noise_config(void) {
   nav_imu_model_config cfg = nav_imu_model_config_default();
   const unsigned terms =
       NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW | NAV_IMU_TERM_NOISE;
@@ -848,6 +847,13 @@ static void test_deferred_bias_state(void **state) {
   cfg.accel.bias_gm_tau_s = v3(50.0);
   cfg.accel.bias_rw_mps2_per_sqrt_s = v3(1e-5);
   cfg.accel.vrw_mps_per_sqrt_s = v3(1e-3);
+  return cfg;
+}
+
+static void test_deferred_bias_state(void **state) {
+  (void)state;
+  const double dt = 0.01;
+  const nav_imu_model_config cfg = bias_noise_config();
   nav_imu_model *eager = NULL, *lazy = NULL;
   assert_int_equal(nav_imu_model_create(&cfg, k_seed, 7, &eager), NAV_OK);
   assert_int_equal(nav_imu_model_create(&cfg, k_seed, 7, &lazy), NAV_OK);
@@ -874,24 +880,15 @@ static void test_deferred_bias_state(void **state) {
   nav_imu_model_destroy(lazy);
 }
 
-/* A model with every term of both triads on (g-sensitivity included), for the lanes test. */
+/* A model with every term of both triads on (g-sensitivity included), for the lanes test: the
+ * bias and noise terms of bias_noise_config() and the rest. */
 static nav_imu_model_config every_term_config(void) {
-  nav_imu_model_config cfg = nav_imu_model_config_default();
-  cfg.gyro.terms = NAV_IMU_TERM_BIAS_TURN_ON | NAV_IMU_TERM_BIAS_GM | NAV_IMU_TERM_BIAS_RW |
-                   NAV_IMU_TERM_NOISE | NAV_IMU_TERM_SCALE_FACTOR | NAV_IMU_TERM_MISALIGNMENT |
-                   NAV_IMU_TERM_G_SENSITIVITY | NAV_IMU_TERM_QUANTISATION | NAV_IMU_TERM_SATURATION;
-  cfg.accel.terms = cfg.gyro.terms & ~(unsigned)NAV_IMU_TERM_G_SENSITIVITY;
-  cfg.gyro.bias_turn_on_sd_rps = v3(1e-4);
-  cfg.gyro.bias_gm_sd_rps = v3(1e-5);
-  cfg.gyro.bias_gm_tau_s = v3(100.0);
-  cfg.gyro.bias_rw_rps_per_sqrt_s = v3(1e-6);
-  cfg.gyro.arw_rad_per_sqrt_s = v3(1e-4);
+  nav_imu_model_config cfg = bias_noise_config();
+  const unsigned more = NAV_IMU_TERM_SCALE_FACTOR | NAV_IMU_TERM_MISALIGNMENT | NAV_IMU_TERM_QUANTISATION |
+                        NAV_IMU_TERM_SATURATION;
+  cfg.gyro.terms |= more | NAV_IMU_TERM_G_SENSITIVITY;
+  cfg.accel.terms |= more;
   cfg.gyro.scale_factor_sd = v3(1e-3);
-  cfg.accel.bias_turn_on_sd_mps2 = v3(1e-3);
-  cfg.accel.bias_gm_sd_mps2 = v3(1e-4);
-  cfg.accel.bias_gm_tau_s = v3(50.0);
-  cfg.accel.bias_rw_mps2_per_sqrt_s = v3(1e-5);
-  cfg.accel.vrw_mps_per_sqrt_s = v3(1e-3);
   cfg.accel.scale_factor_sd = v3(1e-3);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {

@@ -116,11 +116,11 @@ static long drive(nav_ins *ins[4], nav_ins *solo[4], long steps, double dt, int 
     }
     snap before[4];
     for (int l = 0; l < 4; ++l) before[l] = take(ins[l]);
-    /* Every other step through nav_ins_step_lanes_nav(), whose lanes must then hold each INS's
-     * new NED state and the DCM of its attitude. */
+    /* Every other step asks for the new state in lanes, which must then hold each INS's new NED
+     * state and the DCM of its attitude. */
     nav_ins_lanes_nav out;
     const bool with_nav = k % 2 == 1;
-    const bool done = with_nav ? nav_ins_step_lanes_nav(ins, ip, &out) : nav_ins_step_lanes(ins, ip);
+    const bool done = nav_ins_step_lanes(ins, ip, with_nav ? &out : NULL);
     nav_status st[4];
     for (int l = 0; l < 4; ++l) st[l] = nav_ins_step(solo[l], ip[l]);
     if (done && with_nav)

@@ -188,6 +188,14 @@ static nav_filter_ins_state nominal_of(const nav_ins_gnss *x) {
   return o;
 }
 
+/* The filter's specific force and angular rate: the increment's means over its interval. */
+static inline void filter_nav_rates(nav_filter_nav *n, const nav_imu_increment *imu) {
+  const double idt = 1.0 / imu->dt_s;
+  n->f_ib_b_mps2 = nav_vec3_make(imu->dv_b_mps.x * idt, imu->dv_b_mps.y * idt, imu->dv_b_mps.z * idt);
+  n->w_ib_b_rps =
+      nav_vec3_make(imu->dtheta_b_rad.x * idt, imu->dtheta_b_rad.y * idt, imu->dtheta_b_rad.z * idt);
+}
+
 /* Filter inputs from the INS and the compensated increment of the step just taken. A NED
  * mechanization hands over its geodetic state directly (no ECEF round trip at IMU rate); the
  * ECEF one through the frame view. The record is read field by field, never copied whole: a
@@ -211,9 +219,7 @@ static inline bool filter_nav_fill(nav_filter_nav *n, const nav_frame *fr, const
     n->v_eb_n_mps = v.v_n_mps;
     n->C_b_n = nav_quat_to_dcm_inline(v.q_b_n);
   }
-  const double idt = 1.0 / imu->dt_s;
-  n->f_ib_b_mps2 = nav_vec3_make(imu->dv_b_mps.x * idt, imu->dv_b_mps.y * idt, imu->dv_b_mps.z * idt);
-  n->w_ib_b_rps = nav_vec3_make(imu->dtheta_b_rad.x * idt, imu->dtheta_b_rad.y * idt, imu->dtheta_b_rad.z * idt);
+  filter_nav_rates(n, imu);
   return from_ned;
 }
 
@@ -322,7 +328,7 @@ void nav_ins_gnss_step_lanes(nav_ins_gnss *const x[NAV_LANES], const nav_imu_inc
     mp[l] = &m[l];
   }
   nav_ins_lanes_nav out;
-  if (nav_ins_step_lanes_nav(ins, mp, &out)) {
+  if (nav_ins_step_lanes(ins, mp, &out)) {
     /* The filter's inputs from the lanes: filter_nav_fill() of each INS (its NED state, the DCM
      * of its attitude, the increment's mean rates), the same values. */
     for (int l = 0; l < NAV_LANES; ++l) {
@@ -333,10 +339,7 @@ void nav_ins_gnss_step_lanes(nav_ins_gnss *const x[NAV_LANES], const nav_imu_inc
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
           n.C_b_n.m[i][j] = out.C_b_n.m[i][j][l];
-      const double idt = 1.0 / m[l].dt_s;
-      n.f_ib_b_mps2 = nav_vec3_make(m[l].dv_b_mps.x * idt, m[l].dv_b_mps.y * idt, m[l].dv_b_mps.z * idt);
-      n.w_ib_b_rps =
-          nav_vec3_make(m[l].dtheta_b_rad.x * idt, m[l].dtheta_b_rad.y * idt, m[l].dtheta_b_rad.z * idt);
+      filter_nav_rates(&n, &m[l]);
       st[l] = after_strapdown_nav(x[l], &m[l], &n, true);
     }
     return;

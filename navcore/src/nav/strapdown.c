@@ -878,8 +878,9 @@ static bool lanes_config(const nav_ins *ins) {
  * step, a finite state); otherwise nothing is written and false is returned, and the caller
  * steps each INS with nav_ins_step(), which also words any error.
  */
-NAV_CLONE_INLINE bool step_lanes_impl(nav_ins *const ins[NAV_LANES],
-                                      const nav_imu_increment *const imu[NAV_LANES], nav_ins_lanes_nav *out) {
+NAV_HOT_CLONES bool nav_ins_step_lanes(nav_ins *const ins[NAV_LANES],
+                                       const nav_imu_increment *const imu[NAV_LANES],
+                                       nav_ins_lanes_nav *out) {
   nav_l4 dt, lat0, lon0, h0;
   nav_l4v3 dth, dv, pdth, pdv, v0;
   nav_l4q q0;
@@ -1024,15 +1025,4 @@ NAV_CLONE_INLINE bool step_lanes_impl(nav_ins *const ins[NAV_LANES],
     out->C_b_n = l4q_to_dcm(q1);
   }
   return true;
-}
-
-NAV_HOT_CLONES bool nav_ins_step_lanes(nav_ins *const ins[NAV_LANES],
-                                       const nav_imu_increment *const imu[NAV_LANES]) {
-  return step_lanes_impl(ins, imu, NULL);
-}
-
-NAV_HOT_CLONES bool nav_ins_step_lanes_nav(nav_ins *const ins[NAV_LANES],
-                                           const nav_imu_increment *const imu[NAV_LANES],
-                                           nav_ins_lanes_nav *out) {
-  return step_lanes_impl(ins, imu, out);
 }

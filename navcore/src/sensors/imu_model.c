@@ -8,6 +8,7 @@
 #include <assert.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -733,19 +734,26 @@ static bool triad_same_config(const triad *a, const triad *b) {
          memcmp(a->range, b->range, sizeof a->range) == 0;
 }
 
-/* Streams: lanes (model l, axis i) -> (axis i, model l), and back. */
-static void streams_to_lanes(nav_rng_lanes out[3], const nav_rng_lanes *in[NAV_LANES]) {
-  for (int i = 0; i < 3; ++i)
-    for (int w = 0; w < 4; ++w)
-      for (int l = 0; l < NAV_LANES; ++l)
-        out[i].s[w][l] = in[l]->s[w][i];
+/* The streams of one term (the nav_rng_lanes at byte offset member of each triad: lane i is axis
+ * i) to the lanes of the group (lanes[i], lane l: model l's stream of axis i), or back. */
+static void move_streams(nav_rng_lanes lanes[3], triad *const t[NAV_LANES], size_t member, bool into_lanes) {
+  for (int l = 0; l < NAV_LANES; ++l) {
+    nav_rng_lanes *m = (nav_rng_lanes *)((char *)t[l] + member);
+    for (int i = 0; i < 3; ++i)
+      for (int w = 0; w < 4; ++w) {
+        if (into_lanes)
+          lanes[i].s[w][l] = m->s[w][i];
+        else
+          m->s[w][i] = lanes[i].s[w][l];
+      }
+  }
 }
 
-static void streams_from_lanes(const nav_rng_lanes in[3], nav_rng_lanes *out[NAV_LANES]) {
-  for (int i = 0; i < 3; ++i)
-    for (int w = 0; w < 4; ++w)
-      for (int l = 0; l < NAV_LANES; ++l)
-        out[l]->s[w][i] = in[i].s[w][l];
+/* All three terms' streams of a triad, into the lanes or back. */
+static void move_triad_streams(lanes_triad *g, triad *const t[NAV_LANES], bool into_lanes) {
+  move_streams(g->rng_noise, t, offsetof(triad, rng_noise), into_lanes);
+  move_streams(g->rng_gm, t, offsetof(triad, rng_gm), into_lanes);
+  move_streams(g->rng_rw, t, offsetof(triad, rng_rw), into_lanes);
 }
 
 static void triad_to_lanes(lanes_triad *g, triad *const t[NAV_LANES]) {
@@ -759,19 +767,11 @@ static void triad_to_lanes(lanes_triad *g, triad *const t[NAV_LANES]) {
       for (int j = 0; j < 3; ++j)
         g->m[i][j][l] = t[l]->m.m[i][j];
     }
-  const nav_rng_lanes *noise[NAV_LANES], *gm[NAV_LANES], *rw[NAV_LANES];
-  for (int l = 0; l < NAV_LANES; ++l) {
-    noise[l] = &t[l]->rng_noise;
-    gm[l] = &t[l]->rng_gm;
-    rw[l] = &t[l]->rng_rw;
-  }
-  streams_to_lanes(g->rng_noise, noise);
-  streams_to_lanes(g->rng_gm, gm);
-  streams_to_lanes(g->rng_rw, rw);
+  move_triad_streams(g, t, true);
 }
 
 /* The state a sample changes (the per-run constants b0 and M stay as they are in the models). */
-static void triad_from_lanes(const lanes_triad *g, triad *const t[NAV_LANES]) {
+static void triad_from_lanes(lanes_triad *g, triad *const t[NAV_LANES]) {
   for (int l = 0; l < NAV_LANES; ++l)
     for (int i = 0; i < 3; ++i) {
       t[l]->gm_b[i] = g->gm_b[i][l];
@@ -779,15 +779,7 @@ static void triad_from_lanes(const lanes_triad *g, triad *const t[NAV_LANES]) {
       t[l]->ib[i] = g->ib[i][l];
       t[l]->q_res[i] = g->q_res[i][l];
     }
-  nav_rng_lanes *noise[NAV_LANES], *gm[NAV_LANES], *rw[NAV_LANES];
-  for (int l = 0; l < NAV_LANES; ++l) {
-    noise[l] = &t[l]->rng_noise;
-    gm[l] = &t[l]->rng_gm;
-    rw[l] = &t[l]->rng_rw;
-  }
-  streams_from_lanes(g->rng_noise, noise);
-  streams_from_lanes(g->rng_gm, gm);
-  streams_from_lanes(g->rng_rw, rw);
+  move_triad_streams(g, t, false);
 }
 
 nav_imu_lanes *nav_imu_lanes_open(nav_imu_model *const models[NAV_LANES]) {
