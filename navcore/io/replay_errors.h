@@ -16,6 +16,7 @@
 #include "navcore/nav_ins.h"
 #include "navcore/nav_math.h"
 #include "navcore/nav_recorded.h"
+#include "err_math.h"
 
 /* A reference row with the parts of its errors that depend on it alone (ned_errors()), which the
  * reading thread computes ahead of the navigation. */
@@ -49,6 +50,29 @@ static inline nav_vec3 ecef_of(double sl, double cl, double so, double co, doubl
 /* nav_wrap_pi() with its common case (an angle already in (-pi, pi], returned as is) inline. */
 static inline double wrap_pi(double a) { return a > -NAV_PI && a <= NAV_PI ? a : nav_wrap_pi(a); }
 
+/* nav_dcm_to_euler()'s formulas and gimbal-lock rule (navcore's math.c: pitch from atan2 and
+ * hypot, yaw from the well-determined yaw -/+ roll, roll 0 within 1e-12 of pitch +/-90 deg) with
+ * the kernels of err_math.h in place of libm's atan2 and hypot. */
+#define RE_GIMBAL_LOCK_TOL 1e-12
+
+static inline nav_euler em_dcm_to_euler(const nav_mat3 *c) {
+  const double c31 = c->m[2][0];
+  nav_euler e;
+  e.pitch_rad = em_atan2(-c31, em_hypot(c->m[0][0], c->m[1][0]));
+  if (fabs(c31) > 1.0 - RE_GIMBAL_LOCK_TOL) {
+    e.roll_rad = 0.0;
+    e.yaw_rad = wrap_pi(em_atan2(-c->m[0][1], c->m[1][1]));
+  } else {
+    e.roll_rad = wrap_pi(em_atan2(c->m[2][1], c->m[2][2]));
+    const bool up = c31 <= 0.0; /* pitch >= 0: yaw - roll, else yaw + roll */
+    const double yy = up ? c->m[1][2] - c->m[0][1] : -(c->m[0][1] + c->m[1][2]);
+    const double yx = up ? c->m[1][1] + c->m[0][2] : c->m[1][1] - c->m[0][2];
+    const double sg = up ? 1.0 : -1.0;
+    e.yaw_rad = wrap_pi(em_atan2(yy, yx) + sg * e.roll_rad);
+  }
+  return e;
+}
+
 /*
  * The errors of nav_errors_compute() for a NED navigation state against a reference row,
  * without the ECEF round trips of the general path (which cost more than the whole navigation
@@ -56,6 +80,8 @@ static inline double wrap_pi(double a) { return a > -NAV_PI && a <= NAV_PI ? a :
  * the rotation angle between the two body-to-e attitudes, and differences of the local-level
  * Euler angles (the reference's straight from its row). The values agree with the general path
  * to rounding (a few 1e-10 m, 1e-14 rad: the same formulas without the geodetic inversions).
+ * atan2 and hypot are err_math.h's (within 0.75 and 0.53 ulp of the exact values where glibc's are
+ * within about 0.52 and 0.56), so that ned_errors4() can compute them in lanes.
  */
 static inline nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned *e) {
   const nav_rec_pva *ref = &ri->row;
@@ -70,7 +96,7 @@ static inline nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned 
   const nav_vec3 dr =
       nav_vec3_sub(ecef_of(sle, cle, soe, coe, e->pos.h_m), ecef_of(slt, clt, sot, cot, ref->pos.h_m));
   r.pos_err_n_m = nav_mat3_mul_vec(Ct_t, dr);
-  r.pos_err_h_m = hypot(r.pos_err_n_m.x, r.pos_err_n_m.y);
+  r.pos_err_h_m = em_hypot(r.pos_err_n_m.x, r.pos_err_n_m.y);
   r.pos_err_v_m = fabs(r.pos_err_n_m.z);
   const nav_vec3 dv = nav_vec3_sub(nav_mat3_mul_vec(Ce, e->v_n_mps), nav_mat3_mul_vec(Ct, ref->v_n_mps));
   r.vel_err_n_mps = nav_mat3_mul_vec(Ct_t, dv);
@@ -78,24 +104,27 @@ static inline nav_epoch_errors ned_errors(const ref_item *ri, const nav_ins_ned 
   /* C_b_e(ref)^T C_b_e(est) = C_n_b(ref) M C_b_n(est) with M = C_e_n(ref) C_n_e(est) ~ I. */
   const nav_quat qt = ri->qt;
   const nav_quat qm = nav_quat_from_dcm(nav_mat3_mul(Ct_t, Ce));
-  r.att_err_rad = nav_quat_angle_between(qt, nav_quat_mul(qm, e->q_b_n));
-  const nav_euler ee = nav_quat_to_euler(e->q_b_n, NULL);
+  /* nav_quat_angle_between(qt, q2): 2 atan2(|v|, |w|) of the relative quaternion. */
+  const nav_quat rq = nav_quat_mul(nav_quat_conj(qt), nav_quat_mul(qm, e->q_b_n));
+  r.att_err_rad = 2.0 * em_atan2(sqrt(rq.x * rq.x + rq.y * rq.y + rq.z * rq.z), fabs(rq.w));
+  const nav_mat3 Cb = nav_quat_to_dcm(e->q_b_n);
+  const nav_euler ee = em_dcm_to_euler(&Cb);
   r.euler_err.roll_rad = wrap_pi(ee.roll_rad - ref->att.roll_rad);
   r.euler_err.pitch_rad = wrap_pi(ee.pitch_rad - ref->att.pitch_rad);
   r.euler_err.yaw_rad = wrap_pi(ee.yaw_rad - ref->att.yaw_rad);
   return r;
 }
 
-
 /*
  * ned_errors() of four epochs: every lane does the scalar function's operations in its order
  * (IEEE +, -, *, / and sqrt are correctly rounded in a vector lane as in a register, and
  * navcore_io is built with -ffp-contract=off, so no product is fused into a sum), with the same
- * libm calls per lane (sin and cos of the longitude, hypot, atan2, nav_dcm_to_euler, wrap_pi). The
- * inlined parts of nav_quat_from_dcm, nav_quat_angle_between and nav_quat_to_euler follow
- * math.c: the quaternion from its trace branch when every lane takes it (M = C_e_n(ref)
- * C_n_e(est) is within a small rotation of I, so the trace is the largest diagonal sum), else
- * nav_quat_from_dcm per lane. So each result is the scalar one bit for bit (test_replay_errors).
+ * libm calls per lane (sin and cos of the longitude, wrap_pi) and the four-lane forms of
+ * err_math.h's atan2 and hypot, which give their scalar forms' bits. The inlined parts of
+ * nav_quat_from_dcm, nav_quat_angle_between and nav_quat_to_dcm follow math.c: the quaternion from its trace
+ * branch when every lane takes it (M = C_e_n(ref) C_n_e(est) is within a small rotation of I, so the trace is
+ * the largest diagonal sum), else nav_quat_from_dcm per lane. So each result is the scalar one bit for bit
+ * (test_replay_errors).
  */
 typedef double nav_re4 __attribute__((vector_size(32)));
 /* Four-double vectors without AVX are passed in memory, not in a register: a note on the ABI that
@@ -234,28 +263,49 @@ RE4_INLINE void ned_errors4(const ref_item *const ri[4], const nav_ins_ned *cons
   const nav_re4 ry = cw * q2y - cx * q2z + cy * q2w + cz * q2x;
   const nav_re4 rz = cw * q2z + cx * q2y - cy * q2x + cz * q2w;
   const nav_re4 vpart = re4_sqrt(rx * rx + ry * ry + rz * rz), wabs = re4_fabs(rw);
-  /* C_b_n of the estimate (nav_quat_to_dcm), for nav_dcm_to_euler per lane. */
+  /* C_b_n of the estimate (nav_quat_to_dcm). */
   const nav_re4 ww = qew * qew, xx = qex * qex, yy = qey * qey, zz = qez * qez;
   const nav_re4 xy = qex * qey, xz = qex * qez, yz = qey * qez;
   const nav_re4 wx = qew * qex, wy = qew * qey, wz = qew * qez;
   const re4_mat3 Cb = {{{ww + xx - yy - zz, 2.0 * (xy - wz), 2.0 * (xz + wy)},
                         {2.0 * (xy + wz), ww - xx + yy - zz, 2.0 * (yz - wx)},
                         {2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz}}};
+  /* The Euler angles of the estimate in lanes (em_dcm_to_euler's operations); a lane within the
+   * gimbal-lock tolerance takes em_dcm_to_euler itself. */
+  const nav_re4 pos_h = em_hypot4(pn.x, pn.y);
+  const nav_re4 att = 2.0 * em_atan2_4(vpart, wabs);
+  const nav_re4 pitch = em_atan2_4(-Cb.m[2][0], em_hypot4(Cb.m[0][0], Cb.m[1][0]));
+  const nav_re4 roll_raw = em_atan2_4(Cb.m[2][1], Cb.m[2][2]);
+  nav_re4 yy_arg, yx_arg, sg;
+  for (int k = 0; k < 4; ++k) {
+    const bool up = Cb.m[2][0][k] <= 0.0;
+    yy_arg[k] = up ? Cb.m[1][2][k] - Cb.m[0][1][k] : -(Cb.m[0][1][k] + Cb.m[1][2][k]);
+    yx_arg[k] = up ? Cb.m[1][1][k] + Cb.m[0][2][k] : Cb.m[1][1][k] - Cb.m[0][2][k];
+    sg[k] = up ? 1.0 : -1.0;
+  }
+  const nav_re4 yaw_raw = em_atan2_4(yy_arg, yx_arg);
   for (int k = 0; k < 4; ++k) {
     const nav_rec_pva *ref = &ri[k]->row;
     nav_epoch_errors *o = &r[k];
     o->t_s = ref->t_s;
     o->pos_err_n_m = nav_vec3_make(pn.x[k], pn.y[k], pn.z[k]);
-    o->pos_err_h_m = hypot(pn.x[k], pn.y[k]);
+    o->pos_err_h_m = pos_h[k];
     o->pos_err_v_m = fabs(pn.z[k]);
     o->vel_err_n_mps = nav_vec3_make(vn.x[k], vn.y[k], vn.z[k]);
     o->vel_err_mps = vnorm[k];
-    o->att_err_rad = 2.0 * atan2(vpart[k], wabs[k]);
-    nav_mat3 ck;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        ck.m[i][j] = Cb.m[i][j][k];
-    const nav_euler ee = nav_dcm_to_euler(ck, NULL);
+    o->att_err_rad = att[k];
+    nav_euler ee;
+    if (fabs(Cb.m[2][0][k]) > 1.0 - RE_GIMBAL_LOCK_TOL) {
+      nav_mat3 ck;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          ck.m[i][j] = Cb.m[i][j][k];
+      ee = em_dcm_to_euler(&ck);
+    } else {
+      ee.pitch_rad = pitch[k];
+      ee.roll_rad = wrap_pi(roll_raw[k]);
+      ee.yaw_rad = wrap_pi(yaw_raw[k] + sg[k] * ee.roll_rad);
+    }
     o->euler_err.roll_rad = wrap_pi(ee.roll_rad - ref->att.roll_rad);
     o->euler_err.pitch_rad = wrap_pi(ee.pitch_rad - ref->att.pitch_rad);
     o->euler_err.yaw_rad = wrap_pi(ee.yaw_rad - ref->att.yaw_rad);
