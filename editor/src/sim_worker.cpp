@@ -151,8 +151,12 @@ void SimWorker::Launch(std::unique_ptr<Job> job) {
   Job *j = running_.get();
   emit Started();
   poll_.start();
-  thread_ = std::thread([this, j] {
+  const bool hold = hold_next_.exchange(false);
+  thread_ = std::thread([this, j, hold] {
     auto result = std::make_shared<SimResult>();
+    // HoldNextJobForTest: wait for the cancel; the job then goes to the helper cancelled.
+    for (int ms = 0; hold && ms < 60000 && !cancel_.load(); ++ms)
+      usleep(1000);
     RunInHelper(j, result.get());
     std::shared_ptr<const SimResult> done = result;
     // The one crossing to the GUI thread: a queued call on this object (dropped if it is gone).

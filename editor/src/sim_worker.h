@@ -91,6 +91,9 @@ public:
   void Join();
   /** CPU time the helper process that runs the simulations has used so far [s] (0 without one). */
   double HelperCpuS() const;
+  /** Test hook: the next job started waits, before it reaches the helper process, until it is
+   *  cancelled (at most 60 s), so that a test can issue the next edit while it is still running. */
+  void HoldNextJobForTest() { hold_next_.store(true); }
 
 signals:
   void Progress(double fraction);
@@ -131,6 +134,7 @@ private:
   bool busy_ = false;
   std::atomic<double> fraction_{0.0};
   std::atomic<bool> cancel_{false};
+  std::atomic<bool> hold_next_{false};
   mutable std::mutex sim_mutex_;
   Shared *shared_ = nullptr; /* guarded by sim_mutex_: shared_page_ while a job runs */
   Shared *shared_page_ = nullptr;

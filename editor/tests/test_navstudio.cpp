@@ -1109,6 +1109,9 @@ private slots:
     const long r0[2] = {w->MapView()->RenderCount(), w->View3D()->RenderCount()};
     nav_scene e = doc->Scene();
     e.trajectory.waypoints.points[6].r_ned_m.y += 5.0;
+    // The first edit's job waits for its cancel: without the hold, a loaded machine could let it
+    // finish (40-70 ms) before the second edit arrives.
+    w->PreviewWorker()->HoldNextJobForTest();
     doc->Preview(e);
     QVERIFY(w->PreviewWorker()->IsBusy());
     e.trajectory.waypoints.points[6].r_ned_m.y += 5.0;
