@@ -30,9 +30,8 @@
  *
  * gnss-ins-sim's figure: measured in this run with --peer-gnss-ins-sim DIR (a checkout of
  * Aceinna/gnss-ins-sim; its Sim.run needs only Debian's python3-numpy; the timing script below
- * is written into DIR_OUT/logs and run by /usr/bin/python3; the medians of three runs in one
- * process, as ours are medians of repeated generations: one run of it measured 42.6 to 48.2 us per
- * sample on the same machine within an hour), else the figure measured on this
+ * is written into DIR_OUT/logs and run by /usr/bin/python3, three times, each run after one block
+ * of our generations; the row gives the medians of both sides), else the figure measured on this
  * project's machine, labelled with its date and load.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -67,8 +66,7 @@
 /* The timing script run for --peer-gnss-ins-sim (argv: gnss-ins-sim checkout, motion file). */
 static const char k_gis_script[] =
     "# navsim bench: gnss-ins-sim's Sim.run on a motion file with the shared long-drive data set's\n"
-    "# settings (200 Hz IMU, 1 Hz GPS, ref_frame 0), CPU seconds of path_gen and of the whole run\n"
-    "# (the medians of argv[3] runs, each with a new Sim and IMU seeded alike; default one).\n"
+    "# settings (200 Hz IMU, 1 Hz GPS, ref_frame 0), CPU seconds of path_gen and of the whole run.\n"
     "import sys, time\n"
     "sys.path.insert(0, sys.argv[1])\n"
     "import numpy as np\n"
@@ -86,21 +84,16 @@ static const char k_gis_script[] =
     "    tp['cpu'] = time.process_time() - c\n"
     "    return r\n"
     "pathgen.path_gen = timed\n"
-    "runs = int(sys.argv[3]) if len(sys.argv) > 3 else 1\n"
-    "gen, cpu, wall = [], [], []\n"
-    "for i in range(runs):\n"
-    "    imu = imu_model.IMU(accuracy=acc, axis=6, gps=True,\n"
-    "                        gps_opt={'stdp': np.array([0.02, 0.02, 0.05]), 'stdv': np.array([0.05] * 3)})\n"
-    "    np.random.seed(1)\n"
-    "    sim = ins_sim.Sim([200.0, 1.0, 0.0], sys.argv[2], ref_frame=0, imu=imu, mode=None, env=None,\n"
-    "                      algorithm=None)\n"
-    "    w = time.perf_counter(); c = time.process_time()\n"
-    "    sim.run(1)\n"
-    "    cpu.append(time.process_time() - c); wall.append(time.perf_counter() - w); gen.append(tp['cpu'])\n"
-    "    print('gnss-ins-sim-run %d: path_gen_cpu_s=%.4f run_cpu_s=%.4f' % (i + 1, gen[-1], cpu[-1]))\n"
-    "med = lambda v: sorted(v)[len(v) // 2]\n"
-    "print('gnss-ins-sim samples=%d runs=%d path_gen_cpu_s=%.4f run_cpu_s=%.4f run_wall_s=%.4f'\n"
-    "      % (len(sim.dmgr.time.data), runs, med(gen), med(cpu), med(wall)))\n";
+    "imu = imu_model.IMU(accuracy=acc, axis=6, gps=True,\n"
+    "                    gps_opt={'stdp': np.array([0.02, 0.02, 0.05]), 'stdv': np.array([0.05] * 3)})\n"
+    "np.random.seed(1)\n"
+    "sim = ins_sim.Sim([200.0, 1.0, 0.0], sys.argv[2], ref_frame=0, imu=imu, mode=None, env=None,\n"
+    "                  algorithm=None)\n"
+    "w = time.perf_counter(); c = time.process_time()\n"
+    "sim.run(1)\n"
+    "run_c = time.process_time() - c; run_w = time.perf_counter() - w\n"
+    "print('gnss-ins-sim samples=%d path_gen_cpu_s=%.4f run_cpu_s=%.4f run_wall_s=%.4f'\n"
+    "      % (len(sim.dmgr.time.data), tp['cpu'], run_c, run_w))\n";
 
 /* The gnss-ins-sim figures of this suite (NaN: none), for the target line. */
 static struct {
@@ -193,7 +186,7 @@ cleanup:
   return ok;
 }
 
-/* One run of gnss-ins-sim (its timing script with runs = 1; log DIR_OUT/logs/gnss-ins-sim-INDEX.log): its
+/* One run of gnss-ins-sim (its timing script; log DIR_OUT/logs/gnss-ins-sim-INDEX.log): its
  * figures into *gen_s, *run_s and *wall_s (CPU of path_gen, CPU and wall of Sim.run) and its sample count
  * into *samples; false with a message when it cannot run. */
 static bool run_peer_once(const char *gis_dir, const char *out_dir, int index, double *samples, double *gen_s,

@@ -146,6 +146,13 @@ EM_INLINE void em_split(double v, double *h, double *l) {
   *l = v - *h;
 }
 
+/* v^2 - vv exactly, for vv = v * v rounded (Dekker's square in the halves of em_split). */
+EM_INLINE double em_sq_err(double v, double vv) {
+  double h, l;
+  em_split(v, &h, &l);
+  return (((h * h - vv) + h * l) + h * l) + l * l;
+}
+
 EM_INLINE double em_atan2(double y, double x) {
   const double ax = fabs(x), ay = fabs(y);
   if (!em_atan2_kernel(ay, ax)) return atan2(y, x);
@@ -188,19 +195,14 @@ EM_INLINE double em_hypot(double x, double y) {
   if (!em_hypot_kernel(ax, ay)) return hypot(x, y);
   /* s + se + xe + ye = x^2 + y^2 exactly (Dekker's squares, Knuth's sum), h = sqrt(s), then one
    * Newton step h + (x^2 + y^2 - h^2) / 2h with h^2 = h2 + he exact as well. */
-  double xh, xl, yh, yl, hh, hl;
-  em_split(ax, &xh, &xl);
-  em_split(ay, &yh, &yl);
   const double xx = ax * ax, yy = ay * ay;
-  const double xe = (((xh * xh - xx) + xh * xl) + xh * xl) + xl * xl;
-  const double ye = (((yh * yh - yy) + yh * yl) + yh * yl) + yl * yl;
+  const double xe = em_sq_err(ax, xx), ye = em_sq_err(ay, yy);
   const double s = xx + yy;
   const double bv = s - xx;
   const double se = (xx - (s - bv)) + (yy - bv);
   const double h = sqrt(s);
-  em_split(h, &hh, &hl);
   const double h2 = h * h;
-  const double he = (((hh * hh - h2) + hh * hl) + hh * hl) + hl * hl;
+  const double he = em_sq_err(h, h2);
   const double res = (((s - h2) - he) + se) + (xe + ye);
   return h + res / (h + h);
 }
@@ -260,6 +262,12 @@ EM_INLINE void em_split4(em_v4 v, em_v4 *h, em_v4 *l) {
   *l = v - *h;
 }
 
+EM_INLINE em_v4 em_sq_err4(em_v4 v, em_v4 vv) {
+  em_v4 h, l;
+  em_split4(v, &h, &l);
+  return (((h * h - vv) + h * l) + h * l) + l * l;
+}
+
 EM_INLINE em_v4 em_atan2_4(em_v4 y, em_v4 x) {
   const em_v4 ax = em_abs4(x), ay = em_abs4(y);
   const em_v4 zero = {0.0, 0.0, 0.0, 0.0};
@@ -316,19 +324,14 @@ EM_INLINE em_v4 em_hypot4(em_v4 x, em_v4 y) {
   const em_v4 big = {0x1p500, 0x1p500, 0x1p500, 0x1p500}, small = {0x1p-500, 0x1p-500, 0x1p-500, 0x1p-500};
   /* em_hypot_kernel() in lanes. */
   const em_m4 in = (ax <= big) & (ay <= big) & ((ax >= small) | (ay >= small));
-  em_v4 xh, xl, yh, yl, hh, hl;
-  em_split4(ax, &xh, &xl);
-  em_split4(ay, &yh, &yl);
   const em_v4 xx = ax * ax, yy = ay * ay;
-  const em_v4 xe = (((xh * xh - xx) + xh * xl) + xh * xl) + xl * xl;
-  const em_v4 ye = (((yh * yh - yy) + yh * yl) + yh * yl) + yl * yl;
+  const em_v4 xe = em_sq_err4(ax, xx), ye = em_sq_err4(ay, yy);
   const em_v4 s = xx + yy;
   const em_v4 bv = s - xx;
   const em_v4 se = (xx - (s - bv)) + (yy - bv);
   const em_v4 h = em_sqrt4(s);
-  em_split4(h, &hh, &hl);
   const em_v4 h2 = h * h;
-  const em_v4 he = (((hh * hh - h2) + hh * hl) + hh * hl) + hl * hl;
+  const em_v4 he = em_sq_err4(h, h2);
   const em_v4 res = (((s - h2) - he) + se) + (xe + ye);
   em_v4 out = h + res / (h + h);
   if (!em_all(in))

@@ -133,20 +133,6 @@ typedef double nav_re4 __attribute__((vector_size(32)));
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define RE4_INLINE static inline __attribute__((always_inline))
 
-RE4_INLINE nav_re4 re4_sqrt(nav_re4 a) {
-  nav_re4 r;
-  for (int k = 0; k < 4; ++k)
-    r[k] = sqrt(a[k]);
-  return r;
-}
-
-RE4_INLINE nav_re4 re4_fabs(nav_re4 a) {
-  nav_re4 r;
-  for (int k = 0; k < 4; ++k)
-    r[k] = fabs(a[k]);
-  return r;
-}
-
 typedef struct re4_mat3 {
   nav_re4 m[3][3];
 } re4_mat3;
@@ -162,7 +148,7 @@ RE4_INLINE re4_mat3 re4_dcm_n_e(nav_re4 sl, nav_re4 cl, nav_re4 so, nav_re4 co) 
 }
 
 RE4_INLINE re4_vec3 re4_ecef_of(nav_re4 sl, nav_re4 cl, nav_re4 so, nav_re4 co, nav_re4 h) {
-  const nav_re4 rn = NAV_WGS84_A_M / re4_sqrt(1.0 - NAV_WGS84_E2 * sl * sl);
+  const nav_re4 rn = NAV_WGS84_A_M / em_sqrt4(1.0 - NAV_WGS84_E2 * sl * sl);
   const re4_vec3 r = {(rn + h) * cl * co, (rn + h) * cl * so, (rn * (1.0 - NAV_WGS84_E2) + h) * sl};
   return r;
 }
@@ -215,7 +201,7 @@ RE4_INLINE void ned_errors4(const ref_item *const ri[4], const nav_ins_ned *cons
   const re4_vec3 ae = re4_mul_vec(&Ce, ve), at = re4_mul_vec(&Ct, vt);
   const re4_vec3 dv = {ae.x - at.x, ae.y - at.y, ae.z - at.z};
   const re4_vec3 vn = re4_mul_vec(&Ct_t, dv);
-  const nav_re4 vnorm = re4_sqrt(vn.x * vn.x + vn.y * vn.y + vn.z * vn.z);
+  const nav_re4 vnorm = em_sqrt4(vn.x * vn.x + vn.y * vn.y + vn.z * vn.z);
   /* M = Ct_t Ce (nav_mat3_mul), then nav_quat_from_dcm(M). */
   re4_mat3 M;
   for (int i = 0; i < 3; ++i)
@@ -228,13 +214,13 @@ RE4_INLINE void ned_errors4(const ref_item *const ri[4], const nav_ins_ned *cons
     trace_branch = trace_branch && tr[k] >= c11[k] && tr[k] >= c22[k] && tr[k] >= c33[k];
   nav_re4 mw, mx, my, mz;
   if (trace_branch) {
-    const nav_re4 rr = re4_sqrt(1.0 + tr); /* = 2|w| >= 0: no sign flip */
+    const nav_re4 rr = em_sqrt4(1.0 + tr); /* = 2|w| >= 0: no sign flip */
     const nav_re4 f = 0.5 / rr;
     const nav_re4 w = 0.5 * rr;
     const nav_re4 x = (M.m[2][1] - M.m[1][2]) * f;
     const nav_re4 y = (M.m[0][2] - M.m[2][0]) * f;
     const nav_re4 z = (M.m[1][0] - M.m[0][1]) * f;
-    const nav_re4 s = 1.0 / re4_sqrt(w * w + x * x + y * y + z * z);
+    const nav_re4 s = 1.0 / em_sqrt4(w * w + x * x + y * y + z * z);
     mw = w * s;
     mx = x * s;
     my = y * s;
@@ -262,7 +248,7 @@ RE4_INLINE void ned_errors4(const ref_item *const ri[4], const nav_ins_ned *cons
   const nav_re4 rx = cw * q2x + cx * q2w + cy * q2z - cz * q2y;
   const nav_re4 ry = cw * q2y - cx * q2z + cy * q2w + cz * q2x;
   const nav_re4 rz = cw * q2z + cx * q2y - cy * q2x + cz * q2w;
-  const nav_re4 vpart = re4_sqrt(rx * rx + ry * ry + rz * rz), wabs = re4_fabs(rw);
+  const nav_re4 vpart = em_sqrt4(rx * rx + ry * ry + rz * rz), wabs = em_abs4(rw);
   /* C_b_n of the estimate (nav_quat_to_dcm). */
   const nav_re4 ww = qew * qew, xx = qex * qex, yy = qey * qey, zz = qez * qez;
   const nav_re4 xy = qex * qey, xz = qex * qez, yz = qey * qez;
